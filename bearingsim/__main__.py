@@ -1,0 +1,5 @@
+import sys
+
+from bearingsim.cli import main
+
+sys.exit(main())

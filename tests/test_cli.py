@@ -1,0 +1,64 @@
+"""CLI contract: user errors are one line on stderr, exit code 2, no traceback, no archive."""
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import SCENARIOS
+
+
+def bearingsim(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "bearingsim", *map(str, args)], capture_output=True,
+                          text=True, cwd=cwd, timeout=600)
+
+
+def assert_user_error(res, *words):
+    assert res.returncode == 2, res.stderr
+    lines = [line for line in res.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, res.stderr
+    assert "Traceback" not in res.stderr
+    for w in words:
+        assert w in lines[0], lines[0]
+
+
+@pytest.mark.parametrize(
+    "setting, key",
+    [
+        ("bearing.roller_mass_kg=-0.013", "bearing.roller_mass_kg"),
+        ("contact.restitution=2", "contact.restitution"),
+        ("bearing.no_such_key=1", "bearing.no_such_key"),
+        ("operating.inner_ring_speed_rpm=nan", "operating.inner_ring_speed_rpm"),
+        ("bearing.roller_count=0", "bearing.roller_count"),
+    ],
+)
+def test_bad_override_exits_2_naming_key_and_writes_nothing(tmp_path, setting, key):
+    out = tmp_path / "r.h5"
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", out, "--set", setting)
+    assert_user_error(res, key)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_wrong_type_in_file_names_key(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text((SCENARIOS / "paper_3000rpm.toml").read_text().replace("rotations = 1", 'rotations = "one"'))
+    res = bearingsim("run", bad, "-o", tmp_path / "x.h5")
+    assert_user_error(res, "numerics.rotations", str(bad))
+    assert not (tmp_path / "x.h5").exists()
+
+
+def test_missing_scenario_file(tmp_path):
+    res = bearingsim("run", tmp_path / "nope.toml")
+    assert_user_error(res, "nope.toml", "not found")
+
+
+def test_unwritable_output_names_the_file(tmp_path):
+    blocker = tmp_path / "blocker"
+    blocker.write_text("")
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", blocker / "r.h5")
+    assert_user_error(res, "blocker")
+
+
+def test_inspect_refuses_foreign_file(tmp_path):
+    f = tmp_path / "x.h5"
+    f.write_bytes(b"\x00" * 100)
+    assert_user_error(bearingsim("inspect", f), "x.h5")

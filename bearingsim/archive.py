@@ -71,6 +71,19 @@ def git_commit() -> str:
     return "unknown"
 
 
+def check_writable_dir(folder: str | Path) -> Path:
+    """Create ``folder`` if needed and make sure files can be written in it, else a one-line UserError."""
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".bearingsim-probe-{os.getpid()}"
+        probe.touch()
+        probe.unlink()
+    except OSError as exc:
+        raise UserError(f"{folder}: output folder is not writable ({exc.strerror or exc})") from None
+    return folder
+
+
 class TimeSeries:
     """An H5MD ``{step, time, value}`` group appended in buffered blocks (streamed, not held)."""
 

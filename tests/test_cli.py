@@ -62,3 +62,38 @@ def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"
     f.write_bytes(b"\x00" * 100)
     assert_user_error(bearingsim("inspect", f), "x.h5")
+
+
+def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
+    """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every
+    dataset, the resolved scenario) and the Fig. 8 analog PNG; `inspect` reads it back; the same scenario
+    run twice gives the same numbers (determinism)."""
+    import h5py
+    import numpy as np
+
+    out = tmp_path / "p.h5"
+    res = bearingsim("run", SCENARIOS / "paper_500rpm.toml", "-o", out, "--set", "numerics.rotations=3")
+    assert res.returncode == 0, res.stderr
+    assert (tmp_path / "p_pass.png").stat().st_size > 10_000
+    with h5py.File(out, "r") as f:
+        assert f["results/per_rotation/I_dec"].shape == (3, 1)
+        assert f["results/per_rotation/I_acc"].shape == (3, 1)
+        for col in ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face"):
+            assert col in f["results/impacts"]
+        summary = f["results/summary"].attrs
+        for key in ("I_dec_mean_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_std_Ns",
+                    "first_impact_speed_m_s", "first_impact_energy_J"):
+            assert np.isfinite(summary[key]) and f"{key}__unit" in summary
+        missing = []
+        f.visititems(lambda n, o: missing.append(n) if isinstance(o, h5py.Dataset) and n != "scenario"
+                     and not n.startswith("h5md") and "unit" not in o.attrs else None)
+        assert missing == []
+        assert 'inner_ring_speed_rpm = 500' in f["scenario"][()].decode()
+        first = f["results/per_rotation/I_dec"][()]
+    res = bearingsim("inspect", out)
+    assert res.returncode == 0 and "I_dec_mean_Ns" in res.stdout
+    out2 = tmp_path / "q.h5"
+    assert bearingsim("run", SCENARIOS / "paper_500rpm.toml", "-o", out2, "--set", "numerics.rotations=3",
+                      "--no-plots", "-q").returncode == 0
+    with h5py.File(out2, "r") as f:
+        assert np.array_equal(f["results/per_rotation/I_dec"][()], first)

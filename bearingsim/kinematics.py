@@ -67,7 +67,7 @@ def quasi_static_load_zone(radial_load, roller_count, roller_length, radial_clea
 
     Rollers are smeared over the circumference (continuous load distribution, Harris & Kotzalas
     Sec. 7.2), each with inner and outer Palmgren contacts in series; the diametral clearance
-    P_d opens the load zone: psi_l = arccos(P_d / (2 delta_r)). Returns (pi, 0) for zero clearance
+    P_d opens the load zone: psi_l = arccos(P_d / (2 delta_r)). Returns (pi/2, delta) for zero clearance
     and (0, 0) for zero load.
     """
     from scipy.optimize import brentq

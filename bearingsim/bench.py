@@ -1,0 +1,256 @@
+"""`bearingsim bench`: speed against error of every solver, in one run, on this machine.
+
+Writes to the output folder:
+
+* ``bench.csv``: one row per solver setting with at least ``model, method, scene, dt_s, wall_s,
+  rel_error`` (wall time of one no-load pass for the reduced model, of one cage rotation for the
+  multibody model; ``rel_error`` = error of the mean I_dec against the converged reference);
+* ``bench.png``: wall time against error, log-log;
+* ``bench_meta.json``: machine, package versions, date, command, and the long-run check;
+* ``bench.md``: the same table as markdown (what the README shows).
+
+Times are medians of repeats, measured in the same process one after the other, so ratios between
+rows are meaningful even on a noisy machine; absolute times are not.
+
+The reduced model's reference is the event solver itself; the event row's own error is measured
+against an event solve with tighter tolerances (Chebyshev tail 2e-15, Zeno height 1e-9 s). Euler's
+convergence onto it (first order) independently confirms it.
+"""
+from __future__ import annotations
+
+import csv
+import datetime as _dt
+import json
+import math
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REDUCED_SPEEDS = (500, 2000, 6000)
+EULER_DTS = (1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7)
+COLUMNS = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "rel_error", "I_dec_Ns", "unit_of_work", "repeats",
+           "notes")
+
+
+def _median_time(fn, repeats: int):
+    times = []
+    out = None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return statistics.median(times), out
+
+
+def reduced_rows(quick: bool) -> list[dict]:
+    """Event and euler at 500, 2000 and 6000 rpm (the paper's conditions, 970 N, φ = 23.5°)."""
+    from bearingsim.reduced.core import PassInputs
+    from bearingsim.reduced.euler import max_stable_dt, solve_euler
+    from bearingsim.reduced.event import solve_event
+    from bearingsim.reduced.studies import paper_scenario
+
+    rows = []
+    for rpm in REDUCED_SPEEDS:
+        inp = PassInputs.from_scenario(paper_scenario(rpm))
+        solve_event(inp, trace_points=0)  # compile / load the cache outside the timing
+        solve_euler(inp, 1e-4, trace_points=0)
+        ref = solve_event(inp, trace_points=0).I_dec
+        tight = solve_event(inp, trace_points=0, cheb_tol=2e-15, zeno_height=1e-9).I_dec
+        wall, sol = _median_time(lambda: solve_event(inp, trace_points=0), 7 if quick else 21)
+        rows.append(dict(model="reduced", method="event", scene="single_pocket", rpm=rpm, dt_s=float("nan"),
+                         wall_s=wall, rel_error=abs(sol.I_dec - tight) / abs(tight), I_dec_Ns=sol.I_dec,
+                         unit_of_work="no-load pass", repeats=7 if quick else 21,
+                         notes="error against tighter event tolerances"))
+        dtmax = max_stable_dt(inp)
+        for dt in EULER_DTS:
+            if dt > dtmax:
+                continue
+            reps = 3 if dt >= 1e-6 or not quick else 1
+            wall, sol = _median_time(lambda: solve_euler(inp, dt, trace_points=0), reps)
+            rows.append(dict(model="reduced", method="euler", scene="single_pocket", rpm=rpm, dt_s=dt, wall_s=wall,
+                             rel_error=abs(sol.I_dec - ref) / ref, I_dec_Ns=sol.I_dec, unit_of_work="no-load pass",
+                             repeats=reps, notes="error against event"))
+    return rows
+
+
+def reduced_goal(rows: list[dict]) -> list[str]:
+    """Issue 2's goal: event reaches <= 1e-6 for <= 1/100 of the time euler needs to reach 1e-4."""
+    lines = []
+    for rpm in REDUCED_SPEEDS:
+        ev = [r for r in rows if r["model"] == "reduced" and r["method"] == "event" and r["rpm"] == rpm][0]
+        eu = sorted((r for r in rows if r["model"] == "reduced" and r["method"] == "euler" and r["rpm"] == rpm),
+                    key=lambda r: -r["dt_s"])
+        # the largest dt from which on every smaller dt of the grid stays within 1e-4
+        need = None
+        for i, r in enumerate(eu):
+            if all(x["rel_error"] <= 1e-4 for x in eu[i:]):
+                need = r
+                break
+        if need is None:
+            lines.append(f"{rpm} rpm: euler does not reach 1e-4 on the dt grid; event {ev['wall_s'] * 1e3:.3f} ms "
+                         f"at error {ev['rel_error']:.1e}")
+            continue
+        ratio = ev["wall_s"] / need["wall_s"]
+        lines.append(
+            f"{rpm} rpm: event {ev['wall_s'] * 1e3:.3f} ms at error {ev['rel_error']:.1e}; euler needs dt = "
+            f"{need['dt_s']:.0e} s and {need['wall_s'] * 1e3:.3f} ms for 1e-4; ratio {ratio:.3g} "
+            f"(goal <= 0.01: {'met' if ratio <= 0.01 and ev['rel_error'] <= 1e-6 else 'not met'})"
+        )
+    return lines
+
+
+def multibody_rows(quick: bool) -> list[dict]:
+    from bearingsim.multibody.bench import bench_cases
+
+    return bench_cases(quick)
+
+
+def long_run_check(outdir: Path, rotations: int) -> dict:
+    """Run the full multibody scene at 6000 rpm for ``rotations`` and for rotations/10 in fresh processes;
+    report peak memory of each, boundedness, and stationarity of per-rotation I_dec."""
+    res = {}
+    for n in (max(rotations // 10, 4), rotations):
+        out = outdir / f"long_{n}.h5"
+        code = (
+            "import resource, sys, json, numpy as np, h5py\n"
+            "from bearingsim.scenario import load_scenario\n"
+            "from bearingsim.simulation import run_scenario\n"
+            f"sc = load_scenario('{_scenarios_dir() / 'multibody_6000rpm.toml'}', "
+            f"['numerics.rotations={n}', 'numerics.warmup_rotations=2'])\n"
+            f"run_scenario(sc, '{out}', figures=False)\n"
+            "rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0\n"
+            f"f = h5py.File('{out}', 'r'); I = f['results/per_rotation/I_dec'][()]\n"
+            "print(json.dumps(dict(rss_MiB=rss, I=I.mean(axis=1).tolist(), finite=bool(np.isfinite(I).all()))))\n"
+        )
+        t0 = time.perf_counter()
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        if proc.returncode != 0:
+            res[n] = dict(error=proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")
+            continue
+        d = json.loads(proc.stdout.strip().splitlines()[-1])
+        d["wall_s"] = time.perf_counter() - t0
+        I = np.array(d.pop("I"))
+        h = len(I) // 2
+        a, b = I[:h], I[h:]
+        scatter = 2.0 * math.sqrt(a.var(ddof=1) / len(a) + b.var(ddof=1) / len(b)) if len(I) >= 4 else float("nan")
+        d.update(rotations=n, I_dec_first_half=float(a.mean()), I_dec_second_half=float(b.mean()),
+                 two_sigma_of_difference=scatter, stationary=bool(abs(a.mean() - b.mean()) <= scatter),
+                 archive_MiB=out.stat().st_size / 2**20)
+        out.unlink(missing_ok=True)
+        res[n] = d
+    return res
+
+
+def _scenarios_dir() -> Path:
+    here = Path(__file__).resolve().parents[1] / "scenarios"
+    return here if here.is_dir() else Path("scenarios").resolve()
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "-"
+        return f"{v:.3g}"
+    return str(v)
+
+
+def _markdown(rows: list[dict]) -> str:
+    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "rel_error", "unit_of_work")
+    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        out.append("| " + " | ".join(_fmt(r.get(c, "")) for c in cols) + " |")
+    return "\n".join(out)
+
+
+def _plot(rows: list[dict], path: Path) -> None:
+    from bearingsim.plotting import plt
+
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    groups = {}
+    for r in rows:
+        groups.setdefault((r["model"], r["method"], r["scene"], r["rpm"]), []).append(r)
+    markers = {"event": "*", "euler": "o", "pymunk": "s"}
+    for (model, method, scene, rpm), rs in sorted(groups.items(), key=lambda kv: str(kv[0])):
+        err = np.array([max(x["rel_error"], 1e-17) for x in rs])
+        wall = np.array([x["wall_s"] for x in rs])
+        ok = np.isfinite(err) & np.isfinite(wall)
+        if not ok.any():
+            continue
+        label = f"{model} {method}{'' if scene == 'single_pocket' else ' ' + scene} {rpm} rpm"
+        ax.loglog(err[ok], wall[ok], marker=markers.get(method, "d"), ms=8 if method == "event" else 5,
+                  ls="-" if ok.sum() > 1 else "none", label=label)
+    ax.set_xlabel("relative error of mean $I_{dec}$")
+    ax.set_ylabel("wall time [s] (reduced: per no-load pass; multibody: per cage rotation)")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=7, ncol=2)
+    ax.set_title("bearingsim: speed against error (medians of repeats, one core)", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=130)
+    plt.close(fig)
+
+
+def machine_info() -> dict:
+    from bearingsim.archive import package_versions
+
+    info = dict(date_utc=_dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+                platform=platform.platform(), processor=platform.processor() or platform.machine(),
+                cpu_count=os.cpu_count(), python=sys.version.split()[0], command=" ".join(sys.argv))
+    try:
+        with open("/proc/cpuinfo") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    info["cpu"] = line.split(":", 1)[1].strip()
+                    break
+    except OSError:
+        pass
+    info["versions"] = package_versions()
+    return info
+
+
+def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True) -> list[dict]:
+    """Run the benchmark and write its files to ``outdir`` (see the module docstring)."""
+    from bearingsim.archive import check_writable_dir
+
+    outdir = check_writable_dir(outdir)
+    t0 = time.perf_counter()
+    print("reduced model: event and euler at 500, 2000, 6000 rpm ...", flush=True)
+    rows = reduced_rows(quick)
+    meta = machine_info()
+    meta["quick"] = quick
+    meta["reduced_goal"] = reduced_goal(rows)
+    if include_multibody:
+        print("multibody model: full and reduced-equivalent scenes over dt ...", flush=True)
+        try:
+            rows += multibody_rows(quick)
+        except ImportError as exc:  # pragma: no cover - reported, not hidden
+            meta["multibody_error"] = f"multibody benchmark unavailable: {exc}"
+        if not quick:
+            print("long run: 200 cage rotations of the full scene at 6000 rpm ...", flush=True)
+            meta["long_run"] = long_run_check(outdir, 200)
+    meta["bench_wall_s"] = time.perf_counter() - t0
+    with open(outdir / "bench.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(COLUMNS) + sorted({k for r in rows for k in r} - set(COLUMNS)))
+        w.writeheader()
+        for r in rows:
+            w.writerow(r)
+    (outdir / "bench.md").write_text(_markdown(rows) + "\n")
+    (outdir / "bench_meta.json").write_text(json.dumps(meta, indent=2, default=str) + "\n")
+    _plot(rows, outdir / "bench.png")
+    print(_markdown(rows))
+    print()
+    for line in meta["reduced_goal"]:
+        print(line)
+    for k in ("multibody_goal", "multibody_error"):
+        if k in meta:
+            print(meta[k])
+    if "long_run" in meta:
+        print("long run:", json.dumps(meta["long_run"], default=str))
+    print(f"machine: {meta.get('cpu', meta['processor'])}, {meta['cpu_count']} cores, {meta['platform']}")
+    print(f"wrote {outdir / 'bench.csv'}, bench.md, bench.png, bench_meta.json ({meta['bench_wall_s']:.0f} s)")
+    return rows

@@ -108,6 +108,21 @@ class ReducedResult:
             "zeno_closure": np.tile(imp["kind"], self.rotations).astype(np.int8),
         }
 
+    def wear(self) -> dict[str, float]:
+        """Archard wear of the pocket faces from the paper's index (Eq. 16): V = k I_c r_r ω_r / H.
+
+        ``*_per_rotation_m3`` per cage rotation; ``*_per_hour_m3_h`` at this speed. k and H are the
+        scenario's ``[wear] wear_coefficient`` and ``hardness_Pa``.
+        """
+        sc = self.scenario
+        k, hard = float(sc.wear.wear_coefficient), float(sc.wear.hardness_Pa)
+        sliding = self.inputs.roller_radius * self.inputs.omega_r  # r_r ω_r [m/s]
+        rot_per_hour = 3600.0 * self.inputs.omega_c / (2.0 * math.pi)
+        rear = k * self.solution.I_dec * sliding / hard
+        front = k * self.solution.I_acc * sliding / hard
+        return {"rear_per_rotation_m3": rear, "front_per_rotation_m3": front,
+                "rear_per_hour_m3_h": rear * rot_per_hour, "front_per_hour_m3_h": front * rot_per_hour}
+
     # --- archive -----------------------------------------------------------------------------
     def write(self, aw) -> None:
         sol = self.solution
@@ -143,6 +158,7 @@ class ReducedResult:
             {"omega_c_rad_s": "rad/s", "omega_r_rad_s": "rad/s", "rolling_velocity_m_s": "m/s"},
         )
         aw.set_attrs("results/summary", self.summary, self.SUMMARY_UNITS)
+        aw.set_attrs("results/wear", self.wear(), {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in self.wear()})
         aw.provenance["solver"] = f"reduced/{sol.method}"
         aw.provenance["solver_wall_s"] = sol.wall_s
         aw.provenance["dt_s"] = sol.dt if sol.dt is not None else float("nan")

@@ -94,6 +94,7 @@ class TimeSeries:
         self._buf_step: list = []
         self._buf_time: list = []
         self._buf_value: list = []
+        self._buffered = 0  # rows waiting in the buffers
         row_bytes = 8 * int(np.prod(self._shape, dtype=np.int64) or 1)
         chunk_rows = max(16, min(65536, _CHUNK_BYTES // row_bytes))
         kw = dict(compression="gzip", compression_opts=4, shuffle=True)
@@ -112,7 +113,8 @@ class TimeSeries:
         self._buf_step.append(step)
         self._buf_time.append(np.atleast_1d(np.asarray(time_s, dtype=np.float64)))
         self._buf_value.append(np.asarray(value, dtype=np.float64).reshape((len(step), *self._shape)))
-        if sum(len(s) for s in self._buf_step) >= self._block:
+        self._buffered += len(step)
+        if self._buffered >= self._block:
             self.flush()
 
     def flush(self) -> None:
@@ -126,6 +128,7 @@ class TimeSeries:
             ds.resize(n0 + len(s), axis=0)
             ds[n0:] = arr
         self._buf_step, self._buf_time, self._buf_value = [], [], []
+        self._buffered = 0
 
 
 class ArchiveWriter:
@@ -217,6 +220,13 @@ class ArchiveWriter:
         ts = TimeSeries(g, value_shape, unit)
         self._series.append(ts)
         return ts
+
+    def discard_timeseries(self) -> None:
+        """Delete every time series written so far (a run restarted with a new time step)."""
+        for ts in self._series:
+            name = ts._group.name
+            del self.f[name]
+        self._series.clear()
 
     # --- completion ---------------------------------------------------------------------------
     def __exit__(self, exc_type, exc, tb) -> bool:

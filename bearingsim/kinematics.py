@@ -89,3 +89,32 @@ def quasi_static_load_zone(radial_load, roller_count, roller_length, radial_clea
     if half_pd == 0.0:
         return math.pi / 2.0, delta_r
     return math.acos(min(1.0, half_pd / delta_r)), delta_r
+
+
+def loaded_rollers_with_one_at_centre(radial_load, roller_count, roller_length, radial_clearance):
+    """Number of rollers that carry load, quasi-statically, when one roller sits at the load-zone centre.
+
+    Discrete rollers at ``psi_k = 2 pi k / Z``, inner and outer Palmgren contacts in series, ring
+    displaced by ``delta_r`` along the load (by symmetry not sideways): a roller carries load where
+    ``delta_r cos psi_k > P_d / 2``. This is the configuration with the fewest loaded rollers; if it has
+    only one, the inner ring then rests on a single roller and its sideways position is undetermined
+    (an unstable equilibrium, like a disc on a disc): a massless, quasi-static ring is not defined and the
+    rotor's inertia must decide (``multibody.inner_ring = "dynamic"``). Returns 0 for zero load.
+    """
+    from scipy.optimize import brentq
+
+    if radial_load <= 0.0:
+        return 0
+    k_series = palmgren_stiffness(roller_length) / 2.0 ** (10.0 / 9.0)
+    psi = 2.0 * math.pi * np.arange(roller_count) / roller_count
+    half_pd = radial_clearance / 2.0
+
+    def residual(delta_r):
+        d = np.clip(delta_r * np.cos(psi) - half_pd, 0.0, None)
+        return float(np.sum(k_series * d ** (10.0 / 9.0) * np.cos(psi))) - radial_load
+
+    hi = half_pd + 1e-9
+    while residual(hi) < 0.0:
+        hi = 2.0 * hi + 1e-9
+    delta_r = brentq(residual, half_pd, hi, xtol=1e-15, rtol=1e-13)
+    return int(np.count_nonzero(delta_r * np.cos(psi) - half_pd > 1e-12 * delta_r))

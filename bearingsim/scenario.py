@@ -39,6 +39,10 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # Proc. R. Soc. A 356:215; Harris & Kotzalas, Rolling Bearing Analysis, Fig. 4.11).
         "traction_mu_max": 0.06,
         "traction_slip_ref": 0.02,
+        # inner ring: quasi-static (massless) while the load is always shared by >= 2 rollers, else
+        # dynamic with the rotor's mass (docs/stability.md); the radial load is the rotor's weight
+        "inner_ring": "auto",
+        "inner_ring_mass_kg": "auto",
     },
     # Archard & Hirst (1956), Proc. R. Soc. A 236:397, Table 1: 60/40 brass on tool steel,
     # k = 6e-4; high-strength brass hardness ~HV 150 -> 1.5e9 Pa.
@@ -108,6 +112,15 @@ class MultibodySection(_Section):
     scene: Literal["full", "reduced_equivalent"]
     traction_mu_max: float = Field(ge=0.0)
     traction_slip_ref: float = Field(gt=0.0)
+    inner_ring: Literal["auto", "quasi_static", "dynamic"]
+    inner_ring_mass_kg: float | Literal["auto"]
+
+    @field_validator("inner_ring_mass_kg")
+    @classmethod
+    def _ring_mass(cls, v):
+        if v != "auto" and not v > 0.0:
+            raise ValueError("must be 'auto' or a positive mass in kg")
+        return v
 
 
 class WearSection(_Section):

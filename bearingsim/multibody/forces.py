@@ -1,0 +1,379 @@
+"""Raceway force laws of the multi-pocket model as one compiled kernel. SI throughout.
+
+Every roller touches two raceways through force laws (not pymunk shapes):
+
+* normal: Palmgren line contact ``Q = K delta^(10/9)`` (Palmgren 1959; Harris & Kotzalas, *Rolling
+  Bearing Analysis*, Eq. 6.49) plus a stiffness-proportional contact damping
+  ``c = c_r k_lin`` (``c_r`` after Kraemer, *Dynamics of Rotors and Foundations*, 1993, as used by
+  Sopanen & Mikkola, Proc. IMechE K 217:201, 2003) that is faded in over the first few nanometres of
+  approach so that ``Q`` is continuous at ``delta = 0``; ``Q >= 0``;
+* tangential: EHL traction ``mu(slip) = mu_max tanh(slip / slip_ref)`` with ``slip`` the sliding speed
+  over the entrainment speed (shape of measured traction curves, Johnson & Tevaarwerk 1977);
+* the oil-film rolling resistance of the seed paper, Eq. (2), ``F_o = c N^0.246 V^0.648`` with that
+  contact's own ``N = Q`` and entrainment speed ``V``, acting on the roller centre against its motion
+  relative to that raceway.
+
+The radial clearance ``P_d`` (diametral) is split between the races: the outer raceway radius is
+``r_o + P_d/4``, the inner one ``r_i - P_d/4``.
+
+Time integration (how pymunk and this kernel fit together). pymunk's step moves positions first with
+the old velocities, ``x_{n+1} = x_n + h v_n``, then adds ``h F / m`` to the velocities, then solves the
+roller-cage contacts. Forces set before the step are therefore evaluated here at the *predicted*
+positions ``x_{n+1}`` (never at ``x_n``: that is forward Euler and unstable with Hertz stiffness): the
+normal forces are symplectic Euler, stable for ``h < 2/omega_n`` of the stiffest contact. The contact
+damping uses the approach rate over the step, ``(delta_{n+1} - delta_n) / h``, which is exactly zero for
+a roller orbiting on its raceway. (An earlier version linearised the normal force implicitly in
+Cartesian coordinates about ``v_n``; because the contact normal turns by ``omega h`` per step, that
+turned the orbital speed into a spurious approach rate ``omega h v`` and doubled the raceway loads at
+6000 rpm; it is gone.) Traction and drag, whose velocity stiffness is large at low entrainment speed,
+stay implicitly linearised in velocity: one 3x3 (2x2 with fixed spin) solve per roller.
+
+The inner ring turns at a prescribed speed. Its centre is either
+
+* quasi-static (``P_RING_MASS = 0``): each step a 2-D Newton solve on the predicted roller positions
+  makes the inner-raceway normal forces (elastic and damping) balance the radial load. Tangential
+  raceway forces are not fed back into the ring balance (they are two orders below the normal loads
+  and the ring's lateral position would move by ~1e-8 m). Defined only while at least two rollers
+  carry the load: on a single roller the ring's sideways equilibrium is unstable;
+* dynamic (``P_RING_MASS = M > 0``, the rotor's mass): integrated like the bodies in pymunk
+  (symplectic Euler: position with the old velocity, then ``v += h F / M``) under the radial load and
+  the reactions of every inner-raceway contact (normal, traction and drag), evaluated at the predicted
+  positions of rollers and ring.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+# Indices of the parameter vector passed to the kernel (one float64 array keeps the signature short).
+P_RR, P_MASS, P_INERTIA, P_RO_RACE, P_RI_RACE, P_RO_GEOM, P_RI_GEOM = 0, 1, 2, 3, 4, 5, 6
+P_K, P_CDAMP, P_DFADE, P_MU, P_SLIPREF, P_UMIN, P_CDRAG, P_WEPS = 7, 8, 9, 10, 11, 12, 13, 14
+P_OMEGA_RING, P_LOAD, P_GRAV, P_INNER, P_TRACTION, P_SPIN, P_NEWTON_STEP = 15, 16, 17, 18, 19, 20, 21
+P_RING_MASS = 22  # 0: quasi-static (massless) inner ring; > 0: dynamic ring of this mass [kg]
+N_PARAMS = 23
+
+# Columns of the per-roller diagnostics array.
+D_Q_OUT, D_Q_IN, D_DELTA_OUT, D_DELTA_IN, D_SLIP_OUT, D_SLIP_IN, D_FO_OUT, D_FO_IN = range(8)
+N_DIAG = 8
+
+TEN_NINTHS = 10.0 / 9.0
+DRAG_N_EXP = 0.246
+DRAG_V_EXP = 0.648
+
+
+@njit(cache=True)
+def _normal_force(delta, delta_rate, K, c_r, d_fade):
+    """Normal force [N], its derivative in delta [N/m] and in delta_rate [N s/m] of one contact."""
+    if delta <= 0.0:
+        return 0.0, 0.0, 0.0
+    q_el = K * delta**TEN_NINTHS
+    k_lin = TEN_NINTHS * K * delta ** (1.0 / 9.0)
+    fade = delta / d_fade if delta < d_fade else 1.0
+    dfade = 1.0 / d_fade if delta < d_fade else 0.0
+    c = c_r * k_lin * fade
+    q = q_el + c * delta_rate
+    if q <= 0.0:
+        return 0.0, 0.0, 0.0
+    # d(c)/d(delta): c_r (k_lin' fade + k_lin fade'); k_lin' = k_lin / (9 delta)
+    dc = c_r * (k_lin / (9.0 * delta) * fade + k_lin * dfade)
+    return q, k_lin + dc * delta_rate, c
+
+
+@njit(cache=True)
+def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
+    """Quasi-static inner-ring centre: Newton on sum_i Q_i N_i = (0, -W).
+
+    Parameters
+    ----------
+    xp : (n, 2) predicted roller centres [m].
+    delta_prev : (n,) inner-race approach of each roller at the current positions and ``c_prev`` [m];
+        the damping uses the rate ``(delta - delta_prev) / h`` over the step.
+    c_prev : (2,) ring centre of the previous step [m].
+    h : time step [s].
+    prm : parameter vector.
+    out_c : (2,) in: initial guess, out: solution [m].
+
+    Returns
+    -------
+    (iterations, residual norm [N]); iterations < 0 if Newton did not converge.
+    """
+    n = xp.shape[0]
+    rr = prm[P_RR]
+    r_race = prm[P_RI_RACE]
+    K = prm[P_K]
+    c_r = prm[P_CDAMP]
+    d_fade = prm[P_DFADE]
+    load = prm[P_LOAD]
+    max_step = prm[P_NEWTON_STEP]
+    cx = out_c[0]
+    cy = out_c[1]
+    tol = 1e-9 * (load + 1.0)
+    res = 0.0
+    for it in range(60):
+        rx = 0.0
+        ry = load  # residual = sum Q N - (0, -W)
+        j00 = 0.0
+        j01 = 0.0
+        j10 = 0.0
+        j11 = 0.0
+        for i in range(n):
+            dx = xp[i, 0] - cx
+            dy = xp[i, 1] - cy
+            d = math.sqrt(dx * dx + dy * dy)
+            nx = dx / d
+            ny = dy / d
+            delta = r_race + rr - d
+            if delta <= 0.0:
+                continue
+            rate = (delta - delta_prev[i]) / h
+            q, dq_dd, dq_drate = _normal_force(delta, rate, K, c_r, d_fade)
+            if q <= 0.0:
+                continue
+            rx += q * nx
+            ry += q * ny
+            # d delta / dc = N ; d rate / dc = N / h (through c_dot); d N / dc = -(I - N N^T) / d
+            g = dq_dd + dq_drate / h
+            qd = q / d
+            j00 += g * nx * nx - qd * (1.0 - nx * nx)
+            j01 += g * nx * ny + qd * nx * ny
+            j10 += g * ny * nx + qd * nx * ny
+            j11 += g * ny * ny - qd * (1.0 - ny * ny)
+        res = math.sqrt(rx * rx + ry * ry)
+        if res <= tol:
+            out_c[0] = cx
+            out_c[1] = cy
+            return it, res
+        det = j00 * j11 - j01 * j10
+        if abs(det) <= 1e-12 * (j00 * j00 + j11 * j11) + 1e-300:
+            # fewer than two loaded contacts: regularise (Levenberg) so the step heads along the
+            # residual towards the rollers that must take the load; the step limit below bounds it
+            lam = 1e-3 * (abs(j00) + abs(j11)) + 1.0
+            j00 += lam
+            j11 += lam
+            det = j00 * j11 - j01 * j10
+        sx = -(j11 * rx - j01 * ry) / det
+        sy = -(-j10 * rx + j00 * ry) / det
+        sn = math.sqrt(sx * sx + sy * sy)
+        if sn > max_step:
+            sx *= max_step / sn
+            sy *= max_step / sn
+        cx += sx
+        cy += sy
+        if sn < 1e-16:
+            break
+    out_c[0] = cx
+    out_c[1] = cy
+    return -1, res
+
+
+@njit(cache=True)
+def _contact(
+    px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, r_race_geom, omega_race, orbit,
+    prm, jac, f, diag, col_q, col_d, col_s, col_fo,
+):
+    """Add one raceway contact to the generalized force ``f`` (fx, fy, torque) and its Jacobians.
+
+    ``(nx, ny)`` is the direction of the normal force on the roller, ``u_race`` the raceway surface
+    speed along the tangent ``T = rot90(N)`` at the contact, ``w_race`` the speed along T of the raceway
+    material at the roller centre, ``orbit`` the roller's orbital angular speed [rad/s].
+    ``jac`` is (C, K) packed as a 3x3 velocity Jacobian and 2x2 stiffness in a (3, 5) array.
+    """
+    rr = prm[P_RR]
+    q, dq_dd, dq_drate = _normal_force(delta, rate, prm[P_K], prm[P_CDAMP], prm[P_DFADE])
+    diag[col_d] = delta
+    diag[col_q] = q
+    if q <= 0.0:
+        return
+    tx = -ny
+    ty = nx
+    f[0] += q * nx
+    f[1] += q * ny
+    # The normal force is explicit at the predicted position (symplectic Euler): linearising it in
+    # Cartesian coordinates about v_n would turn the orbital motion (the normal turns by omega h per
+    # step) into a spurious approach rate omega h v and an O(omega h)^2 k force bias.
+    # entrainment (rolling) speed: mean surface speed of roller and raceway relative to the contact
+    # point, which moves with the roller's orbit (reduces to the paper's Eq. 4 in pure rolling)
+    u_ent = 0.5 * (abs(w - orbit) * rr + abs(omega_race - orbit) * r_race_geom)
+    u_ref = max(u_ent, prm[P_UMIN])
+    # oil-film rolling resistance, Eq. (2), on the roller centre against its motion relative to the race
+    fo = prm[P_CDRAG] * q**DRAG_N_EXP * u_ent**DRAG_V_EXP
+    rel = vx * tx + vy * ty - w_race
+    weps = prm[P_WEPS]
+    sq = math.sqrt(rel * rel + weps * weps)
+    f[0] -= fo * rel / sq * tx
+    f[1] -= fo * rel / sq * ty
+    gd = fo * weps * weps / (sq * sq * sq)
+    jac[0, 0] -= gd * tx * tx
+    jac[0, 1] -= gd * tx * ty
+    jac[1, 0] -= gd * ty * tx
+    jac[1, 1] -= gd * ty * ty
+    diag[col_fo] = fo
+    if prm[P_TRACTION] > 0.0:
+        # sliding speed of the roller surface over the raceway along T; generalized direction
+        # a = (tx, ty, -rr) for (vx, vy, w)
+        s = vx * tx + vy * ty - w * rr - u_race
+        x = s / (prm[P_SLIPREF] * u_ref)
+        th = math.tanh(x)
+        mu = prm[P_MU] * th
+        ft = -mu * q
+        f[0] += ft * tx
+        f[1] += ft * ty
+        f[2] += -rr * ft
+        g = prm[P_MU] * (1.0 - th * th) * q / (prm[P_SLIPREF] * u_ref)
+        a0 = tx
+        a1 = ty
+        a2 = -rr
+        jac[0, 0] -= g * a0 * a0
+        jac[0, 1] -= g * a0 * a1
+        jac[0, 2] -= g * a0 * a2
+        jac[1, 0] -= g * a1 * a0
+        jac[1, 1] -= g * a1 * a1
+        jac[1, 2] -= g * a1 * a2
+        jac[2, 0] -= g * a2 * a0
+        jac[2, 1] -= g * a2 * a1
+        jac[2, 2] -= g * a2 * a2
+        diag[col_s] = s / u_ref
+
+
+@njit(cache=True)
+def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag):
+    """Implicitly linearised raceway forces on every roller for the coming pymunk step.
+
+    Parameters
+    ----------
+    state : (nb, 6) body state before the step, rows (x, y, angle, vx, vy, omega) in SI; rows
+        ``0..n-1`` are the rollers.
+    h : time step [s].
+    prm : parameter vector (see ``P_*``).
+    ring_c : (2,) inner-ring centre [m]: in, the previous solution; out, this step's.
+    ring_c_prev : (2,) scratch, receives the previous centre.
+    ring_v : (2,) velocity of the ring centre [m/s] (dynamic ring: in and out; quasi-static: unused).
+    hold : (n,) bool, rollers whose motion is prescribed this step (get zero force).
+    out_f : (nb * 3,) flat (fx, fy, torque) per body for ``pymunk.batch.set_space_bodies`` [N, N m].
+    diag : (n, N_DIAG) per-roller contact diagnostics (loads [N], approaches [m], slips, drags [N]).
+
+    Returns
+    -------
+    Newton iteration count of the ring solve (negative if it failed; 0 if no inner ring).
+    """
+    n = diag.shape[0]
+    m = prm[P_MASS]
+    inertia = prm[P_INERTIA]
+    g = prm[P_GRAV]
+    spin_free = prm[P_SPIN] > 0.0
+    xp = np.empty((n, 2))
+    din_prev = np.empty(n)
+    dout_prev = np.empty(n)
+    rr = prm[P_RR]
+    for i in range(n):
+        xp[i, 0] = state[i, 0] + h * state[i, 3]
+        xp[i, 1] = state[i, 1] + h * state[i, 4]
+        # approaches at the current positions: contact rates are (delta_{n+1} - delta_n) / h
+        dout_prev[i] = math.sqrt(state[i, 0] ** 2 + state[i, 1] ** 2) + rr - prm[P_RO_RACE]
+        din_prev[i] = prm[P_RI_RACE] + rr - math.sqrt((state[i, 0] - ring_c[0]) ** 2
+                                                      + (state[i, 1] - ring_c[1]) ** 2)
+    it = 0
+    inner = prm[P_INNER] > 0.0
+    cdx = 0.0
+    cdy = 0.0
+    ring_mass = prm[P_RING_MASS]
+    dynamic = ring_mass > 0.0
+    if inner:
+        ring_c_prev[0] = ring_c[0]
+        ring_c_prev[1] = ring_c[1]
+        if dynamic:
+            ring_c[0] += h * ring_v[0]
+            ring_c[1] += h * ring_v[1]
+        else:
+            it, _ = solve_ring_centre(xp, din_prev, ring_c_prev, h, prm, ring_c)
+        cdx = (ring_c[0] - ring_c_prev[0]) / h
+        cdy = (ring_c[1] - ring_c_prev[1]) / h
+    frx = 0.0
+    fry = -prm[P_LOAD]  # force on a dynamic ring: the load, plus the reactions added below
+    out_f[:] = 0.0
+    jac = np.zeros((3, 5))
+    f = np.zeros(3)
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    omega_ring = prm[P_OMEGA_RING]
+    for i in range(n):
+        for k in range(N_DIAG):
+            diag[i, k] = 0.0
+        if hold[i]:
+            out_f[3 * i + 1] = m * g  # prescribed motion: cancel pymunk's gravity
+            continue
+        px = xp[i, 0]
+        py = xp[i, 1]
+        vx = state[i, 3]
+        vy = state[i, 4]
+        w = state[i, 5]
+        jac[:, :] = 0.0
+        f[:] = 0.0
+        r = math.sqrt(px * px + py * py)
+        orbit = (px * vy - py * vx) / (r * r)
+        # outer raceway (fixed): force along N = -p/|p|
+        nx = -px / r
+        ny = -py / r
+        delta = r + rr - prm[P_RO_RACE]
+        rate = (delta - dout_prev[i]) / h
+        _contact(px, py, vx, vy, w, nx, ny, delta, rate, 0.0, 0.0, prm[P_RO_GEOM], 0.0, orbit,
+                 prm, jac, f, diag[i], D_Q_OUT, D_DELTA_OUT, D_SLIP_OUT, D_FO_OUT)
+        if inner:
+            dx = px - ring_c[0]
+            dy = py - ring_c[1]
+            d = math.sqrt(dx * dx + dy * dy)
+            nx = dx / d
+            ny = dy / d
+            delta = prm[P_RI_RACE] + rr - d
+            rate = (delta - din_prev[i]) / h
+            tx = -ny
+            ty = nx
+            u_race = cdx * tx + cdy * ty + omega_ring * prm[P_RI_GEOM]
+            w_race = cdx * tx + cdy * ty + omega_ring * d
+            f_before_x = f[0]
+            f_before_y = f[1]
+            _contact(px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, prm[P_RI_GEOM],
+                     omega_ring, orbit, prm, jac, f, diag[i], D_Q_IN, D_DELTA_IN, D_SLIP_IN, D_FO_IN)
+            frx -= f[0] - f_before_x
+            fry -= f[1] - f_before_y
+        # implicit velocity update: (M - h C - h^2 K) dq = h (F + h K v + M g)
+        A[0, 0] = m - h * jac[0, 0] - h * h * jac[0, 3]
+        A[0, 1] = -h * jac[0, 1] - h * h * jac[0, 4]
+        A[1, 0] = -h * jac[1, 0] - h * h * jac[1, 3]
+        A[1, 1] = m - h * jac[1, 1] - h * h * jac[1, 4]
+        b[0] = h * (f[0] + h * (jac[0, 3] * vx + jac[0, 4] * vy))
+        b[1] = h * (f[1] + h * (jac[1, 3] * vx + jac[1, 4] * vy) - m * g)
+        if spin_free:
+            A[0, 2] = -h * jac[0, 2]
+            A[1, 2] = -h * jac[1, 2]
+            A[2, 0] = -h * jac[2, 0]
+            A[2, 1] = -h * jac[2, 1]
+            A[2, 2] = inertia - h * jac[2, 2]
+            b[2] = h * f[2]
+            # 3x3 solve by Cramer's rule (well conditioned: diagonal-dominant mass matrix)
+            det = (A[0, 0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
+                   - A[0, 1] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
+                   + A[0, 2] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]))
+            d0 = (b[0] * (A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1])
+                  - A[0, 1] * (b[1] * A[2, 2] - A[1, 2] * b[2])
+                  + A[0, 2] * (b[1] * A[2, 1] - A[1, 1] * b[2])) / det
+            d1 = (A[0, 0] * (b[1] * A[2, 2] - A[1, 2] * b[2])
+                  - b[0] * (A[1, 0] * A[2, 2] - A[1, 2] * A[2, 0])
+                  + A[0, 2] * (A[1, 0] * b[2] - b[1] * A[2, 0])) / det
+            d2 = (A[0, 0] * (A[1, 1] * b[2] - b[1] * A[2, 1])
+                  - A[0, 1] * (A[1, 0] * b[2] - b[1] * A[2, 0])
+                  + b[0] * (A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0])) / det
+            out_f[3 * i + 2] = inertia * d2 / h
+        else:
+            det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+            d0 = (A[1, 1] * b[0] - A[0, 1] * b[1]) / det
+            d1 = (A[0, 0] * b[1] - A[1, 0] * b[0]) / det
+        # pymunk adds gravity itself: hand it the rest
+        out_f[3 * i] = m * d0 / h
+        out_f[3 * i + 1] = m * d1 / h + m * g
+    if inner and dynamic:
+        ring_v[0] += h * frx / ring_mass
+        ring_v[1] += h * fry / ring_mass
+    return it

@@ -1,0 +1,270 @@
+"""Physics tests of the multi-pocket model (issue 3). Each test says why its check must hold.
+
+Runs are short (a few cage rotations) and shared through module-scoped fixtures.
+"""
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from bearingsim.scenario import load_scenario
+from tests.conftest import SCENARIOS
+
+from bearingsim.multibody import simulate
+from bearingsim.multibody.core import choose_dt
+from bearingsim.multibody.scene import build_scene
+
+PHI_DEG = 23.5  # paper Sec. 2.3, load-zone half angle at 970 N
+
+
+def _scenario(rpm=3000, scene="full", rotations=4, warmup=1, extra=()):
+    return load_scenario(SCENARIOS / "multibody_3000rpm.toml", [
+        f"operating.inner_ring_speed_rpm={rpm}", f"multibody.scene={scene}",
+        f"numerics.rotations={rotations}", f"numerics.warmup_rotations={warmup}",
+        f"reduced.load_zone_half_angle_deg={PHI_DEG}", *extra])
+
+
+@pytest.fixture(scope="module")
+def full_3000():
+    """Full scene, 3000 rpm, 20 recorded rotations after 1 warm-up rotation (~20 s)."""
+    return simulate(_scenario(rotations=20))
+
+
+@pytest.fixture(scope="module")
+def full_3000_reverse():
+    return simulate(_scenario(rotations=20, extra=["operating.direction=reverse"]))
+
+
+@pytest.fixture(scope="module")
+def full_3000_frictionless():
+    return simulate(_scenario(rotations=10, extra=["contact.cage_friction=0"]))
+
+
+# ------------------------------------------------------------------------------------------------
+def test_rebound_ratio_equals_restitution():
+    """Newton's restitution law, which pymunk applies at every contact: after one roller-cage impact
+    the normal relative speed is -e times the approach speed. Minimal scene: kinematic cage at rest,
+    no gravity, no raceways, one roller moving straight at its front face. Tolerance 0.5 %: the only
+    deviation is pymunk's position-bias velocity, bounded by slop/dt (1e-8 m / 1e-6 s = 1 % of
+    1 m/s; measured much smaller at 0.1 m/s)."""
+    sc = _scenario()
+    geo, op = sc.geometry, sc.operating_point
+    e = sc.contact.restitution
+    s = build_scene(geo, op, e, 0.0, half_angle=math.radians(45), n_seg=3, kinematic_cage=True,
+                    spin_free=True)
+    s.space.gravity = (0.0, 0.0)
+    s.cage.angular_velocity = 0.0
+    for b in s.rollers:
+        b.velocity = (0.0, 0.0)
+        b.angular_velocity = 0.0
+    a = s.pocket_body_angle[0]
+    et = np.array([-math.sin(a), math.cos(a)]) * op.sign
+    v0 = 0.1
+    roller = s.rollers[0]
+    roller.velocity = tuple(v0 * et)
+    h = 1e-6
+    v_after = None
+    for _ in range(20000):
+        s.space.step(h)
+        vn = float(np.dot(np.array(roller.velocity), et))
+        if vn < 0.0:
+            v_after = -vn
+            break
+    assert v_after is not None, "roller never hit the front face"
+    assert v_after / v0 == pytest.approx(e, rel=5e-3)
+
+
+def test_no_penetration(full_3000):
+    """A roller never passes through a cage face: pymunk's contact solver keeps the overlap at the
+    collision slop plus what one step's approach can add. Bound from the issue: 1 % of s."""
+    s = full_3000.scenario.geometry.pocket_clearance
+    assert full_3000.max_penetration_all < 0.01 * s, full_3000.max_penetration_all
+
+
+def test_cage_angular_momentum_balance(full_3000):
+    """Over 20 steady rotations the torque impulses of all roller contacts (normal and friction)
+    equal the change of the cage's angular momentum (the cage has no other torque). Closes within
+    1 % of the drive impulse moment sum(I_acc) r_p."""
+    assert abs(full_3000.torque_balance_residual) < 0.01
+
+
+def test_frictionless_acc_dec_balance(full_3000_frictionless):
+    """With frictionless pockets the only torques on the cage are the circumferential pocket forces;
+    at steady cage speed their long-run mean cancels: I_acc / I_dec -> 1 (PHYSICS Sec. 4).
+    Tolerance 3 % (issue): residual cage acceleration over 10 rotations and the radial component
+    of arc-face contacts away from the centre line."""
+    r = full_3000_frictionless
+    ratio = r.per_rotation_I_acc.mean() / r.per_rotation_I_dec.mean()
+    assert ratio == pytest.approx(1.0, abs=0.03), ratio
+
+
+def test_force_location(full_3000):
+    """Paper Sec. 3.1 / Fig. 5: the roller drives the cage (net front-face force) in the load zone,
+    and braking (F_dec) begins after the no-load-zone entrance theta = phi, once the roller has
+    lagged across the pocket clearance. Checks: (a) > 80 % of the positive net circumferential force
+    (F_acc - F_dec, mean over pockets) lies within |theta| <= phi + 15 deg; (b) no F_dec before
+    phi; the first theta > phi where the mean F_dec exceeds 10 % of its no-load-zone maximum lies
+    within phi + 60 deg (the reduced model's first impact is at phi + 40..55 deg)."""
+    r = full_3000
+    th = r.theta_deg
+    phi = r.load_zone_half_angle_deg
+    net = (r.force_acc - r.force_dec).mean(axis=1)
+    pos = np.clip(net, 0, None)
+    lz = (th <= phi + 15) | (th >= 360 - phi - 15)
+    assert pos[lz].sum() > 0.8 * pos.sum(), pos[lz].sum() / pos.sum()
+    fdec = r.force_dec.mean(axis=1)
+    nl = (th > phi) & (th < 180)
+    onset = th[nl][np.argmax(fdec[nl] > 0.1 * fdec[nl].max())]
+    assert phi < onset < phi + 60, onset
+
+
+def test_forward_reverse_same_I_dec(full_3000, full_3000_reverse):
+    """Mirror symmetry (paper Fig. 7): reversing the rotation mirrors the scene, so the mean I_dec is
+    the same; 5 % covers the statistical scatter of 320 pocket-rotations (std/mean ~ 0.3, correlated)."""
+    a = full_3000.per_rotation_I_dec.mean()
+    b = full_3000_reverse.per_rotation_I_dec.mean()
+    assert b == pytest.approx(a, rel=0.05), (a, b)
+
+
+def test_load_zone_half_angle(full_3000):
+    """Paper Sec. 2.3: the load zone at 970 N has a half angle of 23.5 deg. That number is the classical
+    half angle psi_l = arccos(P_d / (2 delta_r)) (Harris & Kotzalas Sec. 7.2) of the ring displacement
+    delta_r; here delta_r is the time-mean displacement of the inner ring that emerges from the Palmgren
+    contacts, the radial clearance and the moving rollers. +-3 deg (issue): discrete rollers make
+    delta_r oscillate by ~0.5 um (+-1.5 deg of psi_l)."""
+    assert full_3000.load_zone_half_angle_deg == pytest.approx(PHI_DEG, abs=3.0)
+
+
+def _discrete_contact_edge(scenario, samples=90):
+    """Largest angle [deg] from the load-zone centre at which a roller still carries load, quasi-
+    statically, over all positions of a discrete roller set whose inner ring is free in x and y (two
+    force equations per configuration). Written here independently of the simulator's kernels."""
+    from scipy.optimize import root
+
+    from bearingsim.kinematics import palmgren_stiffness
+
+    g = scenario.geometry
+    z, hp, load = g.roller_count, 0.5 * g.radial_clearance, scenario.operating_point.radial_load
+    ks = palmgren_stiffness(g.roller_length) / 2.0 ** (10.0 / 9.0)  # inner and outer contact in series
+    edge, guess = 0.0, np.array([0.0, hp + 4e-6])
+    for psi0 in np.linspace(0.0, 2 * np.pi / z, samples, endpoint=False):
+        psi = np.mod(psi0 + 2 * np.pi * np.arange(z) / z + np.pi, 2 * np.pi) - np.pi
+
+        def q(d):
+            return ks * np.clip(d[0] * np.sin(psi) + d[1] * np.cos(psi) - hp, 0.0, None) ** (10.0 / 9.0)
+
+        def f(d):
+            return [np.sum(q(d) * np.sin(psi)) / load, np.sum(q(d) * np.cos(psi)) / load - 1.0]
+
+        sol = root(f, guess, method="hybr", options={"xtol": 1e-13})
+        assert np.max(np.abs(f(sol.x))) < 1e-9  # force balance to 1e-9 of the load
+        guess = sol.x
+        edge = max(edge, np.degrees(np.abs(psi[q(sol.x) > 0.0])).max())
+    return edge
+
+
+def test_inner_race_contact_extent_matches_discrete_quasi_statics(full_3000):
+    """The measured inner-race contact extends beyond the classical half angle: with 16 discrete rollers
+    the inner ring, free sideways, shifts towards a roller leaving the zone (+-2 um) and keeps it loaded
+    to ~27 deg. A quasi-static calculation of the same discrete bearing (independent code, above) gives
+    the edge; +-1.5 deg covers the 1 deg bins of the time-mean load profile (1 % of its maximum is the
+    cut) and the roller's play in its pocket and the dynamic loads."""
+    edge = _discrete_contact_edge(full_3000.scenario)
+    assert full_3000.load_zone_contact_half_angle_deg == pytest.approx(edge, abs=1.5), edge
+
+
+def test_dynamic_inner_ring_agrees_with_quasi_static_where_both_apply(full_3000):
+    """With 16 rollers at 970 N the load is always shared by >= 2 rollers, so a dynamic inner ring (the
+    rotor's mass W/g) must carry the same mean load on the same mean displacement as the quasi-static
+    one: the ring's momentum balance makes the time-mean contact reaction equal W. Mean displacement
+    within 2 % (Hertz nonlinearity under the ring's vibration shifts the mean slightly; measured 0.5 %),
+    mean I_dec within 10 % (8 rotations against 20: statistical scatter, std/mean ~0.4)."""
+    sc = _scenario(rotations=8, extra=["multibody.inner_ring=dynamic"])
+    r = simulate(sc)
+    assert "dynamic" in r.raw["inner_ring"]
+    assert r.summary["inner_ring_displacement_m"] == pytest.approx(
+        full_3000.summary["inner_ring_displacement_m"], rel=0.02)
+    assert r.per_rotation_I_dec.mean() == pytest.approx(full_3000.per_rotation_I_dec.mean(), rel=0.10)
+
+
+def test_inner_ring_auto_choice():
+    """A ring resting on a single roller has no stable sideways equilibrium: "auto" keeps the massless
+    quasi-static ring only when >= 2 rollers carry the load with one roller at the centre (16 rollers at
+    970 N: 3 loaded), and makes it dynamic with the rotor's mass W/g otherwise (3 rollers: the
+    neighbours at 120 deg can never be loaded; 16 rollers at 300 N: only the centre roller)."""
+    from bearingsim.kinematics import loaded_rollers_with_one_at_centre as loaded
+    from bearingsim.multibody.core import STANDARD_GRAVITY, inner_ring_model
+
+    g = _scenario().geometry
+    assert loaded(970.0, 16, g.roller_length, g.radial_clearance) == 3
+    assert loaded(970.0, 3, g.roller_length, g.radial_clearance) == 1
+    assert loaded(300.0, 16, g.roller_length, g.radial_clearance) == 1
+    assert loaded(970.0, 16, g.roller_length, 0.0) == 7  # no clearance: every roller below the centre
+    assert inner_ring_model(_scenario())[0] == 0.0
+    mass, how = inner_ring_model(_scenario(extra=["bearing.roller_count=3"]))
+    assert mass == pytest.approx(970.0 / STANDARD_GRAVITY) and "dynamic" in how
+
+
+@pytest.mark.parametrize("rpm", [1000, 3000, 6000])
+def test_reduced_equivalent_matches_event_model(rpm):
+    """The reduced-equivalent scene makes the reduced model's assumptions (PHYSICS Sec. 4), so its mean
+    I_dec per no-load pass must equal the exact event solution within 2 % (issue)."""
+    from bearingsim.reduced.core import PassInputs
+    from bearingsim.reduced.event import solve_event
+
+    sc = _scenario(rpm=rpm, scene="reduced_equivalent", rotations=1)
+    ref = solve_event(PassInputs.from_scenario(sc)).I_dec
+    r = simulate(sc)
+    assert r.per_rotation_I_dec.mean() == pytest.approx(ref, rel=0.02)
+
+
+def test_I_dec_converges_with_dt():
+    """Time-step convergence: over three halvings of dt the change of I_dec shrinks (deterministic
+    reduced-equivalent scene at 3000 rpm, dt from 0.5x to 1/16x of the explicit Hertz limit). The
+    scheme is first order at impacts (a new contact is detected one step late, overlap v dt), so the
+    differences need not shrink at every single halving (measured: 5.9e-7, 7.0e-7, 2.8e-7 N s, all
+    ~1e-4 of I_dec); the last one must be smaller than the first, and all four agree to 0.1 %."""
+    sc = _scenario(rpm=3000, scene="reduced_equivalent", rotations=1)
+    _, _, lim = choose_dt(sc)
+    vals = [simulate(sc, dt=lim * f).per_rotation_I_dec.mean() for f in (0.5, 0.25, 0.125, 0.0625)]
+    d = np.abs(np.diff(vals))
+    assert d[-1] < d[0], vals
+    # and the whole sequence already agrees to 0.1 % of I_dec (the accuracy goal of issue 3 is 1 %)
+    assert np.ptp(vals) < 1e-3 * np.mean(vals), vals
+
+
+def test_dt_far_too_large_is_user_error():
+    """A dt far above the Hertz stability limit is refused up front with a message naming the key."""
+    from bearingsim.errors import UserError
+
+    sc = _scenario(extra=["numerics.dt_s=1e-4"])
+    with pytest.raises(UserError, match="numerics.dt_s"):
+        simulate(sc)
+
+
+def test_cli_main_job(tmp_path):
+    """The README's main job writes an archive with the public names and units."""
+    out = tmp_path / "mb.h5"
+    res = subprocess.run([sys.executable, "-m", "bearingsim", "run", str(SCENARIOS / "multibody_6000rpm.toml"),
+                          "-o", str(out), "--no-plots"], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr
+    sc = load_scenario(SCENARIOS / "multibody_6000rpm.toml")
+    with h5py.File(out) as f:
+        assert f["/results/per_rotation/I_dec"].shape == (sc.numerics.rotations, 16)
+        assert f["/results/per_rotation/I_dec"].attrs["unit"] == "N s"
+        assert f["/results/per_rotation/I_acc"].shape == (sc.numerics.rotations, 16)
+        s = f["/results/summary"].attrs
+        for k in ("I_dec_mean_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_std_Ns", "first_impact_speed_m_s",
+                  "first_impact_energy_J", "cage_speed_mean_rad_s", "cage_slip", "load_zone_half_angle_deg"):
+            assert k in s and f"{k}__unit" in s, k
+        for col in ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face"):
+            assert col in f["/results/impacts"]
+        assert f["/results/force_vs_theta"].shape == (360, 16)
+        assert "dt_s" in f["provenance"].attrs and "dt_choice" in f["provenance"].attrs
+        for k in ("paper_index_front", "paper_index_rear", "sliding_work_front", "sliding_work_rear"):
+            assert f[f"/results/wear/{k}"].attrs["unit"] == "m^3"

@@ -161,7 +161,7 @@ def _fmt(v):
 
 
 def _markdown(rows: list[dict]) -> str:
-    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "rel_error", "unit_of_work")
+    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "pymunk_step_s", "rel_error", "unit_of_work")
     out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
         out.append("| " + " | ".join(_fmt(r.get(c, "")) for c in cols) + " |")
@@ -227,7 +227,11 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
     if include_multibody:
         print("multibody model: full and reduced-equivalent scenes over dt ...", flush=True)
         try:
-            rows += multibody_rows(quick)
+            mrows = multibody_rows(quick)
+            rows += mrows
+            from bearingsim.multibody.bench import goal_lines
+
+            meta["multibody_goal"] = goal_lines(mrows)
         except ImportError as exc:  # pragma: no cover - reported, not hidden
             meta["multibody_error"] = f"multibody benchmark unavailable: {exc}"
         if not quick:
@@ -246,9 +250,10 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
     print()
     for line in meta["reduced_goal"]:
         print(line)
-    for k in ("multibody_goal", "multibody_error"):
-        if k in meta:
-            print(meta[k])
+    if "multibody_error" in meta:
+        print(meta["multibody_error"])
+    for line in meta.get("multibody_goal", []) if isinstance(meta.get("multibody_goal"), list) else []:
+        print(line)
     if "long_run" in meta:
         print("long run:", json.dumps(meta["long_run"], default=str))
     print(f"machine: {meta.get('cpu', meta['processor'])}, {meta['cpu_count']} cores, {meta['platform']}")

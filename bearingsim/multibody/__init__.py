@@ -150,6 +150,16 @@ def _load_zone_half_angle(q_bin, tq_bin):
     return 0.5 * width
 
 
+def _save(fig, path) -> Path:
+    """Lay out, write (120 dpi) and close one report figure; return its path."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return Path(path)
+
+
 class MultibodyResult:
     """Result of :func:`simulate`. Arrays are per rotation x pocket unless stated."""
 
@@ -317,11 +327,7 @@ class MultibodyResult:
         ax.set_xlim(0, 360)
         ax.set_title(title + ": pocket force vs theta")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        p = Path(f"{stem}_forces.png")
-        fig.savefig(p, dpi=120)
-        plt.close(fig)
-        out.append(p)
+        out.append(_save(fig, f"{stem}_forces.png"))
         # impulses per pocket (Fig. 7 analog)
         fig, ax = plt.subplots(figsize=(8, 4))
         x = np.arange(n)
@@ -333,11 +339,7 @@ class MultibodyResult:
         ax.set_ylabel("impulse per cage rotation [mN s]")
         ax.set_title(title + f": mean +- std over {self.rotations} rotations")
         ax.legend()
-        fig.tight_layout()
-        p = Path(f"{stem}_impulses.png")
-        fig.savefig(p, dpi=120)
-        plt.close(fig)
-        out.append(p)
+        out.append(_save(fig, f"{stem}_impulses.png"))
         # cage-centre orbit
         fig, ax = plt.subplots(figsize=(5, 5))
         o = self.orbit[np.isfinite(self.orbit[:, 0])]
@@ -346,11 +348,7 @@ class MultibodyResult:
         ax.set_xlabel("cage centre x [um]")
         ax.set_ylabel("cage centre y [um]")
         ax.set_title("cage-centre orbit (recorded, last samples)", fontsize=9)
-        fig.tight_layout()
-        p = Path(f"{stem}_orbit.png")
-        fig.savefig(p, dpi=120)
-        plt.close(fig)
-        out.append(p)
+        out.append(_save(fig, f"{stem}_orbit.png"))
         # wear per pocket face (Fig. 14 analog)
         fig, ax = plt.subplots(figsize=(8, 4))
         wdt = 0.2
@@ -362,9 +360,5 @@ class MultibodyResult:
         ax.set_ylabel("wear per cage rotation [um^3]")
         ax.set_title(title + ": Archard wear per pocket face")
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        p = Path(f"{stem}_wear.png")
-        fig.savefig(p, dpi=120)
-        plt.close(fig)
-        out.append(p)
+        out.append(_save(fig, f"{stem}_wear.png"))
         return out

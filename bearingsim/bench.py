@@ -252,7 +252,7 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
         print(line)
     if "multibody_error" in meta:
         print(meta["multibody_error"])
-    for line in meta.get("multibody_goal", []) if isinstance(meta.get("multibody_goal"), list) else []:
+    for line in meta.get("multibody_goal", []):
         print(line)
     if "long_run" in meta:
         print("long run:", json.dumps(meta["long_run"], default=str))

@@ -70,22 +70,12 @@ def quasi_static_load_zone(radial_load, roller_count, roller_length, radial_clea
     P_d opens the load zone: psi_l = arccos(P_d / (2 delta_r)). Returns (pi/2, delta) for zero clearance
     and (0, 0) for zero load.
     """
-    from scipy.optimize import brentq
-
     if radial_load <= 0.0:
         return 0.0, 0.0
-    k_series = palmgren_stiffness(roller_length) / 2.0 ** (10.0 / 9.0)
     psi = np.linspace(-math.pi, math.pi, n_points, endpoint=False)
     half_pd = radial_clearance / 2.0
-
-    def residual(delta_r):
-        d = np.clip(delta_r * np.cos(psi) - half_pd, 0.0, None)
-        return roller_count * np.mean(k_series * d ** (10.0 / 9.0) * np.cos(psi)) - radial_load
-
-    hi = half_pd + 1e-9
-    while residual(hi) < 0.0:
-        hi = 2.0 * hi + 1e-9
-    delta_r = brentq(residual, half_pd, hi, xtol=1e-15, rtol=1e-13)
+    # the smeared rollers: each grid point carries Z / n_points of a roller
+    delta_r = _ring_displacement(radial_load, psi, roller_count / n_points, roller_length, half_pd)
     if half_pd == 0.0:
         return math.pi / 2.0, delta_r
     return math.acos(min(1.0, half_pd / delta_r)), delta_r
@@ -101,20 +91,27 @@ def loaded_rollers_with_one_at_centre(radial_load, roller_count, roller_length, 
     (an unstable equilibrium, like a disc on a disc): a massless, quasi-static ring is not defined and the
     rotor's inertia must decide (``multibody.inner_ring = "dynamic"``). Returns 0 for zero load.
     """
-    from scipy.optimize import brentq
-
     if radial_load <= 0.0:
         return 0
-    k_series = palmgren_stiffness(roller_length) / 2.0 ** (10.0 / 9.0)
     psi = 2.0 * math.pi * np.arange(roller_count) / roller_count
     half_pd = radial_clearance / 2.0
+    delta_r = _ring_displacement(radial_load, psi, 1.0, roller_length, half_pd)
+    return int(np.count_nonzero(delta_r * np.cos(psi) - half_pd > 1e-12 * delta_r))
+
+
+def _ring_displacement(radial_load, psi, weight, roller_length, half_pd):
+    """Ring displacement delta_r [m] along the load that balances it on rollers at angles ``psi``
+    (``weight`` rollers each), inner and outer Palmgren contacts in series:
+    ``sum weight K_s (delta_r cos psi - P_d/2)_+^(10/9) cos psi = W``."""
+    from scipy.optimize import brentq
+
+    k_series = palmgren_stiffness(roller_length) / 2.0 ** (10.0 / 9.0)
 
     def residual(delta_r):
         d = np.clip(delta_r * np.cos(psi) - half_pd, 0.0, None)
-        return float(np.sum(k_series * d ** (10.0 / 9.0) * np.cos(psi))) - radial_load
+        return weight * float(np.sum(k_series * d ** (10.0 / 9.0) * np.cos(psi))) - radial_load
 
     hi = half_pd + 1e-9
     while residual(hi) < 0.0:
         hi = 2.0 * hi + 1e-9
-    delta_r = brentq(residual, half_pd, hi, xtol=1e-15, rtol=1e-13)
-    return int(np.count_nonzero(delta_r * np.cos(psi) - half_pd > 1e-12 * delta_r))
+    return brentq(residual, half_pd, hi, xtol=1e-15, rtol=1e-13)

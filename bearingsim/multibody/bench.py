@@ -25,19 +25,21 @@ GOAL_S_PER_ROTATION = 0.2  # issue 3: full scene at 6000 rpm
 GOAL_ERROR = 0.01
 
 
-def _scenario(rpm: float, rotations: int, warmup: int, scene: str = "full"):
+def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "full", load: float = 970.0,
+                       phi="auto", source: str = "<bench>"):
+    """The reference bearing (NU214) in the multibody model at one speed and load; ``phi`` is the
+    reduced-equivalent scene's load-zone half angle [deg] or "auto"."""
     doc = {
         "schema_version": 1,
-        "name": f"bench_multibody_{scene}_{rpm:g}rpm",
+        "name": f"multibody_{scene}_{rpm:g}rpm_{load:g}N",
         "model": "multibody",
         "bearing": {"preset": "NU214-Suzuki2023"},
-        "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": 970.0},
+        "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": float(load)},
         "multibody": {"scene": scene},
         "numerics": {"rotations": rotations, "warmup_rotations": warmup},
+        "reduced": {"load_zone_half_angle_deg": phi},
     }
-    if scene == "reduced_equivalent":
-        doc["reduced"] = {"load_zone_half_angle_deg": 23.5}
-    return resolve(doc, source="<bench>")
+    return resolve(doc, source=source)
 
 
 def _row(scene, rpm, dt, runs, total_rot, ref_idec, ref_what):
@@ -69,9 +71,9 @@ def bench_cases(quick: bool) -> list[dict]:
         dt_ref = 1e-6
         repeats = 3
     rows = []
-    simulate(_scenario(6000, 1, 0))  # load the compiled kernels once (not timed in any row)
+    simulate(reference_scenario(6000, 1, 0))  # load the compiled kernels once (not timed in any row)
     for rpm, nrot in plan.items():
-        sc = _scenario(rpm, nrot, 1)
+        sc = reference_scenario(rpm, nrot, 1)
         total_rot = nrot + 1
         ref = simulate(sc, dt=dt_ref)
         ref_idec = ref.summary["I_dec_mean_Ns"]
@@ -80,7 +82,7 @@ def bench_cases(quick: bool) -> list[dict]:
             rows.append(_row("full", rpm, dt, runs, total_rot, ref_idec, f"full scene at dt = {dt_ref:g} s"))
         rows.append(_row("full", rpm, dt_ref, [ref], total_rot, ref_idec, "itself"))
     # deterministic scene against the exact reduced solution
-    sc = _scenario(3000, 1, 1, scene="reduced_equivalent")
+    sc = reference_scenario(3000, 1, 1, scene="reduced_equivalent", phi=23.5)
     exact = solve_event(PassInputs.from_scenario(sc)).I_dec
     _, _, lim = choose_dt(sc)
     for f in (0.5, 0.25, 0.125) if quick else (1.0, 0.5, 0.25, 0.125, 0.0625):

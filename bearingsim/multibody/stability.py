@@ -21,26 +21,14 @@ import time
 
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody.core import PenetrationExceeded, choose_dt, run
-from bearingsim.scenario import resolve
-
-
-def _scenario(scene, rpm, load):
-    doc = {"schema_version": 1, "name": f"stability_{scene}_{rpm:g}_{load:g}", "model": "multibody",
-           "bearing": {"preset": "NU214-Suzuki2023"},
-           "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": float(load)},
-           "multibody": {"scene": scene}, "numerics": {"rotations": 1, "warmup_rotations": 0}}
-    if scene == "reduced_equivalent":
-        doc["reduced"] = {"load_zone_half_angle_deg": "auto"}
-    return resolve(doc, source="<stability>")
+from bearingsim.multibody.bench import reference_scenario
 
 
 def _ok(sc, dt, limit):
     try:
         run(sc, dt=dt, penetration_limit=limit)
         return True
-    except (SimulationUnstable, PenetrationExceeded):
-        return False
-    except UserError:  # above the refusal threshold
+    except (SimulationUnstable, PenetrationExceeded, UserError):  # UserError: above the refusal threshold
         return False
 
 
@@ -72,7 +60,7 @@ def main(argv=None):
     for scene in ("full", "reduced_equivalent"):
         for rpm in speeds:
             for load in (loads if scene == "full" else (970.0,)):
-                sc = _scenario(scene, rpm, load)
+                sc = reference_scenario(rpm, 1, 0, scene=scene, load=load, source="<stability>")
                 t0 = time.perf_counter()
                 auto, _, lim = choose_dt(sc)
                 run_dt = largest_dt(sc, 0.5)

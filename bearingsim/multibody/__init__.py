@@ -56,7 +56,7 @@ import numpy as np
 from bearingsim.multibody import recorder as rk
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
-                                       PenetrationExceeded, run)
+                                       PenetrationExceeded, choose_dt, run)
 
 __all__ = ["simulate", "MultibodyResult"]
 
@@ -99,8 +99,8 @@ def simulate(scenario, archive=None, progress=False, dt=None) -> "MultibodyResul
             dt = new_dt
             if archive is not None:
                 archive.discard_timeseries()
-    if retries:
-        raw["dt_choice"] = raw["dt_choice"] + "; " + "; ".join(retries)
+    if retries:  # the last run was given its dt: describe how the first one was chosen, then the restarts
+        raw["dt_choice"] = "; ".join([choose_dt(scenario)[1], *retries])
     res = MultibodyResult(raw)
     if archive is not None:
         archive.provenance["dt_s"] = res.dt

@@ -1,16 +1,12 @@
-"""Driver of the multi-pocket model: scene, time step, step loop, recording. SI throughout.
+"""Driver of the multi-pocket model: scene, time step, run set-up, errors, results. SI throughout.
 
 See the package docstring of :mod:`bearingsim.multibody` for the definitions of the recorded
-quantities. The step loop per time step ``h``:
-
-1. ``pymunk.batch.get_space_bodies`` -> state ``(x, y, angle, vx, vy, omega)`` of every body;
-2. (reduced-equivalent scene) rollers inside the load zone are put at the front of their pockets,
-   moving with the cage;
-3. one numba kernel (:func:`bearingsim.multibody.forces.raceway_forces`) evaluates the raceway
-   forces at the predicted positions, implicitly linearised, and hands them to pymunk in one batch;
-4. ``Space.step(h)`` (roller-cage contacts by pymunk);
-5. one numba kernel (:func:`bearingsim.multibody.recorder.record_step`) attributes the batch arbiter
-   impulses to pockets, faces and rotations into fixed-size accumulators.
+quantities. The step loop itself is compiled (:func:`bearingsim.multibody.loop.advance`: per time step
+``h`` the body states are read in one batch, the raceway forces computed by one numba kernel
+(:func:`bearingsim.multibody.forces.raceway_forces`) at the predicted positions and handed to pymunk
+in one batch, ``cpSpaceStep(h)`` solves the roller-cage contacts, and
+:func:`bearingsim.multibody.recorder.record_step` attributes the arbiter impulses to pockets, faces
+and rotations); Python only sees it every 2048 output samples, to write them and move the progress bar.
 """
 from __future__ import annotations
 
@@ -19,13 +15,11 @@ import sys
 import time
 
 import numpy as np
-import pymunk.batch as pb
-from numba import njit
-from pymunk._chipmunk_cffi import ffi, lib
 
 from bearingsim import kinematics as kin
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody import forces as fk
+from bearingsim.multibody import loop as lp
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
 
@@ -46,16 +40,6 @@ DT_FRACTION = 0.5
 DT_MAX_FACTOR = 2.0  # dt above this multiple of 2/omega_n is refused (UserError); between 1x and 2x a run may still blow up (SimulationUnstable)
 IMPACT_OVERLAP_FRACTION = 0.005  # auto dt: one step's approach at the impact speed <= 0.5 % of s
 DT_CAP_S = 2.0e-5  # never above this (impact resolution: s / v_rel >> dt for v_rel ~ 1 m/s)
-
-BODY_GET = (pb.BodyFields.POSITION | pb.BodyFields.ANGLE | pb.BodyFields.VELOCITY
-            | pb.BodyFields.ANGULAR_VELOCITY)
-BODY_SET_FORCE = pb.BodyFields.FORCE | pb.BodyFields.TORQUE
-BODY_SET_ALL = (pb.BodyFields.POSITION | pb.BodyFields.VELOCITY | pb.BodyFields.FORCE
-                | pb.BodyFields.TORQUE)
-ARB_GET = (pb.ArbiterFields.BODY_A_ID | pb.ArbiterFields.BODY_B_ID | pb.ArbiterFields.CONTACT_COUNT
-           | pb.ArbiterFields.TOTAL_IMPULSE | pb.ArbiterFields.NORMAL | pb.ArbiterFields.POINT_A_1
-           | pb.ArbiterFields.POINT_B_1 | pb.ArbiterFields.DISTANCE_1)
-
 
 PENETRATION_LIMIT = 0.01  # largest roller-cage overlap accepted, as a fraction of the pocket clearance
 
@@ -184,123 +168,6 @@ def choose_dt(scenario, dt=None):
     return float(dt), how, lim
 
 
-def _entry_point(dispatcher, args):
-    """The compiled entry point of ``dispatcher`` for these arguments (skips numba's per-call type
-    dispatch, ~0.1 us per argument; the arguments' types never change during a run)."""
-    import numba
-
-    sig = tuple(numba.typeof(a) for a in args)
-    try:
-        return dispatcher.overloads[sig].entry_point
-    except KeyError:  # pragma: no cover - unexpected signature mismatch: keep the dispatcher
-        return dispatcher
-
-
-class _Block:
-    """Fixed-size block buffer in front of an archive time series (append whole blocks: flat memory)."""
-
-    def __init__(self, ts, width, rows=2048):
-        self.ts = ts
-        self.step = np.zeros(rows, dtype=np.int64)
-        self.time = np.zeros(rows)
-        self.val = np.zeros((rows, width))
-        self.width = width
-        self.k = 0
-
-    def add(self, step, t, *vals):
-        k = self.k
-        self.step[k] = step
-        self.time[k] = t
-        self.val[k, :] = vals
-        self.k = k + 1
-        if self.k == len(self.time):
-            self.flush()
-
-    def flush(self):
-        if self.k:
-            v = self.val[: self.k]
-            self.ts.append(self.step[: self.k].copy(), self.time[: self.k].copy(),
-                           v[:, 0].copy() if self.width == 1 else v.copy())
-            self.k = 0
-
-
-class _BatchIO:
-    """Allocation-free batched access to the space (pymunk.batch's C iterators, called directly).
-
-    The state is double-buffered in two fixed C arrays viewed by numpy (no copy per step); the arbiter
-    buffers are preallocated. ``step`` calls ``cpSpaceStep`` directly: the scene never adds or removes
-    anything and has no callbacks, so pymunk's Python bookkeeping around the step is not needed.
-    """
-
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap=4096):
-        self.sp = space._space
-        self.nb = nb
-        self._keep = []
-        self.get_fn = ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")
-        self.set_fn = ffi.addressof(lib, "pmSpaceBodySetIteratorFuncBatched")
-        self.arb_fn = ffi.addressof(lib, "pmSpaceArbiterIteratorFuncBatched")
-        self.ia = lib.pmIntArrayNew(nb)
-        self.fa = []
-        self.gd = []
-        self.views = []
-        for _ in range(2):
-            fa = lib.pmFloatArrayNew(2 * nb * 6 + 16)
-            d = ffi.new("pmBatchedData *")
-            d.fields = BODY_GET.value
-            d.floatArray = fa
-            d.intArray = self.ia
-            self.fa.append(fa)
-            self.gd.append(d)
-            self.views.append(None)
-        self.maxes = [-1, -1]
-        self.set_buf = pb.Buffer()
-        self.set_buf.set_float_buf(set_arr)
-        self.sd = ffi.new("pmBatchedData *")
-        self.sd.fields = set_fields.value
-        self.sd.floatArray = self.set_buf._float_arr
-        self.sd.intArray = self.set_buf._int_arr
-        self.arb_cap = arb_cap
-        self.afa = lib.pmFloatArrayNew(rk.ARB_F * arb_cap)
-        self.aia = lib.pmIntArrayNew(rk.ARB_I * arb_cap)
-        self.amax = (-1, -1)
-        self.ad = ffi.new("pmBatchedData *")
-        self.ad.fields = ARB_GET.value
-        self.ad.floatArray = self.afa
-        self.ad.intArray = self.aia
-        self._arb_views()
-
-    def _arb_views(self):
-        self.amax = (self.afa.max, self.aia.max)
-        self.arb_f = np.frombuffer(ffi.buffer(self.afa.arr, 8 * self.afa.max), dtype=np.float64)
-        self.arb_i = np.frombuffer(ffi.buffer(self.aia.arr, 8 * self.aia.max), dtype=np.uint64)
-
-    def get(self, k):
-        fa = self.fa[k]
-        fa.num = 0
-        lib.cpSpaceEachBody(self.sp, self.get_fn, self.gd[k])
-        if fa.max != self.maxes[k]:  # first call, or the C array was reallocated
-            self.maxes[k] = fa.max
-            self.views[k] = np.frombuffer(ffi.buffer(fa.arr, 8 * self.nb * 6),
-                                          dtype=np.float64).reshape(self.nb, 6)
-        return self.views[k]
-
-    def set(self):
-        self.sd.floatArray.num = 0
-        lib.cpSpaceEachBody(self.sp, self.set_fn, self.sd)
-
-    def arbiters(self):
-        """Number of arbiters read into ``arb_f`` / ``arb_i``."""
-        self.afa.num = 0
-        self.aia.num = 0
-        lib.cpSpaceEachCachedArbiter(self.sp, self.arb_fn, self.ad)
-        if (self.afa.max, self.aia.max) != self.amax:
-            self._arb_views()  # the C arrays grew (reallocated)
-        return self.aia.num // rk.ARB_I
-
-    def step(self, h):
-        lib.cpSpaceStep(self.sp, h)
-
-
 def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT):
     """Run the scenario; return a dict of raw accumulators (see :class:`MultibodyResult`)."""
     t_wall0 = time.perf_counter()
@@ -400,181 +267,127 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     # reduced-equivalent: held rollers sit at the front of their pockets on the outer race
     phi = load_zone_phi(scenario) if reduced_eq else 0.0
     if reduced_eq:
-        set_fields = BODY_SET_ALL
+        set_fields = lp.BODY_SET_ALL
         set_arr = np.zeros(nb * 7)
     else:
-        set_fields = BODY_SET_FORCE
+        set_fields = lp.BODY_SET_FORCE
         set_arr = np.zeros(nb * 3)
     # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
     out_f = np.zeros(nb * 3) if reduced_eq else set_arr
-    io = _BatchIO(space, nb, set_fields, set_arr)
+    # room for every roller against every face segment of every pocket: pymunk never grows the arrays
+    arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
+    io = lp.BatchIO(space, nb, set_fields, set_arr, arb_cap)
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot
     omega_nom = op.omega_c
     steps_est = int(math.ceil(travel_end / omega_nom / h))
     out_every = max(1, int(round(1.0 / (float(scenario.numerics.output_rate_hz) * h))))
-    ts_cage = ts_slip = ts_orbit = ts_ring = None
+    series = None
     if archive is not None:
-        ts_cage = _Block(archive.timeseries("cage_angular_speed", (), "rad/s",
-                                            "cage angular speed in the direction of rotation"), 1)
-        ts_slip = _Block(archive.timeseries("cage_slip", (), "1",
-                                            "1 - cage speed / epicyclic speed (Eq. 11)"), 1)
-        ts_orbit = _Block(archive.timeseries("cage_centre", (2,), "m",
-                                             "cage centre (x, y); y up, radial load along -y"), 2)
+        series = [
+            (archive.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
+             lp.S_W, 1),
+            (archive.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), lp.S_SLIP, 1),
+            (archive.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
+             lp.S_CX, 2),
+        ]
         if not reduced_eq:
-            ts_ring = _Block(archive.timeseries("inner_ring_centre", (2,), "m",
-                                                "quasi-static inner-ring centre (x, y)"), 2)
+            series.append((archive.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
+                           lp.S_RX, 2))
     bar = None
     if progress:
         from tqdm import tqdm
 
         bar = tqdm(total=total_rot, unit="rot", desc="cage rotations", file=sys.stderr)
     bar_done = 0
-    cur = 0
-    prev = io.get(cur)
-    cage_w_start = None
-    t = 0.0
-    step = 0
-    pymunk_s = 0.0
-    orbit_max = 0.0
-    pen_limit = penetration_limit * s  # (the stability scan passes 0.5 to look for blow-up alone)
-    ring_sum_x = 0.0
-    ring_sum_y = 0.0
-    ring_n = 0
-    newton_fail = 0
-    rec_started = False
+    io.read_states()
     hold_radius = rp - (n_centrifugal / K) ** 0.9
     front_off = 0.5 * s
-    max_steps = int(3 * steps_est + 1000)
-    perf = time.perf_counter
-    rf = fk.raceway_forces
-    rs = rk.record_step
     pocket_a = np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64)
     ORBIT_KEEP = 4096
     orbit_buf = np.full((ORBIT_KEEP, 3), np.nan)
-    n_orbit = 0
-    t_loop0 = perf()
+    lim = np.zeros(lp.N_LIM)
+    lim[lp.LIM_TRAVEL_END] = travel_end
+    lim[lp.LIM_TRAVEL_REC] = 2.0 * math.pi * warm
+    lim[lp.LIM_PEN] = penetration_limit * s  # (the stability scan passes 0.5 to look for blow-up alone)
+    lim[lp.LIM_OMEGA] = 3.0 * op.omega_i + 10.0
+    lim[lp.LIM_OMEGA_NOM] = omega_nom
+    lsi = np.zeros(lp.N_LI, dtype=np.int64)
+    lsi[lp.LI_OUT_EVERY] = out_every
+    lsi[lp.LI_MAX_STEPS] = int(3 * steps_est + 1000)
+    lsf = np.zeros(lp.N_LF)
+    smp_step = np.zeros(2048, dtype=np.int64)
+    smp = np.zeros((2048, lp.N_SCOL))
+    args = (io.step_fn, io.each_body_fn, io.each_arb_fn, io.clock_fn, io.timed, io.ptr, *io.hdr, *io.states,
+            io.arb_f, io.arb_i, io.ts, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, set_arr, diag, reduced_eq,
+            phi, pocket_a, hold_radius, front_off, omega_cage, ids_sorted, ids_index, cfg, theta0, win, first_imp,
+            f_bin, t_bin, q_bin, tq_bin, j_int, glob, impacts, lim, lsi, lsf, smp_step, smp, orbit_buf)
+    t_loop0 = time.perf_counter()
     while True:
-        travel = sign * prev[n, 2]
-        if travel >= travel_end:
+        code = lp.advance(*args)
+        k = int(lsi[lp.LI_NSMP])
+        if series is not None and k:
+            for ts, col, width in series:
+                ts.append(smp_step[:k].copy(), smp[:k, lp.S_T].copy(),
+                          smp[:k, col].copy() if width == 1 else smp[:k, col:col + width].copy())
+        lsi[lp.LI_NSMP] = 0
+        t = float(lsf[lp.LF_T])
+        step = int(lsi[lp.LI_STEP])
+        state = io.states[int(lsi[lp.LI_CUR])]
+        if bar is not None:
+            done = min(total_rot, int(sign * state[n, 2] / (2.0 * math.pi)))
+            if done > bar_done:
+                bar.update(done - bar_done)
+                bar_done = done
+        if code == lp.CODE_BLOCK_FULL:
+            continue
+        if code == lp.CODE_DONE:
             break
-        if step > max_steps:
+        if bar is not None:
+            bar.close()
+        if code == lp.CODE_NONFINITE:
+            raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
+                                     f"try a smaller numerics.dt_s than {h:.3g} s")
+        if code == lp.CODE_PENETRATION:
+            raise PenetrationExceeded(glob[rk.G_MAXPEN_ALL], lim[lp.LIM_PEN], h, glob[rk.G_MAXPEN_TIME],
+                                      glob[rk.G_MAXPEN_APPROACH])
+        if code == lp.CODE_BLOWUP:
             raise SimulationUnstable(
-                f"cage did not complete {total_rot} rotations in {max_steps} steps "
-                f"(cage speed {prev[n, 5]:.3g} rad/s): the cage stalled")
-        if not rec_started and travel >= 2.0 * math.pi * warm:
-            rec_started = True
-            cage_w_start = prev[n, 5]
-            t_rec0 = t
-        if reduced_eq:
-            _hold_rollers(prev, n, sign, phi, sc.pocket_body_angle, hold, hold_radius, front_off,
-                          omega_cage)
-        if rf(prev, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag) < 0:
-            newton_fail += 1
-        if rec_started:
-            ring_sum_x += ring_c[0]
-            ring_sum_y += ring_c[1]
-            ring_n += 1
-        if reduced_eq:
-            _pack_all(prev, out_f, set_arr, nb)
-        io.set()
-        t0 = perf()
-        io.step(h)
-        pymunk_s += perf() - t0
-        t += h
-        step += 1
-        cur ^= 1
-        now = io.get(cur)
-        n_arb = io.arbiters()
-        rargs = (io.arb_f, io.arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg,
-                 pocket_a, theta0, diag, win, first_imp, f_bin, t_bin, q_bin, tq_bin, j_int, glob,
-                 impacts, n_imp)
-        n_imp = rs(*rargs)
-        if step == 1:
-            rs = _entry_point(rk.record_step, rargs)
-            rf = _entry_point(fk.raceway_forces, (prev, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag))
-        if _hook is not None:
-            _hook(step, t, prev, now, io, n_arb, diag, ring_c)
-        prev = now
-        if step % out_every == 0:
-            if not np.all(np.isfinite(now)):
-                raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
-                                         f"try a smaller numerics.dt_s than {h:.3g} s")
-            if glob[rk.G_MAXPEN_ALL] > pen_limit:
-                raise PenetrationExceeded(glob[rk.G_MAXPEN_ALL], pen_limit, h, glob[rk.G_MAXPEN_TIME],
-                                          glob[rk.G_MAXPEN_APPROACH])
-            dmax = diag[:, fk.D_DELTA_OUT].max()
-            if dmax > 50e-6 or abs(now[n, 5]) > 3.0 * op.omega_i + 10.0:
-                raise SimulationUnstable(
-                    f"raceway approach {dmax:.3g} m or cage speed {now[n, 5]:.3g} rad/s out of bounds "
-                    f"at t = {t:.6g} s (energy blow-up); try a smaller numerics.dt_s than {h:.3g} s")
-            wc = sign * now[n, 5]
-            if rec_started:
-                orbit_buf[n_orbit % ORBIT_KEEP] = (t, now[n, 0], now[n, 1])
-                n_orbit += 1
-                orbit_max = max(orbit_max, math.hypot(now[n, 0], now[n, 1]))
-            if ts_cage is not None:
-                ts_cage.add(step, t, wc)
-                ts_slip.add(step, t, 1.0 - wc / omega_nom)
-                ts_orbit.add(step, t, now[n, 0], now[n, 1])
-                if ts_ring is not None:
-                    ts_ring.add(step, t, ring_c[0], ring_c[1])
-            if bar is not None:
-                done = min(total_rot, int(sign * now[n, 2] / (2.0 * math.pi)))
-                if done > bar_done:
-                    bar.update(done - bar_done)
-                    bar_done = done
-    for blk in (ts_cage, ts_slip, ts_orbit, ts_ring):
-        if blk is not None:
-            blk.flush()
+                f"raceway approach {diag[:, fk.D_DELTA_OUT].max():.3g} m or cage speed {state[n, 5]:.3g} rad/s "
+                f"out of bounds at t = {t:.6g} s (energy blow-up); try a smaller numerics.dt_s than {h:.3g} s")
+        if code == lp.CODE_STALLED:
+            raise SimulationUnstable(
+                f"cage did not complete {total_rot} rotations in {step} steps "
+                f"(cage speed {state[n, 5]:.3g} rad/s): the cage stalled")
+        raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
     if bar is not None:
         bar.update(total_rot - bar_done)
         bar.close()
-    loop_s = perf() - t_loop0
+    loop_s = time.perf_counter() - t_loop0
+    n_imp = int(lsi[lp.LI_NIMP])
+    # impacts in one step come in pymunk's arbiter order, which follows shape addresses: sort them by
+    # (time, pocket, face) so that the table is the same in every run
+    imp = impacts[:n_imp]
+    imp = imp[np.lexsort((imp[:, rk.I_FACE], imp[:, rk.I_POCKET], imp[:, rk.I_TIME]))]
     wall = time.perf_counter() - t_wall0
-    t_rec = t - t_rec0 if rec_started else 0.0
+    prev = io.states[int(lsi[lp.LI_CUR])]
+    rec_started = lsi[lp.LI_REC] == 1
+    t_rec = t - lsf[lp.LF_T_REC0] if rec_started else 0.0
+    ring_n = lsf[lp.LF_RING_N]
+    n_orbit = int(lsi[lp.LI_NORBIT])
+    pymunk_s = lsf[lp.LF_PYMUNK_NS] * 1e-9 if io.timed else float("nan")
     return dict(
         scenario=scenario, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
         wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, t_end=t, t_record=t_rec, win=win, first_imp=first_imp,
-        f_bin=f_bin, t_bin=t_bin, q_bin=q_bin, tq_bin=tq_bin, glob=glob.copy(), impacts=impacts[:n_imp].copy(),
-        impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=cage_w_start, cage_w_end=prev[n, 5],
-        cage_inertia=geo.cage_inertia, newton_failures=newton_fail, orbit_max=orbit_max, phi=phi,
+        f_bin=f_bin, t_bin=t_bin, q_bin=q_bin, tq_bin=tq_bin, glob=glob.copy(), impacts=imp,
+        impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=lsf[lp.LF_W_START] if rec_started else None,
+        cage_w_end=prev[n, 5],
+        cage_inertia=geo.cage_inertia, newton_failures=int(lsi[lp.LI_NEWTON_FAIL]), orbit_max=lsf[lp.LF_ORBIT_MAX],
+        phi=phi,
         final_state=prev.copy(), orbit=np.roll(orbit_buf, -(n_orbit % ORBIT_KEEP), axis=0),
-        ring_centre_mean=(np.array([ring_sum_x, ring_sum_y]) / ring_n if ring_n and not reduced_eq
+        ring_centre_mean=(lsf[[lp.LF_RING_SX, lp.LF_RING_SY]] / ring_n if ring_n and not reduced_eq
                           else np.full(2, np.nan)),
         radial_clearance=geo.radial_clearance,
     )
 
-
-@njit(cache=True)
-def _hold_rollers(state, n, sign, phi, pocket_a, hold, radius, front_off, omega_cage):
-    """Reduced-equivalent: rollers in the load zone ride at the front of their pockets with the cage."""
-    phic = state[n, 2]
-    for i in range(n):
-        th = rk.pocket_theta(sign, phic, pocket_a[i])
-        inside = th < phi or th > 2.0 * math.pi - phi
-        hold[i] = inside
-        if inside:
-            a = phic + pocket_a[i]
-            ca = math.cos(a)
-            sa = math.sin(a)
-            # pocket centre on the pitch circle; roller on the outer race, shifted by s/2 along e_t
-            etx = -sign * sa
-            ety = sign * ca
-            px = radius * ca + front_off * etx
-            py = radius * sa + front_off * ety
-            # velocity of that point of the (kinematic) cage
-            state[i, 0] = px
-            state[i, 1] = py
-            state[i, 3] = -omega_cage * py
-            state[i, 4] = omega_cage * px
-
-
-@njit(cache=True)
-def _pack_all(state, out_f, set_arr, nb):
-    a = set_arr.reshape(nb, 7)
-    a[:, 0:2] = state[:, 0:2]
-    a[:, 2:4] = state[:, 3:5]
-    f = out_f.reshape(nb, 3)
-    a[:, 4:7] = f

@@ -263,8 +263,15 @@ def test_cli_main_job(tmp_path):
         for k in ("I_dec_mean_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_std_Ns", "first_impact_speed_m_s",
                   "first_impact_energy_J", "cage_speed_mean_rad_s", "cage_slip", "load_zone_half_angle_deg"):
             assert k in s and f"{k}__unit" in s, k
-        for col in ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face"):
+        for col in ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation"):
             assert col in f["/results/impacts"]
+        # each impact's rotation is a row of per_rotation, and per pocket it never goes back in time
+        imp = {k: f["/results/impacts"][k][()] for k in ("time_s", "pocket", "rotation")}
+        assert set(np.unique(imp["rotation"])) == set(range(sc.numerics.rotations))  # impacts in every rotation
+        for p in range(16):
+            sel = imp["pocket"] == p
+            order = np.argsort(imp["time_s"][sel], kind="stable")
+            assert np.all(np.diff(imp["rotation"][sel][order]) >= 0)
         assert f["/results/force_vs_theta"].shape == (360, 16)
         assert "dt_s" in f["provenance"].attrs and "dt_choice" in f["provenance"].attrs
         for k in ("paper_index_front", "paper_index_rear", "sliding_work_front", "sliding_work_rear"):

@@ -284,10 +284,12 @@ class MultibodyResult:
             "approach_speed_m_s": imp[:, rk.I_SPEED], "impulse_Ns": imp[:, rk.I_IMPULSE],
             "pocket": imp[:, rk.I_POCKET].astype(np.int64),
             "face": np.where(imp[:, rk.I_FACE] == 0, "front", "rear"),  # same strings as the reduced model
+            "rotation": imp[:, rk.I_ROT].astype(np.int64),
         }, {"time_s": "s", "theta_deg": "deg", "approach_speed_m_s": "m/s", "impulse_Ns": "N s",
-            "pocket": "1", "face": "1"},
+            "pocket": "1", "face": "1", "rotation": "1"},
             description=f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
-                        "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the pocket centre")
+                        "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the pocket centre; "
+                        "rotation = row of /results/per_rotation the impact counts in")
         aw.write_array("/results/wear/paper_index_front", self.wear_index_front, "m^3",
                        "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket")
         aw.write_array("/results/wear/paper_index_rear", self.wear_index_rear, "m^3",

@@ -1,7 +1,7 @@
 """Attribution of pymunk's roller-cage contact impulses to pockets, faces, rotations. SI throughout.
 
 One compiled kernel reads pymunk's batched arbiter list after each step and updates fixed-size
-accumulators, so the Python side of a step costs the same at any run length. Definitions (also in the
+accumulators, so the cost of a step is the same at any run length. Definitions (also in the
 package docstring of :mod:`bearingsim.multibody`):
 
 * the pocket of a contact is its roller's index (roller ``i`` lives in pocket ``i``);
@@ -36,8 +36,8 @@ G_MAXPEN_THETA, G_MAXPEN_TIME, G_MAXPEN_FACE = 7, 8, 9  # where the deepest over
 G_MAXPEN_COS, G_MAXPEN_APPROACH, G_MAXPEN_POCKET = 10, 11, 12  # n . e_t, approach speed, pocket
 N_GLOB = 13
 # impact table columns
-I_TIME, I_THETA, I_SPEED, I_IMPULSE, I_POCKET, I_FACE = range(6)
-N_ICOL = 6
+I_TIME, I_THETA, I_SPEED, I_IMPULSE, I_POCKET, I_FACE, I_ROT = range(7)
+N_ICOL = 7
 ARB_F = 9  # floats per arbiter: total impulse (2), normal (2), point a (2), point b (2), distance
 ARB_I = 3  # ints per arbiter: body a id, body b id, contact count
 
@@ -80,7 +80,6 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
     nrot = int(cfg[C_ROT])
     nbins = int(cfg[C_NBINS])
     vthr = cfg[C_VTHR]
-    mass = cfg[C_MASS]
     phic = now[n, 2]
     xc = now[n, 0]
     yc = now[n, 1]
@@ -195,6 +194,7 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
                     impacts[n_imp, I_IMPULSE] = jn
                     impacts[n_imp, I_POCKET] = i
                     impacts[n_imp, I_FACE] = face
+                    impacts[n_imp, I_ROT] = k
                     n_imp += 1
             elif approach > 0.0:
                 glob[G_N_CHATTER] += 1.0

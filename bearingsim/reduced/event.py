@@ -15,10 +15,19 @@ f ∝ N^0.246 is singular; bisection towards such an end is a geometric grading 
 ``min_width`` rad, and f = 0 where N ≤ 0 (the roller has left the outer race).
 
 **Impacts are never missed.** The roots of a(θ) are found once per pass (Lipschitz exclusion with a
-bound on |a'| from each panel's Chebyshev coefficients, then bisection to machine precision). Between
+bound on |a'| from each panel's Chebyshev coefficients, down to pieces proved monotone by a bound on
+|a''|, whose single root is then located by safeguarded Newton to machine precision). Between
 consecutive roots of a, v is monotone, so it has at most one root (found by safeguarded Newton); between
 roots of v, l is monotone, so a face is reached inside a sub-segment exactly when the gap changes sign
-at its ends. Each crossing is then located by safeguarded Newton (derivative v/ω) to machine precision.
+at its ends. Each crossing is then located by safeguarded Newton (derivative v/ω), started from the
+second-order Taylor prediction of the crossing, to the rounding of the closed form: iteration stops
+when |l − target| is within a few ulps of the magnitudes of the terms summed into l (below that its
+sign is noise; the crossing is defined to ~1e-12 relative in θ on bounce sequences, not to 1 ulp).
+
+**Cost.** One evaluation of the closed form runs the three Clenshaw recurrences of f, F1 and F2 in one
+loop, with everything that depends on the flight start only (F1(θs), F2(θs), cos θs, sin θs) computed
+once per flight; the scan reuses the states at segment ends, so an impact costs about ten evaluations.
+Table, roots and pass run in one compiled call.
 
 **Faces and resting contact.** A rear impact (l = 0, approach speed u) adds m(1+e)u to I_dec, a front
 impact (l = s) adds m(1+e)u to I_acc (Eq. 6). While the roller rests on a face and a(θ) presses it
@@ -59,7 +68,6 @@ from bearingsim.reduced.core import (
     REST_REAR,
     PassInputs,
     drag_accel,
-    gravity_dl,
     gravity_dv,
 )
 
@@ -74,9 +82,13 @@ DEFAULT_ZENO_FLOOR = 1e-11  # x s: a few hundred times the position rounding of 
 DEFAULT_MIN_WIDTH = 1e-13  # rad: smallest Chebyshev panel next to an N = 0 singularity
 
 _MAX_AROOTS = 256
+# A face crossing (a root of v) is accepted when |l − target| (|v|) is below this many ulps of the
+# magnitudes summed into l (v), lmag (vmag) of _flight: inside that band the computed sign is noise.
+_ROUND_L = 4.0 * 2.0**-52
 STATUS_OK = 0
 STATUS_OVERFLOW = 1
 STATUS_STUCK = 2
+STATUS_TABLE_OVERFLOW = 3
 
 
 # ---- Chebyshev machinery ------------------------------------------------------------------------
@@ -149,7 +161,9 @@ def _fit_panel(a, b, K, A, g, root, sin_root, nodes, cosmat, fv, out):
 def _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, cap):
     """Adaptive piecewise-Chebyshev table of f and of its time integrals F1, F2 on [th0, th1].
 
-    Returns (breaks, fco, q1, q2, F1L, F2L, npan); npan = −1 when more than ``cap`` panels are needed.
+    Returns (breaks, fco, q1, q2, F1L, F2L, co, npan); npan = −1 when more than ``cap`` panels are needed.
+    ``co[p]`` holds the coefficients of f, F1 and F2 (local parts) of panel p, zero-padded to a common
+    length, for the fused evaluation :func:`_cheb3`.
     """
     n = nodes.shape[0] - 1
     breaks = np.empty(cap + 1)
@@ -178,7 +192,7 @@ def _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, ro
         hi = base[i + 1]
         mid = 0.5 * (lo + hi)
         if npan >= cap:
-            return breaks, fco, fco, fco, breaks, breaks, -1
+            return breaks, fco, fco, fco, breaks, breaks, np.empty((0, 3, 0)), -1
         if nroots_n > 0 and A + g * math.cos(mid) <= 0.0:
             # the roller is off the outer race on the whole interval: f = 0
             breaks[npan] = lo
@@ -209,7 +223,7 @@ def _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, ro
             tail = abs(coef[n]) + abs(coef[n - 1])
             if tail <= tol * fscale or (b - a) <= min_width or top >= 510:
                 if npan >= cap:
-                    return breaks, fco, fco, fco, breaks, breaks, -1
+                    return breaks, fco, fco, fco, breaks, breaks, np.empty((0, 3, 0)), -1
                 breaks[npan] = a
                 for k in range(n + 1):
                     fco[npan, k] = coef[k]
@@ -246,7 +260,15 @@ def _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, ro
         q2_end = _clenshaw(q2[p], n + 3, 1.0)
         acc2 = acc2 + acc1 * (2.0 * half) / omega + q2_end
         acc1 = acc1 + q1_end
-    return breaks, fco, q1, q2, F1L, F2L, npan
+    co = np.zeros((npan, 3, n + 3))
+    for p in range(npan):
+        for k in range(n + 1):
+            co[p, 0, k] = fco[p, k]
+        for k in range(n + 2):
+            co[p, 1, k] = q1[p, k]
+        for k in range(n + 3):
+            co[p, 2, k] = q2[p, k]
+    return breaks, fco, q1, q2, F1L, F2L, co, npan
 
 
 @njit(cache=True)
@@ -293,91 +315,251 @@ def _F1(tab, npan, th):
 
 
 @njit(cache=True)
-def _drag_dl(tab, npan, omega, ths, F1s, th):
-    """∫_{θs}^{θ} [F1(θ') − F1(θs)] dt': the drag part of the displacement from a flight start."""
-    breaks, q1, q2, F1L, F2L = tab[0], tab[2], tab[3], tab[4], tab[5]
-    p = _panel(breaks, npan, th)
-    ps = _panel(breaks, npan, ths)
-    tau = (th - ths) / omega
-    x = _local_x(breaks, p, th)
-    n2 = q2.shape[1]
-    if p == ps:  # same panel: local polynomials, no large cumulative constants to cancel
-        xs = _local_x(breaks, p, ths)
-        return _clenshaw(q2[p], n2, x) - _clenshaw(q2[p], n2, xs) - _clenshaw(q1[p], q1.shape[1], xs) * tau
-    F2 = F2L[p] + F1L[p] * (th - breaks[p]) / omega + _clenshaw(q2[p], n2, x)
-    xs = _local_x(breaks, ps, ths)
-    F2s = F2L[ps] + F1L[ps] * (ths - breaks[ps]) / omega + _clenshaw(q2[ps], n2, xs)
-    return F2 - F2s - F1s * tau
-
-
-@njit(cache=True)
 def _accel(tab, npan, g, th):
     """a(θ) consistent with the table (the derivative of the closed-form v)."""
     return -g * math.sin(th) - _f_eval(tab, npan, th)
 
 
 @njit(cache=True)
-def _flight(tab, npan, omega, g, ths, ls, vs, F1s, th):
-    """(l, v) at θ of a free flight that started at (θs, ls, vs); F1s = F1(θs)."""
-    v = vs + gravity_dv(ths, th, omega, g) - (_F1(tab, npan, th) - F1s)
-    tau = (th - ths) / omega
-    l = ls + vs * tau + gravity_dl(ths, th, omega, g) - _drag_dl(tab, npan, omega, ths, F1s, th)
-    return l, v
+def _cheb3(co, p, x):
+    """(f, F1 − F1L, F2 − F2L-part) at local x of panel p: the three Clenshaw recurrences in one loop.
+
+    The three series share x, so running them together costs about one recurrence's latency. The rows
+    of ``co`` are zero-padded to a common length; leading zeros leave the recurrence exactly 0, so each
+    value is bit-for-bit that of :func:`_clenshaw` on the unpadded coefficients.
+    """
+    x2 = 2.0 * x
+    f1 = 0.0
+    f2 = 0.0
+    a1 = 0.0
+    a2 = 0.0
+    b1 = 0.0
+    b2 = 0.0
+    for k in range(co.shape[2] - 1, 0, -1):
+        f0 = x2 * f1 - f2 + co[p, 0, k]
+        a0 = x2 * a1 - a2 + co[p, 1, k]
+        b0 = x2 * b1 - b2 + co[p, 2, k]
+        f2 = f1
+        f1 = f0
+        a2 = a1
+        a1 = a0
+        b2 = b1
+        b1 = b0
+    return x * f1 - f2 + co[p, 0, 0], x * a1 - a2 + co[p, 1, 0], x * b1 - b2 + co[p, 2, 0]
+
+
+@njit(cache=True)
+def _sin_minus_x(h):
+    """sin h − h without cancellation: :func:`bearingsim.reduced.core.sin_minus_x`, stopping the series
+    once a term no longer changes the sum (the remaining terms are smaller still)."""
+    if abs(h) >= 1.0:
+        return math.sin(h) - h
+    h2 = h * h
+    term = -h * h2 / 6.0
+    total = term
+    k = 3
+    while k < 25:
+        term = -term * h2 / ((k + 1) * (k + 2))
+        new = total + term
+        if new == total:
+            break
+        total = new
+        k += 2
+    return total
+
+
+@njit(cache=True)
+def _flight_start(tab, npan, omega, ths, ls, vs):
+    """Constants of a free flight that starts at (θs, ls, vs), evaluated once per flight.
+
+    Returns fs = [θs, ls, vs, panel of θs, q1 part of F1(θs), q2 part of F2(θs), F1(θs), F2(θs),
+    cos θs, sin θs] for :func:`_flight`.
+    """
+    breaks, co, F1L, F2L = tab[0], tab[6], tab[4], tab[5]
+    ps = _panel(breaks, npan, ths)
+    xs = _local_x(breaks, ps, ths)
+    _, c1s, c2s = _cheb3(co, ps, xs)
+    fs = np.empty(10)
+    fs[0] = ths
+    fs[1] = ls
+    fs[2] = vs
+    fs[3] = ps
+    fs[4] = c1s
+    fs[5] = c2s
+    fs[6] = F1L[ps] + c1s
+    fs[7] = F2L[ps] + F1L[ps] * (ths - breaks[ps]) / omega + c2s
+    fs[8] = math.cos(ths)
+    fs[9] = math.sin(ths)
+    return fs
+
+
+@njit(cache=True)
+def _flight(tab, npan, omega, g, fs, th):
+    """(l, v, a, lmag, vmag) at θ of the free flight with start constants ``fs`` (see :func:`_flight_start`).
+
+    The closed form of the module docstring: gravity as in :func:`bearingsim.reduced.core.gravity_dv`
+    and ``gravity_dl`` (same cancellation-free expressions, with cos θs, sin θs and sin(h/2) shared),
+    the drag from one fused evaluation of f, F1 and F2; a(θ) = −g sin θ − f(θ) is the derivative of v.
+    lmag (vmag) is the sum of the magnitudes of the terms summed into l (v): l carries a rounding error
+    of a few ulps of lmag, which is how precisely a crossing of a face can be located at all.
+    """
+    breaks, co, F1L, F2L = tab[0], tab[6], tab[4], tab[5]
+    ths = fs[0]
+    ls = fs[1]
+    vs = fs[2]
+    ps = int(fs[3])
+    p = _panel(breaks, npan, th)
+    x = _local_x(breaks, p, th)
+    cf, c1, c2 = _cheb3(co, p, x)
+    h = th - ths
+    sh = math.sin(0.5 * h)
+    dv_grav = -2.0 * g / omega * math.sin(ths + 0.5 * h) * sh
+    F1 = F1L[p] + c1
+    v = vs + dv_grav - (F1 - fs[6])
+    tau = h / omega
+    dl_grav = g / omega**2 * (fs[8] * _sin_minus_x(h) - fs[9] * (2.0 * sh**2))
+    if p == ps:  # same panel: local polynomials, no large cumulative constants to cancel
+        dl_drag = c2 - fs[5] - fs[4] * tau
+        mag_drag = abs(c2) + abs(fs[5]) + abs(fs[4] * tau)
+    else:
+        F2 = F2L[p] + F1L[p] * (th - breaks[p]) / omega + c2
+        dl_drag = F2 - fs[7] - fs[6] * tau
+        mag_drag = abs(F2) + abs(fs[7]) + abs(fs[6] * tau)
+    l = ls + vs * tau + dl_grav - dl_drag
+    lmag = abs(ls) + abs(vs * tau) + abs(dl_grav) + mag_drag
+    vmag = abs(vs) + abs(dv_grav) + abs(F1) + abs(fs[6])
+    return l, v, -g * math.sin(th) - cf, lmag, vmag
 
 
 # ---- roots of a(θ) ---------------------------------------------------------------------------
 @njit(cache=True)
+def _cheb_deriv(c, n, out):
+    """Chebyshev coefficients (n−1 of them, into ``out``) of d/dx Σ_{k<n} c_k T_k(x)."""
+    for k in range(n):
+        out[k] = 0.0
+    for k in range(n - 1, 0, -1):
+        out[k - 1] = (out[k + 1] if k + 1 < n else 0.0) + 2.0 * k * c[k]
+    out[0] *= 0.5
+
+
+@njit(cache=True)
+def _accel_root_in(fco, p, dco, breaks, g, half, x0, f0, x1, f1):
+    """The root of a(θ) in [x0, x1], where a is monotone and a(x0), a(x1) have opposite signs.
+
+    Safeguarded Newton (derivative from the differentiated panel series ``dco``), started at the
+    regula-falsi point; stops at the rounding of θ, or when |a| is below the rounding of its terms.
+    """
+    n = fco.shape[1]
+    lo = x0
+    hi = x1
+    lo_pos = f0 > 0.0
+    x = x0 + (x1 - x0) * (f0 / (f0 - f1))
+    if not (x0 < x < x1):
+        x = 0.5 * (x0 + x1)
+    for _ in range(200):
+        xl = _local_x(breaks, p, x)
+        sg = g * math.sin(x)
+        fx = _clenshaw(fco[p], n, xl)
+        ax = -sg - fx
+        if abs(ax) <= 4.0 * 2.0**-52 * (abs(sg) + abs(fx)):
+            return x
+        if (ax > 0.0) == lo_pos:
+            lo = x
+        else:
+            hi = x
+        if not (hi - lo > 4e-16 * max(abs(lo), abs(hi))):
+            return 0.5 * (lo + hi)
+        da = -g * math.cos(x) - _clenshaw(dco, n - 1, xl) / half
+        xn = x - ax / da if da != 0.0 else 0.5 * (lo + hi)
+        if not (min(lo, hi) < xn < max(lo, hi)):
+            xn = 0.5 * (lo + hi)
+        elif abs(xn - x) <= 4e-16 * abs(x):
+            return xn
+        x = xn
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
 def _accel_roots(tab, npan, g):
-    """Sign changes of a(θ) over the table, to machine precision; never misses one wider than 1e-12 rad."""
+    """Sign changes of a(θ) over the table, to machine precision; never misses one wider than 1e-12 rad.
+
+    Each panel is subdivided (bisection, keeping the end values) until every piece is either
+    excluded — |a| at its ends exceeds L × width, L a bound on |a'| from the panel's Chebyshev
+    coefficients (|T_k'| ≤ k²) — or proved monotone — |a'| at its midpoint exceeds M × width/2, M a
+    bound on |a''| (|T_k''| ≤ k²(k²−1)/3) — and so holds at most one root, present exactly when a
+    changes sign at its ends; that root is then located by safeguarded Newton. Pieces narrower than
+    1e-12 rad that are neither are bisected for a sign change as before.
+    """
     breaks, fco = tab[0], tab[1]
     n = fco.shape[1]
     roots = np.empty(_MAX_AROOTS)
     nr = 0
     sa = np.empty(256)
     sb = np.empty(256)
+    sfa = np.empty(256)
+    sfb = np.empty(256)
+    dco = np.empty(n)
     for p in range(npan):
         a0 = breaks[p]
         a1 = breaks[p + 1]
         half = 0.5 * (a1 - a0)
         dmax = 0.0
+        d2max = 0.0
         for k in range(1, n):
             dmax += k * k * abs(fco[p, k])
+            d2max += k * k * (k * k - 1) / 3.0 * abs(fco[p, k])
         # 10 % margin: the bound is tight for a linear a(θ), and rounding must not exclude a root
         lip = 1.1 * (abs(g) + (dmax / half if half > 0 else 0.0))
+        lip2 = 1.1 * (abs(g) + (d2max / (half * half) if half > 0 else 0.0))
+        _cheb_deriv(fco[p], n, dco)
         sa[0] = a0
         sb[0] = a1
+        sfa[0] = -g * math.sin(a0) - _clenshaw(fco[p], n, _local_x(breaks, p, a0))
+        sfb[0] = -g * math.sin(a1) - _clenshaw(fco[p], n, _local_x(breaks, p, a1))
         top = 1
         while top > 0:
             top -= 1
             x0 = sa[top]
             x1 = sb[top]
-            f0 = -g * math.sin(x0) - _clenshaw(fco[p], n, _local_x(breaks, p, x0))
-            f1 = -g * math.sin(x1) - _clenshaw(fco[p], n, _local_x(breaks, p, x1))
+            f0 = sfa[top]
+            f1 = sfb[top]
             if abs(f0) + abs(f1) > lip * (x1 - x0) or lip == 0.0:
                 continue  # no root inside
+            m = 0.5 * (x0 + x1)
+            xm = _local_x(breaks, p, m)
+            dam = -g * math.cos(m) - _clenshaw(dco, n - 1, xm) / half
+            if abs(dam) > lip2 * 0.5 * (x1 - x0):  # a is strictly monotone on [x0, x1]
+                if (f0 > 0.0) != (f1 > 0.0) and nr < _MAX_AROOTS:
+                    roots[nr] = _accel_root_in(fco, p, dco, breaks, g, half, x0, f0, x1, f1)
+                    nr += 1
+                continue
             if (x1 - x0) <= 1e-12 or top >= 250:
                 if (f0 > 0.0) != (f1 > 0.0):
                     lo = x0
                     hi = x1
                     flo = f0 > 0.0
                     for _ in range(200):
-                        m = 0.5 * (lo + hi)
-                        if m <= lo or m >= hi:
+                        mm = 0.5 * (lo + hi)
+                        if mm <= lo or mm >= hi:
                             break
-                        fm = -g * math.sin(m) - _clenshaw(fco[p], n, _local_x(breaks, p, m))
+                        fm = -g * math.sin(mm) - _clenshaw(fco[p], n, _local_x(breaks, p, mm))
                         if (fm > 0.0) == flo:
-                            lo = m
+                            lo = mm
                         else:
-                            hi = m
+                            hi = mm
                     if nr < _MAX_AROOTS:
                         roots[nr] = 0.5 * (lo + hi)
                         nr += 1
                 continue
-            m = 0.5 * (x0 + x1)
+            fm = -g * math.sin(m) - _clenshaw(fco[p], n, xm)
             sa[top] = m
             sb[top] = x1
+            sfa[top] = fm
+            sfb[top] = f1
             sa[top + 1] = x0
             sb[top + 1] = m
+            sfa[top + 1] = f0
+            sfb[top + 1] = fm
             top += 2
         # a sign change exactly across a panel boundary (continuous f, rounding only)
         if p + 1 < npan:
@@ -401,19 +583,51 @@ def _next_root(roots, th):
 
 # ---- safeguarded Newton ----------------------------------------------------------------------
 @njit(cache=True)
-def _root_gap(tab, npan, omega, g, ths, ls, vs, F1s, target, xa, xb):
-    """θ in [xa, xb] where l(θ) = target; l − target changes sign on [xa, xb] and l is monotone."""
-    la, _ = _flight(tab, npan, omega, g, ths, ls, vs, F1s, xa)
+def _taylor_time(d, v, a):
+    """Smallest τ > 0 with d + v τ + a τ²/2 = 0 (cancellation-free quadratic formula), or −1 if none."""
+    if a == 0.0:
+        if v != 0.0 and -d / v > 0.0:
+            return -d / v
+        return -1.0
+    disc = v * v - 2.0 * a * d
+    if disc < 0.0:
+        return -1.0
+    q = -0.5 * (v + math.copysign(math.sqrt(disc), v))
+    best = -1.0
+    if q != 0.0:
+        t1 = 2.0 * q / a
+        t2 = d / q
+        if t1 > 0.0:
+            best = t1
+        if t2 > 0.0 and (best < 0.0 or t2 < best):
+            best = t2
+    return best
+
+
+@njit(cache=True)
+def _root_gap(tab, npan, omega, g, fs, target, xa, la, va, aa, xb, lb):
+    """θ in [xa, xb] where l(θ) = target; l − target changes sign on [xa, xb] and l is monotone.
+
+    (la, va, aa) is the state at xa and lb the gap at xb, known from the scan. Safeguarded Newton
+    (derivative v/ω, bisection when a step leaves the bracket), started from the second-order Taylor
+    prediction of the crossing from xa (or the regula-falsi point when that prediction leaves the
+    bracket): the flights between bounces are short, so the start is already close and Newton needs
+    a few steps. Stops when the bracket or the Newton step is at the rounding of θ.
+    """
     lo_is_neg = (la - target) < 0.0
     lo = xa
     hi = xb
-    # start from the end whose slope is larger (the crossing side)
-    x = xb
+    tau = _taylor_time(la - target, va, aa)
+    x = xa + omega * tau
+    if not (tau > 0.0 and xa < x < xb):
+        x = xa + (xb - xa) * ((la - target) / (la - lb))
+        if not (xa < x < xb):
+            x = 0.5 * (xa + xb)
     for _ in range(300):
-        lx, vx = _flight(tab, npan, omega, g, ths, ls, vs, F1s, x)
+        lx, vx, _, lmag, _ = _flight(tab, npan, omega, g, fs, x)
         gx = lx - target
-        if gx == 0.0:
-            return x
+        if abs(gx) <= _ROUND_L * (lmag + abs(target)):
+            return x  # a root of l − target to the rounding of the closed form
         if (gx < 0.0) == lo_is_neg:
             lo = x
         else:
@@ -431,24 +645,31 @@ def _root_gap(tab, npan, omega, g, ths, ls, vs, F1s, target, xa, xb):
 
 
 @njit(cache=True)
-def _root_velocity(tab, npan, omega, g, ths, vs, F1s, xa, xb):
-    """θ in (xa, xb) where the flight's v = 0 (v monotone and changing sign on [xa, xb])."""
-    va = vs + gravity_dv(ths, xa, omega, g) - (_F1(tab, npan, xa) - F1s)
+def _root_velocity(tab, npan, omega, g, fs, xa, va, aa, xb, vb):
+    """θ in (xa, xb) where the flight's v = 0 (v monotone and changing sign on [xa, xb]).
+
+    (va, aa) at xa and vb at xb are known from the scan. Safeguarded Newton (derivative a/ω) started
+    from the first-order prediction xa − ω va/aa (or the regula-falsi point when that leaves the bracket).
+    """
     lo_is_neg = va < 0.0
     lo = xa
     hi = xb
-    x = 0.5 * (xa + xb)
+    x = xa - omega * va / aa if aa != 0.0 else xa
+    if not (xa < x < xb):
+        x = xa + (xb - xa) * (va / (va - vb))
+        if not (xa < x < xb):
+            x = 0.5 * (xa + xb)
     for _ in range(300):
-        vx = vs + gravity_dv(ths, x, omega, g) - (_F1(tab, npan, x) - F1s)
-        if vx == 0.0:
-            return x
+        _, vx, ax, _, vmag = _flight(tab, npan, omega, g, fs, x)
+        if abs(vx) <= _ROUND_L * vmag:
+            return x  # a root of v to the rounding of the closed form
         if (vx < 0.0) == lo_is_neg:
             lo = x
         else:
             hi = x
         if not (hi - lo > 4e-16 * max(abs(lo), abs(hi))):
             return 0.5 * (lo + hi)
-        slope = _accel(tab, npan, g, x) / omega
+        slope = ax / omega
         xn = x - vx / slope if slope != 0.0 else 0.5 * (lo + hi)
         if not (lo < xn < hi):
             xn = 0.5 * (lo + hi)
@@ -498,7 +719,11 @@ def _event_pass(par, tab, npan, roots, cap):
     mode = REST_FRONT if a_start > 0.0 else FREE
     status = STATUS_OK
     guard = 0
-    subs = np.empty(3)
+    sub_x = np.empty(3)  # sub-segment ends of one scan segment, with l, v, a there
+    sub_l = np.empty(3)
+    sub_v = np.empty(3)
+    sub_a = np.empty(3)
+    sub_sign = np.empty(2)  # sign of v on each sub-segment
     while True:
         guard += 1
         if guard > 50 * cap:
@@ -537,68 +762,83 @@ def _event_pass(par, tab, npan, roots, cap):
                 mode = REST_REAR if l == 0.0 else REST_FRONT
             continue
         # ---- free flight from (th, l, v)
-        ths = th
-        ls = l
-        vs = v
-        F1s = _F1(tab, npan, ths)
-        thc = ths
+        fs = _flight_start(tab, npan, omega, th, l, v)
+        # scan the segments between roots of a; (lc, vc, ac) is the state at thc, exact at the start
+        thc = th
+        lc = l
+        vc = v
+        ac = _accel(tab, npan, g, th)
         hit = False
         thi = 0.0
         face = -1
         while thc < th1:
             thn = min(_next_root(roots, thc), th1)
-            _, vc = _flight(tab, npan, omega, g, ths, ls, vs, F1s, thc)
-            _, vn = _flight(tab, npan, omega, g, ths, ls, vs, F1s, thn)
-            nsub = 2
-            subs[0] = thc
-            subs[1] = thn
+            ln, vn, an, _, _ = _flight(tab, npan, omega, g, fs, thn)
+            # v is monotone on [thc, thn]: one sub-segment, or two split at its root. On each, v keeps
+            # one sign (taken from an end where it is not zero), so l is monotone there and a face is
+            # reached exactly when the gap changes sign at the sub-segment's ends.
+            nsub = 1
+            sub_x[0] = thc
+            sub_l[0] = lc
+            sub_v[0] = vc
+            sub_a[0] = ac
             if (vc < 0.0 and vn > 0.0) or (vc > 0.0 and vn < 0.0):
-                subs[1] = _root_velocity(tab, npan, omega, g, ths, vs, F1s, thc, thn)
-                subs[2] = thn
-                nsub = 3
-            for k in range(nsub - 1):
-                xa = subs[k]
-                xb = subs[k + 1]
+                xr = _root_velocity(tab, npan, omega, g, fs, thc, vc, ac, thn, vn)
+                lr, vr, ar, _, _ = _flight(tab, npan, omega, g, fs, xr)
+                sub_x[1] = xr
+                sub_l[1] = lr
+                sub_v[1] = vr
+                sub_a[1] = ar
+                sub_sign[0] = vc
+                sub_sign[1] = vn
+                nsub = 2
+            else:
+                sub_sign[0] = vc if vc != 0.0 else vn
+            sub_x[nsub] = thn
+            sub_l[nsub] = ln
+            for k in range(nsub):
+                xa = sub_x[k]
+                xb = sub_x[k + 1]
                 if xb <= xa:
                     continue
-                _, vm = _flight(tab, npan, omega, g, ths, ls, vs, F1s, 0.5 * (xa + xb))
-                if vm < 0.0:
-                    la, _ = _flight(tab, npan, omega, g, ths, ls, vs, F1s, xa)
-                    lb, _ = _flight(tab, npan, omega, g, ths, ls, vs, F1s, xb)
+                la = sub_l[k]
+                lb = sub_l[k + 1]
+                if sub_sign[k] < 0.0:
                     if la <= 0.0:
                         hit = True
                         thi = xa
                     elif lb <= 0.0:
                         hit = True
-                        thi = _root_gap(tab, npan, omega, g, ths, ls, vs, F1s, 0.0, xa, xb)
+                        thi = _root_gap(tab, npan, omega, g, fs, 0.0, xa, la, sub_v[k], sub_a[k], xb, lb)
                     if hit:
                         face = FACE_REAR
                         break
-                elif vm > 0.0:
-                    la, _ = _flight(tab, npan, omega, g, ths, ls, vs, F1s, xa)
-                    lb, _ = _flight(tab, npan, omega, g, ths, ls, vs, F1s, xb)
+                elif sub_sign[k] > 0.0:
                     if la >= s:
                         hit = True
                         thi = xa
                     elif lb >= s:
                         hit = True
-                        thi = _root_gap(tab, npan, omega, g, ths, ls, vs, F1s, s, xa, xb)
+                        thi = _root_gap(tab, npan, omega, g, fs, s, xa, la, sub_v[k], sub_a[k], xb, lb)
                     if hit:
                         face = FACE_FRONT
                         break
             if hit:
                 break
             thc = thn
+            lc = ln
+            vc = vn
+            ac = an
         if not hit:
-            l, v = _flight(tab, npan, omega, g, ths, ls, vs, F1s, th1)
+            l = lc
+            v = vc
             th = th1
             continue
         # ---- impact at thi
         if n_imp >= cap:
             status = STATUS_OVERFLOW
             break
-        _, vi = _flight(tab, npan, omega, g, ths, ls, vs, F1s, thi)
-        ai = _accel(tab, npan, g, thi)
+        _, vi, ai, _, _ = _flight(tab, npan, omega, g, fs, thi)
         if face == FACE_REAR:
             u = max(-vi, 0.0)
             pressing = ai < 0.0
@@ -669,8 +909,8 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
         ths = pieces[kk, 0]
         mode = int(pieces[kk, 1])
         if mode == FREE:
-            F1s = _F1(tab, npan, ths)
-            l, v = _flight(tab, npan, omega, g, ths, pieces[kk, 2], pieces[kk, 3], F1s, th)
+            fs = _flight_start(tab, npan, omega, ths, pieces[kk, 2], pieces[kk, 3])
+            l, v, _, _, _ = _flight(tab, npan, omega, g, fs, th)
             idec = pieces[kk, 4]
         else:
             l = pieces[kk, 2]
@@ -682,6 +922,35 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
         vo[i] = v
         io[i] = idec
     return lo, vo, io
+
+
+@njit(cache=True)
+def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, capacity):
+    """Table, roots of a and the pass in one compiled call (one dispatch, few arrays to box).
+
+    Returns (status, npan, n_imp, n_pieces, totals, impacts[:n_imp], pieces[:n_pieces], roots);
+    status STATUS_TABLE_OVERFLOW when the table needs more than 65536 panels, STATUS_OVERFLOW when
+    more than 67 million events would be needed.
+    """
+    omega, g, th0, th1 = par[2], par[3], par[5], par[6]
+    cap = 64
+    while True:
+        tab8 = _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, cap)
+        npan = tab8[7]
+        if npan >= 0 or cap > (1 << 14):
+            break
+        cap *= 4
+    empty = np.empty((0, 5))
+    if npan < 0:
+        return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), empty, np.empty((0, 6)), np.empty(0)
+    tab = (tab8[0], tab8[1], tab8[2], tab8[3], tab8[4], tab8[5], tab8[6])
+    roots = _accel_roots(tab, npan, g)
+    while True:
+        status, totals, impacts, n_imp, pieces, n_pc = _event_pass(par, tab, npan, roots, capacity)
+        if status != STATUS_OVERFLOW or capacity > (1 << 24):
+            break
+        capacity *= 4
+    return status, npan, n_imp, n_pc, totals, impacts[:n_imp].copy(), pieces[:n_pc].copy(), roots
 
 
 # ---- Python wrapper ----------------------------------------------------------------------------
@@ -731,7 +1000,7 @@ def drag_table(inp: PassInputs, cheb_tol: float = DEFAULT_CHEB_TOL, min_width: f
     """Piecewise-Chebyshev table of f = F_o/m and its time integrals over the pass.
 
     Returns ``(tab, npan)``; ``tab`` = (breaks [rad], f coefficients, F1 and F2 local antiderivative
-    coefficients, F1 and F2 at panel starts). Raises :class:`SimulationUnstable` if the table overflows.
+    coefficients, F1 and F2 at panel starts, the three coefficient sets packed per panel). Raises :class:`SimulationUnstable` if the table overflows.
     """
     nroots = inp.normal_load_roots()
     r = list(nroots) + [0.0, 0.0]
@@ -741,13 +1010,13 @@ def drag_table(inp: PassInputs, cheb_tol: float = DEFAULT_CHEB_TOL, min_width: f
             inp.theta_start, inp.theta_end, inp.omega_c, inp.drag_scale, inp.centripetal, inp.gravity,
             cheb_tol, min_width, len(nroots), r[0], r[1], CHEB_NODES, CHEB_COS, cap,
         )
-        npan = int(out[6])
+        npan = int(out[7])
         if npan >= 0:
             break
         cap *= 4
         if cap > 1 << 16:
             raise SimulationUnstable("event solver: drag table needs more than 65536 Chebyshev panels")
-    return out[:6], npan
+    return out[:7], npan
 
 
 def solve_event(
@@ -776,22 +1045,22 @@ def solve_event(
     if inp.omega_c <= 0.0:
         raise SimulationUnstable("event solver: the cage does not turn (omega_c = 0)")
     t0 = time.perf_counter()
-    tab, npan = drag_table(inp, cheb_tol, min_width)
-    roots = _accel_roots(tab, npan, inp.gravity)
+    nroots = inp.normal_load_roots()
+    r = list(nroots) + [0.0, 0.0]
     par = _params(inp, zeno_height, zeno_floor)
-    while True:
-        status, totals, impacts, n_imp, pieces, n_pc = _event_pass(par, tab, npan, roots, capacity)
-        if status != STATUS_OVERFLOW:
-            break
-        capacity *= 4
-        if capacity > 1 << 26:
-            raise SimulationUnstable("event solver: more than 67 million events in one pass")
+    status, npan, n_imp, n_pc, totals, imp, pieces, roots = _solve(
+        par, inp.drag_scale, inp.centripetal, cheb_tol, min_width, len(nroots), r[0], r[1],
+        CHEB_NODES, CHEB_COS, capacity,
+    )
     wall = time.perf_counter() - t0
+    if status == STATUS_TABLE_OVERFLOW:
+        raise SimulationUnstable("event solver: drag table needs more than 65536 Chebyshev panels")
+    if status == STATUS_OVERFLOW:
+        raise SimulationUnstable("event solver: more than 67 million events in one pass")
     if status == STATUS_STUCK:
         raise SimulationUnstable("event solver: no progress (stuck event loop)")
-    if not np.all(np.isfinite(totals)):
+    if not all(math.isfinite(x) for x in totals.tolist()):
         raise SimulationUnstable("event solver: non-finite impulse")
-    imp = impacts[:n_imp]
     theta = imp[:, 0].copy()
     sol = PassSolution(
         method="event",
@@ -813,10 +1082,11 @@ def solve_event(
         wall_s=wall,
         termination="end of the no-load pass reached (theta = 2*pi - phi)",
         dt=None,
-        info=dict(panels=npan, accel_roots=roots.copy(), pieces=n_pc, cheb_tol=cheb_tol,
+        info=dict(panels=npan, accel_roots=roots, pieces=n_pc, cheb_tol=cheb_tol,
                   zeno_height=zeno_height, zeno_floor=zeno_floor, min_width=min_width),
     )
     if trace_points > 0:
+        tab, _ = drag_table(inp, cheb_tol, min_width)  # deterministic: the table the pass used
         grid = np.linspace(inp.theta_start, inp.theta_end, trace_points)
         ev = theta
         th_all = np.concatenate([grid, ev, ev])

@@ -28,9 +28,7 @@ if it ever did, :func:`advance` stops with ``CODE_BUFFER_GREW`` rather than read
 from __future__ import annotations
 
 import ctypes
-import hashlib
 import math
-from pathlib import Path
 
 import numba.experimental.function_type  # noqa: F401  (registers typeof for WrapperAddressProtocol)
 import numpy as np
@@ -38,6 +36,7 @@ import pymunk.batch as pb
 from numba import njit, types
 from pymunk._chipmunk_cffi import ffi, lib
 
+from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import recorder as rk
 
@@ -346,21 +345,4 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hv0, hv1, 
     return code
 
 
-def _drop_stale_cache(dispatcher, modules):
-    """Empty ``dispatcher``'s on-disk numba cache when the source of ``modules`` changed.
-
-    numba checks only the file of the cached function itself, but :func:`advance` compiles the force
-    and recording kernels of other files into itself: without this, an edit of those files would run
-    the old kernels from the cache. The digest of their sources is kept beside the cache.
-    """
-    digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in modules)).hexdigest()
-    try:
-        stamp = Path(dispatcher._cache._cache_path) / f"{dispatcher.__name__}.sources.sha256"
-        if not stamp.exists() or stamp.read_text() != digest:
-            dispatcher._cache.flush()
-            stamp.write_text(digest)
-    except (OSError, AttributeError):  # read-only install or another numba: nothing cached to go stale
-        pass
-
-
-_drop_stale_cache(advance, (fk, rk))
+drop_stale_caches(__name__, (fk, rk))  # advance() compiles the force and recording kernels in

@@ -23,6 +23,8 @@ import time
 import numpy as np
 from numba import njit
 
+from bearingsim._jit import drop_stale_caches
+from bearingsim.reduced import core as _core
 from bearingsim.errors import UserError
 from bearingsim.reduced.core import (
     FACE_FRONT,
@@ -209,3 +211,6 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
         sol.trace = dict(theta=trace[:, 0].copy(), l_r=trace[:, 1].copy(), dl_r_dt=trace[:, 2].copy(),
                          I_dec_cumulative=trace[:, 3].copy())
     return sol
+
+
+drop_stale_caches(__name__, (_core,))  # the kernels here compile in those of reduced/core.py

@@ -57,6 +57,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from bearingsim._jit import drop_stale_caches
+from bearingsim.reduced import core as _core
 from bearingsim.errors import SimulationUnstable
 from bearingsim.reduced.core import (
     FACE_FRONT,
@@ -1097,3 +1099,6 @@ def solve_event(
         lr, vr, ir = _trace(par, tab, npan, pieces, n_pc, th_all, left)
         sol.trace = dict(theta=th_all, l_r=lr, dl_r_dt=vr, I_dec_cumulative=ir)
     return sol
+
+
+drop_stale_caches(__name__, (_core,))  # the kernels here compile in those of reduced/core.py

@@ -1,0 +1,35 @@
+"""numba on-disk caches that follow the kernels they inline from other files.
+
+numba's ``cache=True`` checks only the source file of the cached function itself. A compiled function
+that calls a kernel from another file carries that kernel's code inside its cache entry, so after an
+edit of the other file it would keep running the old kernel. :func:`drop_stale_caches`, called at the
+end of such a module, keeps a digest of the sources it depends on beside the cache and empties the
+module's caches when the digest changes.
+"""
+from __future__ import annotations
+
+import hashlib
+import sys
+from pathlib import Path
+
+from numba.core.dispatcher import Dispatcher
+
+
+def drop_stale_caches(module_name: str, dependencies) -> None:
+    """Empty the numba caches of every compiled function of ``module_name`` if any module in
+    ``dependencies`` changed since the caches were written (a read-only install is left alone)."""
+    module = sys.modules[module_name]
+    dispatchers = [v for v in vars(module).values()
+                   if isinstance(v, Dispatcher) and getattr(v, "__module__", None) == module_name]
+    if not dispatchers:
+        return
+    digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in dependencies)).hexdigest()
+    try:
+        stamp = Path(dispatchers[0]._cache._cache_path) / f"{module_name}.sources.sha256"
+        if stamp.exists() and stamp.read_text() == digest:
+            return
+        for d in dispatchers:
+            d._cache.flush()
+        stamp.write_text(digest)
+    except (OSError, AttributeError):  # read-only install, or a numba without these internals
+        pass

@@ -1,0 +1,50 @@
+"""The numba disk cache of a kernel that inlines a kernel from another file follows edits of that file
+(bearingsim._jit.drop_stale_caches; numba itself checks only the cached function's own file)."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+
+DEP = """
+from numba import njit
+
+@njit(cache=True)
+def value():
+    return {v}
+"""
+
+USER = """
+import dep
+from numba import njit
+from bearingsim._jit import drop_stale_caches
+
+@njit(cache=True)
+def call():
+    return dep.value()
+
+{guard}
+"""
+
+
+def _run(tmp_path, v, guard):
+    (tmp_path / "dep.py").write_text(textwrap.dedent(DEP.format(v=v)))
+    user = tmp_path / "user.py"
+    if not user.exists():  # only the dependency is edited
+        user.write_text(textwrap.dedent(USER.format(guard="drop_stale_caches(__name__, (dep,))" if guard else "")))
+    out = subprocess.run([sys.executable, "-c", "import user; print(user.call())"], cwd=tmp_path,
+                         capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    return int(out.stdout.strip())
+
+
+def test_numba_alone_keeps_the_stale_kernel(tmp_path):
+    """The hazard the guard exists for (if numba ever fixes it, this test says so)."""
+    assert _run(tmp_path, 1, guard=False) == 1
+    assert _run(tmp_path, 2, guard=False) == 1
+
+
+def test_guard_recompiles_after_an_edit_of_the_dependency(tmp_path):
+    assert _run(tmp_path, 1, guard=True) == 1
+    assert _run(tmp_path, 2, guard=True) == 2
+    assert _run(tmp_path, 2, guard=True) == 2

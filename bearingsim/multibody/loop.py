@@ -103,7 +103,7 @@ def _clock_function():
     """``clock_gettime`` from the C library, or None where there is none (then no pymunk timing)."""
     try:
         fn = ctypes.CDLL(None).clock_gettime
-    except (OSError, AttributeError):  # pragma: no cover - platforms without clock_gettime
+    except (OSError, AttributeError, TypeError):  # pragma: no cover - platforms without clock_gettime
         return None
     return _CFunction(ctypes.cast(fn, ctypes.c_void_p).value, _CLOCK_SIG)
 

@@ -183,7 +183,8 @@ def net_accel(theta, drag_scale, centripetal, gravity):
 
 @njit(cache=True)
 def sin_minus_x(h):
-    """sin h − h without cancellation [-] (series for |h| < 1)."""
+    """sin h − h without cancellation [-] (series for |h| < 1, stopped once a term no longer changes
+    the sum: the later terms are smaller still, so the result is that of the full series)."""
     if abs(h) >= 1.0:
         return math.sin(h) - h
     h2 = h * h
@@ -192,7 +193,10 @@ def sin_minus_x(h):
     k = 3
     while k < 25:
         term = -term * h2 / ((k + 1) * (k + 2))
-        total += term
+        new = total + term
+        if new == total:
+            break
+        total = new
         k += 2
     return total
 

@@ -24,8 +24,8 @@ import numpy as np
 from numba import njit
 
 from bearingsim._jit import drop_stale_caches
-from bearingsim.reduced import core as _core
 from bearingsim.errors import UserError
+from bearingsim.reduced import core as _core
 from bearingsim.reduced.core import (
     FACE_FRONT,
     FACE_REAR,

@@ -58,8 +58,8 @@ import numpy as np
 from numba import njit
 
 from bearingsim._jit import drop_stale_caches
-from bearingsim.reduced import core as _core
 from bearingsim.errors import SimulationUnstable
+from bearingsim.reduced import core as _core
 from bearingsim.reduced.core import (
     FACE_FRONT,
     FACE_REAR,
@@ -71,6 +71,7 @@ from bearingsim.reduced.core import (
     PassInputs,
     drag_accel,
     gravity_dv,
+    sin_minus_x,
 )
 
 CHEB_DEGREE = 32
@@ -351,26 +352,6 @@ def _cheb3(co, p, x):
 
 
 @njit(cache=True)
-def _sin_minus_x(h):
-    """sin h − h without cancellation: :func:`bearingsim.reduced.core.sin_minus_x`, stopping the series
-    once a term no longer changes the sum (the remaining terms are smaller still)."""
-    if abs(h) >= 1.0:
-        return math.sin(h) - h
-    h2 = h * h
-    term = -h * h2 / 6.0
-    total = term
-    k = 3
-    while k < 25:
-        term = -term * h2 / ((k + 1) * (k + 2))
-        new = total + term
-        if new == total:
-            break
-        total = new
-        k += 2
-    return total
-
-
-@njit(cache=True)
 def _flight_start(tab, npan, omega, ths, ls, vs):
     """Constants of a free flight that starts at (θs, ls, vs), evaluated once per flight.
 
@@ -419,7 +400,7 @@ def _flight(tab, npan, omega, g, fs, th):
     F1 = F1L[p] + c1
     v = vs + dv_grav - (F1 - fs[6])
     tau = h / omega
-    dl_grav = g / omega**2 * (fs[8] * _sin_minus_x(h) - fs[9] * (2.0 * sh**2))
+    dl_grav = g / omega**2 * (fs[8] * sin_minus_x(h) - fs[9] * (2.0 * sh**2))
     if p == ps:  # same panel: local polynomials, no large cumulative constants to cancel
         dl_drag = c2 - fs[5] - fs[4] * tau
         mag_drag = abs(c2) + abs(fs[5]) + abs(fs[4] * tau)

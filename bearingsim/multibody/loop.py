@@ -108,6 +108,15 @@ def _clock_function():
     return _CFunction(ctypes.cast(fn, ctypes.c_void_p).value, _CLOCK_SIG)
 
 
+def _float_array(n):
+    """A pymunk C float array of capacity n, freed with its Python object."""
+    return ffi.gc(lib.pmFloatArrayNew(n), lib.pmFloatArrayFree)
+
+
+def _int_array(n):
+    return ffi.gc(lib.pmIntArrayNew(n), lib.pmIntArrayFree)
+
+
 class BatchIO:
     """The space's batched C buffers and function pointers, set up once for :func:`advance`.
 
@@ -127,11 +136,11 @@ class BatchIO:
         self.timed = clock is not None
         self.clock_fn = clock if clock is not None else self.each_body_fn  # never called when untimed
         self.ts = np.zeros(2, dtype=np.int64)  # struct timespec
-        ia = lib.pmIntArrayNew(nb)
+        ia = _int_array(nb)
         self._keep = [ia]  # the C objects must outlive the run
         self.states, data, arrays = [], [], []
         for _ in range(2):  # two state arrays, alternating
-            fa = lib.pmFloatArrayNew(2 * nb * 6 + 16)  # headroom: a push never reallocates
+            fa = _float_array(2 * nb * 6 + 16)  # headroom: a push never reallocates
             d = ffi.new("pmBatchedData *")
             d.fields = BODY_GET.value
             d.floatArray = fa
@@ -145,8 +154,8 @@ class BatchIO:
         sd.fields = set_fields.value
         sd.floatArray = self.set_buf._float_arr
         sd.intArray = self.set_buf._int_arr
-        afa = lib.pmFloatArrayNew(rk.ARB_F * arb_cap)
-        aia = lib.pmIntArrayNew(rk.ARB_I * arb_cap)
+        afa = _float_array(rk.ARB_F * arb_cap)
+        aia = _int_array(rk.ARB_I * arb_cap)
         ad = ffi.new("pmBatchedData *")
         ad.fields = ARB_GET.value
         ad.floatArray = afa

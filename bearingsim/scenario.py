@@ -43,6 +43,10 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # dynamic with the rotor's mass (docs/stability.md); the radial load is the rotor's weight
         "inner_ring": "auto",
         "inner_ring_mass_kg": "auto",
+        # pocket faces: arcs about the pocket centre within +-45 deg of the circumferential direction
+        # (the paper gives no pocket drawing; a cylindrical-roller cage pocket wraps the roller enough
+        # to guide it radially). Narrower arcs guide the cage less (README: the cage whirls more).
+        "pocket_face_half_angle_deg": 45.0,
     },
     # Archard & Hirst (1956), Proc. R. Soc. A 236:397, Table 1: 60/40 brass on tool steel,
     # k = 6e-4; high-strength brass hardness ~HV 150 -> 1.5e9 Pa.
@@ -114,6 +118,7 @@ class MultibodySection(_Section):
     traction_slip_ref: float = Field(gt=0.0)
     inner_ring: Literal["auto", "quasi_static", "dynamic"]
     inner_ring_mass_kg: float | Literal["auto"]
+    pocket_face_half_angle_deg: float = Field(gt=0.0, lt=90.0)
 
     @field_validator("inner_ring_mass_kg")
     @classmethod

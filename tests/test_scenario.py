@@ -73,6 +73,8 @@ def test_override_values_are_toml_with_bare_words_as_strings():
         ("reduced.method=rk4", "reduced.method"),
         ("numerics.dt_s=0", "numerics.dt_s"),
         ("schema_version=2", "schema_version"),
+        ("multibody.pocket_face_half_angle_deg=0", "multibody.pocket_face_half_angle_deg"),
+        ("multibody.pocket_face_half_angle_deg=90", "multibody.pocket_face_half_angle_deg"),
     ],
 )
 def test_bad_values_name_the_key(override, key):

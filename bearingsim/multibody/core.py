@@ -24,7 +24,6 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
-POCKET_FACE_HALF_ANGLE_DEG = 45.0  # angular half-width of each pocket face arc about e_t
 POCKET_FACE_SEGMENTS = 3  # pymunk segments per face (odd: a central segment tangent at e_t)
 CONTACT_DAMPING_S = 2.5e-6  # c = c_r k_lin [s]; lower end of the range 0.25e-5..2.5e-5 s of Kraemer (1993) / Sopanen & Mikkola (2003): the normal force is explicit
 DAMPING_FADE_M = 5.0e-9  # fade-in depth of the contact damping (continuity of Q at delta = 0)
@@ -193,7 +192,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     ro_race = geo.outer_race_radius + 0.25 * pd
     ri_race = geo.inner_race_radius - 0.25 * pd
 
-    sc = build_scene(geo, op, e, mu_c, half_angle=math.radians(POCKET_FACE_HALF_ANGLE_DEG),
+    sc = build_scene(geo, op, e, mu_c, half_angle=math.radians(float(scenario.multibody.pocket_face_half_angle_deg)),
                      n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=reduced_eq, spin_free=not reduced_eq)
     space = sc.space
     nb = n + 1

@@ -5,7 +5,7 @@ centre is at the bottom. ``sign`` = +1 is counter-clockwise (forward) inner-ring
 
 Pocket faces. A pocket is a circle of diameter ``2 r_r + s`` around the pocket centre on the pitch
 circle. The cage material only exists within its radial wall, so each face is the arc of that circle
-within ``+-pocket_face_half_angle`` of the circumferential direction: the *front* face lies ahead of
+within ``+-multibody.pocket_face_half_angle_deg`` (default 45 deg) of the circumferential direction: the *front* face lies ahead of
 the pocket centre in the direction of cage rotation, the *rear* face behind it. Each arc is replaced
 by ``pocket_face_segments`` pymunk segments that are *tangent* to the true arc at their midpoints
 (circumscribed polyline): the circumferential clearance at the pocket centre line is exactly ``s``

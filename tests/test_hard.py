@@ -125,6 +125,19 @@ def test_run_that_goes_unstable_midway_is_stopped_and_not_written(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_cage_that_escapes_its_pockets_is_stopped_and_not_written(tmp_path):
+    """Only the rollers guide the cage in this model. With pocket faces of +-10 deg the cage centre
+    wanders past the radial reach of the face arcs (R sin A = 1.15 mm) and, unchecked, flew 90 mm off
+    the axis with an I_acc 40 times the default's; the run must stop (exit 3) naming the key, no archive."""
+    out = tmp_path / "c.h5"
+    res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "multibody.pocket_face_half_angle_deg=10",
+                     "--set", "numerics.rotations=3", "-o", out, "--no-plots")
+    assert res.returncode == 3, res.stderr
+    lines = [line for line in res.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and "multibody.pocket_face_half_angle_deg" in lines[0], res.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_automatic_dt_restart_is_recorded():
     """The 0.02 mm pocket needs a shorter step than the automatic estimate (approach ~0.3 m/s against a
     20 um clearance): the run restarts at a step scaled to the measured overlap, ends within the 1 % bound,

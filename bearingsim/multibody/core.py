@@ -312,6 +312,9 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     lim[lp.LIM_PEN] = penetration_limit * s  # (the stability scan passes 0.5 to look for blow-up alone)
     lim[lp.LIM_OMEGA] = 3.0 * op.omega_i + 10.0
     lim[lp.LIM_OMEGA_NOM] = omega_nom
+    # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
+    face_reach = (rr + 0.5 * s) * math.sin(math.radians(float(scenario.multibody.pocket_face_half_angle_deg)))
+    lim[lp.LIM_ORBIT] = face_reach
     lsi = np.zeros(lp.N_LI, dtype=np.int64)
     lsi[lp.LI_OUT_EVERY] = out_every
     lsi[lp.LI_MAX_STEPS] = int(3 * steps_est + 1000)
@@ -359,6 +362,12 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
             raise SimulationUnstable(
                 f"cage did not complete {total_rot} rotations in {step} steps "
                 f"(cage speed {state[n, 5]:.3g} rad/s): the cage stalled")
+        if code == lp.CODE_CAGE_LOST:
+            raise SimulationUnstable(
+                f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
+                f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({face_reach * 1e3:.4g} mm): the rollers no "
+                f"longer hold it; this pocket shape needs a land-guided cage, which the model does not have: use a "
+                f"larger multibody.pocket_face_half_angle_deg")
         raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
     if bar is not None:
         bar.update(total_rot - bar_done)

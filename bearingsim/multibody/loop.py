@@ -51,7 +51,7 @@ ARB_GET = (pb.ArbiterFields.BODY_A_ID | pb.ArbiterFields.BODY_B_ID | pb.ArbiterF
 
 # return codes of advance()
 CODE_DONE, CODE_BLOCK_FULL, CODE_NONFINITE, CODE_PENETRATION, CODE_BLOWUP, CODE_STALLED = range(6)
-CODE_BUFFER_GREW = 6
+CODE_BUFFER_GREW, CODE_CAGE_LOST = 6, 7
 # integer loop state
 LI_STEP, LI_CUR, LI_NIMP, LI_NSMP, LI_NORBIT, LI_REC, LI_NEWTON_FAIL, LI_OUT_EVERY, LI_MAX_STEPS = range(9)
 N_LI = 9
@@ -59,8 +59,8 @@ N_LI = 9
 LF_T, LF_PYMUNK_NS, LF_RING_SX, LF_RING_SY, LF_RING_N, LF_W_START, LF_T_REC0, LF_ORBIT_MAX = range(8)
 N_LF = 8
 # limits
-LIM_TRAVEL_END, LIM_TRAVEL_REC, LIM_PEN, LIM_DELTA, LIM_OMEGA, LIM_OMEGA_NOM = range(6)
-N_LIM = 6
+LIM_TRAVEL_END, LIM_TRAVEL_REC, LIM_PEN, LIM_DELTA, LIM_OMEGA, LIM_OMEGA_NOM, LIM_ORBIT = range(7)
+N_LIM = 7
 # sample columns: t, cage speed along the rotation, slip, cage x, cage y, ring x, ring y
 S_T, S_W, S_SLIP, S_CX, S_CY, S_RX, S_RY = range(7)
 N_SCOL = 7
@@ -322,6 +322,9 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hv0, hv1, 
                 dmax = max(dmax, diag[i, fk.D_DELTA_OUT])
             if dmax > DELTA_LIMIT_M or abs(now[n, 5]) > lim[LIM_OMEGA]:
                 code = CODE_BLOWUP
+                break
+            if math.hypot(now[n, 0], now[n, 1]) > lim[LIM_ORBIT]:
+                code = CODE_CAGE_LOST
                 break
             wc = sign * now[n, 5]
             if lsi[LI_REC] == 1:

@@ -92,6 +92,7 @@ STATUS_OK = 0
 STATUS_OVERFLOW = 1
 STATUS_STUCK = 2
 STATUS_TABLE_OVERFLOW = 3
+TABLE_OVERFLOW_MESSAGE = "event solver: drag table needs more than 65536 Chebyshev panels"
 
 
 # ---- Chebyshev machinery ------------------------------------------------------------------------
@@ -874,7 +875,7 @@ def _event_pass(par, tab, npan, roots, cap):
 @njit(cache=True)
 def _trace(par, tab, npan, pieces, n_pc, thetas, left):
     """l, v and cumulative I_dec at sorted θ (left[i]: take the limit from the left at θ)."""
-    m, s, omega, g = par[0], par[1], par[2], par[3]
+    m, omega, g = par[0], par[2], par[3]
     resting = par[9] > 0.5
     n = thetas.shape[0]
     lo = np.empty(n)
@@ -908,6 +909,21 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
 
 
 @njit(cache=True)
+def _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat):
+    """The drag table of the pass (see :func:`_build_table`), grown until its panels fit; returns
+    ``(tab, npan)`` with npan < 0 if more than 65536 panels would be needed."""
+    omega, g, th0, th1 = par[2], par[3], par[5], par[6]
+    cap = 64
+    while True:
+        t = _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, cap)
+        npan = t[7]
+        if npan >= 0 or cap > (1 << 14):
+            break
+        cap *= 4
+    return (t[0], t[1], t[2], t[3], t[4], t[5], t[6]), npan
+
+
+@njit(cache=True)
 def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, capacity):
     """Table, roots of a and the pass in one compiled call (one dispatch, few arrays to box).
 
@@ -915,18 +931,10 @@ def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat,
     status STATUS_TABLE_OVERFLOW when the table needs more than 65536 panels, STATUS_OVERFLOW when
     more than 67 million events would be needed.
     """
-    omega, g, th0, th1 = par[2], par[3], par[5], par[6]
-    cap = 64
-    while True:
-        tab8 = _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, cap)
-        npan = tab8[7]
-        if npan >= 0 or cap > (1 << 14):
-            break
-        cap *= 4
-    empty = np.empty((0, 5))
+    g = par[3]
+    tab, npan = _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat)
     if npan < 0:
-        return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), empty, np.empty((0, 6)), np.empty(0)
-    tab = (tab8[0], tab8[1], tab8[2], tab8[3], tab8[4], tab8[5], tab8[6])
+        return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), np.empty((0, 5)), np.empty((0, 6)), np.empty(0)
     roots = _accel_roots(tab, npan, g)
     while True:
         status, totals, impacts, n_imp, pieces, n_pc = _event_pass(par, tab, npan, roots, capacity)
@@ -987,19 +995,11 @@ def drag_table(inp: PassInputs, cheb_tol: float = DEFAULT_CHEB_TOL, min_width: f
     """
     nroots = inp.normal_load_roots()
     r = list(nroots) + [0.0, 0.0]
-    cap = 64
-    while True:
-        out = _build_table(
-            inp.theta_start, inp.theta_end, inp.omega_c, inp.drag_scale, inp.centripetal, inp.gravity,
-            cheb_tol, min_width, len(nroots), r[0], r[1], CHEB_NODES, CHEB_COS, cap,
-        )
-        npan = int(out[7])
-        if npan >= 0:
-            break
-        cap *= 4
-        if cap > 1 << 16:
-            raise SimulationUnstable("event solver: drag table needs more than 65536 Chebyshev panels")
-    return out[:7], npan
+    tab, npan = _table(_params(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR), inp.drag_scale, inp.centripetal,
+                       cheb_tol, min_width, len(nroots), r[0], r[1], CHEB_NODES, CHEB_COS)
+    if npan < 0:
+        raise SimulationUnstable(TABLE_OVERFLOW_MESSAGE)
+    return tab, int(npan)
 
 
 def solve_event(
@@ -1037,7 +1037,7 @@ def solve_event(
     )
     wall = time.perf_counter() - t0
     if status == STATUS_TABLE_OVERFLOW:
-        raise SimulationUnstable("event solver: drag table needs more than 65536 Chebyshev panels")
+        raise SimulationUnstable(TABLE_OVERFLOW_MESSAGE)
     if status == STATUS_OVERFLOW:
         raise SimulationUnstable("event solver: more than 67 million events in one pass")
     if status == STATUS_STUCK:

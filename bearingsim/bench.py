@@ -52,7 +52,7 @@ def reduced_rows(quick: bool) -> list[dict]:
     """Event and euler at 500, 2000 and 6000 rpm (the paper's conditions, 970 N, φ = 23.5°)."""
     from bearingsim.reduced.core import PassInputs
     from bearingsim.reduced.euler import max_stable_dt, solve_euler
-    from bearingsim.reduced.event import solve_event
+    from bearingsim.reduced.event import closed_form_cost, solve_event
     from bearingsim.reduced.studies import paper_scenario
 
     rows = []
@@ -66,7 +66,8 @@ def reduced_rows(quick: bool) -> list[dict]:
         rows.append(dict(model="reduced", method="event", scene="single_pocket", rpm=rpm, dt_s=float("nan"),
                          wall_s=wall, rel_error=abs(sol.I_dec - tight) / abs(tight), I_dec_Ns=sol.I_dec,
                          unit_of_work="no-load pass", repeats=7 if quick else 21,
-                         notes="error against tighter event tolerances"))
+                         notes="error against tighter event tolerances", impacts=len(sol.impacts["theta"]),
+                         **closed_form_cost(inp, evaluations=50_000 if quick else 200_000)))
         dtmax = max_stable_dt(inp)
         for dt in EULER_DTS:
             if dt > dtmax:
@@ -102,6 +103,14 @@ def reduced_goal(rows: list[dict]) -> list[str]:
             f"{need['dt_s']:.0e} s and {need['wall_s'] * 1e3:.3f} ms for 1e-4; ratio {ratio:.3g} "
             f"(goal <= 0.01: {'met' if ratio <= 0.01 and ev['rel_error'] <= 1e-6 else 'not met'})"
         )
+        if "eval_s" in ev:
+            budget = 0.01 * need["wall_s"]
+            floor = ev["call_s"] + ev["impacts"] * ev["eval_s"]
+            lines.append(
+                f"  budget 1/100 x euler = {budget * 1e6:.2f} us; floor of this closed form = one call "
+                f"{ev['call_s'] * 1e6:.2f} us + {ev['impacts']} impacts x one evaluation {ev['eval_s'] * 1e9:.0f} ns "
+                f"= {floor * 1e6:.2f} us ({'below' if floor <= budget else 'above'} the budget)"
+            )
     return lines
 
 

@@ -388,7 +388,8 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
         if pocket >= chord:
             most = max(int(math.pi / math.asin(min(1.0, pocket / b.pitch_diameter_mm))), 0)
             raise UserError(
-                f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm do not fit "
+                f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm (bearing.roller_diameter_mm "
+                f"+ bearing.pocket_clearance_mm) do not fit "
                 f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart; "
                 f"at most {most} fit)"
             )

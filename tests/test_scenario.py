@@ -85,6 +85,14 @@ def test_bad_values_name_the_key(override, key):
     assert f": {key}:" in msg, msg
 
 
+def test_overlapping_pockets_name_both_keys():
+    # 16 pockets of 80 + 0.2 mm on a 97.5 mm pitch circle overlap (chord 2 r_p sin(pi/16) = 19.0 mm)
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "paper_3000rpm.toml", ["bearing.roller_diameter_mm=80"])
+    msg = str(err.value)
+    assert ": bearing.roller_count:" in msg and "bearing.roller_diameter_mm" in msg and "at most 3 fit" in msg, msg
+
+
 def test_missing_geometry_without_preset_names_the_key(base_reduced):
     del base_reduced["bearing"]["preset"]
     with pytest.raises(UserError, match=r"bearing\.roller_count: missing"):

@@ -947,7 +947,7 @@ def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat,
 @njit(cache=True)
 def _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, n):
     """Evaluate the closed form of one flight at n angles spread over [th0, th1] (for
-    :func:`closed_form_cost`); returns the sum of l so that nothing is optimised away."""
+    the benchmark's cost floor); returns the sum of l so that nothing is optimised away."""
     acc = 0.0
     for i in range(n):
         l, _, _, _, _ = _flight(tab, npan, omega, g, fs, th0 + (th1 - th0) * (i + 0.5) / n)
@@ -1093,31 +1093,20 @@ def solve_event(
     return sol
 
 
-def closed_form_cost(inp: PassInputs, evaluations: int = 200_000, repeats: int = 5) -> dict:
-    """What one pass of this solver costs at the least, measured on this machine (for the benchmark).
-
-    Returns ``eval_s``: one evaluation of the closed form (l, v, a at one θ of a flight, the pass's own
-    drag table; median of ``repeats`` loops of ``evaluations``), and ``call_s``: one call from Python
-    into a compiled function with the table's arguments (median of 201 calls doing nothing). Any
-    solver that reports each impact evaluates the motion at least once per impact and is called at
-    least once, so ``call_s + impacts × eval_s`` is a lower bound on a pass of this method.
-    """
+def closed_form_evaluator(inp: PassInputs):
+    """``evaluate(n)``: the closed form of one flight of this pass (its own drag table) evaluated at n
+    angles in one compiled call; ``evaluate(0)`` is a bare call into compiled code. For the benchmark's
+    cost floor (:func:`bearingsim.bench.reduced_rows`)."""
     tab, npan = drag_table(inp)
     par = _params(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR)
     omega, g, th0, th1 = float(par[2]), float(par[3]), float(par[5]), float(par[6])
     fs = _flight_start(tab, npan, omega, th0, float(par[1]), 0.0)
-    _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, 1)  # compile / load outside the timing
-    loops = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, evaluations)
-        loops.append((time.perf_counter() - t0) / evaluations)
-    calls = []
-    for _ in range(201):
-        t0 = time.perf_counter()
-        _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, 0)
-        calls.append(time.perf_counter() - t0)
-    return dict(eval_s=float(np.median(loops)), call_s=float(np.median(calls)))
+
+    def evaluate(n: int) -> float:
+        return _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, n)
+
+    evaluate(1)  # compile / load the cache outside any timing
+    return evaluate
 
 
 drop_stale_caches(__name__, (_core,))  # the kernels here compile in those of reduced/core.py

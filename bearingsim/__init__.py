@@ -1,9 +1,46 @@
 """bearingsim: roller/cage dynamics of rolling bearings and the cage-wear impulse.
 
 SI units throughout the package; units appear in names only at the edges (scenario keys, plots).
+
+The Python API::
+
+    import bearingsim
+    sc = bearingsim.load_scenario("scenarios/paper_3000rpm.toml", set={"operating.inner_ring_speed_rpm": 500})
+    r = bearingsim.run(sc)            # a Result: r.summary, r.per_rotation["I_dec"], r.impacts, r.plot_*()
+    r.save("x.h5")
+    r2 = bearingsim.load("x.h5")      # the same result, read back from the archive
 """
 __version__ = "0.1.0"
 
-from bearingsim.errors import UserError  # noqa: E402
+from bearingsim.errors import SimulationUnstable, UserError  # noqa: E402
 
-__all__ = ["UserError", "__version__"]
+
+def load_scenario(path, set: dict | None = None, overrides: list[str] | None = None):
+    """Read a scenario file, merge its preset and the package defaults, apply overrides, validate.
+
+    Parameters
+    ----------
+    path : scenario TOML file.
+    set : ``{"dotted.key": value}`` overrides with Python values (``{"numerics.rotations": 10}``).
+    overrides : ``["dotted.key=VALUE", ...]`` overrides as on the command line (VALUE read as TOML).
+    """
+    from bearingsim import scenario
+
+    return scenario.load_scenario(path, overrides, values=set)
+
+
+def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None):
+    """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result."""
+    from bearingsim.simulation import run as _run
+
+    return _run(scenario, progress=progress, sink=sink, dt=dt)
+
+
+def load(path):
+    """Read an archive back into its result (:func:`bearingsim.archive.read`)."""
+    from bearingsim.archive import read
+
+    return read(path)
+
+
+__all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load"]

@@ -1,4 +1,6 @@
-"""HDF5 archives: H5MD-like layout, a ``unit`` on every physical dataset, written atomically.
+"""HDF5 archives: the only module that uses h5py. H5MD-like layout, a ``unit`` on every physical
+dataset, written atomically; :func:`write` stores any :class:`bearingsim.results.Result`, :func:`read`
+gives it back as the same class.
 
 Layout (format documented in ``docs/archive.md``)::
 
@@ -13,7 +15,9 @@ Layout (format documented in ``docs/archive.md``)::
     /observables/<name>/{step,time,value}   time series
 
 A run writes ``.<name>.tmp-<pid>`` beside the target and renames it when complete; on any error the
-temporary file is removed, so a file at the target name is always a complete archive.
+temporary file is removed, so a file at the target name is always a complete archive. A long run
+streams its time series into that temporary file through a :class:`Spool` (the sink the model is
+given), so they are never held in memory; :func:`write` then completes the same file.
 """
 from __future__ import annotations
 
@@ -43,10 +47,12 @@ def _lazy_h5py():
 
 def package_versions() -> dict[str, str]:
     out = {"python": sys.version.split()[0]}
+    from importlib import metadata
+
     for mod in ("numpy", "scipy", "pymunk", "h5py", "numba", "matplotlib", "pydantic"):
         try:
-            out[mod] = __import__(mod).__version__
-        except Exception:  # pragma: no cover - optional package missing
+            out[mod] = metadata.version(mod)
+        except metadata.PackageNotFoundError:  # pragma: no cover - optional package missing
             out[mod] = "not installed"
     return out
 
@@ -131,87 +137,55 @@ class TimeSeries:
         self._buffered = 0
 
 
-class ArchiveWriter:
-    """Context manager that writes one run's archive atomically.
+def _tmp_name(path: Path) -> Path:
+    return path.with_name(f".{path.name}.tmp-{os.getpid()}")
 
-    Parameters
-    ----------
-    path : target file name (``.h5``). Its folder is created if missing.
-    scenario : resolved :class:`bearingsim.scenario.Scenario`.
-    provenance : extra provenance attributes (dt, dt choice, seed, solver, ...).
+
+def _prepare_target(path) -> Path:
+    """Check that an archive can be written at ``path`` (one-line UserError if not); return it."""
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"{path}: cannot create output folder ({exc.strerror})") from None
+    if path.is_dir():
+        raise UserError(f"{path}: output path is a directory")
+    tmp = _tmp_name(path)
+    try:
+        tmp.touch()
+    except OSError as exc:
+        raise UserError(f"{path}: output is not writable ({exc.strerror})") from None
+    tmp.unlink()
+    return path
+
+
+class Spool:
+    """The sink a model streams its time series into: the temporary file of the archive to be.
+
+    Use as a context manager around the run and :func:`write`: on any error the temporary file is
+    removed. ``timeseries(name, value_shape, unit, description)`` returns an appender
+    (:class:`TimeSeries`); ``discard_timeseries()`` drops what was streamed (a restarted run).
     """
 
-    def __init__(self, path: str | Path, scenario, provenance: dict[str, Any] | None = None):
-        self.path = Path(path)
-        self.scenario = scenario
-        self.provenance = dict(provenance or {})
+    def __init__(self, path):
+        self.path = _prepare_target(path)
+        self.tmp = _tmp_name(self.path)
         self._series: list[TimeSeries] = []
-        self._t0 = time.perf_counter()
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise UserError(f"{self.path}: cannot create output folder ({exc.strerror})") from None
-        if self.path.is_dir():
-            raise UserError(f"{self.path}: output path is a directory")
-        self.tmp = self.path.with_name(f".{self.path.name}.tmp-{os.getpid()}")
-        try:
-            self.tmp.touch()
-        except OSError as exc:
-            raise UserError(f"{self.path}: output is not writable ({exc.strerror})") from None
-        self.tmp.unlink()
+        self.f = None
 
-    def __enter__(self) -> "ArchiveWriter":
-        h5py = _lazy_h5py()
-        self.f = h5py.File(self.tmp, "w")
-        f = self.f
-        f.attrs["title"] = f"bearingsim archive: {self.scenario.name}"
-        h5md = f.create_group("h5md")
-        h5md.attrs["version"] = np.array([1, 1])
-        creator = h5md.create_group("creator")
-        creator.attrs["name"] = "bearingsim"
-        creator.attrs["version"] = __version__
-        g = f.create_group("bearingsim")
-        g.attrs["format_version"] = FORMAT_VERSION
-        g.attrs["model"] = self.scenario.model
-        g.attrs["scenario_name"] = self.scenario.name
-        g.attrs["complete"] = False
-        ds = f.create_dataset("scenario", data=self.scenario.to_toml())
-        ds.attrs["format"] = "TOML (resolved: defaults, preset and overrides applied)"
-        ds.attrs["source"] = str(self.scenario.source)
+    def __enter__(self) -> "Spool":
+        self.f = _lazy_h5py().File(self.tmp, "w")
         return self
 
-    # --- writing helpers -------------------------------------------------------------------
-    def write_array(self, name: str, data, unit: str, description: str = "", compress: bool = False):
-        arr = np.asarray(data)
-        kw = {}
-        if compress and arr.size > 4096:
-            kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True)
-        ds = self.f.create_dataset(name, data=arr, **kw)
-        ds.attrs["unit"] = unit
-        if description:
-            ds.attrs["description"] = description
-        return ds
-
-    def write_table(self, name: str, columns: dict[str, Any], units: dict[str, str], description: str = ""):
-        g = self.f.create_group(name)
-        if description:
-            g.attrs["description"] = description
-        g.attrs["columns"] = list(columns)
-        for col, values in columns.items():
-            arr = np.asarray(values)
-            if arr.dtype.kind == "U":
-                arr = arr.astype("S")
-            ds = g.create_dataset(col, data=arr)
-            ds.attrs["unit"] = units.get(col, "1")
-        return g
-
-    def set_attrs(self, group: str, attrs: dict[str, Any], units: dict[str, str] | None = None):
-        g = self.f.require_group(group)
-        for k, v in attrs.items():
-            g.attrs[k] = v
-        for k, u in (units or {}).items():
-            g.attrs[f"{k}__unit"] = u
-        return g
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if self.f is not None:
+            try:
+                self.f.close()
+            except Exception:  # pragma: no cover - closing a file after an HDF5 error
+                pass
+            self.f = None
+        self.tmp.unlink(missing_ok=True)  # written and renamed by write(), else abandoned
+        return False
 
     def timeseries(self, name: str, value_shape=(), unit: str = "1", description: str = "") -> TimeSeries:
         g = self.f.create_group(f"observables/{name}")
@@ -222,41 +196,183 @@ class ArchiveWriter:
         return ts
 
     def discard_timeseries(self) -> None:
-        """Delete every time series written so far (a run restarted with a new time step)."""
         for ts in self._series:
-            name = ts._group.name
-            del self.f[name]
+            del self.f[ts._group.name]
         self._series.clear()
 
-    # --- completion ---------------------------------------------------------------------------
-    def __exit__(self, exc_type, exc, tb) -> bool:
-        if exc_type is not None:
-            try:
-                self.f.close()
-            finally:
-                self.tmp.unlink(missing_ok=True)
-            return False
-        try:
-            for ts in self._series:
-                ts.flush()
-            prov = self.f.create_group("provenance")
-            prov.attrs["bearingsim_version"] = __version__
-            prov.attrs["git_commit"] = git_commit()
-            prov.attrs["created_utc"] = _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
-            prov.attrs["wall_time_s"] = time.perf_counter() - self._t0
-            prov.attrs["platform"] = platform.platform()
-            prov.attrs["command"] = " ".join(sys.argv)
-            for k, v in package_versions().items():
-                prov.attrs[f"version_{k}"] = v
-            for k, v in self.provenance.items():
-                prov.attrs[k] = v
-            self.f["bearingsim"].attrs["complete"] = True
-            self.f.close()
-            os.replace(self.tmp, self.path)
-        except BaseException:
-            self.tmp.unlink(missing_ok=True)
-            raise
-        return False
+    def collect(self) -> dict:
+        """The streamed series stay in the file: nothing to hand to the result."""
+        for ts in self._series:
+            ts.flush()
+        return {}
+
+
+def write(result, path, spool: Spool | None = None) -> Path:
+    """Write ``result`` as a complete archive at ``path`` (atomically); return the path.
+
+    With ``spool`` (the sink the run streamed into), its temporary file is completed and renamed;
+    otherwise a new file is written, time series included from ``result.series``.
+    """
+    if spool is None:
+        with Spool(path) as sp:
+            return write(result, path, sp)
+    f = spool.f
+    try:
+        for ts in spool._series:
+            ts.flush()
+        _write_header(f, result)
+        for name, s in result.series.items():
+            g = f.create_group(f"observables/{name}")
+            if s.description:
+                g.attrs["description"] = s.description
+            ts = TimeSeries(g, s.value.shape[1:], s.unit)
+            ts.append(s.step, s.time, s.value)
+            ts.flush()
+        for path_, arr in result.data.items():
+            _write_array(f, path_, arr)
+        for path_, desc in result.tables.items():
+            g = f.require_group(path_)
+            g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
+            if desc:
+                g.attrs["description"] = desc
+        for path_, grp in result.groups.items():
+            g = f.require_group(path_)
+            if grp.description:
+                g.attrs["description"] = grp.description
+            for k, v in grp.attrs.items():
+                g.attrs[k] = v
+            for k, u in grp.units.items():
+                g.attrs[f"{k}__unit"] = u
+        prov = f.create_group("provenance")
+        for k, v in _provenance(result).items():
+            prov.attrs[k] = v
+        f["bearingsim"].attrs["complete"] = True
+        f.close()
+        spool.f = None
+        os.replace(spool.tmp, spool.path)
+    except BaseException:
+        spool.tmp.unlink(missing_ok=True)
+        raise
+    return spool.path
+
+
+def _write_header(f, result) -> None:
+    sc = result.scenario
+    f.attrs["title"] = f"bearingsim archive: {sc.name}"
+    h5md = f.create_group("h5md")
+    h5md.attrs["version"] = np.array([1, 1])
+    creator = h5md.create_group("creator")
+    creator.attrs["name"] = "bearingsim"
+    creator.attrs["version"] = __version__
+    g = f.create_group("bearingsim")
+    g.attrs["format_version"] = FORMAT_VERSION
+    g.attrs["model"] = result.model
+    g.attrs["scenario_name"] = sc.name
+    g.attrs["complete"] = False
+    ds = f.create_dataset("scenario", data=sc.to_toml())
+    ds.attrs["format"] = "TOML (resolved: defaults, preset and overrides applied)"
+    ds.attrs["source"] = str(sc.source)
+
+
+def _write_array(f, path: str, arr) -> None:
+    data = np.asarray(arr.data)
+    if data.dtype.kind == "U":
+        data = data.astype("S")
+    kw = {}
+    if data.size > 4096:
+        kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True)
+    ds = f.create_dataset(path, data=data, **kw)
+    ds.attrs["unit"] = arr.unit
+    if arr.description:
+        ds.attrs["description"] = arr.description
+
+
+def _provenance(result) -> dict[str, Any]:
+    """Provenance, written in this one place: the package, its versions, the machine and the run."""
+    prov = {"bearingsim_version": __version__, "git_commit": git_commit(),
+            "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
+            "platform": platform.platform(), "command": " ".join(sys.argv)}
+    for k, v in package_versions().items():
+        prov[f"version_{k}"] = v
+    for k, v in result.provenance.items():
+        if k.startswith("version_") or k in ("bearingsim_version", "git_commit", "created_utc", "platform", "command"):
+            continue  # a result read back from an archive keeps the provenance of the run that made it
+        prov[k] = v
+    return prov
+
+
+def read(path):
+    """Read a complete archive back into its result class (one-line UserError for a bad file)."""
+    import tomllib
+
+    from bearingsim.results import AttrGroup, NamedArray, Series
+    from bearingsim.scenario import resolve
+
+    f = open_archive(path)
+    try:
+        model = str(f["bearingsim"].attrs["model"])
+        text = f["scenario"][()]
+        text = text.decode() if isinstance(text, bytes) else str(text)
+        scenario = resolve(tomllib.loads(text), f"{path}:/scenario")
+        data: dict[str, NamedArray] = {}
+        groups: dict[str, AttrGroup] = {}
+        tables: dict[str, str] = {}
+
+        def visit(name, obj):
+            if name.startswith("results"):
+                if hasattr(obj, "shape"):
+                    v = obj[()]
+                    if v.dtype.kind == "S":
+                        v = v.astype("U")
+                    data[name] = NamedArray(v, str(obj.attrs.get("unit", "1")), str(obj.attrs.get("description", "")))
+                elif "columns" in obj.attrs:
+                    tables[name] = str(obj.attrs.get("description", ""))
+                else:
+                    attrs = {k: _plain(v) for k, v in obj.attrs.items() if not k.endswith("__unit") and k != "description"}
+                    if attrs:
+                        units = {k[:-6]: str(v) for k, v in obj.attrs.items() if k.endswith("__unit")}
+                        groups[name] = AttrGroup(attrs, units, str(obj.attrs.get("description", "")))
+
+        f.visititems(visit)
+        series = {}
+        for name, g in f.get("observables", {}).items():
+            series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
+                                  str(g.attrs.get("description", "")))
+        provenance = {k: _plain(v) for k, v in f["provenance"].attrs.items()} if "provenance" in f else {}
+    except UserError:
+        raise
+    except (KeyError, ValueError, TypeError, OSError) as exc:
+        raise UserError(f"{path}: damaged archive ({exc.__class__.__name__}: {exc})") from None
+    finally:
+        f.close()
+    cls = result_class(model)
+    return cls(scenario, data, groups, series=series, provenance=provenance, tables=tables)
+
+
+def result_class(model: str):
+    """The result class of a model name."""
+    if model == "reduced":
+        from bearingsim.reduced import ReducedResult
+
+        return ReducedResult
+    if model == "multibody":
+        from bearingsim.multibody import MultibodyResult
+
+        return MultibodyResult
+    raise UserError(f"archive of an unknown model {model!r}")
+
+
+def _plain(v):
+    """An HDF5 attribute as a plain Python value (str, float, int, bool, or a numpy array)."""
+    if isinstance(v, bytes):
+        return v.decode()
+    if isinstance(v, np.bool_):
+        return bool(v)
+    if isinstance(v, np.integer):
+        return int(v)
+    if isinstance(v, np.floating):
+        return float(v)
+    return v
 
 
 def open_archive(path: str | Path):

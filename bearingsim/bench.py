@@ -50,6 +50,7 @@ def _median_time(fn, repeats: int):
 
 def reduced_rows(quick: bool) -> list[dict]:
     """Event and euler at 500, 2000 and 6000 rpm (the paper's conditions, 970 N, φ = 23.5°)."""
+    from bearingsim.parameters import Parameters
     from bearingsim.reduced.core import PassInputs
     from bearingsim.reduced.euler import max_stable_dt, solve_euler
     from bearingsim.reduced.event import solve_event
@@ -57,7 +58,7 @@ def reduced_rows(quick: bool) -> list[dict]:
 
     rows = []
     for rpm in REDUCED_SPEEDS:
-        inp = PassInputs.from_scenario(paper_scenario(rpm))
+        inp = PassInputs.from_parameters(Parameters.from_scenario(paper_scenario(rpm)))
         solve_event(inp, trace_points=0)  # compile / load the cache outside the timing
         solve_euler(inp, 1e-4, trace_points=0)
         ref = solve_event(inp, trace_points=0).I_dec

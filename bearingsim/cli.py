@@ -13,22 +13,38 @@ from bearingsim import __version__
 from bearingsim.errors import SimulationUnstable, UserError
 
 
+def _refuse_archive_as_scenario(path) -> None:
+    """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(8)
+    except OSError:
+        return  # the scenario reader reports missing and unreadable files
+    if head == b"\x89HDF\r\n\x1a\n":
+        raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
+                        f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
+
+
+def _print_summary(summary) -> None:
+    for key in ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip",
+                "load_zone_half_angle_deg"):
+        if key in summary:
+            print(f"  {key:28s} {summary[key]:.6g}")
+
+
 def _cmd_run(args) -> int:
     from bearingsim.scenario import load_scenario
     from bearingsim.simulation import run_scenario
 
+    _refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress)
     if not args.quiet:
-        summary = out.result.summary
         print(f"wrote {out.archive}")
         for png in out.figures:
             print(f"wrote {png}")
-        for key in ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip",
-                    "load_zone_half_angle_deg"):
-            if key in summary:
-                print(f"  {key:28s} {summary[key]:.6g}")
+        _print_summary(out.result.summary)
     return 0
 
 
@@ -37,6 +53,74 @@ def _cmd_inspect(args) -> int:
 
     print(describe(args.archive))
     return 0
+
+
+def _cmd_show(args) -> int:
+    from bearingsim.archive import read
+
+    sys.stdout.write(read(args.archive).scenario.to_toml())
+    return 0
+
+
+def _cmd_plot(args) -> int:
+    from bearingsim.archive import check_writable_dir, read
+
+    path = Path(args.archive)
+    result = read(path)
+    folder = check_writable_dir(args.output) if args.output else path.parent
+    for png in result.save_figures(folder / path.stem):
+        print(f"wrote {png}")
+    return 0
+
+
+def _cmd_rerun(args) -> int:
+    from bearingsim.archive import Spool, package_versions, read, write
+    from bearingsim.compare import compare_results
+    from bearingsim.simulation import run
+
+    old = read(args.archive)
+    progress = sys.stderr.isatty()
+    if args.output:
+        with Spool(args.output) as spool:
+            new = run(old.scenario, progress=progress, sink=spool)
+            write(new, args.output, spool)
+        print(f"wrote {args.output}")
+    else:
+        new = run(old.scenario, progress=progress)
+    from bearingsim import __version__ as version
+
+    new.provenance.update({f"version_{k}": v for k, v in package_versions().items()}, bearingsim_version=version)
+    c = compare_results(old, new)
+    if c.identical:
+        print(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
+              f"{len(old.per_rotation)} per-rotation arrays)")
+        return 0
+    print(f"{args.archive}: rerun differs")
+    print(c.summary_table())
+    for name in c.arrays_differ:
+        print(f"  differs: {name}")
+    for k, va, vb in c.versions:
+        print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
+    return 1
+
+
+def _cmd_compare(args) -> int:
+    from bearingsim.archive import read
+    from bearingsim.compare import compare_results
+
+    a, b = read(args.a), read(args.b)
+    c = compare_results(a, b)
+    if c.scenario_keys:
+        print("scenario keys that differ (A -> B):")
+        for k, va, vb in c.scenario_keys:
+            print(f"  {k}: {va!r} -> {vb!r}")
+    else:
+        print("scenarios: identical")
+    print(c.summary_table())
+    for name in c.arrays_differ:
+        print(f"  differs: {name}")
+    print("results: identical" if c.identical else "results: differ")
+    return 0 if c.identical else 1
 
 
 def _cmd_validate(args) -> int:
@@ -79,6 +163,26 @@ def build_parser() -> argparse.ArgumentParser:
     i = sub.add_parser("inspect", help="print what an archive holds")
     i.add_argument("archive")
     i.set_defaults(func=_cmd_inspect)
+
+    sh = sub.add_parser("show", help="print the scenario stored in an archive as TOML (a runnable scenario file)")
+    sh.add_argument("archive")
+    sh.set_defaults(func=_cmd_show)
+
+    pl = sub.add_parser("plot", help="draw every figure of a run again from its archive alone")
+    pl.add_argument("archive")
+    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the archive)")
+    pl.set_defaults(func=_cmd_plot)
+
+    rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
+    rr.add_argument("archive")
+    rr.add_argument("-o", "--output", help="also write the new run's archive here")
+    rr.set_defaults(func=_cmd_rerun)
+
+    cp = sub.add_parser("compare", help="scenario keys and summary numbers of two archives side by side "
+                                        "(exit 0 identical, 1 different, 2 bad file)")
+    cp.add_argument("a")
+    cp.add_argument("b")
+    cp.set_defaults(func=_cmd_compare)
 
     v = sub.add_parser("validate", help="Fig. 9 analog: reduced-model I_dec against speed (table and PNG)")
     v.add_argument("-o", "--output", default="outputs/validate", help="output folder")

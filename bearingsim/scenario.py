@@ -2,7 +2,7 @@
 
 Resolution order for every key: package defaults < the named preset (``[bearing] preset``) < the
 scenario file < ``--set KEY=VALUE`` overrides. Keys carry their units (``_mm``, ``_rpm``, ``_N``…);
-:attr:`Scenario.geometry` and friends give the SI view used inside the package.
+:meth:`bearingsim.parameters.Parameters.from_scenario` gives the SI view the models take.
 
 Every problem is reported as a :class:`bearingsim.errors.UserError` whose one-line message names the
 offending key (dotted, e.g. ``bearing.pocket_clearance_mm``) and the file it came from.
@@ -12,7 +12,6 @@ from __future__ import annotations
 import copy
 import math
 import tomllib
-from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -20,7 +19,6 @@ from typing import Any, Literal
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from bearingsim import kinematics as kin
 from bearingsim.errors import UserError
 
 SCHEMA_VERSION = 1
@@ -147,49 +145,6 @@ class ScenarioModel(_Section):
     wear: WearSection
 
 
-@dataclass(frozen=True)
-class BearingGeometry:
-    """SI view of the bearing. Raceway radii follow from the pitch circle and the roller."""
-
-    roller_count: int
-    roller_radius: float  # r_r [m]
-    roller_length: float  # [m]
-    roller_mass: float  # m [kg]
-    pitch_radius: float  # r_p [m]
-    pocket_clearance: float  # s [m]: pocket diameter minus roller diameter
-    radial_clearance: float  # P_d [m], diametral
-    cage_mass: float  # [kg]
-    cage_inertia: float  # [kg m^2]
-
-    @property
-    def outer_race_radius(self) -> float:
-        """r_o = r_p + r_r (paper, Eq. 4) [m]."""
-        return self.pitch_radius + self.roller_radius
-
-    @property
-    def inner_race_radius(self) -> float:
-        """r_i = r_p - r_r [m]."""
-        return self.pitch_radius - self.roller_radius
-
-    @property
-    def roller_inertia(self) -> float:
-        """Solid cylinder about its axis, m r_r^2 / 2 [kg m^2]."""
-        return 0.5 * self.roller_mass * self.roller_radius**2
-
-
-@dataclass(frozen=True)
-class OperatingPoint:
-    """SI operating point. ``sign`` is +1 forward, -1 reverse; speeds here are magnitudes."""
-
-    omega_i: float  # |inner ring| [rad/s], Eq. (10)
-    omega_c: float  # epicyclic cage speed [rad/s], Eq. (11)
-    omega_r: float  # roller spin [rad/s], Eq. (12)
-    rolling_velocity: float  # V [m/s], Eq. (4)
-    sign: int
-    radial_load: float  # [N]
-    gravity: float  # [m/s^2], 0 when switched off
-
-
 class Scenario:
     """A validated, fully resolved scenario. ``raw`` is the merged dictionary (the archive's copy)."""
 
@@ -206,38 +161,6 @@ class Scenario:
 
     def to_toml(self) -> str:
         return tomli_w.dumps(self.raw)
-
-    @property
-    def geometry(self) -> BearingGeometry:
-        b = self.model_.bearing
-        return BearingGeometry(
-            roller_count=b.roller_count,
-            roller_radius=b.roller_diameter_mm * 0.5e-3,
-            roller_length=b.roller_length_mm * 1e-3,
-            roller_mass=b.roller_mass_kg,
-            pitch_radius=b.pitch_diameter_mm * 0.5e-3,
-            pocket_clearance=b.pocket_clearance_mm * 1e-3,
-            radial_clearance=b.radial_clearance_mm * 1e-3,
-            cage_mass=b.cage_mass_kg,
-            cage_inertia=b.cage_inertia_kgm2,
-        )
-
-    @property
-    def operating_point(self) -> OperatingPoint:
-        g = self.geometry
-        o = self.model_.operating
-        omega_i = kin.inner_ring_angular_speed(o.inner_ring_speed_rpm)
-        omega_c = kin.cage_angular_speed(omega_i, g.roller_radius, g.pitch_radius)
-        omega_r = kin.roller_spin_speed(omega_i, g.roller_radius, g.pitch_radius)
-        return OperatingPoint(
-            omega_i=omega_i,
-            omega_c=omega_c,
-            omega_r=omega_r,
-            rolling_velocity=kin.rolling_speed(omega_r, omega_c, g.roller_radius, g.outer_race_radius),
-            sign=1 if o.direction == "forward" else -1,
-            radial_load=o.radial_load_N,
-            gravity=kin.STANDARD_GRAVITY if o.gravity else 0.0,
-        )
 
     def replace(self, **dotted: Any) -> "Scenario":
         """A new scenario with dotted keys replaced, e.g. ``replace(**{"operating.direction": "reverse"})``."""
@@ -320,12 +243,21 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
         raise UserError(f"{p}: not valid TOML ({exc})") from None
 
 
-def load_scenario(path: str | Path, overrides: list[str] | None = None) -> Scenario:
-    """Read, merge with preset and defaults, apply ``KEY=VALUE`` overrides, and validate."""
+def load_scenario(path: str | Path, overrides: list[str] | None = None,
+                  values: dict[str, Any] | None = None) -> Scenario:
+    """Read, merge with preset and defaults, apply overrides, and validate.
+
+    ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line);
+    ``values`` maps dotted keys to Python values; both name keys as ``section.key``.
+    """
     raw = read_toml_file(path)
     for item in overrides or []:
         key, value = parse_override(item)
         _set_dotted(raw, key, value, origin="--set")
+    for key, value in (values or {}).items():
+        if not isinstance(key, str) or not key or any(not part for part in key.split(".")):
+            raise UserError(f"set: {key!r}: expected a dotted key such as operating.inner_ring_speed_rpm")
+        _set_dotted(raw, key, value, origin="set")
     raw.setdefault("name", Path(path).stem)
     return resolve(raw, str(path))
 

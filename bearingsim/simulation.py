@@ -1,19 +1,26 @@
-"""Orchestration: pick the model a scenario names, run it into an archive, write its figures.
+"""Orchestration: a scenario in, a result out (and, if asked, its archive and figures).
 
-The models themselves live in :mod:`bearingsim.reduced` and :mod:`bearingsim.multibody`; both offer
-``simulate(scenario, archive=None, progress=False)`` returning a result with ``write(aw)``,
-``summary`` and ``save_figures(stem)``.
+The path of one run (``docs/architecture.md``)::
+
+    scenario file --load_scenario--> Scenario --Parameters.from_scenario--> Parameters (frozen, SI)
+        --model.simulate(parameters, sink)--> Result --archive.write--> archive.h5 --archive.read--> Result
+        --Result.save_figures--> PNG figures
+
+The models (:mod:`bearingsim.reduced`, :mod:`bearingsim.multibody`) take the parameters and a sink
+for their time series and return a result; they never see the scenario file or the archive.
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bearingsim.archive import ArchiveWriter
+from bearingsim.parameters import Parameters
 from bearingsim.scenario import Scenario
 
 
 def model_module(name: str):
+    """The module of a model (``simulate(parameters, sink=None, progress=False, dt=None)``)."""
     if name == "reduced":
         from bearingsim import reduced
 
@@ -21,6 +28,24 @@ def model_module(name: str):
     from bearingsim import multibody
 
     return multibody
+
+
+def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):
+    """Run a resolved scenario and return its :class:`bearingsim.results.Result`.
+
+    Parameters
+    ----------
+    scenario : resolved scenario (:func:`bearingsim.load_scenario`).
+    progress : show a progress bar on stderr (multibody runs).
+    sink : where time series are streamed (default: kept in memory with the result).
+    dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice.
+    """
+    t0 = time.perf_counter()
+    params = Parameters.from_scenario(scenario)
+    result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
+    result.scenario = scenario
+    result.provenance["wall_time_s"] = time.perf_counter() - t0
+    return result
 
 
 @dataclass
@@ -41,19 +66,23 @@ def run_scenario(
     figures: bool = True,
     progress: bool = False,
 ) -> RunOutput:
-    """Run ``scenario`` and write its archive (atomically) and, optionally, its PNG figures.
+    """Run ``scenario``, write its archive (atomically, time series streamed into it) and, optionally,
+    its PNG figures, drawn from the archive as written.
 
     Parameters
     ----------
     scenario : resolved scenario
     out : archive path; default ``outputs/<name>.h5``
-    figures : write PNG figures beside the archive (``<stem>*.png``)
+    figures : write PNG figures beside the archive (``<stem>_<figure>.png``)
     progress : show a progress bar (multibody runs)
     """
+    from bearingsim import archive
+
     out = Path(out) if out is not None else default_output(scenario)
-    module = model_module(scenario.model)
-    with ArchiveWriter(out, scenario) as aw:
-        result = module.simulate(scenario, archive=aw, progress=progress)
-        result.write(aw)
-    pngs = result.save_figures(out.with_suffix("")) if figures else []
+    with archive.Spool(out) as spool:
+        result = run(scenario, progress=progress, sink=spool)
+        archive.write(result, out, spool)
+    pngs = []
+    if figures:
+        pngs = archive.read(out).save_figures(out.with_suffix(""))
     return RunOutput(archive=out, figures=list(pngs), result=result)

@@ -19,3 +19,10 @@ def base_reduced() -> dict:
         "reduced": {"load_zone_half_angle_deg": 23.5},
         "numerics": {"rotations": 1},
     }
+
+
+def si(scenario):
+    """The SI parameters of a resolved scenario (what the models take)."""
+    from bearingsim.parameters import Parameters
+
+    return Parameters.from_scenario(scenario)

@@ -3,20 +3,30 @@ import h5py
 import numpy as np
 import pytest
 
-from bearingsim.archive import ArchiveWriter, describe, open_archive
+from bearingsim import archive
+from bearingsim.archive import Spool, describe, open_archive
 from bearingsim.errors import UserError
 from bearingsim.scenario import resolve
 
 
+def _result(scenario):
+    from bearingsim.results import AttrGroup, NamedArray, Result
+
+    res = Result(scenario, {"results/per_rotation/I_dec": NamedArray(np.ones((3, 2)), "N s")},
+                 {"results/summary": AttrGroup({"I_dec_mean_Ns": 1.0}, {"I_dec_mean_Ns": "N s"})},
+                 provenance={"dt_s": 1e-6, "wall_time_s": 0.5})
+    res.model = "reduced"
+    return res
+
+
 def _write(path, scenario, fail=False):
-    with ArchiveWriter(path, scenario, {"dt_s": 1e-6}) as aw:
-        aw.write_array("results/per_rotation/I_dec", np.ones((3, 2)), unit="N s")
-        aw.set_attrs("results/summary", {"I_dec_mean_Ns": 1.0}, units={"I_dec_mean_Ns": "N s"})
-        ts = aw.timeseries("cage_angular_speed", (), unit="rad/s")
+    with Spool(path) as spool:
+        ts = spool.timeseries("cage_angular_speed", (), unit="rad/s")
         for k in range(10000):  # more than one buffered block: streamed, not held
             ts.append(k, k * 1e-6, 100.0 + k)
         if fail:
             raise RuntimeError("simulated crash mid-run")
+        archive.write(_result(scenario), path, spool)
 
 
 def test_complete_archive_has_header_scenario_provenance_units(tmp_path, base_reduced):
@@ -60,7 +70,7 @@ def test_unwritable_output_is_a_user_error_before_running(tmp_path, base_reduced
     blocker = tmp_path / "file"
     blocker.write_text("x")
     with pytest.raises(UserError, match="file"):
-        ArchiveWriter(blocker / "sub" / "a.h5", resolve(base_reduced))
+        Spool(blocker / "sub" / "a.h5")
 
 
 def test_foreign_truncated_and_incomplete_files_are_refused(tmp_path, base_reduced):
@@ -87,3 +97,31 @@ def test_foreign_truncated_and_incomplete_files_are_refused(tmp_path, base_reduc
         open_archive(incomplete)
     with pytest.raises(UserError, match="not found"):
         open_archive(tmp_path / "missing.h5")
+
+
+def test_read_gives_back_the_written_result(tmp_path, base_reduced):
+    """write(result) then read(path): same class, scenario, summary, arrays, units and time series."""
+    import bearingsim
+
+    sc = resolve(base_reduced)
+    r = bearingsim.run(sc)
+    path = r.save(tmp_path / "r.h5")
+    back = bearingsim.load(path)
+    assert type(back) is type(r) and back.scenario.raw == sc.raw
+    assert back.summary == r.summary
+    for k, v in r.data.items():
+        assert np.array_equal(back.data[k].data, v.data), k
+        assert back.data[k].unit == v.unit, k
+    assert back.impacts["face"].tolist() == r.impacts["face"].tolist()
+    assert back.provenance["solver"] == "reduced/event"
+    assert back.provenance["version_pymunk"] != "not installed"
+
+
+def test_memory_series_are_written_and_read_back(tmp_path, base_reduced):
+    from bearingsim.results import Series
+
+    res = _result(resolve(base_reduced))
+    res.series["x"] = Series(np.arange(5), np.arange(5) * 1e-3, np.ones((5, 2)), "m", "a test series")
+    back = archive.read(archive.write(res, tmp_path / "s.h5"))
+    s = back.series["x"]
+    assert s.unit == "m" and s.value.shape == (5, 2) and np.array_equal(s.step, np.arange(5))

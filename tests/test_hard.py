@@ -22,7 +22,7 @@ from bearingsim.errors import UserError
 from bearingsim.scenario import load_scenario
 from bearingsim.simulation import run_scenario
 
-from .conftest import SCENARIOS
+from .conftest import SCENARIOS, si
 from .test_cli import assert_user_error, bearingsim
 
 HARD = sorted((SCENARIOS / "hard").glob("*.toml"))
@@ -77,10 +77,10 @@ def _check_reduced(result):
 
 
 def _check_multibody(result, sc):
-    s = sc.geometry.pocket_clearance
-    assert np.all(np.isfinite(result.per_rotation_I_dec)) and np.all(result.per_rotation_I_dec >= 0)
-    assert result.max_penetration_all <= 0.01 * s, result.max_penetration_all
-    assert abs(result.summary["cage_speed_mean_rad_s"]) <= sc.operating_point.omega_i
+    s = si(sc).bearing.pocket_clearance
+    assert np.all(np.isfinite(result.per_rotation["I_dec"])) and np.all(result.per_rotation["I_dec"] >= 0)
+    assert result.summary["max_penetration_all_m"] <= 0.01 * s, result.summary["max_penetration_all_m"]
+    assert abs(result.summary["cage_speed_mean_rad_s"]) <= si(sc).operating.omega_i
 
 
 def test_dt_too_large_exits_2_from_the_cli(tmp_path):
@@ -96,7 +96,7 @@ def test_zero_restitution_and_tight_pocket_end_at_rest_with_the_drag_impulse():
     braking impulse m ∫ (g sin θ + F_o/m) dt of the pass, whatever happened on the way."""
     for name in ("reduced_restitution_0", "reduced_clearance_0.02mm"):
         sc = load_scenario(SCENARIOS / "hard" / f"{name}.toml", REDUCED_LENGTH)
-        from bearingsim.reduced import simulate
+        from bearingsim.simulation import run as simulate
 
         r = simulate(sc)
         inp = r.inputs
@@ -114,7 +114,7 @@ def test_run_that_goes_unstable_midway_is_stopped_and_not_written(tmp_path):
     from bearingsim.multibody.core import choose_dt
 
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml")
-    _, _, limit = choose_dt(sc)
+    _, _, limit = choose_dt(si(sc))
     out = tmp_path / "u.h5"
     res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "--set", f"numerics.dt_s={1.5 * limit!r}",
                      "--set", "numerics.rotations=1", "-o", out, "--no-plots")
@@ -142,10 +142,10 @@ def test_automatic_dt_restart_is_recorded():
     """The 0.02 mm pocket needs a shorter step than the automatic estimate (approach ~0.3 m/s against a
     20 um clearance): the run restarts at a step scaled to the measured overlap, ends within the 1 % bound,
     and the archive's dt_choice says how the first step was chosen and why it was shortened."""
-    from bearingsim.multibody import simulate
+    from bearingsim.simulation import run as simulate
 
     sc = load_scenario(SCENARIOS / "hard" / "multibody_clearance_0.02mm.toml", REDUCED_LENGTH)
     r = simulate(sc)
-    how = r.raw["dt_choice"]
+    how = r.provenance["dt_choice"]
     assert how.startswith("auto:") and "restarted at dt" in how, how
-    assert r.max_penetration_all <= 0.01 * sc.geometry.pocket_clearance
+    assert r.summary["max_penetration_all_m"] <= 0.01 * si(sc).bearing.pocket_clearance

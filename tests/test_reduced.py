@@ -7,9 +7,11 @@ import math
 
 import numpy as np
 import pytest
+
+from .conftest import si
 from scipy.integrate import quad
 
-from bearingsim.reduced import simulate
+from bearingsim.simulation import run as simulate
 from bearingsim.reduced.core import PassInputs
 from bearingsim.reduced.euler import max_stable_dt, solve_euler
 from bearingsim.reduced.event import solve_event
@@ -17,7 +19,7 @@ from bearingsim.reduced.studies import idec_per_rotation, paper_scenario
 
 
 def _inputs(rpm, **kw):
-    return PassInputs.from_scenario(paper_scenario(rpm, **kw))
+    return PassInputs.from_parameters(si(paper_scenario(rpm, **kw)))
 
 
 @pytest.fixture(scope="module")

@@ -6,12 +6,12 @@ import pytest
 from bearingsim.errors import UserError
 from bearingsim.scenario import load_preset, load_scenario, parse_override, resolve
 
-from .conftest import SCENARIOS
+from .conftest import SCENARIOS, si
 
 
 def test_preset_fills_unset_values_and_marks_reconstructions(base_reduced):
     sc = resolve(base_reduced)
-    g = sc.geometry
+    g = si(sc).bearing
     assert g.roller_count == 16
     assert g.roller_radius == pytest.approx(6.5e-3)
     assert g.pitch_radius == pytest.approx(48.75e-3)
@@ -28,16 +28,16 @@ def test_preset_fills_unset_values_and_marks_reconstructions(base_reduced):
 
 def test_scenario_value_beats_preset_and_override_beats_scenario(base_reduced):
     base_reduced["bearing"]["pocket_clearance_mm"] = 0.3
-    assert resolve(base_reduced).geometry.pocket_clearance == pytest.approx(0.3e-3)
+    assert si(resolve(base_reduced)).bearing.pocket_clearance == pytest.approx(0.3e-3)
     sc = load_scenario(SCENARIOS / "paper_3000rpm.toml",
                        ["bearing.pocket_clearance_mm=0.25", "operating.direction=reverse", "model=reduced"])
-    assert sc.geometry.pocket_clearance == pytest.approx(0.25e-3)
+    assert si(sc).bearing.pocket_clearance == pytest.approx(0.25e-3)
     assert sc.operating.direction == "reverse"
 
 
 def test_kinematics_follow_eqs_10_to_12(base_reduced):
     """Eqs. (10)-(12) of the paper: omega_c = (1-g) w_i/2, omega_r = (1/g - g) w_i/2, g = r_r/r_p."""
-    op = resolve(base_reduced).operating_point
+    op = si(resolve(base_reduced)).operating
     w_i = 2 * math.pi * 3000 / 60
     gam = 6.5 / 48.75
     assert op.omega_c == pytest.approx((1 - gam) * w_i / 2, rel=1e-12)

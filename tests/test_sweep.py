@@ -3,7 +3,7 @@ import csv
 
 import pytest
 
-from bearingsim.reduced import simulate
+from bearingsim.simulation import run as simulate
 from bearingsim.scenario import load_scenario
 
 from .conftest import SCENARIOS

@@ -31,6 +31,11 @@ contains one whole load zone exit, no-load zone and load zone entry. Everything 
 discarded. The run stops at a cage travel of ``360 (W + R)`` deg (R = ``numerics.rotations``), so
 W >= 1 is needed for complete windows (with W = 0 the first window of pockets i > 0 is partial).
 
+The model takes :class:`bearingsim.parameters.Parameters` and returns a :class:`MultibodyResult`; time
+series go to the sink it is given (:class:`bearingsim.results.MemorySink` by default,
+:class:`bearingsim.archive.Spool` to stream them into an archive). It never sees a scenario file or
+an archive.
+
 Recorded quantities (per pocket i, per rotation k)
 -------------------------------------------------
 * face: a roller-cage contact is on the *front* face when its normal from roller to cage points along
@@ -49,14 +54,15 @@ Recorded quantities (per pocket i, per rotation k)
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
 
-from bearingsim.multibody import recorder as rk
+from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
+from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, choose_dt, run)
+from bearingsim.results import AttrGroup, MemorySink, NamedArray, Result
 
 __all__ = ["simulate", "MultibodyResult"]
 
@@ -65,15 +71,16 @@ SUMMARY_UNITS = {
     "first_impact_speed_m_s": "m/s", "first_impact_energy_J": "J", "cage_speed_mean_rad_s": "rad/s",
     "cage_slip": "1", "load_zone_half_angle_deg": "deg",
     "load_zone_contact_half_angle_deg": "deg", "inner_ring_displacement_m": "m", "torque_balance_residual": "1",
-    "max_penetration_m": "m", "dt_s": "s", "wall_s": "s", "steps": "1", "pymunk_step_s": "s",
+    "max_penetration_m": "m", "max_penetration_all_m": "m", "cage_orbit_max_m": "m", "dt_s": "s", "steps": "1",
 }
 
 
 MAX_DT_RETRIES = 4
 
 
-def simulate(scenario, archive=None, progress=False, dt=None) -> "MultibodyResult":
-    """Run the multi-pocket model. ``dt`` [s] overrides ``numerics.dt_s`` and the automatic choice.
+def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
+    """Run the multi-pocket model for the SI parameters ``p``. ``dt`` [s] overrides ``numerics.dt``
+    and the automatic choice; time series go to ``sink`` (kept in memory when None).
 
     A roller may not overlap a cage face by more than ``PENETRATION_LIMIT`` (1 %) of the pocket
     clearance: the overlap is the approach covered in the step in which a contact is found, ~v dt.
@@ -81,11 +88,13 @@ def simulate(scenario, archive=None, progress=False, dt=None) -> "MultibodyResul
     speed (at most ``MAX_DT_RETRIES`` times; the history goes into ``dt_choice``); with a given time
     step it stops with :class:`SimulationUnstable` naming the largest step that would do.
     """
-    auto = dt is None and scenario.numerics.dt_s is None
+    if sink is None:
+        sink = MemorySink()
+    auto = dt is None and p.numerics.dt is None
     retries = []
     while True:
         try:
-            raw = run(scenario, archive=archive, progress=progress, dt=dt)
+            raw = run(p, sink=sink, progress=progress, dt=dt)
             break
         except PenetrationExceeded as exc:
             new_dt = exc.suggested_dt()
@@ -97,32 +106,12 @@ def simulate(scenario, archive=None, progress=False, dt=None) -> "MultibodyResul
             retries.append(f"restarted at dt = {new_dt:.3g} s after overlap {exc.pen:.3g} m > "
                            f"{PENETRATION_LIMIT:.0%} s at dt = {exc.dt:.3g} s (approach {exc.approach:.3g} m/s)")
             dt = new_dt
-            if archive is not None:
-                archive.discard_timeseries()
+            sink.discard_timeseries()
     if retries:  # the last run was given its dt: describe how the first one was chosen, then the restarts
-        raw["dt_choice"] = "; ".join([choose_dt(scenario)[1], *retries])
-    res = MultibodyResult(raw)
-    if archive is not None:
-        archive.provenance["dt_s"] = res.dt
-        archive.provenance["dt_choice"] = raw["dt_choice"]
-        archive.provenance["solver"] = "pymunk 7 (roller-cage) + numba raceway kernel"
-        archive.provenance["steps"] = res.steps
-        archive.provenance["ring_newton_failures"] = raw["newton_failures"]
-        archive.provenance["inner_ring"] = raw["inner_ring"]
+        raw["dt_choice"] = "; ".join([choose_dt(p)[1], *retries])
+    res = MultibodyResult.from_raw(p, raw)
+    res.series = sink.collect()
     return res
-
-
-def _load_zone_from_ring(ring_centre_mean, radial_clearance):
-    """Load-zone half angle [deg] from the mean inner-ring displacement (Harris & Kotzalas Sec. 7.2):
-    the arc over which the ring's displacement delta_r along the load closes the clearance,
-    ``psi_l = arccos(P_d / (2 delta_r))``; 0 when delta_r <= P_d / 2, 90 deg for zero clearance."""
-    delta_r = -float(ring_centre_mean[1])  # the load points along -y
-    if not math.isfinite(delta_r):
-        return float("nan")
-    half_pd = 0.5 * radial_clearance
-    if delta_r <= half_pd:
-        return 90.0 if half_pd == 0.0 and delta_r > 0.0 else 0.0
-    return math.degrees(math.acos(half_pd / delta_r))
 
 
 def _load_zone_half_angle(q_bin, tq_bin):
@@ -150,217 +139,229 @@ def _load_zone_half_angle(q_bin, tq_bin):
     return 0.5 * width
 
 
-def _save(fig, path) -> Path:
-    """Lay out, write (120 dpi) and close one report figure; return its path."""
-    import matplotlib.pyplot as plt
+class MultibodyResult(Result):
+    """Result of :func:`simulate` (or read back from an archive). Arrays are [rotation, pocket] unless
+    stated; ``raw`` holds the step loop's own accumulators on a fresh result (None when read back)."""
 
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return Path(path)
+    model = "multibody"
+    FIGURES = ("forces", "impulses", "orbit", "wear")
 
-
-class MultibodyResult:
-    """Result of :func:`simulate`. Arrays are per rotation x pocket unless stated."""
-
-    def __init__(self, raw):
+    def __init__(self, *args, raw=None, **kw):
+        super().__init__(*args, **kw)
         self.raw = raw
-        sc = raw["scenario"]
-        geo = sc.geometry
-        op = sc.operating_point
-        self.scenario = sc
-        self.scene = raw["scene"]
-        self.dt = raw["dt"]
-        self.steps = raw["steps"]
-        self.wall_s = raw["wall_s"]
-        self.pymunk_step_s = raw["pymunk_step_s"]
-        self.rotations = sc.numerics.rotations
+
+    @classmethod
+    def from_raw(cls, p, raw) -> "MultibodyResult":
+        """Lay out the step loop's accumulators as a result."""
+        geo, op = p.bearing, p.operating
+        scene = raw["scene"]
+        rotations = p.numerics.rotations
         w = raw["win"]
-        self.per_rotation_I_acc = w[:, :, rk.W_IACC].copy()
-        self.per_rotation_I_dec = w[:, :, rk.W_IDEC].copy()
-        self.per_rotation_Jn_front = w[:, :, rk.W_JN_F].copy()
-        self.per_rotation_Jn_rear = w[:, :, rk.W_JN_R].copy()
-        self.per_rotation_Jf_front = w[:, :, rk.W_JF_F].copy()
-        self.per_rotation_Jf_rear = w[:, :, rk.W_JF_R].copy()
-        self.per_rotation_work_front = w[:, :, rk.W_WORK_F].copy()
-        self.per_rotation_work_rear = w[:, :, rk.W_WORK_R].copy()
-        self.first_impact_speed = raw["first_imp"]
-        self.impacts = raw["impacts"]
+        per = {name: w[:, :, col].copy() for name, col in (
+            ("I_acc", rk.W_IACC), ("I_dec", rk.W_IDEC), ("Jn_front", rk.W_JN_F), ("Jn_rear", rk.W_JN_R),
+            ("Jf_front", rk.W_JF_F), ("Jf_rear", rk.W_JF_R), ("slide_work_front", rk.W_WORK_F),
+            ("slide_work_rear", rk.W_WORK_R))}
+        first_imp = raw["first_imp"]
         nb = THETA_BINS
-        self.theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
+        theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
         tb = raw["t_bin"]  # (n, nb)
         with np.errstate(invalid="ignore", divide="ignore"):
-            self.force_acc = np.where(tb > 0, raw["f_bin"][:, :, 0] / tb, 0.0).T  # (nb, n)
-            self.force_dec = np.where(tb > 0, raw["f_bin"][:, :, 1] / tb, 0.0).T
+            force_acc = np.where(tb > 0, raw["f_bin"][:, :, 0] / tb, 0.0).T  # (nb, n)
+            force_dec = np.where(tb > 0, raw["f_bin"][:, :, 1] / tb, 0.0).T
             tq = raw["tq_bin"]
-            self.load_inner = np.where(tq > 0, raw["q_bin"][:, 0] / np.maximum(tq, 1e-300), 0.0)
-            self.load_outer = np.where(tq > 0, raw["q_bin"][:, 1] / np.maximum(tq, 1e-300), 0.0)
-        full = self.scene == "full"
+            load_inner = np.where(tq > 0, raw["q_bin"][:, 0] / np.maximum(tq, 1e-300), 0.0)
+            load_outer = np.where(tq > 0, raw["q_bin"][:, 1] / np.maximum(tq, 1e-300), 0.0)
+        full = scene == "full"
         # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
         # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
         # (wider with discrete rollers: the laterally free ring shifts towards the exiting roller)
-        self.ring_centre_mean = raw["ring_centre_mean"]
-        self.load_zone_half_angle_deg = (_load_zone_from_ring(self.ring_centre_mean, raw["radial_clearance"])
-                                         if full else math.degrees(raw["phi"]))
-        self.load_zone_contact_half_angle_deg = (_load_zone_half_angle(raw["q_bin"], raw["tq_bin"])
-                                                 if full else math.degrees(raw["phi"]))
+        ring_centre_mean = raw["ring_centre_mean"]
+        if full:
+            phi_deg = math.degrees(laws.load_zone_from_displacement(-ring_centre_mean[1], geo.radial_clearance))
+            phi_contact_deg = _load_zone_half_angle(raw["q_bin"], raw["tq_bin"])
+        else:
+            phi_deg = phi_contact_deg = math.degrees(raw["phi"])
         t_rec = raw["t_record"]
-        self.cage_speed_mean = 2.0 * math.pi * self.rotations / t_rec if t_rec > 0 else float("nan")
-        self.cage_slip = 1.0 - self.cage_speed_mean / op.omega_c
+        cage_speed_mean = 2.0 * math.pi * rotations / t_rec if t_rec > 0 else float("nan")
         g = raw["glob"]
-        self.torque_impulse_normal = g[rk.G_TAU_N]
-        self.torque_impulse_friction = g[rk.G_TAU_F]
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
-        self.cage_momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
-        drive = abs(self.per_rotation_I_acc.sum()) * geo.pitch_radius
-        self.torque_balance_residual = (
-            (self.torque_impulse_normal + self.torque_impulse_friction - self.cage_momentum_change)
-            / drive if drive > 0 else float("nan"))
-        self.max_penetration = max(g[rk.G_MAXPEN_F], g[rk.G_MAXPEN_R])
-        self.max_penetration_all = g[rk.G_MAXPEN_ALL]
-        k = float(sc.wear.wear_coefficient)
-        H = float(sc.wear.hardness_Pa)
-        fac = k * geo.roller_radius * op.omega_r / H
-        self.wear_index_front = fac * self.per_rotation_I_acc.mean(axis=0)
-        self.wear_index_rear = fac * self.per_rotation_I_dec.mean(axis=0)
-        self.wear_work_front = k * self.per_rotation_work_front.mean(axis=0) / H
-        self.wear_work_rear = k * self.per_rotation_work_rear.mean(axis=0) / H
-        fi = self.first_impact_speed[np.isfinite(self.first_impact_speed)]
+        momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
+        drive = abs(per["I_acc"].sum()) * geo.pitch_radius
+        torque_residual = ((g[rk.G_TAU_N] + g[rk.G_TAU_F] - momentum_change) / drive if drive > 0 else float("nan"))
+        w_ = p.wear
+        wear = {
+            "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
+                                                          geo.roller_radius, op.omega_r, w_.hardness),
+            "paper_index_rear": laws.archard_wear_volume(w_.wear_coefficient, per["I_dec"].mean(axis=0),
+                                                         geo.roller_radius, op.omega_r, w_.hardness),
+            "sliding_work_front": w_.wear_coefficient * per["slide_work_front"].mean(axis=0) / w_.hardness,
+            "sliding_work_rear": w_.wear_coefficient * per["slide_work_rear"].mean(axis=0) / w_.hardness,
+        }
+        fi = first_imp[np.isfinite(first_imp)]
         v1 = float(fi.mean()) if fi.size else float("nan")
-        self.summary = {
-            "I_dec_mean_Ns": float(self.per_rotation_I_dec.mean()),
-            "I_dec_std_Ns": float(self.per_rotation_I_dec.std()),
-            "I_acc_mean_Ns": float(self.per_rotation_I_acc.mean()),
-            "I_acc_std_Ns": float(self.per_rotation_I_acc.std()),
+        summary = {
+            "I_dec_mean_Ns": float(per["I_dec"].mean()),
+            "I_dec_std_Ns": float(per["I_dec"].std()),
+            "I_acc_mean_Ns": float(per["I_acc"].mean()),
+            "I_acc_std_Ns": float(per["I_acc"].std()),
             "first_impact_speed_m_s": v1,
             "first_impact_energy_J": 0.5 * geo.roller_mass * v1 * v1,
-            "cage_speed_mean_rad_s": float(self.cage_speed_mean),
-            "cage_slip": float(self.cage_slip),
-            "load_zone_half_angle_deg": float(self.load_zone_half_angle_deg),
-            "load_zone_contact_half_angle_deg": float(self.load_zone_contact_half_angle_deg),
-            "inner_ring_displacement_m": float(-self.ring_centre_mean[1]),
-            "torque_balance_residual": float(self.torque_balance_residual),
-            "max_penetration_m": float(self.max_penetration),
-            "dt_s": float(self.dt),
-            "wall_s": float(self.wall_s),
-            "steps": int(self.steps),
-            "pymunk_step_s": float(self.pymunk_step_s),
+            "cage_speed_mean_rad_s": float(cage_speed_mean),
+            "cage_slip": float(1.0 - cage_speed_mean / op.omega_c),
+            "load_zone_half_angle_deg": float(phi_deg),
+            "load_zone_contact_half_angle_deg": float(phi_contact_deg),
+            "inner_ring_displacement_m": float(-ring_centre_mean[1]),
+            "torque_balance_residual": float(torque_residual),
+            "max_penetration_m": float(max(g[rk.G_MAXPEN_F], g[rk.G_MAXPEN_R])),
+            "max_penetration_all_m": float(g[rk.G_MAXPEN_ALL]),
+            "cage_orbit_max_m": float(raw["orbit_max"]),
+            "dt_s": float(raw["dt"]),
+            "steps": int(raw["steps"]),
         }
-        self.orbit = raw["orbit"]
-
-    # ------------------------------------------------------------------------------------------
-    def write(self, aw) -> None:
-        n = self.per_rotation_I_dec.shape[1]
-        pr = "/results/per_rotation"
         desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
-        aw.write_array(f"{pr}/I_acc", self.per_rotation_I_acc, "N s",
-                       "front-face impulse, circumferential component, " + desc)
-        aw.write_array(f"{pr}/I_dec", self.per_rotation_I_dec, "N s",
-                       "rear-face impulse, circumferential component (braking), " + desc)
-        aw.write_array(f"{pr}/Jn_front", self.per_rotation_Jn_front, "N s", "front-face normal impulse, " + desc)
-        aw.write_array(f"{pr}/Jn_rear", self.per_rotation_Jn_rear, "N s", "rear-face normal impulse, " + desc)
-        aw.write_array(f"{pr}/Jf_front", self.per_rotation_Jf_front, "N s", "front-face friction impulse, " + desc)
-        aw.write_array(f"{pr}/Jf_rear", self.per_rotation_Jf_rear, "N s", "rear-face friction impulse, " + desc)
-        aw.write_array(f"{pr}/slide_work_front", self.per_rotation_work_front, "J",
-                       "sum J_n |v_slide| on the front face, " + desc)
-        aw.write_array(f"{pr}/slide_work_rear", self.per_rotation_work_rear, "J",
-                       "sum J_n |v_slide| on the rear face, " + desc)
-        aw.write_array(f"{pr}/first_impact_speed", self.first_impact_speed, "m/s",
-                       "approach speed of the first rear-face impact in the no-load zone (NaN: none), " + desc)
-        aw.write_array("/results/theta_deg", self.theta_deg, "deg", "bin centres of theta (load-zone centre = 0)")
-        aw.write_array("/results/force_vs_theta", self.force_acc - self.force_dec, "N",
-                       "mean circumferential roller-cage force on the cage (F_acc - F_dec) per theta bin "
-                       "(rows, /results/theta_deg) and pocket (columns), recorded rotations")
-        aw.write_array("/results/force_vs_theta_acc", self.force_acc, "N", "mean F_acc (front face) [theta bin, pocket]")
-        aw.write_array("/results/force_vs_theta_dec", self.force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]")
-        if self.scene == "full":
-            aw.write_array("/results/raceway_load_inner", self.load_inner, "N",
-                           "mean inner-race roller load per theta bin (all rollers)")
-            aw.write_array("/results/raceway_load_outer", self.load_outer, "N",
-                           "mean outer-race roller load per theta bin (all rollers)")
-        imp = self.impacts
-        aw.write_table("/results/impacts", {
-            "time_s": imp[:, rk.I_TIME], "theta_deg": imp[:, rk.I_THETA],
-            "approach_speed_m_s": imp[:, rk.I_SPEED], "impulse_Ns": imp[:, rk.I_IMPULSE],
-            "pocket": imp[:, rk.I_POCKET].astype(np.int64),
-            "face": np.where(imp[:, rk.I_FACE] == 0, "front", "rear"),  # same strings as the reduced model
-            "rotation": imp[:, rk.I_ROT].astype(np.int64),
-        }, {"time_s": "s", "theta_deg": "deg", "approach_speed_m_s": "m/s", "impulse_Ns": "N s",
-            "pocket": "1", "face": "1", "rotation": "1"},
-            description=f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
-                        "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the pocket centre; "
-                        "rotation = row of /results/per_rotation the impact counts in")
-        aw.write_array("/results/wear/paper_index_front", self.wear_index_front, "m^3",
-                       "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket")
-        aw.write_array("/results/wear/paper_index_rear", self.wear_index_rear, "m^3",
-                       "Archard wear per cage rotation, rear face, k I_dec r_r omega_r / H, per pocket")
-        aw.write_array("/results/wear/sliding_work_front", self.wear_work_front, "m^3",
-                       "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket")
-        aw.write_array("/results/wear/sliding_work_rear", self.wear_work_rear, "m^3",
-                       "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket")
-        attrs = dict(self.summary)
-        attrs["scene"] = self.scene
-        attrs["pockets"] = n
-        aw.set_attrs("/results/summary", attrs, {k: v for k, v in SUMMARY_UNITS.items()})
+        pr = "results/per_rotation"
+        data = {
+            f"{pr}/I_acc": NamedArray(per["I_acc"], "N s", "front-face impulse, circumferential component, " + desc),
+            f"{pr}/I_dec": NamedArray(per["I_dec"], "N s", "rear-face impulse, circumferential component (braking), " + desc),
+            f"{pr}/Jn_front": NamedArray(per["Jn_front"], "N s", "front-face normal impulse, " + desc),
+            f"{pr}/Jn_rear": NamedArray(per["Jn_rear"], "N s", "rear-face normal impulse, " + desc),
+            f"{pr}/Jf_front": NamedArray(per["Jf_front"], "N s", "front-face friction impulse, " + desc),
+            f"{pr}/Jf_rear": NamedArray(per["Jf_rear"], "N s", "rear-face friction impulse, " + desc),
+            f"{pr}/slide_work_front": NamedArray(per["slide_work_front"], "J", "sum J_n |v_slide| on the front face, " + desc),
+            f"{pr}/slide_work_rear": NamedArray(per["slide_work_rear"], "J", "sum J_n |v_slide| on the rear face, " + desc),
+            f"{pr}/first_impact_speed": NamedArray(first_imp, "m/s", "approach speed of the first rear-face impact "
+                                                   "in the no-load zone (NaN: none), " + desc),
+            "results/theta_deg": NamedArray(theta_deg, "deg", "bin centres of theta (load-zone centre = 0)"),
+            "results/force_vs_theta": NamedArray(force_acc - force_dec, "N",
+                                                 "mean circumferential roller-cage force on the cage (F_acc - F_dec) per "
+                                                 "theta bin (rows, /results/theta_deg) and pocket (columns), recorded rotations"),
+            "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
+            "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
+        }
+        if full:
+            data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
+            data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
+        imp = raw["impacts"]
+        data.update({
+            "results/impacts/time_s": NamedArray(imp[:, rk.I_TIME], "s"),
+            "results/impacts/theta_deg": NamedArray(imp[:, rk.I_THETA], "deg"),
+            "results/impacts/approach_speed_m_s": NamedArray(imp[:, rk.I_SPEED], "m/s"),
+            "results/impacts/impulse_Ns": NamedArray(imp[:, rk.I_IMPULSE], "N s"),
+            "results/impacts/pocket": NamedArray(imp[:, rk.I_POCKET].astype(np.int64)),
+            "results/impacts/face": NamedArray(np.where(imp[:, rk.I_FACE] == 0, "front", "rear")),
+            "results/impacts/rotation": NamedArray(imp[:, rk.I_ROT].astype(np.int64)),
+        })
+        wear_desc = {
+            "paper_index_front": "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket",
+            "paper_index_rear": "Archard wear per cage rotation, rear face, k I_dec r_r omega_r / H, per pocket",
+            "sliding_work_front": "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket",
+            "sliding_work_rear": "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket",
+        }
+        for k, v in wear.items():
+            data[f"results/wear/{k}"] = NamedArray(v, "m^3", wear_desc[k])
+        orbit = raw["orbit"]
+        data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
+                                                "last recorded samples of the cage centre: columns time, x, y")
+        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count},
+                                               dict(SUMMARY_UNITS))}
+        provenance = {
+            "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
+            "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),
+            "ring_newton_failures": int(raw["newton_failures"]), "inner_ring": raw["inner_ring"],
+            "solver_wall_s": float(raw["wall_s"]), "pymunk_step_s": float(raw["pymunk_step_s"]),
+        }
+        tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
+                                     "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "
+                                     "pocket centre; rotation = row of /results/per_rotation the impact counts in"}
+        res = cls(None, data, groups, provenance=provenance, tables=tables, raw=raw)
+        res._parameters = p
+        return res
 
-    # ------------------------------------------------------------------------------------------
-    def save_figures(self, stem) -> list[Path]:
-        import matplotlib
+    def description(self) -> str:
+        scene = self.groups["results/summary"].attrs.get("scene", "?")
+        return f"multibody, {scene} scene"
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+    # --- figures -----------------------------------------------------------------------------
+    def _rotations(self) -> int:
+        return self.per_rotation["I_dec"].shape[0]
 
-        stem = Path(stem)
-        stem.parent.mkdir(parents=True, exist_ok=True)
-        title = f"{self.scenario.name} ({self.scene}, {self.scenario.operating.inner_ring_speed_rpm:g} rpm)"
-        out = []
-        n = self.per_rotation_I_dec.shape[1]
-        # forces against theta (Fig. 5 analog): pocket 0 and the mean over pockets
-        fig, ax = plt.subplots(figsize=(8, 4))
-        ax.plot(self.theta_deg, self.force_acc[:, 0], lw=0.8, color="C0", label="F_acc pocket 0")
-        ax.plot(self.theta_deg, -self.force_dec[:, 0], lw=0.8, color="C3", label="-F_dec pocket 0")
-        ax.plot(self.theta_deg, self.force_acc.mean(axis=1), lw=1.5, color="C0", ls="--", label="F_acc mean")
-        ax.plot(self.theta_deg, -self.force_dec.mean(axis=1), lw=1.5, color="C3", ls="--", label="-F_dec mean")
-        phi = self.load_zone_half_angle_deg
-        for x in (phi, 360 - phi):
-            ax.axvline(x, color="grey", lw=0.6, ls=":")
-        ax.set_xlabel("theta from load-zone centre [deg]")
+    def plot_forces(self):
+        """Fig. 5 analog: mean circumferential pocket force against θ, pocket 0 and the mean over pockets."""
+        from bearingsim.plotting import legend_outside, plt
+
+        th = self.get("theta_deg")
+        fa, fd = self.get("force_vs_theta_acc"), self.get("force_vs_theta_dec")
+        fig, ax = plt.subplots(figsize=(9, 4))
+        ax.plot(th, fa[:, 0], lw=0.8, color="C0", label="$F_{acc}$ (front face), pocket 0")
+        ax.plot(th, -fd[:, 0], lw=0.8, color="C3", label="$-F_{dec}$ (rear face), pocket 0")
+        ax.plot(th, fa.mean(axis=1), lw=1.5, color="C0", ls="--", label="$F_{acc}$, mean over pockets")
+        ax.plot(th, -fd.mean(axis=1), lw=1.5, color="C3", ls="--", label="$-F_{dec}$, mean over pockets")
+        phi = self.summary["load_zone_half_angle_deg"]
+        ax.axvline(phi, color="grey", lw=0.8, ls=":", label=f"load-zone limits ±{phi:.1f}°")
+        ax.axvline(360 - phi, color="grey", lw=0.8, ls=":")
+        ax.axvline(180.0, color="0.6", lw=0.6, ls="-.", label="θ = 180° (top)")
+        ax.axhline(0.0, color="0.3", lw=0.5)
+        ax.set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
         ax.set_ylabel("mean circumferential pocket force [N]")
         ax.set_xlim(0, 360)
-        ax.set_title(title + ": pocket force vs theta")
-        ax.legend(fontsize=8)
-        out.append(_save(fig, f"{stem}_forces.png"))
-        # impulses per pocket (Fig. 7 analog)
-        fig, ax = plt.subplots(figsize=(8, 4))
-        x = np.arange(n)
-        ax.errorbar(x - 0.12, self.per_rotation_I_acc.mean(0) * 1e3, yerr=self.per_rotation_I_acc.std(0) * 1e3,
-                    fmt="o", label="I_acc (front)")
-        ax.errorbar(x + 0.12, self.per_rotation_I_dec.mean(0) * 1e3, yerr=self.per_rotation_I_dec.std(0) * 1e3,
-                    fmt="s", label="I_dec (rear)")
+        ax.set_title(f"{self.title()}\npocket force against θ over {self._rotations()} cage rotations", fontsize=9)
+        legend_outside(ax)
+        return fig
+
+    def plot_impulses(self):
+        """Fig. 7 analog: I_acc and I_dec per pocket, mean ± std over rotations."""
+        from bearingsim.plotting import legend_outside, plt
+
+        ia, idc = self.per_rotation["I_acc"], self.per_rotation["I_dec"]
+        x = np.arange(ia.shape[1])
+        fig, ax = plt.subplots(figsize=(9, 4))
+        ax.errorbar(x - 0.12, ia.mean(0) * 1e3, yerr=ia.std(0) * 1e3, fmt="o", label="$I_{acc}$ (front face)")
+        ax.errorbar(x + 0.12, idc.mean(0) * 1e3, yerr=idc.std(0) * 1e3, fmt="s", label="$I_{dec}$ (rear face)")
         ax.set_xlabel("pocket")
+        ax.set_xticks(x)
         ax.set_ylabel("impulse per cage rotation [mN s]")
-        ax.set_title(title + f": mean +- std over {self.rotations} rotations")
-        ax.legend()
-        out.append(_save(fig, f"{stem}_impulses.png"))
-        # cage-centre orbit
-        fig, ax = plt.subplots(figsize=(5, 5))
-        o = self.orbit[np.isfinite(self.orbit[:, 0])]
-        ax.plot(o[:, 1] * 1e6, o[:, 2] * 1e6, lw=0.6)
+        ax.set_ylim(bottom=0.0)
+        ax.set_title(f"{self.title()}\nmean ± std over {self._rotations()} cage rotations", fontsize=9)
+        legend_outside(ax)
+        return fig
+
+    def plot_orbit(self):
+        """Cage-centre orbit (last recorded samples), with the bearing axis and the reach of the faces."""
+        from bearingsim.plotting import legend_outside, plt
+
+        o = self.get("cage_orbit")
+        fig, ax = plt.subplots(figsize=(6.5, 5))
+        ax.plot(o[:, 1] * 1e6, o[:, 2] * 1e6, lw=0.6, label="cage centre")
+        ax.plot([0.0], [0.0], "k+", ms=12, label="bearing axis")
+        p = self.parameters
+        reach = (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(p.multibody.pocket_face_half_angle)
+        circ = np.linspace(0.0, 2.0 * math.pi, 361)
+        ax.plot(reach * 1e6 * np.cos(circ), reach * 1e6 * np.sin(circ), color="C3", lw=0.8, ls="--",
+                label=f"reach of the pocket faces ({reach * 1e6:.0f} µm)")
         ax.set_aspect("equal")
-        ax.set_xlabel("cage centre x [um]")
-        ax.set_ylabel("cage centre y [um]")
-        ax.set_title("cage-centre orbit (recorded, last samples)", fontsize=9)
-        out.append(_save(fig, f"{stem}_orbit.png"))
-        # wear per pocket face (Fig. 14 analog)
-        fig, ax = plt.subplots(figsize=(8, 4))
+        ax.set_xlabel("cage centre x [µm]")
+        ax.set_ylabel("cage centre y [µm] (load along −y)")
+        ax.set_title(f"{self.title()}\ncage-centre orbit, last {len(o)} samples", fontsize=9)
+        legend_outside(ax)
+        return fig
+
+    def plot_wear(self):
+        """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
+        from bearingsim.plotting import legend_outside, plt
+
+        op = self.parameters.operating
+        per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e18  # cage rotations per hour, m^3 -> µm^3
+        x = np.arange(self.per_rotation["I_dec"].shape[1])
+        fig, ax = plt.subplots(figsize=(9, 4))
         wdt = 0.2
-        ax.bar(x - 1.5 * wdt, self.wear_index_front * 1e18, wdt, label="front, k I r_r w_r / H")
-        ax.bar(x - 0.5 * wdt, self.wear_index_rear * 1e18, wdt, label="rear, k I r_r w_r / H")
-        ax.bar(x + 0.5 * wdt, self.wear_work_front * 1e18, wdt, label="front, k sum(F|v_s|dt) / H")
-        ax.bar(x + 1.5 * wdt, self.wear_work_rear * 1e18, wdt, label="rear, k sum(F|v_s|dt) / H")
+        ax.bar(x - 1.5 * wdt, self.get("wear/paper_index_front") * per_hour, wdt, label="front face, impulse index (Eq. 16)")
+        ax.bar(x - 0.5 * wdt, self.get("wear/paper_index_rear") * per_hour, wdt, label="rear face, impulse index (Eq. 16)")
+        ax.bar(x + 0.5 * wdt, self.get("wear/sliding_work_front") * per_hour, wdt, label="front face, sliding work")
+        ax.bar(x + 1.5 * wdt, self.get("wear/sliding_work_rear") * per_hour, wdt, label="rear face, sliding work")
         ax.set_xlabel("pocket")
-        ax.set_ylabel("wear per cage rotation [um^3]")
-        ax.set_title(title + ": Archard wear per pocket face")
-        ax.legend(fontsize=8)
-        out.append(_save(fig, f"{stem}_wear.png"))
-        return out
+        ax.set_xticks(x)
+        ax.set_ylabel("Archard wear volume [µm³ per hour]")
+        ax.set_title(f"{self.title()}\nwear of the pocket faces at this speed (k = {self.parameters.wear.wear_coefficient:g}, "
+                     f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
+        legend_outside(ax)
+        return fig

@@ -20,6 +20,7 @@ import statistics
 
 from bearingsim.multibody import simulate
 from bearingsim.multibody.core import choose_dt
+from bearingsim.parameters import Parameters
 from bearingsim.scenario import resolve
 
 GOAL_S_PER_ROTATION = 0.2  # issue 3: full scene at 6000 rpm
@@ -44,15 +45,15 @@ def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "fu
 
 
 def _row(scene, rpm, dt, runs, total_rot, ref_idec, ref_what):
-    wall = statistics.median(r.wall_s for r in runs)
-    pm = statistics.median(r.pymunk_step_s for r in runs)
+    wall = statistics.median(r.provenance["solver_wall_s"] for r in runs)
+    pm = statistics.median(r.provenance["pymunk_step_s"] for r in runs)
     idec = runs[0].summary["I_dec_mean_Ns"]
     return {
         "model": "multibody", "method": "pymunk", "scene": scene, "rpm": rpm, "dt_s": dt,
         "wall_s": wall / total_rot, "pymunk_step_s": pm / total_rot, "unit_of_work": "cage rotation",
         "run_wall_s": wall, "I_dec_Ns": idec,
         "rel_error": float("nan") if ref_what == "itself" else abs(idec - ref_idec) / ref_idec,
-        "reference": ref_what, "rotations": total_rot, "steps": runs[0].steps, "repeats": len(runs),
+        "reference": ref_what, "rotations": total_rot, "steps": int(runs[0].summary["steps"]), "repeats": len(runs),
     }
 
 
@@ -72,9 +73,9 @@ def bench_cases(quick: bool) -> list[dict]:
         dt_ref = 1e-6
         repeats = 3
     rows = []
-    simulate(reference_scenario(6000, 1, 0))  # load the compiled kernels once (not timed in any row)
+    simulate(Parameters.from_scenario(reference_scenario(6000, 1, 0)))  # load the compiled kernels once (not timed in any row)
     for rpm, nrot in plan.items():
-        sc = reference_scenario(rpm, nrot, 1)
+        sc = Parameters.from_scenario(reference_scenario(rpm, nrot, 1))
         total_rot = nrot + 1
         ref = simulate(sc, dt=dt_ref)
         ref_idec = ref.summary["I_dec_mean_Ns"]
@@ -83,8 +84,8 @@ def bench_cases(quick: bool) -> list[dict]:
             rows.append(_row("full", rpm, dt, runs, total_rot, ref_idec, f"full scene at dt = {dt_ref:g} s"))
         rows.append(_row("full", rpm, dt_ref, [ref], total_rot, ref_idec, "itself"))
     # deterministic scene against the exact reduced solution
-    sc = reference_scenario(3000, 1, 1, scene="reduced_equivalent", phi=23.5)
-    exact = solve_event(PassInputs.from_scenario(sc)).I_dec
+    sc = Parameters.from_scenario(reference_scenario(3000, 1, 1, scene="reduced_equivalent", phi=23.5))
+    exact = solve_event(PassInputs.from_parameters(sc)).I_dec
     _, _, lim = choose_dt(sc)
     for f in (0.5, 0.25, 0.125) if quick else (1.0, 0.5, 0.25, 0.125, 0.0625):
         runs = [simulate(sc, dt=f * lim) for _ in range(repeats)]

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from bearingsim import kinematics as kin
+from bearingsim import laws
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import loop as lp
@@ -57,21 +57,7 @@ class PenetrationExceeded(Exception):
         return 0.8 * self.dt * self.limit / self.pen
 
 
-def load_zone_phi(scenario) -> float:
-    """Load-zone half angle [rad] used by the reduced-equivalent scene (same rule as the reduced model)."""
-    v = scenario.reduced.load_zone_half_angle_deg
-    if isinstance(v, (int, float)):
-        return math.radians(float(v))
-    g = scenario.geometry
-    phi, _ = kin.quasi_static_load_zone(scenario.operating_point.radial_load, g.roller_count,
-                                        g.roller_length, g.radial_clearance)
-    return phi
-
-
-STANDARD_GRAVITY = 9.80665  # m/s^2
-
-
-def inner_ring_model(scenario):
+def inner_ring_model(p):
     """(mass [kg], description) of the inner ring: mass 0 is quasi-static (massless).
 
     ``multibody.inner_ring = "auto"`` keeps the quasi-static ring while the load is always shared by at
@@ -81,83 +67,83 @@ def inner_ring_model(scenario):
     ``multibody.inner_ring_mass_kg``; "auto" takes the radial load as the weight of the rotor the
     bearing carries (the paper's rig), ``M = W / g_n``.
     """
-    mb = scenario.multibody
-    if scenario.multibody.scene != "full":
+    mb = p.multibody
+    if mb.scene != "full":
         return 0.0, "none (reduced-equivalent scene)"
-    geo = scenario.geometry
-    load = scenario.operating_point.radial_load
+    geo = p.bearing
+    load = p.operating.radial_load
     mode = mb.inner_ring
     why = ""
     if mode == "auto":
         if load <= 0.0:
             mode, why = "quasi_static", "auto: no radial load"
         else:
-            k = kin.loaded_rollers_with_one_at_centre(load, geo.roller_count, geo.roller_length,
+            k = laws.loaded_rollers_with_one_at_centre(load, geo.roller_count, geo.roller_length,
                                                       geo.radial_clearance)
             mode = "quasi_static" if k >= 2 else "dynamic"
             why = (f"auto: {k} roller(s) loaded with one at the load-zone centre "
                    f"({'>= 2: quasi-static' if k >= 2 else 'the ring would rest on one roller: dynamic'})")
     if mode == "quasi_static":
         return 0.0, "quasi-static (massless)" + (f"; {why}" if why else "")
-    if mb.inner_ring_mass_kg == "auto":
+    if mb.inner_ring_mass is None:
         if load <= 0.0:
             raise UserError("multibody.inner_ring_mass_kg: a dynamic inner ring without radial load needs its "
                             "mass (there is no rotor weight to take it from); set it in kg")
-        mass = load / STANDARD_GRAVITY
+        mass = load / laws.STANDARD_GRAVITY
         src = f"W / g_n = {mass:.4g} kg"
     else:
-        mass = float(mb.inner_ring_mass_kg)
+        mass = mb.inner_ring_mass
         src = f"multibody.inner_ring_mass_kg = {mass:.4g} kg"
     return mass, f"dynamic, mass {src}" + (f"; {why}" if why else "")
 
 
-def max_roller_load(scenario) -> float:
+def max_roller_load(p) -> float:
     """Estimate of the largest raceway load [N]: Stribeck 5 W / Z plus the centrifugal load."""
-    g = scenario.geometry
-    op = scenario.operating_point
+    g = p.bearing
+    op = p.operating
     return 5.0 * op.radial_load / g.roller_count + g.roller_mass * g.pitch_radius * op.omega_c**2 + 1.0
 
 
-def stability_limit(scenario) -> float:
+def stability_limit(p) -> float:
     """Explicit stability limit 2/omega_n [s] of a roller between two linearised Palmgren contacts."""
-    g = scenario.geometry
-    K = kin.palmgren_stiffness(g.roller_length)
-    q = max_roller_load(scenario)
+    g = p.bearing
+    K = laws.palmgren_stiffness(g.roller_length)
+    q = max_roller_load(p)
     delta = (q / K) ** 0.9
     k_lin = 10.0 / 9.0 * q / delta
     omega_n = math.sqrt(2.0 * k_lin / g.roller_mass)
     return 2.0 / omega_n
 
 
-def impact_dt(scenario) -> float:
+def impact_dt(p) -> float:
     """Impact resolution [s]: a rear impact may overlap the face by at most 0.5 % of s in one step.
 
     Approach speed estimate: free flight across the clearance under the no-load-zone deceleration
     (F_o at the centrifugal load, plus g), ``v = sqrt(2 a s)``, as in the reduced model.
     """
-    g = scenario.geometry
-    op = scenario.operating_point
+    g = p.bearing
+    op = p.operating
     n_c = g.roller_mass * g.pitch_radius * op.omega_c**2
-    f_o = kin.oil_film_drag(float(scenario.lubrication.drag_coefficient), n_c, op.rolling_velocity)
+    f_o = laws.oil_film_drag(p.contact.drag_coefficient, n_c, op.rolling_velocity)
     a = float(f_o) / g.roller_mass + op.gravity + 1e-3
     v = math.sqrt(2.0 * a * g.pocket_clearance)
     return IMPACT_OVERLAP_FRACTION * g.pocket_clearance / v
 
 
-def choose_dt(scenario, dt=None):
+def choose_dt(p, dt=None):
     """(dt [s], how it was chosen, explicit limit [s]). Raises UserError for a dt far above stable."""
-    lim = stability_limit(scenario)
+    lim = stability_limit(p)
     largest = DT_MAX_FACTOR * lim
-    if dt is None and scenario.numerics.dt_s is not None:
-        dt = float(scenario.numerics.dt_s)
+    if dt is None and p.numerics.dt is not None:
+        dt = p.numerics.dt
         how = "numerics.dt_s"
     elif dt is not None:
         how = "simulate(dt=...)"
     else:
-        dti = impact_dt(scenario)
+        dti = impact_dt(p)
         dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
         how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
-               f"(Palmgren, Q_max = {max_roller_load(scenario):.0f} N; 2/omega_n = {lim:.3e} s), "
+               f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
                f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s")
     if dt > largest:
         raise UserError(
@@ -167,32 +153,34 @@ def choose_dt(scenario, dt=None):
     return float(dt), how, lim
 
 
-def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT):
-    """Run the scenario; return a dict of raw accumulators (see :class:`MultibodyResult`)."""
+def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT):
+    """Run the parameters ``p``; return a dict of raw accumulators (see :class:`MultibodyResult`).
+
+    Time series go to ``sink`` (``timeseries(...)`` appenders; see :class:`bearingsim.results.MemorySink`)."""
     t_wall0 = time.perf_counter()
-    geo = scenario.geometry
-    op = scenario.operating_point
-    scene_kind = scenario.multibody.scene
+    geo = p.bearing
+    op = p.operating
+    scene_kind = p.multibody.scene
     reduced_eq = scene_kind == "reduced_equivalent"
     n = geo.roller_count
     if n < 3:
         raise UserError(f"bearing.roller_count = {n}: the multibody model needs at least 3 rollers")
-    h, dt_how, dt_lim = choose_dt(scenario, dt)
+    h, dt_how, dt_lim = choose_dt(p, dt)
     sign = op.sign
-    e = float(scenario.contact.restitution)
-    mu_c = float(scenario.contact.cage_friction)
-    warm = int(scenario.numerics.warmup_rotations)
-    nrot = int(scenario.numerics.rotations)
+    e = p.contact.restitution
+    mu_c = p.contact.cage_friction
+    warm = p.numerics.warmup_rotations
+    nrot = p.numerics.rotations
     s = geo.pocket_clearance
     rr = geo.roller_radius
     rp = geo.pitch_radius
-    K = kin.palmgren_stiffness(geo.roller_length)
+    K = laws.palmgren_stiffness(geo.roller_length)
     # the reduced-equivalent scene keeps the paper's roller path on the pitch circle (no clearance)
     pd = 0.0 if reduced_eq else geo.radial_clearance
     ro_race = geo.outer_race_radius + 0.25 * pd
     ri_race = geo.inner_race_radius - 0.25 * pd
 
-    sc = build_scene(geo, op, e, mu_c, half_angle=math.radians(float(scenario.multibody.pocket_face_half_angle_deg)),
+    sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,
                      n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=reduced_eq, spin_free=not reduced_eq)
     space = sc.space
     nb = n + 1
@@ -216,10 +204,10 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     prm[fk.P_K] = K
     prm[fk.P_CDAMP] = CONTACT_DAMPING_S
     prm[fk.P_DFADE] = DAMPING_FADE_M
-    prm[fk.P_MU] = float(scenario.multibody.traction_mu_max)
-    prm[fk.P_SLIPREF] = float(scenario.multibody.traction_slip_ref)
+    prm[fk.P_MU] = p.contact.traction_mu_max
+    prm[fk.P_SLIPREF] = p.contact.traction_slip_ref
     prm[fk.P_UMIN] = MIN_ENTRAINMENT_M_S
-    prm[fk.P_CDRAG] = float(scenario.lubrication.drag_coefficient)
+    prm[fk.P_CDRAG] = p.contact.drag_coefficient
     prm[fk.P_WEPS] = DRAG_DIRECTION_EPS_M_S
     prm[fk.P_OMEGA_RING] = sign * op.omega_i
     prm[fk.P_LOAD] = op.radial_load
@@ -228,7 +216,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     prm[fk.P_TRACTION] = 0.0 if reduced_eq else 1.0
     prm[fk.P_SPIN] = 0.0 if reduced_eq else 1.0
     prm[fk.P_NEWTON_STEP] = NEWTON_MAX_STEP_M
-    ring_mass, ring_how = inner_ring_model(scenario)
+    ring_mass, ring_how = inner_ring_model(p)
     prm[fk.P_RING_MASS] = ring_mass
 
     # pocket angles from the load-zone centre at t = 0, in [0, 2 pi)
@@ -254,7 +242,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     diag = np.zeros((n, fk.N_DIAG))
     hold = np.zeros(n, dtype=np.bool_)
     # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
-    _, delta_qs = kin.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not reduced_eq else (0, 0)
+    _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not reduced_eq else (0, 0)
     ring_c = np.array([0.0, -max(0.5 * pd, delta_qs)])
     ring_c_prev = np.zeros(2)
     ring_v = np.zeros(2)
@@ -264,7 +252,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     ids_index = order.astype(np.int64)
 
     # reduced-equivalent: held rollers sit at the front of their pockets on the outer race
-    phi = load_zone_phi(scenario) if reduced_eq else 0.0
+    phi = p.reduced.load_zone_half_angle if reduced_eq else 0.0
     if reduced_eq:
         set_fields = lp.BODY_SET_ALL
         set_arr = np.zeros(nb * 7)
@@ -281,18 +269,18 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     travel_end = 2.0 * math.pi * total_rot
     omega_nom = op.omega_c
     steps_est = int(math.ceil(travel_end / omega_nom / h))
-    out_every = max(1, int(round(1.0 / (float(scenario.numerics.output_rate_hz) * h))))
+    out_every = max(1, int(round(1.0 / (p.numerics.output_rate * h))))
     series = None
-    if archive is not None:
+    if sink is not None:
         series = [
-            (archive.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
+            (sink.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
              lp.S_W, 1),
-            (archive.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), lp.S_SLIP, 1),
-            (archive.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
+            (sink.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), lp.S_SLIP, 1),
+            (sink.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
              lp.S_CX, 2),
         ]
         if not reduced_eq:
-            series.append((archive.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
+            series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
                            lp.S_RX, 2))
     bar = None
     if progress:
@@ -313,7 +301,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     lim[lp.LIM_OMEGA] = 3.0 * op.omega_i + 10.0
     lim[lp.LIM_OMEGA_NOM] = omega_nom
     # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
-    face_reach = (rr + 0.5 * s) * math.sin(math.radians(float(scenario.multibody.pocket_face_half_angle_deg)))
+    face_reach = (rr + 0.5 * s) * math.sin(p.multibody.pocket_face_half_angle)
     lim[lp.LIM_ORBIT] = face_reach
     lsi = np.zeros(lp.N_LI, dtype=np.int64)
     lsi[lp.LI_OUT_EVERY] = out_every
@@ -386,7 +374,7 @@ def run(scenario, archive=None, progress=False, dt=None, _hook=None, penetration
     n_orbit = int(lsi[lp.LI_NORBIT])
     pymunk_s = lsf[lp.LF_PYMUNK_NS] * 1e-9 if io.timed else float("nan")
     return dict(
-        scenario=scenario, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
+        parameters=p, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
         wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, t_end=t, t_record=t_rec, win=win, first_imp=first_imp,
         f_bin=f_bin, t_bin=t_bin, q_bin=q_bin, tq_bin=tq_bin, glob=glob.copy(), impacts=imp,
         impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=lsf[lp.LF_W_START] if rec_started else None,

@@ -22,6 +22,7 @@ import time
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody.core import PenetrationExceeded, choose_dt, run
 from bearingsim.multibody.bench import reference_scenario
+from bearingsim.parameters import Parameters
 
 
 def _ok(sc, dt, limit):
@@ -60,7 +61,7 @@ def main(argv=None):
     for scene in ("full", "reduced_equivalent"):
         for rpm in speeds:
             for load in (loads if scene == "full" else (970.0,)):
-                sc = reference_scenario(rpm, 1, 0, scene=scene, load=load, source="<stability>")
+                sc = Parameters.from_scenario(reference_scenario(rpm, 1, 0, scene=scene, load=load, source="<stability>"))
                 t0 = time.perf_counter()
                 auto, _, lim = choose_dt(sc)
                 run_dt = largest_dt(sc, 0.5)

@@ -15,6 +15,9 @@ rotations is zero by construction (the multibody model is where it comes from). 
 the mirror image of forward rotation with θ measured along the cage's rotation, so it yields the same
 numbers.
 
+The model takes :class:`bearingsim.parameters.Parameters` and returns a :class:`ReducedResult`; it
+never sees a scenario file or an archive.
+
 Sign convention of the archive: impulses are positive magnitudes; ``I_dec`` is the rear face's (the
 cage drags a lagging roller), ``I_acc`` the front face's (in this model, the front-face impulse of the
 no-load pass: gravity throws the roller forward on the descending side at low speed).
@@ -22,18 +25,23 @@ no-load pass: gravity throws the roller forward on the descending side at low sp
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from bearingsim.reduced.core import PassInputs, load_zone_half_angle
+from bearingsim import laws
+from bearingsim.reduced.core import FACE_REAR, PassInputs
 from bearingsim.reduced.euler import default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
+from bearingsim.results import AttrGroup, NamedArray, Result
 
 __all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolution"]
 
-FACE_NAMES = np.array(["rear", "front"])
+FACE_NAMES = np.array(["rear", "front"])  # indexed by the face codes of reduced/core.py
+
+SUMMARY_UNITS = {
+    "I_dec_mean_Ns": "N s", "I_dec_std_Ns": "N s", "I_acc_mean_Ns": "N s", "I_acc_std_Ns": "N s",
+    "first_impact_speed_m_s": "m/s", "first_impact_energy_J": "J", "load_zone_half_angle_deg": "deg",
+}
 
 
 def solve_pass(inp: PassInputs, method: str = "event", dt: float | None = None, trace_points: int = 2000):
@@ -44,178 +52,147 @@ def solve_pass(inp: PassInputs, method: str = "event", dt: float | None = None, 
     return solve_euler(inp, dt if dt is not None else default_dt(inp), trace_points=trace_points)
 
 
-@dataclass
-class ReducedResult:
-    """One reduced-model run: the solved pass, replicated over ``rotations`` cage rotations."""
+class ReducedResult(Result):
+    """One reduced-model run: the solved pass, replicated over ``rotations`` cage rotations.
 
-    scenario: object
-    inputs: PassInputs
-    solution: PassSolution
-    rotations: int
-    dt_choice: str
+    Built by :func:`simulate` (then :attr:`inputs` and :attr:`solution` hold the solver's own objects)
+    or read back from an archive (then they are ``None``; everything else is the same).
+    """
 
-    # --- derived -----------------------------------------------------------------------------
-    @property
-    def first_rear_impact(self) -> tuple[float, float]:
-        """(approach speed [m/s], kinetic energy ½ m u² [J]) of the first rear-face impact (NaN if none)."""
-        imp = self.solution.impacts
-        rear = np.flatnonzero(imp["face"] == 0)
-        if rear.size == 0:
-            return math.nan, math.nan
-        u = float(imp["approach_speed"][rear[0]])
-        return u, 0.5 * self.inputs.mass * u * u
+    model = "reduced"
+    FIGURES = ("pass",)
 
-    @property
-    def per_rotation_I_dec(self) -> np.ndarray:
-        return np.full((self.rotations, 1), self.solution.I_dec)
+    def __init__(self, *args, inputs: PassInputs | None = None, solution: PassSolution | None = None, **kw):
+        super().__init__(*args, **kw)
+        self.inputs = inputs
+        self.solution = solution
 
-    @property
-    def per_rotation_I_acc(self) -> np.ndarray:
-        return np.full((self.rotations, 1), self.solution.I_acc)
-
-    @property
-    def summary(self) -> dict[str, float]:
-        u, ek = self.first_rear_impact
-        return {
-            "I_dec_mean_Ns": float(self.per_rotation_I_dec.mean()),
-            "I_dec_std_Ns": float(self.per_rotation_I_dec.std()),
-            "I_acc_mean_Ns": float(self.per_rotation_I_acc.mean()),
-            "I_acc_std_Ns": float(self.per_rotation_I_acc.std()),
-            "first_impact_speed_m_s": u,
-            "first_impact_energy_J": ek,
-            "load_zone_half_angle_deg": math.degrees(self.inputs.theta_start),
-        }
-
-    SUMMARY_UNITS = {
-        "I_dec_mean_Ns": "N s", "I_dec_std_Ns": "N s", "I_acc_mean_Ns": "N s", "I_acc_std_Ns": "N s",
-        "first_impact_speed_m_s": "m/s", "first_impact_energy_J": "J", "load_zone_half_angle_deg": "deg",
-    }
-
-    def impact_table(self) -> dict[str, np.ndarray]:
-        """All impacts of all recorded rotations (the pass repeated; time from the first pass start)."""
-        imp = self.solution.impacts
+    @classmethod
+    def from_solution(cls, p, inp: PassInputs, sol: PassSolution, dt_choice: str) -> "ReducedResult":
+        """Lay out a solved pass as a result (per rotation, impacts, trace, pass, wear, summary)."""
+        rotations = p.numerics.rotations
+        per_dec = np.full((rotations, 1), sol.I_dec)
+        per_acc = np.full((rotations, 1), sol.I_acc)
+        imp = sol.impacts
         n = imp["theta"].size
-        period = 2.0 * math.pi / self.inputs.omega_c
-        rot = np.repeat(np.arange(self.rotations), n)
-        return {
-            "time_s": np.tile(imp["time"], self.rotations) + rot * period,
-            "theta_deg": np.tile(np.degrees(imp["theta"]), self.rotations),
-            "approach_speed_m_s": np.tile(imp["approach_speed"], self.rotations),
-            "impulse_Ns": np.tile(imp["impulse"], self.rotations),
-            "pocket": np.zeros(n * self.rotations, dtype=np.int64),
-            "face": np.tile(FACE_NAMES[imp["face"]], self.rotations),
-            "rotation": rot,
-            "zeno_closure": np.tile(imp["kind"], self.rotations).astype(np.int8),
+        period = 2.0 * math.pi / inp.omega_c
+        rot = np.repeat(np.arange(rotations), n)
+        desc = "[rotation, pocket]"
+        data = {
+            "results/per_rotation/I_dec": NamedArray(per_dec, "N s", "rear-face impulse per cage rotation " + desc),
+            "results/per_rotation/I_acc": NamedArray(per_acc, "N s", "front-face impulse per cage rotation " + desc),
+            # all impacts of all recorded rotations (the pass repeated; time from the first pass start)
+            "results/impacts/time_s": NamedArray(np.tile(imp["time"], rotations) + rot * period, "s"),
+            "results/impacts/theta_deg": NamedArray(np.tile(np.degrees(imp["theta"]), rotations), "deg"),
+            "results/impacts/approach_speed_m_s": NamedArray(np.tile(imp["approach_speed"], rotations), "m/s"),
+            "results/impacts/impulse_Ns": NamedArray(np.tile(imp["impulse"], rotations), "N s"),
+            "results/impacts/pocket": NamedArray(np.zeros(n * rotations, dtype=np.int64)),
+            "results/impacts/face": NamedArray(np.tile(FACE_NAMES[imp["face"]], rotations)),
+            "results/impacts/rotation": NamedArray(rot),
+            "results/impacts/zeno_closure": NamedArray(np.tile(imp["kind"], rotations).astype(np.int8)),
         }
-
-    def wear(self) -> dict[str, float]:
-        """Archard wear of the pocket faces from the paper's index (Eq. 16): V = k I_c r_r ω_r / H.
-
-        ``*_per_rotation_m3`` per cage rotation; ``*_per_hour_m3_h`` at this speed. k and H are the
-        scenario's ``[wear] wear_coefficient`` and ``hardness_Pa``.
-        """
-        sc = self.scenario
-        k, hard = float(sc.wear.wear_coefficient), float(sc.wear.hardness_Pa)
-        sliding = self.inputs.roller_radius * self.inputs.omega_r  # r_r ω_r [m/s]
-        rot_per_hour = 3600.0 * self.inputs.omega_c / (2.0 * math.pi)
-        rear = k * self.solution.I_dec * sliding / hard
-        front = k * self.solution.I_acc * sliding / hard
-        return {"rear_per_rotation_m3": rear, "front_per_rotation_m3": front,
-                "rear_per_hour_m3_h": rear * rot_per_hour, "front_per_hour_m3_h": front * rot_per_hour}
-
-    # --- archive -----------------------------------------------------------------------------
-    def write(self, aw) -> None:
-        sol = self.solution
-        inp = self.inputs
-        aw.write_array("results/per_rotation/I_dec", self.per_rotation_I_dec, "N s",
-                       "rear-face impulse per cage rotation [rotation, pocket]")
-        aw.write_array("results/per_rotation/I_acc", self.per_rotation_I_acc, "N s",
-                       "front-face impulse per cage rotation [rotation, pocket]")
-        aw.write_table(
-            "results/impacts", self.impact_table(),
-            {"time_s": "s", "theta_deg": "deg", "approach_speed_m_s": "m/s", "impulse_Ns": "N s",
-             "pocket": "1", "face": "1", "rotation": "1", "zeno_closure": "1"},
-            "roller-cage impacts; zeno_closure = 1 marks an impact that closes a bounce sequence",
-        )
         if sol.trace is not None:
             tr = sol.trace
-            aw.write_array("results/trace/theta_deg", np.degrees(tr["theta"]), "deg", "roller angle from the load-zone centre")
-            aw.write_array("results/trace/l_r", tr["l_r"], "m", "roller position in the pocket (0 rear face, s front face)")
-            aw.write_array("results/trace/dl_r_dt", tr["dl_r_dt"], "m/s", "roller speed relative to the cage")
-            aw.write_array("results/trace/I_dec_cumulative", tr["I_dec_cumulative"], "N s", "cumulative rear-face impulse")
-        aw.set_attrs(
-            "results/pass",
-            {"I_dec_Ns": sol.I_dec, "I_acc_Ns": sol.I_acc, "I_dec_resting_Ns": sol.I_dec_resting,
-             "I_acc_resting_Ns": sol.I_acc_resting, "theta_start_deg": math.degrees(inp.theta_start),
-             "theta_end_deg": math.degrees(inp.theta_end), "duration_s": inp.pass_duration,
-             "l_end_m": sol.l_end, "v_end_m_s": sol.v_end, "termination": sol.termination},
-            {"I_dec_Ns": "N s", "I_acc_Ns": "N s", "I_dec_resting_Ns": "N s", "I_acc_resting_Ns": "N s",
-             "theta_start_deg": "deg", "theta_end_deg": "deg", "duration_s": "s", "l_end_m": "m", "v_end_m_s": "m/s"},
-        )
-        aw.set_attrs(
-            "results/operating_point",
-            {"omega_c_rad_s": inp.omega_c, "omega_r_rad_s": inp.omega_r, "rolling_velocity_m_s": inp.rolling_velocity},
-            {"omega_c_rad_s": "rad/s", "omega_r_rad_s": "rad/s", "rolling_velocity_m_s": "m/s"},
-        )
-        aw.set_attrs("results/summary", self.summary, self.SUMMARY_UNITS)
-        aw.set_attrs("results/wear", self.wear(), {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in self.wear()})
-        aw.provenance["solver"] = f"reduced/{sol.method}"
-        aw.provenance["solver_wall_s"] = sol.wall_s
-        aw.provenance["dt_s"] = sol.dt if sol.dt is not None else float("nan")
-        aw.provenance["dt_choice"] = self.dt_choice
+            data.update({
+                "results/trace/theta_deg": NamedArray(np.degrees(tr["theta"]), "deg", "roller angle from the load-zone centre"),
+                "results/trace/l_r": NamedArray(tr["l_r"], "m", "roller position in the pocket (0 rear face, s front face)"),
+                "results/trace/dl_r_dt": NamedArray(tr["dl_r_dt"], "m/s", "roller speed relative to the cage"),
+                "results/trace/I_dec_cumulative": NamedArray(tr["I_dec_cumulative"], "N s", "cumulative rear-face impulse"),
+            })
+        rear = np.flatnonzero(imp["face"] == FACE_REAR)
+        u = float(imp["approach_speed"][rear[0]]) if rear.size else math.nan
+        ek = 0.5 * inp.mass * u * u
+        summary = {
+            "I_dec_mean_Ns": float(per_dec.mean()),
+            "I_dec_std_Ns": float(per_dec.std()),
+            "I_acc_mean_Ns": float(per_acc.mean()),
+            "I_acc_std_Ns": float(per_acc.std()),
+            "first_impact_speed_m_s": u,
+            "first_impact_energy_J": ek,
+            "load_zone_half_angle_deg": math.degrees(inp.theta_start),
+        }
+        # Archard wear of the pocket faces from the paper's index, Eq. (16), per rotation and per hour
+        w = p.wear
+        rear_v = laws.archard_wear_volume(w.wear_coefficient, sol.I_dec, inp.roller_radius, inp.omega_r, w.hardness)
+        front_v = laws.archard_wear_volume(w.wear_coefficient, sol.I_acc, inp.roller_radius, inp.omega_r, w.hardness)
+        rot_per_hour = 3600.0 * inp.omega_c / (2.0 * math.pi)
+        wear = {"rear_per_rotation_m3": rear_v, "front_per_rotation_m3": front_v,
+                "rear_per_hour_m3_h": rear_v * rot_per_hour, "front_per_hour_m3_h": front_v * rot_per_hour}
+        groups = {
+            "results/pass": AttrGroup(
+                {"I_dec_Ns": sol.I_dec, "I_acc_Ns": sol.I_acc, "I_dec_resting_Ns": sol.I_dec_resting,
+                 "I_acc_resting_Ns": sol.I_acc_resting, "theta_start_deg": math.degrees(inp.theta_start),
+                 "theta_end_deg": math.degrees(inp.theta_end), "duration_s": inp.pass_duration,
+                 "l_end_m": sol.l_end, "v_end_m_s": sol.v_end, "termination": sol.termination},
+                {"I_dec_Ns": "N s", "I_acc_Ns": "N s", "I_dec_resting_Ns": "N s", "I_acc_resting_Ns": "N s",
+                 "theta_start_deg": "deg", "theta_end_deg": "deg", "duration_s": "s", "l_end_m": "m",
+                 "v_end_m_s": "m/s"}),
+            "results/operating_point": AttrGroup(
+                {"omega_c_rad_s": inp.omega_c, "omega_r_rad_s": inp.omega_r, "rolling_velocity_m_s": inp.rolling_velocity},
+                {"omega_c_rad_s": "rad/s", "omega_r_rad_s": "rad/s", "rolling_velocity_m_s": "m/s"}),
+            "results/summary": AttrGroup(summary, dict(SUMMARY_UNITS)),
+            "results/wear": AttrGroup(wear, {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in wear}),
+        }
+        provenance = {"solver": f"reduced/{sol.method}", "solver_wall_s": sol.wall_s,
+                      "dt_s": sol.dt if sol.dt is not None else float("nan"), "dt_choice": dt_choice}
         for k, v in sol.info.items():
             if np.isscalar(v):
-                aw.provenance[f"solver_{k}"] = v
+                provenance[f"solver_{k}"] = v
+        tables = {"results/impacts": "roller-cage impacts; zeno_closure = 1 marks an impact that closes a bounce sequence"}
+        res = cls(None, data, groups, provenance=provenance, tables=tables, inputs=inp, solution=sol)
+        res._parameters = p
+        return res
+
+    def description(self) -> str:
+        return f"reduced model ({self.provenance.get('solver', 'reduced/?').split('/')[-1]})"
 
     # --- figures -----------------------------------------------------------------------------
-    def save_figures(self, stem: Path) -> list[Path]:
+    def plot_pass(self):
         """Fig. 8 analog: l_r, dl_r/dt and cumulative I_dec against θ over the no-load pass."""
         from bearingsim.plotting import plt
 
-        sol = self.solution
-        if sol.trace is None:
-            return []
-        tr = sol.trace
-        th = np.degrees(tr["theta"])
-        fig, ax = plt.subplots(3, 1, figsize=(7.0, 7.5), sharex=True)
-        ax[0].plot(th, tr["l_r"] * 1e3, lw=1.0)
-        ax[0].set_ylabel("$l_r$ [mm]\n(0 rear, s front)")
-        ax[1].plot(th, tr["dl_r_dt"], lw=1.0)
-        ax[1].set_ylabel("$dl_r/dt$ [m/s]")
-        ax[2].plot(th, tr["I_dec_cumulative"] * 1e3, lw=1.2)
+        fig, ax = plt.subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
+        if "results/trace/theta_deg" not in self.data:
+            ax[0].text(0.5, 0.5, "no trace recorded", transform=ax[0].transAxes, ha="center")
+            return fig
+        th = self.get("trace/theta_deg")
+        p = self.parameters
+        ax[0].plot(th, self.get("trace/l_r") * 1e6, lw=1.0)
+        ax[0].axhline(0.0, color="0.5", lw=0.6, ls="--", label="rear face")
+        ax[0].axhline(p.bearing.pocket_clearance * 1e6, color="0.5", lw=0.6, ls="-.", label="front face")
+        ax[0].set_ylabel("roller position $l_r$ [µm]")
+        ax[1].plot(th, self.get("trace/dl_r_dt"), lw=1.0)
+        ax[1].set_ylabel("speed in the pocket\n$dl_r/dt$ [m/s]")
+        ax[2].plot(th, self.get("trace/I_dec_cumulative") * 1e3, lw=1.2)
         ax[2].set_ylabel("cumulative $I_{dec}$ [mN s]")
-        ax[2].set_xlabel("θ from the load-zone centre [deg]")
-        sc = self.scenario
-        ax[0].set_title(
-            f"{sc.name}: reduced model ({sol.method}), {sc.operating.inner_ring_speed_rpm:g} rpm, "
-            f"c = {sc.lubrication.drag_coefficient:g}, e = {sc.contact.restitution:g}, "
-            f"$I_{{dec}}$ = {sol.I_dec * 1e3:.3f} mN s",
-            fontsize=9,
-        )
+        ax[2].set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
+        s = self.summary
+        ax[0].set_title(f"{self.title()}\nc = {p.contact.drag_coefficient:g}, e = {p.contact.restitution:g}, "
+                        f"$I_{{dec}}$ = {s['I_dec_mean_Ns'] * 1e3:.3f} mN s per pass", fontsize=9)
         for a in ax:
             a.grid(alpha=0.3)
-            a.axvline(180.0, color="0.6", lw=0.6)
-        fig.tight_layout()
-        out = Path(f"{stem}_pass.png")
-        fig.savefig(out, dpi=130)
-        plt.close(fig)
-        return [out]
+            a.axvline(180.0, color="0.6", lw=0.6, label="θ = 180° (top)")
+        from bearingsim.plotting import legend_outside
+
+        legend_outside(ax[0])
+        return fig
 
 
-def simulate(scenario, archive=None, progress: bool = False, dt: float | None = None) -> ReducedResult:
-    """Run the reduced model for ``scenario`` (see the module docstring)."""
-    inp = PassInputs.from_scenario(scenario)
-    method = scenario.reduced.method
+def simulate(p, sink=None, progress: bool = False, dt: float | None = None) -> ReducedResult:
+    """Run the reduced model for the SI parameters ``p`` (see the module docstring).
+
+    ``sink`` and ``progress`` are accepted for symmetry with the multibody model: one pass has no
+    time series to stream and takes milliseconds. ``dt`` [s] overrides ``numerics.dt`` (euler only).
+    """
+    inp = PassInputs.from_parameters(p)
+    method = p.reduced.method
     dt_choice = "event-driven: no time step"
     if method == "euler":
         if dt is None:
-            dt = scenario.numerics.dt_s
+            dt = p.numerics.dt
             dt_choice = "numerics.dt_s"
         if dt is None:
             dt = default_dt(inp)
             dt_choice = "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
     sol = solve_pass(inp, method, dt)
-    return ReducedResult(scenario, inp, sol, int(scenario.numerics.rotations), dt_choice)
-
-
-__all__ += ["load_zone_half_angle"]
+    return ReducedResult.from_solution(p, inp, sol, dt_choice)

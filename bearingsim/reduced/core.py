@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from bearingsim import kinematics as kin
+from bearingsim import laws
 
 # Mode codes shared by the solvers (numba kernels cannot use enums cheaply).
 FREE = 0
@@ -87,30 +87,28 @@ class PassInputs:
     resting_contact: bool
 
     @classmethod
-    def from_scenario(cls, scenario) -> "PassInputs":
-        """Build the inputs from a resolved :class:`bearingsim.scenario.Scenario`.
+    def from_parameters(cls, p) -> "PassInputs":
+        """The inputs of one pass from :class:`bearingsim.parameters.Parameters` ``p``.
 
-        The load-zone half angle φ is ``reduced.load_zone_half_angle_deg``, or, when it is
-        ``"auto"``, the quasi-static half angle of :func:`bearingsim.kinematics.quasi_static_load_zone`
-        for the scenario's radial load, roller count, roller length and radial clearance.
+        φ is ``p.reduced.load_zone_half_angle``: the scenario's ``reduced.load_zone_half_angle_deg`` or,
+        for ``"auto"``, the quasi-static half angle (:func:`bearingsim.laws.load_zone_half_angle`).
         """
-        geo = scenario.geometry
-        op = scenario.operating_point
-        phi = load_zone_half_angle(scenario)
+        b, op = p.bearing, p.operating
+        phi = p.reduced.load_zone_half_angle
         return cls(
-            mass=geo.roller_mass,
-            pitch_radius=geo.pitch_radius,
-            roller_radius=geo.roller_radius,
-            pocket_clearance=geo.pocket_clearance,
+            mass=b.roller_mass,
+            pitch_radius=b.pitch_radius,
+            roller_radius=b.roller_radius,
+            pocket_clearance=b.pocket_clearance,
             omega_c=abs(op.omega_c),
             omega_r=abs(op.omega_r),
             rolling_velocity=abs(op.rolling_velocity),
-            drag_coefficient=float(scenario.lubrication.drag_coefficient),
-            gravity=float(op.gravity),
-            restitution=float(scenario.contact.restitution),
+            drag_coefficient=p.contact.drag_coefficient,
+            gravity=op.gravity,
+            restitution=p.contact.restitution,
             theta_start=phi,
             theta_end=2.0 * math.pi - phi,
-            resting_contact=bool(scenario.reduced.resting_contact),
+            resting_contact=p.reduced.resting_contact,
         )
 
     # ---- derived quantities ------------------------------------------------------------------
@@ -124,8 +122,8 @@ class PassInputs:
         """K such that F_o/m = K (r_p ω_c² + g cos θ)^0.246 where positive [SI]."""
         return (
             self.drag_coefficient
-            * self.mass ** (kin.DRAG_LOAD_EXPONENT - 1.0)
-            * self.rolling_velocity**kin.DRAG_SPEED_EXPONENT
+            * self.mass ** (laws.DRAG_LOAD_EXPONENT - 1.0)
+            * self.rolling_velocity**laws.DRAG_SPEED_EXPONENT
         )
 
     @property
@@ -135,8 +133,8 @@ class PassInputs:
 
     def drag_force(self, theta):
         """F_o(θ) [N] through :func:`bearingsim.kinematics.oil_film_drag` (vectorised; reference)."""
-        n = kin.outer_race_normal_load(self.mass, self.pitch_radius, self.omega_c, theta, self.gravity)
-        return kin.oil_film_drag(self.drag_coefficient, n, self.rolling_velocity)
+        n = laws.outer_race_normal_load(self.mass, self.pitch_radius, self.omega_c, theta, self.gravity)
+        return laws.oil_film_drag(self.drag_coefficient, n, self.rolling_velocity)
 
     def acceleration(self, theta):
         """Free-flight acceleration a(θ) = −g sin θ − F_o/m [m/s²] (vectorised; reference)."""
@@ -153,18 +151,6 @@ class PassInputs:
         return (lo, 2.0 * math.pi - lo) if lo < math.pi else (math.pi,)
 
 
-def load_zone_half_angle(scenario) -> float:
-    """φ [rad]: the scenario's ``reduced.load_zone_half_angle_deg`` or the quasi-static value."""
-    value = scenario.reduced.load_zone_half_angle_deg
-    if value == "auto":
-        geo = scenario.geometry
-        phi, _ = kin.quasi_static_load_zone(
-            scenario.operating_point.radial_load, geo.roller_count, geo.roller_length, geo.radial_clearance
-        )
-        return float(phi)
-    return math.radians(float(value))
-
-
 # ---- scalar kernels (numba) -------------------------------------------------------------------
 @njit(cache=True)
 def drag_accel(theta, drag_scale, centripetal, gravity):
@@ -172,7 +158,7 @@ def drag_accel(theta, drag_scale, centripetal, gravity):
     n_over_m = centripetal + gravity * math.cos(theta)
     if n_over_m <= 0.0:
         return 0.0
-    return drag_scale * n_over_m**0.246
+    return drag_scale * n_over_m**laws.DRAG_LOAD_EXPONENT
 
 
 @njit(cache=True)
@@ -214,3 +200,8 @@ def gravity_dl(theta0, theta, omega, gravity):
     h = theta - theta0
     one_minus_cos = 2.0 * math.sin(0.5 * h) ** 2
     return gravity / omega**2 * (math.cos(theta0) * sin_minus_x(h) - math.sin(theta0) * one_minus_cos)
+
+
+from bearingsim._jit import drop_stale_caches  # noqa: E402
+
+drop_stale_caches(__name__, (laws,))  # the kernels here compile in laws.py constants

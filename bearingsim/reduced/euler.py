@@ -23,6 +23,7 @@ import time
 import numpy as np
 from numba import njit
 
+from bearingsim import laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.errors import UserError
 from bearingsim.reduced import core as _core
@@ -150,7 +151,7 @@ def max_stable_dt(inp: PassInputs) -> float:
     allows, u_max = sqrt(2 a_max s) (the roller starts at rest and can fall at most the clearance s
     between rebounds, which only lose speed), may cross at most 10 % of s in one step.
     """
-    a_max = inp.gravity + inp.drag_scale * (inp.centripetal + inp.gravity) ** 0.246
+    a_max = inp.gravity + inp.drag_scale * (inp.centripetal + inp.gravity) ** laws.DRAG_LOAD_EXPONENT
     u_max = math.sqrt(2.0 * max(a_max, 1e-30) * inp.pocket_clearance)
     return min(inp.pass_duration / MIN_STEPS_PER_PASS, MAX_TRAVEL_FRACTION * inp.pocket_clearance / u_max)
 
@@ -213,4 +214,4 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
     return sol
 
 
-drop_stale_caches(__name__, (_core,))  # the kernels here compile in those of reduced/core.py
+drop_stale_caches(__name__, (_core, laws))  # the kernels here compile in those of reduced/core.py and laws.py

@@ -57,6 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numba import njit
 
+from bearingsim import laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.errors import SimulationUnstable
 from bearingsim.reduced import core as _core
@@ -151,7 +152,7 @@ def _fit_panel(a, b, K, A, g, root, sin_root, nodes, cosmat, fv, out):
             d = off + half * nodes[j]
             h = 0.5 * d
             nm = -2.0 * g * (sin_root * math.cos(h) + cos_root * math.sin(h)) * math.sin(h)
-            fv[j] = K * nm**0.246 if nm > 0.0 else 0.0
+            fv[j] = K * nm**laws.DRAG_LOAD_EXPONENT if nm > 0.0 else 0.0
     for k in range(n + 1):
         s = 0.5 * (fv[0] * cosmat[0, k] + fv[n] * cosmat[n, k])
         for j in range(1, n):
@@ -172,7 +173,7 @@ def _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, ro
     n = nodes.shape[0] - 1
     breaks = np.empty(cap + 1)
     fco = np.empty((cap, n + 1))
-    fscale = K * max(A + g, 0.0) ** 0.246
+    fscale = K * max(A + g, 0.0) ** laws.DRAG_LOAD_EXPONENT
     # base intervals: split at the roots of N = 0 inside the pass
     base = np.empty(4)
     nb = 0
@@ -1109,4 +1110,4 @@ def closed_form_evaluator(inp: PassInputs):
     return evaluate
 
 
-drop_stale_caches(__name__, (_core,))  # the kernels here compile in those of reduced/core.py
+drop_stale_caches(__name__, (_core, laws))  # the kernels here compile in those of reduced/core.py and laws.py

@@ -8,6 +8,7 @@ import numpy as np
 
 from bearingsim.reduced.core import PassInputs
 from bearingsim.reduced.event import solve_event
+from bearingsim.parameters import Parameters
 from bearingsim.scenario import resolve
 
 FIG9_SPEEDS_RPM = (500, 750, 1000, 1500, 2000, 3000, 4000, 5000, 6000)
@@ -35,7 +36,8 @@ def paper_scenario(rpm: float, drag: float = 0.02, previous: bool = False, direc
 
 def idec_per_rotation(rpm: float, drag: float = 0.02, previous: bool = False) -> float:
     """I_dec of one cage rotation [N s] by the event solver."""
-    return solve_event(PassInputs.from_scenario(paper_scenario(rpm, drag, previous)), trace_points=0).I_dec
+    return solve_event(PassInputs.from_parameters(Parameters.from_scenario(paper_scenario(rpm, drag, previous))),
+                       trace_points=0).I_dec
 
 
 def fig9_table(speeds=FIG9_SPEEDS_RPM, drags=FIG9_DRAG) -> dict[str, np.ndarray]:

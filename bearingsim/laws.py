@@ -1,4 +1,16 @@
-"""Pure float-in/float-out kernels: bearing kinematics and the paper's force laws. SI throughout.
+"""The physics laws both models use, each written once: pure float-in/float-out functions, SI throughout.
+
+* kinematics of the bearing, Eqs. (10)-(12) and (4) of the seed paper;
+* the outer-race normal load, Eq. (3), and the oil-film (EHL rolling) resistance, Eq. (2), with a
+  compiled scalar form for the kernels (:func:`oil_film_drag_scalar`);
+* the Palmgren line contact ``Q = K delta^(10/9)`` (:func:`palmgren_stiffness`,
+  :func:`palmgren_load`);
+* the load-zone rule: the half angle ``psi_l = arccos(P_d / (2 delta_r))`` of a ring displaced by
+  ``delta_r`` (:func:`load_zone_from_displacement`), the quasi-static displacement that carries a
+  radial load (:func:`quasi_static_load_zone`), and the half angle a model uses
+  (:func:`load_zone_half_angle`: the scenario's value or the quasi-static one);
+* Archard's wear law in the paper's impulse form, Eq. (16) (:func:`archard_wear_volume`);
+* gravity (:data:`STANDARD_GRAVITY`).
 
 Equation numbers refer to Suzuki et al., Machines 11(6):594, 2023 (the seed paper).
 """
@@ -7,6 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 
@@ -51,6 +64,63 @@ def oil_film_drag(drag_coefficient, normal_load, rolling_velocity):
     return drag_coefficient * n**DRAG_LOAD_EXPONENT * np.abs(rolling_velocity) ** DRAG_SPEED_EXPONENT
 
 
+@njit(cache=True)
+def oil_film_drag_scalar(drag_coefficient, normal_load, rolling_velocity):
+    """Eq. (2) for one contact, compiled: F_o = c N^0.246 V^0.648 [N] for N > 0, else 0.
+
+    Parameters
+    ----------
+    drag_coefficient : float
+        c of Eq. (2), SI.
+    normal_load : float
+        N [N].
+    rolling_velocity : float
+        V [m/s], >= 0.
+    """
+    if normal_load <= 0.0:
+        return 0.0
+    return drag_coefficient * normal_load**DRAG_LOAD_EXPONENT * rolling_velocity**DRAG_SPEED_EXPONENT
+
+
+@njit(cache=True)
+def palmgren_load(stiffness, approach):
+    """Palmgren line contact: Q = K delta^(10/9) [N] for an approach delta [m] > 0, else 0."""
+    if approach <= 0.0:
+        return 0.0
+    return stiffness * approach ** (10.0 / 9.0)
+
+
+def archard_wear_volume(wear_coefficient, impulse, roller_radius, omega_r, hardness):
+    """Archard wear volume [m^3] in the paper's impulse form, Eq. (16): V = k I_c r_r omega_r / H.
+
+    ``W L_s = integral F_c dL_s ~ I_c r_r omega_r``: the sliding distance is the roller surface speed
+    ``r_r omega_r`` times the contact time. ``impulse`` [N s] may be an array; k [-], H [Pa].
+    """
+    return wear_coefficient * impulse * (roller_radius * omega_r) / hardness
+
+
+def load_zone_from_displacement(ring_displacement, radial_clearance):
+    """Load-zone half angle [rad] of a ring displaced by ``delta_r`` along the load (Harris & Kotzalas,
+    Sec. 7.2): ``psi_l = arccos(P_d / (2 delta_r))``; 0 when ``delta_r <= P_d / 2`` (no roller loaded),
+    pi/2 for zero clearance; NaN for a non-finite displacement."""
+    delta_r = float(ring_displacement)
+    if not math.isfinite(delta_r):
+        return float("nan")
+    half_pd = 0.5 * radial_clearance
+    if delta_r <= half_pd:
+        return 0.5 * math.pi if half_pd == 0.0 and delta_r > 0.0 else 0.0
+    return math.acos(half_pd / delta_r)
+
+
+def load_zone_half_angle(given_deg, radial_load, roller_count, roller_length, radial_clearance):
+    """The load-zone half angle phi [rad] a model uses: ``given_deg`` (degrees) when it is a number,
+    else (``None``) the quasi-static half angle of :func:`quasi_static_load_zone` for the load."""
+    if given_deg is not None:
+        return math.radians(float(given_deg))
+    phi, _ = quasi_static_load_zone(radial_load, roller_count, roller_length, radial_clearance)
+    return float(phi)
+
+
 def palmgren_stiffness(roller_length: float) -> float:
     """Palmgren line-contact constant K of Q = K delta^(10/9), in SI (N / m^(10/9)).
 
@@ -76,9 +146,7 @@ def quasi_static_load_zone(radial_load, roller_count, roller_length, radial_clea
     half_pd = radial_clearance / 2.0
     # the smeared rollers: each grid point carries Z / n_points of a roller
     delta_r = _ring_displacement(radial_load, psi, roller_count / n_points, roller_length, half_pd)
-    if half_pd == 0.0:
-        return math.pi / 2.0, delta_r
-    return math.acos(min(1.0, half_pd / delta_r)), delta_r
+    return load_zone_from_displacement(delta_r, radial_clearance), delta_r
 
 
 def loaded_rollers_with_one_at_centre(radial_load, roller_count, roller_length, radial_clearance):

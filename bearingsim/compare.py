@@ -1,0 +1,80 @@
+"""Comparing two results: scenario keys, summary numbers and per-rotation arrays, bit for bit.
+
+Used by ``bearingsim compare A.h5 B.h5`` and ``bearingsim rerun ARCHIVE``.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+def _flatten(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict):
+            out.update(_flatten(v, key + "."))
+        else:
+            out[key] = v
+    return out
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b and type(a) is type(b)
+
+
+@dataclass
+class Comparison:
+    """What differs between two results (empty lists: identical)."""
+
+    scenario_keys: list[tuple[str, object, object]] = field(default_factory=list)
+    summary: list[tuple[str, float, float]] = field(default_factory=list)  # every key of either
+    summary_differs: list[str] = field(default_factory=list)
+    arrays_differ: list[str] = field(default_factory=list)
+    versions: list[tuple[str, object, object]] = field(default_factory=list)
+
+    @property
+    def identical(self) -> bool:
+        """True when every summary number and per-rotation array is bit-identical."""
+        return not self.summary_differs and not self.arrays_differ
+
+    def summary_table(self) -> str:
+        """The summary numbers side by side with their absolute and relative difference."""
+        rows = [f"{'summary':34s} {'A':>14s} {'B':>14s} {'B - A':>11s} {'(B - A)/|A|':>11s}"]
+        for k, a, b in self.summary:
+            d = b - a
+            rel = d / abs(a) if a not in (0.0,) and math.isfinite(a) else float("nan")
+            mark = "" if k not in self.summary_differs else "  *"
+            rows.append(f"{k:34s} {a:14.7g} {b:14.7g} {d:11.3g} {rel:11.3g}{mark}")
+        return "\n".join(rows)
+
+
+def compare_results(a, b) -> Comparison:
+    """Compare results ``a`` and ``b`` (:class:`bearingsim.results.Result`)."""
+    c = Comparison()
+    fa, fb = _flatten(a.scenario.raw), _flatten(b.scenario.raw)
+    for k in sorted(set(fa) | set(fb)):
+        va, vb = fa.get(k, "(unset)"), fb.get(k, "(unset)")
+        if not _same(va, vb):
+            c.scenario_keys.append((k, va, vb))
+    sa, sb = a.summary, b.summary
+    for k in list(sa) + [k for k in sb if k not in sa]:
+        va, vb = sa.get(k, float("nan")), sb.get(k, float("nan"))
+        c.summary.append((k, va, vb))
+        if k not in sa or k not in sb or not _same(va, vb):
+            c.summary_differs.append(k)
+    pa, pb = a.per_rotation, b.per_rotation
+    for k in list(pa) + [k for k in pb if k not in pa]:
+        x, y = pa.get(k), pb.get(k)
+        if x is None or y is None or x.shape != y.shape or not np.array_equal(x, y, equal_nan=x.dtype.kind == "f"):
+            c.arrays_differ.append(f"per_rotation/{k}")
+    va = {k: v for k, v in a.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
+    vb = {k: v for k, v in b.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
+    for k in sorted(set(va) | set(vb)):
+        if va.get(k) != vb.get(k):
+            c.versions.append((k, va.get(k, "?"), vb.get(k, "?")))
+    return c

@@ -1,0 +1,204 @@
+"""The parameters layer: a resolved scenario turned once into frozen SI objects. SI throughout.
+
+Both models take a :class:`Parameters` and nothing else: no model reads a scenario's text keys or
+converts a unit. The groups follow their lifetime (ROSS-style frozen dataclasses):
+
+* :class:`Bearing`: geometry and masses of the bearing and its cage (fixed for a bearing design);
+* :class:`OperatingPoint`: speeds, direction, load and gravity (what a test rig changes);
+* :class:`ContactLubrication`: roller-cage impact and friction, oil-film drag, EHL traction;
+* :class:`Numerics`: time step, run length, output rate;
+* :class:`ReducedOptions` / :class:`MultibodyOptions`: the model options of each model;
+* :class:`Wear`: Archard's coefficient and the cage hardness.
+
+A new physical parameter is added in three places: the schema (:mod:`bearingsim.scenario`, with its
+unit in the key name and a default or a preset value), its SI field in one group here (converted in
+:meth:`Parameters.from_scenario`), and the model code that uses it (``docs/architecture.md``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from bearingsim import laws
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """Bearing geometry and masses [SI]. Raceway radii follow from the pitch circle and the roller."""
+
+    roller_count: int
+    roller_radius: float  # r_r [m]
+    roller_length: float  # l [m]
+    roller_mass: float  # m [kg]
+    pitch_radius: float  # r_p [m]
+    pocket_clearance: float  # s [m]: pocket diameter minus roller diameter
+    radial_clearance: float  # P_d [m], diametral, operating
+    cage_mass: float  # [kg]
+    cage_inertia: float  # polar moment [kg m^2]
+
+    @property
+    def outer_race_radius(self) -> float:
+        """r_o = r_p + r_r (paper, Eq. 4) [m]."""
+        return self.pitch_radius + self.roller_radius
+
+    @property
+    def inner_race_radius(self) -> float:
+        """r_i = r_p - r_r [m]."""
+        return self.pitch_radius - self.roller_radius
+
+    @property
+    def roller_inertia(self) -> float:
+        """Solid cylinder about its axis, m r_r^2 / 2 [kg m^2]."""
+        return 0.5 * self.roller_mass * self.roller_radius**2
+
+    @property
+    def palmgren_stiffness(self) -> float:
+        """K of the roller's line contacts, Q = K delta^(10/9) [N / m^(10/9)]."""
+        return laws.palmgren_stiffness(self.roller_length)
+
+
+@dataclass(frozen=True)
+class OperatingPoint:
+    """Speeds (magnitudes), direction, load and gravity [SI]. ``sign`` is +1 forward, -1 reverse."""
+
+    inner_ring_speed_rpm: float  # n_i [rpm], kept for labels and reports
+    omega_i: float  # |inner ring| [rad/s], Eq. (10)
+    omega_c: float  # epicyclic cage speed [rad/s], Eq. (11)
+    omega_r: float  # roller spin [rad/s], Eq. (12)
+    rolling_velocity: float  # V [m/s], Eq. (4)
+    sign: int
+    radial_load: float  # W [N], the rotor's weight: it points down (-y)
+    gravity: float  # g [m/s^2], 0 when switched off
+
+
+@dataclass(frozen=True)
+class ContactLubrication:
+    """Roller-cage contact and lubrication [SI]."""
+
+    restitution: float  # e of a roller-cage impact, Eq. (6) [-]
+    cage_friction: float  # roller-cage Coulomb friction coefficient [-]
+    drag_coefficient: float  # c of Eq. (2), SI
+    traction_mu_max: float  # EHL traction mu_max of mu = mu_max tanh(slip / slip_ref) [-]
+    traction_slip_ref: float  # slip_ref of the traction curve [-]
+
+
+@dataclass(frozen=True)
+class Numerics:
+    """Time step and run length."""
+
+    dt: float | None  # [s]; None: the model chooses
+    rotations: int  # recorded cage rotations
+    warmup_rotations: int  # cage rotations run before recording
+    output_rate: float  # time-series samples per second [Hz]
+
+
+@dataclass(frozen=True)
+class ReducedOptions:
+    """Options of the reduced single-pocket model (and of the reduced-equivalent multibody scene)."""
+
+    method: str  # "event" or "euler"
+    load_zone_half_angle: float  # phi [rad]: the scenario's value or the quasi-static one
+    load_zone_rule: str  # how phi was obtained: "given" or "quasi-static"
+    resting_contact: bool  # count the resting-contact impulse of Eq. (9)
+
+
+@dataclass(frozen=True)
+class MultibodyOptions:
+    """Options of the multi-pocket model."""
+
+    scene: str  # "full" or "reduced_equivalent"
+    inner_ring: str  # "auto", "quasi_static" or "dynamic"
+    inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
+    pocket_face_half_angle: float  # angular half-width of each pocket face arc [rad]
+
+
+@dataclass(frozen=True)
+class Wear:
+    """Archard wear of the cage: V = k W L / H."""
+
+    wear_coefficient: float  # k [-]
+    hardness: float  # H [Pa]
+
+
+@dataclass(frozen=True)
+class Parameters:
+    """Everything a model run depends on, in SI, grouped by lifetime.
+
+    ``name`` and ``model`` identify the run (labels); :meth:`from_scenario` is the only place where
+    scenario keys are read and units converted.
+    """
+
+    name: str
+    model: str
+    bearing: Bearing
+    operating: OperatingPoint
+    contact: ContactLubrication
+    numerics: Numerics
+    reduced: ReducedOptions
+    multibody: MultibodyOptions
+    wear: Wear
+
+    @classmethod
+    def from_scenario(cls, scenario) -> "Parameters":
+        """Build the SI parameters of a resolved :class:`bearingsim.scenario.Scenario`."""
+        b = scenario.bearing
+        bearing = Bearing(
+            roller_count=b.roller_count,
+            roller_radius=b.roller_diameter_mm * 0.5e-3,
+            roller_length=b.roller_length_mm * 1e-3,
+            roller_mass=b.roller_mass_kg,
+            pitch_radius=b.pitch_diameter_mm * 0.5e-3,
+            pocket_clearance=b.pocket_clearance_mm * 1e-3,
+            radial_clearance=b.radial_clearance_mm * 1e-3,
+            cage_mass=b.cage_mass_kg,
+            cage_inertia=b.cage_inertia_kgm2,
+        )
+        o = scenario.operating
+        omega_i = laws.inner_ring_angular_speed(o.inner_ring_speed_rpm)
+        omega_c = laws.cage_angular_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
+        omega_r = laws.roller_spin_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
+        operating = OperatingPoint(
+            inner_ring_speed_rpm=float(o.inner_ring_speed_rpm),
+            omega_i=omega_i,
+            omega_c=omega_c,
+            omega_r=omega_r,
+            rolling_velocity=laws.rolling_speed(omega_r, omega_c, bearing.roller_radius,
+                                                bearing.outer_race_radius),
+            sign=1 if o.direction == "forward" else -1,
+            radial_load=float(o.radial_load_N),
+            gravity=laws.STANDARD_GRAVITY if o.gravity else 0.0,
+        )
+        mb = scenario.multibody
+        contact = ContactLubrication(
+            restitution=float(scenario.contact.restitution),
+            cage_friction=float(scenario.contact.cage_friction),
+            drag_coefficient=float(scenario.lubrication.drag_coefficient),
+            traction_mu_max=float(mb.traction_mu_max),
+            traction_slip_ref=float(mb.traction_slip_ref),
+        )
+        nu = scenario.numerics
+        numerics = Numerics(
+            dt=None if nu.dt_s is None else float(nu.dt_s),
+            rotations=int(nu.rotations),
+            warmup_rotations=int(nu.warmup_rotations),
+            output_rate=float(nu.output_rate_hz),
+        )
+        r = scenario.reduced
+        given = None if r.load_zone_half_angle_deg == "auto" else float(r.load_zone_half_angle_deg)
+        reduced = ReducedOptions(
+            method=r.method,
+            load_zone_half_angle=laws.load_zone_half_angle(given, operating.radial_load, bearing.roller_count,
+                                                           bearing.roller_length, bearing.radial_clearance),
+            load_zone_rule="quasi-static" if given is None else "given",
+            resting_contact=bool(r.resting_contact),
+        )
+        multibody = MultibodyOptions(
+            scene=mb.scene,
+            inner_ring=mb.inner_ring,
+            inner_ring_mass=None if mb.inner_ring_mass_kg == "auto" else float(mb.inner_ring_mass_kg),
+            pocket_face_half_angle=math.radians(float(mb.pocket_face_half_angle_deg)),
+        )
+        wear = Wear(wear_coefficient=float(scenario.wear.wear_coefficient),
+                    hardness=float(scenario.wear.hardness_Pa))
+        return cls(name=scenario.name, model=scenario.model, bearing=bearing, operating=operating,
+                   contact=contact, numerics=numerics, reduced=reduced, multibody=multibody, wear=wear)

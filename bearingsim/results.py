@@ -1,0 +1,202 @@
+"""Results as objects: what one run produced, in SI, readable back from its archive.
+
+A :class:`Result` is plain data with units, laid out as in the archive (``docs/archive.md``):
+
+* ``data``: named arrays keyed by their archive path (``"results/per_rotation/I_dec"``,
+  ``"results/impacts/time_s"``, ``"results/theta_deg"`` ...), each a :class:`NamedArray` with its unit;
+* ``groups``: named attribute groups (``"results/summary"``, ``"results/pass"`` ...), each a
+  :class:`AttrGroup` of values and their units;
+* ``series``: time series (:class:`Series`, H5MD ``{step, time, value}``);
+* ``provenance``: how the run was made (solver, time step and how it was chosen, run facts);
+* ``scenario``: the resolved :class:`bearingsim.scenario.Scenario` it was run from.
+
+A model builds its result from what it computed and never sees an archive; :mod:`bearingsim.archive`
+writes any result and reads it back into the same class, so every figure (``plot_*`` methods, each
+returning a matplotlib figure without showing it) can be drawn again from a file.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+PER_ROTATION = "results/per_rotation"
+IMPACTS = "results/impacts"
+SUMMARY = "results/summary"
+
+
+@dataclass
+class NamedArray:
+    """An array with its unit (``"1"`` for dimensionless or counts) and a one-line description."""
+
+    data: np.ndarray
+    unit: str = "1"
+    description: str = ""
+
+
+@dataclass
+class AttrGroup:
+    """Scalar attributes with the units of those that have one, and a description of the group."""
+
+    attrs: dict[str, Any]
+    units: dict[str, str] = field(default_factory=dict)
+    description: str = ""
+
+
+@dataclass
+class Series:
+    """A time series: sample ``step`` numbers, ``time`` [s] and ``value[T, ...]`` in ``unit``."""
+
+    step: np.ndarray
+    time: np.ndarray
+    value: np.ndarray
+    unit: str = "1"
+    description: str = ""
+
+
+class Result:
+    """One run's results (base class; :class:`bearingsim.reduced.ReducedResult` and
+    :class:`bearingsim.multibody.MultibodyResult` add the model's figures).
+
+    Parameters
+    ----------
+    scenario : the resolved scenario that was run.
+    data, groups, series, provenance : see the module docstring.
+    tables : archive paths of the groups in ``data`` that are tables (equal-length columns), with
+        their descriptions, e.g. ``{"results/impacts": "roller-cage impacts ..."}``.
+    """
+
+    model = "?"
+
+    def __init__(self, scenario, data: dict[str, NamedArray], groups: dict[str, AttrGroup],
+                 series: dict[str, Series] | None = None, provenance: dict[str, Any] | None = None,
+                 tables: dict[str, str] | None = None):
+        self.scenario = scenario
+        self.data = data
+        self.groups = groups
+        self.series = dict(series or {})
+        self.provenance = dict(provenance or {})
+        self.tables = dict(tables or {})
+        self._parameters = None
+
+    # --- the API ---------------------------------------------------------------------------
+    @property
+    def parameters(self):
+        """The SI :class:`bearingsim.parameters.Parameters` of :attr:`scenario`."""
+        if self._parameters is None:
+            from bearingsim.parameters import Parameters
+
+            self._parameters = Parameters.from_scenario(self.scenario)
+        return self._parameters
+
+    @property
+    def summary(self) -> dict[str, float]:
+        """The headline numbers in SI (names carry their unit), as floats."""
+        attrs = self.groups[SUMMARY].attrs
+        return {k: float(v) for k, v in attrs.items()
+                if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)}
+
+    @property
+    def summary_units(self) -> dict[str, str]:
+        return dict(self.groups[SUMMARY].units)
+
+    @property
+    def per_rotation(self) -> dict[str, np.ndarray]:
+        """Per cage rotation and pocket arrays ``[rotations, pockets]``: ``I_dec``, ``I_acc``, ..."""
+        return self._under(PER_ROTATION)
+
+    @property
+    def impacts(self) -> dict[str, np.ndarray]:
+        """The impact table: one array per column (``time_s``, ``theta_deg``, ``face`` ...)."""
+        return self._under(IMPACTS)
+
+    def get(self, name: str) -> np.ndarray:
+        """The array stored at ``results/<name>`` (e.g. ``"theta_deg"``, ``"wear/paper_index_rear"``)."""
+        return self.data[f"results/{name}"].data
+
+    def _under(self, prefix: str) -> dict[str, np.ndarray]:
+        p = prefix + "/"
+        return {k[len(p):]: v.data for k, v in self.data.items() if k.startswith(p) and "/" not in k[len(p):]}
+
+    def save(self, path) -> Path:
+        """Write this result as an archive at ``path`` (atomically); return the path."""
+        from bearingsim import archive
+
+        return archive.write(self, path)
+
+    # --- figures ---------------------------------------------------------------------------
+    #: names of the figures of this model: method ``plot_<name>`` draws each, file ``<stem>_<name>.png``
+    FIGURES: tuple[str, ...] = ()
+
+    def figures(self) -> dict:
+        """Every figure of this result, ``{name: matplotlib figure}`` (none is shown)."""
+        return {name: getattr(self, f"plot_{name}")() for name in self.FIGURES}
+
+    def save_figures(self, stem) -> list[Path]:
+        """Write every figure as ``<stem>_<name>.png``; return the paths."""
+        from bearingsim.plotting import save_figure
+
+        stem = Path(stem)
+        out = []
+        for name in self.FIGURES:
+            out.append(save_figure(getattr(self, f"plot_{name}")(), Path(f"{stem}_{name}.png")))
+        return out
+
+    def title(self) -> str:
+        """``<scenario>: <what ran>, <speed> rpm <direction>``: names the run as it was actually made."""
+        sc = self.scenario
+        op = sc.operating
+        return (f"{sc.name}: {self.description()}, {op.inner_ring_speed_rpm:g} rpm {op.direction}, "
+                f"{op.radial_load_N:g} N")
+
+    def description(self) -> str:  # pragma: no cover - overridden
+        return self.model
+
+    def __repr__(self) -> str:
+        s = self.summary
+        head = ", ".join(f"{k}={s[k]:.4g}" for k in ("I_dec_mean_Ns", "I_acc_mean_Ns") if k in s)
+        return f"<{type(self).__name__} {self.scenario.name!r}: {head}>"
+
+
+class MemorySink:
+    """The default sink of a run: time series kept in memory and handed to the result.
+
+    A sink is what a model streams its time series into (``timeseries(name, value_shape, unit,
+    description)`` returns an appender with ``append(step, time, value)``; ``discard_timeseries()``
+    drops them for a restarted run; ``collect()`` gives what the result holds).
+    :class:`bearingsim.archive.Spool` is the other one: it streams into the archive's file.
+    """
+
+    def __init__(self):
+        self._series: dict[str, _MemorySeries] = {}
+
+    def timeseries(self, name: str, value_shape=(), unit: str = "1", description: str = ""):
+        s = _MemorySeries(tuple(value_shape), unit, description)
+        self._series[name] = s
+        return s
+
+    def discard_timeseries(self) -> None:
+        self._series.clear()
+
+    def collect(self) -> dict[str, Series]:
+        return {name: s.series() for name, s in self._series.items()}
+
+
+class _MemorySeries:
+    def __init__(self, shape, unit, description):
+        self.shape, self.unit, self.description = shape, unit, description
+        self.steps, self.times, self.values = [], [], []
+
+    def append(self, step, time_s, value) -> None:
+        step = np.atleast_1d(np.asarray(step, dtype=np.int64))
+        self.steps.append(step)
+        self.times.append(np.atleast_1d(np.asarray(time_s, dtype=np.float64)))
+        self.values.append(np.asarray(value, dtype=np.float64).reshape((len(step), *self.shape)))
+
+    def series(self) -> Series:
+        if not self.steps:
+            return Series(np.zeros(0, np.int64), np.zeros(0), np.zeros((0, *self.shape)), self.unit, self.description)
+        return Series(np.concatenate(self.steps), np.concatenate(self.times), np.concatenate(self.values),
+                      self.unit, self.description)

@@ -37,10 +37,10 @@ def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None)
 
 
 def load(path):
-    """Read an archive back into its result (:func:`bearingsim.archive.read`)."""
-    from bearingsim.archive import read
+    """Read an archive back into its result (:func:`bearingsim.simulation.load`)."""
+    from bearingsim.simulation import load as _load
 
-    return read(path)
+    return _load(path)
 
 
 __all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load"]

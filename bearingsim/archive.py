@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from bearingsim import __version__
+from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim.errors import UserError
 
 FORMAT_VERSION = "1.0"
@@ -301,11 +302,22 @@ def _provenance(result) -> dict[str, Any]:
     return prov
 
 
-def read(path):
-    """Read a complete archive back into its result class (one-line UserError for a bad file)."""
+def model_of(path) -> str:
+    """The model name an archive was written by (one-line UserError for a bad file)."""
+    f = open_archive(path)
+    try:
+        return str(f["bearingsim"].attrs["model"])
+    finally:
+        f.close()
+
+
+def read(path, result_class):
+    """Read a complete archive back into ``result_class`` (one-line UserError for a bad file).
+
+    ``bearingsim.load`` picks the class of the archive's model (:func:`bearingsim.simulation.load`).
+    """
     import tomllib
 
-    from bearingsim.results import AttrGroup, NamedArray, Series
     from bearingsim.scenario import resolve
 
     f = open_archive(path)
@@ -345,21 +357,9 @@ def read(path):
         raise UserError(f"{path}: damaged archive ({exc.__class__.__name__}: {exc})") from None
     finally:
         f.close()
-    cls = result_class(model)
-    return cls(scenario, data, groups, series=series, provenance=provenance, tables=tables)
-
-
-def result_class(model: str):
-    """The result class of a model name."""
-    if model == "reduced":
-        from bearingsim.reduced import ReducedResult
-
-        return ReducedResult
-    if model == "multibody":
-        from bearingsim.multibody import MultibodyResult
-
-        return MultibodyResult
-    raise UserError(f"archive of an unknown model {model!r}")
+    if model != result_class.model:
+        raise UserError(f"{path}: archive of the {model!r} model, not {result_class.model!r}")
+    return result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
 
 
 def _plain(v):

@@ -56,14 +56,15 @@ def _cmd_inspect(args) -> int:
 
 
 def _cmd_show(args) -> int:
-    from bearingsim.archive import read
+    from bearingsim.simulation import load as read
 
     sys.stdout.write(read(args.archive).scenario.to_toml())
     return 0
 
 
 def _cmd_plot(args) -> int:
-    from bearingsim.archive import check_writable_dir, read
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.simulation import load as read
 
     path = Path(args.archive)
     result = read(path)
@@ -74,7 +75,8 @@ def _cmd_plot(args) -> int:
 
 
 def _cmd_rerun(args) -> int:
-    from bearingsim.archive import Spool, package_versions, read, write
+    from bearingsim.archive import Spool, package_versions, write
+    from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
     from bearingsim.simulation import run
 
@@ -105,7 +107,7 @@ def _cmd_rerun(args) -> int:
 
 
 def _cmd_compare(args) -> int:
-    from bearingsim.archive import read
+    from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
 
     a, b = read(args.a), read(args.b)

@@ -21,6 +21,6 @@ def save_figure(fig, path) -> Path:
     """Lay out, write (120 dpi) and close one report figure; return its path."""
     path = Path(path)
     fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    fig.savefig(path, dpi=120, bbox_inches="tight")  # keeps a legend placed outside the axes
     plt.close(fig)
     return path

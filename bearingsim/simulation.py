@@ -20,14 +20,26 @@ from bearingsim.scenario import Scenario
 
 
 def model_module(name: str):
-    """The module of a model (``simulate(parameters, sink=None, progress=False, dt=None)``)."""
+    """The module of a model: ``simulate(parameters, sink=None, progress=False, dt=None)`` and its
+    result class ``RESULT``."""
     if name == "reduced":
         from bearingsim import reduced
 
         return reduced
-    from bearingsim import multibody
+    if name == "multibody":
+        from bearingsim import multibody
 
-    return multibody
+        return multibody
+    from bearingsim.errors import UserError
+
+    raise UserError(f"model {name!r}: unknown (reduced, multibody)")
+
+
+def load(path):
+    """Read an archive back into the result class of its model."""
+    from bearingsim import archive
+
+    return archive.read(path, model_module(archive.model_of(path)).RESULT)
 
 
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):
@@ -84,5 +96,5 @@ def run_scenario(
         archive.write(result, out, spool)
     pngs = []
     if figures:
-        pngs = archive.read(out).save_figures(out.with_suffix(""))
+        pngs = load(out).save_figures(out.with_suffix(""))
     return RunOutput(archive=out, figures=list(pngs), result=result)

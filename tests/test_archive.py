@@ -10,12 +10,12 @@ from bearingsim.scenario import resolve
 
 
 def _result(scenario):
-    from bearingsim.results import AttrGroup, NamedArray, Result
+    from bearingsim.datatypes import AttrGroup, NamedArray
+    from bearingsim.reduced import ReducedResult
 
-    res = Result(scenario, {"results/per_rotation/I_dec": NamedArray(np.ones((3, 2)), "N s")},
+    res = ReducedResult(scenario, {"results/per_rotation/I_dec": NamedArray(np.ones((3, 2)), "N s")},
                  {"results/summary": AttrGroup({"I_dec_mean_Ns": 1.0}, {"I_dec_mean_Ns": "N s"})},
                  provenance={"dt_s": 1e-6, "wall_time_s": 0.5})
-    res.model = "reduced"
     return res
 
 
@@ -118,10 +118,10 @@ def test_read_gives_back_the_written_result(tmp_path, base_reduced):
 
 
 def test_memory_series_are_written_and_read_back(tmp_path, base_reduced):
-    from bearingsim.results import Series
+    from bearingsim.datatypes import Series
 
     res = _result(resolve(base_reduced))
     res.series["x"] = Series(np.arange(5), np.arange(5) * 1e-3, np.ones((5, 2)), "m", "a test series")
-    back = archive.read(archive.write(res, tmp_path / "s.h5"))
+    back = archive.read(archive.write(res, tmp_path / "s.h5"), type(res))
     s = back.series["x"]
     assert s.unit == "m" and s.value.shape == (5, 2) and np.array_equal(s.step, np.arange(5))

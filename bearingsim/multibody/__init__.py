@@ -62,7 +62,8 @@ from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, choose_dt, run)
-from bearingsim.results import AttrGroup, MemorySink, NamedArray, Result
+from bearingsim.datatypes import AttrGroup, NamedArray
+from bearingsim.results import MemorySink, Result
 
 __all__ = ["simulate", "MultibodyResult"]
 
@@ -336,8 +337,15 @@ class MultibodyResult(Result):
         p = self.parameters
         reach = (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(p.multibody.pocket_face_half_angle)
         circ = np.linspace(0.0, 2.0 * math.pi, 361)
-        ax.plot(reach * 1e6 * np.cos(circ), reach * 1e6 * np.sin(circ), color="C3", lw=0.8, ls="--",
-                label=f"reach of the pocket faces ({reach * 1e6:.0f} µm)")
+        r_max = float(np.max(np.hypot(o[:, 1], o[:, 2]))) if len(o) else 0.0
+        if r_max > 0.0:
+            ax.plot(r_max * 1e6 * np.cos(circ), r_max * 1e6 * np.sin(circ), color="0.5", lw=0.6, ls=":",
+                    label=f"largest distance from the axis ({r_max * 1e6:.0f} µm)")
+        if reach <= 3.0 * r_max or r_max == 0.0:
+            ax.plot(reach * 1e6 * np.cos(circ), reach * 1e6 * np.sin(circ), color="C3", lw=0.8, ls="--",
+                    label=f"reach of the pocket faces ({reach * 1e6:.0f} µm)")
+        else:  # far outside the orbit: named, not drawn (it would shrink the orbit to a dot)
+            ax.plot([], [], " ", label=f"reach of the pocket faces: {reach * 1e6:.0f} µm (off scale)")
         ax.set_aspect("equal")
         ax.set_xlabel("cage centre x [µm]")
         ax.set_ylabel("cage centre y [µm] (load along −y)")
@@ -365,3 +373,4 @@ class MultibodyResult(Result):
                      f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
         legend_outside(ax)
         return fig
+RESULT = MultibodyResult

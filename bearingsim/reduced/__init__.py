@@ -32,7 +32,8 @@ from bearingsim import laws
 from bearingsim.reduced.core import FACE_REAR, PassInputs
 from bearingsim.reduced.euler import default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
-from bearingsim.results import AttrGroup, NamedArray, Result
+from bearingsim.datatypes import AttrGroup, NamedArray
+from bearingsim.results import Result
 
 __all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolution"]
 
@@ -196,3 +197,4 @@ def simulate(p, sink=None, progress: bool = False, dt: float | None = None) -> R
             dt_choice = "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
     sol = solve_pass(inp, method, dt)
     return ReducedResult.from_solution(p, inp, sol, dt_choice)
+RESULT = ReducedResult

@@ -1,0 +1,107 @@
+"""Archives as a working tool: the Python API, and `plot`, `rerun`, `compare`, `show` on archives."""
+import re
+import shutil
+
+import h5py
+import numpy as np
+import pytest
+
+import bearingsim
+
+from .conftest import ROOT, SCENARIOS
+from .test_cli import assert_user_error, bearingsim as cli
+
+
+def test_readme_api_example_runs(tmp_path, monkeypatch):
+    """The README's Python example, run as written (from the repository root, in a scratch copy)."""
+    text = (ROOT / "README.md").read_text()
+    block = re.search(r"<!-- api-example -->\s*```python\n(.*?)```", text, re.S)
+    assert block, "README has no api-example block"
+    monkeypatch.chdir(tmp_path)
+    shutil.copytree(SCENARIOS, tmp_path / "scenarios")
+    ns = {}
+    exec(compile(block.group(1), "README api-example", "exec"), ns)
+    r, r2 = ns["r"], ns["r2"]
+    # the override took effect, and the archive gives the same result back
+    assert r.scenario.operating.inner_ring_speed_rpm == 500
+    assert r2.summary == r.summary
+    assert np.array_equal(r2.per_rotation["I_dec"], r.per_rotation["I_dec"])
+    assert r.per_rotation["I_dec"].shape == (1, 1)
+    assert set(r.impacts) >= {"time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face"}
+
+
+def test_figure_title_names_the_speed_actually_run():
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"operating.inner_ring_speed_rpm": 500.0})
+    r = bearingsim.run(sc)
+    fig = r.plot_pass()
+    title = fig.axes[0].get_title()
+    assert "500 rpm" in title and "3000 rpm" not in title.split(":", 1)[1]
+
+
+def test_set_with_a_bad_key_is_a_user_error():
+    with pytest.raises(bearingsim.UserError, match="bearing.nope"):
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"bearing.nope": 1.0})
+
+
+@pytest.fixture(scope="module")
+def reduced_archive(tmp_path_factory):
+    d = tmp_path_factory.mktemp("arch")
+    res = cli("run", SCENARIOS / "paper_1000rpm.toml", "-o", d / "a.h5", "-q")
+    assert res.returncode == 0, res.stderr
+    return d / "a.h5"
+
+
+@pytest.fixture(scope="module")
+def multibody_archive(tmp_path_factory):
+    d = tmp_path_factory.mktemp("mb")
+    res = cli("run", SCENARIOS / "multibody_6000rpm.toml", "--set", "numerics.rotations=1", "-o", d / "m.h5", "-q")
+    assert res.returncode == 0, res.stderr
+    return d / "m.h5"
+
+
+def test_plot_draws_every_figure_again_from_the_archive_alone(tmp_path, multibody_archive):
+    lone = tmp_path / "copy.h5"
+    shutil.copy(multibody_archive, lone)  # no PNG, no scenario file beside it
+    res = cli("plot", lone, "-o", tmp_path / "figs")
+    assert res.returncode == 0, res.stderr
+    names = sorted(p.name for p in (tmp_path / "figs").iterdir())
+    assert names == ["copy_forces.png", "copy_impulses.png", "copy_orbit.png", "copy_wear.png"]
+    assert all((tmp_path / "figs" / n).stat().st_size > 10_000 for n in names)
+
+
+def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive):
+    res = cli("rerun", reduced_archive)
+    assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
+    tampered = tmp_path / "t.h5"
+    shutil.copy(reduced_archive, tampered)
+    with h5py.File(tampered, "r+") as f:
+        f["results/summary"].attrs["I_dec_mean_Ns"] *= 1.0 + 1e-12
+        f["provenance"].attrs["version_numpy"] = "0.0.1"
+    res = cli("rerun", tampered)
+    assert res.returncode == 1
+    assert "I_dec_mean_Ns" in res.stdout and "differs" in res.stdout and "numpy: archive 0.0.1" in res.stdout
+
+
+def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
+    assert cli("compare", reduced_archive, reduced_archive).returncode == 0
+    other = tmp_path / "o.h5"
+    assert cli("run", SCENARIOS / "paper_1000rpm.toml", "--set", "contact.restitution=0.7", "-o", other, "-q").returncode == 0
+    res = cli("compare", reduced_archive, other)
+    assert res.returncode == 1
+    assert "contact.restitution: 0.8 -> 0.7" in res.stdout and "I_dec_mean_Ns" in res.stdout
+    bad = tmp_path / "bad.h5"
+    bad.write_text("not an archive")
+    assert_user_error(cli("compare", reduced_archive, bad), "bad.h5")
+
+
+def test_show_gives_a_runnable_scenario_with_the_same_results(tmp_path, reduced_archive):
+    res = cli("show", reduced_archive)
+    assert res.returncode == 0
+    toml = tmp_path / "again.toml"
+    toml.write_text(res.stdout)
+    assert cli("run", toml, "-o", tmp_path / "again.h5", "-q").returncode == 0
+    assert cli("compare", reduced_archive, tmp_path / "again.h5").returncode == 0
+
+
+def test_run_on_an_archive_gets_a_hint(reduced_archive):
+    assert_user_error(cli("run", reduced_archive), "archive", "rerun", "show")

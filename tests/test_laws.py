@@ -1,0 +1,72 @@
+"""Unit tests of the physics laws (bearingsim/laws.py): each against its source, not against itself."""
+import math
+
+import numpy as np
+import pytest
+
+from bearingsim import laws
+
+
+def test_palmgren_constant_in_si():
+    """Palmgren (Harris & Kotzalas Eq. 6.49): K = 8.06e4 l^(8/9) N/mm^(10/9), l in mm. For l = 13 mm a
+    contact carrying 1000 N is compressed by delta = (1000 / K_mm)^(9/10) mm; the SI constant must give
+    the same force for the same approach in m (to rounding)."""
+    k_mm = 8.06e4 * 13.0 ** (8.0 / 9.0)
+    delta_mm = (1000.0 / k_mm) ** 0.9
+    assert laws.palmgren_load(laws.palmgren_stiffness(13e-3), delta_mm * 1e-3) == pytest.approx(1000.0, rel=1e-12)
+    assert laws.palmgren_load(1e9, 0.0) == 0.0 and laws.palmgren_load(1e9, -1e-6) == 0.0
+
+
+def test_oil_film_drag_eq2_scalar_and_array_forms_agree():
+    """Eq. (2), F_o = c N^0.246 V^0.648: the compiled scalar form equals the vectorised one, is zero
+    without contact (N <= 0), and scales with the paper's exponents."""
+    for n, v in [(3.5, 1.2), (120.0, 18.0), (0.0, 5.0), (-2.0, 5.0)]:
+        assert laws.oil_film_drag_scalar(0.02, n, v) == pytest.approx(float(laws.oil_film_drag(0.02, n, v)), rel=1e-14)
+    assert laws.oil_film_drag_scalar(0.02, 0.0, 5.0) == 0.0
+    base = laws.oil_film_drag_scalar(0.02, 10.0, 2.0)
+    assert laws.oil_film_drag_scalar(0.02, 20.0, 2.0) / base == pytest.approx(2.0**0.246, rel=1e-14)
+    assert laws.oil_film_drag_scalar(0.02, 10.0, 4.0) / base == pytest.approx(2.0**0.648, rel=1e-14)
+
+
+def test_epicyclic_kinematics_pure_rolling():
+    """Eqs. (11)-(12): in pure rolling the roller's surface speed relative to the cage equals that of
+    the inner race, (omega_i - omega_c) r_i = omega_r r_r, and of the outer race, omega_c r_o = omega_r r_r."""
+    rr, rp = 6.5e-3, 48.75e-3
+    wi = laws.inner_ring_angular_speed(3000.0)
+    wc = laws.cage_angular_speed(wi, rr, rp)
+    wr = laws.roller_spin_speed(wi, rr, rp)
+    assert wi == pytest.approx(2 * math.pi * 50.0, rel=1e-15)
+    assert (wi - wc) * (rp - rr) == pytest.approx(wr * rr, rel=1e-12)
+    assert wc * (rp + rr) == pytest.approx(wr * rr, rel=1e-12)
+    assert laws.rolling_speed(wr, wc, rr, rp + rr) == pytest.approx(wr * rr, rel=1e-12)
+
+
+def test_outer_race_load_eq3():
+    """Eq. (3): N = m r_p omega_c^2 + m g cos(theta): centrifugal plus weight at the bottom, minus at the top."""
+    m, rp, wc, g = 0.013, 48.75e-3, 100.0, laws.STANDARD_GRAVITY
+    n = laws.outer_race_normal_load(m, rp, wc, np.array([0.0, math.pi]), g)
+    assert n[0] - n[1] == pytest.approx(2 * m * g, rel=1e-12)
+    assert n.mean() == pytest.approx(m * rp * wc**2, rel=1e-12)
+
+
+def test_load_zone_rule():
+    """psi_l = arccos(P_d / 2 delta_r) (Harris & Kotzalas Sec. 7.2): 0 when the ring closes no clearance,
+    60 deg when delta_r = P_d, 90 deg for zero clearance; the quasi-static solution at the paper's 970 N
+    on the reference bearing gives the paper's 23.5 deg within the 0.5 deg the preset's reasoning states."""
+    assert laws.load_zone_from_displacement(40e-6, 80e-6) == 0.0
+    assert math.degrees(laws.load_zone_from_displacement(80e-6, 80e-6)) == pytest.approx(60.0, rel=1e-12)
+    assert laws.load_zone_from_displacement(1e-6, 0.0) == pytest.approx(math.pi / 2)
+    assert math.isnan(laws.load_zone_from_displacement(float("nan"), 80e-6))
+    phi = laws.load_zone_half_angle(None, 970.0, 16, 13e-3, 80e-6)
+    assert math.degrees(phi) == pytest.approx(23.5, abs=0.5)
+    assert laws.load_zone_half_angle(23.5, 970.0, 16, 13e-3, 80e-6) == pytest.approx(math.radians(23.5), rel=1e-15)
+    # the ring must close the clearance (P_d / 2 = 40 um) to carry any load
+    _, delta = laws.quasi_static_load_zone(970.0, 16, 13e-3, 80e-6)
+    assert delta > 40e-6
+
+
+def test_archard_eq16():
+    """Eq. (16): V = k W L / H with W L = I r_r omega_r: linear in each factor."""
+    v = laws.archard_wear_volume(6e-4, 5e-3, 6.5e-3, 2000.0, 1.5e9)
+    assert v == pytest.approx(6e-4 * 5e-3 * 6.5e-3 * 2000.0 / 1.5e9, rel=1e-15)
+    assert laws.archard_wear_volume(6e-4, np.array([1e-3, 2e-3]), 6.5e-3, 2000.0, 1.5e9)[1] == pytest.approx(2 * v / 5)

@@ -110,6 +110,7 @@ class MultibodyOptions:
     inner_ring: str  # "auto", "quasi_static" or "dynamic"
     inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
     pocket_face_half_angle: float  # angular half-width of each pocket face arc [rad]
+    flat_pockets: tuple[int, ...]  # pockets with two plane faces D + s apart (the rig's instrumented pocket)
 
 
 @dataclass(frozen=True)
@@ -197,6 +198,8 @@ class Parameters:
             inner_ring=mb.inner_ring,
             inner_ring_mass=None if mb.inner_ring_mass_kg == "auto" else float(mb.inner_ring_mass_kg),
             pocket_face_half_angle=math.radians(float(mb.pocket_face_half_angle_deg)),
+            flat_pockets=(tuple(range(bearing.roller_count)) if mb.pocket_shape == "flat"
+                          else tuple(sorted(mb.flat_pockets))),
         )
         wear = Wear(wear_coefficient=float(scenario.wear.wear_coefficient),
                     hardness=float(scenario.wear.hardness_Pa))

@@ -45,6 +45,11 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # (the paper gives no pocket drawing; a cylindrical-roller cage pocket wraps the roller enough
         # to guide it radially). Narrower arcs guide the cage less (README: the cage whirls more).
         "pocket_face_half_angle_deg": 45.0,
+        # pocket shape: "arc" (the cage's own pockets wrap the roller) or "flat" (two plane faces D + s
+        # apart, as the paper's instrumented pocket, machined flat for its load cells, Sec. 2.1);
+        # flat_pockets lists pockets that are flat whatever pocket_shape says (the rig's pocket 0)
+        "pocket_shape": "arc",
+        "flat_pockets": [],
     },
     # Archard & Hirst (1956), Proc. R. Soc. A 236:397, Table 1: 60/40 brass on tool steel,
     # k = 6e-4; high-strength brass hardness ~HV 150 -> 1.5e9 Pa.
@@ -117,6 +122,8 @@ class MultibodySection(_Section):
     inner_ring: Literal["auto", "quasi_static", "dynamic"]
     inner_ring_mass_kg: float | Literal["auto"]
     pocket_face_half_angle_deg: float = Field(gt=0.0, lt=90.0)
+    pocket_shape: Literal["arc", "flat"]
+    flat_pockets: list[int]
 
     @field_validator("inner_ring_mass_kg")
     @classmethod
@@ -334,6 +341,18 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
         raise UserError(
             f"{source}: bearing.roller_count: the multibody model needs at least 3 rollers to hold the cage"
         )
+    flat = m.multibody.flat_pockets
+    bad = [i for i in flat if not 0 <= i < b.roller_count]
+    if bad:
+        raise UserError(f"{source}: multibody.flat_pockets: pocket {bad[0]} does not exist "
+                        f"(pockets 0..{b.roller_count - 1}, bearing.roller_count = {b.roller_count})")
+    if len(set(flat)) != len(flat):
+        raise UserError(f"{source}: multibody.flat_pockets: a pocket is listed twice ({flat})")
+    if m.model == "multibody" and (m.multibody.pocket_shape == "flat" or len(set(flat)) == b.roller_count):
+        raise UserError(
+            f"{source}: multibody.pocket_shape: with every pocket flat nothing guides the roller-guided cage "
+            f"radially (flat faces push only along the direction of rotation): the cage would drift off the "
+            f"axis; keep arc pockets and list the flat ones in multibody.flat_pockets")
     if m.reduced.load_zone_half_angle_deg != "auto" and m.model == "reduced":
         if m.reduced.load_zone_half_angle_deg >= 180.0:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")

@@ -120,3 +120,25 @@ def test_every_shipped_scenario_validates():
     assert len(files) >= 14
     for f in files:
         load_scenario(f)
+
+
+@pytest.mark.parametrize(
+    "override, words",
+    [
+        ("multibody.flat_pockets=[16]", ["multibody.flat_pockets", "16"]),
+        ("multibody.flat_pockets=[0, 0]", ["multibody.flat_pockets", "twice"]),
+        ("multibody.flat_pockets=[-1]", ["multibody.flat_pockets"]),
+        ("multibody.pocket_shape=flat", ["multibody.pocket_shape", "radially"]),
+        ("multibody.pocket_shape=square", ["multibody.pocket_shape"]),
+    ],
+)
+def test_pocket_shape_keys_are_validated(override, words):
+    with pytest.raises(UserError) as e:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
+    for w in words:
+        assert w in str(e.value)
+
+
+def test_flat_pockets_reach_the_parameters():
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["multibody.flat_pockets=[3, 0]"])
+    assert si(sc).multibody.flat_pockets == (0, 3)

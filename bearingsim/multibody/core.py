@@ -181,7 +181,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     ri_race = geo.inner_race_radius - 0.25 * pd
 
     sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,
-                     n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=reduced_eq, spin_free=not reduced_eq)
+                     n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=reduced_eq, spin_free=not reduced_eq,
+                     flat_pockets=p.multibody.flat_pockets)
     space = sc.space
     nb = n + 1
     # rollers start on the outer race (centrifugal), moving with the cage

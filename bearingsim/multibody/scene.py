@@ -15,6 +15,13 @@ radial offset from the pocket centre is below ``R tan(beta/n)`` (0.68 mm for 5 s
 covers the circumferential impacts; the slanted outer segments give the radial guidance of a
 roller-guided cage.
 
+Flat pockets (``multibody.flat_pockets``): the paper's instrumented pocket, whose curved faces "were
+machined flat to mount the load cells" set "to match the diameter of the cage pocket" (Sec. 2.1). Each
+face is one plane segment normal to ``e_t`` at ``R`` from the pocket centre (faces ``2R = D + s`` apart,
+parallel to the pocket's radial centre line) reaching ``R`` either side of the pitch circle, more than
+any radial position the roller takes (raceway clearance and cage eccentricity are a fraction of a
+millimetre). It pushes only circumferentially: it does not guide the cage radially.
+
 Collision filtering: rollers collide only with the cage. Elasticities are ``e`` on the roller and 1 on
 the cage (pymunk multiplies them), friction likewise ``cage_friction`` and 1.
 """
@@ -39,7 +46,7 @@ class Scene:
     cage: pymunk.Body
     pocket_body_angle: np.ndarray  # (n,) angle of each pocket centre in the cage frame [rad]
     pocket_radius: float  # R = r_r + s/2 [m]
-    face_vertices: np.ndarray  # (n, 2, n_seg + 1, 2) polyline vertices in the cage frame [m]
+    face_vertices: list  # [pocket][face] polyline vertices (k + 1, 2) in the cage frame [m]
     body_ids: np.ndarray  # (n + 1,) pymunk body ids in batch order (rollers, then cage)
 
 
@@ -69,7 +76,8 @@ def face_polyline(centre, e_t, e_r, radius, half_angle, n_seg):
 
 
 def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_angle: float,
-                n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True) -> Scene:
+                n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
+                flat_pockets=()) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
 
     Parameters
@@ -79,10 +87,11 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     restitution : roller-cage coefficient of restitution e [-].
     cage_friction : roller-cage Coulomb friction coefficient [-].
     half_angle : angular half-width of each pocket face about the circumferential direction [rad].
-    n_seg : segments per face.
+    n_seg : segments per arc face.
     kinematic_cage : cage turned at the epicyclic speed (reduced-equivalent scene) instead of free.
     spin_free : rollers may change their spin (False: infinite moment of inertia).
     spatial_hash : use pymunk's spatial-hash broadphase (faster than the default tree here).
+    flat_pockets : indices of the pockets with flat faces (one segment each).
     """
     n = geometry.roller_count
     rr = geometry.roller_radius
@@ -128,16 +137,21 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     cage.angle = 0.0
     cage.angular_velocity = float(omega_cage)
     cage_filter = pymunk.ShapeFilter(categories=CAGE_CATEGORY, mask=ROLLER_CATEGORY)
-    verts = np.empty((n, 2, n_seg + 1, 2))
+    verts = []
+    flat = set(int(i) for i in flat_pockets)
     shapes = []
     for i in range(n):
         c = np.array([rp * math.cos(a[i]), rp * math.sin(a[i])])
         e_r = np.array([math.cos(a[i]), math.sin(a[i])])
         e_t = sign * np.array([-math.sin(a[i]), math.cos(a[i])])
-        for face, direction in ((0, e_t), (1, -e_t)):  # 0 front, 1 rear
-            pts = face_polyline(c, direction, e_r, R, half_angle, n_seg)
-            verts[i, face] = pts
-            for k in range(n_seg):
+        verts.append([])
+        for direction in (e_t, -e_t):  # front, rear
+            if i in flat:
+                pts = np.array([c + R * direction - R * e_r, c + R * direction + R * e_r])
+            else:
+                pts = face_polyline(c, direction, e_r, R, half_angle, n_seg)
+            verts[i].append(pts)
+            for k in range(len(pts) - 1):
                 seg = pymunk.Segment(cage, tuple(pts[k]), tuple(pts[k + 1]), 0.0)
                 seg.elasticity = 1.0
                 seg.friction = 1.0

@@ -131,6 +131,18 @@ def _cmd_validate(args) -> int:
     paths = save_fig9(Path(args.output))
     for p in paths:
         print(f"wrote {p}")
+    if args.rig_rotations > 0:
+        from bearingsim.multibody.studies import save_rig, rig_table
+
+        rows = rig_table(rotations=args.rig_rotations, jobs=args.jobs)
+        print(f"rig scene (pocket 0 flat), 1 warm-up + {args.rig_rotations} rotations, against the reduced model:")
+        print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
+        for r in rows:
+            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:5.2f} (std) "
+                  f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
+                  f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
+        for p in save_rig(Path(args.output), rows):
+            print(f"wrote {p}")
     return 0
 
 
@@ -186,8 +198,12 @@ def build_parser() -> argparse.ArgumentParser:
     cp.add_argument("b")
     cp.set_defaults(func=_cmd_compare)
 
-    v = sub.add_parser("validate", help="Fig. 9 analog: reduced-model I_dec against speed (table and PNG)")
+    v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
+                                        "(pocket 0 flat) against it (tables and PNGs)")
     v.add_argument("-o", "--output", default="outputs/validate", help="output folder")
+    v.add_argument("--rig-rotations", type=int, default=20,
+                   help="recorded rotations of each rig run (after 1 warm-up); 0 skips the rig (default 20)")
+    v.add_argument("-j", "--jobs", type=int, default=2, help="parallel rig runs")
     v.set_defaults(func=_cmd_validate)
 
     b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot)")

@@ -252,7 +252,7 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
             out = run_sweep(spec, tmp_path / "dask", engine=DaskEngine(cluster=cluster), figures=False,
                             progress=False)
             assert len(cluster.scheduler_info["workers"]) == 2
-            assert {r["hash"] if "hash" in r else r["case"] for r in out.rows} == {c.hash for c in resolve_cases(spec)}
+            assert {r["case"] for r in out.rows} == {c.hash for c in resolve_cases(spec)}
     assert [r["status"] for r in out.rows] == ["done"] * 3
     for a, b in zip(local.rows, out.rows):
         assert a["case"] == b["case"]

@@ -132,7 +132,7 @@ class DaskEngine:
         stamp = f"{os.getpid()}-{time.time_ns()}"
         self._futures = [self.client.submit(run_batch, b, None, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
                          for i, b in enumerate(batches)]
-        for fut in as_completed(self._futures):
+        for fut in as_completed(self._futures, loop=self.client.loop):
             try:
                 yield fut.result()
             except Exception as exc:  # noqa: BLE001 - a lost worker or a task the cluster gave up on

@@ -8,8 +8,9 @@ the stored run's own wall time) and the summary numbers (SI, as in the archives'
 plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.sweeps.worker.standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
-NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, the swept
-keys in ``axes`` and the sweep ``mode``. Both files are written to a temporary name and renamed.
+NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every
+swept key in ``axes``, the grid's axes in ``grid`` (JSON lists), the sweep ``mode`` (``product`` or
+``zip``) and ``grid_rows`` (the grid's cases come first; explicit extra cases follow). Both files are written to a temporary name and renamed.
 """
 from __future__ import annotations
 
@@ -147,6 +148,8 @@ def read_index(path: str | Path) -> tuple[dict[str, np.ndarray], dict]:
             raise UserError(f"{p}: not a bearingsim sweep index")
         meta = {k: f.attrs[k] for k in f.attrs}
         meta["axes"] = json.loads(meta["axes"])
+        meta["grid"] = json.loads(meta.get("grid", "[]"))
+        meta["grid_rows"] = int(meta.get("grid_rows", 0))
         meta["columns"] = json.loads(meta["columns"])
         cols = {}
         for name in meta["columns"]:

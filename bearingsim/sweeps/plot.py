@@ -3,7 +3,8 @@
 * one numeric axis: I_dec and I_acc per cage rotation against the swept value, with error bars of one
   standard error (``I_*_sem_Ns``; see :func:`bearingsim.sweeps.worker.standard_errors`);
 * two numeric axes (a product grid): a heat map of I_dec per cage rotation;
-* more axes: one line per combination of the other axes (at most 8), else no figure.
+* more axes: one line per combination of the other axes (at most 8), else no figure;
+* zipped axes: a line plot against the first of them. Explicit extra cases are not drawn.
 
 Axes are labelled with the parameter's name and unit, read from the key's unit suffix.
 Failed and not-run cases are gaps (NaN), never zeros.
@@ -47,10 +48,19 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None) -
     outdir = Path(outdir) if outdir is not None else index_path.parent
     outdir.mkdir(parents=True, exist_ok=True)
     cols, meta = read_index(index_path)
-    axes = [k for k in meta["axes"] if _numeric(cols[k]) and np.isfinite(cols[k]).any()]
-    if not axes or "I_dec_mean_Ns" not in cols:
+    n = meta["grid_rows"]
+    cols = {k: v[:n] for k, v in cols.items()}  # the grid only; explicit extra cases are not on it
+    axes = [k for k in meta["grid"] if _numeric(cols[k]) and np.isfinite(cols[k]).any()]
+    if meta.get("mode") == "zip":
+        title_extra = ", ".join(f"{name_of(k)} {np.nanmin(cols[k]):g}–{np.nanmax(cols[k]):g}" for k in axes[1:])
+        axes = axes[:1]  # zipped axes move together: one of them is the abscissa
+    else:
+        title_extra = ""
+    if not axes or "I_dec_mean_Ns" not in cols or n == 0:
         return []
     title = f"sweep of {Path(str(meta.get('scenario', ''))).stem or 'cases'}"
+    if title_extra:
+        title += f" (zipped with {title_extra})"
     if len(axes) == 2:
         return [_heat_map(plt, cols, axes, outdir / "sweep_map.png", title)]
     return [_lines(plt, cols, axes, outdir / "sweep_I.png", title)] if _line_groups(cols, axes) else []

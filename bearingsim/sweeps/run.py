@@ -6,6 +6,7 @@ A lock file ``DIR/.sweep.lock`` keeps two sweeps from writing the same folder at
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import signal
@@ -160,11 +161,13 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if isinstance(spec, SweepSpec):
         cases = resolve_cases(spec)
         keys = spec.keys
-        meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin}
+        meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
+                "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
     else:
         cases = list(spec)
         keys = list(dict.fromkeys(k for c in cases for k in c.values))
-        meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)"}
+        meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
+                "grid_rows": 0}
     engine = engine or LocalEngine(1)
     outdir = check_writable_dir(outdir)
     cases_dir = outdir / "cases"

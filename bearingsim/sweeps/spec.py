@@ -11,7 +11,7 @@ axes form a product) or from a sweep file::
 
     [axes]                                  # one list of values per key
     "operating.inner_ring_speed_rpm" = [500, 1000, 2000]
-    "bearing.pocket_clearance_mm" = [0.1, 0.2]
+    "bearing.pocket_clearance_mm" = { start = 0.1, stop = 0.4, num = 4 }   # evenly spaced, ends included
 
     [[cases]]                               # explicit extra cases (any keys)
     "operating.inner_ring_speed_rpm" = 6000
@@ -114,7 +114,7 @@ def _flatten(table: dict, where: str, prefix: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
     for k, v in table.items():
         key = f"{prefix}{k}"
-        if isinstance(v, dict):
+        if isinstance(v, dict) and not _is_range(v):
             sub = _flatten(v, where, key + ".")
         else:
             sub = {key: v}
@@ -123,6 +123,27 @@ def _flatten(table: dict, where: str, prefix: str = "") -> dict[str, Any]:
                 raise UserError(f"{where}: {kk}: given twice")
             out[kk] = vv
     return out
+
+
+def _is_range(v) -> bool:
+    return isinstance(v, dict) and set(v) == {"start", "stop", "num"}
+
+
+class _Range:
+    """``{ start, stop, num }``: ``num`` evenly spaced values from start to stop, both included."""
+
+    def __init__(self, table: dict):
+        self.table = table
+
+    def values(self, where: str) -> list[float]:
+        import numpy as np
+
+        start, stop, num = self.table["start"], self.table["stop"], self.table["num"]
+        num_ok = isinstance(num, int) and not isinstance(num, bool) and num >= 1
+        ends_ok = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop))
+        if not (num_ok and ends_ok):
+            raise UserError(f"{where}: {{ start, stop, num }} needs numbers and an integer num >= 1")
+        return [float(x) for x in np.linspace(float(start), float(stop), num)]
 
 
 def _check_unique(keys: list[str], where: str) -> None:
@@ -183,8 +204,10 @@ def load_sweep_file(path: str | Path) -> SweepSpec:
     sets = _flatten(sets_tab, f"{path}: set")
     axes = _flatten(axes_tab, f"{path}: axes")
     for k, v in axes.items():
-        if not isinstance(v, list) or not v:
-            raise UserError(f"{path}: axes: {k}: must be a non-empty list of values")
+        if _is_range(v):
+            axes[k] = _Range(v).values(f"{path}: axes: {k}")
+        elif not isinstance(v, list) or not v:
+            raise UserError(f"{path}: axes: {k}: must be a non-empty list of values or {{ start, stop, num }}")
     extra = [_flatten(c, f"{path}: cases[{i}]") for i, c in enumerate(cases)]
     return SweepSpec(scenario=(path.parent / base), sets=[f"{k}={toml_value(v)}" for k, v in sets.items()],
                      axes=list(axes.items()), mode=mode, extra=extra, origin=str(path))

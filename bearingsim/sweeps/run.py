@@ -119,13 +119,17 @@ def _clean_temporaries(cases_dir: Path) -> None:
         p.unlink(missing_ok=True)
 
 
-def _progress(total: int, enabled: bool):
+def _progress(total: int, enabled: bool, initial: int):
     if not enabled:
         return None
     from tqdm import tqdm
 
+    import shutil
+
     tqdm.monitor_interval = 0  # no monitor thread
-    return tqdm(total=total, desc="sweep", unit="case", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
+    size = shutil.get_terminal_size((100, 24))  # a terminal that reports no size (a bare pty) gets 100 x 24
+    return tqdm(total=total, desc="sweep", unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
+                nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
@@ -191,10 +195,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                 else:
                     row.update(rec, archive=f"cases/{c.hash}.h5")
             write_index(outdir, rows, keys, meta)
-            bar = _progress(len(cases), progress)
             counts = {"done": 0, "failed": 0, "cached": len(cases) - len(todo)}
+            bar = _progress(len(cases), progress, counts["cached"])
             if bar is not None:
-                bar.update(counts["cached"])
                 bar.set_postfix(counts, refresh=True)
             say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None
                           else (lambda line: print(line, file=sys.stderr)))
@@ -216,8 +219,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         if rec["status"] == "failed":
                             say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
                     if bar is not None:
-                        bar.update(len(records))
                         bar.set_postfix(counts, refresh=False)
+                        bar.update(len(records))
                     if time.monotonic() - last_index >= INDEX_EVERY_S:
                         write_index(outdir, rows, keys, meta)
                         last_index = time.monotonic()

@@ -283,3 +283,17 @@ def test_figures_from_the_index(tmp_path):
     # drawn again from the index alone, into another folder
     again = plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "again")
     assert [p.name for p in again] == ["sweep_I.png"] and again[0].stat().st_size > 10_000
+
+
+def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
+    import psutil
+
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.run import _Lock
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000])])
+    with _Lock(tmp_path):  # another sweep holds the folder
+        with pytest.raises(UserError, match="another sweep is writing"):
+            run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
+    assert psutil.Process().children() == []  # the pool it had started is gone
+    assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1

@@ -111,6 +111,44 @@ def run_sweep_bench(outdir: str | Path = "outputs/bench") -> list[dict]:
     return rows
 
 
+def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2) -> float:
+    """Wall time [s] of the 100 x 100 map ``scenarios/sweeps/map_speed_clearance.toml`` into ``outdir``.
+
+    With ``archives=False`` the workers (forked, so they inherit the change) solve each case without
+    writing its archive: what the engine, the solver and the index cost without ``archive.py``.
+    ``python -m bearingsim.sweeps.bench map [--no-archives] OUTDIR``.
+    """
+    import types
+
+    import bearingsim.simulation as simulation
+    from bearingsim.sweeps.engines import LocalEngine
+    from bearingsim.sweeps.run import run_sweep
+    from bearingsim.sweeps.spec import load_sweep_file
+
+    real = simulation.run_scenario
+    if not archives:
+        def solve_only(scenario, out=None, **kw):
+            from bearingsim.simulation import model_module
+
+            return types.SimpleNamespace(result=model_module(scenario.model).simulate(scenario))
+
+        simulation.run_scenario = solve_only
+    try:
+        t0 = time.perf_counter()
+        spec = load_sweep_file(_scenario_path().parent / "sweeps" / "map_speed_clearance.toml")
+        out = run_sweep(spec, Path(outdir), engine=LocalEngine(jobs), figures=False, progress=False)
+        wall = time.perf_counter() - t0
+    finally:
+        simulation.run_scenario = real
+    print(f"100 x 100 map, {'with' if archives else 'without'} archives, {jobs} workers: "
+          f"{out.count('done')} done, {out.count('cached')} cached in {wall:.1f} s")
+    return wall
+
+
 if __name__ == "__main__":  # pragma: no cover
-    time.sleep(0)
-    run_sweep_bench()
+    import sys
+
+    if sys.argv[1:2] == ["map"]:
+        map_cost(sys.argv[-1], archives="--no-archives" not in sys.argv)
+    else:
+        run_sweep_bench()

@@ -75,16 +75,21 @@ class _Lock:
     def __enter__(self):
         import fcntl
 
+        if self.fh is not None:  # already held (taken before the signal handlers go in)
+            return self
         self.fh = open(self.path, "w")
         try:
             fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
             self.fh.close()
+            self.fh = None
             raise UserError(f"{self.path.parent}: another sweep is writing this folder") from None
         return self
 
     def __exit__(self, *exc):
-        self.fh.close()
+        if self.fh is not None:
+            self.fh.close()
+            self.fh = None
         return False
 
 
@@ -173,9 +178,15 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
                 "grid_rows": 0}
     engine = engine or LocalEngine(1)
-    outdir = check_writable_dir(outdir)
-    cases_dir = outdir / "cases"
-    cases_dir.mkdir(exist_ok=True)
+    engine.start()  # an unreachable scheduler stops the sweep before anything is written
+    try:
+        outdir = check_writable_dir(outdir)
+        cases_dir = outdir / "cases"
+        cases_dir.mkdir(exist_ok=True)
+        lock = _Lock(outdir).__enter__()
+    except BaseException:
+        engine.stop()
+        raise
     if progress is None:
         progress = sys.stderr.isatty()
     rows = [{"case": c.hash, "values": c.values, "status": "pending", "error": "", "archive": "",
@@ -183,7 +194,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     by_hash = {c.hash: i for i, c in enumerate(cases)}
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
 
-    with _Lock(outdir), _Signals() as sig:
+    with lock, _Signals():
         bar = None
         try:
             _clean_temporaries(cases_dir)
@@ -203,7 +214,6 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                           else (lambda line: print(line, file=sys.stderr)))
             last_index = time.monotonic()
             if todo:
-                engine.start()
                 batches = make_batches(todo, engine.workers)
                 for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None):
                     for rec in records:

@@ -56,7 +56,7 @@ def _numbers(summary: dict) -> dict[str, float]:
 def _provenance_cached():
     """Ask git for the source commit once per process instead of once per archive.
 
-    ``bearingsim.archive.git_commit`` runs two ``git`` subprocesses per archive (16 ms of a reduced
+    ``bearingsim.archive.git_commit`` runs two ``git`` subprocesses per archive (8 ms of a reduced
     case's 31 ms here). The code a worker runs cannot change while it runs, so one answer per process
     is the right one. Remove when archive.py caches it itself.
     """

@@ -107,6 +107,13 @@ lubrication.drag_coefficient = [0.01, 0.02, 0.03]
     assert not (tmp_path / "out").exists()
 
 
+def test_shipped_sweep_files_resolve():
+    files = sorted((SCENARIOS / "sweeps").glob("*.toml"))
+    assert len(files) >= 3
+    n = {f.name: len(resolve_cases(load_sweep_file(f))) for f in files}
+    assert n["map_speed_clearance.toml"] == 10_000 and n["speed_zip_and_extras.toml"] == 6
+
+
 def test_same_scenario_twice_is_refused():
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [500, 500.0])])
     with pytest.raises(Exception, match="same scenario"):
@@ -202,8 +209,8 @@ def _descendants(pid):
 def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code):
     import psutil
 
-    # euler at dt = 1 ns: about 2 s per case, so cases are running and queued when the signal comes
-    dts = ",".join(f"{1 + i / 100:.2f}e-9" for i in range(8))
+    # euler at dt = 2 ns: about 1 s per case, so cases are running and queued when the signal comes
+    dts = ",".join(f"{2 + i / 100:.2f}e-9" for i in range(8))
     proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "sweep", str(BASE), "--set", "reduced.method=euler",
                              "--param", f"numerics.dt_s={dts}", "-o", str(tmp_path), "-j", "2", "--no-plots"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -292,8 +299,34 @@ def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
     from bearingsim.sweeps.run import _Lock
 
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000])])
+    before = {p.pid for p in psutil.Process().children(recursive=True)}  # e.g. multiprocessing's resource tracker
     with _Lock(tmp_path):  # another sweep holds the folder
         with pytest.raises(UserError, match="another sweep is writing"):
             run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
-    assert psutil.Process().children() == []  # the pool it had started is gone
+    assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()  # its pool is gone
     assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1
+
+
+def test_figure_kind_follows_the_grid(tmp_path):
+    from bearingsim.sweeps.index import write_index
+
+    def rows(grid):
+        out = []
+        for i, values in enumerate(grid):
+            failed = i == 1  # a failed case: a gap, not a zero
+            out.append({"case": f"c{i}", "values": values, "status": "failed" if failed else "done", "error": "",
+                        "archive": "", "wall_s": 0.1,
+                        "summary": {} if failed else {"I_dec_mean_Ns": 0.005 + 0.001 * i, "I_dec_sem_Ns": 1e-4}})
+        return out
+
+    two = [{SPEED: s, "bearing.pocket_clearance_mm": c} for s in (1000, 2000) for c in (0.1, 0.2)]
+    write_index(tmp_path, rows(two), list(two[0]), {"mode": "product", "grid": f'["{SPEED}", "bearing.pocket_clearance_mm"]',
+                                                   "grid_rows": 4, "scenario": "x.toml"})
+    assert [p.name for p in plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "a")] == ["sweep_map.png"]
+    text = [{SPEED: s, "operating.direction": d} for s in (1000, 2000) for d in ("forward", "reverse")]
+    write_index(tmp_path, rows(text), list(text[0]), {"mode": "product", "grid": f'["{SPEED}", "operating.direction"]',
+                                                     "grid_rows": 4, "scenario": "x.toml"})
+    assert [p.name for p in plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "b")] == ["sweep_I.png"]
+    cols, meta = read_index(tmp_path / "sweep.h5")
+    assert list(cols["operating.direction"]) == ["forward", "reverse"] * 2
+    assert math.isnan(cols["I_dec_mean_Ns"][1]) and cols["I_dec_mean_Ns"][2] == pytest.approx(0.007)

@@ -50,19 +50,19 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None) -
     cols, meta = read_index(index_path)
     n = meta["grid_rows"]
     cols = {k: v[:n] for k, v in cols.items()}  # the grid only; explicit extra cases are not on it
-    axes = [k for k in meta["grid"] if _numeric(cols[k]) and np.isfinite(cols[k]).any()]
-    if meta.get("mode") == "zip":
-        title_extra = ", ".join(f"{name_of(k)} {np.nanmin(cols[k]):g}–{np.nanmax(cols[k]):g}" for k in axes[1:])
-        axes = axes[:1]  # zipped axes move together: one of them is the abscissa
-    else:
-        title_extra = ""
-    if not axes or "I_dec_mean_Ns" not in cols or n == 0:
+    numeric = [k for k in meta["grid"] if _numeric(cols[k]) and np.isfinite(cols[k]).any()]
+    if not numeric or "I_dec_mean_Ns" not in cols or n == 0:
         return []
     title = f"sweep of {Path(str(meta.get('scenario', ''))).stem or 'cases'}"
-    if title_extra:
-        title += f" (zipped with {title_extra})"
-    if len(axes) == 2:
-        return [_heat_map(plt, cols, axes, outdir / "sweep_map.png", title)]
+    if meta.get("mode") == "zip":  # zipped axes move together: the first numeric one is the abscissa
+        title += " (zipped with " + ", ".join(
+            f"{name_of(k)} {np.nanmin(cols[k]):g}–{np.nanmax(cols[k]):g}" for k in numeric[1:]) + ")" \
+            if len(numeric) > 1 else ""
+        axes = numeric[:1]
+    elif len(meta["grid"]) == 2 and len(numeric) == 2:
+        return [_heat_map(plt, cols, numeric, outdir / "sweep_map.png", title)]
+    else:  # abscissa: the first numeric axis; one line per value of the others (text values too)
+        axes = numeric[:1] + [k for k in meta["grid"] if k != numeric[0]]
     return [_lines(plt, cols, axes, outdir / "sweep_I.png", title)] if _line_groups(cols, axes) else []
 
 
@@ -83,7 +83,7 @@ def _lines(plt, cols, axes, path: Path, title: str) -> Path:
     for gi, (other, idx) in enumerate(sorted(groups.items())):
         idx = sorted(idx, key=lambda i: cols[x_key][i])
         x = np.asarray(cols[x_key])[idx]
-        extra = ", ".join(f"{name_of(k)} = {v:g} {unit_of(k) if unit_of(k) != '1' else ''}".strip()
+        extra = ", ".join(f"{name_of(k)} = {_show(v)} {unit_of(k) if unit_of(k) != '1' else ''}".strip()
                           for k, v in zip(axes[1:], other))
         for name, style in (("I_dec", "-o"), ("I_acc", "--s")):
             if f"{name}_mean_Ns" not in cols:
@@ -101,6 +101,10 @@ def _lines(plt, cols, axes, path: Path, title: str) -> Path:
     fig.savefig(path, dpi=120)
     plt.close(fig)
     return path
+
+
+def _show(v) -> str:
+    return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)
 
 
 def _heat_map(plt, cols, axes, path: Path, title: str) -> Path:

@@ -73,6 +73,15 @@ def _provenance_cached():
         archive.git_commit = original
 
 
+def _per_rotation(res):
+    """(I_dec, I_acc) per rotation [rotations, pockets] of a result: ``per_rotation["I_dec"]`` (the
+    results object of issue 11) or ``per_rotation_I_dec`` (today's model results)."""
+    per = getattr(res, "per_rotation", None)
+    if isinstance(per, dict):
+        return per["I_dec"], per["I_acc"]
+    return res.per_rotation_I_dec, res.per_rotation_I_acc
+
+
 def run_case(case_hash: str, toml_text: str, target: Path) -> dict:
     """Run one case into the archive ``target`` (written atomically by the archive writer).
 
@@ -88,7 +97,7 @@ def run_case(case_hash: str, toml_text: str, target: Path) -> dict:
         out = run_scenario(scenario, target, figures=False, progress=False)
         res = out.result
         summary = _numbers(res.summary)
-        summary.update(standard_errors(res.per_rotation_I_dec, res.per_rotation_I_acc))
+        summary.update(standard_errors(*_per_rotation(res)))
         return {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
                 "summary": summary}
     except Exception as exc:  # noqa: BLE001 - a failing case is recorded, the sweep goes on

@@ -22,11 +22,11 @@ given), so they are never held in memory; :func:`write` then completes the same 
 from __future__ import annotations
 
 import datetime as _dt
+import functools
 import os
 import platform
 import subprocess
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +58,7 @@ def package_versions() -> dict[str, str]:
     return out
 
 
+@functools.lru_cache(maxsize=1)
 def git_commit() -> str:
     """Commit of the bearingsim source tree if it is a git checkout, else 'unknown'."""
     here = Path(__file__).resolve().parent
@@ -373,6 +374,85 @@ def _plain(v):
     if isinstance(v, np.floating):
         return float(v)
     return v
+
+
+def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str], attrs: dict[str, Any]) -> Path:
+    """Write a stand-alone table (``/index/<column>`` datasets, root ``attrs``) atomically: a sweep's
+    ``sweep.h5``. String columns are stored as variable-length UTF-8."""
+    h5py = _lazy_h5py()
+    path = Path(path)
+    tmp = _tmp_name(path)
+    try:
+        with h5py.File(tmp, "w") as f:
+            for k, v in attrs.items():
+                f.attrs[k] = v
+            g = f.create_group("index")
+            for name, arr in columns.items():
+                arr = np.asarray(arr)
+                if arr.dtype.kind in "OUS":
+                    ds = g.create_dataset(name, data=arr.astype(object), dtype=h5py.string_dtype())
+                else:
+                    ds = g.create_dataset(name, data=arr)
+                if name in units:
+                    ds.attrs["unit"] = units[name]
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+    """Read a table written by :func:`write_table_file` whose root attribute ``format`` is ``fmt``:
+    (columns, root attributes). One-line UserError for anything else."""
+    h5py = _lazy_h5py()
+    p = Path(path)
+    try:
+        f = h5py.File(p, "r")
+    except (OSError, FileNotFoundError) as exc:
+        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+    with f:
+        if f.attrs.get("format") != fmt or "index" not in f:
+            raise UserError(f"{p}: not a {fmt}")
+        attrs = {k: _plain(v) for k, v in f.attrs.items()}
+        cols = {name: (ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]) for name, ds in f["index"].items()}
+    return cols, attrs
+
+
+def is_table_file(path, fmt: str) -> bool:
+    """True when ``path`` is a table of format ``fmt`` (:func:`write_table_file`)."""
+    try:
+        read_table_file(path, fmt)
+        return True
+    except UserError:
+        return False
+
+
+def peek(path) -> dict[str, Any] | None:
+    """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
+    (TOML text), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``. None for a
+    missing, unreadable or incomplete file (never trusted)."""
+    h5py = _lazy_h5py()
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with h5py.File(path, "r") as f:
+            g = f.get("bearingsim")
+            if g is None or not bool(g.attrs.get("complete", False)):
+                return None
+            text = f["scenario"][()]
+            summary = {k: _plain(v) for k, v in f["results/summary"].attrs.items() if not k.endswith("__unit")}
+            return {
+                "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
+                "summary": {k: float(v) for k, v in summary.items()
+                            if isinstance(v, (int, float)) and not isinstance(v, bool)},
+                "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
+                "wall_time_s": float(f["provenance"].attrs.get("wall_time_s", float("nan"))) if "provenance" in f
+                else float("nan"),
+            }
+    except (OSError, KeyError, ValueError, TypeError):
+        return None
 
 
 def open_archive(path: str | Path):

@@ -141,14 +141,13 @@ def long_run_check(outdir: Path, rotations: int) -> dict:
     for n in (max(rotations // 10, 4), rotations):
         out = outdir / f"long_{n}.h5"
         code = (
-            "import resource, sys, json, numpy as np, h5py\n"
+            "import resource, sys, json, numpy as np\n"
             "from bearingsim.scenario import load_scenario\n"
             "from bearingsim.simulation import run_scenario\n"
             f"sc = load_scenario('{_scenarios_dir() / 'multibody_6000rpm.toml'}', "
             f"['numerics.rotations={n}', 'numerics.warmup_rotations=2'])\n"
-            f"run_scenario(sc, '{out}', figures=False)\n"
+            f"I = run_scenario(sc, '{out}', figures=False).result.per_rotation['I_dec']\n"
             "rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0\n"
-            f"f = h5py.File('{out}', 'r'); I = f['results/per_rotation/I_dec'][()]\n"
             "print(json.dumps(dict(rss_MiB=rss, I=I.mean(axis=1).tolist(), finite=bool(np.isfinite(I).all()))))\n"
         )
         t0 = time.perf_counter()

@@ -67,6 +67,16 @@ def _cmd_plot(args) -> int:
     from bearingsim.simulation import load as read
 
     path = Path(args.archive)
+    from bearingsim import archive
+    from bearingsim.sweeps.index import INDEX_FORMAT
+
+    if archive.is_table_file(path, INDEX_FORMAT):  # a sweep's index: its figures
+        from bearingsim.sweeps import plot_sweep_index
+
+        folder = check_writable_dir(args.output) if args.output else path.parent
+        for png in plot_sweep_index(path, folder):
+            print(f"wrote {png}")
+        return 0
     result = read(path)
     folder = check_writable_dir(args.output) if args.output else path.parent
     for png in result.save_figures(folder / path.stem):
@@ -147,6 +157,11 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
+    if args.sweep:
+        from bearingsim.sweeps.bench import run_sweep_bench
+
+        run_sweep_bench(Path(args.output))
+        return 0
     from bearingsim.bench import run_bench
 
     run_bench(Path(args.output), quick=args.quick)
@@ -154,10 +169,10 @@ def _cmd_bench(args) -> int:
 
 
 def _cmd_sweep(args) -> int:
-    from bearingsim.sweep import run_sweep
+    from bearingsim.sweeps import run_sweep_cli
 
-    run_sweep(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs, figures=not args.no_plots)
-    return 0
+    return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
+                         scheduler=args.scheduler, figures=not args.no_plots)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -208,17 +223,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot)")
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
+    b.add_argument("--sweep", action="store_true",
+                   help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 
-    s = sub.add_parser("sweep", help="what-if sweep over one or more scenario keys")
-    s.add_argument("scenario")
-    s.add_argument("--param", action="append", required=True, metavar="KEY=V1,V2,...",
+    s = sub.add_parser("sweep", help="what-if sweep: resumable, failures recorded, local pool or dask cluster")
+    s.add_argument("scenario", help="scenario TOML (with --param) or sweep file (README: Sweeps)")
+    s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...",
                    help="key and the values to sweep (repeatable: the grid is the product)")
-    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    s.add_argument("-o", "--output", default="outputs/sweep", help="output folder")
-    s.add_argument("-j", "--jobs", type=int, default=1, help="parallel processes")
-    s.add_argument("--no-plots", action="store_true")
+    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="override a scenario key in every case (repeatable)")
+    s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, cases/, figures)")
+    s.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
+    s.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
+    s.add_argument("--no-plots", action="store_true", help="index only, no figures")
     s.set_defaults(func=_cmd_sweep)
     return p
 

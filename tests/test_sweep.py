@@ -1,33 +1,334 @@
-"""What-if sweeps: every grid point is validated before any runs, and each point equals a single run."""
+"""What-if sweeps (issue 15): validation before running, content-hash archives, the index, resume,
+failures, interruption by signals, the local pool and a real dask LocalCluster, figures."""
 import csv
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
 
+import h5py
+import numpy as np
 import pytest
 
+from bearingsim.errors import SimulationUnstable
 from bearingsim.simulation import run as simulate
 from bearingsim.scenario import load_scenario
+from bearingsim.sweeps import LocalEngine, SweepSpec, case_hash, read_index, resolve_cases, run_sweep
+from bearingsim.sweeps.plot import axis_label, plot_sweep_index
+from bearingsim.sweeps.run import make_batches, run_sweep_cli
+from bearingsim.sweeps.spec import Case, load_sweep_file, scenario_from_toml
+from bearingsim.sweeps.worker import standard_errors
 
 from .conftest import SCENARIOS
 from .test_cli import assert_user_error, bearingsim
 
+BASE = SCENARIOS / "paper_3000rpm.toml"
+SPEED = "operating.inner_ring_speed_rpm"
+
+
+def _rows(folder):
+    with open(folder / "sweep.csv") as fh:
+        return list(csv.DictReader(fh))
+
 
 def test_sweep_table_matches_single_runs(tmp_path):
-    res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param",
-                     "operating.inner_ring_speed_rpm=500,6000", "--param", "lubrication.drag_coefficient=0.01,0.03",
+    res = bearingsim("sweep", BASE, "--param", f"{SPEED}=500,6000", "--param", "lubrication.drag_coefficient=0.01,0.03",
                      "-o", tmp_path, "-j", "2")
     assert res.returncode == 0, res.stderr
-    with open(tmp_path / "sweep.csv") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = _rows(tmp_path)
     assert len(rows) == 4
-    assert (tmp_path / "sweep.png").exists()
+    assert (tmp_path / "sweep_map.png").exists()  # two axes: a heat map
     for row in rows:
-        sc = load_scenario(SCENARIOS / "paper_3000rpm.toml", [
-            f"operating.inner_ring_speed_rpm={row['operating.inner_ring_speed_rpm']}",
-            f"lubrication.drag_coefficient={row['lubrication.drag_coefficient']}"])
+        assert row["status"] == "done" and row["error"] == ""
+        sc = load_scenario(BASE, [f"{SPEED}={row[SPEED]}", f"lubrication.drag_coefficient={row['lubrication.drag_coefficient']}"])
         assert float(row["I_dec_mean_Ns"]) == pytest.approx(simulate(sc).summary["I_dec_mean_Ns"], rel=1e-12)
+        # the archive is named by the hash of the scenario it stores
+        with h5py.File(tmp_path / row["archive"], "r") as f:
+            stored = f["scenario"][()].decode()
+            assert bool(f["bearingsim"].attrs["complete"])
+        assert row["archive"] == f"cases/{case_hash(stored)}.h5" == f"cases/{row['case']}.h5"
+    cols, meta = read_index(tmp_path / "sweep.h5")
+    assert meta["axes"] == [SPEED, "lubrication.drag_coefficient"]
+    assert list(cols["status"]) == ["done"] * 4
+    np.testing.assert_array_equal(cols[SPEED], [500.0, 500.0, 6000.0, 6000.0])
 
 
 def test_sweep_with_a_bad_point_runs_nothing(tmp_path):
-    res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "contact.restitution=0.5,1.5",
-                     "-o", tmp_path)
+    res = bearingsim("sweep", BASE, "--param", "contact.restitution=0.5,1.5", "-o", tmp_path)
     assert_user_error(res, "contact.restitution")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("args, key", [
+    (["--param", f"{SPEED}=500,1000", "--param", f"{SPEED}=2000"], SPEED),
+    (["--param", f"{SPEED}=500,1000", "--set", f"{SPEED}=2000"], SPEED),
+    (["--param", "bearing.no_such_key=1,2"], "bearing.no_such_key"),
+])
+def test_key_twice_or_unknown_is_refused_before_running(tmp_path, args, key):
+    res = bearingsim("sweep", BASE, *args, "-o", tmp_path / "out")
+    assert_user_error(res, key)
+    assert not (tmp_path / "out").exists()
+
+
+def test_sweep_file_zip_and_extra_cases(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text(f"""scenario = "{BASE}"
+mode = "zip"
+[set]
+"contact.restitution" = 0.7
+[axes]
+"{SPEED}" = [500, 1000, 2000]
+lubrication.drag_coefficient = [0.01, 0.02, 0.03]
+[[cases]]
+"{SPEED}" = 6000
+"bearing.pocket_clearance_mm" = 0.3
+""")
+    spec = load_sweep_file(f)
+    cases = resolve_cases(spec)
+    assert [c.values for c in cases] == [
+        {SPEED: 500, "lubrication.drag_coefficient": 0.01}, {SPEED: 1000, "lubrication.drag_coefficient": 0.02},
+        {SPEED: 2000, "lubrication.drag_coefficient": 0.03}, {SPEED: 6000, "bearing.pocket_clearance_mm": 0.3}]
+    assert spec.keys == [SPEED, "lubrication.drag_coefficient", "bearing.pocket_clearance_mm"]
+    sc = scenario_from_toml(cases[3].toml)
+    assert sc.contact.restitution == 0.7 and sc.bearing.pocket_clearance_mm == 0.3
+    # a worker rebuilds exactly the scenario that was hashed, or resume could never find a case
+    assert all(scenario_from_toml(c.toml).to_toml() == c.toml for c in cases)
+
+    f.write_text(f.read_text().replace("[0.01, 0.02, 0.03]", "[0.01, 0.02]"))
+    res = bearingsim("sweep", f, "-o", tmp_path / "out")
+    assert_user_error(res, "zip", "lubrication.drag_coefficient: 2")
+    f.write_text(f.read_text().replace('"contact.restitution" = 0.7', f'"{SPEED}" = 100'))
+    assert_user_error(bearingsim("sweep", f, "-o", tmp_path / "out"), SPEED, "both")
+    f.write_text(f'scenario = "{BASE}"\naxis = 1\n')
+    assert_user_error(bearingsim("sweep", f, "-o", tmp_path / "out"), "axis", "unknown key")
+    assert not (tmp_path / "out").exists()
+
+
+def test_shipped_sweep_files_resolve():
+    files = sorted((SCENARIOS / "sweeps").glob("*.toml"))
+    assert len(files) >= 3
+    n = {f.name: len(resolve_cases(load_sweep_file(f))) for f in files}
+    assert n["map_speed_clearance.toml"] == 10_000 and n["speed_zip_and_extras.toml"] == 6
+
+
+def test_same_scenario_twice_is_refused():
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [500, 500.0])])
+    with pytest.raises(Exception, match="same scenario"):
+        resolve_cases(spec)
+
+
+def test_batches_group_cheap_cases_only():
+    red = [Case(f"r{i}", {}, "t", "reduced") for i in range(40)]
+    mb = [Case(f"m{i}", {}, "t", "multibody") for i in range(3)]
+    batches = make_batches(red + mb, workers=2)
+    sizes = sorted(len(b) for b in batches)
+    assert sizes == [1, 1, 1] + [5] * 8  # 40 reduced cases in 4 batches per worker, multibody alone
+    assert sorted(h for b in batches for h, _ in b) == sorted(c.hash for c in red + mb)
+
+
+def test_standard_error_is_over_rotations_of_pocket_means():
+    # two rotations of two pockets: rotation means 2 and 4 -> sample std sqrt(2), over sqrt(2) -> 1
+    se = standard_errors(np.array([[1.0, 3.0], [3.0, 5.0]]), np.zeros((2, 2)))
+    assert se["I_dec_sem_Ns"] == pytest.approx(1.0) and se["I_acc_sem_Ns"] == 0.0
+    assert math.isnan(standard_errors(np.ones((1, 4)), np.ones((1, 4)))["I_dec_sem_Ns"])
+
+
+def test_resume_runs_only_what_is_missing(tmp_path):
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000, 4000])])
+    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert [r["status"] for r in first.rows] == ["done"] * 4
+    cases = tmp_path / "cases"
+    kept = cases / f"{first.rows[0]['case']}.h5"
+    mtime = kept.stat().st_mtime_ns
+    (cases / f"{first.rows[1]['case']}.h5").unlink()  # lost
+    data = (cases / f"{first.rows[2]['case']}.h5").read_bytes()
+    (cases / f"{first.rows[2]['case']}.h5").write_bytes(data[: len(data) // 2])  # truncated
+    with h5py.File(cases / f"{first.rows[3]['case']}.h5", "a") as f:  # complete flag not set: a partial file
+        f["bearingsim"].attrs["complete"] = False
+    (cases / f".{first.rows[1]['case']}.h5.tmp-99999").write_bytes(data)  # a dead worker's temporary file
+
+    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert [r["status"] for r in again.rows] == ["cached", "done", "done", "done"]
+    assert kept.stat().st_mtime_ns == mtime
+    assert not list(cases.glob(".*"))
+    for a, b in zip(first.rows, again.rows):
+        assert a["summary"]["I_dec_mean_Ns"] == b["summary"]["I_dec_mean_Ns"]
+    assert [r["status"] for r in _rows(tmp_path)] == ["cached", "done", "done", "done"]
+
+
+def test_failed_case_is_recorded_and_the_others_go_on(tmp_path):
+    # the euler method refuses a too-large time step only when the case runs
+    res = bearingsim("sweep", BASE, "--set", "reduced.method=euler", "--param", "numerics.dt_s=1e-6,0.01,2e-6",
+                     "-o", tmp_path, "-j", "2")
+    assert res.returncode == 1, res.stderr
+    assert "Traceback" not in res.stderr
+    rows = _rows(tmp_path)
+    assert [r["status"] for r in rows] == ["done", "failed", "done"]
+    assert "numerics.dt_s" in rows[1]["error"] and "\n" not in rows[1]["error"] and rows[1]["archive"] == ""
+    assert rows[1]["case"] in res.stderr.splitlines()[-1] and "1 of 3 cases failed" in res.stderr
+    assert not (tmp_path / "cases" / f"{rows[1]['case']}.h5").exists()
+
+
+def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
+    # forked pool workers inherit the patch: a case at 2000 rpm raises as an unstable run would
+    import bearingsim.simulation as simulation
+
+    real = simulation.run_scenario
+
+    def flaky(scenario, *a, **kw):
+        if scenario.operating.inner_ring_speed_rpm == 2000:
+            raise SimulationUnstable("energy blow-up at t = 0.1 s; try a smaller dt")
+        if scenario.operating.inner_ring_speed_rpm == 3000:
+            raise ZeroDivisionError("float division by zero")
+        return real(scenario, *a, **kw)
+
+    monkeypatch.setattr(simulation, "run_scenario", flaky)
+    code = run_sweep_cli(BASE, [f"{SPEED}=1000,2000,3000"], [], tmp_path, jobs=2, figures=False, quiet=True)
+    assert code == 1
+    rows = _rows(tmp_path)
+    assert [r["status"] for r in rows] == ["done", "failed", "failed"]
+    assert rows[1]["error"] == "energy blow-up at t = 0.1 s; try a smaller dt"
+    assert rows[2]["error"] == "ZeroDivisionError: float division by zero"
+    err = capsys.readouterr().err
+    assert "2 of 3 cases failed" in err and f"{SPEED}=2000" in err and "Traceback" not in err
+
+
+def _descendants(pid):
+    import psutil
+
+    try:
+        return psutil.Process(pid).children(recursive=True)
+    except psutil.NoSuchProcess:
+        return []
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code):
+    import psutil
+
+    # euler at dt = 2 ns: about 1 s per case, so cases are running and queued when the signal comes
+    dts = ",".join(f"{2 + i / 100:.2f}e-9" for i in range(8))
+    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "sweep", str(BASE), "--set", "reduced.method=euler",
+                             "--param", f"numerics.dt_s={dts}", "-o", str(tmp_path), "-j", "2", "--no-plots"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline:
+            if (tmp_path / "sweep.csv").exists() and any(r["status"] == "done" for r in _rows(tmp_path)):
+                break
+            time.sleep(0.05)
+        children = _descendants(proc.pid)
+        assert len(children) >= 2  # the pool's workers
+        t0 = time.monotonic()
+        os.kill(proc.pid, signum)
+        out, err = proc.communicate(timeout=10)
+        took = time.monotonic() - t0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == code, err
+    assert took < 5.0
+    assert "Traceback" not in err and "resume" in err
+    gone, alive = psutil.wait_procs(children, timeout=2)
+    assert alive == []
+    rows = _rows(tmp_path)
+    done = [r for r in rows if r["status"] == "done"]
+    assert done and any(r["status"] == "pending" for r in rows)
+    for r in done:
+        with h5py.File(tmp_path / r["archive"], "r") as f:
+            assert bool(f["bearingsim"].attrs["complete"])
+    assert not list((tmp_path / "cases").glob(".*"))  # no temporary file of a killed worker
+
+
+def test_local_cluster_runs_the_same_cases(tmp_path):
+    pytest.importorskip("distributed")
+    from distributed import LocalCluster
+
+    from bearingsim.sweeps import DaskEngine
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [500, 2000, 6000])])
+    local = run_sweep(spec, tmp_path / "local", engine=LocalEngine(1), figures=False, progress=False)
+    with warnings.catch_warnings(record=True) as seen:
+        # dask's own start-up and shut-down notices (a port in use, comms closing) are recorded, not
+        # raised; none may come from bearingsim itself
+        warnings.simplefilter("always")
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                          host="127.0.0.1") as cluster:
+            out = run_sweep(spec, tmp_path / "dask", engine=DaskEngine(cluster=cluster), figures=False,
+                            progress=False)
+            assert len(cluster.scheduler_info["workers"]) == 2
+            assert {r["case"] for r in out.rows} == {c.hash for c in resolve_cases(spec)}
+    assert [r["status"] for r in out.rows] == ["done"] * 3
+    assert [str(w.message) for w in seen if "bearingsim" in w.filename] == []
+    for a, b in zip(local.rows, out.rows):
+        assert a["case"] == b["case"]
+        assert a["summary"]["I_dec_mean_Ns"] == b["summary"]["I_dec_mean_Ns"]
+        with h5py.File(tmp_path / "dask" / b["archive"], "r") as f:  # written by the client from the bytes
+            assert f["scenario"][()].decode() == scenario_from_toml(f["scenario"][()].decode()).to_toml()
+            assert bool(f["bearingsim"].attrs["complete"])
+
+
+def test_unreachable_scheduler_is_a_user_error():
+    pytest.importorskip("distributed")
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps import DaskEngine
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(UserError, match="cannot reach a dask scheduler"):
+            DaskEngine("tcp://127.0.0.1:9", timeout_s=1).start()
+
+
+def test_figures_from_the_index(tmp_path):
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 3000])], sets=["numerics.rotations=2"])
+    out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=True, progress=False)
+    assert [p.name for p in out.figures] == ["sweep_I.png"]
+    assert axis_label(SPEED) == "inner ring speed [rpm]"
+    assert axis_label("bearing.pocket_clearance_mm") == "pocket clearance [mm]"
+    assert axis_label("lubrication.drag_coefficient") == "drag coefficient"
+    # drawn again from the index alone, into another folder
+    again = plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "again")
+    assert [p.name for p in again] == ["sweep_I.png"] and again[0].stat().st_size > 10_000
+
+
+def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
+    import psutil
+
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.run import _Lock
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000])])
+    before = {p.pid for p in psutil.Process().children(recursive=True)}  # e.g. multiprocessing's resource tracker
+    with _Lock(tmp_path):  # another sweep holds the folder
+        with pytest.raises(UserError, match="another sweep is writing"):
+            run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
+    assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()  # its pool is gone
+    assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1
+
+
+def test_figure_kind_follows_the_grid(tmp_path):
+    from bearingsim.sweeps.index import write_index
+
+    def rows(grid):
+        out = []
+        for i, values in enumerate(grid):
+            failed = i == 1  # a failed case: a gap, not a zero
+            out.append({"case": f"c{i}", "values": values, "status": "failed" if failed else "done", "error": "",
+                        "archive": "", "wall_s": 0.1,
+                        "summary": {} if failed else {"I_dec_mean_Ns": 0.005 + 0.001 * i, "I_dec_sem_Ns": 1e-4}})
+        return out
+
+    two = [{SPEED: s, "bearing.pocket_clearance_mm": c} for s in (1000, 2000) for c in (0.1, 0.2)]
+    write_index(tmp_path, rows(two), list(two[0]), {"mode": "product", "grid": f'["{SPEED}", "bearing.pocket_clearance_mm"]',
+                                                   "grid_rows": 4, "scenario": "x.toml"})
+    assert [p.name for p in plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "a")] == ["sweep_map.png"]
+    text = [{SPEED: s, "operating.direction": d} for s in (1000, 2000) for d in ("forward", "reverse")]
+    write_index(tmp_path, rows(text), list(text[0]), {"mode": "product", "grid": f'["{SPEED}", "operating.direction"]',
+                                                     "grid_rows": 4, "scenario": "x.toml"})
+    assert [p.name for p in plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "b")] == ["sweep_I.png"]
+    cols, meta = read_index(tmp_path / "sweep.h5")
+    assert list(cols["operating.direction"]) == ["forward", "reverse"] * 2
+    assert math.isnan(cols["I_dec_mean_Ns"][1]) and cols["I_dec_mean_Ns"][2] == pytest.approx(0.007)

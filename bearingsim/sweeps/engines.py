@@ -1,0 +1,155 @@
+"""Where cases run: a local process pool, or an existing dask.distributed cluster.
+
+Both take batches of ``(hash, resolved TOML)`` pairs and yield each batch's records as it finishes
+(:func:`bearingsim.sweeps.worker.run_batch`); ``stop()`` cancels what has not started. The local pool
+also ends its worker processes at once (they never outlive the sweep: they are terminated on
+interruption, and on Linux the kernel kills them if the sweep process itself dies).
+"""
+from __future__ import annotations
+
+import os
+import signal
+import time
+from collections.abc import Iterator
+
+from bearingsim.errors import UserError
+
+
+def _pool_worker_init() -> None:
+    # Ctrl-C reaches the whole process group: only the sweep process acts on it and then ends the
+    # pool, so a worker must not die half-way through writing on its own.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    try:  # Linux: die with the parent even if it is killed with SIGKILL
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        if os.getppid() == 1:
+            os._exit(0)
+    except (OSError, AttributeError):  # pragma: no cover - not Linux
+        pass
+
+
+class LocalEngine:
+    """A pool of ``jobs`` worker processes on this machine; archives are written in place.
+
+    Parameters
+    ----------
+    jobs : int
+        Number of worker processes (at least 1).
+    """
+
+    kind = "local"
+    shared_fs = True
+
+    def __init__(self, jobs: int = 1):
+        if jobs < 1:
+            raise UserError(f"--jobs: must be at least 1 (got {jobs})")
+        self.workers = jobs
+        self._pool = None
+
+    def start(self) -> None:
+        import multiprocessing as mp
+
+        if self._pool is None:
+            # fork: workers start in milliseconds and inherit the imported package
+            self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
+
+    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str) -> Iterator[list[dict]]:
+        """Yield the records of each batch as it finishes (in completion order)."""
+        import queue
+
+        from bearingsim.sweeps.worker import one_line_error, run_batch
+
+        self.start()
+        done: queue.Queue = queue.Queue()
+        for b in batches:
+            def lost(exc, b=b):  # the batch itself failed (a worker died): every case of it failed
+                done.put([{"hash": h, "status": "failed", "error": one_line_error(exc), "wall_s": float("nan"),
+                           "summary": {}} for h, _ in b])
+            self._pool.apply_async(run_batch, (b, cases_dir), callback=done.put, error_callback=lost)
+        for _ in batches:
+            while True:
+                try:  # short waits: a signal handler runs between them
+                    records = done.get(timeout=0.25)
+                    break
+                except queue.Empty:
+                    continue
+            yield records
+
+    def stop(self) -> None:
+        """End every worker process now (queued batches are dropped) and wait for them to exit."""
+        if self._pool is not None:
+            self._pool.terminate()
+            self._pool.join()
+            self._pool = None
+
+
+class DaskEngine:
+    """Batches sent to a dask.distributed cluster; archives come back as bytes.
+
+    Parameters
+    ----------
+    address : str or None
+        Scheduler address (``tcp://127.0.0.1:8786``), or None with ``cluster`` given.
+    cluster : distributed.deploy.Cluster, optional
+        A cluster object (e.g. a ``LocalCluster``) to connect to instead of an address.
+    timeout_s : float
+        How long to try to reach the scheduler.
+    """
+
+    kind = "dask"
+    shared_fs = False
+
+    def __init__(self, address: str | None = None, cluster=None, timeout_s: float = 10.0):
+        self.address, self.cluster, self.timeout_s = address, cluster, timeout_s
+        self.client = None
+        self._futures: list = []
+        self.workers = 0
+
+    def start(self) -> None:
+        if self.client is not None:
+            return
+        try:
+            from distributed import Client
+        except ImportError:  # pragma: no cover
+            raise UserError("--scheduler: dask.distributed is not installed (pip install 'dask[distributed]')") from None
+        target = self.cluster if self.cluster is not None else self.address
+        try:
+            self.client = Client(target, timeout=f"{self.timeout_s}s", set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise UserError(f"--scheduler {self.address}: cannot reach a dask scheduler ({exc.__class__.__name__}: "
+                            f"{' '.join(str(exc).split())[:200]})") from None
+        self.workers = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
+
+    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str) -> Iterator[list[dict]]:
+        """Yield the records of each batch as it finishes; archives are in ``record["archive"]`` (bytes)."""
+        from distributed import as_completed
+
+        from bearingsim.sweeps.worker import run_batch
+
+        self.start()
+        stamp = f"{os.getpid()}-{time.time_ns()}"
+        self._futures = [self.client.submit(run_batch, b, None, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
+                         for i, b in enumerate(batches)]
+        for fut in as_completed(self._futures, loop=self.client.loop):
+            try:
+                yield fut.result()
+            except Exception as exc:  # noqa: BLE001 - a lost worker or a task the cluster gave up on
+                from bearingsim.sweeps.worker import one_line_error
+
+                i = self._futures.index(fut)
+                yield [{"hash": h, "status": "failed", "error": f"dask: {one_line_error(exc)}", "wall_s": float("nan"),
+                        "summary": {}} for h, _ in batches[i]]
+
+    def stop(self) -> None:
+        """Cancel every queued batch and disconnect (the cluster itself is the user's and stays up)."""
+        if self.client is None:
+            return
+        try:
+            if self._futures:
+                self.client.cancel(self._futures, force=True)
+        finally:
+            self._futures = []
+            self.client.close(timeout=5)
+            self.client = None

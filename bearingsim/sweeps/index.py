@@ -1,0 +1,172 @@
+"""The sweep's index (``sweep.csv`` and ``sweep.h5``) and the resume check of case archives.
+
+One row per case, in the sweep's case order: ``case`` (content hash), the swept keys, ``status``
+(``done``: run now; ``cached``: a complete archive of the same scenario was already there;
+``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
+``archive`` (path relative to the sweep folder), ``wall_s`` (seconds the case took; for a cached case
+the stored run's own wall time) and the summary numbers (SI, as in the archives' ``/results/summary``,
+plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.sweeps.worker.standard_errors`).
+
+``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
+NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every
+swept key in ``axes``, the grid's axes in ``grid`` (JSON lists), the sweep ``mode`` (``product`` or
+``zip``) and ``grid_rows`` (the grid's cases come first; explicit extra cases follow). Both files are written to a temporary name and renamed.
+"""
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim import archive
+
+INDEX_FORMAT = "bearingsim sweep index 1"
+FIXED = ("status", "error", "archive", "wall_s")
+# summary numbers shown first when present; any others follow in name order
+PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
+             "first_impact_speed_m_s", "first_impact_energy_J", "cage_slip", "load_zone_half_angle_deg")
+
+
+def _tmp(path: Path) -> Path:
+    return path.with_name(f".{path.name}.tmp-{os.getpid()}")
+
+
+def write_atomic_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary name and a rename (never a partial file)."""
+    tmp = _tmp(path)
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def summary_columns(rows: list[dict]) -> list[str]:
+    """Summary number names present in ``rows``: the preferred ones first, then the rest sorted."""
+    present = set()
+    for r in rows:
+        present.update(r.get("summary", {}))
+    return [k for k in PREFERRED if k in present] + sorted(present - set(PREFERRED))
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+
+
+def write_index(outdir: Path, rows: list[dict], keys: list[str], meta: dict) -> tuple[Path, Path]:
+    """Write ``sweep.csv`` and ``sweep.h5`` for ``rows`` atomically; return both paths.
+
+    Each row holds ``case``, ``values`` (dict over ``keys``), ``status``, ``error``, ``archive``,
+    ``wall_s`` and ``summary`` (dict of floats).
+    """
+    outdir = Path(outdir)
+    summ = summary_columns(rows)
+    columns = ["case", *keys, *FIXED, *summ]
+    csv_path, h5_path = outdir / "sweep.csv", outdir / "sweep.h5"
+
+    tmp = _tmp(csv_path)
+    try:
+        with open(tmp, "w", newline="", encoding="utf-8") as fh:
+            w = csv.writer(fh)
+            w.writerow(columns)
+            for r in rows:
+                s = r.get("summary", {})
+                w.writerow([r["case"], *[r["values"].get(k, "") for k in keys], r["status"], r.get("error", ""),
+                            r.get("archive", ""), _fmt(r.get("wall_s")), *[_fmt(s.get(k)) for k in summ]])
+        os.replace(tmp, csv_path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+    cols = {"case": np.array([r["case"] for r in rows], dtype=object)}
+    units = {}
+    for k in keys:
+        vals = [r["values"].get(k) for r in rows]
+        if all(v is None or _is_number(v) for v in vals):
+            cols[k] = np.array([math.nan if v is None else float(v) for v in vals])
+        else:
+            cols[k] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
+        units[k] = unit_of(k)
+    for col in ("status", "error", "archive"):
+        cols[col] = np.array([r.get(col, "") for r in rows], dtype=object)
+    cols["wall_s"] = np.array([_float(r.get("wall_s")) for r in rows])
+    units["wall_s"] = "s"
+    for k in summ:
+        cols[k] = np.array([_float(r.get("summary", {}).get(k)) for r in rows])
+        units[k] = unit_of(k)
+    attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **meta}
+    archive.write_table_file(h5_path, cols, units, attrs)
+    return csv_path, h5_path
+
+
+def _float(v) -> float:
+    return float(v) if _is_number(v) else math.nan
+
+
+def _fmt(v) -> str:
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else repr(float(v)) if _is_number(v) else str(v)
+
+
+def read_index(path: str | Path) -> tuple[dict[str, np.ndarray], dict]:
+    """Read ``sweep.h5``: (columns as arrays, attributes with ``axes`` and ``columns`` decoded).
+
+    Raises
+    ------
+    UserError
+        The file is missing or is not a sweep index.
+    """
+    cols, meta = archive.read_table_file(path, INDEX_FORMAT)
+    meta["axes"] = json.loads(meta["axes"])
+    meta["grid"] = json.loads(meta.get("grid", "[]"))
+    meta["grid_rows"] = int(meta.get("grid_rows", 0))
+    meta["columns"] = json.loads(meta["columns"])
+    cols = {name: cols[name] for name in meta["columns"]}
+    return cols, meta
+
+
+# unit suffixes of scenario and summary keys -> unit text for labels
+UNITS = (("_kgm2", "kg m²"), ("_Ns", "N s"), ("_m_s", "m/s"), ("_rad_s", "rad/s"), ("_mm", "mm"),
+         ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"), ("_hz", "Hz"), ("_N", "N"),
+         ("_J", "J"), ("_s", "s"), ("_m", "m"))
+
+
+def unit_of(key: str) -> str:
+    """Unit from a key's suffix (``operating.inner_ring_speed_rpm`` -> ``rpm``); ``1`` if none."""
+    leaf = key.split(".")[-1]
+    for suffix, unit in UNITS:
+        if leaf.endswith(suffix):
+            return unit
+    return "1"
+
+
+def name_of(key: str) -> str:
+    """Readable name of a key without section and unit suffix (``inner ring speed``)."""
+    leaf = key.split(".")[-1]
+    for suffix, _ in UNITS:
+        if leaf.endswith(suffix):
+            leaf = leaf[: -len(suffix)]
+            break
+    return leaf.replace("_", " ")
+
+
+def read_cached(archive_path: Path, toml_text: str) -> dict | None:
+    """The record of a case whose archive is complete and stores exactly ``toml_text``, else None.
+
+    Only a file at the final name is considered (temporary files are never trusted); an unreadable,
+    incomplete or different archive gives None and the case runs again.
+    """
+    from bearingsim.sweeps.worker import standard_errors
+
+    got = archive.peek(archive_path)
+    if got is None or got["scenario"] != toml_text:
+        return None
+    summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
+    summary.update(standard_errors(got["I_dec"], got["I_acc"]))
+    wall = got["wall_time_s"]
+    return {"status": "cached", "error": "", "wall_s": wall, "summary": summary}

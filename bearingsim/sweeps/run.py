@@ -1,0 +1,291 @@
+"""Running a sweep: resume, batches, failures, interruption, index, progress.
+
+The sweep folder ``DIR`` holds ``cases/<hash>.h5`` (one archive per case), ``sweep.csv`` and
+``sweep.h5`` (the index, :mod:`bearingsim.sweeps.index`) and, with figures, the sweep's PNGs.
+A lock file ``DIR/.sweep.lock`` keeps two sweeps from writing the same folder at once.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import sys
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from bearingsim.errors import UserError
+from bearingsim.sweeps.index import read_cached, write_atomic_bytes, write_index
+from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
+
+# how many cheap (reduced-model) cases one task runs: enough that a task lasts far longer than its
+# dispatch, few enough that every worker gets several tasks and the bar moves
+MAX_BATCH = 200
+INDEX_EVERY_S = 1.0
+
+
+class SweepInterrupted(Exception):
+    """SIGINT or SIGTERM arrived during a sweep; ``signum`` says which."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+@dataclass
+class SweepOutcome:
+    """What a sweep did: the index files, the rows and the counts by status."""
+
+    outdir: Path
+    csv: Path
+    h5: Path
+    rows: list[dict]
+    interrupted: int | None = None  # the signal number, if interrupted
+    wall_s: float = 0.0
+    figures: list[Path] = field(default_factory=list)
+
+    def count(self, status: str) -> int:
+        return sum(r["status"] == status for r in self.rows)
+
+    @property
+    def failed(self) -> list[dict]:
+        return [r for r in self.rows if r["status"] == "failed"]
+
+
+def make_batches(cases: list[Case], workers: int) -> list[list[tuple[str, str]]]:
+    """Cases grouped into tasks: multibody cases one per task, reduced cases in batches.
+
+    A reduced case costs about a millisecond to solve and tens of milliseconds with its archive, so
+    they go in batches of up to :data:`MAX_BATCH`, small enough that each worker still gets about
+    four batches.
+    """
+    reduced = [(c.hash, c.toml) for c in cases if c.model == "reduced"]
+    other = [[(c.hash, c.toml)] for c in cases if c.model != "reduced"]
+    size = max(1, min(MAX_BATCH, math.ceil(len(reduced) / (4 * max(1, workers))))) if reduced else 1
+    return other + [reduced[i:i + size] for i in range(0, len(reduced), size)]
+
+
+class _Lock:
+    def __init__(self, outdir: Path):
+        self.path = outdir / ".sweep.lock"
+        self.fh = None
+
+    def __enter__(self):
+        import fcntl
+
+        if self.fh is not None:  # already held (taken before the signal handlers go in)
+            return self
+        self.fh = open(self.path, "w")
+        try:
+            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            self.fh.close()
+            self.fh = None
+            raise UserError(f"{self.path.parent}: another sweep is writing this folder") from None
+        return self
+
+    def __exit__(self, *exc):
+        if self.fh is not None:
+            self.fh.close()
+            self.fh = None
+        return False
+
+
+class _Signals:
+    """SIGINT/SIGTERM raise :class:`SweepInterrupted` once in the main thread; later ones are ignored
+    while the sweep cleans up."""
+
+    def __init__(self):
+        self.old = {}
+        self.fired: int | None = None
+
+    def _handler(self, signum, frame):
+        if self.fired is None:
+            self.fired = signum
+            raise SweepInterrupted(signum)
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for s in (signal.SIGINT, signal.SIGTERM):
+                self.old[s] = signal.signal(s, self._handler)
+        return self
+
+    def __exit__(self, *exc):
+        for s, h in self.old.items():
+            signal.signal(s, h)
+        return False
+
+
+def _clean_temporaries(cases_dir: Path) -> None:
+    """Remove temporary archives left by workers ended mid-write (this sweep holds the folder's lock)."""
+    for p in cases_dir.glob(".*.h5.tmp-*"):
+        p.unlink(missing_ok=True)
+
+
+def _progress(total: int, enabled: bool, initial: int):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    import shutil
+
+    tqdm.monitor_interval = 0  # no monitor thread
+    size = shutil.get_terminal_size((100, 24))  # a terminal that reports no size (a bare pty) gets 100 x 24
+    return tqdm(total=total, desc="sweep", unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
+                nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
+
+
+def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
+              progress: bool | None = None, log=None) -> SweepOutcome:
+    """Run every case of ``spec`` that has no valid archive yet, and index them all.
+
+    Parameters
+    ----------
+    spec : SweepSpec or list of Case
+        The sweep (resolved and validated here before anything runs) or its resolved cases.
+    outdir : path
+        Sweep folder (created).
+    engine : LocalEngine or DaskEngine, optional
+        Where cases run; default a local pool of one process. The engine is started here and stopped
+        (its queued cases cancelled) when the sweep ends, however it ends.
+    figures : bool
+        Draw the index figures (:func:`bearingsim.sweeps.plot.plot_sweep_index`) at the end.
+    progress : bool, optional
+        Show a progress bar on stderr; default: when stderr is a terminal.
+    log : callable, optional
+        Receives one line per failed case (default: stderr).
+
+    Returns
+    -------
+    SweepOutcome
+        ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the sweep (the index is
+        written and finished archives kept either way).
+    """
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.sweeps.engines import LocalEngine
+
+    t0 = time.perf_counter()
+    if isinstance(spec, SweepSpec):
+        cases = resolve_cases(spec)
+        keys = spec.keys
+        meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
+                "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
+    else:
+        cases = list(spec)
+        keys = list(dict.fromkeys(k for c in cases for k in c.values))
+        meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
+                "grid_rows": 0}
+    engine = engine or LocalEngine(1)
+    engine.start()  # an unreachable scheduler stops the sweep before anything is written
+    try:
+        outdir = check_writable_dir(outdir)
+        cases_dir = outdir / "cases"
+        cases_dir.mkdir(exist_ok=True)
+        lock = _Lock(outdir).__enter__()
+    except BaseException:
+        engine.stop()
+        raise
+    if progress is None:
+        progress = sys.stderr.isatty()
+    rows = [{"case": c.hash, "values": c.values, "status": "pending", "error": "", "archive": "",
+             "wall_s": math.nan, "summary": {}} for c in cases]
+    by_hash = {c.hash: i for i, c in enumerate(cases)}
+    outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
+
+    with lock, _Signals():
+        bar = None
+        try:
+            _clean_temporaries(cases_dir)
+            todo = []
+            for c, row in zip(cases, rows):
+                rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
+                if rec is None:
+                    todo.append(c)
+                else:
+                    row.update(rec, archive=f"cases/{c.hash}.h5")
+            write_index(outdir, rows, keys, meta)
+            counts = {"done": 0, "failed": 0, "cached": len(cases) - len(todo)}
+            bar = _progress(len(cases), progress, counts["cached"])
+            if bar is not None:
+                bar.set_postfix(counts, refresh=True)
+            say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None
+                          else (lambda line: print(line, file=sys.stderr)))
+            last_index = time.monotonic()
+            if todo:
+                batches = make_batches(todo, engine.workers)
+                for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None):
+                    for rec in records:
+                        i = by_hash[rec["hash"]]
+                        row = rows[i]
+                        data = rec.pop("archive", None)
+                        if rec["status"] == "done" and data is not None:
+                            write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
+                        row.update(status=rec["status"], error=rec["error"], wall_s=rec["wall_s"],
+                                   summary=rec["summary"],
+                                   archive=f"cases/{rec['hash']}.h5" if rec["status"] == "done" else "")
+                        counts[rec["status"]] += 1
+                        if rec["status"] == "failed":
+                            say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
+                    if bar is not None:
+                        bar.set_postfix(counts, refresh=False)
+                        bar.update(len(records))
+                    if time.monotonic() - last_index >= INDEX_EVERY_S:
+                        write_index(outdir, rows, keys, meta)
+                        last_index = time.monotonic()
+        except SweepInterrupted as exc:
+            outcome.interrupted = exc.signum
+        finally:
+            try:
+                engine.stop()
+            finally:
+                if bar is not None:
+                    bar.close()
+                _clean_temporaries(cases_dir)
+                write_index(outdir, rows, keys, meta)
+    outcome.wall_s = time.perf_counter() - t0
+    if figures and outcome.interrupted is None:
+        from bearingsim.sweeps.plot import plot_sweep_index
+
+        outcome.figures = plot_sweep_index(outcome.h5, outdir)
+    return outcome
+
+
+def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: int | None = None,
+                  scheduler: str | None = None, figures: bool = True, quiet: bool = False) -> int:
+    """``bearingsim sweep``: run, print what was written and return the exit code.
+
+    0: every case done or cached; 1: some case failed (named on stderr); 130/143: interrupted by
+    SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
+    """
+    from bearingsim.sweeps.engines import DaskEngine, LocalEngine
+    from bearingsim.sweeps.spec import spec_from_args
+
+    spec = spec_from_args(target, params, sets)
+    jobs = jobs if jobs is not None else (os.cpu_count() or 1)
+    if jobs < 1:
+        raise UserError(f"--jobs: must be at least 1 (got {jobs})")
+    engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
+    out = run_sweep(spec, outdir, engine=engine, figures=figures)
+    n = len(out.rows)
+    counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
+    if out.interrupted is not None:
+        print(f"bearingsim: sweep interrupted ({signal.Signals(out.interrupted).name}): {counts}, "
+              f"{out.count('pending')} not run, of {n}; index {out.h5}; run the same command again to resume",
+              file=sys.stderr)
+        return 128 + out.interrupted
+    if not quiet:
+        print(f"wrote {out.csv}")
+        print(f"wrote {out.h5}")
+        for p in out.figures:
+            print(f"wrote {p}")
+        print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
+    if out.failed:
+        names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"
+                          for r in out.failed[:10])
+        more = f" and {len(out.failed) - 10} more" if len(out.failed) > 10 else ""
+        print(f"bearingsim: {len(out.failed)} of {n} cases failed: {names}{more} (errors in {out.csv})",
+              file=sys.stderr)
+        return 1
+    return 0

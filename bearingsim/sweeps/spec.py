@@ -1,0 +1,276 @@
+"""What a sweep is: a base scenario, overrides, axes and extra cases, resolved into cases.
+
+A sweep is read either from the command line (``SCENARIO --param KEY=V1,V2 --set KEY=VALUE``; the
+axes form a product) or from a sweep file::
+
+    scenario = "../paper_3000rpm.toml"     # base scenario, relative to this file
+    mode = "product"                        # or "zip": every axis has the same length
+
+    [set]                                   # overrides applied to every case (like --set)
+    "numerics.rotations" = 1
+
+    [axes]                                  # one list of values per key
+    "operating.inner_ring_speed_rpm" = [500, 1000, 2000]
+    "bearing.pocket_clearance_mm" = { start = 0.1, stop = 0.4, num = 4 }   # evenly spaced, ends included
+
+    [[cases]]                               # explicit extra cases (any keys)
+    "operating.inner_ring_speed_rpm" = 6000
+    "lubrication.drag_coefficient" = 0.05
+
+Keys may be quoted dotted keys (as above) or nested tables (``[axes.operating]``). Every case is
+resolved and validated before anything runs: a key given twice, an unknown key or a bad value stops
+the sweep with a one-line :class:`~bearingsim.errors.UserError` naming it.
+
+A case is identified by the content hash of its resolved scenario (:func:`case_hash`), which names
+its archive ``cases/<hash>.h5``.
+"""
+from __future__ import annotations
+
+import hashlib
+import itertools
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from bearingsim.errors import UserError
+from bearingsim.scenario import load_scenario, parse_override, read_toml_file
+
+SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
+
+
+@dataclass(frozen=True)
+class Case:
+    """One resolved case of a sweep.
+
+    Attributes
+    ----------
+    hash : str
+        First 16 hex digits of the SHA-256 of ``toml`` (names the archive).
+    values : dict
+        The swept keys and their values for this case (keys as given, dotted).
+    toml : str
+        The resolved scenario as TOML text (what the archive stores as ``/scenario``).
+    model : str
+        ``"reduced"`` or ``"multibody"`` (cheap reduced cases run in batches).
+    """
+
+    hash: str
+    values: dict[str, Any]
+    toml: str
+    model: str
+
+    def label(self) -> str:
+        """``key=value, ...`` of the swept values, for messages."""
+        return ", ".join(f"{k}={v}" for k, v in self.values.items()) or "(base scenario)"
+
+
+@dataclass
+class SweepSpec:
+    """A sweep before resolution: base scenario, overrides, axes and extra cases."""
+
+    scenario: Path
+    sets: list[str] = field(default_factory=list)
+    axes: list[tuple[str, list]] = field(default_factory=list)
+    mode: str = "product"
+    extra: list[dict[str, Any]] = field(default_factory=list)
+    origin: str = "--param"
+
+    @property
+    def keys(self) -> list[str]:
+        """Every swept key: the axes' keys, then keys only set by extra cases, in order of appearance."""
+        out = [k for k, _ in self.axes]
+        for case in self.extra:
+            out += [k for k in case if k not in out]
+        return out
+
+
+def case_hash(toml_text: str) -> str:
+    """Content hash of a resolved scenario: the first 16 hex digits of SHA-256 of its TOML text."""
+    return hashlib.sha256(toml_text.encode("utf-8")).hexdigest()[:16]
+
+
+def toml_value(value: Any) -> str:
+    """``value`` written as a TOML value (so ``KEY=<this>`` reads back the same value)."""
+    import tomli_w
+
+    return tomli_w.dumps({"v": value})[4:].strip()
+
+
+def parse_param(item: str) -> tuple[str, list]:
+    """``KEY=V1,V2,...`` into (key, values), each value read as a TOML value (a bare word is a string)."""
+    if "=" not in item:
+        raise UserError(f"--param {item!r}: expected KEY=V1,V2,...")
+    key, text = item.split("=", 1)
+    key = key.strip()
+    values = [parse_override(f"{key}={v}")[1] for v in text.split(",") if v.strip()]
+    if not key or not values:
+        raise UserError(f"--param {item!r}: expected KEY=V1,V2,... with at least one value")
+    return key, values
+
+
+def _flatten(table: dict, where: str, prefix: str = "") -> dict[str, Any]:
+    """Nested or dotted-key tables into one ``{dotted.key: value}``; a key reached twice is an error."""
+    out: dict[str, Any] = {}
+    for k, v in table.items():
+        key = f"{prefix}{k}"
+        if isinstance(v, dict) and not _is_range(v):
+            sub = _flatten(v, where, key + ".")
+        else:
+            sub = {key: v}
+        for kk, vv in sub.items():
+            if kk in out:
+                raise UserError(f"{where}: {kk}: given twice")
+            out[kk] = vv
+    return out
+
+
+def _is_range(v) -> bool:
+    return isinstance(v, dict) and set(v) == {"start", "stop", "num"}
+
+
+class _Range:
+    """``{ start, stop, num }``: ``num`` evenly spaced values from start to stop, both included."""
+
+    def __init__(self, table: dict):
+        self.table = table
+
+    def values(self, where: str) -> list[float]:
+        import numpy as np
+
+        start, stop, num = self.table["start"], self.table["stop"], self.table["num"]
+        num_ok = isinstance(num, int) and not isinstance(num, bool) and num >= 1
+        ends_ok = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop))
+        if not (num_ok and ends_ok):
+            raise UserError(f"{where}: {{ start, stop, num }} needs numbers and an integer num >= 1")
+        return [float(x) for x in np.linspace(float(start), float(stop), num)]
+
+
+def _check_unique(keys: list[str], where: str) -> None:
+    seen = set()
+    for k in keys:
+        if k in seen:
+            raise UserError(f"{where}: {k}: given twice")
+        seen.add(k)
+
+
+def is_sweep_file(path: str | Path) -> bool:
+    """A sweep file names its base ``scenario``; a scenario file has ``schema_version`` instead."""
+    raw = read_toml_file(path)
+    return "schema_version" not in raw and "scenario" in raw
+
+
+def spec_from_args(target: str | Path, params: list[str], sets: list[str]) -> SweepSpec:
+    """The sweep the command line describes: a sweep file (``--param``/``--set`` add to it) or a
+    scenario with ``--param`` axes."""
+    target = Path(target)
+    if is_sweep_file(target):
+        spec = load_sweep_file(target)
+    else:
+        spec = SweepSpec(scenario=target)
+        if not params:
+            raise UserError(f"{target}: a scenario needs at least one --param KEY=V1,V2,... to sweep "
+                            "(or give a sweep file)")
+    extra_axes = [parse_param(p) for p in params]
+    if extra_axes and spec.mode == "zip":
+        raise UserError(f"{target}: mode: --param adds a product axis; not allowed with mode = \"zip\"")
+    spec.axes = spec.axes + extra_axes
+    spec.sets = spec.sets + list(sets)
+    return spec
+
+
+def load_sweep_file(path: str | Path) -> SweepSpec:
+    """Read a sweep file (see the module docstring) into a :class:`SweepSpec`."""
+    path = Path(path)
+    raw = read_toml_file(path)
+    for k in raw:
+        if k not in SWEEP_FILE_KEYS:
+            raise UserError(f"{path}: {k}: unknown key in a sweep file (expected {', '.join(SWEEP_FILE_KEYS)})")
+    base = raw.get("scenario")
+    if not isinstance(base, str) or not base:
+        raise UserError(f"{path}: scenario: must name the base scenario file")
+    mode = raw.get("mode", "product")
+    if mode not in ("product", "zip"):
+        raise UserError(f"{path}: mode: must be \"product\" or \"zip\" (got {mode!r})")
+    sets_tab = raw.get("set", {})
+    axes_tab = raw.get("axes", {})
+    cases = raw.get("cases", [])
+    if not isinstance(sets_tab, dict):
+        raise UserError(f"{path}: set: must be a table of KEY = VALUE")
+    if not isinstance(axes_tab, dict):
+        raise UserError(f"{path}: axes: must be a table of KEY = [values]")
+    if not isinstance(cases, list) or not all(isinstance(c, dict) for c in cases):
+        raise UserError(f"{path}: cases: must be an array of tables ([[cases]])")
+    sets = _flatten(sets_tab, f"{path}: set")
+    axes = _flatten(axes_tab, f"{path}: axes")
+    for k, v in axes.items():
+        if _is_range(v):
+            axes[k] = _Range(v).values(f"{path}: axes: {k}")
+        elif not isinstance(v, list) or not v:
+            raise UserError(f"{path}: axes: {k}: must be a non-empty list of values or {{ start, stop, num }}")
+    extra = [_flatten(c, f"{path}: cases[{i}]") for i, c in enumerate(cases)]
+    return SweepSpec(scenario=(path.parent / base), sets=[f"{k}={toml_value(v)}" for k, v in sets.items()],
+                     axes=list(axes.items()), mode=mode, extra=extra, origin=str(path))
+
+
+def resolve_cases(spec: SweepSpec) -> list[Case]:
+    """Every case of ``spec``, resolved and validated, in a fixed order (axes first, then extras).
+
+    Raises
+    ------
+    UserError
+        A key given twice (within the axes, or both in the overrides and swept), an unknown key,
+        a bad value, unequal zipped axes, or two cases that resolve to the same scenario.
+    """
+    where = spec.origin
+    axis_keys = [k for k, _ in spec.axes]
+    _check_unique(axis_keys, where)
+    set_keys = [parse_override(s)[0] for s in spec.sets]
+    _check_unique(set_keys, f"{where} (--set / [set])")
+    for k in set_keys:
+        if k in axis_keys:
+            raise UserError(f"{where}: {k}: given both as an override and as a swept axis")
+    for i, case in enumerate(spec.extra):
+        for k in case:
+            if k in set_keys:
+                raise UserError(f"{where}: cases[{i}]: {k}: given both as an override and in an extra case")
+    if not spec.axes and not spec.extra:
+        raise UserError(f"{where}: nothing to sweep (no axes and no cases)")
+    points: list[dict[str, Any]] = []
+    if spec.axes:
+        if spec.mode == "zip":
+            lengths = {len(v) for _, v in spec.axes}
+            if len(lengths) != 1:
+                raise UserError(f"{where}: mode = \"zip\" needs axes of equal length (got "
+                                + ", ".join(f"{k}: {len(v)}" for k, v in spec.axes) + ")")
+            combos = zip(*[v for _, v in spec.axes])
+        else:
+            combos = itertools.product(*[v for _, v in spec.axes])
+        points += [dict(zip(axis_keys, c)) for c in combos]
+    points += [dict(c) for c in spec.extra]
+    base = load_scenario(spec.scenario, spec.sets)  # the base alone first: its own errors name it
+    cases: list[Case] = []
+    seen: dict[str, int] = {}
+    for i, values in enumerate(points):
+        try:
+            sc = base.replace(**values)
+        except UserError as exc:
+            raise UserError(f"{exc} (sweep case {_label(values)})") from None
+        text = sc.to_toml()
+        h = case_hash(text)
+        if h in seen:
+            raise UserError(f"{where}: cases {_label(points[seen[h]])} and {_label(values)} are the same scenario")
+        seen[h] = i
+        cases.append(Case(hash=h, values=values, toml=text, model=sc.model))
+    return cases
+
+
+def _label(values: dict) -> str:
+    return ", ".join(f"{k}={v}" for k, v in values.items()) or "(base scenario)"
+
+
+def scenario_from_toml(text: str, source: str = "<sweep case>"):
+    """Rebuild the resolved scenario of a case from its TOML text (inside a worker)."""
+    from bearingsim.scenario import resolve
+
+    return resolve(tomllib.loads(text), source)

@@ -1,0 +1,106 @@
+"""What runs inside a worker: a batch of cases, each into its archive, failures caught one by one.
+
+Imported by local pool processes and by dask workers (which need ``bearingsim`` installed; they need
+no file system shared with the client: with ``return_bytes`` the archive comes back as bytes).
+"""
+from __future__ import annotations
+
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def one_line_error(exc: BaseException) -> str:
+    """A failure as one line: ``str(exc)`` for bearingsim's own errors, else ``Class: message``."""
+    from bearingsim.errors import SimulationUnstable, UserError
+
+    text = str(exc) if isinstance(exc, (UserError, SimulationUnstable)) else f"{exc.__class__.__name__}: {exc}"
+    text = " ".join(text.split())
+    return text[:500] or exc.__class__.__name__
+
+
+def standard_errors(per_rotation_I_dec, per_rotation_I_acc) -> dict[str, float]:
+    """Standard error of the per-rotation mean impulses.
+
+    Each rotation's impulse is averaged over the pockets (pockets of one rotation share the cage's
+    motion, so they are not independent samples); the standard error is the sample standard deviation
+    of those per-rotation means over sqrt(rotations). Rotations are treated as independent, which the
+    cage's whirl can make optimistic. NaN with fewer than 2 rotations; 0 for the reduced model, whose
+    rotations repeat one pass by construction.
+    """
+    out = {}
+    for name, arr in (("I_dec_sem_Ns", per_rotation_I_dec), ("I_acc_sem_Ns", per_rotation_I_acc)):
+        a = np.asarray(arr, dtype=float)
+        series = a.reshape(a.shape[0], -1).mean(axis=1) if a.ndim >= 1 and a.size else np.array([])
+        n = series.size
+        out[name] = float(series.std(ddof=1) / math.sqrt(n)) if n >= 2 else math.nan
+    return out
+
+
+def _numbers(summary: dict) -> dict[str, float]:
+    out = {}
+    for k, v in summary.items():
+        if isinstance(v, (bool, np.bool_)):
+            continue
+        if isinstance(v, (int, float, np.integer, np.floating)) and k != "wall_s":
+            out[k] = float(v)
+    return out
+
+
+def _per_rotation(res):
+    """(I_dec, I_acc) per rotation [rotations, pockets] of a result."""
+    return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
+
+
+def run_case(case_hash: str, toml_text: str, target: Path) -> dict:
+    """Run one case into the archive ``target`` (written atomically by the archive writer).
+
+    Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s`` and the
+    summary numbers with the standard errors of :func:`standard_errors`.
+    """
+    from bearingsim.simulation import run_scenario
+    from bearingsim.sweeps.spec import scenario_from_toml
+
+    t0 = time.perf_counter()
+    try:
+        scenario = scenario_from_toml(toml_text)
+        out = run_scenario(scenario, target, figures=False, progress=False)
+        res = out.result
+        summary = _numbers(res.summary)
+        summary.update(standard_errors(*_per_rotation(res)))
+        return {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
+                "summary": summary}
+    except Exception as exc:  # noqa: BLE001 - a failing case is recorded, the sweep goes on
+        return {"hash": case_hash, "status": "failed", "error": one_line_error(exc),
+                "wall_s": time.perf_counter() - t0, "summary": {}}
+
+
+def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> list[dict]:
+    """Run ``items`` (``(hash, resolved TOML)`` pairs) one after the other.
+
+    Parameters
+    ----------
+    items : list of (str, str)
+        Case hash and resolved scenario TOML.
+    cases_dir : str or None
+        Write each archive as ``cases_dir/<hash>.h5`` (a file system the client sees). With None,
+        run into a private temporary folder and return each archive's bytes under ``"archive"``
+        (dask workers on other machines).
+    """
+    records = []
+    if cases_dir is not None:
+        for h, text in items:
+            records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5"))
+        return records
+    with tempfile.TemporaryDirectory(prefix="bearingsim-sweep-") as tmp:
+        for h, text in items:
+            target = Path(tmp) / f"{h}.h5"
+            rec = run_case(h, text, target)
+            if rec["status"] == "done":
+                rec["archive"] = target.read_bytes()
+                target.unlink()
+            records.append(rec)
+    return records

@@ -128,7 +128,7 @@ def _load_zone_from_ring(ring_centre_mean, radial_clearance):
 def _load_zone_half_angle(q_bin, tq_bin):
     """Half width [deg] of the theta range around 0 where the mean inner-race load > 1 % of its max."""
     nb = len(tq_bin)
-    q = np.where(tq_bin > 0, q_bin[:, 0] / np.maximum(tq_bin, 1e-300), 0.0)
+    q = np.where(tq_bin > 0, q_bin["inner"] / np.maximum(tq_bin, 1e-300), 0.0)
     if q.max() <= 0:
         return 0.0
     loaded = q > 0.01 * q.max()
@@ -176,25 +176,25 @@ class MultibodyResult:
         self.pymunk_step_s = raw["pymunk_step_s"]
         self.rotations = sc.numerics.rotations
         w = raw["win"]
-        self.per_rotation_I_acc = w[:, :, rk.W_IACC].copy()
-        self.per_rotation_I_dec = w[:, :, rk.W_IDEC].copy()
-        self.per_rotation_Jn_front = w[:, :, rk.W_JN_F].copy()
-        self.per_rotation_Jn_rear = w[:, :, rk.W_JN_R].copy()
-        self.per_rotation_Jf_front = w[:, :, rk.W_JF_F].copy()
-        self.per_rotation_Jf_rear = w[:, :, rk.W_JF_R].copy()
-        self.per_rotation_work_front = w[:, :, rk.W_WORK_F].copy()
-        self.per_rotation_work_rear = w[:, :, rk.W_WORK_R].copy()
+        self.per_rotation_I_acc = w["I_acc"].copy()
+        self.per_rotation_I_dec = w["I_dec"].copy()
+        self.per_rotation_Jn_front = w["Jn_front"].copy()
+        self.per_rotation_Jn_rear = w["Jn_rear"].copy()
+        self.per_rotation_Jf_front = w["Jf_front"].copy()
+        self.per_rotation_Jf_rear = w["Jf_rear"].copy()
+        self.per_rotation_work_front = w["work_front"].copy()
+        self.per_rotation_work_rear = w["work_rear"].copy()
         self.first_impact_speed = raw["first_imp"]
         self.impacts = raw["impacts"]
         nb = THETA_BINS
         self.theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
         tb = raw["t_bin"]  # (n, nb)
         with np.errstate(invalid="ignore", divide="ignore"):
-            self.force_acc = np.where(tb > 0, raw["f_bin"][:, :, 0] / tb, 0.0).T  # (nb, n)
-            self.force_dec = np.where(tb > 0, raw["f_bin"][:, :, 1] / tb, 0.0).T
+            self.force_acc = np.where(tb > 0, raw["f_bin"]["front"] / tb, 0.0).T  # (nb, n)
+            self.force_dec = np.where(tb > 0, raw["f_bin"]["rear"] / tb, 0.0).T
             tq = raw["tq_bin"]
-            self.load_inner = np.where(tq > 0, raw["q_bin"][:, 0] / np.maximum(tq, 1e-300), 0.0)
-            self.load_outer = np.where(tq > 0, raw["q_bin"][:, 1] / np.maximum(tq, 1e-300), 0.0)
+            self.load_inner = np.where(tq > 0, raw["q_bin"]["inner"] / np.maximum(tq, 1e-300), 0.0)
+            self.load_outer = np.where(tq > 0, raw["q_bin"]["outer"] / np.maximum(tq, 1e-300), 0.0)
         full = self.scene == "full"
         # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
         # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
@@ -208,16 +208,16 @@ class MultibodyResult:
         self.cage_speed_mean = 2.0 * math.pi * self.rotations / t_rec if t_rec > 0 else float("nan")
         self.cage_slip = 1.0 - self.cage_speed_mean / op.omega_c
         g = raw["glob"]
-        self.torque_impulse_normal = g[rk.G_TAU_N]
-        self.torque_impulse_friction = g[rk.G_TAU_F]
+        self.torque_impulse_normal = g["tau_normal"]
+        self.torque_impulse_friction = g["tau_friction"]
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
         self.cage_momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
         drive = abs(self.per_rotation_I_acc.sum()) * geo.pitch_radius
         self.torque_balance_residual = (
             (self.torque_impulse_normal + self.torque_impulse_friction - self.cage_momentum_change)
             / drive if drive > 0 else float("nan"))
-        self.max_penetration = max(g[rk.G_MAXPEN_F], g[rk.G_MAXPEN_R])
-        self.max_penetration_all = g[rk.G_MAXPEN_ALL]
+        self.max_penetration = max(g["maxpen_front"], g["maxpen_rear"])
+        self.max_penetration_all = g["maxpen_all"]
         k = float(sc.wear.wear_coefficient)
         H = float(sc.wear.hardness_Pa)
         fac = k * geo.roller_radius * op.omega_r / H
@@ -280,11 +280,11 @@ class MultibodyResult:
                            "mean outer-race roller load per theta bin (all rollers)")
         imp = self.impacts
         aw.write_table("/results/impacts", {
-            "time_s": imp[:, rk.I_TIME], "theta_deg": imp[:, rk.I_THETA],
-            "approach_speed_m_s": imp[:, rk.I_SPEED], "impulse_Ns": imp[:, rk.I_IMPULSE],
-            "pocket": imp[:, rk.I_POCKET].astype(np.int64),
-            "face": np.where(imp[:, rk.I_FACE] == 0, "front", "rear"),  # same strings as the reduced model
-            "rotation": imp[:, rk.I_ROT].astype(np.int64),
+            "time_s": imp["time"], "theta_deg": imp["theta_deg"],
+            "approach_speed_m_s": imp["approach_speed"], "impulse_Ns": imp["impulse"],
+            "pocket": imp["pocket"],
+            "face": np.where(imp["face"] == rk.FACE_FRONT, "front", "rear"),  # codes and strings of the reduced model
+            "rotation": imp["rotation"],
         }, {"time_s": "s", "theta_deg": "deg", "approach_speed_m_s": "m/s", "impulse_Ns": "N s",
             "pocket": "1", "face": "1", "rotation": "1"},
             description=f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "

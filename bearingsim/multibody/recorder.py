@@ -122,6 +122,56 @@ def pocket_theta(sign, cage_angle, pocket_angle):
 
 
 @njit(cache=True)
+def _before(k1, k2, roller, i1, i2):
+    """Key order of two arbiters: roller index, then the cage contact point (x, y), then the normal."""
+    if roller[i1] != roller[i2]:
+        return roller[i1] < roller[i2]
+    for c in range(4):
+        if k1[c] != k2[c]:
+            return k1[c] < k2[c]
+    return False
+
+
+@njit(cache=True)
+def arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
+    """Indices of the arbiters with contacts, sorted by (roller, cage contact point x, y, normal x, y).
+
+    pymunk lists cached arbiters in the order of a hash of the shapes' memory addresses, which changes
+    from run to run; summing the impulses of one step in this order instead makes every accumulated
+    sum the same in every run (and in both step loops).
+    """
+    order = np.empty(n_arb, dtype=np.int64)
+    roller = np.empty(n_arb, dtype=np.int64)
+    keys = np.empty((n_arb, 4))
+    m = 0
+    for a in range(n_arb):
+        if arb_i[a * ARB_I + 2] == 0:
+            continue  # cached arbiter without contacts
+        ja = ids_index[np.searchsorted(ids_sorted, arb_i[a * ARB_I])]
+        o = a * ARB_F
+        if ja < n:
+            roller[a] = ja
+            keys[a, 0] = arb_f[o + 6]
+            keys[a, 1] = arb_f[o + 7]
+            keys[a, 2] = arb_f[o + 2]
+            keys[a, 3] = arb_f[o + 3]
+        else:
+            roller[a] = ids_index[np.searchsorted(ids_sorted, arb_i[a * ARB_I + 1])]
+            keys[a, 0] = arb_f[o + 4]
+            keys[a, 1] = arb_f[o + 5]
+            keys[a, 2] = -arb_f[o + 2]
+            keys[a, 3] = -arb_f[o + 3]
+        # insertion sort: a step has a few dozen arbiters
+        j = m
+        while j > 0 and _before(keys[a], keys[order[j - 1]], roller, a, order[j - 1]):
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = a
+        m += 1
+    return order[:m]
+
+
+@njit(cache=True)
 def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0, diag, acc,
                 n_imp):
     """Attribute one step's roller-cage impulses and raceway loads; return the new impact count.
@@ -169,10 +219,7 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
             acc.q_bin[b].inner += diag[i].q_in * h
             acc.q_bin[b].outer += diag[i].q_out * h
             acc.tq_bin[b] += h
-    for a in range(n_arb):
-        count = arb_i[a * ARB_I + 2]
-        if count == 0:
-            continue  # cached arbiter without contacts
+    for a in arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
         ida = arb_i[a * ARB_I]
         idb = arb_i[a * ARB_I + 1]
         ja = ids_index[np.searchsorted(ids_sorted, ida)]

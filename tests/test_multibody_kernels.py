@@ -316,3 +316,20 @@ def test_plain_loop_is_chosen_by_the_environment(monkeypatch):
     space = pymunk.Space()
     loop, why = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
     assert loop.name == "plain" and chipmunk.PLAIN_ENV in why
+
+
+def test_version_guard_falls_back_to_the_plain_loop(monkeypatch):
+    """The installed pymunk passes the guard; a pymunk major version the compiled loop was not checked
+    against does not, and then the plain loop runs (and "compiled" is refused, not run)."""
+    import pymunk
+
+    monkeypatch.delenv(chipmunk.PLAIN_ENV, raising=False)
+    assert chipmunk.guard() is None
+    monkeypatch.setattr(pymunk, "version", "8.0.0")
+    why = chipmunk.guard()
+    assert why is not None and "8.0.0" in why
+    space = pymunk.Space()
+    loop, reason = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
+    assert loop.name == "plain" and reason == why
+    with pytest.raises(RuntimeError, match="cannot run"):
+        chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16, step_loop="compiled")

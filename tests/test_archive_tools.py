@@ -82,6 +82,11 @@ def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive
     assert "I_dec_mean_Ns" in res.stdout and "differs" in res.stdout and "numpy: archive 0.0.1" in res.stdout
 
 
+def test_rerun_of_a_multibody_archive_is_bit_identical(multibody_archive):
+    res = cli("rerun", multibody_archive)
+    assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
+
+
 def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
     assert cli("compare", reduced_archive, reduced_archive).returncode == 0
     other = tmp_path / "o.h5"

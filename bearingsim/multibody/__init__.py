@@ -118,7 +118,7 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
 def _load_zone_half_angle(q_bin, tq_bin):
     """Half width [deg] of the theta range around 0 where the mean inner-race load > 1 % of its max."""
     nb = len(tq_bin)
-    q = np.where(tq_bin > 0, q_bin[:, 0] / np.maximum(tq_bin, 1e-300), 0.0)
+    q = np.where(tq_bin > 0, q_bin["inner"] / np.maximum(tq_bin, 1e-300), 0.0)
     if q.max() <= 0:
         return 0.0
     loaded = q > 0.01 * q.max()
@@ -158,20 +158,20 @@ class MultibodyResult(Result):
         scene = raw["scene"]
         rotations = p.numerics.rotations
         w = raw["win"]
-        per = {name: w[:, :, col].copy() for name, col in (
-            ("I_acc", rk.W_IACC), ("I_dec", rk.W_IDEC), ("Jn_front", rk.W_JN_F), ("Jn_rear", rk.W_JN_R),
-            ("Jf_front", rk.W_JF_F), ("Jf_rear", rk.W_JF_R), ("slide_work_front", rk.W_WORK_F),
-            ("slide_work_rear", rk.W_WORK_R))}
+        per = {name: w[field].copy() for name, field in (
+            ("I_acc", "I_acc"), ("I_dec", "I_dec"), ("Jn_front", "Jn_front"), ("Jn_rear", "Jn_rear"),
+            ("Jf_front", "Jf_front"), ("Jf_rear", "Jf_rear"), ("slide_work_front", "work_front"),
+            ("slide_work_rear", "work_rear"))}
         first_imp = raw["first_imp"]
         nb = THETA_BINS
         theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
         tb = raw["t_bin"]  # (n, nb)
         with np.errstate(invalid="ignore", divide="ignore"):
-            force_acc = np.where(tb > 0, raw["f_bin"][:, :, 0] / tb, 0.0).T  # (nb, n)
-            force_dec = np.where(tb > 0, raw["f_bin"][:, :, 1] / tb, 0.0).T
+            force_acc = np.where(tb > 0, raw["f_bin"]["front"] / tb, 0.0).T  # (nb, n)
+            force_dec = np.where(tb > 0, raw["f_bin"]["rear"] / tb, 0.0).T
             tq = raw["tq_bin"]
-            load_inner = np.where(tq > 0, raw["q_bin"][:, 0] / np.maximum(tq, 1e-300), 0.0)
-            load_outer = np.where(tq > 0, raw["q_bin"][:, 1] / np.maximum(tq, 1e-300), 0.0)
+            load_inner = np.where(tq > 0, raw["q_bin"]["inner"] / np.maximum(tq, 1e-300), 0.0)
+            load_outer = np.where(tq > 0, raw["q_bin"]["outer"] / np.maximum(tq, 1e-300), 0.0)
         full = scene == "full"
         # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
         # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
@@ -188,7 +188,7 @@ class MultibodyResult(Result):
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
         momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
         drive = abs(per["I_acc"].sum()) * geo.pitch_radius
-        torque_residual = ((g[rk.G_TAU_N] + g[rk.G_TAU_F] - momentum_change) / drive if drive > 0 else float("nan"))
+        torque_residual = ((g["tau_normal"] + g["tau_friction"] - momentum_change) / drive if drive > 0 else float("nan"))
         w_ = p.wear
         wear = {
             "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
@@ -213,8 +213,8 @@ class MultibodyResult(Result):
             "load_zone_contact_half_angle_deg": float(phi_contact_deg),
             "inner_ring_displacement_m": float(-ring_centre_mean[1]),
             "torque_balance_residual": float(torque_residual),
-            "max_penetration_m": float(max(g[rk.G_MAXPEN_F], g[rk.G_MAXPEN_R])),
-            "max_penetration_all_m": float(g[rk.G_MAXPEN_ALL]),
+            "max_penetration_m": float(max(g["maxpen_front"], g["maxpen_rear"])),
+            "max_penetration_all_m": float(g["maxpen_all"]),
             "cage_orbit_max_m": float(raw["orbit_max"]),
             "dt_s": float(raw["dt"]),
             "steps": int(raw["steps"]),
@@ -244,13 +244,14 @@ class MultibodyResult(Result):
             data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
         imp = raw["impacts"]
         data.update({
-            "results/impacts/time_s": NamedArray(imp[:, rk.I_TIME], "s"),
-            "results/impacts/theta_deg": NamedArray(imp[:, rk.I_THETA], "deg"),
-            "results/impacts/approach_speed_m_s": NamedArray(imp[:, rk.I_SPEED], "m/s"),
-            "results/impacts/impulse_Ns": NamedArray(imp[:, rk.I_IMPULSE], "N s"),
-            "results/impacts/pocket": NamedArray(imp[:, rk.I_POCKET].astype(np.int64)),
-            "results/impacts/face": NamedArray(np.where(imp[:, rk.I_FACE] == 0, "front", "rear")),
-            "results/impacts/rotation": NamedArray(imp[:, rk.I_ROT].astype(np.int64)),
+            "results/impacts/time_s": NamedArray(imp["time"], "s"),
+            "results/impacts/theta_deg": NamedArray(imp["theta_deg"], "deg"),
+            "results/impacts/approach_speed_m_s": NamedArray(imp["approach_speed"], "m/s"),
+            "results/impacts/impulse_Ns": NamedArray(imp["impulse"], "N s"),
+            "results/impacts/pocket": NamedArray(imp["pocket"].astype(np.int64)),
+            # face codes and strings of the reduced model (reduced/core.py)
+            "results/impacts/face": NamedArray(np.where(imp["face"] == rk.FACE_FRONT, "front", "rear")),
+            "results/impacts/rotation": NamedArray(imp["rotation"].astype(np.int64)),
         })
         wear_desc = {
             "paper_index_front": "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket",
@@ -270,6 +271,7 @@ class MultibodyResult(Result):
             "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),
             "ring_newton_failures": int(raw["newton_failures"]), "inner_ring": raw["inner_ring"],
             "solver_wall_s": float(raw["wall_s"]), "pymunk_step_s": float(raw["pymunk_step_s"]),
+            "step_loop": raw["step_loop"], "step_loop_reason": raw["step_loop_reason"],
         }
         tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
                                      "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "

@@ -1,12 +1,19 @@
 """Driver of the multi-pocket model: scene, time step, run set-up, errors, results. SI throughout.
 
 See the package docstring of :mod:`bearingsim.multibody` for the definitions of the recorded
-quantities. The step loop itself is compiled (:func:`bearingsim.multibody.loop.advance`: per time step
-``h`` the body states are read in one batch, the raceway forces computed by one numba kernel
-(:func:`bearingsim.multibody.forces.raceway_forces`) at the predicted positions and handed to pymunk
-in one batch, ``cpSpaceStep(h)`` solves the roller-cage contacts, and
-:func:`bearingsim.multibody.recorder.record_step` attributes the arbiter impulses to pockets, faces
-and rotations); Python only sees it every 2048 output samples, to write them and move the progress bar.
+quantities. Per time step ``h`` (:mod:`bearingsim.multibody.loop`) the body states are read in one
+batch, the raceway forces computed by one numba kernel (:func:`bearingsim.multibody.forces.raceway_forces`)
+at the predicted positions and handed to pymunk in one batch, pymunk's step solves the roller-cage
+contacts, and :func:`bearingsim.multibody.recorder.record_step` attributes the arbiter impulses to
+pockets, faces and rotations. The loop over steps is compiled (:mod:`bearingsim.multibody.chipmunk`)
+or, where pymunk's private C interface is not as expected, plain Python over pymunk's public API;
+Python sees the compiled loop only every 2048 output samples, to write them and move the progress bar.
+
+:func:`run` assembles the kernels' named inputs: :class:`~bearingsim.multibody.forces.RacewayParams`,
+:class:`~bearingsim.multibody.recorder.RecorderConfig` and the accumulators of
+:func:`~bearingsim.multibody.recorder.accumulators`, :class:`~bearingsim.multibody.loop.LoopLimits`,
+:class:`~bearingsim.multibody.loop.HoldRule`, :class:`~bearingsim.multibody.loop.StepInputs`,
+:class:`~bearingsim.multibody.loop.StepWork` and a :data:`~bearingsim.multibody.loop.LOOP_STATE` record.
 """
 from __future__ import annotations
 
@@ -19,6 +26,7 @@ import numpy as np
 from bearingsim import laws
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody import forces as fk
+from bearingsim.multibody import chipmunk
 from bearingsim.multibody import loop as lp
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
@@ -153,10 +161,15 @@ def choose_dt(p, dt=None):
     return float(dt), how, lim
 
 
-def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT):
+def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT,
+        step_loop=None):
     """Run the parameters ``p``; return a dict of raw accumulators (see :class:`MultibodyResult`).
 
-    Time series go to ``sink`` (``timeseries(...)`` appenders; see :class:`bearingsim.results.MemorySink`)."""
+    Time series go to ``sink`` (``timeseries(...)`` appenders; see :class:`bearingsim.results.MemorySink`).
+
+    ``step_loop``: "compiled", "plain" or None (see :mod:`bearingsim.multibody.chipmunk`); which one ran is
+    ``raw["step_loop"]``.
+    """
     t_wall0 = time.perf_counter()
     geo = p.bearing
     op = p.operating
@@ -194,63 +207,27 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         b.position = (r0 * math.cos(a), r0 * math.sin(a))
         b.velocity = (-omega_cage * r0 * math.sin(a), omega_cage * r0 * math.cos(a))
 
-    prm = np.zeros(fk.N_PARAMS)
-    prm[fk.P_RR] = rr
-    prm[fk.P_MASS] = geo.roller_mass
-    prm[fk.P_INERTIA] = geo.roller_inertia
-    prm[fk.P_RO_RACE] = ro_race
-    prm[fk.P_RI_RACE] = ri_race
-    prm[fk.P_RO_GEOM] = geo.outer_race_radius
-    prm[fk.P_RI_GEOM] = geo.inner_race_radius
-    prm[fk.P_K] = K
-    prm[fk.P_CDAMP] = CONTACT_DAMPING_S
-    prm[fk.P_DFADE] = DAMPING_FADE_M
-    prm[fk.P_MU] = p.contact.traction_mu_max
-    prm[fk.P_SLIPREF] = p.contact.traction_slip_ref
-    prm[fk.P_UMIN] = MIN_ENTRAINMENT_M_S
-    prm[fk.P_CDRAG] = p.contact.drag_coefficient
-    prm[fk.P_WEPS] = DRAG_DIRECTION_EPS_M_S
-    prm[fk.P_OMEGA_RING] = sign * op.omega_i
-    prm[fk.P_LOAD] = op.radial_load
-    prm[fk.P_GRAV] = op.gravity
-    prm[fk.P_INNER] = 0.0 if reduced_eq else 1.0
-    prm[fk.P_TRACTION] = 0.0 if reduced_eq else 1.0
-    prm[fk.P_SPIN] = 0.0 if reduced_eq else 1.0
-    prm[fk.P_NEWTON_STEP] = NEWTON_MAX_STEP_M
     ring_mass, ring_how = inner_ring_model(p)
-    prm[fk.P_RING_MASS] = ring_mass
-
+    prm = fk.RacewayParams(
+        roller_radius=float(rr), roller_mass=float(geo.roller_mass), roller_inertia=float(geo.roller_inertia),
+        outer_race_radius=float(ro_race), inner_race_radius=float(ri_race),
+        outer_race_geom_radius=float(geo.outer_race_radius), inner_race_geom_radius=float(geo.inner_race_radius),
+        palmgren_stiffness=float(K), damping_time=CONTACT_DAMPING_S, damping_fade=DAMPING_FADE_M,
+        traction_mu_max=float(p.contact.traction_mu_max),
+        traction_slip_ref=float(p.contact.traction_slip_ref), min_entrainment=MIN_ENTRAINMENT_M_S,
+        drag_coefficient=float(p.contact.drag_coefficient), drag_direction_eps=DRAG_DIRECTION_EPS_M_S,
+        omega_ring=float(sign * op.omega_i), radial_load=float(op.radial_load), gravity=float(op.gravity),
+        inner_ring=not reduced_eq, traction=not reduced_eq, spin_free=not reduced_eq,
+        newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass))
+    cfg = rk.RecorderConfig(sign=float(sign), roller_count=int(n), warmup_rotations=float(warm), rotations=nrot,
+                            theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S)
+    acc = rk.accumulators(nrot, n, THETA_BINS, IMPACT_CAPACITY)
     # pocket angles from the load-zone centre at t = 0, in [0, 2 pi)
     theta0 = np.mod(-2.0 * math.pi * np.arange(n) / n, 2.0 * math.pi)
-    cfg = np.zeros(rk.N_CFG)
-    cfg[rk.C_SIGN] = sign
-    cfg[rk.C_N] = n
-    cfg[rk.C_WARM] = warm
-    cfg[rk.C_ROT] = nrot
-    cfg[rk.C_NBINS] = THETA_BINS
-    cfg[rk.C_VTHR] = IMPACT_SPEED_THRESHOLD_M_S
-    cfg[rk.C_MASS] = geo.roller_mass
-    win = np.zeros((nrot, n, rk.N_WCOL))
-    first_imp = np.full((nrot, n), np.nan)
-    f_bin = np.zeros((n, THETA_BINS, 2))
-    t_bin = np.zeros((n, THETA_BINS))
-    q_bin = np.zeros((THETA_BINS, 2))
-    tq_bin = np.zeros(THETA_BINS)
-    j_int = np.zeros((n, 2))
-    glob = np.zeros(rk.N_GLOB)
-    impacts = np.zeros((IMPACT_CAPACITY, rk.N_ICOL))
-    n_imp = 0
-    diag = np.zeros((n, fk.N_DIAG))
-    hold = np.zeros(n, dtype=np.bool_)
     # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
     _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not reduced_eq else (0, 0)
-    ring_c = np.array([0.0, -max(0.5 * pd, delta_qs)])
-    ring_c_prev = np.zeros(2)
-    ring_v = np.zeros(2)
     ids = sc.body_ids
     order = np.argsort(ids)
-    ids_sorted = ids[order].astype(np.uint64)
-    ids_index = order.astype(np.int64)
 
     # reduced-equivalent: held rollers sit at the front of their pockets on the outer race
     phi = p.reduced.load_zone_half_angle if reduced_eq else 0.0
@@ -260,11 +237,17 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     else:
         set_fields = lp.BODY_SET_FORCE
         set_arr = np.zeros(nb * 3)
-    # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
-    out_f = np.zeros(nb * 3) if reduced_eq else set_arr
+    ORBIT_KEEP = 4096
+    wk = lp.StepWork(
+        ring_c=np.array([0.0, -max(0.5 * pd, delta_qs)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
+        hold=np.zeros(n, dtype=np.bool_),
+        # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
+        out_f=np.zeros(nb * 3) if reduced_eq else set_arr, set_arr=set_arr,
+        diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
+        orbit=np.full((ORBIT_KEEP, 3), np.nan))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
-    io = lp.BatchIO(space, nb, set_fields, set_arr, arb_cap)
+    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop)
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot
@@ -275,14 +258,14 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     if sink is not None:
         series = [
             (sink.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
-             lp.S_W, 1),
-            (sink.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), lp.S_SLIP, 1),
+             ("cage_speed",)),
+            (sink.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), ("cage_slip",)),
             (sink.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
-             lp.S_CX, 2),
+             ("cage_x", "cage_y")),
         ]
         if not reduced_eq:
             series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
-                           lp.S_RX, 2))
+                           ("ring_x", "ring_y")))
     bar = None
     if progress:
         from tqdm import tqdm
@@ -290,42 +273,34 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         bar = tqdm(total=total_rot, unit="rot", desc="cage rotations", file=sys.stderr)
     bar_done = 0
     io.read_states()
-    hold_radius = rp - (n_centrifugal / K) ** 0.9
-    front_off = 0.5 * s
-    pocket_a = np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64)
-    ORBIT_KEEP = 4096
-    orbit_buf = np.full((ORBIT_KEEP, 3), np.nan)
-    lim = np.zeros(lp.N_LIM)
-    lim[lp.LIM_TRAVEL_END] = travel_end
-    lim[lp.LIM_TRAVEL_REC] = 2.0 * math.pi * warm
-    lim[lp.LIM_PEN] = penetration_limit * s  # (the stability scan passes 0.5 to look for blow-up alone)
-    lim[lp.LIM_OMEGA] = 3.0 * op.omega_i + 10.0
-    lim[lp.LIM_OMEGA_NOM] = omega_nom
     # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
     face_reach = (rr + 0.5 * s) * math.sin(p.multibody.pocket_face_half_angle)
-    lim[lp.LIM_ORBIT] = face_reach
-    lsi = np.zeros(lp.N_LI, dtype=np.int64)
-    lsi[lp.LI_OUT_EVERY] = out_every
-    lsi[lp.LI_MAX_STEPS] = int(3 * steps_est + 1000)
-    lsf = np.zeros(lp.N_LF)
-    smp_step = np.zeros(2048, dtype=np.int64)
-    smp = np.zeros((2048, lp.N_SCOL))
-    args = (io.step_fn, io.each_body_fn, io.each_arb_fn, io.clock_fn, io.timed, io.ptr, *io.hdr, *io.states,
-            io.arb_f, io.arb_i, io.ts, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, set_arr, diag, reduced_eq,
-            phi, pocket_a, hold_radius, front_off, omega_cage, ids_sorted, ids_index, cfg, theta0, win, first_imp,
-            f_bin, t_bin, q_bin, tq_bin, j_int, glob, impacts, lim, lsi, lsf, smp_step, smp, orbit_buf)
+    lim = lp.LoopLimits(
+        travel_end=travel_end, travel_record=2.0 * math.pi * warm,
+        penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
+        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=face_reach, out_every=out_every,
+        max_steps=int(3 * steps_est + 1000))
+    inp = lp.StepInputs(
+        h=float(h), prm=prm, cfg=cfg, lim=lim,
+        hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi), radius=rp - (n_centrifugal / K) ** 0.9,
+                              front_offset=0.5 * s, omega_cage=float(omega_cage)),
+        pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
+        ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64))
+    ls = np.zeros(1, dtype=lp.LOOP_STATE)
+    st = ls[0]
     t_loop0 = time.perf_counter()
     while True:
-        code = lp.advance(*args)
-        k = int(lsi[lp.LI_NSMP])
+        code = io.advance(inp, wk, acc, ls)
+        k = int(st["n_samples"])
         if series is not None and k:
-            for ts, col, width in series:
-                ts.append(smp_step[:k].copy(), smp[:k, lp.S_T].copy(),
-                          smp[:k, col].copy() if width == 1 else smp[:k, col:col + width].copy())
-        lsi[lp.LI_NSMP] = 0
-        t = float(lsf[lp.LF_T])
-        step = int(lsi[lp.LI_STEP])
-        state = io.states[int(lsi[lp.LI_CUR])]
+            smp = wk.smp[:k]
+            for ts, cols in series:
+                ts.append(smp["step"].copy(), smp["t"].copy(),
+                          smp[cols[0]].copy() if len(cols) == 1 else np.stack([smp[c] for c in cols], axis=1))
+        st["n_samples"] = 0
+        t = float(st["t"])
+        step = int(st["step"])
+        state = io.states[int(st["cur"])]
         if bar is not None:
             done = min(total_rot, int(sign * state[n, 2] / (2.0 * math.pi)))
             if done > bar_done:
@@ -341,11 +316,11 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
             raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
                                      f"try a smaller numerics.dt_s than {h:.3g} s")
         if code == lp.CODE_PENETRATION:
-            raise PenetrationExceeded(glob[rk.G_MAXPEN_ALL], lim[lp.LIM_PEN], h, glob[rk.G_MAXPEN_TIME],
-                                      glob[rk.G_MAXPEN_APPROACH])
+            g = acc.glob[0]
+            raise PenetrationExceeded(g["maxpen_all"], lim.penetration, h, g["maxpen_time"], g["maxpen_approach"])
         if code == lp.CODE_BLOWUP:
             raise SimulationUnstable(
-                f"raceway approach {diag[:, fk.D_DELTA_OUT].max():.3g} m or cage speed {state[n, 5]:.3g} rad/s "
+                f"raceway approach {wk.diag['delta_out'].max():.3g} m or cage speed {state[n, 5]:.3g} rad/s "
                 f"out of bounds at t = {t:.6g} s (energy blow-up); try a smaller numerics.dt_s than {h:.3g} s")
         if code == lp.CODE_STALLED:
             raise SimulationUnstable(
@@ -362,29 +337,30 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         bar.update(total_rot - bar_done)
         bar.close()
     loop_s = time.perf_counter() - t_loop0
-    n_imp = int(lsi[lp.LI_NIMP])
+    n_imp = int(st["n_imp"])
     # impacts in one step come in pymunk's arbiter order, which follows shape addresses: sort them by
-    # (time, pocket, face) so that the table is the same in every run
-    imp = impacts[:n_imp]
-    imp = imp[np.lexsort((imp[:, rk.I_FACE], imp[:, rk.I_POCKET], imp[:, rk.I_TIME]))]
+    # (time, pocket, face) so that the table is the same in every run (front before rear, as before the
+    # face codes of the two models were made the same)
+    imp = acc.impacts[:n_imp]
+    imp = imp[np.lexsort((imp["face"] != rk.FACE_FRONT, imp["pocket"], imp["time"]))]
     wall = time.perf_counter() - t_wall0
-    prev = io.states[int(lsi[lp.LI_CUR])]
-    rec_started = lsi[lp.LI_REC] == 1
-    t_rec = t - lsf[lp.LF_T_REC0] if rec_started else 0.0
-    ring_n = lsf[lp.LF_RING_N]
-    n_orbit = int(lsi[lp.LI_NORBIT])
-    pymunk_s = lsf[lp.LF_PYMUNK_NS] * 1e-9 if io.timed else float("nan")
+    prev = io.states[int(st["cur"])]
+    rec_started = st["recording"] == 1
+    t_rec = t - st["t_rec0"] if rec_started else 0.0
+    ring_n = st["ring_n"]
+    n_orbit = int(st["n_orbit"])
+    pymunk_s = st["pymunk_ns"] * 1e-9 if io.timed else float("nan")
     return dict(
         parameters=p, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
-        wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, t_end=t, t_record=t_rec, win=win, first_imp=first_imp,
-        f_bin=f_bin, t_bin=t_bin, q_bin=q_bin, tq_bin=tq_bin, glob=glob.copy(), impacts=imp,
-        impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=lsf[lp.LF_W_START] if rec_started else None,
+        wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, step_loop=io.name, step_loop_reason=loop_why, t_end=t,
+        t_record=t_rec, win=acc.win, first_imp=acc.first_imp, f_bin=acc.f_bin, t_bin=acc.t_bin, q_bin=acc.q_bin,
+        tq_bin=acc.tq_bin, glob=acc.glob.copy()[0], impacts=imp,
+        impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=st["cage_w_start"] if rec_started else None,
         cage_w_end=prev[n, 5],
-        cage_inertia=geo.cage_inertia, newton_failures=int(lsi[lp.LI_NEWTON_FAIL]), orbit_max=lsf[lp.LF_ORBIT_MAX],
+        cage_inertia=geo.cage_inertia, newton_failures=int(st["newton_failures"]), orbit_max=st["orbit_max"],
         phi=phi,
-        final_state=prev.copy(), orbit=np.roll(orbit_buf, -(n_orbit % ORBIT_KEEP), axis=0),
-        ring_centre_mean=(lsf[[lp.LF_RING_SX, lp.LF_RING_SY]] / ring_n if ring_n and not reduced_eq
+        final_state=prev.copy(), orbit=np.roll(wk.orbit, -(n_orbit % ORBIT_KEEP), axis=0),
+        ring_centre_mean=(np.array([st["ring_sum_x"], st["ring_sum_y"]]) / ring_n if ring_n and not reduced_eq
                           else np.full(2, np.nan)),
         radial_clearance=geo.radial_clearance,
     )
-

@@ -30,12 +30,12 @@ stay implicitly linearised in velocity: one 3x3 (2x2 with fixed spin) solve per 
 
 The inner ring turns at a prescribed speed. Its centre is either
 
-* quasi-static (``P_RING_MASS = 0``): each step a 2-D Newton solve on the predicted roller positions
+* quasi-static (``ring_mass = 0``): each step a 2-D Newton solve on the predicted roller positions
   makes the inner-raceway normal forces (elastic and damping) balance the radial load. Tangential
   raceway forces are not fed back into the ring balance (they are two orders below the normal loads
   and the ring's lateral position would move by ~1e-8 m). Defined only while at least two rollers
   carry the load: on a single roller the ring's sideways equilibrium is unstable;
-* dynamic (``P_RING_MASS = M > 0``, the rotor's mass): integrated like the bodies in pymunk
+* dynamic (``ring_mass = M > 0``, the rotor's mass): integrated like the bodies in pymunk
   (symplectic Euler: position with the old velocity, then ``v += h F / M``) under the radial load and
   the reactions of every inner-raceway contact (normal, traction and drag), evaluated at the predicted
   positions of rollers and ring.
@@ -43,20 +43,47 @@ The inner ring turns at a prescribed speed. Its centre is either
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-# Indices of the parameter vector passed to the kernel (one float64 array keeps the signature short).
-P_RR, P_MASS, P_INERTIA, P_RO_RACE, P_RI_RACE, P_RO_GEOM, P_RI_GEOM = 0, 1, 2, 3, 4, 5, 6
-P_K, P_CDAMP, P_DFADE, P_MU, P_SLIPREF, P_UMIN, P_CDRAG, P_WEPS = 7, 8, 9, 10, 11, 12, 13, 14
-P_OMEGA_RING, P_LOAD, P_GRAV, P_INNER, P_TRACTION, P_SPIN, P_NEWTON_STEP = 15, 16, 17, 18, 19, 20, 21
-P_RING_MASS = 22  # 0: quasi-static (massless) inner ring; > 0: dynamic ring of this mass [kg]
-N_PARAMS = 23
 
-# Columns of the per-roller diagnostics array.
-D_Q_OUT, D_Q_IN, D_DELTA_OUT, D_DELTA_IN, D_SLIP_OUT, D_SLIP_IN, D_FO_OUT, D_FO_IN = range(8)
-N_DIAG = 8
+class RacewayParams(NamedTuple):
+    """Inputs of :func:`raceway_forces` that are fixed for a run. SI throughout."""
+
+    roller_radius: float  #: r_r [m]
+    roller_mass: float  #: [kg]
+    roller_inertia: float  #: about the roller axis [kg m^2]
+    outer_race_radius: float  #: outer raceway radius with half the radial clearance, r_o + P_d/4 [m]
+    inner_race_radius: float  #: inner raceway radius with half the radial clearance, r_i - P_d/4 [m]
+    outer_race_geom_radius: float  #: r_o without clearance, for the entrainment speed [m]
+    inner_race_geom_radius: float  #: r_i without clearance [m]
+    palmgren_stiffness: float  #: K of Q = K delta^(10/9) [N/m^(10/9)]
+    damping_time: float  #: c_r of the contact damping c = c_r k_lin [s]
+    damping_fade: float  #: approach over which the damping fades in [m]
+    traction_mu_max: float  #: mu_max of mu(slip) = mu_max tanh(slip / slip_ref)
+    traction_slip_ref: float  #: slip_ref
+    min_entrainment: float  #: floor of the entrainment speed in the slip ratio [m/s]
+    drag_coefficient: float  #: c of Eq. (2), F_o = c N^0.246 V^0.648 [SI]
+    drag_direction_eps: float  #: regularisation speed of the sign of the drag force [m/s]
+    omega_ring: float  #: inner-ring angular speed, signed [rad/s]
+    radial_load: float  #: W, along -y [N]
+    gravity: float  #: g, along -y [m/s^2]
+    inner_ring: bool  #: an inner raceway is present
+    traction: bool  #: raceway traction is on
+    spin_free: bool  #: roller spin is a degree of freedom (else fixed)
+    newton_max_step: float  #: step limit of the ring-centre Newton iteration [m]
+    ring_mass: float  #: 0: quasi-static (massless) inner ring; > 0: dynamic ring of this mass [kg]
+
+
+#: Per-roller contact diagnostics of a step, array shape (n,).
+DIAG = np.dtype([
+    ("q_out", np.float64), ("q_in", np.float64),  # raceway loads [N]
+    ("delta_out", np.float64), ("delta_in", np.float64),  # approaches [m]
+    ("slip_out", np.float64), ("slip_in", np.float64),  # sliding speed / entrainment speed
+    ("drag_out", np.float64), ("drag_in", np.float64),  # oil-film rolling resistance F_o [N]
+], align=True)
 
 TEN_NINTHS = 10.0 / 9.0
 DRAG_N_EXP = 0.246
@@ -92,7 +119,7 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
         the damping uses the rate ``(delta - delta_prev) / h`` over the step.
     c_prev : (2,) ring centre of the previous step [m].
     h : time step [s].
-    prm : parameter vector.
+    prm : :class:`RacewayParams`.
     out_c : (2,) in: initial guess, out: solution [m].
 
     Returns
@@ -100,13 +127,13 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
     (iterations, residual norm [N]); iterations < 0 if Newton did not converge.
     """
     n = xp.shape[0]
-    rr = prm[P_RR]
-    r_race = prm[P_RI_RACE]
-    K = prm[P_K]
-    c_r = prm[P_CDAMP]
-    d_fade = prm[P_DFADE]
-    load = prm[P_LOAD]
-    max_step = prm[P_NEWTON_STEP]
+    rr = prm.roller_radius
+    r_race = prm.inner_race_radius
+    K = prm.palmgren_stiffness
+    c_r = prm.damping_time
+    d_fade = prm.damping_fade
+    load = prm.radial_load
+    max_step = prm.newton_max_step
     cx = out_c[0]
     cy = out_c[1]
     tol = 1e-9 * (load + 1.0)
@@ -170,22 +197,24 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
 
 @njit(cache=True)
 def _contact(
-    px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, r_race_geom, omega_race, orbit,
-    prm, jac, f, diag, col_q, col_d, col_s, col_fo,
+    px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, r_race_geom, omega_race, orbit, prm, jac, f,
 ):
     """Add one raceway contact to the generalized force ``f`` (fx, fy, torque) and its Jacobians.
 
     ``(nx, ny)`` is the direction of the normal force on the roller, ``u_race`` the raceway surface
-    speed along the tangent ``T = rot90(N)`` at the contact, ``w_race`` the speed along T of the raceway
-    material at the roller centre, ``orbit`` the roller's orbital angular speed [rad/s].
+    speed along the tangent ``T = rot90(N)`` at the contact [m/s], ``w_race`` the speed along T of the
+    raceway material at the roller centre [m/s], ``orbit`` the roller's orbital angular speed [rad/s].
     ``jac`` is (C, K) packed as a 3x3 velocity Jacobian and 2x2 stiffness in a (3, 5) array.
+
+    Returns
+    -------
+    (load Q [N], approach delta [m], slip ratio (sliding / entrainment speed), drag F_o [N]); slip and
+    drag are 0 where the contact is open (and slip where traction is off).
     """
-    rr = prm[P_RR]
-    q, dq_dd, dq_drate = _normal_force(delta, rate, prm[P_K], prm[P_CDAMP], prm[P_DFADE])
-    diag[col_d] = delta
-    diag[col_q] = q
+    rr = prm.roller_radius
+    q, dq_dd, dq_drate = _normal_force(delta, rate, prm.palmgren_stiffness, prm.damping_time, prm.damping_fade)
     if q <= 0.0:
-        return
+        return q, delta, 0.0, 0.0
     tx = -ny
     ty = nx
     f[0] += q * nx
@@ -196,11 +225,11 @@ def _contact(
     # entrainment (rolling) speed: mean surface speed of roller and raceway relative to the contact
     # point, which moves with the roller's orbit (reduces to the paper's Eq. 4 in pure rolling)
     u_ent = 0.5 * (abs(w - orbit) * rr + abs(omega_race - orbit) * r_race_geom)
-    u_ref = max(u_ent, prm[P_UMIN])
+    u_ref = max(u_ent, prm.min_entrainment)
     # oil-film rolling resistance, Eq. (2), on the roller centre against its motion relative to the race
-    fo = prm[P_CDRAG] * q**DRAG_N_EXP * u_ent**DRAG_V_EXP
+    fo = prm.drag_coefficient * q**DRAG_N_EXP * u_ent**DRAG_V_EXP
     rel = vx * tx + vy * ty - w_race
-    weps = prm[P_WEPS]
+    weps = prm.drag_direction_eps
     sq = math.sqrt(rel * rel + weps * weps)
     f[0] -= fo * rel / sq * tx
     f[1] -= fo * rel / sq * ty
@@ -209,19 +238,18 @@ def _contact(
     jac[0, 1] -= gd * tx * ty
     jac[1, 0] -= gd * ty * tx
     jac[1, 1] -= gd * ty * ty
-    diag[col_fo] = fo
-    if prm[P_TRACTION] > 0.0:
+    if prm.traction:
         # sliding speed of the roller surface over the raceway along T; generalized direction
         # a = (tx, ty, -rr) for (vx, vy, w)
         s = vx * tx + vy * ty - w * rr - u_race
-        x = s / (prm[P_SLIPREF] * u_ref)
+        x = s / (prm.traction_slip_ref * u_ref)
         th = math.tanh(x)
-        mu = prm[P_MU] * th
+        mu = prm.traction_mu_max * th
         ft = -mu * q
         f[0] += ft * tx
         f[1] += ft * ty
         f[2] += -rr * ft
-        g = prm[P_MU] * (1.0 - th * th) * q / (prm[P_SLIPREF] * u_ref)
+        g = prm.traction_mu_max * (1.0 - th * th) * q / (prm.traction_slip_ref * u_ref)
         a0 = tx
         a1 = ty
         a2 = -rr
@@ -234,7 +262,8 @@ def _contact(
         jac[2, 0] -= g * a2 * a0
         jac[2, 1] -= g * a2 * a1
         jac[2, 2] -= g * a2 * a2
-        diag[col_s] = s / u_ref
+        return q, delta, s / u_ref, fo
+    return q, delta, 0.0, fo
 
 
 @njit(cache=True)
@@ -246,39 +275,39 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     state : (nb, 6) body state before the step, rows (x, y, angle, vx, vy, omega) in SI; rows
         ``0..n-1`` are the rollers.
     h : time step [s].
-    prm : parameter vector (see ``P_*``).
+    prm : :class:`RacewayParams`.
     ring_c : (2,) inner-ring centre [m]: in, the previous solution; out, this step's.
     ring_c_prev : (2,) scratch, receives the previous centre.
     ring_v : (2,) velocity of the ring centre [m/s] (dynamic ring: in and out; quasi-static: unused).
     hold : (n,) bool, rollers whose motion is prescribed this step (get zero force).
     out_f : (nb * 3,) flat (fx, fy, torque) per body for ``pymunk.batch.set_space_bodies`` [N, N m].
-    diag : (n, N_DIAG) per-roller contact diagnostics (loads [N], approaches [m], slips, drags [N]).
+    diag : (n,) :data:`DIAG`, out: per-roller contact diagnostics (loads [N], approaches [m], slips, drags [N]).
 
     Returns
     -------
     Newton iteration count of the ring solve (negative if it failed; 0 if no inner ring).
     """
     n = diag.shape[0]
-    m = prm[P_MASS]
-    inertia = prm[P_INERTIA]
-    g = prm[P_GRAV]
-    spin_free = prm[P_SPIN] > 0.0
+    m = prm.roller_mass
+    inertia = prm.roller_inertia
+    g = prm.gravity
+    spin_free = prm.spin_free
     xp = np.empty((n, 2))
     din_prev = np.empty(n)
     dout_prev = np.empty(n)
-    rr = prm[P_RR]
+    rr = prm.roller_radius
     for i in range(n):
         xp[i, 0] = state[i, 0] + h * state[i, 3]
         xp[i, 1] = state[i, 1] + h * state[i, 4]
         # approaches at the current positions: contact rates are (delta_{n+1} - delta_n) / h
-        dout_prev[i] = math.sqrt(state[i, 0] ** 2 + state[i, 1] ** 2) + rr - prm[P_RO_RACE]
-        din_prev[i] = prm[P_RI_RACE] + rr - math.sqrt((state[i, 0] - ring_c[0]) ** 2
+        dout_prev[i] = math.sqrt(state[i, 0] ** 2 + state[i, 1] ** 2) + rr - prm.outer_race_radius
+        din_prev[i] = prm.inner_race_radius + rr - math.sqrt((state[i, 0] - ring_c[0]) ** 2
                                                       + (state[i, 1] - ring_c[1]) ** 2)
     it = 0
-    inner = prm[P_INNER] > 0.0
+    inner = prm.inner_ring
     cdx = 0.0
     cdy = 0.0
-    ring_mass = prm[P_RING_MASS]
+    ring_mass = prm.ring_mass
     dynamic = ring_mass > 0.0
     if inner:
         ring_c_prev[0] = ring_c[0]
@@ -291,16 +320,17 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         cdx = (ring_c[0] - ring_c_prev[0]) / h
         cdy = (ring_c[1] - ring_c_prev[1]) / h
     frx = 0.0
-    fry = -prm[P_LOAD]  # force on a dynamic ring: the load, plus the reactions added below
+    fry = -prm.radial_load  # force on a dynamic ring: the load, plus the reactions added below
     out_f[:] = 0.0
     jac = np.zeros((3, 5))
     f = np.zeros(3)
     A = np.zeros((3, 3))
     b = np.zeros(3)
-    omega_ring = prm[P_OMEGA_RING]
+    omega_ring = prm.omega_ring
     for i in range(n):
-        for k in range(N_DIAG):
-            diag[i, k] = 0.0
+        d_i = diag[i]
+        d_i.q_out = d_i.q_in = d_i.delta_out = d_i.delta_in = 0.0
+        d_i.slip_out = d_i.slip_in = d_i.drag_out = d_i.drag_in = 0.0
         if hold[i]:
             out_f[3 * i + 1] = m * g  # prescribed motion: cancel pymunk's gravity
             continue
@@ -316,26 +346,27 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         # outer raceway (fixed): force along N = -p/|p|
         nx = -px / r
         ny = -py / r
-        delta = r + rr - prm[P_RO_RACE]
+        delta = r + rr - prm.outer_race_radius
         rate = (delta - dout_prev[i]) / h
-        _contact(px, py, vx, vy, w, nx, ny, delta, rate, 0.0, 0.0, prm[P_RO_GEOM], 0.0, orbit,
-                 prm, jac, f, diag[i], D_Q_OUT, D_DELTA_OUT, D_SLIP_OUT, D_FO_OUT)
+        d_i.q_out, d_i.delta_out, d_i.slip_out, d_i.drag_out = _contact(
+            px, py, vx, vy, w, nx, ny, delta, rate, 0.0, 0.0, prm.outer_race_geom_radius, 0.0, orbit, prm, jac, f)
         if inner:
             dx = px - ring_c[0]
             dy = py - ring_c[1]
             d = math.sqrt(dx * dx + dy * dy)
             nx = dx / d
             ny = dy / d
-            delta = prm[P_RI_RACE] + rr - d
+            delta = prm.inner_race_radius + rr - d
             rate = (delta - din_prev[i]) / h
             tx = -ny
             ty = nx
-            u_race = cdx * tx + cdy * ty + omega_ring * prm[P_RI_GEOM]
+            u_race = cdx * tx + cdy * ty + omega_ring * prm.inner_race_geom_radius
             w_race = cdx * tx + cdy * ty + omega_ring * d
             f_before_x = f[0]
             f_before_y = f[1]
-            _contact(px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, prm[P_RI_GEOM],
-                     omega_ring, orbit, prm, jac, f, diag[i], D_Q_IN, D_DELTA_IN, D_SLIP_IN, D_FO_IN)
+            d_i.q_in, d_i.delta_in, d_i.slip_in, d_i.drag_in = _contact(
+                px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, prm.inner_race_geom_radius, omega_ring,
+                orbit, prm, jac, f)
             frx -= f[0] - f_before_x
             fry -= f[1] - f_before_y
         # implicit velocity update: (M - h C - h^2 K) dq = h (F + h K v + M g)

@@ -1,44 +1,39 @@
-"""The compiled step loop of the multi-pocket model: pymunk's C functions called from numba.
+"""One time step of the multi-pocket model as two compiled kernels, and the plain pymunk step loop.
 
-The per-step work of :func:`bearingsim.multibody.core.run` is one numba function, :func:`advance`,
-that calls chipmunk (pymunk's C library) directly through its function pointers, so no Python runs
-between steps:
+Per time step ``h`` of :func:`bearingsim.multibody.core.run`:
 
-1. read the state of every body (pymunk's batched body iterator, into a fixed C array viewed by numpy;
-   two arrays alternate so the state before and after a step are both at hand);
-2. (reduced-equivalent scene) rollers inside the load zone are put at the front of their pockets;
-3. raceway forces (:func:`bearingsim.multibody.forces.raceway_forces`) written into the batched
-   set buffer, and handed to the bodies by pymunk's batched setter;
-4. ``cpSpaceStep(h)``, timed on its own with ``clock_gettime(CLOCK_MONOTONIC)`` (that is the
-   ``pymunk_step_s`` of a result);
-5. the arbiters read by pymunk's batched arbiter iterator and attributed to pockets, faces and
-   rotations (:func:`bearingsim.multibody.recorder.record_step`);
-6. every ``out_every`` steps: a time-series sample into a fixed block, and the run's health checks.
+1. :func:`before_step` on the body states before the step: end and stall checks, start of the
+   recorded period, (reduced-equivalent scene) rollers inside the load zone put at the front of their
+   pockets, raceway forces (:func:`bearingsim.multibody.forces.raceway_forces`) written into the set
+   buffer;
+2. pymunk: the forces (and, reduced-equivalent, the held states) handed to the bodies, one step
+   ``h``, the body states and the arbiters read back;
+3. :func:`after_step`: time and step advanced, the arbiters attributed to pockets, faces and rotations
+   (:func:`bearingsim.multibody.recorder.record_step`) and, every ``out_every`` steps, a time-series
+   sample and the run's health checks.
 
-:func:`advance` returns to Python with a code (``CODE_*``) when the run is done, when the sample block
-is full or ``CHUNK_STEPS`` steps have passed (Python flushes the samples to the archive, moves the
-progress bar and sees Ctrl-C), or when a check failed (Python raises the matching error). Loop state that lives across calls is kept in two small arrays
-(``lsi`` integers, ``lsf`` floats; ``LI_*`` and ``LF_*`` name their slots).
-
-Nothing in the scene is added or removed during a run and there are no collision callbacks, so
-calling ``cpSpaceStep`` directly (without pymunk's Python wrapper around the step) is what
-``Space.step`` does for this space. The C arrays are sized so that pymunk never has to grow them;
-if it ever did, :func:`advance` stops with ``CODE_BUFFER_GREW`` rather than read a stale pointer.
+Step 2 is done either by the compiled loop of :mod:`bearingsim.multibody.chipmunk`, which calls
+chipmunk's C functions from numba so that no Python runs between steps, or by :func:`advance_plain`
+here, a Python loop over ``Space.step`` and pymunk's public ``pymunk.batch`` functions (slower, the
+same numbers: it calls the same two kernels with the same inputs). Both return to Python with a code
+(``CODE_*``) when the run is done, when the sample block is full or ``CHUNK_STEPS`` steps have passed
+(Python flushes the samples, moves the progress bar and sees Ctrl-C), or when a check failed (Python
+raises the matching error). State that lives across calls is one :data:`LOOP_STATE` record.
 """
 from __future__ import annotations
 
-import ctypes
 import math
+import time
+from typing import NamedTuple
 
-import numba.experimental.function_type  # noqa: F401  (registers typeof for WrapperAddressProtocol)
 import numpy as np
 import pymunk.batch as pb
-from numba import njit, types
-from pymunk._chipmunk_cffi import ffi, lib
+from numba import njit
 
 from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import recorder as rk
+from bearingsim.reduced import core as _reduced_core
 
 BODY_GET = (pb.BodyFields.POSITION | pb.BodyFields.ANGLE | pb.BodyFields.VELOCITY
             | pb.BodyFields.ANGULAR_VELOCITY)
@@ -49,147 +44,98 @@ ARB_GET = (pb.ArbiterFields.BODY_A_ID | pb.ArbiterFields.BODY_B_ID | pb.ArbiterF
            | pb.ArbiterFields.TOTAL_IMPULSE | pb.ArbiterFields.NORMAL | pb.ArbiterFields.POINT_A_1
            | pb.ArbiterFields.POINT_B_1 | pb.ArbiterFields.DISTANCE_1)
 
-# return codes of advance()
+# return codes of the step loops (CODE_CONTINUE: the step kernels have nothing to report)
+CODE_CONTINUE = -1
 CODE_DONE, CODE_BLOCK_FULL, CODE_NONFINITE, CODE_PENETRATION, CODE_BLOWUP, CODE_STALLED = range(6)
 CODE_BUFFER_GREW, CODE_CAGE_LOST = 6, 7
-# integer loop state
-LI_STEP, LI_CUR, LI_NIMP, LI_NSMP, LI_NORBIT, LI_REC, LI_NEWTON_FAIL, LI_OUT_EVERY, LI_MAX_STEPS = range(9)
-N_LI = 9
-# float loop state
-LF_T, LF_PYMUNK_NS, LF_RING_SX, LF_RING_SY, LF_RING_N, LF_W_START, LF_T_REC0, LF_ORBIT_MAX = range(8)
-N_LF = 8
-# limits
-LIM_TRAVEL_END, LIM_TRAVEL_REC, LIM_PEN, LIM_DELTA, LIM_OMEGA, LIM_OMEGA_NOM, LIM_ORBIT = range(7)
-N_LIM = 7
-# sample columns: t, cage speed along the rotation, slip, cage x, cage y, ring x, ring y
-S_T, S_W, S_SLIP, S_CX, S_CY, S_RX, S_RY = range(7)
-N_SCOL = 7
 CHUNK_STEPS = 20_000  # return to Python at least this often (progress bar, Ctrl-C: ~0.3 s)
 DELTA_LIMIT_M = 50e-6  # a raceway approach beyond this is an energy blow-up
-CLOCK_MONOTONIC = 1  # Linux and macOS
+
+#: Loop state that lives across calls of the step loop, one record (array shape (1,)).
+LOOP_STATE = np.dtype([
+    ("step", np.int64),  # steps done
+    ("cur", np.int64),  # which of the two state arrays holds the current state (0 or 1)
+    ("n_imp", np.int64),  # impact rows used
+    ("n_samples", np.int64),  # samples in the block not yet handed to Python
+    ("n_orbit", np.int64),  # cage-centre samples written into the orbit ring buffer
+    ("recording", np.int64),  # 1 once the cage has turned through the warm-up rotations
+    ("newton_failures", np.int64),  # steps whose ring-centre Newton solve did not converge
+    ("t", np.float64),  # time [s]
+    ("pymunk_ns", np.float64),  # time spent in pymunk's step [ns]
+    ("ring_sum_x", np.float64), ("ring_sum_y", np.float64),  # sum of inner-ring centres, recorded steps [m]
+    ("ring_n", np.float64),  # number of steps in those sums
+    ("cage_w_start", np.float64),  # cage angular velocity when recording started [rad/s]
+    ("t_rec0", np.float64),  # time when recording started [s]
+    ("orbit_max", np.float64),  # largest cage-centre offset in the recorded period [m]
+], align=True)
+
+#: Time-series samples, one row every ``out_every`` steps (array shape (block,)).
+SAMPLE = np.dtype([
+    ("step", np.int64),
+    ("t", np.float64),  # [s]
+    ("cage_speed", np.float64),  # cage angular speed in the direction of rotation [rad/s]
+    ("cage_slip", np.float64),  # 1 - cage speed / epicyclic speed
+    ("cage_x", np.float64), ("cage_y", np.float64),  # cage centre [m]
+    ("ring_x", np.float64), ("ring_y", np.float64),  # inner-ring centre [m]
+], align=True)
 
 
-class _CFunction(types.WrapperAddressProtocol):
-    """A C function pointer that numba code can take as an argument and call (first-class function).
+class LoopLimits(NamedTuple):
+    """When the step loop stops, and the health checks of a run."""
 
-    Passed as an argument (not a global), it keeps the compiled loop cacheable on disk."""
-
-    def __init__(self, address: int, signature):
-        self._address = int(address)
-        self._signature = signature
-
-    def __wrapper_address__(self):
-        return self._address
-
-    def signature(self):
-        return self._signature
+    travel_end: float  #: cage travel at which the run is done [rad]
+    travel_record: float  #: cage travel at which recording starts [rad]
+    penetration: float  #: largest roller-cage overlap accepted [m]
+    omega: float  #: largest cage angular speed accepted [rad/s]
+    omega_nominal: float  #: epicyclic cage speed, for the slip [rad/s]
+    orbit: float  #: largest cage-centre offset accepted (reach of the pocket faces) [m]
+    out_every: int  #: steps between samples and checks
+    max_steps: int  #: steps after which the cage counts as stalled
 
 
-def _chipmunk(name: str, signature) -> _CFunction:
-    return _CFunction(int(ffi.cast("intptr_t", ffi.addressof(lib, name))), signature)
+class HoldRule(NamedTuple):
+    """Reduced-equivalent scene: rollers inside the load zone ride at the front of their pockets."""
+
+    active: bool  #: the rule applies (reduced-equivalent scene)
+    phi: float  #: load-zone half angle [rad]
+    radius: float  #: radius of the held roller centres (on the outer race) [m]
+    front_offset: float  #: offset of a held roller from its pocket centre along e_t, s/2 [m]
+    omega_cage: float  #: signed angular speed of the kinematic cage [rad/s]
 
 
-def _address(cdata) -> int:
-    return int(ffi.cast("intptr_t", cdata))
+class StepInputs(NamedTuple):
+    """Everything the step kernels read and never change during a run."""
+
+    h: float  #: time step [s]
+    prm: fk.RacewayParams
+    cfg: rk.RecorderConfig
+    lim: LoopLimits
+    hold_rule: HoldRule
+    pocket_a: np.ndarray  #: (n,) pocket centre angles in the cage frame [rad]
+    theta0: np.ndarray  #: (n,) angle of each pocket from the load-zone centre at t = 0 [rad]
+    ids_sorted: np.ndarray  #: (nb,) pymunk body ids, sorted (uint64)
+    ids_index: np.ndarray  #: (nb,) batch row of each sorted id
 
 
-# pointers are passed as int64 (same registers as a pointer in the C calling convention)
-_STEP_SIG = types.void(types.int64, types.float64)
-_EACH_SIG = types.void(types.int64, types.int64, types.int64)
-_CLOCK_SIG = types.int32(types.int32, types.int64)
+class StepWork(NamedTuple):
+    """Arrays the step kernels write, besides the recorder's accumulators."""
 
-
-def _clock_function():
-    """``clock_gettime`` from the C library, or None where there is none (then no pymunk timing)."""
-    try:
-        fn = ctypes.CDLL(None).clock_gettime
-    except (OSError, AttributeError, TypeError):  # pragma: no cover - platforms without clock_gettime
-        return None
-    return _CFunction(ctypes.cast(fn, ctypes.c_void_p).value, _CLOCK_SIG)
-
-
-def _float_array(n):
-    """A pymunk C float array of capacity n, freed with its Python object."""
-    return ffi.gc(lib.pmFloatArrayNew(n), lib.pmFloatArrayFree)
-
-
-def _int_array(n):
-    return ffi.gc(lib.pmIntArrayNew(n), lib.pmIntArrayFree)
-
-
-class BatchIO:
-    """The space's batched C buffers and function pointers, set up once for :func:`advance`.
-
-    ``states``: the two (nb, 6) state arrays (numpy views of C arrays); ``arb_f``/``arb_i``: the
-    arbiter buffers (``arb_cap`` arbiters); ``hdr``: int32 views of the (num, max) header of the C
-    arrays: state 0, state 1, set buffer, arbiter floats, arbiter ints; ``ptr``: addresses of the
-    space, the three batched iterator functions, their four data blocks and the timespec buffer.
-    """
-
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap):
-        self.nb = nb
-        self._space = space._space
-        self.step_fn = _chipmunk("cpSpaceStep", _STEP_SIG)
-        self.each_body_fn = _chipmunk("cpSpaceEachBody", _EACH_SIG)
-        self.each_arb_fn = _chipmunk("cpSpaceEachCachedArbiter", _EACH_SIG)
-        clock = _clock_function()
-        self.timed = clock is not None
-        self.clock_fn = clock if clock is not None else self.each_body_fn  # never called when untimed
-        self.ts = np.zeros(2, dtype=np.int64)  # struct timespec
-        ia = _int_array(nb)
-        self._keep = [ia]  # the C objects must outlive the run
-        self.states, data, arrays = [], [], []
-        for _ in range(2):  # two state arrays, alternating
-            fa = _float_array(2 * nb * 6 + 16)  # headroom: a push never reallocates
-            d = ffi.new("pmBatchedData *")
-            d.fields = BODY_GET.value
-            d.floatArray = fa
-            d.intArray = ia
-            self.states.append(np.frombuffer(ffi.buffer(fa.arr, 8 * nb * 6), dtype=np.float64).reshape(nb, 6))
-            data.append(d)
-            arrays.append(fa)
-        self.set_buf = pb.Buffer()
-        self.set_buf.set_float_buf(set_arr)
-        sd = ffi.new("pmBatchedData *")
-        sd.fields = set_fields.value
-        sd.floatArray = self.set_buf._float_arr
-        sd.intArray = self.set_buf._int_arr
-        afa = _float_array(rk.ARB_F * arb_cap)
-        aia = _int_array(rk.ARB_I * arb_cap)
-        ad = ffi.new("pmBatchedData *")
-        ad.fields = ARB_GET.value
-        ad.floatArray = afa
-        ad.intArray = aia
-        arrays += [self.set_buf._float_arr, afa, aia]
-        self._data = data
-        self._keep += data + arrays + [sd, ad]
-        self.arb_f = np.frombuffer(ffi.buffer(afa.arr, 8 * afa.max), dtype=np.float64)
-        self.arb_i = np.frombuffer(ffi.buffer(aia.arr, 8 * aia.max), dtype=np.uint64)
-        assert ffi.offsetof("pmFloatArray", "num") == 0 and ffi.offsetof("pmFloatArray", "max") == 4
-        self.hdr = [np.frombuffer(ffi.buffer(a, 8), dtype=np.int32) for a in arrays]
-        self.ptr = np.array([
-            _address(space._space),
-            _address(ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")),
-            _address(ffi.addressof(lib, "pmSpaceBodySetIteratorFuncBatched")),
-            _address(ffi.addressof(lib, "pmSpaceArbiterIteratorFuncBatched")),
-            _address(data[0]), _address(data[1]), _address(sd), _address(ad),
-            self.ts.ctypes.data,
-        ], dtype=np.int64)
-
-    def read_states(self):
-        """Fill state array 0 from the space (before the first step)."""
-        cap = int(self.hdr[0][1])
-        self.hdr[0][0] = 0
-        lib.cpSpaceEachBody(self._space, ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched"), self._data[0])
-        if self.hdr[0][1] != cap or self.hdr[0][0] != 6 * self.nb:
-            raise RuntimeError("multibody step loop: pymunk's batched body read did not fit its buffer")
-        return self.states[0]
+    ring_c: np.ndarray  #: (2,) inner-ring centre [m]
+    ring_c_prev: np.ndarray  #: (2,) scratch
+    ring_v: np.ndarray  #: (2,) inner-ring velocity (dynamic ring) [m/s]
+    hold: np.ndarray  #: (n,) bool, rollers held this step
+    out_f: np.ndarray  #: (nb * 3,) (fx, fy, torque) per body [N, N m]
+    set_arr: np.ndarray  #: the buffer pymunk's batched setter reads (is ``out_f`` in the full scene)
+    diag: np.ndarray  #: (n,) :data:`bearingsim.multibody.forces.DIAG`
+    smp: np.ndarray  #: (block,) :data:`SAMPLE`
+    orbit: np.ndarray  #: (keep, 3) ring buffer of (t [s], x [m], y [m]) of the cage centre
 
 
 @njit(cache=True)
-def _hold_rollers(state, n, sign, phi, pocket_a, hold, radius, front_off, omega_cage):
+def _hold_rollers(state, n, sign, rule, pocket_a, hold):
     """Reduced-equivalent: rollers in the load zone ride at the front of their pockets with the cage."""
     phic = state[n, 2]
+    phi = rule.phi
     for i in range(n):
         th = rk.pocket_theta(sign, phic, pocket_a[i])
         inside = th < phi or th > 2.0 * math.pi - phi
@@ -201,13 +147,13 @@ def _hold_rollers(state, n, sign, phi, pocket_a, hold, radius, front_off, omega_
             # pocket centre on the pitch circle; roller on the outer race, shifted by s/2 along e_t
             etx = -sign * sa
             ety = sign * ca
-            px = radius * ca + front_off * etx
-            py = radius * sa + front_off * ety
+            px = rule.radius * ca + rule.front_offset * etx
+            py = rule.radius * sa + rule.front_offset * ety
             # velocity of that point of the (kinematic) cage
             state[i, 0] = px
             state[i, 1] = py
-            state[i, 3] = -omega_cage * py
-            state[i, 4] = omega_cage * px
+            state[i, 3] = -rule.omega_cage * py
+            state[i, 4] = rule.omega_cage * px
 
 
 @njit(cache=True)
@@ -220,141 +166,170 @@ def _pack_all(state, out_f, set_arr, nb):
 
 
 @njit(cache=True)
-def _now_ns(clock, ptr_ts, ts):
-    clock(np.int32(CLOCK_MONOTONIC), ptr_ts)
-    return ts[0] * 1_000_000_000 + ts[1]
+def before_step(prev, inp, wk, ls):
+    """Checks and raceway forces before a step; return ``CODE_CONTINUE`` or the code to stop with.
+
+    Parameters
+    ----------
+    prev : (nb, 6) body states before the step (x [m], y [m], angle [rad], vx [m/s], vy [m/s],
+        omega [rad/s]); held rollers are overwritten.
+    inp : :class:`StepInputs`.
+    wk : :class:`StepWork`; ``set_arr`` receives what pymunk's batched setter reads.
+    ls : (1,) :data:`LOOP_STATE`.
+    """
+    s = ls[0]
+    lim = inp.lim
+    n = inp.cfg.roller_count
+    sign = inp.cfg.sign
+    travel = sign * prev[n, 2]
+    if travel >= lim.travel_end:
+        return CODE_DONE
+    if s.step > lim.max_steps:
+        return CODE_STALLED
+    if s.recording == 0 and travel >= lim.travel_record:
+        s.recording = 1
+        s.cage_w_start = prev[n, 5]
+        s.t_rec0 = s.t
+    if inp.hold_rule.active:
+        _hold_rollers(prev, n, sign, inp.hold_rule, inp.pocket_a, wk.hold)
+    if fk.raceway_forces(prev, inp.h, inp.prm, wk.ring_c, wk.ring_c_prev, wk.ring_v, wk.hold, wk.out_f,
+                         wk.diag) < 0:
+        s.newton_failures += 1
+    if s.recording == 1:
+        s.ring_sum_x += wk.ring_c[0]
+        s.ring_sum_y += wk.ring_c[1]
+        s.ring_n += 1.0
+    if inp.hold_rule.active:
+        _pack_all(prev, wk.out_f, wk.set_arr, n + 1)
+    return CODE_CONTINUE
 
 
 @njit(cache=True)
-def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hv0, hv1, hvs, hva, hvi, st0, st1, arb_f,
-            arb_i, ts, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, set_arr, diag, reduced_eq, phi, pocket_a,
-            hold_radius, front_off, omega_cage, ids_sorted, ids_index, cfg, theta0, win, first_imp, f_bin, t_bin,
-            q_bin, tq_bin, j_int, glob, impacts, lim, lsi, lsf, smp_step, smp, orbit):
-    """Advance the run until it is done, the sample block is full, or a check fails; return a CODE_*.
+def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
+    """Advance time and step, record the step, sample and check; return ``CODE_CONTINUE`` or a code.
 
-    ``hv0, hv1, hvs, hva, hvi`` are the int32 (num, max) headers of the C arrays (:class:`BatchIO`);
-    the loop resets ``num`` before each batched call and stops if pymunk ever grew an array (``max``
-    changed), which the sizes chosen in :class:`BatchIO` rule out. The other arguments are those of
-    :func:`bearingsim.multibody.forces.raceway_forces` and
-    :func:`bearingsim.multibody.recorder.record_step`, the limits ``lim`` (``LIM_*``), the loop state
-    ``lsi``/``lsf`` and the sample block ``smp_step``/``smp`` (``S_*``) and orbit ring buffer.
+    Parameters
+    ----------
+    st0, st1 : (nb, 6) the two state arrays; pymunk has written the state after the step into the one
+        that did not hold the state before it (``ls[0].cur`` is toggled here).
+    arb_f, arb_i, n_arb : pymunk's batched arbiters (see :func:`bearingsim.multibody.recorder.record_step`).
+    inp : :class:`StepInputs`.
+    wk : :class:`StepWork`.
+    acc : :class:`bearingsim.multibody.recorder.Accumulators`.
+    ls : (1,) :data:`LOOP_STATE`.
     """
-    sp = ptr[0]
-    n = int(cfg[rk.C_N])
+    s = ls[0]
+    lim = inp.lim
+    n = inp.cfg.roller_count
     nb = n + 1
-    sign = cfg[rk.C_SIGN]
-    cap0 = hv0[1]
-    cap1 = hv1[1]
-    capf = hva[1]
-    capi = hvi[1]
-    out_every = lsi[LI_OUT_EVERY]
-    step = lsi[LI_STEP]
-    cur = lsi[LI_CUR]
-    n_imp = lsi[LI_NIMP]
-    t = lsf[LF_T]
-    step_return = step + CHUNK_STEPS
-    code = CODE_DONE
-    while True:
-        prev = st0 if cur == 0 else st1
-        travel = sign * prev[n, 2]
-        if travel >= lim[LIM_TRAVEL_END]:
-            code = CODE_DONE
-            break
-        if step > lsi[LI_MAX_STEPS]:
-            code = CODE_STALLED
-            break
-        if lsi[LI_REC] == 0 and travel >= lim[LIM_TRAVEL_REC]:
-            lsi[LI_REC] = 1
-            lsf[LF_W_START] = prev[n, 5]
-            lsf[LF_T_REC0] = t
-        if reduced_eq:
-            _hold_rollers(prev, n, sign, phi, pocket_a, hold, hold_radius, front_off, omega_cage)
-        if fk.raceway_forces(prev, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag) < 0:
-            lsi[LI_NEWTON_FAIL] += 1
-        if lsi[LI_REC] == 1:
-            lsf[LF_RING_SX] += ring_c[0]
-            lsf[LF_RING_SY] += ring_c[1]
-            lsf[LF_RING_N] += 1.0
-        if reduced_eq:
-            _pack_all(prev, out_f, set_arr, nb)
-        hvs[0] = 0  # the setter reads the buffer from the start
-        each_body_fn(sp, ptr[2], ptr[6])
-        if timed:
-            t0 = _now_ns(clock_fn, ptr[8], ts)
-            step_fn(sp, h)
-            lsf[LF_PYMUNK_NS] += _now_ns(clock_fn, ptr[8], ts) - t0
-        else:
-            step_fn(sp, h)
-        t += h
-        step += 1
-        cur ^= 1
-        if cur == 0:
-            hv0[0] = 0
-            each_body_fn(sp, ptr[1], ptr[4])
-            now = st0
-        else:
-            hv1[0] = 0
-            each_body_fn(sp, ptr[1], ptr[5])
-            now = st1
-        hva[0] = 0
-        hvi[0] = 0
-        each_arb_fn(sp, ptr[3], ptr[7])
-        if hv0[1] != cap0 or hv1[1] != cap1 or hva[1] != capf or hvi[1] != capi:
-            code = CODE_BUFFER_GREW
-            break
-        n_arb = hvi[0] // rk.ARB_I
-        n_imp = rk.record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0,
-                               diag, win, first_imp, f_bin, t_bin, q_bin, tq_bin, j_int, glob, impacts, n_imp)
-        if step % out_every == 0:
-            ok = True
-            for i in range(nb):
-                for j in range(6):
-                    if not math.isfinite(now[i, j]):
-                        ok = False
-            if not ok:
-                code = CODE_NONFINITE
-                break
-            if glob[rk.G_MAXPEN_ALL] > lim[LIM_PEN]:
-                code = CODE_PENETRATION
-                break
-            dmax = 0.0
-            for i in range(n):
-                dmax = max(dmax, diag[i, fk.D_DELTA_OUT])
-            if dmax > DELTA_LIMIT_M or abs(now[n, 5]) > lim[LIM_OMEGA]:
-                code = CODE_BLOWUP
-                break
-            if math.hypot(now[n, 0], now[n, 1]) > lim[LIM_ORBIT]:
-                code = CODE_CAGE_LOST
-                break
-            wc = sign * now[n, 5]
-            if lsi[LI_REC] == 1:
-                k = lsi[LI_NORBIT] % orbit.shape[0]
-                orbit[k, 0] = t
-                orbit[k, 1] = now[n, 0]
-                orbit[k, 2] = now[n, 1]
-                lsi[LI_NORBIT] += 1
-                lsf[LF_ORBIT_MAX] = max(lsf[LF_ORBIT_MAX], math.hypot(now[n, 0], now[n, 1]))
-            k = lsi[LI_NSMP]
-            smp_step[k] = step
-            smp[k, S_T] = t
-            smp[k, S_W] = wc
-            smp[k, S_SLIP] = 1.0 - wc / lim[LIM_OMEGA_NOM]
-            smp[k, S_CX] = now[n, 0]
-            smp[k, S_CY] = now[n, 1]
-            smp[k, S_RX] = ring_c[0]
-            smp[k, S_RY] = ring_c[1]
-            lsi[LI_NSMP] = k + 1
-            if k + 1 == smp.shape[0]:
-                code = CODE_BLOCK_FULL
-                break
-        if step >= step_return:
-            code = CODE_BLOCK_FULL
-            break
-    lsi[LI_STEP] = step
-    lsi[LI_CUR] = cur
-    lsi[LI_NIMP] = n_imp
-    lsf[LF_T] = t
-    return code
+    sign = inp.cfg.sign
+    s.t += inp.h
+    s.step += 1
+    s.cur ^= 1
+    if s.cur == 0:
+        now = st0
+        prev = st1
+    else:
+        now = st1
+        prev = st0
+    t = s.t
+    s.n_imp = rk.record_step(arb_f, arb_i, n_arb, inp.ids_sorted, inp.ids_index, prev, now, t, inp.h, inp.cfg,
+                             inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp)
+    if s.step % lim.out_every == 0:
+        ok = True
+        for i in range(nb):
+            for j in range(6):
+                if not math.isfinite(now[i, j]):
+                    ok = False
+        if not ok:
+            return CODE_NONFINITE
+        if acc.glob[0].maxpen_all > lim.penetration:
+            return CODE_PENETRATION
+        dmax = 0.0
+        for i in range(n):
+            dmax = max(dmax, wk.diag[i].delta_out)
+        if dmax > DELTA_LIMIT_M or abs(now[n, 5]) > lim.omega:
+            return CODE_BLOWUP
+        if math.hypot(now[n, 0], now[n, 1]) > lim.orbit:
+            return CODE_CAGE_LOST
+        wc = sign * now[n, 5]
+        if s.recording == 1:
+            orbit = wk.orbit
+            k = s.n_orbit % orbit.shape[0]
+            orbit[k, 0] = t
+            orbit[k, 1] = now[n, 0]
+            orbit[k, 2] = now[n, 1]
+            s.n_orbit += 1
+            s.orbit_max = max(s.orbit_max, math.hypot(now[n, 0], now[n, 1]))
+        k = s.n_samples
+        r = wk.smp[k]
+        r.step = s.step
+        r.t = t
+        r.cage_speed = wc
+        r.cage_slip = 1.0 - wc / lim.omega_nominal
+        r.cage_x = now[n, 0]
+        r.cage_y = now[n, 1]
+        r.ring_x = wk.ring_c[0]
+        r.ring_y = wk.ring_c[1]
+        s.n_samples = k + 1
+        if k + 1 == wk.smp.shape[0]:
+            return CODE_BLOCK_FULL
+    return CODE_CONTINUE
 
 
-drop_stale_caches(__name__, (fk, rk))  # advance() compiles the force and recording kernels in
+class PlainLoop:
+    """The step loop in Python over pymunk's public API (``Space.step``, ``pymunk.batch``).
+
+    ``states``: the two (nb, 6) state arrays; ``timed``: the time in pymunk's step is measured.
+    """
+
+    name = "plain"
+    timed = True
+
+    def __init__(self, space, nb, set_fields, set_arr):
+        self.space = space
+        self.nb = nb
+        self.set_fields = set_fields
+        self.states = [np.zeros((nb, 6)), np.zeros((nb, 6))]
+        self._bodies = pb.Buffer()
+        self._arbiters = pb.Buffer()
+        self._set = pb.Buffer()
+        self._set.set_float_buf(set_arr)
+
+    def _read_bodies(self, out):
+        self._bodies.clear()
+        pb.get_space_bodies(self.space, BODY_GET, self._bodies)
+        out[:] = np.frombuffer(self._bodies.float_buf(), dtype=np.float64).reshape(self.nb, 6)
+
+    def read_states(self):
+        """Fill state array 0 from the space (before the first step)."""
+        self._read_bodies(self.states[0])
+        return self.states[0]
+
+    def advance(self, inp, wk, acc, ls):
+        """Step until :func:`before_step` or :func:`after_step` report a code, or ``CHUNK_STEPS`` steps."""
+        st0, st1 = self.states
+        step_return = int(ls[0]["step"]) + CHUNK_STEPS
+        h = inp.h
+        while True:
+            cur = int(ls[0]["cur"])
+            code = before_step(self.states[cur], inp, wk, ls)
+            if code != CODE_CONTINUE:
+                return code
+            pb.set_space_bodies(self.space, self.set_fields, self._set)
+            t0 = time.perf_counter_ns()
+            self.space.step(h)
+            ls[0]["pymunk_ns"] += time.perf_counter_ns() - t0
+            self._read_bodies(self.states[cur ^ 1])
+            self._arbiters.clear()
+            pb.get_space_arbiters(self.space, ARB_GET, self._arbiters)
+            arb_f = np.frombuffer(self._arbiters.float_buf(), dtype=np.float64)
+            arb_i = np.frombuffer(self._arbiters.int_buf(), dtype=np.uint64)
+            code = after_step(st0, st1, arb_f, arb_i, arb_i.shape[0] // rk.ARB_I, inp, wk, acc, ls)
+            if code != CODE_CONTINUE:
+                return code
+            if ls[0]["step"] >= step_return:
+                return CODE_BLOCK_FULL
+
+
+drop_stale_caches(__name__, (fk, rk, _reduced_core))  # the step kernels compile in the force and recording kernels

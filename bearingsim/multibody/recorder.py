@@ -20,24 +20,93 @@ package docstring of :mod:`bearingsim.multibody`):
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-# cfg vector indices
-C_SIGN, C_N, C_WARM, C_ROT, C_NBINS, C_VTHR, C_MASS = 0, 1, 2, 3, 4, 5, 6
-N_CFG = 7
-# window accumulator columns
-W_IACC, W_IDEC, W_JN_F, W_JN_R, W_JF_F, W_JF_R, W_WORK_F, W_WORK_R = range(8)
-N_WCOL = 8
-# global accumulator slots
-G_TAU_N, G_TAU_F, G_MAXPEN_F, G_MAXPEN_R, G_MAXPEN_ALL, G_N_CHATTER, G_CHATTER_VMAX = range(7)
-G_MAXPEN_THETA, G_MAXPEN_TIME, G_MAXPEN_FACE = 7, 8, 9  # where the deepest overlap happened
-G_MAXPEN_COS, G_MAXPEN_APPROACH, G_MAXPEN_POCKET = 10, 11, 12  # n . e_t, approach speed, pocket
-N_GLOB = 13
-# impact table columns
-I_TIME, I_THETA, I_SPEED, I_IMPULSE, I_POCKET, I_FACE, I_ROT = range(7)
-N_ICOL = 7
+from bearingsim._jit import drop_stale_caches
+from bearingsim.reduced import core as _reduced_core
+from bearingsim.reduced.core import FACE_FRONT, FACE_REAR  # one meaning of the face codes in both models
+
+
+class RecorderConfig(NamedTuple):
+    """Fixed inputs of :func:`record_step` (immutable for a run)."""
+
+    sign: float  #: +1 forward, -1 reverse rotation
+    roller_count: int  #: n, rollers = pockets
+    warmup_rotations: float  #: W, cage rotations before rotation 0 (a whole number)
+    rotations: int  #: R, recorded rotations
+    theta_bins: int  #: number of bins of theta over 2 pi
+    impact_speed_threshold: float  #: approach speed above which a contact step is an impact [m/s]
+
+
+#: Per rotation and pocket accumulators, array shape (R, n) [N s] and [J].
+WINDOW = np.dtype([
+    ("I_acc", np.float64),  # circumferential impulse on the cage, front face
+    ("I_dec", np.float64),  # minus the circumferential impulse on the cage, rear face
+    ("Jn_front", np.float64), ("Jn_rear", np.float64),  # normal impulses
+    ("Jf_front", np.float64), ("Jf_rear", np.float64),  # friction impulse magnitudes
+    ("work_front", np.float64), ("work_rear", np.float64),  # sum J_n |v_slide|
+], align=True)
+
+#: Run-wide accumulators, one record (array shape (1,)).
+GLOBALS = np.dtype([
+    ("tau_normal", np.float64),  # angular impulse of the normal contact impulses about the cage centre [N m s]
+    ("tau_friction", np.float64),  # same, friction impulses [N m s]
+    ("maxpen_front", np.float64), ("maxpen_rear", np.float64),  # deepest overlap in recorded rotations [m]
+    ("maxpen_all", np.float64),  # deepest overlap of the run [m]
+    ("n_chatter", np.float64),  # contact steps approaching slower than the impact threshold
+    ("chatter_vmax", np.float64),  # their largest approach speed [m/s]
+    # where the deepest overlap of the run happened
+    ("maxpen_theta_deg", np.float64), ("maxpen_time", np.float64), ("maxpen_face", np.float64),
+    ("maxpen_cos", np.float64),  # n . e_t
+    ("maxpen_approach", np.float64),  # approach speed [m/s]
+    ("maxpen_pocket", np.float64),
+], align=True)
+
+#: One row per impact (array shape (capacity,)).
+IMPACT = np.dtype([
+    ("time", np.float64),  # end of the step [s]
+    ("theta_deg", np.float64),  # pocket centre from the load-zone centre [deg]
+    ("approach_speed", np.float64),  # [m/s]
+    ("impulse", np.float64),  # normal impulse [N s]
+    ("pocket", np.int64),
+    ("face", np.int64),  # FACE_REAR or FACE_FRONT
+    ("rotation", np.int64),  # row of the per-rotation arrays
+], align=True)
+
+#: Circumferential contact impulse by theta bin, array shape (n, bins) [N s].
+FACE_BIN = np.dtype([("front", np.float64), ("rear", np.float64)], align=True)
+#: Raceway load x time by theta bin, array shape (bins,) [N s].
+RACE_BIN = np.dtype([("inner", np.float64), ("outer", np.float64)], align=True)
+
+
+class Accumulators(NamedTuple):
+    """The arrays :func:`record_step` adds to (created by :func:`accumulators`)."""
+
+    win: np.ndarray  #: (R, n) WINDOW
+    first_imp: np.ndarray  #: (R, n) approach speed of the first rear impact in the no-load zone [m/s], NaN: none
+    f_bin: np.ndarray  #: (n, bins) FACE_BIN [N s]
+    t_bin: np.ndarray  #: (n, bins) residence time [s]
+    q_bin: np.ndarray  #: (bins,) RACE_BIN [N s]
+    tq_bin: np.ndarray  #: (bins,) roller-time [s]
+    j_int: np.ndarray  #: (n,) FACE_BIN, circumferential impulses since the last output sample [N s]
+    glob: np.ndarray  #: (1,) GLOBALS
+    impacts: np.ndarray  #: (capacity,) IMPACT
+
+
+def accumulators(rotations: int, roller_count: int, theta_bins: int, impact_capacity: int) -> Accumulators:
+    """Zeroed accumulators (``first_imp`` NaN) for a run."""
+    r, n = rotations, roller_count
+    return Accumulators(
+        win=np.zeros((r, n), dtype=WINDOW), first_imp=np.full((r, n), np.nan),
+        f_bin=np.zeros((n, theta_bins), dtype=FACE_BIN), t_bin=np.zeros((n, theta_bins)),
+        q_bin=np.zeros(theta_bins, dtype=RACE_BIN), tq_bin=np.zeros(theta_bins),
+        j_int=np.zeros(n, dtype=FACE_BIN), glob=np.zeros(1, dtype=GLOBALS),
+        impacts=np.zeros(impact_capacity, dtype=IMPACT))
+
+
 ARB_F = 9  # floats per arbiter: total impulse (2), normal (2), point a (2), point b (2), distance
 ARB_I = 3  # ints per arbiter: body a id, body b id, contact count
 
@@ -53,33 +122,85 @@ def pocket_theta(sign, cage_angle, pocket_angle):
 
 
 @njit(cache=True)
-def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0,
-                diag, win, first_imp, f_bin, t_bin, q_bin, tq_bin, j_int, glob, impacts, n_imp):
+def _before(k1, k2, roller, i1, i2):
+    """Key order of two arbiters: roller index, then the cage contact point (x, y), then the normal."""
+    if roller[i1] != roller[i2]:
+        return roller[i1] < roller[i2]
+    for c in range(4):
+        if k1[c] != k2[c]:
+            return k1[c] < k2[c]
+    return False
+
+
+@njit(cache=True)
+def arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
+    """Indices of the arbiters with contacts, sorted by (roller, cage contact point x, y, normal x, y).
+
+    pymunk lists cached arbiters in the order of a hash of the shapes' memory addresses, which changes
+    from run to run; summing the impulses of one step in this order instead makes every accumulated
+    sum the same in every run (and in both step loops).
+    """
+    order = np.empty(n_arb, dtype=np.int64)
+    roller = np.empty(n_arb, dtype=np.int64)
+    keys = np.empty((n_arb, 4))
+    m = 0
+    for a in range(n_arb):
+        if arb_i[a * ARB_I + 2] == 0:
+            continue  # cached arbiter without contacts
+        ja = ids_index[np.searchsorted(ids_sorted, arb_i[a * ARB_I])]
+        o = a * ARB_F
+        if ja < n:
+            roller[a] = ja
+            keys[a, 0] = arb_f[o + 6]
+            keys[a, 1] = arb_f[o + 7]
+            keys[a, 2] = arb_f[o + 2]
+            keys[a, 3] = arb_f[o + 3]
+        else:
+            roller[a] = ids_index[np.searchsorted(ids_sorted, arb_i[a * ARB_I + 1])]
+            keys[a, 0] = arb_f[o + 4]
+            keys[a, 1] = arb_f[o + 5]
+            keys[a, 2] = -arb_f[o + 2]
+            keys[a, 3] = -arb_f[o + 3]
+        # insertion sort: a step has a few dozen arbiters
+        j = m
+        while j > 0 and _before(keys[a], keys[order[j - 1]], roller, a, order[j - 1]):
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = a
+        m += 1
+    return order[:m]
+
+
+@njit(cache=True)
+def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0, diag, acc,
+                n_imp):
     """Attribute one step's roller-cage impulses and raceway loads; return the new impact count.
 
     Parameters
     ----------
-    arb_f, arb_i : flat float and int arbiter buffers from ``pymunk.batch.get_space_arbiters``;
-        ``n_arb`` arbiters are valid.
+    arb_f, arb_i : flat float and int arbiter buffers from ``pymunk.batch.get_space_arbiters``
+        (``ARB_F`` floats and ``ARB_I`` ints per arbiter, SI); ``n_arb`` arbiters are valid.
     ids_sorted, ids_index : body ids sorted, and the batch row of each (rollers 0..n-1, cage n).
-    prev, now : (nb, 6) body states before and after the step (x, y, angle, vx, vy, omega).
-    t : time at the end of the step [s]; h : step [s].
-    cfg : configuration vector (``C_*``).
-    pocket_a : (n,) pocket centre angles in the cage frame [rad]; theta0 : (n,) unwrapped angle of
-        each pocket from the load-zone centre at t = 0 [rad].
-    diag : (n, N_DIAG) raceway diagnostics of the step (loads).
-    win : (R, n, N_WCOL) per-rotation accumulators; first_imp : (R, n) first rear impact speed.
-    f_bin : (n, nb, 2) circumferential contact impulse by theta bin [N s]; t_bin : (n, nb) time [s];
-    q_bin : (nb, 2) raceway load x time (inner, outer) [N s]; tq_bin : (nb,) roller-time [s].
-    j_int : (n, 2) circumferential impulses since the last output sample [N s].
-    glob : (N_GLOB,) global accumulators; impacts : (cap, N_ICOL) impact rows; n_imp : rows used.
+    prev, now : (nb, 6) body states before and after the step (x [m], y [m], angle [rad], vx [m/s],
+        vy [m/s], omega [rad/s]).
+    t : time at the end of the step [s].
+    h : step [s].
+    cfg : :class:`RecorderConfig`.
+    pocket_a : (n,) pocket centre angles in the cage frame [rad].
+    theta0 : (n,) unwrapped angle of each pocket from the load-zone centre at t = 0 [rad].
+    diag : (n,) :data:`bearingsim.multibody.forces.DIAG` raceway diagnostics of the step (loads [N]).
+    acc : :class:`Accumulators`, added to.
+    n_imp : rows of ``acc.impacts`` used before the step.
     """
-    sign = cfg[C_SIGN]
-    n = int(cfg[C_N])
-    warm = cfg[C_WARM]
-    nrot = int(cfg[C_ROT])
-    nbins = int(cfg[C_NBINS])
-    vthr = cfg[C_VTHR]
+    sign = cfg.sign
+    n = cfg.roller_count
+    warm = cfg.warmup_rotations
+    nrot = cfg.rotations
+    nbins = cfg.theta_bins
+    vthr = cfg.impact_speed_threshold
+    win = acc.win
+    g = acc.glob[0]
+    impacts = acc.impacts
     phic = now[n, 2]
     xc = now[n, 0]
     yc = now[n, 1]
@@ -94,14 +215,11 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
         m = math.floor((sign * phic + theta0[i]) / TWO_PI)
         k = int(m - warm)
         if 0 <= k < nrot:
-            t_bin[i, b] += h
-            q_bin[b, 0] += diag[i, 1] * h
-            q_bin[b, 1] += diag[i, 0] * h
-            tq_bin[b] += h
-    for a in range(n_arb):
-        count = arb_i[a * ARB_I + 2]
-        if count == 0:
-            continue  # cached arbiter without contacts
+            acc.t_bin[i, b] += h
+            acc.q_bin[b].inner += diag[i].q_in * h
+            acc.q_bin[b].outer += diag[i].q_out * h
+            acc.tq_bin[b] += h
+    for a in arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
         ida = arb_i[a * ARB_I]
         idb = arb_i[a * ARB_I + 1]
         ja = ids_index[np.searchsorted(ids_sorted, ida)]
@@ -132,7 +250,7 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
         etx = -sign * math.sin(alpha)
         ety = sign * math.cos(alpha)
         front = nx * etx + ny * ety > 0.0
-        face = 0 if front else 1
+        face = FACE_FRONT if front else FACE_REAR
         jn = jcx * nx + jcy * ny
         jfx = jcx - jn * nx
         jfy = jcy - jn * ny
@@ -152,55 +270,63 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
         vsx = vbx - vn * nx
         vsy = vby - vn * ny
         vslide = math.sqrt(vsx * vsx + vsy * vsy)
-        if pen > glob[G_MAXPEN_ALL]:
-            glob[G_MAXPEN_ALL] = pen
-            glob[G_MAXPEN_THETA] = pocket_theta(sign, phic, pocket_a[i]) * 180.0 / math.pi
-            glob[G_MAXPEN_TIME] = t
-            glob[G_MAXPEN_FACE] = 0.0 if nx * (-sign * math.sin(phic + pocket_a[i])) + ny * (sign * math.cos(phic + pocket_a[i])) > 0.0 else 1.0
-            glob[G_MAXPEN_COS] = nx * (-sign * math.sin(phic + pocket_a[i])) + ny * (sign * math.cos(phic + pocket_a[i]))
-            glob[G_MAXPEN_POCKET] = i
-            glob[G_MAXPEN_APPROACH] = approach
+        if pen > g.maxpen_all:
+            g.maxpen_all = pen
+            g.maxpen_theta_deg = pocket_theta(sign, phic, pocket_a[i]) * 180.0 / math.pi
+            g.maxpen_time = t
+            g.maxpen_face = FACE_FRONT if nx * (-sign * math.sin(phic + pocket_a[i])) + ny * (sign * math.cos(phic + pocket_a[i])) > 0.0 else FACE_REAR
+            g.maxpen_cos = nx * (-sign * math.sin(phic + pocket_a[i])) + ny * (sign * math.cos(phic + pocket_a[i]))
+            g.maxpen_pocket = i
+            g.maxpen_approach = approach
         if front:
-            j_int[i, 0] += circ
+            acc.j_int[i].front += circ
         else:
-            j_int[i, 1] -= circ
+            acc.j_int[i].rear -= circ
         th = pocket_theta(sign, phic, pocket_a[i])
         m = math.floor((sign * phic + theta0[i]) / TWO_PI)
         k = int(m - warm)
         if 0 <= k < nrot:
-            if front:
-                win[k, i, W_IACC] += circ
-                win[k, i, W_JN_F] += jn
-                win[k, i, W_JF_F] += jf
-                win[k, i, W_WORK_F] += jn * vslide
-            else:
-                win[k, i, W_IDEC] -= circ
-                win[k, i, W_JN_R] += jn
-                win[k, i, W_JF_R] += jf
-                win[k, i, W_WORK_R] += jn * vslide
+            w = win[k, i]
             b = int(th / TWO_PI * nbins)
             if b >= nbins:
                 b = nbins - 1
-            f_bin[i, b, face] += circ if front else -circ
-            if pen > glob[G_MAXPEN_F + face]:
-                glob[G_MAXPEN_F + face] = pen
+            if front:
+                w.I_acc += circ
+                w.Jn_front += jn
+                w.Jf_front += jf
+                w.work_front += jn * vslide
+                acc.f_bin[i, b].front += circ
+                if pen > g.maxpen_front:
+                    g.maxpen_front = pen
+            else:
+                w.I_dec -= circ
+                w.Jn_rear += jn
+                w.Jf_rear += jf
+                w.work_rear += jn * vslide
+                acc.f_bin[i, b].rear += -circ
+                if pen > g.maxpen_rear:
+                    g.maxpen_rear = pen
             if approach > vthr:
-                if (not front) and th < math.pi and first_imp[k, i] != first_imp[k, i]:
-                    first_imp[k, i] = approach
+                if (not front) and th < math.pi and acc.first_imp[k, i] != acc.first_imp[k, i]:
+                    acc.first_imp[k, i] = approach
                 if n_imp < impacts.shape[0]:
-                    impacts[n_imp, I_TIME] = t
-                    impacts[n_imp, I_THETA] = th * 180.0 / math.pi
-                    impacts[n_imp, I_SPEED] = approach
-                    impacts[n_imp, I_IMPULSE] = jn
-                    impacts[n_imp, I_POCKET] = i
-                    impacts[n_imp, I_FACE] = face
-                    impacts[n_imp, I_ROT] = k
+                    r = impacts[n_imp]
+                    r.time = t
+                    r.theta_deg = th * 180.0 / math.pi
+                    r.approach_speed = approach
+                    r.impulse = jn
+                    r.pocket = i
+                    r.face = face
+                    r.rotation = k
                     n_imp += 1
             elif approach > 0.0:
-                glob[G_N_CHATTER] += 1.0
-                if approach > glob[G_CHATTER_VMAX]:
-                    glob[G_CHATTER_VMAX] = approach
+                g.n_chatter += 1.0
+                if approach > g.chatter_vmax:
+                    g.chatter_vmax = approach
         if rec_on:
-            glob[G_TAU_N] += rxc * (jn * ny) - ryc * (jn * nx)
-            glob[G_TAU_F] += rxc * jfy - ryc * jfx
+            g.tau_normal += rxc * (jn * ny) - ryc * (jn * nx)
+            g.tau_friction += rxc * jfy - ryc * jfx
     return n_imp
+
+
+drop_stale_caches(__name__, (_reduced_core,))  # record_step compiles in the face codes of reduced/core.py

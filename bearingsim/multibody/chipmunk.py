@@ -1,0 +1,324 @@
+"""The compiled step loop: chipmunk's C functions called from numba, behind a version guard.
+
+This is the only module that uses pymunk's private C interface (``pymunk._chipmunk_cffi``: the cffi
+``ffi`` and ``lib``, chipmunk's ``cpSpaceStep``, ``cpSpaceEachBody`` and ``cpSpaceEachCachedArbiter``,
+pymunk's batched iterator functions ``pmSpaceBody{Get,Set}IteratorFuncBatched`` and
+``pmSpaceArbiterIteratorFuncBatched``, and its C array structs ``pmFloatArray``/``pmIntArray``/
+``pmBatchedData``). :func:`advance` calls them through their function pointers, so no Python runs
+between steps; per step it calls the same kernels as the plain loop
+(:func:`bearingsim.multibody.loop.before_step`, then the batched set, ``cpSpaceStep(h)`` timed with
+``clock_gettime(CLOCK_MONOTONIC)``, the batched reads, then
+:func:`bearingsim.multibody.loop.after_step`).
+
+Nothing in the scene is added or removed during a run and there are no collision callbacks, so
+calling ``cpSpaceStep`` directly (without pymunk's Python wrapper around the step) is what
+``Space.step`` does for this space. The C arrays are sized so that pymunk never has to grow them;
+if it ever did, :func:`advance` stops with ``CODE_BUFFER_GREW`` rather than read a stale pointer.
+
+Which loop runs
+---------------
+:func:`open_step_loop` gives the compiled loop when :func:`guard` passes: pymunk's version is one this
+module is known to work with (``SUPPORTED_PYMUNK``, checked against ``pymunk.version``) and the
+symbols and struct layout it relies on are there. Otherwise, or when asked for with
+``run(..., step_loop="plain")`` or the environment variable ``BEARINGSIM_PLAIN_PYMUNK=1``, it gives
+:class:`bearingsim.multibody.loop.PlainLoop`, a Python loop over ``Space.step`` and the public
+``pymunk.batch`` functions that calls the same kernels in the same order on the same inputs: the same
+numbers bit for bit, slower. A run records which loop ran (``raw["step_loop"]``) and why
+(``raw["step_loop_reason"]``).
+"""
+from __future__ import annotations
+
+import ctypes
+import os
+from typing import NamedTuple
+
+import numba.experimental.function_type  # noqa: F401  (registers typeof for WrapperAddressProtocol)
+import numpy as np
+import pymunk
+import pymunk.batch as pb
+from numba import njit, types
+
+from bearingsim._jit import drop_stale_caches
+from bearingsim.multibody import forces as fk
+from bearingsim.multibody import loop as lp
+from bearingsim.multibody import recorder as rk
+from bearingsim.reduced import core as _reduced_core
+
+try:
+    from pymunk._chipmunk_cffi import ffi, lib
+except ImportError:  # pragma: no cover - a pymunk without its cffi module
+    ffi = lib = None
+
+#: pymunk major versions the compiled loop is known to work with (checked: 7.3.1)
+SUPPORTED_PYMUNK = (7,)
+PLAIN_ENV = "BEARINGSIM_PLAIN_PYMUNK"
+_FUNCTIONS = ("cpSpaceStep", "cpSpaceEachBody", "cpSpaceEachCachedArbiter", "pmSpaceBodyGetIteratorFuncBatched",
+              "pmSpaceBodySetIteratorFuncBatched", "pmSpaceArbiterIteratorFuncBatched", "pmFloatArrayNew",
+              "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree")
+CLOCK_MONOTONIC = 1  # Linux and macOS
+
+
+def guard() -> str | None:
+    """None when the compiled loop can run with this pymunk, else the reason it cannot."""
+    version = getattr(pymunk, "version", "")
+    try:
+        major = int(version.split(".")[0])
+    except ValueError:
+        return f"pymunk version {version!r} not understood"
+    if major not in SUPPORTED_PYMUNK:
+        return f"pymunk {version} is not a version the compiled loop is known to work with ({SUPPORTED_PYMUNK})"
+    if lib is None:
+        return "pymunk._chipmunk_cffi is missing"
+    missing = [f for f in _FUNCTIONS if not hasattr(lib, f)]
+    if missing:
+        return f"pymunk's C library lacks {', '.join(missing)}"
+    if not all(hasattr(pb.Buffer, a) for a in ("_float_arr", "_int_arr")):
+        return "pymunk.batch.Buffer has no _float_arr/_int_arr"
+    try:
+        layout_ok = (ffi.sizeof("cpFloat") == 8 and ffi.sizeof("uintptr_t") == 8
+                     and ffi.offsetof("pmFloatArray", "num") == 0 and ffi.offsetof("pmFloatArray", "max") == 4
+                     and ffi.offsetof("pmFloatArray", "arr") == 8
+                     and ffi.offsetof("pmIntArray", "num") == 0 and ffi.offsetof("pmIntArray", "max") == 4
+                     and ffi.offsetof("pmIntArray", "arr") == 8
+                     and {"fields", "floatArray", "intArray"} <= {f for f, _ in ffi.typeof("pmBatchedData").fields})
+    except (ffi.error, KeyError, TypeError) as exc:
+        return f"pymunk's C structs are not as expected ({exc})"
+    if not layout_ok:
+        return "pymunk's C array structs do not have the expected layout"
+    return None
+
+
+def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None):
+    """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
+
+    Parameters
+    ----------
+    space : the run's ``pymunk.Space``.
+    nb : number of bodies (rollers and cage).
+    set_fields : ``pymunk.batch.BodyFields`` that the set buffer holds per body.
+    set_arr : float64 set buffer (``nb`` rows of ``set_fields``).
+    arb_cap : arbiters the compiled loop's buffers hold.
+    step_loop : "compiled", "plain" or None (compiled unless ``BEARINGSIM_PLAIN_PYMUNK=1`` or the guard fails).
+    """
+    if step_loop not in (None, "compiled", "plain"):
+        raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
+    why_not = guard()
+    if step_loop is None:
+        if os.environ.get(PLAIN_ENV, "") not in ("", "0"):
+            step_loop, reason = "plain", f"{PLAIN_ENV}={os.environ[PLAIN_ENV]}"
+        elif why_not is not None:
+            step_loop, reason = "plain", why_not
+        else:
+            step_loop, reason = "compiled", f"pymunk {pymunk.version}"
+    elif step_loop == "compiled":
+        if why_not is not None:
+            raise RuntimeError(f"the compiled step loop cannot run: {why_not}")
+        reason = "asked for"
+    else:
+        reason = "asked for"
+    if step_loop == "plain":
+        return lp.PlainLoop(space, nb, set_fields, set_arr), reason
+    return BatchIO(space, nb, set_fields, set_arr, arb_cap), reason
+
+
+class _CFunction(types.WrapperAddressProtocol):
+    """A C function pointer that numba code can take as an argument and call (first-class function).
+
+    Passed as an argument (not a global), it keeps the compiled loop cacheable on disk."""
+
+    def __init__(self, address: int, signature):
+        self._address = int(address)
+        self._signature = signature
+
+    def __wrapper_address__(self):
+        return self._address
+
+    def signature(self):
+        return self._signature
+
+
+def _chipmunk(name: str, signature) -> _CFunction:
+    return _CFunction(int(ffi.cast("intptr_t", ffi.addressof(lib, name))), signature)
+
+
+def _address(cdata) -> int:
+    return int(ffi.cast("intptr_t", cdata))
+
+
+# pointers are passed as int64 (same registers as a pointer in the C calling convention)
+_STEP_SIG = types.void(types.int64, types.float64)
+_EACH_SIG = types.void(types.int64, types.int64, types.int64)
+_CLOCK_SIG = types.int32(types.int32, types.int64)
+
+
+def _clock_function():
+    """``clock_gettime`` from the C library, or None where there is none (then no pymunk timing)."""
+    try:
+        fn = ctypes.CDLL(None).clock_gettime
+    except (OSError, AttributeError, TypeError):  # pragma: no cover - platforms without clock_gettime
+        return None
+    return _CFunction(ctypes.cast(fn, ctypes.c_void_p).value, _CLOCK_SIG)
+
+
+def _float_array(n):
+    """A pymunk C float array of capacity n, freed with its Python object."""
+    return ffi.gc(lib.pmFloatArrayNew(n), lib.pmFloatArrayFree)
+
+
+def _int_array(n):
+    return ffi.gc(lib.pmIntArrayNew(n), lib.pmIntArrayFree)
+
+
+class Pointers(NamedTuple):
+    """Addresses (int64) that :func:`advance` hands to chipmunk."""
+
+    space: int  #: the cpSpace
+    body_get: int  #: pmSpaceBodyGetIteratorFuncBatched
+    body_set: int  #: pmSpaceBodySetIteratorFuncBatched
+    arbiters: int  #: pmSpaceArbiterIteratorFuncBatched
+    data_state0: int  #: pmBatchedData reading into state array 0
+    data_state1: int  #: pmBatchedData reading into state array 1
+    data_set: int  #: pmBatchedData of the set buffer
+    data_arbiters: int  #: pmBatchedData of the arbiter buffers
+    timespec: int  #: struct timespec for clock_gettime
+
+
+class Headers(NamedTuple):
+    """int32 (num, max) views of the headers of the C arrays (pymunk appends at ``num``)."""
+
+    state0: np.ndarray
+    state1: np.ndarray
+    set: np.ndarray
+    arb_f: np.ndarray
+    arb_i: np.ndarray
+
+
+class BatchIO:
+    """The space's batched C buffers and function pointers, set up once for :func:`advance`.
+
+    ``states``: the two (nb, 6) state arrays (numpy views of C arrays); ``arb_f``/``arb_i``: the
+    arbiter buffers (``arb_cap`` arbiters); ``hdr``: :class:`Headers`; ``ptr``: :class:`Pointers`.
+    """
+
+    name = "compiled"
+
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap):
+        self.nb = nb
+        self._space = space._space
+        self.step_fn = _chipmunk("cpSpaceStep", _STEP_SIG)
+        self.each_body_fn = _chipmunk("cpSpaceEachBody", _EACH_SIG)
+        self.each_arb_fn = _chipmunk("cpSpaceEachCachedArbiter", _EACH_SIG)
+        clock = _clock_function()
+        self.timed = clock is not None
+        self.clock_fn = clock if clock is not None else self.each_body_fn  # never called when untimed
+        self.ts = np.zeros(2, dtype=np.int64)  # struct timespec
+        ia = _int_array(nb)
+        self._keep = [ia]  # the C objects must outlive the run
+        self.states, data, arrays = [], [], []
+        for _ in range(2):  # two state arrays, alternating
+            fa = _float_array(2 * nb * 6 + 16)  # headroom: a push never reallocates
+            d = ffi.new("pmBatchedData *")
+            d.fields = lp.BODY_GET.value
+            d.floatArray = fa
+            d.intArray = ia
+            self.states.append(np.frombuffer(ffi.buffer(fa.arr, 8 * nb * 6), dtype=np.float64).reshape(nb, 6))
+            data.append(d)
+            arrays.append(fa)
+        self.set_buf = pb.Buffer()
+        self.set_buf.set_float_buf(set_arr)
+        sd = ffi.new("pmBatchedData *")
+        sd.fields = set_fields.value
+        sd.floatArray = self.set_buf._float_arr
+        sd.intArray = self.set_buf._int_arr
+        afa = _float_array(rk.ARB_F * arb_cap)
+        aia = _int_array(rk.ARB_I * arb_cap)
+        ad = ffi.new("pmBatchedData *")
+        ad.fields = lp.ARB_GET.value
+        ad.floatArray = afa
+        ad.intArray = aia
+        arrays += [self.set_buf._float_arr, afa, aia]
+        self._data = data
+        self._keep += data + arrays + [sd, ad]
+        self.arb_f = np.frombuffer(ffi.buffer(afa.arr, 8 * afa.max), dtype=np.float64)
+        self.arb_i = np.frombuffer(ffi.buffer(aia.arr, 8 * aia.max), dtype=np.uint64)
+        self.hdr = Headers(*[np.frombuffer(ffi.buffer(a, 8), dtype=np.int32) for a in arrays])
+        self.ptr = Pointers(
+            _address(space._space),
+            _address(ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched")),
+            _address(ffi.addressof(lib, "pmSpaceBodySetIteratorFuncBatched")),
+            _address(ffi.addressof(lib, "pmSpaceArbiterIteratorFuncBatched")),
+            _address(data[0]), _address(data[1]), _address(sd), _address(ad),
+            self.ts.ctypes.data,
+        )
+
+    def read_states(self):
+        """Fill state array 0 from the space (before the first step)."""
+        cap = int(self.hdr.state0[1])
+        self.hdr.state0[0] = 0
+        lib.cpSpaceEachBody(self._space, ffi.addressof(lib, "pmSpaceBodyGetIteratorFuncBatched"), self._data[0])
+        if self.hdr.state0[1] != cap or self.hdr.state0[0] != 6 * self.nb:
+            raise RuntimeError("multibody step loop: pymunk's batched body read did not fit its buffer")
+        return self.states[0]
+
+    def advance(self, inp, wk, acc, ls):
+        """Run :func:`advance` until it returns a code."""
+        return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.timed, self.ptr,
+                       self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts, inp, wk, acc, ls)
+
+
+@njit(cache=True)
+def _now_ns(clock, ptr_ts, ts):
+    clock(np.int32(CLOCK_MONOTONIC), ptr_ts)
+    return ts[0] * 1_000_000_000 + ts[1]
+
+
+@njit(cache=True)
+def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc,
+            ls):
+    """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
+    ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
+
+    ``hdr`` (:class:`Headers`): the loop resets ``num`` before each batched call and stops if pymunk
+    ever grew an array (``max`` changed), which the sizes chosen in :class:`BatchIO` rule out. ``inp``,
+    ``wk``, ``acc``, ``ls``: those of the step kernels.
+    """
+    sp = ptr.space
+    cap0 = hdr.state0[1]
+    cap1 = hdr.state1[1]
+    capf = hdr.arb_f[1]
+    capi = hdr.arb_i[1]
+    s = ls[0]
+    step_return = s.step + lp.CHUNK_STEPS
+    h = inp.h
+    while True:
+        cur = s.cur
+        code = lp.before_step(st0 if cur == 0 else st1, inp, wk, ls)
+        if code != lp.CODE_CONTINUE:
+            return code
+        hdr.set[0] = 0  # the setter reads the buffer from the start
+        each_body_fn(sp, ptr.body_set, ptr.data_set)
+        if timed:
+            t0 = _now_ns(clock_fn, ptr.timespec, ts)
+            step_fn(sp, h)
+            s.pymunk_ns += _now_ns(clock_fn, ptr.timespec, ts) - t0
+        else:
+            step_fn(sp, h)
+        if cur == 0:  # the state after the step goes into the other array
+            hdr.state1[0] = 0
+            each_body_fn(sp, ptr.body_get, ptr.data_state1)
+        else:
+            hdr.state0[0] = 0
+            each_body_fn(sp, ptr.body_get, ptr.data_state0)
+        hdr.arb_f[0] = 0
+        hdr.arb_i[0] = 0
+        each_arb_fn(sp, ptr.arbiters, ptr.data_arbiters)
+        if hdr.state0[1] != cap0 or hdr.state1[1] != cap1 or hdr.arb_f[1] != capf or hdr.arb_i[1] != capi:
+            return lp.CODE_BUFFER_GREW
+        code = lp.after_step(st0, st1, arb_f, arb_i, hdr.arb_i[0] // rk.ARB_I, inp, wk, acc, ls)
+        if code != lp.CODE_CONTINUE:
+            return code
+        if s.step >= step_return:
+            return lp.CODE_BLOCK_FULL
+
+
+drop_stale_caches(__name__, (fk, rk, lp, _reduced_core))  # advance() compiles in the step kernels

@@ -1,0 +1,335 @@
+"""Unit tests of the multibody model's compiled kernels: raceway force laws, ring balance, recording,
+and the two step loops (compiled chipmunk calls and plain pymunk) giving the same numbers.
+
+Each test states its source and why its tolerance is what it is.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bearingsim import laws as kin
+from bearingsim.multibody import chipmunk
+from bearingsim.multibody import forces as fk
+from bearingsim.multibody import recorder as rk
+from bearingsim.multibody.core import run
+from bearingsim.multibody.scene import pocket_angles
+from bearingsim.reduced.core import FACE_FRONT, FACE_REAR
+from bearingsim.scenario import load_scenario
+from tests.conftest import SCENARIOS, si
+
+ROLLER_LENGTH = 13e-3  # NU214-Suzuki2023 [m]
+ROLLER_RADIUS = 6.5e-3  # [m]
+ROLLER_MASS = 0.013  # [kg]
+K = kin.palmgren_stiffness(ROLLER_LENGTH)
+
+
+def _params(**over):
+    """Raceway parameters of the reference bearing (no clearance), overridable by name."""
+    p = dict(roller_radius=ROLLER_RADIUS, roller_mass=ROLLER_MASS, roller_inertia=0.5 * ROLLER_MASS * ROLLER_RADIUS**2,
+             outer_race_radius=0.0555, inner_race_radius=0.0425, outer_race_geom_radius=0.0555,
+             inner_race_geom_radius=0.0425, palmgren_stiffness=K, damping_time=2.5e-6, damping_fade=5e-9,
+             traction_mu_max=0.05, traction_slip_ref=0.01, min_entrainment=0.1, drag_coefficient=0.0,
+             drag_direction_eps=1e-3, omega_ring=0.0, radial_load=0.0, gravity=0.0, inner_ring=False,
+             traction=False, spin_free=False, newton_max_step=2e-6, ring_mass=0.0)
+    p.update(over)
+    return fk.RacewayParams(**p)
+
+
+# --- normal force ---------------------------------------------------------------------------------
+@pytest.mark.parametrize("load", [10.0, 100.0, 1000.0, 5000.0])
+def test_normal_force_is_palmgren_line_contact(load):
+    """Harris & Kotzalas, Rolling Bearing Analysis (5th ed.), Eq. 6.49 in its usual engineering form
+    ``delta = 3.84e-5 Q^0.9 / l^0.8`` [mm, N, mm]: at that approach and no approach rate the kernel's
+    load is Q. Tolerance 0.2 %: the book's coefficient has three digits (3.84 +- 0.005, i.e. 0.13 % in
+    delta, 0.145 % in Q = K delta^(10/9))."""
+    delta = 3.84e-5 * load**0.9 / (ROLLER_LENGTH * 1e3) ** 0.8 * 1e-3
+    q, _, _ = fk._normal_force(delta, 0.0, K, 2.5e-6, 5e-9)
+    assert q == pytest.approx(load, rel=2e-3)
+
+
+@pytest.mark.parametrize("delta, rate", [(1e-6, 0.0), (2e-6, 1e-3), (3e-9, 1e-4), (1e-5, -0.05)])
+def test_normal_force_derivatives_match_finite_differences(delta, rate):
+    """dQ/d(delta) and dQ/d(rate) of the kernel against central differences, inside (3 nm) and outside
+    the damping fade. Step 1e-4 of the variable: truncation error ~1e-8 relative (Q is smooth on each
+    side of the fade depth, which no step crosses), round-off ~1e-12; tolerance 1e-6."""
+    c_r, fade = 2.5e-6, 5e-9
+    q, dq_dd, dq_drate = fk._normal_force(delta, rate, K, c_r, fade)
+    assert q > 0.0
+    e = 1e-4 * delta
+    fd = (fk._normal_force(delta + e, rate, K, c_r, fade)[0] - fk._normal_force(delta - e, rate, K, c_r, fade)[0]) / (2 * e)
+    assert dq_dd == pytest.approx(fd, rel=1e-6)
+    er = 1e-4 * max(abs(rate), 1e-3)
+    fdr = (fk._normal_force(delta, rate + er, K, c_r, fade)[0] - fk._normal_force(delta, rate - er, K, c_r, fade)[0]) / (2 * er)
+    assert dq_drate == pytest.approx(fdr, rel=1e-6)
+
+
+def test_normal_force_is_zero_without_contact_and_continuous_at_contact():
+    """No tension: Q = 0 for delta <= 0 and when damping would pull (Q >= 0). Continuity at delta = 0
+    at any approach rate: inside the fade depth the damping force ``c_r k_lin (delta / d_fade) rate``
+    grows like delta^(10/9), as the elastic force does, so Q -> 0 with delta as delta^(10/9) (ratio
+    over a decade 10^(-10/9), to round-off: 1e-9)."""
+    assert fk._normal_force(-1e-6, 1.0, K, 2.5e-6, 5e-9) == (0.0, 0.0, 0.0)
+    assert fk._normal_force(1e-7, -1e3, K, 2.5e-6, 5e-9)[0] == 0.0
+    q15 = fk._normal_force(1e-15, 1.0, K, 2.5e-6, 5e-9)[0]
+    q16 = fk._normal_force(1e-16, 1.0, K, 2.5e-6, 5e-9)[0]
+    assert q15 > 0.0 and q16 / q15 == pytest.approx(10.0 ** (-10.0 / 9.0), rel=1e-9)
+
+
+# --- quasi-static inner ring ----------------------------------------------------------------------
+def _ring_rollers(n, clearance_radial=0.0):
+    """Roller centres [m] around the inner raceway, one at the bottom, symmetric about the y axis."""
+    a = -0.5 * math.pi + 2.0 * math.pi * np.arange(n) / n
+    r = 0.0425 + ROLLER_RADIUS + clearance_radial
+    return np.ascontiguousarray(np.stack([r * np.cos(a), r * np.sin(a)], axis=1))
+
+
+def test_ring_centre_balances_the_load_on_a_symmetric_set():
+    """W = 970 N on 16 rollers without clearance, elastic only (no damping): the ring sinks straight
+    down (x = 0 to round-off, 1e-15 m), the raceway loads sum to W along -y (Newton tolerance 1e-9 W),
+    and the largest roller load is Stribeck's ``Q_max = 4.08 W / Z`` for line contact and zero
+    clearance (Harris & Kotzalas, Sec. 7.2); 4.08 is Stribeck's rounded value for many rollers, so the
+    discrete 16-roller set (7 rollers loaded; 4.084 here) is allowed 0.5 %."""
+    n, load, h = 16, 970.0, 1e-6
+    prm = _params(damping_time=0.0, radial_load=load, inner_ring=True)
+    xp = _ring_rollers(n)
+    c = np.zeros(2)
+    it, res = fk.solve_ring_centre(xp, np.zeros(n), np.zeros(2), h, prm, c)
+    assert it >= 0 and res <= 1e-9 * (load + 1.0)
+    assert abs(c[0]) < 1e-15 and c[1] < 0.0
+    d = xp - c
+    dist = np.hypot(d[:, 0], d[:, 1])
+    delta = np.clip(prm.inner_race_radius + ROLLER_RADIUS - dist, 0.0, None)
+    q = K * delta ** (10.0 / 9.0)
+    force = (q[:, None] * d / dist[:, None]).sum(axis=0)  # on the rollers, along the ring-to-roller normals
+    assert force[1] == pytest.approx(-load, rel=1e-9)
+    assert abs(force[0]) < 1e-9 * load
+    assert q.max() == pytest.approx(4.08 * load / n, rel=0.005)
+
+
+# --- one roller on the outer race -----------------------------------------------------------------
+def _orbiting_roller(omega, r0):
+    state = np.zeros((2, 6))  # roller, cage (unused by the force kernel)
+    state[0, 0] = r0
+    state[0, 4] = omega * r0
+    return state
+
+
+def test_roller_on_outer_race_carries_its_centrifugal_load():
+    """A roller orbiting at omega on radius r0 presses on the outer race with its centrifugal load
+    ``m r0 omega^2``: with the race placed so that the roller overlaps it by the Palmgren approach of that load,
+    ``delta = (m r0 omega^2 / K)^0.9``, the kernel's contact force is the centripetal force, and the
+    approach it reports is delta. With h = 1 ps the prediction ``x + h v`` moves the roller outward by
+    r0 (omega h)^2 / 2 ~ 1e-21 m and the damping adds c_r k_lin r0 omega^2 h / 2 ~ 2e-6 N to the 57 N
+    load: tolerance 1e-6."""
+    omega, r0, h = 300.0, 0.04875, 1e-12
+    qc = ROLLER_MASS * r0 * omega**2
+    delta = (qc / K) ** 0.9
+    prm = _params(outer_race_radius=r0 + ROLLER_RADIUS - delta)
+    state = _orbiting_roller(omega, r0)
+    out_f = np.zeros(6)
+    diag = np.zeros(1, dtype=fk.DIAG)
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag)
+    assert diag[0]["delta_out"] == pytest.approx(delta, rel=1e-6)
+    assert diag[0]["q_out"] == pytest.approx(qc, rel=1e-6)
+    # force on the roller: radially inward, magnitude m r0 omega^2 (no traction, drag, gravity)
+    assert out_f[0] == pytest.approx(-qc, rel=1e-6)
+    assert abs(out_f[1]) < 1e-6 * qc
+
+
+@pytest.mark.parametrize("spin", [200.0, -200.0])
+def test_traction_opposes_slip(spin):
+    """A roller spinning on the fixed outer race without orbiting slides at ``-omega r_r`` along the
+    tangent T; the traction force along T and its torque must both oppose that sliding (they take
+    power out of it). At this slip (200 slip_ref) tanh is 1 to machine precision, so the magnitudes are
+    ``mu_max Q`` and ``r_r mu_max Q`` (tolerance 1e-9; the implicit velocity Jacobian vanishes where
+    tanh is saturated)."""
+    r0, h = 0.04875, 1e-7
+    qc = 50.0
+    delta = (qc / K) ** 0.9
+    prm = _params(outer_race_radius=r0 + ROLLER_RADIUS - delta, traction=True, spin_free=True)
+    state = np.zeros((2, 6))
+    state[0, 0] = r0
+    state[0, 5] = spin
+    out_f = np.zeros(6)
+    diag = np.zeros(1, dtype=fk.DIAG)
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag)
+    q = diag[0]["q_out"]
+    # outer contact at +x: N = (-1, 0), T = rot90(N) = (0, -1); roller surface slides at s = -omega r_r along T
+    slide = -spin * ROLLER_RADIUS
+    f_t = -out_f[1]
+    torque = out_f[2]
+    assert f_t * slide < 0.0 and torque * spin < 0.0
+    assert abs(f_t) == pytest.approx(prm.traction_mu_max * q, rel=1e-9)
+    assert abs(torque) == pytest.approx(ROLLER_RADIUS * prm.traction_mu_max * q, rel=1e-9)
+    assert np.sign(diag[0]["slip_out"]) == np.sign(slide)
+
+
+# --- recording ------------------------------------------------------------------------------------
+N_POCKETS = 4
+IDS = np.array([10, 11, 12, 13, 20], dtype=np.uint64)  # rollers 0..3, cage
+
+
+def _cfg():
+    return rk.RecorderConfig(sign=1.0, roller_count=N_POCKETS, warmup_rotations=0.0, rotations=1, theta_bins=360,
+                             impact_speed_threshold=0.01)
+
+
+def _record(arbiters, prev, now, t=1e-3, h=1e-6):
+    """Run record_step on a list of (id_a, id_b, impulse on A, normal A->B, point A, point B, overlap)."""
+    arb_f = np.zeros(rk.ARB_F * len(arbiters))
+    arb_i = np.zeros(rk.ARB_I * len(arbiters), dtype=np.uint64)
+    for k, (ida, idb, jimp, nrm, pa, pb, pen) in enumerate(arbiters):
+        arb_f[k * rk.ARB_F:(k + 1) * rk.ARB_F] = [*jimp, *nrm, *pa, *pb, -pen]
+        arb_i[k * rk.ARB_I:(k + 1) * rk.ARB_I] = [ida, idb, 1]
+    order = np.argsort(IDS)
+    acc = rk.accumulators(1, N_POCKETS, 360, 16)
+    pocket_a = pocket_angles(N_POCKETS, 1)
+    theta0 = np.mod(-2.0 * math.pi * np.arange(N_POCKETS) / N_POCKETS, 2.0 * math.pi)
+    n_imp = rk.record_step(arb_f, arb_i, len(arbiters), IDS[order], order.astype(np.int64), prev, now, t, h, _cfg(),
+                           pocket_a, theta0, np.zeros(N_POCKETS, dtype=fk.DIAG), acc, 0)
+    return acc, n_imp
+
+
+def _pocket0_states(v_rel):
+    """Cage at rest at the origin; roller 0 in pocket 0 (bottom, e_t = +x) moving at v_rel along +x."""
+    st = np.zeros((N_POCKETS + 1, 6))
+    st[0, 0:2] = (0.0, -0.04875)
+    st[0, 3] = v_rel
+    return st, st.copy()
+
+
+# pocket 0 sits at the bottom; the cage turns counter-clockwise (sign +1), so e_t there is +x
+J, JT, V = 2e-4, 3e-5, 0.2
+FRONT_CONTACT = ((1.0, 0.0), (ROLLER_RADIUS, -0.04875), (ROLLER_RADIUS, -0.04875))  # normal roller -> cage, points
+REAR_CONTACT = ((-1.0, 0.0), (-ROLLER_RADIUS, -0.04875), (-ROLLER_RADIUS, -0.04875))
+
+
+@pytest.mark.parametrize("roller_is_a", [True, False])
+def test_front_face_impulse_is_I_acc(roller_is_a):
+    """A roller moving ahead (+e_t) into the front face pushes the cage forward: the cage receives
+    J along e_t, which counts as I_acc = J (normal impulse J, friction |JT|), not as I_dec, and the
+    impact row says front face, pocket 0, theta 0, approach speed V. The arbiter's total impulse is the
+    one applied to body A (chipmunk's cpArbiterTotalImpulse), its normal points from A to B; the answer
+    must not depend on which body pymunk lists first. Exact arithmetic on these values: 1e-15."""
+    nrm, pr, pc = FRONT_CONTACT
+    on_roller = (-J, -JT)  # normal impulse on the roller along -n, friction impulse along -y
+    if roller_is_a:
+        arb = (10, 20, on_roller, nrm, pr, pc, 1e-6)
+    else:
+        arb = (20, 10, (-on_roller[0], -on_roller[1]), (-nrm[0], -nrm[1]), pc, pr, 1e-6)
+    prev, now = _pocket0_states(V)
+    acc, n_imp = _record([arb], prev, now)
+    w = acc.win[0, 0]
+    assert w["I_acc"] == pytest.approx(J, abs=1e-15) and w["I_dec"] == 0.0
+    assert w["Jn_front"] == pytest.approx(J, abs=1e-15) and w["Jn_rear"] == 0.0
+    assert w["Jf_front"] == pytest.approx(JT, abs=1e-15)
+    assert acc.f_bin[0]["front"].sum() == pytest.approx(J, abs=1e-15) and acc.f_bin[0]["rear"].sum() == 0.0
+    assert acc.glob[0]["maxpen_front"] == pytest.approx(1e-6) and acc.glob[0]["maxpen_rear"] == 0.0
+    assert n_imp == 1
+    row = acc.impacts[0]
+    assert row["face"] == FACE_FRONT and row["pocket"] == 0 and row["rotation"] == 0
+    assert row["theta_deg"] == pytest.approx(0.0, abs=1e-12)
+    assert row["approach_speed"] == pytest.approx(V, abs=1e-15)
+    assert row["impulse"] == pytest.approx(J, abs=1e-15)
+    assert np.all(acc.win[0, 1:]["I_acc"] == 0.0)
+
+
+def test_rear_face_impulse_is_I_dec():
+    """A roller lagging (-e_t) against the rear face is pulled forward by the cage: the cage receives J
+    along -e_t, which counts as I_dec = +J on the rear face (and is the first rear impact of the
+    rotation, since theta = 0 < 180 deg). Exact: 1e-15."""
+    nrm, pr, pc = REAR_CONTACT
+    prev, now = _pocket0_states(-V)
+    acc, n_imp = _record([(10, 20, (J, 0.0), nrm, pr, pc, 2e-6)], prev, now)
+    w = acc.win[0, 0]
+    assert w["I_dec"] == pytest.approx(J, abs=1e-15) and w["I_acc"] == 0.0
+    assert w["Jn_rear"] == pytest.approx(J, abs=1e-15) and w["Jn_front"] == 0.0
+    assert acc.f_bin[0]["rear"].sum() == pytest.approx(J, abs=1e-15)
+    assert acc.glob[0]["maxpen_rear"] == pytest.approx(2e-6)
+    assert n_imp == 1 and acc.impacts[0]["face"] == FACE_REAR
+    assert acc.first_imp[0, 0] == pytest.approx(V, abs=1e-15)
+
+
+def test_slow_contacts_are_chatter_and_empty_arbiters_are_skipped():
+    """A contact approaching below the 0.01 m/s threshold is chatter, not an impact, but its impulse
+    still counts; an arbiter with contact count 0 (cached, separated) adds nothing."""
+    nrm, pr, pc = FRONT_CONTACT
+    prev, now = _pocket0_states(0.005)
+    acc, n_imp = _record([(10, 20, (-J, 0.0), nrm, pr, pc, 0.0)], prev, now)
+    assert n_imp == 0 and acc.glob[0]["n_chatter"] == 1.0
+    assert acc.glob[0]["chatter_vmax"] == pytest.approx(0.005, abs=1e-15)
+    assert acc.win[0, 0]["I_acc"] == pytest.approx(J, abs=1e-15)
+    arb_f = np.zeros(rk.ARB_F)
+    arb_f[0:4] = (-J, 0.0, 1.0, 0.0)
+    arb_i = np.array([10, 20, 0], dtype=np.uint64)
+    acc0 = rk.accumulators(1, N_POCKETS, 360, 16)
+    order = np.argsort(IDS)
+    rk.record_step(arb_f, arb_i, 1, IDS[order], order.astype(np.int64), prev, now, 1e-3, 1e-6, _cfg(),
+                   pocket_angles(N_POCKETS, 1), np.zeros(N_POCKETS), np.zeros(N_POCKETS, dtype=fk.DIAG), acc0, 0)
+    assert acc0.win["I_acc"].sum() == 0.0 and acc0.glob[0]["n_chatter"] == 0.0
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+def test_pocket_theta_advances_with_cage_travel(sign):
+    """theta of pocket i is ``(travel - 2 pi i / n) mod 2 pi`` with travel = sign x cage angle: 0 at the
+    load-zone centre (the bottom) for pocket 0 at the start, growing in the direction of rotation for
+    either direction (round-off of angles of a few rad: 1e-12)."""
+    n = 16
+    pa = pocket_angles(n, sign)
+    for travel in (0.0, 0.3, 2.0, 7.5):
+        for i in range(n):
+            th = rk.pocket_theta(float(sign), sign * travel, pa[i])
+            expected = (travel - 2.0 * math.pi * i / n) % (2.0 * math.pi)
+            diff = (th - expected + math.pi) % (2.0 * math.pi) - math.pi  # 0 and 2 pi are the same angle
+            assert 0.0 <= th < 2.0 * math.pi and abs(diff) < 1e-12
+
+
+# --- the two step loops ---------------------------------------------------------------------------
+COMPARED = ("steps", "t_end", "t_record", "win", "first_imp", "f_bin", "t_bin", "q_bin", "tq_bin", "glob", "impacts",
+            "final_state", "orbit", "ring_centre_mean", "cage_w_start", "cage_w_end", "newton_failures", "orbit_max")
+
+
+@pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
+@pytest.mark.parametrize("scenario", ["multibody_3000rpm", "multibody_reduced_equivalent_3000rpm"])
+def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario):
+    """The plain loop (``Space.step`` and ``pymunk.batch``) calls the same kernels on the same inputs as
+    the compiled one, so every accumulator, the impact table and the final state are identical bytes
+    (one rotation, no warm-up: ~11 500 steps, a few hundred impacts)."""
+    sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0"])
+    compiled = run(si(sc), step_loop="compiled")
+    plain = run(si(sc), step_loop="plain")
+    assert (compiled["step_loop"], plain["step_loop"]) == ("compiled", "plain")
+    assert len(compiled["impacts"]) > 0
+    for key in COMPARED:
+        a, b = np.asarray(compiled[key]), np.asarray(plain[key])
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+
+
+def test_plain_loop_is_chosen_by_the_environment(monkeypatch):
+    """``BEARINGSIM_PLAIN_PYMUNK=1`` selects the plain loop without a keyword."""
+    import pymunk
+
+    monkeypatch.setenv(chipmunk.PLAIN_ENV, "1")
+    space = pymunk.Space()
+    loop, why = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
+    assert loop.name == "plain" and chipmunk.PLAIN_ENV in why
+
+
+def test_version_guard_falls_back_to_the_plain_loop(monkeypatch):
+    """The installed pymunk passes the guard; a pymunk major version the compiled loop was not checked
+    against does not, and then the plain loop runs (and "compiled" is refused, not run)."""
+    import pymunk
+
+    monkeypatch.delenv(chipmunk.PLAIN_ENV, raising=False)
+    assert chipmunk.guard() is None
+    monkeypatch.setattr(pymunk, "version", "8.0.0")
+    why = chipmunk.guard()
+    assert why is not None and "8.0.0" in why
+    space = pymunk.Space()
+    loop, reason = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
+    assert loop.name == "plain" and reason == why
+    with pytest.raises(RuntimeError, match="cannot run"):
+        chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16, step_loop="compiled")

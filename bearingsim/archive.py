@@ -30,6 +30,7 @@ import numpy as np
 
 from bearingsim import __version__
 from bearingsim.errors import UserError
+from bearingsim import outputs  # reliability hook
 
 FORMAT_VERSION = "1.0"
 _CHUNK_BYTES = 256 * 1024
@@ -153,6 +154,7 @@ class ArchiveWriter:
             raise UserError(f"{self.path}: cannot create output folder ({exc.strerror})") from None
         if self.path.is_dir():
             raise UserError(f"{self.path}: output path is a directory")
+        outputs.check_target(self.path, [getattr(scenario, "source", None)])  # reliability hook
         self.tmp = self.path.with_name(f".{self.path.name}.tmp-{os.getpid()}")
         try:
             self.tmp.touch()
@@ -162,7 +164,11 @@ class ArchiveWriter:
 
     def __enter__(self) -> "ArchiveWriter":
         h5py = _lazy_h5py()
-        self.f = h5py.File(self.tmp, "w")
+        try:  # reliability hook: a full disk or I/O error at creation is one line naming the path
+            self.f = h5py.File(self.tmp, "w")
+        except OSError as exc:  # reliability hook
+            self.tmp.unlink(missing_ok=True)  # reliability hook
+            raise outputs.write_error(self.path, exc) from None  # reliability hook
         f = self.f
         f.attrs["title"] = f"bearingsim archive: {self.scenario.name}"
         h5md = f.create_group("h5md")
@@ -232,9 +238,13 @@ class ArchiveWriter:
     def __exit__(self, exc_type, exc, tb) -> bool:
         if exc_type is not None:
             try:
-                self.f.close()
+                outputs.close_quietly(self.f)  # reliability hook (was self.f.close())
+            except OSError:  # reliability hook: on a full disk the close fails too; the write error is reported
+                pass  # reliability hook
             finally:
                 self.tmp.unlink(missing_ok=True)
+            if issubclass(exc_type, OSError):  # reliability hook
+                raise outputs.write_error(self.path, exc) from None  # reliability hook
             return False
         try:
             for ts in self._series:
@@ -251,8 +261,11 @@ class ArchiveWriter:
             for k, v in self.provenance.items():
                 prov.attrs[k] = v
             self.f["bearingsim"].attrs["complete"] = True
-            self.f.close()
+            outputs.close_quietly(self.f)  # reliability hook (was self.f.close())
             os.replace(self.tmp, self.path)
+        except OSError as exc:  # reliability hook: ENOSPC/EIO on flush or close
+            self.tmp.unlink(missing_ok=True)  # reliability hook
+            raise outputs.write_error(self.path, exc) from None  # reliability hook
         except BaseException:
             self.tmp.unlink(missing_ok=True)
             raise
@@ -328,6 +341,8 @@ def describe(path: str | Path) -> str:
                 lines.append(f"  /{name:52s} {str(obj.shape):14s} {obj.dtype!s:8s} {unit}")
 
         f.visititems(visit)
+    except (KeyError, TypeError, ValueError) as exc:  # reliability hook: attributes missing or malformed
+        raise UserError(f"{path}: damaged archive (missing or malformed attribute {exc})") from None  # reliability hook
     finally:
         f.close()
-    return "\n".join(lines)
+    return outputs.printable("\n".join(lines))  # reliability hook: escape control characters

@@ -10,6 +10,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.archive import ArchiveWriter
+from bearingsim import outputs, plausibility  # reliability hook
+from bearingsim.errors import UserError  # reliability hook
 from bearingsim.scenario import Scenario
 
 
@@ -31,7 +33,7 @@ class RunOutput:
 
 
 def default_output(scenario: Scenario, root: str | Path = "outputs") -> Path:
-    return Path(root) / f"{scenario.name}.h5"
+    return outputs.default_output(scenario.name, root)  # reliability hook: never outside root
 
 
 def run_scenario(
@@ -52,8 +54,18 @@ def run_scenario(
     """
     out = Path(out) if out is not None else default_output(scenario)
     module = model_module(scenario.model)
-    with ArchiveWriter(out, scenario) as aw:
-        result = module.simulate(scenario, archive=aw, progress=progress)
-        result.write(aw)
-    pngs = result.save_figures(out.with_suffix("")) if figures else []
+    outputs.check_target(out, [scenario.source])  # reliability hook: before the lock creates the folder
+    lock = outputs.OutputLock(out).acquire()  # reliability hook: one writer per target, figures included
+    outputs.clean_stale_temporaries(out.parent)  # reliability hook
+    try:  # reliability hook
+        with ArchiveWriter(out, scenario) as aw:
+            result = module.simulate(scenario, archive=aw, progress=progress)
+            plausibility.check(result, scenario)  # reliability hook: exit 3 before anything is written
+            result.write(aw)
+        try:  # reliability hook
+            pngs = result.save_figures(out.with_suffix("")) if figures else []
+        except OSError as exc:  # reliability hook
+            raise UserError(f"{exc.filename or out}: cannot write figure ({exc.strerror or exc})") from None
+    finally:  # reliability hook
+        lock.release()  # reliability hook
     return RunOutput(archive=out, figures=list(pngs), result=result)

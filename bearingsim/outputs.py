@@ -15,6 +15,7 @@ Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) 
 """
 from __future__ import annotations
 
+import contextlib
 import errno
 import fcntl
 import os
@@ -192,19 +193,27 @@ class OutputLock:
         return False
 
 
-def close_quietly(f) -> None:
-    """Close an h5py file with file descriptor 2 sent to /dev/null: when the disk is full HDF5 prints
-    its error stack there for every object it frees; the failure itself still raises ``OSError``."""
+@contextlib.contextmanager
+def quiet_stderr():
+    """Send file descriptor 2 to /dev/null for the block: while an archive is written, HDF5 prints its
+    error stack there for each object it fails to flush when the disk is full (and carries on); the
+    failure itself surfaces as an ``OSError`` at the latest when the file is closed."""
     sys.stderr.flush()
     saved = os.dup(2)
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 2)
     os.close(devnull)
     try:
-        f.close()
+        yield
     finally:
         os.dup2(saved, 2)
         os.close(saved)
+
+
+def close_quietly(f) -> None:
+    """Close an h5py file inside :func:`quiet_stderr`."""
+    with quiet_stderr():
+        f.close()
 
 
 class ArchiveWriteError(UserError):

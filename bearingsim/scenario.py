@@ -375,6 +375,8 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
             data = fh.read(MAX_SCENARIO_BYTES + 1)
         if len(data) > MAX_SCENARIO_BYTES:
             raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")
+        if data.startswith(b"\x89HDF"):
+            raise UserError(f"{p}: is an HDF5 file (an archive?), not a scenario TOML file")
         text = data.decode("utf-8")
     except FileNotFoundError:
         raise UserError(f"{p}: scenario file not found") from None
@@ -382,8 +384,6 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
         raise UserError(f"{p}: is a directory, not a scenario file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise UserError(f"{p}: cannot read scenario file ({exc.__class__.__name__})") from None
-    if text.startswith("\x89HDF"):
-        raise UserError(f"{p}: is an HDF5 file (an archive?), not a scenario TOML file")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -6,6 +6,7 @@ The models themselves live in :mod:`bearingsim.reduced` and :mod:`bearingsim.mul
 """
 from __future__ import annotations
 
+import sys  # reliability hook
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -60,12 +61,15 @@ def run_scenario(
     try:  # reliability hook
         with ArchiveWriter(out, scenario) as aw:
             result = module.simulate(scenario, archive=aw, progress=progress)
-            plausibility.check(result, scenario)  # reliability hook: exit 3 before anything is written
-            result.write(aw)
+            for note in plausibility.check(result, scenario, aw.provenance):  # reliability hook: exit 3 before
+                print(note, file=sys.stderr)  # anything is written; notes (ring_newton_failures) on stderr
+            with outputs.quiet_stderr():  # reliability hook: HDF5 error stacks on a full disk
+                result.write(aw)
         try:  # reliability hook
             pngs = result.save_figures(out.with_suffix("")) if figures else []
         except OSError as exc:  # reliability hook
-            raise UserError(f"{exc.filename or out}: cannot write figure ({exc.strerror or exc})") from None
+            raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
+                            f"({exc.strerror or exc}); the archive {out} is complete") from None
     finally:  # reliability hook
         lock.release()  # reliability hook
     return RunOutput(archive=out, figures=list(pngs), result=result)

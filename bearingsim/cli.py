@@ -16,10 +16,11 @@ from bearingsim.errors import SimulationUnstable, UserError
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import load_scenario
+    from bearingsim.scenario import check_run_request, load_scenario
     from bearingsim.simulation import run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
+    check_run_request(scenario)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress)
     if not args.quiet:

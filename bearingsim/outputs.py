@@ -8,8 +8,9 @@ Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) 
 * an existing target that is not a bearingsim archive is not replaced;
 * a figure path of the run (``<stem>_*.png``) that is a directory is refused before the run;
 * one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target, held from
-  the start of the run until its archive and figures are written; a second run to the same target is
-  refused, not interleaved (the lock file stays; it holds no data);
+  the start of the run until its archive and figures are written, then removed; a second run to the
+  same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
+  the next run takes over: the lock dies with its process);
 * temporary archives ``.<name>.tmp-<pid>`` whose process is gone (a run killed by SIGKILL or a power
   cut) are removed on the next run into that folder, with a note on stderr.
 """
@@ -163,24 +164,37 @@ class OutputLock:
         self._fd: int | None = None
 
     def acquire(self) -> "OutputLock":
-        try:
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-            fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
-        except OSError as exc:
-            raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError as exc:
+        for _ in range(10):  # the holder may unlink the lock file between our open and flock: retry
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as exc:
+                raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                os.close(fd)
+                if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    raise UserError(f"{self.path}: another bearingsim run is writing this archive "
+                                    f"(lock {self.lock_path.name} is held); wait for it or choose another -o") from None
+                raise UserError(f"{self.path}: cannot lock output ({exc.strerror or exc})") from None
+            try:
+                same = os.stat(self.lock_path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self._fd = fd
+                return self
             os.close(fd)
-            if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                raise UserError(f"{self.path}: another bearingsim run is writing this archive "
-                                f"(lock {self.lock_path.name} is held); wait for it or choose another -o") from None
-            raise UserError(f"{self.path}: cannot lock output ({exc.strerror or exc})") from None
-        self._fd = fd
-        return self
+        raise UserError(f"{self.path}: cannot lock output (lock file keeps changing)")
 
     def release(self) -> None:
+        """Remove the lock file, then unlock: nothing is left beside the archive."""
         if self._fd is not None:
+            try:
+                self.lock_path.unlink()
+            except OSError:
+                pass
             fcntl.flock(self._fd, fcntl.LOCK_UN)
             os.close(self._fd)
             self._fd = None

@@ -83,10 +83,10 @@ def check_target(path: str | Path, inputs: list[str | Path] = ()) -> Path:
     for src in inputs:
         if src and _same_file(p, Path(src)):
             raise UserError(f"{p}: output path is the input scenario file; choose another -o")
-    if p.suffix.lower() not in ARCHIVE_SUFFIXES:
-        raise UserError(f"{p}: archive path must end in .h5 or .hdf5 (got {p.suffix or 'no suffix'!r})")
     if p.is_dir():
         raise UserError(f"{p}: output path is a directory")
+    if p.suffix.lower() not in ARCHIVE_SUFFIXES:
+        raise UserError(f"{p}: archive path must end in .h5 or .hdf5 (got {p.suffix or 'no suffix'!r})")
     if p.exists() and not _is_bearingsim_archive(p):
         raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another -o)")
     stem = p.with_suffix("")

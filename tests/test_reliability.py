@@ -154,7 +154,7 @@ DEEP_TABLES = "schema_version = 1\n[" + ".".join(f"k{i}" for i in range(20)) + "
 CASES: list[Case] = [
     # scenario files
     Case("file-missing", "scenario file", ["run", "{tmp}/nope.toml"], 2, ("nope.toml", "not found")),
-    Case("file-directory", "scenario file", ["run", "{tmp}"], 2, ("is a directory",)),
+    Case("file-directory", "scenario file", ["run", "{tmp}"], 2, ("is a directory, not a scenario",)),
     Case("file-dev-zero", "scenario file", ["run", "/dev/zero"], 2, ("/dev/zero", "larger than")),
     Case("file-huge", "scenario file", run(scenario="{tmp}/s.toml"), 2, ("s.toml", "larger than"),
          setup=lambda t: _scenario(t, "# " + "x" * (2 << 20) + "\n")),
@@ -247,13 +247,13 @@ CASES: list[Case] = [
          setup=_setup_foreign_h5),
     Case("out-existing-archive-replaced", "output path", run(o="{tmp}/a.h5"), 0, ("wrote",),
          setup=_setup_archive(), allow_new=("a.h5",)),
-    Case("out-directory", "output path", run(o="{tmp}"), 2, ("directory",)),
-    Case("out-dir-named-h5", "output path", run(o="{tmp}/d.h5"), 2, ("d.h5", "directory"),
+    Case("out-directory", "output path", run(o="{tmp}"), 2, ("output path is a directory",)),
+    Case("out-dir-named-h5", "output path", run(o="{tmp}/d.h5"), 2, ("d.h5", "output path is a directory"),
          setup=lambda t: (t / "d.h5").mkdir()),
     Case("out-under-a-file", "output path", run(o="{tmp}/blocker/r.h5"), 2, ("blocker",),
          setup=_setup_text("blocker")),
     Case("out-figure-path-is-dir", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
-         ("out_pass.png", "directory"), setup=_setup_figure_dir),
+         ("out_pass.png", "figure path is a directory"), setup=_setup_figure_dir),
     Case("out-locked", "output path", run(), 2, ("another bearingsim run",), setup="lock"),
     Case("out-stale-tmp-cleaned", "output path", run(), 0, ("removed stale temporary file",),
          setup=_setup_dead_tmp, gone=(".out.h5.tmp-*",), allow_new=("out.h5",)),
@@ -265,7 +265,7 @@ CASES: list[Case] = [
          allow_new=("small/out.h5",)),
     # archives given to inspect
     Case("inspect-missing", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("a.h5", "not found")),
-    Case("inspect-directory", "inspect", ["inspect", "{tmp}"], 2, ("directory",)),
+    Case("inspect-directory", "inspect", ["inspect", "{tmp}"], 2, ("is a directory, not an archive",)),
     Case("inspect-zeros", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("a.h5", "not an HDF5"),
          setup=lambda t: (t / "a.h5").write_bytes(b"\0" * 100)),
     Case("inspect-foreign-hdf5", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("not a bearingsim archive",),
@@ -281,7 +281,6 @@ CASES: list[Case] = [
          setup=_setup_archive(name="\x1b[2J\x1b[31mevil")),
     # runs that work
     Case("works-reduced", "works", run(), 0, ("wrote",), allow_new=("out.h5",)),
-    Case("works-multibody-1-rotation", "works", run(*S(*MB1), scenario=MB), 0, ("wrote",), allow_new=("out.h5",)),
     Case("note-ring-newton-failures", "works", run(*S("numerics.rotations=2"), scenario=SCENARIOS / "multibody_6000rpm.toml"),
          0, ("ring_newton_failures", "did not converge", "wrote"), allow_new=("out.h5",)),
     # known, not yet fixed in bearingsim/multibody (see the report of issue 14)
@@ -336,6 +335,7 @@ def execute(case: Case, tmp: Path) -> Observed:
     if any(ord(c) < 32 and c not in "\n\t" for c in res.stderr + res.stdout):
         obs.problems.append("control character printed")
     text = lines[0] if (case.exit != 0 and lines) else res.stdout + res.stderr
+    text = text.replace(str(tmp), "{tmp}")  # the words must be in the message, not in the folder's name
     if case.exit != 0 and len(lines) != 1:
         obs.problems.append(f"{len(lines)} stderr lines, expected 1")
     for w in case.words:
@@ -513,7 +513,9 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
             if str(case.setup).startswith("tmpfs") and not _unshare_works():
                 rows.append((case, None))
                 continue
-            rows.append((case, execute(case, Path(d))))
+            obs = execute(case, Path(d))
+            obs.err, obs.out = obs.err.replace(d, "{tmp}"), obs.out.replace(d, "{tmp}")
+            rows.append((case, obs))
     sig_rows = []
     for sig, code in ((signal.SIGTERM, 143), (signal.SIGINT, 130)):
         with tempfile.TemporaryDirectory() as d:
@@ -561,6 +563,11 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
         lines.append(f"| {sig.name} | signal | `bearingsim run scenarios/multibody_3000rpm.toml -o {{tmp}}/m.h5 "
                      f"--set numerics.rotations=200`, {sig.name} once running | exit {code} within 1.5 s, no "
                      f"archive, no temporary file | exit {obs.code}: {cell(first)} | {status} |")
+    lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
+              "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
+              "writes), and unit tests of `bearingsim/plausibility.py` (the Palmgren displacement bound, "
+              "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
+              "refused above)."]
     path.write_text("\n".join(lines) + "\n")
     print(f"wrote {path}")
 

@@ -152,6 +152,10 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("bearingsim: interrupted, no archive written", file=sys.stderr)
         return 130
+    except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
+        where = exc.filename or "bearingsim"
+        print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
+        return 2
     except MemoryError:
         print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
               "interval", file=sys.stderr)

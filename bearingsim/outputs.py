@@ -27,7 +27,10 @@ from pathlib import Path
 from bearingsim.errors import UserError
 
 ARCHIVE_SUFFIXES = (".h5", ".hdf5")
-_TMP_RE = re.compile(r"^\..+\.tmp-(\d+)$")
+# ArchiveWriter's temporary name, ".<name>.h5.tmp-<pid>"; only such files that are empty or start with
+# the HDF5 signature are removed, so another program's temporary file is never touched.
+_TMP_RE = re.compile(r"^\..+\.(?:h5|hdf5)\.tmp-(\d+)$")
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
 def default_output(name: str, root: str | Path = "outputs") -> Path:
@@ -135,6 +138,13 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
             continue
         pid = int(m.group(1))
         if pid == os.getpid() or _pid_alive(pid):
+            continue
+        try:
+            with open(entry, "rb") as fh:
+                head = fh.read(len(_HDF5_SIGNATURE))
+        except OSError:
+            continue
+        if head and head != _HDF5_SIGNATURE:
             continue
         try:
             entry.unlink()

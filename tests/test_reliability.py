@@ -92,7 +92,12 @@ def _setup_copy_paper(tmp):
 
 
 def _setup_dead_tmp(tmp):
-    (tmp / f".out.h5.tmp-{_dead_pid()}").write_bytes(b"half an archive")
+    (tmp / f".out.h5.tmp-{_dead_pid()}").write_bytes(b"\x89HDF\r\n\x1a\n half an archive")
+
+
+def _setup_foreign_tmp(tmp):
+    (tmp / f".notes.txt.tmp-{_dead_pid()}").write_bytes(b"another program's file")
+    (tmp / f".other.h5.tmp-{_dead_pid()}").write_bytes(b"not HDF5")
 
 
 def _setup_live_tmp(tmp):
@@ -257,6 +262,9 @@ CASES: list[Case] = [
     Case("out-locked", "output path", run(), 2, ("another bearingsim run",), setup="lock"),
     Case("out-stale-tmp-cleaned", "output path", run(), 0, ("removed stale temporary file",),
          setup=_setup_dead_tmp, gone=(".out.h5.tmp-*",), allow_new=("out.h5",)),
+    Case("out-foreign-tmp-kept", "output path", run(), 0, ("wrote",), setup=_setup_foreign_tmp, allow_new=("out.h5",)),
+    Case("validate-output-under-a-file", "output path", ["validate", "-o", "{tmp}/blocker/v"], 2, ("blocker",),
+         setup=_setup_text("blocker")),
     Case("out-live-tmp-kept", "output path", run(), 0, ("wrote",), setup=_setup_live_tmp, allow_new=("out.h5",)),
     Case("out-full-disk", "output path", ["run", str(PAPER), "-o", "{tmp}/small/out.h5"], 2,
          ("out.h5", "No space left on device", "nothing was written"), setup="tmpfs:12k"),

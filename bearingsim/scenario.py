@@ -490,7 +490,8 @@ def _check_limits(m: ScenarioModel, source: str) -> None:
     if not lo <= m.wear.hardness_Pa <= hi:
         raise UserError(f"{source}: wear.hardness_Pa: {m.wear.hardness_Pa:g} Pa is outside the hardness of "
                         f"solids ({lo:g}..{hi:g} Pa)")
-    g_r, op = Scenario(m, source).geometry, Scenario(m, source).operating_point
+    view = Scenario(m, source)
+    g_r, op = view.geometry, view.operating_point
     n_free = g_r.roller_mass * (g_r.pitch_radius * op.omega_c**2 + op.gravity)  # Eq. (3), least N
     if n_free > 0:
         drag = float(kin.oil_film_drag(m.lubrication.drag_coefficient, n_free, op.rolling_velocity))

@@ -483,6 +483,29 @@ def test_two_runs_to_one_archive_second_is_refused(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]
 
 
+def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
+    """SIGKILL cannot be handled: the run leaves ``.m.h5.tmp-PID`` (and its lock file, whose lock died
+    with the process); the next run into that folder removes the temporary, says so, and writes
+    (taking over the lock file and removing it when done)."""
+    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp_path / "m.h5"),
+                             "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=ENV)
+    try:
+        deadline = time.monotonic() + 120
+        while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGKILL)
+        proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    left = list(tmp_path.glob(".m.h5.tmp-*"))
+    assert len(left) == 1
+    res = bearingsim("run", PAPER, "-o", tmp_path / "m.h5", "--no-plots")
+    assert res.returncode == 0, res.stderr
+    assert f"removed stale temporary file {left[0]}" in res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]  # the dead run's lock file is gone too
+
+
 def signal_case(tmp: Path, sig) -> Observed:
     """Start a long multibody run, signal it once its temporary archive exists, time the exit."""
     proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp / "m.h5"),
@@ -573,7 +596,8 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
                      f"archive, no temporary file | exit {obs.code}: {cell(first)} | {status} |")
     lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
               "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
-              "writes), and unit tests of `bearingsim/plausibility.py` (the Palmgren displacement bound, "
+              "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "
+              "into that folder), and unit tests of `bearingsim/plausibility.py` (the Palmgren displacement bound, "
               "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
               "refused above)."]
     path.write_text("\n".join(lines) + "\n")

@@ -222,8 +222,12 @@ def quiet_stderr():
     """Send file descriptor 2 to /dev/null for the block: while an archive is written, HDF5 prints its
     error stack there for each object it fails to flush when the disk is full (and carries on); the
     failure itself surfaces as an ``OSError`` at the latest when the file is closed."""
-    sys.stderr.flush()
-    saved = os.dup(2)
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no stderr to quieten (closed)
+        yield
+        return
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 2)
     os.close(devnull)

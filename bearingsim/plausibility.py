@@ -107,7 +107,8 @@ def check(result, scenario, provenance: dict | None = None) -> list[str]:
             if samples < MIN_ORBIT_SAMPLES:
                 raise SimulationUnstable(
                     f"{samples} time-series samples recorded; raise numerics.output_rate_hz or numerics.rotations")
-        fails = int((provenance or {}).get("ring_newton_failures", 0) or 0)
+        # today in the provenance only; read from the summary too once the model puts it there
+        fails = int(summary.get("ring_newton_failures", (provenance or {}).get("ring_newton_failures", 0)) or 0)
         steps = int(summary.get("steps", 0) or 0)
         if fails and steps:
             msg = (f"the inner ring's force balance did not converge in {fails} of {steps} steps "

@@ -34,6 +34,7 @@ import numpy as np
 
 from bearingsim import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
+from bearingsim import outputs
 from bearingsim.errors import UserError
 
 FORMAT_VERSION = "1.0"
@@ -152,6 +153,7 @@ def _prepare_target(path) -> Path:
         raise UserError(f"{path}: cannot create output folder ({exc.strerror})") from None
     if path.is_dir():
         raise UserError(f"{path}: output path is a directory")
+    outputs.check_target(path, (), is_archive)  # .h5 name; never replaces a file that is not an archive
     tmp = _tmp_name(path)
     try:
         tmp.touch()
@@ -176,17 +178,23 @@ class Spool:
         self.f = None
 
     def __enter__(self) -> "Spool":
-        self.f = _lazy_h5py().File(self.tmp, "w")
+        try:  # a full disk or I/O error at creation: one line naming the path
+            self.f = _lazy_h5py().File(self.tmp, "w")
+        except OSError as exc:
+            self.tmp.unlink(missing_ok=True)
+            raise outputs.write_error(self.path, exc) from None
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:
         if self.f is not None:
             try:
-                self.f.close()
-            except Exception:  # pragma: no cover - closing a file after an HDF5 error
+                outputs.close_quietly(self.f)
+            except Exception:  # closing a file after an HDF5 error (a full disk): the first error is reported
                 pass
             self.f = None
         self.tmp.unlink(missing_ok=True)  # written and renamed by write(), else abandoned
+        if exc_type is not None and issubclass(exc_type, OSError) and not isinstance(exc, UserError):
+            raise outputs.write_error(self.path, exc) from None
         return False
 
     def timeseries(self, name: str, value_shape=(), unit: str = "1", description: str = "") -> TimeSeries:
@@ -220,38 +228,42 @@ def write(result, path, spool: Spool | None = None) -> Path:
             return write(result, path, sp)
     f = spool.f
     try:
-        for ts in spool._series:
-            ts.flush()
-        _write_header(f, result)
-        for name, s in result.series.items():
-            g = f.create_group(f"observables/{name}")
-            if s.description:
-                g.attrs["description"] = s.description
-            ts = TimeSeries(g, s.value.shape[1:], s.unit)
-            ts.append(s.step, s.time, s.value)
-            ts.flush()
-        for path_, arr in result.data.items():
-            _write_array(f, path_, arr)
-        for path_, desc in result.tables.items():
-            g = f.require_group(path_)
-            g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
-            if desc:
-                g.attrs["description"] = desc
-        for path_, grp in result.groups.items():
-            g = f.require_group(path_)
-            if grp.description:
-                g.attrs["description"] = grp.description
-            for k, v in grp.attrs.items():
-                g.attrs[k] = v
-            for k, u in grp.units.items():
-                g.attrs[f"{k}__unit"] = u
-        prov = f.create_group("provenance")
-        for k, v in _provenance(result).items():
-            prov.attrs[k] = v
-        f["bearingsim"].attrs["complete"] = True
-        f.close()
-        spool.f = None
+        with outputs.quiet_stderr():  # HDF5 prints error stacks on a full disk; the OSError says it
+            for ts in spool._series:
+                ts.flush()
+            _write_header(f, result)
+            for name, s in result.series.items():
+                g = f.create_group(f"observables/{name}")
+                if s.description:
+                    g.attrs["description"] = s.description
+                ts = TimeSeries(g, s.value.shape[1:], s.unit)
+                ts.append(s.step, s.time, s.value)
+                ts.flush()
+            for path_, arr in result.data.items():
+                _write_array(f, path_, arr)
+            for path_, desc in result.tables.items():
+                g = f.require_group(path_)
+                g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
+                if desc:
+                    g.attrs["description"] = desc
+            for path_, grp in result.groups.items():
+                g = f.require_group(path_)
+                if grp.description:
+                    g.attrs["description"] = grp.description
+                for k, v in grp.attrs.items():
+                    g.attrs[k] = v
+                for k, u in grp.units.items():
+                    g.attrs[f"{k}__unit"] = u
+            prov = f.create_group("provenance")
+            for k, v in _provenance(result).items():
+                prov.attrs[k] = v
+            f["bearingsim"].attrs["complete"] = True
+            outputs.close_quietly(f)
+            spool.f = None
         os.replace(spool.tmp, spool.path)
+    except OSError as exc:  # ENOSPC/EIO on flush or close: one line, nothing left behind
+        spool.tmp.unlink(missing_ok=True)
+        raise outputs.write_error(spool.path, exc) from None
     except BaseException:
         spool.tmp.unlink(missing_ok=True)
         raise
@@ -301,6 +313,18 @@ def _provenance(result) -> dict[str, Any]:
             continue  # a result read back from an archive keeps the provenance of the run that made it
         prov[k] = v
     return prov
+
+
+def is_archive(path) -> bool:
+    """True when ``path`` is an HDF5 file written by bearingsim (complete or not)."""
+    try:
+        h5py = _lazy_h5py()
+        if not h5py.is_hdf5(path):
+            return False
+        with h5py.File(path, "r") as f:
+            return "bearingsim" in f and "format_version" in f["bearingsim"].attrs
+    except Exception:  # unreadable or damaged: not something we may replace
+        return False
 
 
 def model_of(path) -> str:
@@ -524,6 +548,8 @@ def describe(path: str | Path) -> str:
                 lines.append(f"  /{name:52s} {str(obj.shape):14s} {obj.dtype!s:8s} {unit}")
 
         f.visititems(visit)
+    except (KeyError, TypeError, ValueError) as exc:  # attributes missing or malformed
+        raise UserError(f"{path}: damaged archive (missing or malformed attribute {exc})") from None
     finally:
         f.close()
-    return "\n".join(lines)
+    return outputs.printable("\n".join(lines))  # attributes may carry terminal escape sequences

@@ -6,6 +6,8 @@ that goes numerically unstable exits 3 and writes no archive.
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
 from pathlib import Path
 
@@ -33,11 +35,12 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import load_scenario
+    from bearingsim.scenario import check_run_request, load_scenario
     from bearingsim.simulation import run_scenario
 
     _refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
+    check_run_request(scenario)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress)
     if not args.quiet:
@@ -243,23 +246,68 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like SIGINT's KeyboardInterrupt so that every clean-up path (temporary archive
+    removed, output lock released) runs the same way."""
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
+def _one_line(exc: BaseException) -> str:
+    from bearingsim.outputs import printable
+
+    return printable(str(exc), keep_newlines=False)
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run one ``bearingsim`` command; return its exit code.
+
+    Exit codes: 0 success, 2 bad input or an unwritable output (one line on stderr), 3 an unstable or
+    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (no archive, no temporary file).
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
+    previous = None
+    try:
+        previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
+        pass
     try:
         return args.func(args)
     except UserError as exc:
-        print(f"bearingsim: error: {exc}", file=sys.stderr)
+        line = f"bearingsim: error: {_one_line(exc)}"
+        fd = getattr(exc, "stderr_fd", None)
+        if fd is not None:  # failed archive write: HDF5 cannot be torn down cleanly (outputs.ArchiveWriteError)
+            sys.stdout.flush()
+            os.write(fd, (line + "\n").encode())
+            os._exit(exc.exit_code)
+        print(line, file=sys.stderr)
         return exc.exit_code
     except SimulationUnstable as exc:
-        print(f"bearingsim: unstable run, no archive written: {exc}", file=sys.stderr)
+        print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
+    except Terminated:
+        print("bearingsim: terminated (SIGTERM), no archive written", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("bearingsim: interrupted, no archive written", file=sys.stderr)
         return 130
+    except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
+        where = exc.filename or "bearingsim"
+        print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
+              "interval", file=sys.stderr)
+        return 2
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
         sys.stderr.close()
         return 0
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":  # pragma: no cover

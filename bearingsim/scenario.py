@@ -58,6 +58,41 @@ DEFAULTS: dict[str, dict[str, Any]] = {
 
 PRESET_DIR = "params"
 
+# --- limits on what a scenario may ask for (issue 14). Each says why. ------------------------------
+# Scenario files are about 1 kB and presets about 5 kB; reading is bounded so that `run /dev/zero` or a
+# wrong multi-GB file stops at once instead of filling memory.
+MAX_SCENARIO_BYTES = 1 << 20
+# Sections nest two deep (section.key); a value is a scalar. Deeper nesting is never a scenario, and
+# very deep nesting would overflow the parser's recursion.
+MAX_NESTING_DEPTH = 8
+# The scenario name is the default archive file name (outputs/<name>.h5): a plain file name only, and
+# short enough that the longest name a run derives from it (".<name>.h5.tmp-<pid>", name + 16 bytes)
+# fits the 255-byte file-name limit of ext4, XFS, btrfs and APFS.
+MAX_NAME_BYTES = 200
+# Per-rotation arrays, the impact table and the run time grow with the number of rotations: the
+# multibody model takes ~0.2 s per cage rotation (README), so 1e5 rotations is ~6 h; the reduced
+# model's impact table is ~1e2 rows per rotation, so 1e5 rotations is ~1e7 rows (~0.6 GB in memory).
+MAX_ROTATIONS = 100_000
+# dm*n: the fastest rolling bearings in service (jet-lubricated aircraft-engine mainshaft bearings)
+# reach about 3e6 mm*rpm (Harris & Kotzalas, Advanced Concepts of Bearing Technology, 5th ed., 2007,
+# ch. 2 on high-speed operation); 4e6 leaves a margin. Beyond it the rollers' centrifugal loads and
+# the lubricant model of Eq. (2) are outside anything measured.
+MAX_DM_N_MM_RPM = 4.0e6
+# Implied roller density m / (pi/4 d^2 l): between light engineering polymers (~0.9e3 kg/m^3,
+# polyethylene) and tungsten carbide (~15.6e3 kg/m^3), with a margin; bearing steel is 7.8e3.
+ROLLER_DENSITY_RANGE_KG_M3 = (500.0, 20_000.0)
+# Vickers hardness of cage materials: from soft polymers (PTFE ~ 3e7 Pa) to hard ceramics (~2e10 Pa);
+# 1e7..1.2e11 Pa (diamond ~1e11 Pa) bounds every solid (Archard's H in Eq. 16).
+HARDNESS_RANGE_PA = (1.0e7, 1.2e11)
+# Oil-film rolling resistance F_o = c N^0.246 V^0.648 (Eq. 2) is a small fraction of the contact load
+# (measured EHL rolling-resistance coefficients are 1e-3..1e-2); F_o > N at the operating point would
+# be a drag larger than the load that causes it.
+MAX_DRAG_TO_LOAD = 1.0
+# Basic static load rating of a radial roller bearing, ISO 76:2006 Eq. (8): C0r = 44 (1 - D cos a / Dpw)
+# i Z Lwe D cos a [N, mm], the load giving 4000 MPa at the most loaded contact. Beyond it the raceways
+# deform permanently (> 1e-4 D) and the elastic Palmgren contact law of both models does not hold.
+ISO76_C0_FACTOR = 44.0
+
 
 class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
@@ -141,6 +176,16 @@ class WearSection(_Section):
 class ScenarioModel(_Section):
     schema_version: int
     name: str = Field(min_length=1)
+
+    @field_validator("name")
+    @classmethod
+    def _plain_file_name(cls, v):
+        bad = [c for c in v if ord(c) < 32 or ord(c) == 127 or c in "/\\"]
+        if bad or v in (".", "..") or v.startswith(".") or len(v.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES:
+            raise ValueError(
+                f"must be a plain file name (it names the archive outputs/<name>.h5): no '/', '\\', "
+                f"control characters or leading '.', at most {MAX_NAME_BYTES} bytes")
+        return v
     model: Literal["reduced", "multibody"]
     bearing: BearingSection
     operating: OperatingSection
@@ -206,11 +251,30 @@ def parse_override(item: str) -> tuple[str, Any]:
     key = key.strip()
     if not key or any(not part for part in key.split(".")):
         raise UserError(f"--set {item!r}: empty key")
+    if len(item) > MAX_SCENARIO_BYTES:
+        raise UserError(f"--set {key}: value longer than {MAX_SCENARIO_BYTES} bytes")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         value = text.strip()
+    except RecursionError:
+        raise UserError(f"--set {key}: value nested too deeply") from None
+    _check_depth(value, f"--set {key}", depth=len(key.split(".")))
     return key, value
+
+
+def _check_depth(node: Any, where: str, depth: int = 0) -> None:
+    """Refuse data nested deeper than :data:`MAX_NESTING_DEPTH` (iteratively: no recursion limit)."""
+    stack = [(node, depth)]
+    while stack:
+        item, d = stack.pop()
+        if d > MAX_NESTING_DEPTH:
+            raise UserError(f"{where}: nested more than {MAX_NESTING_DEPTH} levels deep (a scenario has "
+                            "sections of keys)")
+        if isinstance(item, dict):
+            stack.extend((v, d + 1) for v in item.values())
+        elif isinstance(item, list):
+            stack.extend((v, d + 1) for v in item)
 
 
 def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
@@ -237,7 +301,15 @@ def _merge(base: dict, top: dict) -> dict:
 def read_toml_file(path: str | Path) -> dict[str, Any]:
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
+        if "\x00" in str(path):
+            raise UserError(f"{str(path)!r}: file name contains a NUL byte")
+        with open(p, "rb") as fh:  # bounded: /dev/zero or a huge file stops at once
+            data = fh.read(MAX_SCENARIO_BYTES + 1)
+        if len(data) > MAX_SCENARIO_BYTES:
+            raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")
+        if data.startswith(b"\x89HDF"):
+            raise UserError(f"{p}: is an HDF5 file (an archive?), not a scenario TOML file")
+        text = data.decode("utf-8")
     except FileNotFoundError:
         raise UserError(f"{p}: scenario file not found") from None
     except IsADirectoryError:
@@ -245,9 +317,13 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
     except (OSError, UnicodeDecodeError) as exc:
         raise UserError(f"{p}: cannot read scenario file ({exc.__class__.__name__})") from None
     try:
-        return tomllib.loads(text)
+        raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{p}: not valid TOML ({exc})") from None
+    except RecursionError:
+        raise UserError(f"{p}: nested too deeply to be a scenario") from None
+    _check_depth(raw, str(p))
+    return raw
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
@@ -258,6 +334,8 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     ``values`` maps dotted keys to Python values; both name keys as ``section.key``.
     """
     raw = read_toml_file(path)
+    if not isinstance(raw.get("name", ""), str):
+        raise UserError(f"{path}: name: must be a string")
     for item in overrides or []:
         key, value = parse_override(item)
         _set_dotted(raw, key, value, origin="--set")
@@ -311,7 +389,71 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
                 msg += f" (got {err['input']!r})"
         raise UserError(f"{source}: {key}: {msg}") from None
     _check_geometry(model, source)
+    _check_limits(model, source)
     return Scenario(model, source)
+
+
+def check_run_request(scenario: "Scenario") -> None:
+    """Checks for a ``bearingsim run`` from the command line, beyond what the schema allows.
+
+    ``numerics.warmup_rotations = 0`` with the multibody model: every pocket's first window then
+    starts from the assembled state, and the means over rotations are biased (issue 14 measured the
+    mean I_dec of the reduced-equivalent scene 21 % low). The Python API still accepts it, because a
+    stability scan (``bearingsim.multibody.stability``) and the robustness tests want exactly one
+    rotation from the start state; a user asking the CLI for results is refused.
+    """
+    if scenario.model == "multibody" and scenario.numerics.warmup_rotations < 1:
+        raise UserError(f"{scenario.source}: numerics.warmup_rotations: 0 with the multibody model averages "
+                        "windows that start from the assembled state (biased means); use at least 1 warm-up rotation")
+
+
+def _check_limits(m: ScenarioModel, source: str) -> None:
+    """Sizes, run length and physically absurd values, each refused with the limit and its reason
+    (the constants above)."""
+    b, o, n = m.bearing, m.operating, m.numerics
+    total = n.rotations + n.warmup_rotations
+    if total > MAX_ROTATIONS:
+        key = "numerics.rotations" if n.rotations > n.warmup_rotations else "numerics.warmup_rotations"
+        raise UserError(f"{source}: {key}: {total} rotations in all exceed {MAX_ROTATIONS} (memory and run "
+                        "time grow with rotations); run fewer")
+    dmn = o.inner_ring_speed_rpm * b.pitch_diameter_mm
+    if dmn > MAX_DM_N_MM_RPM:
+        raise UserError(f"{source}: operating.inner_ring_speed_rpm: {o.inner_ring_speed_rpm:g} rpm gives "
+                        f"dm*n = {dmn:.3g} mm rpm, beyond any rolling bearing (limit {MAX_DM_N_MM_RPM:.0e})")
+    rho = b.roller_mass_kg / (math.pi / 4 * (b.roller_diameter_mm * 1e-3) ** 2 * b.roller_length_mm * 1e-3)
+    lo, hi = ROLLER_DENSITY_RANGE_KG_M3
+    if not lo <= rho <= hi:
+        raise UserError(f"{source}: bearing.roller_mass_kg: {b.roller_mass_kg:g} kg gives a roller density of "
+                        f"{rho:.3g} kg/m^3, outside any roller material ({lo:g}..{hi:g} kg/m^3)")
+    lo, hi = HARDNESS_RANGE_PA
+    if not lo <= m.wear.hardness_Pa <= hi:
+        raise UserError(f"{source}: wear.hardness_Pa: {m.wear.hardness_Pa:g} Pa is outside the hardness of "
+                        f"solids ({lo:g}..{hi:g} Pa)")
+    from bearingsim import laws
+    from bearingsim.parameters import Parameters
+
+    view = Parameters.from_scenario(Scenario(m, source))
+    g_r, op = view.bearing, view.operating
+    n_free = g_r.roller_mass * (g_r.pitch_radius * op.omega_c**2 + op.gravity)  # Eq. (3), least N
+    if n_free > 0:
+        drag = float(laws.oil_film_drag(m.lubrication.drag_coefficient, n_free, op.rolling_velocity))
+        if drag > MAX_DRAG_TO_LOAD * n_free:
+            raise UserError(f"{source}: lubrication.drag_coefficient: {m.lubrication.drag_coefficient:g} gives an "
+                            f"oil-film drag of {drag:.3g} N against a roller load of {n_free:.3g} N (Eq. 2); "
+                            f"rolling resistance is a small fraction of the load")
+    c0 = ISO76_C0_FACTOR * (1 - b.roller_diameter_mm / b.pitch_diameter_mm) * b.roller_count * \
+        b.roller_length_mm * b.roller_diameter_mm
+    if o.radial_load_N > c0:
+        raise UserError(f"{source}: operating.radial_load_N: {o.radial_load_N:g} N exceeds the static load rating "
+                        f"C0r = {c0:.4g} N of this bearing (ISO 76); the raceways would yield")
+    if m.model == "multibody":
+        period = 2 * math.pi / op.omega_c
+        per_rotation = n.output_rate_hz * period
+        need = 2 * b.roller_count  # Nyquist for the roller-pass frequency in the cage orbit
+        if per_rotation < need:
+            raise UserError(f"{source}: numerics.output_rate_hz: {n.output_rate_hz:g} Hz gives {per_rotation:.3g} "
+                            f"samples per cage rotation; at least {need} (2 per roller pass) are needed, use "
+                            f">= {need / period:.3g} Hz")
 
 
 def _check_geometry(m: ScenarioModel, source: str) -> None:

@@ -11,6 +11,7 @@ for their time series and return a result; they never see the scenario file or t
 """
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -68,7 +69,10 @@ class RunOutput:
 
 
 def default_output(scenario: Scenario, root: str | Path = "outputs") -> Path:
-    return Path(root) / f"{scenario.name}.h5"
+    """``<root>/<name>.h5``, never outside ``root`` (:func:`bearingsim.outputs.default_output`)."""
+    from bearingsim import outputs
+
+    return outputs.default_output(scenario.name, root)
 
 
 def run_scenario(
@@ -77,6 +81,7 @@ def run_scenario(
     *,
     figures: bool = True,
     progress: bool = False,
+    exclusive: bool = True,
 ) -> RunOutput:
     """Run ``scenario``, write its archive (atomically, time series streamed into it) and, optionally,
     its PNG figures, drawn from the archive as written.
@@ -87,14 +92,31 @@ def run_scenario(
     out : archive path; default ``outputs/<name>.h5``
     figures : write PNG figures beside the archive (``<stem>_<figure>.png``)
     progress : show a progress bar (multibody runs)
+    exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
+        temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
     """
-    from bearingsim import archive
+    from bearingsim import archive, outputs, plausibility
+    from bearingsim.errors import UserError
 
     out = Path(out) if out is not None else default_output(scenario)
-    with archive.Spool(out) as spool:
-        result = run(scenario, progress=progress, sink=spool)
-        archive.write(result, out, spool)
-    pngs = []
-    if figures:
-        pngs = load(out).save_figures(out.with_suffix(""))
+    outputs.check_target(out, [scenario.source], archive.is_archive)  # before the lock creates the folder
+    lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
+    try:
+        if exclusive:
+            outputs.clean_stale_temporaries(out.parent)
+        with archive.Spool(out) as spool:
+            result = run(scenario, progress=progress, sink=spool)
+            for note in plausibility.check(result):  # exit 3 before anything is written
+                print(note, file=sys.stderr)
+            archive.write(result, out, spool)
+        pngs = []
+        if figures:
+            try:
+                pngs = load(out).save_figures(out.with_suffix(""))
+            except OSError as exc:
+                raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
+                                f"({exc.strerror or exc}); the archive {out} is complete") from None
+    finally:
+        if lock is not None:
+            lock.release()
     return RunOutput(archive=out, figures=list(pngs), result=result)

@@ -112,6 +112,20 @@ def max_roller_load(p) -> float:
     return 5.0 * op.radial_load / g.roller_count + g.roller_mass * g.pitch_radius * op.omega_c**2 + 1.0
 
 
+RACEWAY_APPROACH_FACTOR = 3.0  # blow-up: approach > 3x that of one roller carrying the whole load alone
+
+
+def raceway_approach_limit(p) -> float:
+    """Largest outer-raceway approach [m] a sound run reaches, with margin: ``RACEWAY_APPROACH_FACTOR``
+    times the Palmgren approach of one roller carrying the whole radial load and its centrifugal load
+    alone (no roller ever carries more), and never below ``loop.DELTA_LIMIT_M`` (50 um). Beyond it the
+    run has blown up. (A fixed 50 um refused a legitimate 100 kN load: the most loaded roller's
+    approach is ~50 um per race there.)"""
+    g, op = p.bearing, p.operating
+    q = op.radial_load + g.roller_mass * g.pitch_radius * op.omega_c**2
+    return max(lp.DELTA_LIMIT_M, RACEWAY_APPROACH_FACTOR * (q / laws.palmgren_stiffness(g.roller_length)) ** 0.9)
+
+
 def stability_limit(p) -> float:
     """Explicit stability limit 2/omega_n [s] of a roller between two linearised Palmgren contacts."""
     g = p.bearing
@@ -278,7 +292,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     lim = lp.LoopLimits(
         travel_end=travel_end, travel_record=2.0 * math.pi * warm,
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
-        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=face_reach, out_every=out_every,
+        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=face_reach,
+        raceway_approach=raceway_approach_limit(p), out_every=out_every,
         max_steps=int(3 * steps_est + 1000))
     inp = lp.StepInputs(
         h=float(h), prm=prm, cfg=cfg, lim=lim,
@@ -320,8 +335,10 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
             raise PenetrationExceeded(g["maxpen_all"], lim.penetration, h, g["maxpen_time"], g["maxpen_approach"])
         if code == lp.CODE_BLOWUP:
             raise SimulationUnstable(
-                f"raceway approach {wk.diag['delta_out'].max():.3g} m or cage speed {state[n, 5]:.3g} rad/s "
-                f"out of bounds at t = {t:.6g} s (energy blow-up); try a smaller numerics.dt_s than {h:.3g} s")
+                f"raceway approach {wk.diag['delta_out'].max():.3g} m (limit {lim.raceway_approach:.3g} m, 3x the "
+                f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
+                f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); try a smaller "
+                f"numerics.dt_s than {h:.3g} s")
         if code == lp.CODE_STALLED:
             raise SimulationUnstable(
                 f"cage did not complete {total_rot} rotations in {step} steps "

@@ -49,7 +49,7 @@ CODE_CONTINUE = -1
 CODE_DONE, CODE_BLOCK_FULL, CODE_NONFINITE, CODE_PENETRATION, CODE_BLOWUP, CODE_STALLED = range(6)
 CODE_BUFFER_GREW, CODE_CAGE_LOST = 6, 7
 CHUNK_STEPS = 20_000  # return to Python at least this often (progress bar, Ctrl-C: ~0.3 s)
-DELTA_LIMIT_M = 50e-6  # a raceway approach beyond this is an energy blow-up
+DELTA_LIMIT_M = 50e-6  # floor of LoopLimits.raceway_approach (core.raceway_approach_limit)
 
 #: Loop state that lives across calls of the step loop, one record (array shape (1,)).
 LOOP_STATE = np.dtype([
@@ -89,6 +89,7 @@ class LoopLimits(NamedTuple):
     omega: float  #: largest cage angular speed accepted [rad/s]
     omega_nominal: float  #: epicyclic cage speed, for the slip [rad/s]
     orbit: float  #: largest cage-centre offset accepted (reach of the pocket faces) [m]
+    raceway_approach: float  #: largest outer-raceway approach accepted (beyond: an energy blow-up) [m]
     out_every: int  #: steps between samples and checks
     max_steps: int  #: steps after which the cage counts as stalled
 
@@ -248,7 +249,7 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         dmax = 0.0
         for i in range(n):
             dmax = max(dmax, wk.diag[i].delta_out)
-        if dmax > DELTA_LIMIT_M or abs(now[n, 5]) > lim.omega:
+        if dmax > lim.raceway_approach or abs(now[n, 5]) > lim.omega:
             return CODE_BLOWUP
         if math.hypot(now[n, 0], now[n, 1]) > lim.orbit:
             return CODE_CAGE_LOST

@@ -202,6 +202,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             for c, row in zip(cases, rows):
                 rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
                 if rec is None:
+                    # the sweep's own file, incomplete or damaged: it is run again and replaced
+                    (cases_dir / f"{c.hash}.h5").unlink(missing_ok=True)
                     todo.append(c)
                 else:
                     row.update(rec, archive=f"cases/{c.hash}.h5")

@@ -67,7 +67,7 @@ def run_case(case_hash: str, toml_text: str, target: Path) -> dict:
     t0 = time.perf_counter()
     try:
         scenario = scenario_from_toml(toml_text)
-        out = run_scenario(scenario, target, figures=False, progress=False)
+        out = run_scenario(scenario, target, figures=False, progress=False, exclusive=False)
         res = out.result
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res)))

@@ -1,0 +1,286 @@
+"""Output-path policy: where a run may write, and who may write there at once.
+
+Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any work:
+
+* a default output name (``outputs/<name>.h5``) never leaves the output folder;
+* an archive path ends in ``.h5`` / ``.hdf5`` (so ``-o my.toml`` or ``-o notes.txt`` is refused);
+* the target is never the input scenario file;
+* an existing target that is not a bearingsim archive is not replaced;
+* a figure path of the run (``<stem>_*.png``) that is a directory is refused before the run;
+* one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target, held from
+  the start of the run until its archive and figures are written, then removed; a second run to the
+  same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
+  the next run takes over: the lock dies with its process);
+* temporary archives ``.<name>.tmp-<pid>`` whose process is gone (a run killed by SIGKILL or a power
+  cut) are removed on the next run into that folder, with a note on stderr.
+"""
+from __future__ import annotations
+
+import contextlib
+import errno
+import fcntl
+import os
+import re
+import sys
+from pathlib import Path
+
+from bearingsim.errors import UserError
+
+ARCHIVE_SUFFIXES = (".h5", ".hdf5")
+# ArchiveWriter's temporary name, ".<name>.h5.tmp-<pid>"; only such files that are empty or start with
+# the HDF5 signature are removed, so another program's temporary file is never touched.
+_TMP_RE = re.compile(r"^\..+\.(?:h5|hdf5)\.tmp-(\d+)$")
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def default_output(name: str, root: str | Path = "outputs") -> Path:
+    """``root/<name>.h5``, refusing a name that would resolve outside ``root``.
+
+    Parameters
+    ----------
+    name : scenario name (already checked by the scenario schema to be a plain file name)
+    root : output folder
+    """
+    root = Path(root)
+    out = root / f"{name}.h5"
+    if out.resolve().parent != root.resolve():
+        raise UserError(f"name: {name!r} is not a plain file name (it would write outside {root}/)")
+    return out
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None) -> Path:
+    """Check that a run may write its archive at ``path`` (rules in the module docstring).
+
+    Parameters
+    ----------
+    path : archive path
+    inputs : files the run reads (the scenario file); the target may not be one of them
+    is_archive : ``is_archive(path) -> bool``, what may be replaced (:func:`bearingsim.archive.is_archive`);
+        None: the file signature of HDF5
+
+    Returns
+    -------
+    Path
+        ``path`` as a :class:`~pathlib.Path`.
+    """
+    p = Path(path)
+    if "\x00" in str(p):
+        raise UserError(f"{str(p)!r}: output path contains a NUL byte")
+    for src in inputs:
+        if src and _same_file(p, Path(src)):
+            raise UserError(f"{p}: output path is the input scenario file; choose another -o")
+    if p.is_dir():
+        raise UserError(f"{p}: output path is a directory")
+    if p.suffix.lower() not in ARCHIVE_SUFFIXES:
+        raise UserError(f"{p}: archive path must end in .h5 or .hdf5 (got {p.suffix or 'no suffix'!r})")
+    if is_archive is None:
+        def is_archive(q):
+            with open(q, "rb") as fh:
+                return fh.read(8) == _HDF5_SIGNATURE
+    if p.exists() and not is_archive(p):
+        raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another -o)")
+    stem = p.with_suffix("")
+    if p.parent.is_dir():
+        for fig in p.parent.glob(f"{_glob_escape(stem.name)}_*.png"):
+            if fig.is_dir():
+                raise UserError(f"{fig}: figure path is a directory")
+    return p
+
+
+def _glob_escape(s: str) -> str:
+    return re.sub(r"([*?\[])", r"[\1]", s)
+
+
+def _pid_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's live process
+        return True
+    return True
+
+
+def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
+    """Remove ``.<name>.tmp-<pid>`` files in ``folder`` whose process no longer exists.
+
+    Parameters
+    ----------
+    folder : output folder
+    report : callable taking one line (default: print to stderr)
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    folder = Path(folder)
+    report = report or (lambda line: print(line, file=sys.stderr))
+    removed = []
+    if not folder.is_dir():
+        return removed
+    for entry in folder.iterdir():
+        m = _TMP_RE.match(entry.name)
+        if not m or not entry.is_file():
+            continue
+        pid = int(m.group(1))
+        if pid == os.getpid() or _pid_alive(pid):
+            continue
+        try:
+            with open(entry, "rb") as fh:
+                head = fh.read(len(_HDF5_SIGNATURE))
+        except OSError:
+            continue
+        if head and head != _HDF5_SIGNATURE:
+            continue
+        try:
+            entry.unlink()
+        except OSError as exc:
+            report(f"bearingsim: note: stale temporary file {entry} of a dead run (pid {pid}) "
+                   f"could not be removed ({exc.strerror})")
+            continue
+        removed.append(entry)
+        report(f"bearingsim: note: removed stale temporary file {entry} of a dead run (pid {pid})")
+    return removed
+
+
+class OutputLock:
+    """Exclusive, non-blocking ``fcntl.flock`` on ``.<name>.lock`` beside an archive path.
+
+    Released when the process exits, however it exits, so a killed run never leaves a held lock.
+
+    Parameters
+    ----------
+    path : archive path the lock guards
+    """
+
+    def __init__(self, path: str | Path):
+        p = Path(path)
+        self.path = p
+        self.lock_path = p.with_name(f".{p.name}.lock")
+        self._fd: int | None = None
+
+    def acquire(self) -> "OutputLock":
+        for _ in range(10):  # the holder may unlink the lock file between our open and flock: retry
+            try:
+                self.path.parent.mkdir(parents=True, exist_ok=True)
+                fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
+            except OSError as exc:
+                raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                os.close(fd)
+                if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    raise UserError(f"{self.path}: another bearingsim run is writing this archive "
+                                    f"(lock {self.lock_path.name} is held); wait for it or choose another -o") from None
+                raise UserError(f"{self.path}: cannot lock output ({exc.strerror or exc})") from None
+            try:
+                same = os.stat(self.lock_path).st_ino == os.fstat(fd).st_ino
+            except FileNotFoundError:
+                same = False
+            if same:
+                self._fd = fd
+                return self
+            os.close(fd)
+        raise UserError(f"{self.path}: cannot lock output (lock file keeps changing)")
+
+    def release(self) -> None:
+        """Remove the lock file, then unlock: nothing is left beside the archive."""
+        if self._fd is not None:
+            try:
+                self.lock_path.unlink()
+            except OSError:
+                pass
+            fcntl.flock(self._fd, fcntl.LOCK_UN)
+            os.close(self._fd)
+            self._fd = None
+
+    def __enter__(self) -> "OutputLock":
+        return self.acquire()
+
+    def __exit__(self, *exc) -> bool:
+        self.release()
+        return False
+
+
+@contextlib.contextmanager
+def quiet_stderr():
+    """Send file descriptor 2 to /dev/null for the block: while an archive is written, HDF5 prints its
+    error stack there for each object it fails to flush when the disk is full (and carries on); the
+    failure itself surfaces as an ``OSError`` at the latest when the file is closed."""
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError):  # no stderr to quieten (closed)
+        yield
+        return
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(devnull, 2)
+    os.close(devnull)
+    try:
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+
+
+def close_quietly(f) -> None:
+    """Close an h5py file inside :func:`quiet_stderr`."""
+    with quiet_stderr():
+        f.close()
+
+
+class ArchiveWriteError(UserError):
+    """The archive could not be written (full disk, I/O error). After such a failure HDF5's objects
+    cannot be released cleanly (h5py prints error stacks while freeing them and the interpreter may
+    crash at exit), so :func:`write_error` sends file descriptor 2 to /dev/null and keeps the real
+    stderr in ``stderr_fd``; :func:`bearingsim.cli.main` prints the one line there and ends the
+    process at once (the temporary file is already removed)."""
+
+    stderr_fd: int | None = None
+
+
+def write_error(path: str | Path, exc: OSError) -> ArchiveWriteError:
+    """A one-line :class:`ArchiveWriteError` for an OS error while writing ``path``."""
+    code = getattr(exc, "errno", None)
+    if code is None or f"errno = {code}," not in str(exc):  # h5py puts the real errno in its message
+        for c in (errno.ENOSPC, errno.EIO, errno.EDQUOT, errno.EFBIG, errno.EROFS):
+            if f"errno = {c}," in str(exc):
+                code = c
+                break
+    what = os.strerror(code) if code else "write failed"
+    err = ArchiveWriteError(f"{path}: cannot write archive ({what}); nothing was written")
+    try:
+        sys.stderr.flush()
+        err.stderr_fd = os.dup(2)
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 2)
+        os.close(devnull)
+    except OSError:
+        err.stderr_fd = None
+    return err
+
+
+_CONTROL_RE = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def printable(text: str, keep_newlines: bool = True) -> str:
+    """``text`` with control characters (terminal escape sequences included) shown as ``\\xNN``.
+
+    Parameters
+    ----------
+    text : text read from a file or given by a user
+    keep_newlines : keep ``\\n`` (multi-line listings); otherwise it is escaped too (one-line errors)
+    """
+    text = str(text)
+    if not keep_newlines:
+        text = text.replace("\n", "\\n")
+    return _CONTROL_RE.sub(lambda m: f"\\x{ord(m.group()):02x}", text)

@@ -1,0 +1,112 @@
+"""Plausibility of a finished run, checked before anything is written (issue 14).
+
+A run that finishes with non-finite numbers, an inner ring displaced further than the contact law
+allows for its load, or too few time-series samples is not a result: :func:`check` raises
+:class:`bearingsim.errors.SimulationUnstable` (exit 3) with advice naming the key to change, and the
+caller writes no archive.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from bearingsim import laws
+from bearingsim.errors import SimulationUnstable
+
+# The mean inner-ring displacement along the load is at most half the diametral clearance plus the
+# approach at the inner and the outer race of a roller that carries the whole load alone; twice that
+# bound leaves room for vibration about the mean. A larger displacement means the ring has left the
+# rollers (a blown-up or unloaded ring), not a result.
+DISPLACEMENT_MARGIN = 2.0
+# Fewest recorded samples of the cage orbit that make a figure and a mean of it.
+MIN_ORBIT_SAMPLES = 2
+# Steps in which the quasi-static inner ring's force balance (Newton iteration) did not converge: a
+# few isolated steps are harmless (the next step starts again from the last iterate) and are reported
+# as a note; in more than 1 % of the steps the ring equilibrium the model assumes is not met.
+MAX_NEWTON_FAILURE_FRACTION = 0.01
+
+
+def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
+    """Approach [m] of one roller pressed on one raceway with ``load_N`` [N]: Palmgren's line contact
+    ``Q = K delta^(10/9)`` (:func:`bearingsim.laws.palmgren_stiffness`; Harris & Kotzalas Eq. 6.40 writes
+    the same law as delta = 3.84e-5 Q^0.9 / l^0.8 in mm)."""
+    return (max(load_N, 0.0) / laws.palmgren_stiffness(roller_length_m)) ** 0.9
+
+
+def max_ring_displacement_m(p) -> float:
+    """Largest plausible mean inner-ring displacement [m] for the load of the SI parameters ``p``."""
+    load = p.operating.radial_load
+    if p.multibody.inner_ring_mass is not None:  # a dynamic ring carries its own weight too
+        load += p.multibody.inner_ring_mass * laws.STANDARD_GRAVITY
+    bound = 0.5 * p.bearing.radial_clearance + 2.0 * palmgren_approach_m(load, p.bearing.roller_length)
+    return DISPLACEMENT_MARGIN * bound
+
+
+def _nonfinite(summary: dict) -> list[str]:
+    bad = []
+    for k, v in summary.items():
+        if isinstance(v, (bool, np.bool_, str)):
+            continue
+        try:
+            if not math.isfinite(float(v)):
+                bad.append(k)
+        except (TypeError, ValueError):
+            continue
+    return bad
+
+
+def check(result) -> list[str]:
+    """Raise :class:`SimulationUnstable` if ``result`` (:class:`bearingsim.results.Result`) is not a
+    plausible run of its parameters.
+
+    Returns
+    -------
+    list of str
+        One-line notes for the user about a run that is plausible but not clean.
+    """
+    notes = []
+    p = result.parameters
+    summary = dict(result.summary)
+    bad = _nonfinite(summary)
+    if bad:
+        if p.model == "reduced" and set(bad) <= {"first_impact_speed_m_s", "first_impact_energy_J"}:
+            advice = ("the no-load pass has no rear-face impact; reduced.load_zone_half_angle_deg "
+                      f"= {summary.get('load_zone_half_angle_deg', float('nan')):.4g} deg leaves too short a pass")
+        else:
+            advice = _advice(p)
+        raise SimulationUnstable(f"non-finite result ({', '.join(sorted(bad))}); {advice}")
+    for name in ("I_dec", "I_acc"):
+        arr = np.asarray(result.per_rotation.get(name, np.zeros(0)))
+        if arr.size and not np.all(np.isfinite(arr)):
+            raise SimulationUnstable(f"non-finite {name} per rotation; {_advice(p)}")
+    if p.model == "multibody":
+        disp = abs(float(summary.get("inner_ring_displacement_m", 0.0)))
+        limit = max_ring_displacement_m(p)
+        if disp > limit:
+            raise SimulationUnstable(
+                f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
+                f"for this load and clearance; {_advice(p)}")
+        orbit = result.get("cage_orbit")
+        samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
+        if samples < MIN_ORBIT_SAMPLES:
+            raise SimulationUnstable(
+                f"{samples} time-series samples recorded; raise numerics.output_rate_hz or numerics.rotations")
+        fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
+        steps = int(summary.get("steps", 0) or 0)
+        if fails and steps:
+            msg = (f"the inner ring's force balance did not converge in {fails} of {steps} steps "
+                   f"({fails / steps:.2%}; provenance ring_newton_failures)")
+            if fails > MAX_NEWTON_FAILURE_FRACTION * steps:
+                raise SimulationUnstable(f"{msg}; set a smaller numerics.dt_s or multibody.inner_ring=dynamic")
+            notes.append(f"bearingsim: note: {msg}")
+    return notes
+
+
+def _advice(p) -> str:
+    if p.model == "multibody" and p.multibody.inner_ring != "quasi_static":
+        return ("check multibody.inner_ring_mass_kg and operating.radial_load_N, or set "
+                "multibody.inner_ring=quasi_static, or a smaller numerics.dt_s")
+    if p.model == "multibody":
+        return "check operating.radial_load_N and operating.inner_ring_speed_rpm, or set a smaller numerics.dt_s"
+    return "check bearing.roller_mass_kg, lubrication.drag_coefficient and reduced.load_zone_half_angle_deg"

@@ -332,6 +332,8 @@ def model_of(path) -> str:
     f = open_archive(path)
     try:
         return str(f["bearingsim"].attrs["model"])
+    except KeyError:
+        raise UserError(f"{path}: damaged archive (no /bearingsim@model: which model wrote it is unknown)") from None
     finally:
         f.close()
 

@@ -363,14 +363,18 @@ class MultibodyResult(Result):
         per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e18  # cage rotations per hour, m^3 -> µm^3
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = plt.subplots(figsize=(9, 4))
+        bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16)"),
+                (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16)"),
+                (self.get("wear/sliding_work_front"), "front face, sliding work"),
+                (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
+        top = max(float(np.max(v)) * per_hour for v, _ in bars)
+        exp = 3 * int(math.floor(math.log10(top) / 3.0)) if top > 0 else 0  # label in 10^(3k) µm³/h
         wdt = 0.2
-        ax.bar(x - 1.5 * wdt, self.get("wear/paper_index_front") * per_hour, wdt, label="front face, impulse index (Eq. 16)")
-        ax.bar(x - 0.5 * wdt, self.get("wear/paper_index_rear") * per_hour, wdt, label="rear face, impulse index (Eq. 16)")
-        ax.bar(x + 0.5 * wdt, self.get("wear/sliding_work_front") * per_hour, wdt, label="front face, sliding work")
-        ax.bar(x + 1.5 * wdt, self.get("wear/sliding_work_rear") * per_hour, wdt, label="rear face, sliding work")
+        for j, (v, label) in enumerate(bars):
+            ax.bar(x + (j - 1.5) * wdt, v * per_hour / 10.0**exp, wdt, label=label)
         ax.set_xlabel("pocket")
         ax.set_xticks(x)
-        ax.set_ylabel("Archard wear volume [µm³ per hour]")
+        ax.set_ylabel("Archard wear volume\n" + (f"[10$^{{{exp}}}$ µm³ per hour]" if exp else "[µm³ per hour]"))
         ax.set_title(f"{self.title()}\nwear of the pocket faces at this speed (k = {self.parameters.wear.wear_coefficient:g}, "
                      f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
         legend_outside(ax)

@@ -55,6 +55,25 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def write_csv(path: str | Path, header, rows) -> Path:
+    """Write a CSV table (``header``, then ``rows`` of already formatted cells) through a temporary name
+    and a rename, so a reader never sees half a table; return the path."""
+    import csv
+
+    path = Path(path)
+    tmp = path.with_name(path.name + ".tmp")
+    try:
+        with open(tmp, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            w.writerows(rows)
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
 def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None) -> Path:
     """Check that a run may write its archive at ``path`` (rules in the module docstring).
 

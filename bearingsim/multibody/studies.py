@@ -9,13 +9,13 @@ speed (the paper's conditions, phi = 23.5 deg).
 """
 from __future__ import annotations
 
-import csv
 import math
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
+from bearingsim.outputs import write_csv
 from bearingsim.scenario import resolve
 
 RIG_SPEEDS_RPM = (500, 1000, 2000, 3000, 4000)
@@ -87,15 +87,11 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     from bearingsim.plotting import legend_outside, plt, save_figure
 
     outdir = Path(outdir)
-    csv_path = outdir / "rig_idec_vs_speed.csv"
-    tmp = csv_path.with_name(csv_path.name + ".tmp")
-    with open(tmp, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(CSV_COLUMNS)
-        for r in rows:
-            vals = {**r, "pocket0_over_reduced": r["pocket0_I_dec_mean_Ns"] / r["reduced_I_dec_Ns"]}
-            w.writerow([f"{vals[c]:g}" if c in ("rpm", "rotations") else f"{vals[c]:.6e}" for c in CSV_COLUMNS])
-    tmp.replace(csv_path)
+    cells = []
+    for r in rows:
+        vals = {**r, "pocket0_over_reduced": r["pocket0_I_dec_mean_Ns"] / r["reduced_I_dec_Ns"]}
+        cells.append([f"{vals[c]:g}" if c in ("rpm", "rotations") else f"{vals[c]:.6e}" for c in CSV_COLUMNS])
+    csv_path = write_csv(outdir / "rig_idec_vs_speed.csv", CSV_COLUMNS, cells)
 
     n = np.array([r["rpm"] for r in rows])
     fig, ax = plt.subplots(figsize=(8.5, 4.5))

@@ -1,13 +1,13 @@
 """Studies of the reduced model: the Fig. 9 analog (I_dec against speed) of `bearingsim validate`."""
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from bearingsim.reduced.core import PassInputs
 from bearingsim.reduced.event import solve_event
+from bearingsim.outputs import write_csv
 from bearingsim.parameters import Parameters
 from bearingsim.scenario import resolve
 
@@ -57,14 +57,9 @@ def save_fig9(outdir: str | Path) -> list[Path]:
     outdir = check_writable_dir(outdir)
     table = fig9_table()
     cols = list(table)
-    csv_path = outdir / "fig9_idec_vs_speed.csv"
-    tmp = csv_path.with_name(csv_path.name + ".tmp")
-    with open(tmp, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(cols)
-        for i in range(len(table["speed_rpm"])):
-            w.writerow([f"{table['speed_rpm'][i]:g}"] + [f"{table[c][i]:.6e}" for c in cols[1:]])
-    tmp.replace(csv_path)
+    csv_path = write_csv(outdir / "fig9_idec_vs_speed.csv", cols,
+                         [[f"{table['speed_rpm'][i]:g}"] + [f"{table[c][i]:.6e}" for c in cols[1:]]
+                          for i in range(len(table["speed_rpm"]))])
 
     fig, ax = plt.subplots(figsize=(6.5, 4.5))
     n = table["speed_rpm"]

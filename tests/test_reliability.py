@@ -310,6 +310,16 @@ CASES: list[Case] = [
          ("a.h5:/scenario", "name"), setup=_setup_archive()),
     Case("compare-second-missing", "archive tools", ["compare", "{tmp}", "{tmp}/b.h5"], 2, ("is a directory",)),
     Case("compare-directory", "archive tools", ["compare", "{tmp}", "{tmp}"], 2, ("is a directory",)),
+    # sweeps: refused before anything runs (the sweep's own failures, resume and signals: tests/test_sweep.py)
+    Case("sweep-key-twice", "sweep", ["sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=500,1000",
+                                      "--param", "operating.inner_ring_speed_rpm=2000", "-o", "{tmp}/sw"], 2,
+         ("operating.inner_ring_speed_rpm",)),
+    Case("sweep-unknown-key", "sweep", ["sweep", PAPER, "--param", "bearing.nope=1,2", "-o", "{tmp}/sw"], 2,
+         ("bearing.nope",)),
+    Case("sweep-bad-value", "sweep", ["sweep", PAPER, "--param", "contact.restitution=0.5,7", "-o", "{tmp}/sw"], 2,
+         ("contact.restitution",)),
+    Case("sweep-missing-scenario", "sweep", ["sweep", "{tmp}/nope.toml", "--param", "contact.restitution=0.5",
+                                             "-o", "{tmp}/sw"], 2, ("nope.toml",)),
     # runs that work
     Case("works-reduced", "works", run(), 0, ("wrote",), allow_new=("out.h5",)),
     Case("note-ring-newton-failures", "works", run(*S("numerics.rotations=2"), scenario=SCENARIOS / "multibody_6000rpm.toml"),

@@ -69,6 +69,12 @@ def check(result) -> list[str]:
     p = result.parameters
     summary = dict(result.summary)
     bad = _nonfinite(summary)
+    no_impact = {"first_impact_speed_m_s", "first_impact_energy_J"}
+    if p.model == "multibody" and bad and set(bad) <= no_impact:
+        # NaN is defined there: no rear-face impact above the impact threshold in any no-load pass
+        notes.append("bearingsim: note: no rear-face impact was recorded in the no-load zone; "
+                     "first_impact_speed_m_s and first_impact_energy_J are NaN (none)")
+        bad = []
     if bad:
         if p.model == "reduced" and set(bad) <= {"first_impact_speed_m_s", "first_impact_energy_J"}:
             advice = ("the no-load pass has no rear-face impact; reduced.load_zone_half_angle_deg "

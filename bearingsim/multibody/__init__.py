@@ -211,7 +211,6 @@ class MultibodyResult(Result):
             "cage_slip": float(1.0 - cage_speed_mean / op.omega_c),
             "load_zone_half_angle_deg": float(phi_deg),
             "load_zone_contact_half_angle_deg": float(phi_contact_deg),
-            "inner_ring_displacement_m": float(-ring_centre_mean[1]),
             "torque_balance_residual": float(torque_residual),
             "max_penetration_m": float(max(g["maxpen_front"], g["maxpen_rear"])),
             "max_penetration_all_m": float(g["maxpen_all"]),
@@ -219,6 +218,8 @@ class MultibodyResult(Result):
             "dt_s": float(raw["dt"]),
             "steps": int(raw["steps"]),
         }
+        if full:  # the reduced-equivalent scene has no inner ring
+            summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
         desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
         pr = "results/per_rotation"
         data = {

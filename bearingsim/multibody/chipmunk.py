@@ -38,6 +38,7 @@ import pymunk
 import pymunk.batch as pb
 from numba import njit, types
 
+from bearingsim import laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import loop as lp
@@ -321,4 +322,4 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hdr, st0, 
             return lp.CODE_BLOCK_FULL
 
 
-drop_stale_caches(__name__, (fk, rk, lp, _reduced_core))  # advance() compiles in the step kernels
+drop_stale_caches(__name__, (fk, rk, lp, _reduced_core, laws))  # advance() compiles in the step kernels

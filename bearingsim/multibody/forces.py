@@ -48,6 +48,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from bearingsim import laws
+
 
 class RacewayParams(NamedTuple):
     """Inputs of :func:`raceway_forces` that are fixed for a run. SI throughout."""
@@ -86,8 +88,6 @@ DIAG = np.dtype([
 ], align=True)
 
 TEN_NINTHS = 10.0 / 9.0
-DRAG_N_EXP = 0.246
-DRAG_V_EXP = 0.648
 
 
 @njit(cache=True)
@@ -95,7 +95,7 @@ def _normal_force(delta, delta_rate, K, c_r, d_fade):
     """Normal force [N], its derivative in delta [N/m] and in delta_rate [N s/m] of one contact."""
     if delta <= 0.0:
         return 0.0, 0.0, 0.0
-    q_el = K * delta**TEN_NINTHS
+    q_el = laws.palmgren_load(K, delta)  # Q = K delta^(10/9), delta > 0 here
     k_lin = TEN_NINTHS * K * delta ** (1.0 / 9.0)
     fade = delta / d_fade if delta < d_fade else 1.0
     dfade = 1.0 / d_fade if delta < d_fade else 0.0
@@ -227,7 +227,7 @@ def _contact(
     u_ent = 0.5 * (abs(w - orbit) * rr + abs(omega_race - orbit) * r_race_geom)
     u_ref = max(u_ent, prm.min_entrainment)
     # oil-film rolling resistance, Eq. (2), on the roller centre against its motion relative to the race
-    fo = prm.drag_coefficient * q**DRAG_N_EXP * u_ent**DRAG_V_EXP
+    fo = laws.oil_film_drag_scalar(prm.drag_coefficient, q, u_ent)  # Eq. (2) with this contact's N and V
     rel = vx * tx + vy * ty - w_race
     weps = prm.drag_direction_eps
     sq = math.sqrt(rel * rel + weps * weps)
@@ -408,3 +408,8 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         ring_v[0] += h * frx / ring_mass
         ring_v[1] += h * fry / ring_mass
     return it
+
+
+from bearingsim._jit import drop_stale_caches  # noqa: E402
+
+drop_stale_caches(__name__, (laws,))  # the contact kernels compile in the laws of laws.py

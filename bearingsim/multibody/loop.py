@@ -30,6 +30,7 @@ import numpy as np
 import pymunk.batch as pb
 from numba import njit
 
+from bearingsim import laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import recorder as rk
@@ -333,4 +334,4 @@ class PlainLoop:
                 return CODE_BLOCK_FULL
 
 
-drop_stale_caches(__name__, (fk, rk, _reduced_core))  # the step kernels compile in the force and recording kernels
+drop_stale_caches(__name__, (fk, rk, _reduced_core, laws))  # the step kernels compile in the force and recording kernels

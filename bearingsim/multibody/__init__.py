@@ -61,7 +61,7 @@ from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
-                                       PenetrationExceeded, choose_dt, run)
+                                       PenetrationExceeded, choose_dt, paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.results import MemorySink, Result
 
@@ -172,12 +172,13 @@ class MultibodyResult(Result):
             tq = raw["tq_bin"]
             load_inner = np.where(tq > 0, raw["q_bin"]["inner"] / np.maximum(tq, 1e-300), 0.0)
             load_outer = np.where(tq > 0, raw["q_bin"]["outer"] / np.maximum(tq, 1e-300), 0.0)
-        full = scene == "full"
+        # every scene but the reduced-equivalent one has an inner ring: its load zone emerges
+        with_ring = not paper_assumptions(scene)
         # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
         # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
         # (wider with discrete rollers: the laterally free ring shifts towards the exiting roller)
         ring_centre_mean = raw["ring_centre_mean"]
-        if full:
+        if with_ring:
             phi_deg = math.degrees(laws.load_zone_from_displacement(-ring_centre_mean[1], geo.radial_clearance))
             phi_contact_deg = _load_zone_half_angle(raw["q_bin"], raw["tq_bin"])
         else:
@@ -239,7 +240,7 @@ class MultibodyResult(Result):
             "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
             "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
         }
-        if full:
+        if with_ring:
             data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
             data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
         imp = raw["impacts"]

@@ -189,6 +189,8 @@ class MultibodyResult(Result):
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
         momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
         drive = abs(per["I_acc"].sum()) * geo.pitch_radius
+        if drive == 0.0:  # nothing drives the cage (a kinematic cage turned by its prescription): scale by
+            drive = abs(per["I_dec"].sum()) * geo.pitch_radius  # the braking; -1 = all from the prescription
         torque_residual = ((g["tau_normal"] + g["tau_friction"] - momentum_change) / drive if drive > 0 else float("nan"))
         w_ = p.wear
         wear = {

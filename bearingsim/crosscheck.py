@@ -284,7 +284,7 @@ def verdicts(rows: list[dict]) -> list[str]:
             d = b["I_dec_mean_Ns"] - a["I_dec_mean_Ns"]
             se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
             sig = "significant" if abs(d) > 2.0 * se else "not significant"
-            parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig}, 2 SE = {2 * se * 1e3:.2f})")
+            parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig}: 2 SE = {2 * se * 1e3:.2g})")
         big = max(rs[1:], key=lambda r: abs(r["change_from_previous"]))
         out.append(f"{rpm:g} rpm: the largest change of I_dec is at rung {big['rung']} {big['scene']} "
                    f"({big['change_from_previous'] * 1e3:+.2f} mN s; full - reduced = "

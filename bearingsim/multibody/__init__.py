@@ -12,6 +12,12 @@ Scenes (``[multibody] scene``)
     The load zone emerges from the contact mechanics. Roller-cage contacts are pymunk contacts
     (restitution e, friction mu) on pocket faces that are arcs around the pocket centre (pocket
     diameter D + s), front and rear faces as separate polylines of a few segments.
+``"centred_cage"``
+    As ``"full"``, but the cage centre is held on the bearing axis by a pivot joint (the cage still
+    turns freely under its contact torques): rung 4 of ``bearingsim crosscheck``.
+``"kinematic_cage"``
+    As ``"full"`` (raceway contacts, traction, inner ring: the load zone emerges), but the cage is a
+    kinematic body centred on the axis turning at the epicyclic speed: rung 3 of the cross-check.
 ``"reduced_equivalent"``
     The seed paper's assumptions in the plane: cage kinematic at the epicyclic speed, no inner ring,
     roller spin fixed, no traction. Inside the load zone (``|theta| < phi``; phi =

@@ -73,6 +73,13 @@ def _cmd_plot(args) -> int:
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT
 
+    from bearingsim import crosscheck
+
+    if archive.is_table_file(path, crosscheck.INDEX_FORMAT):  # a cross-check's index: its figure
+        folder = check_writable_dir(args.output) if args.output else path.parent
+        for png in crosscheck.plot_crosscheck(path, folder):
+            print(f"wrote {png}")
+        return 0
     if archive.is_table_file(path, INDEX_FORMAT):  # a sweep's index: its figures
         from bearingsim.sweeps import plot_sweep_index
 
@@ -178,6 +185,33 @@ def _cmd_sweep(args) -> int:
                          scheduler=args.scheduler, figures=not args.no_plots)
 
 
+def _cmd_crosscheck(args) -> int:
+    import time
+
+    from bearingsim import crosscheck as cc
+    from bearingsim.scenario import load_scenario
+
+    _refuse_archive_as_scenario(args.scenario)
+    speeds = cc.parse_speeds(args.speeds)
+    if args.rotations < 1:
+        raise UserError(f"--rotations {args.rotations}: give at least 1 recorded rotation")
+    scenario = load_scenario(args.scenario, args.set)
+    cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
+    t0 = time.perf_counter()
+    rows = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, args.jobs)
+    wall = time.perf_counter() - t0
+    print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
+          f"{args.rotations} rotations each, {args.jobs} process(es), {wall:.1f} s; impulses per pocket and cage "
+          f"rotation, mean over all pockets ± batch-means standard error")
+    print(cc.format_table(rows))
+    for line in cc.verdicts(rows):
+        print(line)
+    for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
+        print(f"wrote {Path(args.output) / name}")
+    print(f"wrote {len(rows)} rung archives in {Path(args.output) / 'rungs'}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="bearingsim", description="Roller/cage dynamics and cage-wear impulse.")
     p.add_argument("--version", action="version", version=f"bearingsim {__version__}")
@@ -243,6 +277,16 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     s.add_argument("--no-plots", action="store_true", help="index only, no figures")
     s.set_defaults(func=_cmd_sweep)
+    cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
+                                           "(README: Cross-check)")
+    cc.add_argument("scenario", help="multibody scenario TOML, full scene")
+    cc.add_argument("--speeds", default="1000,3000,6000", help="inner-ring speeds in rpm (default 1000,3000,6000)")
+    cc.add_argument("--rotations", type=int, default=10, help="recorded cage rotations of every rung (default 10)")
+    cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a scenario key (repeatable)")
+    cc.add_argument("-o", "--output", default="outputs/crosscheck", help="output folder")
+    cc.add_argument("-j", "--jobs", type=int, default=2, help="parallel runs (default 2)")
+    cc.set_defaults(func=_cmd_crosscheck)
     return p
 
 

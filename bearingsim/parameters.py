@@ -106,7 +106,7 @@ class ReducedOptions:
 class MultibodyOptions:
     """Options of the multi-pocket model."""
 
-    scene: str  # "full" or "reduced_equivalent"
+    scene: str  # "full", "reduced_equivalent", "kinematic_cage" or "centred_cage" (README: Cross-check)
     inner_ring: str  # "auto", "quasi_static" or "dynamic"
     inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
     pocket_face_half_angle: float  # angular half-width of each pocket face arc [rad]

@@ -151,7 +151,7 @@ class NumericsSection(_Section):
 
 
 class MultibodySection(_Section):
-    scene: Literal["full", "reduced_equivalent"]
+    scene: Literal["full", "reduced_equivalent", "kinematic_cage", "centred_cage"]
     traction_mu_max: float = Field(ge=0.0)
     traction_slip_ref: float = Field(gt=0.0)
     inner_ring: Literal["auto", "quasi_static", "dynamic"]

@@ -12,6 +12,12 @@ Scenes (``[multibody] scene``)
     The load zone emerges from the contact mechanics. Roller-cage contacts are pymunk contacts
     (restitution e, friction mu) on pocket faces that are arcs around the pocket centre (pocket
     diameter D + s), front and rear faces as separate polylines of a few segments.
+``"centred_cage"``
+    As ``"full"``, but the cage centre is held on the bearing axis by a pivot joint (the cage still
+    turns freely under its contact torques): rung 4 of ``bearingsim crosscheck``.
+``"kinematic_cage"``
+    As ``"full"`` (raceway contacts, traction, inner ring: the load zone emerges), but the cage is a
+    kinematic body centred on the axis turning at the epicyclic speed: rung 3 of the cross-check.
 ``"reduced_equivalent"``
     The seed paper's assumptions in the plane: cage kinematic at the epicyclic speed, no inner ring,
     roller spin fixed, no traction. Inside the load zone (``|theta| < phi``; phi =
@@ -61,7 +67,7 @@ from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
-                                       PenetrationExceeded, choose_dt, run)
+                                       PenetrationExceeded, choose_dt, paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.results import MemorySink, Result
 
@@ -172,12 +178,13 @@ class MultibodyResult(Result):
             tq = raw["tq_bin"]
             load_inner = np.where(tq > 0, raw["q_bin"]["inner"] / np.maximum(tq, 1e-300), 0.0)
             load_outer = np.where(tq > 0, raw["q_bin"]["outer"] / np.maximum(tq, 1e-300), 0.0)
-        full = scene == "full"
+        # every scene but the reduced-equivalent one has an inner ring: its load zone emerges
+        with_ring = not paper_assumptions(scene)
         # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
         # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
         # (wider with discrete rollers: the laterally free ring shifts towards the exiting roller)
         ring_centre_mean = raw["ring_centre_mean"]
-        if full:
+        if with_ring:
             phi_deg = math.degrees(laws.load_zone_from_displacement(-ring_centre_mean[1], geo.radial_clearance))
             phi_contact_deg = _load_zone_half_angle(raw["q_bin"], raw["tq_bin"])
         else:
@@ -188,6 +195,8 @@ class MultibodyResult(Result):
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
         momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
         drive = abs(per["I_acc"].sum()) * geo.pitch_radius
+        if drive == 0.0:  # nothing drives the cage (a kinematic cage turned by its prescription): scale by
+            drive = abs(per["I_dec"].sum()) * geo.pitch_radius  # the braking; -1 = all from the prescription
         torque_residual = ((g["tau_normal"] + g["tau_friction"] - momentum_change) / drive if drive > 0 else float("nan"))
         w_ = p.wear
         wear = {
@@ -218,7 +227,7 @@ class MultibodyResult(Result):
             "dt_s": float(raw["dt"]),
             "steps": int(raw["steps"]),
         }
-        if full:  # the reduced-equivalent scene has no inner ring
+        if with_ring:  # the reduced-equivalent scene has no inner ring
             summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
         desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
         pr = "results/per_rotation"
@@ -240,7 +249,7 @@ class MultibodyResult(Result):
             "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
             "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
         }
-        if full:
+        if with_ring:
             data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
             data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
         imp = raw["impacts"]

@@ -51,6 +51,17 @@ DT_CAP_S = 2.0e-5  # never above this (impact resolution: s / v_rel >> dt for v_
 PENETRATION_LIMIT = 0.01  # largest roller-cage overlap accepted, as a fraction of the pocket clearance
 
 
+# scenes whose cage is a pymunk KINEMATIC body turning at the epicyclic speed about the bearing axis
+KINEMATIC_CAGE_SCENES = ("reduced_equivalent", "kinematic_cage")
+
+
+def paper_assumptions(scene: str) -> bool:
+    """True for the scene that makes the reduced model's assumptions in the plane (no inner ring, no
+    traction, roller spin fixed, rollers held at the front of their pockets through the load zone):
+    ``reduced_equivalent``. Every other scene has the inner ring, traction and free spin."""
+    return scene == "reduced_equivalent"
+
+
 class PenetrationExceeded(Exception):
     """A roller overlapped a cage face by more than ``PENETRATION_LIMIT`` of s: the step is too long
     for the approach speeds of this scene (the run is stopped, not written)."""
@@ -76,7 +87,7 @@ def inner_ring_model(p):
     bearing carries (the paper's rig), ``M = W / g_n``.
     """
     mb = p.multibody
-    if mb.scene != "full":
+    if paper_assumptions(mb.scene):
         return 0.0, "none (reduced-equivalent scene)"
     geo = p.bearing
     load = p.operating.radial_load
@@ -188,7 +199,11 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     geo = p.bearing
     op = p.operating
     scene_kind = p.multibody.scene
-    reduced_eq = scene_kind == "reduced_equivalent"
+    # two separate choices of the scene (README: Cross-check): the paper's assumptions (no inner ring,
+    # no traction, fixed spin, rollers held at the front of their pockets in the load zone, roller path
+    # on the pitch circle) and a kinematic cage turning at the epicyclic speed
+    reduced_eq = paper_assumptions(scene_kind)
+    kinematic = scene_kind in KINEMATIC_CAGE_SCENES
     n = geo.roller_count
     if n < 3:
         raise UserError(f"bearing.roller_count = {n}: the multibody model needs at least 3 rollers")
@@ -208,8 +223,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     ri_race = geo.inner_race_radius - 0.25 * pd
 
     sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,
-                     n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=reduced_eq, spin_free=not reduced_eq,
-                     flat_pockets=p.multibody.flat_pockets)
+                     n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=kinematic, spin_free=not reduced_eq,
+                     flat_pockets=p.multibody.flat_pockets, centred_cage=scene_kind == "centred_cage")
     space = sc.space
     nb = n + 1
     # rollers start on the outer race (centrifugal), moving with the cage

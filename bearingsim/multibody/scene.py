@@ -77,7 +77,7 @@ def face_polyline(centre, e_t, e_r, radius, half_angle, n_seg):
 
 def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_angle: float,
                 n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
-                flat_pockets=()) -> Scene:
+                flat_pockets=(), centred_cage: bool = False) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
 
     Parameters
@@ -92,6 +92,8 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     spin_free : rollers may change their spin (False: infinite moment of inertia).
     spatial_hash : use pymunk's spatial-hash broadphase (faster than the default tree here).
     flat_pockets : indices of the pockets with flat faces (one segment each).
+    centred_cage : hold the (free) cage's centre on the bearing axis with a pivot joint to the static
+        body at (0, 0); it still turns freely under its contact torques (the ``centred_cage`` scene).
     """
     n = geometry.roller_count
     rr = geometry.roller_radius
@@ -158,5 +160,14 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
                 seg.filter = cage_filter
                 shapes.append(seg)
     space.add(cage, *shapes)
+    if centred_cage and not kinematic_cage:
+        # a static anchor of its own, not added to the space: the space's own static_body would be
+        # added to its bodies, and the batched body read expects rollers and cage only
+        anchor = pymunk.Body(body_type=pymunk.Body.STATIC)
+        pivot = pymunk.PivotJoint(anchor, cage, (0.0, 0.0), (0.0, 0.0))
+        # correct any drift of the centre within one step (like collision_bias = 0 above); the joint
+        # applies a force through the cage centre only, so it adds no torque about it
+        pivot.error_bias = 0.0
+        space.add(pivot)
     ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
     return Scene(space, rollers, cage, a, R, verts, ids)

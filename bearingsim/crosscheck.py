@@ -1,0 +1,306 @@
+"""The cross-check ladder (``bearingsim crosscheck``): the paper's reduced model against the whole bearing,
+one assumption at a time.
+
+Five rungs at each speed; each drops one assumption of the paper's model and keeps the others:
+
+1. ``reduced``: the reduced event model (one pocket, cage at the epicyclic speed, rollers leave the load
+   zone at the front of their pockets, no inner ring), built from the multibody scenario: the same
+   bearing, operating point, contact, lubrication and ``reduced.load_zone_half_angle_deg``;
+2. ``reduced_equivalent``: the same assumptions in pymunk, every pocket;
+3. ``kinematic_cage``: rollers driven by their raceway contacts (Hertz, traction, inner ring: the load
+   zone emerges); the cage still centred and turning at the epicyclic speed, prescribed;
+4. ``centred_cage``: the cage turns freely under its contact torques; its centre held on the axis;
+5. ``full``: the cage free in the plane, guided as the scenario says: the very run ``bearingsim run``
+   makes of the scenario at that speed (and with ``--rotations``, that many rotations).
+
+Numbers per rung: the mean impulses per pocket and cage rotation over all pockets (SI), their standard
+error from batch means (:func:`bearingsim.multibody.studies.batch_sem`) of the pocket-mean series over
+rotations (rotations of a chaotic scene are correlated), the mean first rear-impact speed and the cage
+slip. ``change_from_previous`` is the change of ``I_dec_mean_Ns`` from the rung before, so the changes
+add up to full minus reduced exactly.
+
+Outputs in ``DIR``: ``crosscheck.csv``, ``crosscheck.h5`` (the same table as an index, one dataset per
+column, ``archive`` naming each rung's archive), ``crosscheck.png`` (drawn from the index:
+:func:`plot_crosscheck`) and ``rungs/<rpm>rpm_<rung>_<scene>.h5`` (ordinary archives).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+
+INDEX_FORMAT = "bearingsim crosscheck index 1"
+DEFAULT_SPEEDS_RPM = (1000.0, 3000.0, 6000.0)
+DEFAULT_ROTATIONS = 10
+
+#: (rung, scene, the assumption of the paper's model this rung drops)
+RUNGS = (
+    (1, "reduced", "none: the paper's reduced model (one pocket; cage at the epicyclic speed)"),
+    (2, "reduced_equivalent", "one pocket: every pocket in the plane (pymunk)"),
+    (3, "kinematic_cage", "rollers carried through the load zone: raceway contacts (Hertz; traction; inner ring)"),
+    (4, "centred_cage", "cage speed prescribed: the cage turns under its contact torques"),
+    (5, "full", "cage centre on the axis: the cage free in the plane"),
+)
+
+COLUMNS = ("rpm", "rung", "scene", "relaxed", "I_dec_mean_Ns", "I_dec_sem_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns",
+           "first_impact_speed_m_s", "cage_slip", "change_from_previous")
+UNITS = {"rpm": "rpm", "rung": "1", "I_dec_mean_Ns": "N s", "I_dec_sem_Ns": "N s", "I_acc_mean_Ns": "N s",
+         "I_acc_sem_Ns": "N s", "first_impact_speed_m_s": "m/s", "cage_slip": "1", "change_from_previous": "N s"}
+
+
+def parse_speeds(text: str) -> tuple[float, ...]:
+    """``"1000,3000,6000"`` -> speeds [rpm]; a one-line UserError naming ``--speeds`` otherwise."""
+    try:
+        speeds = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        raise UserError(f"--speeds {text!r}: give inner-ring speeds in rpm separated by commas, e.g. 1000,3000,6000") from None
+    if not speeds or not all(math.isfinite(v) and v > 0 for v in speeds):
+        raise UserError(f"--speeds {text!r}: every speed must be a positive number of rpm")
+    if len(set(speeds)) != len(speeds):
+        raise UserError(f"--speeds {text!r}: a speed is given twice")
+    return speeds
+
+
+def rung_scenarios(scenario, rpm: float, rotations: int | None = None) -> list[tuple[int, str, str, object]]:
+    """The five rungs' scenarios at ``rpm``: ``[(rung, scene, relaxed, Scenario), ...]``.
+
+    Parameters
+    ----------
+    scenario : resolved multibody scenario whose ``multibody.scene`` is ``"full"`` (rung 5 is that
+        scenario itself).
+    rpm : inner-ring speed [rpm] (``operating.inner_ring_speed_rpm``).
+    rotations : recorded cage rotations (``numerics.rotations``); None keeps the scenario's.
+
+    Raises
+    ------
+    UserError
+        A reduced-model scenario (the ladder needs the whole bearing; give its multibody scenario), or
+        a multibody scenario whose scene is not ``full``.
+    """
+    if scenario.model != "multibody":
+        raise UserError(f"{scenario.source}: model = {scenario.model!r}: the cross-check climbs from the reduced model "
+                        f"to the whole bearing; give a scenario with model = \"multibody\" and scene = \"full\" (it builds "
+                        f"the reduced rung from it)")
+    if scenario.multibody.scene != "full":
+        raise UserError(f"{scenario.source}: multibody.scene = {scenario.multibody.scene!r}: the cross-check's last rung "
+                        f"is the scenario itself and must be the full scene; set multibody.scene = \"full\"")
+    over = {"operating.inner_ring_speed_rpm": float(rpm)}
+    if rotations is not None:
+        over["numerics.rotations"] = int(rotations)
+    full = scenario.replace(**over)
+    out = []
+    for rung, scene, relaxed in RUNGS:
+        if scene == "full":
+            sc = full
+        elif scene == "reduced":
+            sc = full.replace(model="reduced")
+        else:
+            sc = full.replace(**{"multibody.scene": scene})
+        out.append((rung, scene, relaxed, sc))
+    return out
+
+
+def rung_numbers(result, reduced: bool) -> dict:
+    """The table's numbers of one rung's result (SI).
+
+    The standard errors are batch-means errors of the per-rotation pocket-mean impulses; the reduced
+    model repeats one no-load pass every rotation, so its scatter is zero by construction, and its cage
+    turns at the epicyclic speed by assumption (cage slip 0).
+    """
+    from bearingsim.multibody.studies import batch_sem
+
+    s = result.summary
+    d = result.per_rotation["I_dec"].mean(axis=1)
+    a = result.per_rotation["I_acc"].mean(axis=1)
+    return {
+        "I_dec_mean_Ns": float(s["I_dec_mean_Ns"]), "I_dec_sem_Ns": 0.0 if reduced else batch_sem(d),
+        "I_acc_mean_Ns": float(s["I_acc_mean_Ns"]), "I_acc_sem_Ns": 0.0 if reduced else batch_sem(a),
+        "first_impact_speed_m_s": float(s["first_impact_speed_m_s"]),
+        "cage_slip": 0.0 if reduced else float(s["cage_slip"]),
+    }
+
+
+def _run_rung(job):
+    """Worker: resolve the rung's scenario, run it as ``bearingsim run`` does (archive written, no
+    figures) and return its numbers."""
+    from bearingsim.scenario import resolve
+    from bearingsim.simulation import run_scenario
+
+    rpm, rung, scene, relaxed, raw, source, path = job
+    sc = resolve(raw, source)
+    out = run_scenario(sc, path, figures=False)
+    return {"rpm": rpm, "rung": rung, "scene": scene, "relaxed": relaxed, "archive": path,
+            "wall_s": float(out.result.provenance.get("wall_time_s", math.nan)),
+            **rung_numbers(out.result, scene == "reduced")}
+
+
+def add_changes(rows: list[dict]) -> list[dict]:
+    """Fill ``change_from_previous`` (I_dec, N s) within each speed, rungs in order; NaN for rung 1."""
+    rows = sorted(rows, key=lambda r: (r["rpm"], r["rung"]))
+    prev = {}
+    for r in rows:
+        p = prev.get(r["rpm"])
+        r["change_from_previous"] = math.nan if p is None else r["I_dec_mean_Ns"] - p["I_dec_mean_Ns"]
+        prev[r["rpm"]] = r
+    return rows
+
+
+def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int | None = DEFAULT_ROTATIONS,
+                   jobs: int = 2) -> list[dict]:
+    """Run every rung at every speed (``jobs`` processes), write the rung archives, the CSV, the index
+    and the figure into ``outdir``; return the table's rows (sorted by speed and rung).
+
+    Parameters
+    ----------
+    scenario : resolved multibody scenario, full scene (:func:`rung_scenarios`).
+    outdir : output folder (created).
+    speeds : inner-ring speeds [rpm].
+    rotations : recorded cage rotations of every rung (None: the scenario's ``numerics.rotations``).
+    jobs : worker processes (1: run here).
+    """
+    from bearingsim.archive import check_writable_dir
+
+    if jobs < 1:
+        raise UserError(f"-j {jobs}: give at least 1 worker process")
+    outdir = check_writable_dir(outdir)
+    (outdir / "rungs").mkdir(exist_ok=True)
+    work = []
+    for rpm in speeds:
+        for rung, scene, relaxed, sc in rung_scenarios(scenario, rpm, rotations):
+            path = str(outdir / "rungs" / f"{rpm:g}rpm_{rung}_{scene}.h5")
+            work.append((float(rpm), rung, scene, relaxed, sc.raw, sc.source, path))
+    # the longest runs first (low speed, multibody) so that the workers finish together
+    work.sort(key=lambda j: (j[2] == "reduced", j[0], -j[1]))
+    if jobs == 1:
+        rows = [_run_rung(j) for j in work]
+    else:
+        with ProcessPoolExecutor(max_workers=jobs) as ex:
+            rows = list(ex.map(_run_rung, work))
+    rows = add_changes(rows)
+    for r in rows:
+        r["archive"] = str(Path(r["archive"]).relative_to(outdir))
+    write_table(outdir, rows, scenario)
+    plot_crosscheck(outdir / "crosscheck.h5", outdir)
+    return rows
+
+
+def _fmt(v) -> str:
+    if isinstance(v, str):
+        return v
+    if isinstance(v, (int, np.integer)):
+        return str(int(v))
+    return "" if math.isnan(v) else repr(float(v))
+
+
+def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
+    """Write ``crosscheck.csv`` (exactly :data:`COLUMNS`) and ``crosscheck.h5`` (the same columns and
+    ``archive``, ``wall_s``, as an index table; :func:`bearingsim.archive.write_table_file`) atomically."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import write_atomic_bytes
+
+    outdir = Path(outdir)
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for r in rows:
+        w.writerow([_fmt(r[c]) for c in COLUMNS])
+    csv_path = outdir / "crosscheck.csv"
+    write_atomic_bytes(csv_path, buf.getvalue().encode("utf-8"))
+    columns = (*COLUMNS, "archive", "wall_s")
+    cols = {}
+    for c in columns:
+        vals = [r[c] for r in rows]
+        cols[c] = np.array(vals, dtype=object) if isinstance(vals[0], str) else np.array(vals, dtype=float)
+    units = {**UNITS, "wall_s": "s"}
+    attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
+             "scenario_name": scenario.name}
+    h5_path = archive.write_table_file(outdir / "crosscheck.h5", cols, units, attrs)
+    return csv_path, h5_path
+
+
+def read_table(path) -> tuple[list[dict], dict]:
+    """Read ``crosscheck.h5``: (rows as dicts, root attributes). One-line UserError if it is not one."""
+    from bearingsim import archive
+
+    cols, meta = archive.read_table_file(path, INDEX_FORMAT)
+    names = json.loads(meta["columns"])
+    n = len(cols[names[0]])
+    rows = []
+    for i in range(n):
+        row = {}
+        for c in names:
+            v = cols[c][i]
+            row[c] = v if isinstance(v, str) else float(v)
+        row["rung"] = int(row["rung"])
+        rows.append(row)
+    return rows, meta
+
+
+def plot_crosscheck(index_path, outdir) -> list[Path]:
+    """Draw ``crosscheck.png`` from the index alone: I_dec and I_acc against the rung, one line per
+    speed, error bars ± 1 standard error (batch means)."""
+    from bearingsim.plotting import legend_outside, plt, save_figure
+
+    rows, meta = read_table(index_path)
+    speeds = sorted({r["rpm"] for r in rows})
+    labels = {r["rung"]: f"{r['rung']} {r['scene']}" for r in rows}
+    fig, axes = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    for k, rpm in enumerate(speeds):
+        rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
+        x = np.array([r["rung"] for r in rs]) + (k - 0.5 * (len(speeds) - 1)) * 0.06
+        for ax, q in zip(axes, ("I_dec", "I_acc")):
+            ax.errorbar(x, [r[f"{q}_mean_Ns"] * 1e3 for r in rs], yerr=[r[f"{q}_sem_Ns"] * 1e3 for r in rs],
+                        marker="o", ms=4, capsize=3, color=f"C{k}", label=f"{rpm:g} rpm")
+    axes[0].set_ylabel("$I_{dec}$ per pocket and\ncage rotation [mN s]")
+    axes[1].set_ylabel("$I_{acc}$ per pocket and\ncage rotation [mN s]")
+    for ax in axes:
+        ax.set_ylim(bottom=0.0)
+        ax.grid(alpha=0.3)
+    ticks = sorted(labels)
+    axes[1].set_xticks(ticks)
+    axes[1].set_xticklabels([labels[t] for t in ticks], rotation=15)
+    axes[1].set_xlabel("rung of the cross-check (each drops one assumption of the paper's model)")
+    axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets ± 1 standard error "
+                      "(batch means over rotations)", fontsize=9)
+    legend_outside(axes[0], title="inner ring speed")
+    return [save_figure(fig, Path(outdir) / "crosscheck.png")]
+
+
+def verdicts(rows: list[dict]) -> list[str]:
+    """One sentence per speed: the rung whose I_dec change is largest, and each change against two
+    standard errors of the difference, sqrt(sem_a^2 + sem_b^2)."""
+    out = []
+    for rpm in sorted({r["rpm"] for r in rows}):
+        rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
+        parts = []
+        for a, b in zip(rs, rs[1:]):
+            d = b["I_dec_mean_Ns"] - a["I_dec_mean_Ns"]
+            se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
+            sig = "significant" if abs(d) > 2.0 * se else "not significant"
+            parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig}: 2 SE = {2 * se * 1e3:.2g})")
+        big = max(rs[1:], key=lambda r: abs(r["change_from_previous"]))
+        out.append(f"{rpm:g} rpm: the largest change of I_dec is at rung {big['rung']} {big['scene']} "
+                   f"({big['change_from_previous'] * 1e3:+.2f} mN s; full - reduced = "
+                   f"{(rs[-1]['I_dec_mean_Ns'] - rs[0]['I_dec_mean_Ns']) * 1e3:+.2f} mN s); " + "; ".join(parts) + ".")
+    return out
+
+
+def format_table(rows: list[dict]) -> str:
+    """The table for the terminal (impulses in mN s)."""
+    head = (f"{'rpm':>6s} {'rung':>4s} {'scene':18s} {'I_dec [mN s]':>16s} {'I_acc [mN s]':>16s} "
+            f"{'v1 [m/s]':>9s} {'cage slip':>10s} {'change [mN s]':>13s}")
+    lines = [head]
+    for r in rows:
+        ch = "" if math.isnan(r["change_from_previous"]) else f"{r['change_from_previous'] * 1e3:+.3f}"
+        lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
+                     f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {r['I_dec_sem_Ns'] * 1e3:6.3f} "
+                     f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {r['I_acc_sem_Ns'] * 1e3:6.3f} "
+                     f"{r['first_impact_speed_m_s']:9.4f} {r['cage_slip']:10.2e} {ch:>13s}")
+    return "\n".join(lines)

@@ -76,6 +76,11 @@ SUMMARY_UNITS = {
 }
 
 
+LAND_SUMMARY_UNITS = {
+    "land_normal_impulse_mean_Ns": "N s", "land_friction_impulse_mean_Ns": "N s",
+    "land_torque_impulse_Nms": "N m s", "land_overlap_max_m": "m", "land_stiffness_N_m": "N/m",
+}
+
 MAX_DT_RETRIES = 4
 
 
@@ -188,7 +193,11 @@ class MultibodyResult(Result):
         ws, we = raw["cage_w_start"], raw["cage_w_end"]
         momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
         drive = abs(per["I_acc"].sum()) * geo.pitch_radius
-        torque_residual = ((g["tau_normal"] + g["tau_friction"] - momentum_change) / drive if drive > 0 else float("nan"))
+        land = raw.get("land")
+        tau = g["tau_normal"] + g["tau_friction"]
+        if land is not None:  # the land friction torque on a land-guided cage
+            tau = tau + land["tau"]
+        torque_residual = ((tau - momentum_change) / drive if drive > 0 else float("nan"))
         w_ = p.wear
         wear = {
             "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
@@ -219,6 +228,16 @@ class MultibodyResult(Result):
             "dt_s": float(raw["dt"]),
             "steps": int(raw["steps"]),
         }
+        units = dict(SUMMARY_UNITS)
+        if land is not None:
+            summary.update({
+                "land_normal_impulse_mean_Ns": float(land["win"][:, 0].mean()),
+                "land_friction_impulse_mean_Ns": float(land["win"][:, 1].mean()),
+                "land_torque_impulse_Nms": float(land["tau"]),
+                "land_overlap_max_m": float(land["overlap_max"]),
+                "land_stiffness_N_m": float(land["stiffness"]),
+            })
+            units.update(LAND_SUMMARY_UNITS)
         desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
         pr = "results/per_rotation"
         data = {
@@ -239,6 +258,16 @@ class MultibodyResult(Result):
             "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
             "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
         }
+        if land is not None:
+            land_desc = ("per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start), "
+                         "land-guided cage")
+            data[f"{pr}/land_normal"] = NamedArray(land["win"][:, 0].copy(), "N s",
+                                                   "normal impulse of the cage rim on its guiding land, " + land_desc)
+            data[f"{pr}/land_friction"] = NamedArray(land["win"][:, 1].copy(), "N s",
+                                                     "friction impulse magnitude on the land, " + land_desc)
+            data[f"{pr}/land_torque"] = NamedArray(land["win"][:, 2].copy(), "N m s",
+                                                   "angular impulse of the land friction on the cage about its "
+                                                   "centre (counter-clockwise positive), " + land_desc)
         if full:
             data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
             data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
@@ -264,8 +293,7 @@ class MultibodyResult(Result):
         orbit = raw["orbit"]
         data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
                                                 "last recorded samples of the cage centre: columns time, x, y")
-        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count},
-                                               dict(SUMMARY_UNITS))}
+        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count}, units)}
         provenance = {
             "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
             "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),

@@ -376,6 +376,10 @@ class MultibodyResult(Result):
                     label=f"reach of the pocket faces ({reach * 1e6:.0f} µm)")
         else:  # far outside the orbit: named, not drawn (it would shrink the orbit to a dot)
             ax.plot([], [], " ", label=f"reach of the pocket faces: {reach * 1e6:.0f} µm (off scale)")
+        if p.bearing.cage_guidance != "rollers":
+            half = 0.5 * p.bearing.cage_land_clearance
+            ax.plot(half * 1e6 * np.cos(circ), half * 1e6 * np.sin(circ), color="C2", lw=0.8, ls="-.",
+                    label=f"half the land clearance ({half * 1e6:.0f} µm, {p.bearing.cage_guidance.replace('_', ' ')})")
         ax.set_aspect("equal")
         ax.set_xlabel("cage centre x [µm]")
         ax.set_ylabel("cage centre y [µm] (load along −y)")

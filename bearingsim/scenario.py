@@ -27,7 +27,9 @@ SCHEMA_VERSION = 1
 # source beside them; bearing geometry has no default (it comes from a preset or the scenario).
 DEFAULTS: dict[str, dict[str, Any]] = {
     # cage guidance: "rollers" (the paper's rolling-element-guided cage, Sec. 1), or a ring land
-    # ("outer_land", "inner_land"): the land clearance and the cage diameters come from the preset
+    # ("outer_land", "inner_land"): the land clearance and the cage diameters come from the preset.
+    # Only the multibody model's full scene has a free cage; the reduced model and the
+    # reduced-equivalent scene (cage turning uniformly about the axis) do not use these keys
     "bearing": {"cage_guidance": "rollers"},
     "operating": {"direction": "forward", "gravity": True},
     # land_friction: reconstructed, not from a source: Coulomb friction of a lubricated brass rim on a

@@ -29,7 +29,7 @@ def _refuse_archive_as_scenario(path) -> None:
 
 def _print_summary(summary) -> None:
     for key in ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip",
-                "load_zone_half_angle_deg"):
+                "load_zone_half_angle_deg", "land_normal_impulse_mean_Ns"):
         if key in summary:
             print(f"  {key:28s} {summary[key]:.6g}")
 

@@ -35,6 +35,19 @@ class Bearing:
     radial_clearance: float  # P_d [m], diametral, operating
     cage_mass: float  # [kg]
     cage_inertia: float  # polar moment [kg m^2]
+    cage_guidance: str = "rollers"  # "rollers", "outer_land" or "inner_land"
+    cage_land_clearance: float | None = None  # c_L [m], diametral, cage rim to ring land (land guidance)
+    cage_outer_radius: float | None = None  # [m], the outer land contact radius
+    cage_inner_radius: float | None = None  # [m], the inner land contact radius
+
+    @property
+    def cage_land_radius(self) -> float | None:
+        """Radius of the cage rim that runs on the guiding land [m] (None: roller-guided cage)."""
+        if self.cage_guidance == "outer_land":
+            return self.cage_outer_radius
+        if self.cage_guidance == "inner_land":
+            return self.cage_inner_radius
+        return None
 
     @property
     def outer_race_radius(self) -> float:
@@ -80,6 +93,7 @@ class ContactLubrication:
     drag_coefficient: float  # c of Eq. (2), SI
     traction_mu_max: float  # EHL traction mu_max of mu = mu_max tanh(slip / slip_ref) [-]
     traction_slip_ref: float  # slip_ref of the traction curve [-]
+    land_friction: float = 0.0  # Coulomb friction of the cage rim on its guiding land [-]
 
 
 @dataclass(frozen=True)
@@ -153,6 +167,10 @@ class Parameters:
             radial_clearance=b.radial_clearance_mm * 1e-3,
             cage_mass=b.cage_mass_kg,
             cage_inertia=b.cage_inertia_kgm2,
+            cage_guidance=b.cage_guidance,
+            cage_land_clearance=None if b.cage_land_clearance_mm is None else b.cage_land_clearance_mm * 1e-3,
+            cage_outer_radius=None if b.cage_outer_diameter_mm is None else b.cage_outer_diameter_mm * 0.5e-3,
+            cage_inner_radius=None if b.cage_inner_diameter_mm is None else b.cage_inner_diameter_mm * 0.5e-3,
         )
         o = scenario.operating
         omega_i = laws.inner_ring_angular_speed(o.inner_ring_speed_rpm)
@@ -176,6 +194,7 @@ class Parameters:
             drag_coefficient=float(scenario.lubrication.drag_coefficient),
             traction_mu_max=float(mb.traction_mu_max),
             traction_slip_ref=float(mb.traction_slip_ref),
+            land_friction=float(scenario.contact.land_friction),
         )
         nu = scenario.numerics
         numerics = Numerics(

@@ -26,8 +26,15 @@ SCHEMA_VERSION = 1
 # Package defaults: everything a preset or a scenario does not set. Literature defaults cite their
 # source beside them; bearing geometry has no default (it comes from a preset or the scenario).
 DEFAULTS: dict[str, dict[str, Any]] = {
+    # cage guidance: "rollers" (the paper's rolling-element-guided cage, Sec. 1), or a ring land
+    # ("outer_land", "inner_land"): the land clearance and the cage diameters come from the preset.
+    # Only the multibody model's full scene has a free cage; the reduced model and the
+    # reduced-equivalent scene (cage turning uniformly about the axis) do not use these keys
+    "bearing": {"cage_guidance": "rollers"},
     "operating": {"direction": "forward", "gravity": True},
-    "contact": {"cage_friction": 0.1},
+    # land_friction: reconstructed, not from a source: Coulomb friction of a lubricated brass rim on a
+    # steel land in boundary/mixed lubrication, taken equal to the roller-cage friction (brass on steel)
+    "contact": {"cage_friction": 0.1, "land_friction": 0.1},
     "reduced": {"method": "event", "load_zone_half_angle_deg": "auto", "resting_contact": True},
     "numerics": {"rotations": 5, "warmup_rotations": 1, "output_rate_hz": 20000.0},
     "multibody": {
@@ -112,6 +119,18 @@ class BearingSection(_Section):
     radial_clearance_mm: float = Field(ge=0.0)
     cage_mass_kg: float = Field(gt=0.0)
     cage_inertia_kgm2: float = Field(gt=0.0)
+    cage_guidance: Literal["rollers", "outer_land", "inner_land"]
+    cage_land_clearance_mm: float | None = None  # diametral; needed with a land-guided cage
+    cage_outer_diameter_mm: float | None = Field(default=None, gt=0.0)
+    cage_inner_diameter_mm: float | None = Field(default=None, gt=0.0)
+
+    @field_validator("cage_land_clearance_mm")
+    @classmethod
+    def _land_clearance(cls, v):
+        if v is not None and not v > 0.0:
+            raise ValueError("must be > 0 mm (diametral clearance between the cage rim and the ring land; "
+                             "with none the cage would be jammed on the land)")
+        return v
 
 
 class OperatingSection(_Section):
@@ -128,6 +147,7 @@ class LubricationSection(_Section):
 class ContactSection(_Section):
     restitution: float = Field(ge=0.0, le=1.0)
     cage_friction: float = Field(ge=0.0)
+    land_friction: float = Field(ge=0.0)
 
 
 class ReducedSection(_Section):
@@ -490,11 +510,39 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
                         f"(pockets 0..{b.roller_count - 1}, bearing.roller_count = {b.roller_count})")
     if len(set(flat)) != len(flat):
         raise UserError(f"{source}: multibody.flat_pockets: a pocket is listed twice ({flat})")
-    if m.model == "multibody" and (m.multibody.pocket_shape == "flat" or len(set(flat)) == b.roller_count):
+    land = b.cage_guidance != "rollers"
+    if land:
+        _check_land(m, source)
+    if m.model == "multibody" and not land and (m.multibody.pocket_shape == "flat" or len(set(flat)) == b.roller_count):
         raise UserError(
             f"{source}: multibody.pocket_shape: with every pocket flat nothing guides the roller-guided cage "
             f"radially (flat faces push only along the direction of rotation): the cage would drift off the "
-            f"axis; keep arc pockets and list the flat ones in multibody.flat_pockets")
+            f"axis; keep arc pockets and list the flat ones in multibody.flat_pockets, or guide the cage on a "
+            f"ring land (bearing.cage_guidance)")
     if m.reduced.load_zone_half_angle_deg != "auto" and m.model == "reduced":
         if m.reduced.load_zone_half_angle_deg >= 180.0:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")
+
+
+def _check_land(m: ScenarioModel, source: str) -> None:
+    """A land-guided cage: the land clearance and the cage diameters are given, and the land lies
+    between the raceways (outer land: the outer ring's land bore, cage OD + c_L, inside the outer
+    raceway; inner land: the inner ring's land, cage ID - c_L, outside the inner raceway)."""
+    b = m.bearing
+    for key in ("cage_land_clearance_mm", "cage_outer_diameter_mm", "cage_inner_diameter_mm"):
+        if getattr(b, key) is None:
+            raise UserError(f"{source}: bearing.{key}: missing; bearing.cage_guidance = {b.cage_guidance!r} needs it "
+                            f"(set it in the scenario or name a [bearing] preset that has it)")
+    od, idia, c = b.cage_outer_diameter_mm, b.cage_inner_diameter_mm, b.cage_land_clearance_mm
+    if not idia < b.pitch_diameter_mm < od:
+        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage ({idia:g}..{od:g} mm, "
+                        f"bearing.cage_inner_diameter_mm..cage_outer_diameter_mm) must straddle the pitch "
+                        f"diameter {b.pitch_diameter_mm:g} mm")
+    if b.cage_guidance == "outer_land" and od + c >= b.pitch_diameter_mm + b.roller_diameter_mm:
+        raise UserError(f"{source}: bearing.cage_land_clearance_mm: the outer land bore, cage OD + c_L = "
+                        f"{od + c:g} mm, must be smaller than the outer raceway diameter "
+                        f"{b.pitch_diameter_mm + b.roller_diameter_mm:g} mm")
+    if b.cage_guidance == "inner_land" and idia - c <= b.pitch_diameter_mm - b.roller_diameter_mm:
+        raise UserError(f"{source}: bearing.cage_land_clearance_mm: the inner land, cage ID - c_L = "
+                        f"{idia - c:g} mm, must be larger than the inner raceway diameter "
+                        f"{b.pitch_diameter_mm - b.roller_diameter_mm:g} mm")

@@ -10,7 +10,8 @@ UserError (exit code 2) whose message says what to change. Files whose name cont
   the relative speed by -e and resting sets it to 0, so only the applied forces can raise it: a
   larger speed is energy from nowhere);
 * multibody model: no NaN, no roller deeper than 1 % of the pocket clearance in a cage face, and the
-  cage speed bounded by the inner ring's (it is driven by rollers that roll on the inner ring).
+  cage speed bounded by the inner ring's (it is driven by rollers that roll on the inner ring); a cage
+  on the outer land stays within half the land clearance plus the land contact's 1 % overlap bound.
 """
 import math
 
@@ -81,6 +82,12 @@ def _check_multibody(result, sc):
     assert np.all(np.isfinite(result.per_rotation["I_dec"])) and np.all(result.per_rotation["I_dec"] >= 0)
     assert result.summary["max_penetration_all_m"] <= 0.01 * s, result.summary["max_penetration_all_m"]
     assert abs(result.summary["cage_speed_mean_rad_s"]) <= si(sc).operating.omega_i
+    if sc.bearing.cage_guidance == "outer_land":  # the fixed outer land holds the cage centre (tests/test_land.py)
+        from bearingsim.multibody.core import LAND_OVERLAP_FRACTION
+
+        half = 0.5 * si(sc).bearing.cage_land_clearance
+        assert result.summary["land_overlap_max_m"] <= LAND_OVERLAP_FRACTION * half
+        assert result.summary["cage_orbit_max_m"] <= half * (1.0 + LAND_OVERLAP_FRACTION)
 
 
 def test_dt_too_large_exits_2_from_the_cli(tmp_path):

@@ -82,6 +82,11 @@ SUMMARY_UNITS = {
 }
 
 
+LAND_SUMMARY_UNITS = {
+    "land_normal_impulse_mean_Ns": "N s", "land_friction_impulse_mean_Ns": "N s",
+    "land_torque_impulse_Nms": "N m s", "land_overlap_max_m": "m", "land_stiffness_N_m": "N/m",
+}
+
 MAX_DT_RETRIES = 4
 
 
@@ -197,7 +202,11 @@ class MultibodyResult(Result):
         drive = abs(per["I_acc"].sum()) * geo.pitch_radius
         if drive == 0.0:  # nothing drives the cage (a kinematic cage turned by its prescription): scale by
             drive = abs(per["I_dec"].sum()) * geo.pitch_radius  # the braking; -1 = all from the prescription
-        torque_residual = ((g["tau_normal"] + g["tau_friction"] - momentum_change) / drive if drive > 0 else float("nan"))
+        land = raw.get("land")
+        tau = g["tau_normal"] + g["tau_friction"]
+        if land is not None:  # the land friction torque on a land-guided cage
+            tau = tau + land["tau"]
+        torque_residual = ((tau - momentum_change) / drive if drive > 0 else float("nan"))
         w_ = p.wear
         wear = {
             "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
@@ -229,6 +238,16 @@ class MultibodyResult(Result):
         }
         if with_ring:  # the reduced-equivalent scene has no inner ring
             summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
+        units = dict(SUMMARY_UNITS)
+        if land is not None:
+            summary.update({
+                "land_normal_impulse_mean_Ns": float(land["win"][:, 0].mean()),
+                "land_friction_impulse_mean_Ns": float(land["win"][:, 1].mean()),
+                "land_torque_impulse_Nms": float(land["tau"]),
+                "land_overlap_max_m": float(land["overlap_max"]),
+                "land_stiffness_N_m": float(land["stiffness"]),
+            })
+            units.update(LAND_SUMMARY_UNITS)
         desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
         pr = "results/per_rotation"
         data = {
@@ -249,6 +268,16 @@ class MultibodyResult(Result):
             "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
             "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
         }
+        if land is not None:
+            land_desc = ("per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start), "
+                         "land-guided cage")
+            data[f"{pr}/land_normal"] = NamedArray(land["win"][:, 0].copy(), "N s",
+                                                   "normal impulse of the cage rim on its guiding land, " + land_desc)
+            data[f"{pr}/land_friction"] = NamedArray(land["win"][:, 1].copy(), "N s",
+                                                     "friction impulse magnitude on the land, " + land_desc)
+            data[f"{pr}/land_torque"] = NamedArray(land["win"][:, 2].copy(), "N m s",
+                                                   "angular impulse of the land friction on the cage about its "
+                                                   "centre (counter-clockwise positive), " + land_desc)
         if with_ring:
             data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
             data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
@@ -274,8 +303,7 @@ class MultibodyResult(Result):
         orbit = raw["orbit"]
         data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
                                                 "last recorded samples of the cage centre: columns time, x, y")
-        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count},
-                                               dict(SUMMARY_UNITS))}
+        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count}, units)}
         provenance = {
             "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
             "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),
@@ -358,6 +386,10 @@ class MultibodyResult(Result):
                     label=f"reach of the pocket faces ({reach * 1e6:.0f} µm)")
         else:  # far outside the orbit: named, not drawn (it would shrink the orbit to a dot)
             ax.plot([], [], " ", label=f"reach of the pocket faces: {reach * 1e6:.0f} µm (off scale)")
+        if p.bearing.cage_guidance != "rollers":
+            half = 0.5 * p.bearing.cage_land_clearance
+            ax.plot(half * 1e6 * np.cos(circ), half * 1e6 * np.sin(circ), color="C2", lw=0.8, ls="-.",
+                    label=f"half the land clearance ({half * 1e6:.0f} µm, {p.bearing.cage_guidance.replace('_', ' ')})")
         ax.set_aspect("equal")
         ax.set_xlabel("cage centre x [µm]")
         ax.set_ylabel("cage centre y [µm] (load along −y)")

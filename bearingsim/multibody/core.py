@@ -49,6 +49,44 @@ IMPACT_OVERLAP_FRACTION = 0.005  # auto dt: one step's approach at the impact sp
 DT_CAP_S = 2.0e-5  # never above this (impact resolution: s / v_rel >> dt for v_rel ~ 1 m/s)
 
 PENETRATION_LIMIT = 0.01  # largest roller-cage overlap accepted, as a fraction of the pocket clearance
+# land-guided cage: the land contact is a linear penalty whose stiffness keeps the overlap below
+# LAND_OVERLAP_FRACTION of c_L/2 under land_reference_force(); a run whose cage goes further than
+# LAND_ORBIT_MARGIN x c_L/2 beyond the land (ten times that bound) is stopped as a lost cage
+LAND_OVERLAP_FRACTION = 0.01
+LAND_ORBIT_MARGIN = 0.1
+
+
+def land_reference_force(p) -> float:
+    """Largest radial force [N] expected on a land-guided cage: the radial load, the centrifugal loads
+    of all rollers and the cage's weight, ``W + Z m r_p omega_c^2 + m_cage g``. The cage is pushed
+    radially only by its weight and by the rollers, and the rollers' forces on it come from what the
+    raceways give them, which sums to about W and the centrifugal loads."""
+    g, op = p.bearing, p.operating
+    return (op.radial_load + g.roller_count * g.roller_mass * g.pitch_radius * op.omega_c**2
+            + g.cage_mass * op.gravity)
+
+
+def land_params(p, active: bool) -> fk.LandParams:
+    """:class:`~bearingsim.multibody.forces.LandParams` of the cage's guiding land (inactive: rollers).
+
+    Stiffness ``k = F_ref / (LAND_OVERLAP_FRACTION c_L/2)`` with ``F_ref`` from
+    :func:`land_reference_force`; damping ``c = c_r k`` with the raceway contacts' ``c_r``
+    (``CONTACT_DAMPING_S``). For the reference cage (c_L = 0.30 mm, 970 N, 3000 rpm) k ~ 8e8 N/m, of
+    the order of the linearised Palmgren stiffness of a few-mm-wide steel line contact at ~100 N
+    (~2e8 N/m for l = 5 mm), and 2/omega_n = 2 sqrt(m_cage / k) ~ 3e-5 s, ten times the time step.
+    """
+    g, op = p.bearing, p.operating
+    if not active:
+        return fk.LandParams(active=False, side=1.0, rim_radius=0.0, half_clearance=0.0, stiffness=0.0, damping=0.0,
+                             damping_fade=DAMPING_FADE_M, friction=0.0, inner=False, omega_ring=0.0,
+                             slide_eps=DRAG_DIRECTION_EPS_M_S)
+    half = 0.5 * g.cage_land_clearance
+    k = land_reference_force(p) / (LAND_OVERLAP_FRACTION * half)
+    inner = g.cage_guidance == "inner_land"
+    return fk.LandParams(active=True, side=-1.0 if inner else 1.0, rim_radius=float(g.cage_land_radius),
+                         half_clearance=float(half), stiffness=float(k), damping=float(CONTACT_DAMPING_S * k),
+                         damping_fade=DAMPING_FADE_M, friction=float(p.contact.land_friction), inner=inner,
+                         omega_ring=float(op.sign * op.omega_i) if inner else 0.0, slide_eps=DRAG_DIRECTION_EPS_M_S)
 
 
 # scenes whose cage is a pymunk KINEMATIC body turning at the epicyclic speed about the bearing axis
@@ -273,7 +311,7 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
         out_f=np.zeros(nb * 3) if reduced_eq else set_arr, set_arr=set_arr,
         diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
-        orbit=np.full((ORBIT_KEEP, 3), np.nan))
+        orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
     io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop)
@@ -304,16 +342,23 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     io.read_states()
     # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
     face_reach = (rr + 0.5 * s) * math.sin(p.multibody.pocket_face_half_angle)
+    # a land-guided cage is held by its land (the full scene's free cage only)
+    land = land_params(p, active=scene_kind == "full" and geo.cage_guidance != "rollers")
+    orbit_limit = face_reach
+    if land.active:  # the inner land moves with the inner ring, at most P_d/2 plus its raceway approach
+        orbit_limit = land.half_clearance * (1.0 + LAND_ORBIT_MARGIN) + (
+            0.5 * pd + raceway_approach_limit(p) if land.inner else 0.0)
     lim = lp.LoopLimits(
         travel_end=travel_end, travel_record=2.0 * math.pi * warm,
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
-        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=face_reach,
+        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=out_every,
         max_steps=int(3 * steps_est + 1000))
     inp = lp.StepInputs(
         h=float(h), prm=prm, cfg=cfg, lim=lim,
         hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi), radius=rp - (n_centrifugal / K) ** 0.9,
                               front_offset=0.5 * s, omega_cage=float(omega_cage)),
+        land=land,
         pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
         ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64))
     ls = np.zeros(1, dtype=lp.LOOP_STATE)
@@ -358,6 +403,12 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
             raise SimulationUnstable(
                 f"cage did not complete {total_rot} rotations in {step} steps "
                 f"(cage speed {state[n, 5]:.3g} rad/s): the cage stalled")
+        if code == lp.CODE_CAGE_LOST and land.active:
+            raise SimulationUnstable(
+                f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
+                f"t = {t:.6g} s, more than {LAND_ORBIT_MARGIN:.0%} of half the land clearance "
+                f"(bearing.cage_land_clearance_mm) beyond its {geo.cage_guidance.replace('_', ' ')}: the land "
+                f"contact did not hold it; try a smaller numerics.dt_s than {h:.3g} s")
         if code == lp.CODE_CAGE_LOST:
             raise SimulationUnstable(
                 f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
@@ -395,4 +446,6 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         ring_centre_mean=(np.array([st["ring_sum_x"], st["ring_sum_y"]]) / ring_n if ring_n and not reduced_eq
                           else np.full(2, np.nan)),
         radial_clearance=geo.radial_clearance,
+        land=(dict(win=wk.land_win.copy(), tau=float(st["land_tau"]), overlap_max=float(st["land_overlap_max"]),
+                   stiffness=land.stiffness, half_clearance=land.half_clearance) if land.active else None),
     )

@@ -410,6 +410,103 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     return it
 
 
+class LandParams(NamedTuple):
+    """Inputs of :func:`land_force` that are fixed for a run (a cage guided on a ring land). SI throughout."""
+
+    active: bool  #: the cage runs on a ring land (else :func:`land_force` is not called)
+    side: float  #: +1: outer land (contact at the cage's outer rim); -1: inner land (at the cage's bore)
+    rim_radius: float  #: radius of the cage rim on the land, R_land [m]
+    half_clearance: float  #: half the diametral land clearance, c_L/2 [m]
+    stiffness: float  #: linear penalty stiffness k of the land contact [N/m]
+    damping: float  #: contact damping c [N s/m], faded in over ``damping_fade``
+    damping_fade: float  #: approach over which the damping fades in [m]
+    friction: float  #: Coulomb friction coefficient mu of the rim on the land
+    inner: bool  #: the land is on the inner ring (moves with its centre, turns at ``omega_ring``)
+    omega_ring: float  #: signed angular speed of the guiding ring [rad/s] (0: the fixed outer ring)
+    slide_eps: float  #: regularisation speed of the friction direction [m/s]
+
+
+#: What :func:`land_force` reports for one step, array shape (4,): normal force N [N], friction force
+#: along the tangent t = rot90(u) [N], its torque on the cage [N m], overlap e - c_L/2 [m] (<= 0: open).
+LAND_N, LAND_FT, LAND_TORQUE, LAND_OVERLAP = range(4)
+
+
+@njit(cache=True)
+def land_force(state, h, lp, ring_c, ring_c_prev, out_f, out):
+    """Add the land contact force and friction torque on the cage (the last body) to ``out_f``.
+
+    The cage rim (radius ``R = lp.rim_radius``) runs on a land of the guiding ring with a diametral
+    clearance ``c_L``. With ``e`` the offset of the cage centre from the guiding ring's centre (outer
+    ring: the bearing axis; inner ring: its current centre) and ``u`` its direction, the rim touches the
+    land when ``e > c_L/2``, at ``P = x_cage + side R u``. The normal force on the cage is
+    ``N = k (e - c_L/2) + c d(e)/dt`` (clamped at 0, damping faded in as in the raceway contacts) along
+    ``-u``; Coulomb friction ``mu N`` acts along the tangent ``t = rot90(u)`` against the sliding speed of
+    the rim over the land (rim: ``v_cage . t + omega_cage side R``; land: 0 on the fixed outer ring,
+    ``v_ring . t + omega_ring (e - R)`` on the inner ring), with the sign regularised over
+    ``lp.slide_eps``. Its torque on the cage is ``side R F_t``. As the raceway forces, everything is
+    evaluated at the predicted cage position ``x + h v`` (pymunk moves positions with the old
+    velocities first), the damping with the overlap rate over the step.
+
+    The reaction on an inner ring is not fed back into the ring's balance (the land force is of the
+    order of the cage weight, three orders below the radial load the ring carries).
+
+    Parameters
+    ----------
+    state : (nb, 6) body states before the step (x [m], y [m], angle [rad], vx [m/s], vy [m/s],
+        omega [rad/s]); the cage is the last row.
+    h : time step [s].
+    lp : :class:`LandParams`.
+    ring_c, ring_c_prev : (2,) inner-ring centre of this step and of the previous one [m] (inner land).
+    out_f : (nb * 3,) (fx [N], fy [N], torque [N m]) per body; the cage's row is added to.
+    out : (4,) out: :data:`LAND_N`, :data:`LAND_FT`, :data:`LAND_TORQUE`, :data:`LAND_OVERLAP`.
+    """
+    n = state.shape[0] - 1
+    x = state[n, 0]
+    y = state[n, 1]
+    vx = state[n, 3]
+    vy = state[n, 4]
+    w = state[n, 5]
+    gx = gy = gx0 = gy0 = gvx = gvy = 0.0
+    if lp.inner:
+        gx = ring_c[0]
+        gy = ring_c[1]
+        gx0 = ring_c_prev[0]
+        gy0 = ring_c_prev[1]
+        gvx = (gx - gx0) / h
+        gvy = (gy - gy0) / h
+    ex = x + h * vx - gx
+    ey = y + h * vy - gy
+    e = math.sqrt(ex * ex + ey * ey)
+    delta = e - lp.half_clearance
+    out[LAND_N] = 0.0
+    out[LAND_FT] = 0.0
+    out[LAND_TORQUE] = 0.0
+    out[LAND_OVERLAP] = delta
+    if delta <= 0.0:
+        return
+    delta0 = math.sqrt((x - gx0) ** 2 + (y - gy0) ** 2) - lp.half_clearance
+    fade = delta / lp.damping_fade if delta < lp.damping_fade else 1.0
+    q = lp.stiffness * delta + lp.damping * fade * (delta - delta0) / h
+    if q <= 0.0:
+        return
+    ux = ex / e
+    uy = ey / e
+    tx = -uy
+    ty = ux
+    r = lp.side * lp.rim_radius
+    slide = vx * tx + vy * ty + w * r  # rim speed along t at P
+    if lp.inner:  # minus the land's: the contact point is (e - R) u from the ring centre
+        slide -= gvx * tx + gvy * ty + lp.omega_ring * (e - lp.rim_radius)
+    ft = -lp.friction * q * slide / math.sqrt(slide * slide + lp.slide_eps * lp.slide_eps)
+    torque = r * ft
+    out_f[3 * n] += -q * ux + ft * tx
+    out_f[3 * n + 1] += -q * uy + ft * ty
+    out_f[3 * n + 2] += torque
+    out[LAND_N] = q
+    out[LAND_FT] = ft
+    out[LAND_TORQUE] = torque
+
+
 from bearingsim._jit import drop_stale_caches  # noqa: E402
 
 drop_stale_caches(__name__, (laws,))  # the contact kernels compile in the laws of laws.py

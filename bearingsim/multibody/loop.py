@@ -68,6 +68,8 @@ LOOP_STATE = np.dtype([
     ("cage_w_start", np.float64),  # cage angular velocity when recording started [rad/s]
     ("t_rec0", np.float64),  # time when recording started [s]
     ("orbit_max", np.float64),  # largest cage-centre offset in the recorded period [m]
+    ("land_tau", np.float64),  # angular impulse of the land friction on the cage, recorded steps [N m s]
+    ("land_overlap_max", np.float64),  # largest overlap of the cage rim with its land in the run [m]
 ], align=True)
 
 #: Time-series samples, one row every ``out_every`` steps (array shape (block,)).
@@ -113,6 +115,7 @@ class StepInputs(NamedTuple):
     cfg: rk.RecorderConfig
     lim: LoopLimits
     hold_rule: HoldRule
+    land: fk.LandParams  #: the land contact of a land-guided cage (``active`` False: roller-guided)
     pocket_a: np.ndarray  #: (n,) pocket centre angles in the cage frame [rad]
     theta0: np.ndarray  #: (n,) angle of each pocket from the load-zone centre at t = 0 [rad]
     ids_sorted: np.ndarray  #: (nb,) pymunk body ids, sorted (uint64)
@@ -131,6 +134,8 @@ class StepWork(NamedTuple):
     diag: np.ndarray  #: (n,) :data:`bearingsim.multibody.forces.DIAG`
     smp: np.ndarray  #: (block,) :data:`SAMPLE`
     orbit: np.ndarray  #: (keep, 3) ring buffer of (t [s], x [m], y [m]) of the cage centre
+    land_out: np.ndarray  #: (4,) the land contact of the step (:func:`bearingsim.multibody.forces.land_force`)
+    land_win: np.ndarray  #: (R, 3) per cage rotation: land normal impulse [N s], friction impulse [N s], friction torque impulse [N m s]
 
 
 @njit(cache=True)
@@ -168,6 +173,24 @@ def _pack_all(state, out_f, set_arr, nb):
 
 
 @njit(cache=True)
+def _land_step(prev, travel, inp, wk, s):
+    """Land contact force on the cage (after the raceway forces, which zero the set buffer), and its
+    impulses over the step: per cage rotation (rotation k: cage travel in [2 pi (W + k), 2 pi (W + k + 1)))
+    and, for the cage's angular-momentum balance, the friction torque impulse of the recorded steps."""
+    h = inp.h
+    out = wk.land_out
+    fk.land_force(prev, h, inp.land, wk.ring_c, wk.ring_c_prev, wk.out_f, out)
+    s.land_overlap_max = max(s.land_overlap_max, out[fk.LAND_OVERLAP])
+    if s.recording == 1:
+        s.land_tau += out[fk.LAND_TORQUE] * h
+        k = int(math.floor(travel / (2.0 * math.pi) - inp.cfg.warmup_rotations))
+        if 0 <= k < wk.land_win.shape[0]:
+            wk.land_win[k, 0] += out[fk.LAND_N] * h
+            wk.land_win[k, 1] += abs(out[fk.LAND_FT]) * h
+            wk.land_win[k, 2] += out[fk.LAND_TORQUE] * h
+
+
+@njit(cache=True)
 def before_step(prev, inp, wk, ls):
     """Checks and raceway forces before a step; return ``CODE_CONTINUE`` or the code to stop with.
 
@@ -197,6 +220,8 @@ def before_step(prev, inp, wk, ls):
     if fk.raceway_forces(prev, inp.h, inp.prm, wk.ring_c, wk.ring_c_prev, wk.ring_v, wk.hold, wk.out_f,
                          wk.diag) < 0:
         s.newton_failures += 1
+    if inp.land.active:
+        _land_step(prev, travel, inp, wk, s)
     if s.recording == 1:
         s.ring_sum_x += wk.ring_c[0]
         s.ring_sum_y += wk.ring_c[1]

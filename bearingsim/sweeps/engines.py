@@ -39,6 +39,8 @@ class LocalEngine:
         Number of worker processes (at least 1).
     """
 
+    should_stop = staticmethod(lambda: False)  # set by run_sweep: a signal arrived
+
     kind = "local"
     shared_fs = True
 
@@ -74,6 +76,8 @@ class LocalEngine:
                     records = done.get(timeout=0.25)
                     break
                 except queue.Empty:
+                    if self.should_stop():  # a signal whose exception was swallowed (raised in a callback)
+                        return
                     continue
             yield records
 
@@ -97,6 +101,8 @@ class DaskEngine:
     timeout_s : float
         How long to try to reach the scheduler.
     """
+
+    should_stop = staticmethod(lambda: False)  # set by run_sweep: a signal arrived
 
     kind = "dask"
     shared_fs = False
@@ -133,6 +139,8 @@ class DaskEngine:
         self._futures = [self.client.submit(run_batch, b, None, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
                          for i, b in enumerate(batches)]
         for fut in as_completed(self._futures, loop=self.client.loop):
+            if self.should_stop():
+                return
             try:
                 yield fut.result()
             except Exception as exc:  # noqa: BLE001 - a lost worker or a task the cluster gave up on

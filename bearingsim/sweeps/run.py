@@ -194,7 +194,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     by_hash = {c.hash: i for i, c in enumerate(cases)}
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
 
-    with lock, _Signals():
+    with lock, _Signals() as signals:
+        engine.should_stop = lambda: signals.fired is not None
         bar = None
         try:
             _clean_temporaries(cases_dir)
@@ -236,6 +237,10 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     if time.monotonic() - last_index >= INDEX_EVERY_S:
                         write_index(outdir, rows, keys, meta)
                         last_index = time.monotonic()
+                    if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
+                        raise SweepInterrupted(signals.fired)
+            if signals.fired is not None:
+                raise SweepInterrupted(signals.fired)
         except SweepInterrupted as exc:
             outcome.interrupted = exc.signum
         finally:

@@ -47,7 +47,19 @@ def _lazy_h5py():
     return h5py
 
 
+@functools.lru_cache(maxsize=1)
+def _package_versions() -> tuple:
+    """(name, version) pairs, read once per process: the packages cannot change under a running
+    process, and reading package metadata costs ~5 ms a package."""
+    return tuple(_read_package_versions().items())
+
+
 def package_versions() -> dict[str, str]:
+    """Versions of python and the packages bearingsim's numbers depend on."""
+    return dict(_package_versions())
+
+
+def _read_package_versions() -> dict[str, str]:
     out = {"python": sys.version.split()[0]}
     from importlib import metadata
 

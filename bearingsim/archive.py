@@ -165,7 +165,7 @@ def _prepare_target(path) -> Path:
         raise UserError(f"{path}: cannot create output folder ({exc.strerror})") from None
     if path.is_dir():
         raise UserError(f"{path}: output path is a directory")
-    outputs.check_target(path, (), is_archive)  # .h5 name; never replaces a file that is not an archive
+    outputs.check_target(path, (), is_archive, figures=False)  # .h5 name; never replaces a non-archive
     tmp = _tmp_name(path)
     try:
         tmp.touch()

@@ -74,7 +74,7 @@ def write_csv(path: str | Path, header, rows) -> Path:
     return path
 
 
-def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None) -> Path:
+def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True) -> Path:
     """Check that a run may write its archive at ``path`` (rules in the module docstring).
 
     Parameters
@@ -83,6 +83,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     inputs : files the run reads (the scenario file); the target may not be one of them
     is_archive : ``is_archive(path) -> bool``, what may be replaced (:func:`bearingsim.archive.is_archive`);
         None: the file signature of HDF5
+    figures : the run also writes ``<stem>_*.png`` beside the archive (check that none of them is a folder)
 
     Returns
     -------
@@ -106,7 +107,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     if p.exists() and not is_archive(p):
         raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another -o)")
     stem = p.with_suffix("")
-    if p.parent.is_dir():
+    if figures and p.parent.is_dir():
         for fig in p.parent.glob(f"{_glob_escape(stem.name)}_*.png"):
             if fig.is_dir():
                 raise UserError(f"{fig}: figure path is a directory")

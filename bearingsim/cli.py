@@ -17,12 +17,9 @@ from bearingsim.errors import SimulationUnstable, UserError
 
 def _refuse_archive_as_scenario(path) -> None:
     """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(8)
-    except OSError:
-        return  # the scenario reader reports missing and unreadable files
-    if head == b"\x89HDF\r\n\x1a\n":
+    from bearingsim.archive import is_archive
+
+    if is_archive(path):  # missing or unreadable files: the scenario reader reports them
         raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
                         f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
 

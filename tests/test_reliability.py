@@ -499,16 +499,23 @@ def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     assert not obs.problems, obs.problems
 
 
+def _start_long_run(tmp_path):
+    """A multibody run into ``tmp_path/m.h5`` long enough to be caught writing; returned once its
+    temporary archive exists (or after 120 s, or if it ended)."""
+    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp_path / "m.h5"),
+                             "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env=ENV)
+    deadline = time.monotonic() + 120
+    while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    return proc
+
+
 def test_two_runs_to_one_archive_second_is_refused(tmp_path):
     """A real second run while the first is writing: refused (exit 2, one line); the first, then
     stopped by SIGTERM, leaves nothing; the lock is then free for a third run."""
-    first = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp_path / "m.h5"),
-                              "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                             text=True, env=ENV)
+    first = _start_long_run(tmp_path)
     try:
-        deadline = time.monotonic() + 120
-        while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and first.poll() is None:
-            time.sleep(0.05)
         second = bearingsim("run", PAPER, "-o", tmp_path / "m.h5", "--no-plots")
         assert second.returncode == 2 and "another bearingsim run" in second.stderr, second.stderr
         assert len(second.stderr.strip().splitlines()) == 1
@@ -527,13 +534,8 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     """SIGKILL cannot be handled: the run leaves ``.m.h5.tmp-PID`` (and its lock file, whose lock died
     with the process); the next run into that folder removes the temporary, says so, and writes
     (taking over the lock file and removing it when done)."""
-    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp_path / "m.h5"),
-                             "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV)
+    proc = _start_long_run(tmp_path)
     try:
-        deadline = time.monotonic() + 120
-        while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
-            time.sleep(0.05)
         proc.send_signal(signal.SIGKILL)
         proc.communicate(timeout=30)
     finally:
@@ -548,12 +550,7 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
 
 def signal_case(tmp: Path, sig) -> Observed:
     """Start a long multibody run, signal it once its temporary archive exists, time the exit."""
-    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp / "m.h5"),
-                             "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV)
-    deadline = time.monotonic() + 120
-    while not list(tmp.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.05)
+    proc = _start_long_run(tmp)
     time.sleep(0.5)
     t0 = time.monotonic()
     proc.send_signal(sig)

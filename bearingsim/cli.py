@@ -169,6 +169,13 @@ def _cmd_bench(args) -> int:
 
         run_sweep_bench(Path(args.output))
         return 0
+    if args.fast_scene:
+        from bearingsim.multibody.fast_bench import run_fast_scene_bench
+
+        _, comps = run_fast_scene_bench(Path(args.output), rotations=args.rotations)
+        print((Path(args.output) / "fast_scene.md").read_text(), end="")
+        print(f"wrote {Path(args.output) / 'fast_scene.csv'}, fast_scene_comparison.csv, fast_scene.md")
+        return 0
     from bearingsim.bench import run_bench
 
     run_bench(Path(args.output), quick=args.quick)
@@ -259,6 +266,9 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
+    b.add_argument("--fast-scene", action="store_true",
+                   help="rigid raceways against the Hertz full scene at 500, 1000, 3000 and 6000 rpm (issue 16)")
+    b.add_argument("--rotations", type=int, default=40, help="recorded rotations per run of --fast-scene")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 

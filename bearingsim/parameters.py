@@ -125,6 +125,7 @@ class MultibodyOptions:
     inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
     pocket_face_half_angle: float  # angular half-width of each pocket face arc [rad]
     flat_pockets: tuple[int, ...]  # pockets with two plane faces D + s apart (the rig's instrumented pocket)
+    raceway_contact: str = "hertz"  # "hertz" (Palmgren springs) or "rigid" (rollers held on the outer race)
 
 
 @dataclass(frozen=True)
@@ -219,6 +220,7 @@ class Parameters:
             pocket_face_half_angle=math.radians(float(mb.pocket_face_half_angle_deg)),
             flat_pockets=(tuple(range(bearing.roller_count)) if mb.pocket_shape == "flat"
                           else tuple(sorted(mb.flat_pockets))),
+            raceway_contact=mb.raceway_contact,
         )
         wear = Wear(wear_coefficient=float(scenario.wear.wear_coefficient),
                     hardness=float(scenario.wear.hardness_Pa))

@@ -57,6 +57,10 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # flat_pockets lists pockets that are flat whatever pocket_shape says (the rig's pocket 0)
         "pocket_shape": "arc",
         "flat_pockets": [],
+        # raceway contacts: "hertz" (Palmgren springs, the rollers' radial motion integrated: dt ~4 us)
+        # or "rigid" (rollers held on the outer race by a unilateral constraint, the inner-race loads
+        # from the quasi-static distribution: dt set by the roller-cage impacts; docs/fast_scene.md)
+        "raceway_contact": "hertz",
     },
     # Archard & Hirst (1956), Proc. R. Soc. A 236:397, Table 1: 60/40 brass on tool steel,
     # k = 6e-4; high-strength brass hardness ~HV 150 -> 1.5e9 Pa.
@@ -179,6 +183,7 @@ class MultibodySection(_Section):
     pocket_face_half_angle_deg: float = Field(gt=0.0, lt=90.0)
     pocket_shape: Literal["arc", "flat"]
     flat_pockets: list[int]
+    raceway_contact: Literal["hertz", "rigid"]
 
     @field_validator("inner_ring_mass_kg")
     @classmethod

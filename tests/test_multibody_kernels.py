@@ -131,7 +131,7 @@ def test_roller_on_outer_race_carries_its_centrifugal_load():
     state = _orbiting_roller(omega, r0)
     out_f = np.zeros(6)
     diag = np.zeros(1, dtype=fk.DIAG)
-    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag)
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1))
     assert diag[0]["delta_out"] == pytest.approx(delta, rel=1e-6)
     assert diag[0]["q_out"] == pytest.approx(qc, rel=1e-6)
     # force on the roller: radially inward, magnitude m r0 omega^2 (no traction, drag, gravity)
@@ -155,7 +155,7 @@ def test_traction_opposes_slip(spin):
     state[0, 5] = spin
     out_f = np.zeros(6)
     diag = np.zeros(1, dtype=fk.DIAG)
-    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag)
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1))
     q = diag[0]["q_out"]
     # outer contact at +x: N = (-1, 0), T = rot90(N) = (0, -1); roller surface slides at s = -omega r_r along T
     slide = -spin * ROLLER_RADIUS
@@ -289,16 +289,20 @@ def test_pocket_theta_advances_with_cage_travel(sign):
 
 # --- the two step loops ---------------------------------------------------------------------------
 COMPARED = ("steps", "t_end", "t_record", "win", "first_imp", "f_bin", "t_bin", "q_bin", "tq_bin", "glob", "impacts",
-            "final_state", "orbit", "ring_centre_mean", "cage_w_start", "cage_w_end", "newton_failures", "orbit_max")
+            "final_state", "orbit", "ring_centre_mean", "cage_w_start", "cage_w_end", "newton_failures", "orbit_max",
+            "lift_max", "beyond_max", "beyond_before", "beyond_vr")
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
-@pytest.mark.parametrize("scenario", ["multibody_3000rpm", "multibody_reduced_equivalent_3000rpm"])
-def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario):
+@pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", []), ("multibody_reduced_equivalent_3000rpm", []),
+                                             ("multibody_3000rpm", ["multibody.raceway_contact=rigid"])])
+def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extra):
     """The plain loop (``Space.step`` and ``pymunk.batch``) calls the same kernels on the same inputs as
     the compiled one, so every accumulator, the impact table and the final state are identical bytes
-    (one rotation, no warm-up: ~11 500 steps, a few hundred impacts)."""
-    sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0"])
+    (one rotation, no warm-up: ~11 500 steps, a few hundred impacts). With rigid raceways the plain loop
+    reads the joints' impulses through ``Constraint.impulse``, the compiled one through
+    ``cpConstraintGetImpulse``: the same numbers."""
+    sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
     compiled = run(si(sc), step_loop="compiled")
     plain = run(si(sc), step_loop="plain")
     assert (compiled["step_loop"], plain["step_loop"]) == ("compiled", "plain")

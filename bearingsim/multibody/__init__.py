@@ -82,6 +82,8 @@ SUMMARY_UNITS = {
 }
 
 
+RIGID_SUMMARY_UNITS = {"roller_lift_max_m": "m", "roller_beyond_race_max_m": "m"}
+
 LAND_SUMMARY_UNITS = {
     "land_normal_impulse_mean_Ns": "N s", "land_friction_impulse_mean_Ns": "N s",
     "land_torque_impulse_Nms": "N m s", "land_overlap_max_m": "m", "land_stiffness_N_m": "N/m",
@@ -239,6 +241,10 @@ class MultibodyResult(Result):
         if with_ring:  # the reduced-equivalent scene has no inner ring
             summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
         units = dict(SUMMARY_UNITS)
+        if raw.get("lift_max") is not None:  # rigid raceways (docs/fast_scene.md)
+            summary["roller_lift_max_m"] = float(raw["lift_max"])
+            summary["roller_beyond_race_max_m"] = float(raw["beyond_max"])
+            units.update(RIGID_SUMMARY_UNITS)
         if land is not None:
             summary.update({
                 "land_normal_impulse_mean_Ns": float(land["win"][:, 0].mean()),

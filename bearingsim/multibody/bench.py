@@ -10,6 +10,9 @@ pymunk_step_s`` is the rest of the step (force kernel, recording, batched copies
   chaotic (pocket-to-pocket scatter of I_dec ~30 %), so over a few rotations this error holds
   statistical scatter (trajectories separate) as well as the dt error: it bounds the dt error from
   above, it does not measure it;
+* ``scene = full_rigid_raceways``: the full scene with ``multibody.raceway_contact = "rigid"`` at its
+  automatic step, error against the same Hertz reference (so it holds the chaotic scatter too;
+  ``bearingsim bench --fast-scene`` compares the two scenes over 40 rotations with standard errors);
 * ``scene = reduced_equivalent``: deterministic, at 3000 rpm over dt; ``rel_error`` against the exact
   event solution of the reduced model, whose assumptions this scene makes (so it also holds the small
   modelling difference of the polyline pocket faces).
@@ -28,7 +31,7 @@ GOAL_ERROR = 0.01
 
 
 def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "full", load: float = 970.0,
-                       phi="auto", source: str = "<bench>"):
+                       phi="auto", source: str = "<bench>", raceway_contact: str = "hertz"):
     """The reference bearing (NU214) in the multibody model at one speed and load; ``phi`` is the
     reduced-equivalent scene's load-zone half angle [deg] or "auto"."""
     doc = {
@@ -37,7 +40,7 @@ def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "fu
         "model": "multibody",
         "bearing": {"preset": "NU214-Suzuki2023"},
         "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": float(load)},
-        "multibody": {"scene": scene},
+        "multibody": {"scene": scene, "raceway_contact": raceway_contact},
         "numerics": {"rotations": rotations, "warmup_rotations": warmup},
         "reduced": {"load_zone_half_angle_deg": phi},
     }
@@ -74,6 +77,7 @@ def bench_cases(quick: bool) -> list[dict]:
         repeats = 3
     rows = []
     simulate(Parameters.from_scenario(reference_scenario(6000, 1, 0)))  # load the compiled kernels once (not timed in any row)
+    simulate(Parameters.from_scenario(reference_scenario(6000, 1, 0, raceway_contact="rigid")))
     for rpm, nrot in plan.items():
         sc = Parameters.from_scenario(reference_scenario(rpm, nrot, 1))
         total_rot = nrot + 1
@@ -83,6 +87,11 @@ def bench_cases(quick: bool) -> list[dict]:
             runs = [simulate(sc, dt=dt) for _ in range(repeats)]
             rows.append(_row("full", rpm, dt, runs, total_rot, ref_idec, f"full scene at dt = {dt_ref:g} s"))
         rows.append(_row("full", rpm, dt_ref, [ref], total_rot, ref_idec, "itself"))
+        # rigid raceways (issue 16) at their automatic step, against the same Hertz reference
+        rig = Parameters.from_scenario(reference_scenario(rpm, nrot, 1, raceway_contact="rigid"))
+        runs = [simulate(rig) for _ in range(repeats)]
+        rows.append(_row("full_rigid_raceways", rpm, runs[0].provenance["dt_s"], runs, total_rot, ref_idec,
+                         f"full scene (Hertz raceways) at dt = {dt_ref:g} s"))
     # deterministic scene against the exact reduced solution
     sc = Parameters.from_scenario(reference_scenario(3000, 1, 1, scene="reduced_equivalent", phi=23.5))
     exact = solve_event(PassInputs.from_parameters(sc)).I_dec

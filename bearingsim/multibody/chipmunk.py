@@ -55,7 +55,7 @@ SUPPORTED_PYMUNK = (7,)
 PLAIN_ENV = "BEARINGSIM_PLAIN_PYMUNK"
 _FUNCTIONS = ("cpSpaceStep", "cpSpaceEachBody", "cpSpaceEachCachedArbiter", "pmSpaceBodyGetIteratorFuncBatched",
               "pmSpaceBodySetIteratorFuncBatched", "pmSpaceArbiterIteratorFuncBatched", "pmFloatArrayNew",
-              "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree")
+              "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree", "cpConstraintGetImpulse")
 CLOCK_MONOTONIC = 1  # Linux and macOS
 
 
@@ -89,7 +89,7 @@ def guard() -> str | None:
     return None
 
 
-def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None):
+def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=()):
     """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
 
     Parameters
@@ -100,6 +100,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None):
     set_arr : float64 set buffer (``nb`` rows of ``set_fields``).
     arb_cap : arbiters the compiled loop's buffers hold.
     step_loop : "compiled", "plain" or None (compiled unless ``BEARINGSIM_PLAIN_PYMUNK=1`` or the guard fails).
+    joints : rigid raceways: the rollers' outer-race joints, in roller order; after each step their
+        impulses over ``h`` go into ``StepWork.n_out``.
     """
     if step_loop not in (None, "compiled", "plain"):
         raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
@@ -118,8 +120,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None):
     else:
         reason = "asked for"
     if step_loop == "plain":
-        return lp.PlainLoop(space, nb, set_fields, set_arr), reason
-    return BatchIO(space, nb, set_fields, set_arr, arb_cap), reason
+        return lp.PlainLoop(space, nb, set_fields, set_arr, joints), reason
+    return BatchIO(space, nb, set_fields, set_arr, arb_cap, joints), reason
 
 
 class _CFunction(types.WrapperAddressProtocol):
@@ -150,6 +152,7 @@ def _address(cdata) -> int:
 _STEP_SIG = types.void(types.int64, types.float64)
 _EACH_SIG = types.void(types.int64, types.int64, types.int64)
 _CLOCK_SIG = types.int32(types.int32, types.int64)
+_IMPULSE_SIG = types.float64(types.int64)
 
 
 def _clock_function():
@@ -203,9 +206,12 @@ class BatchIO:
 
     name = "compiled"
 
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap):
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=()):
         self.nb = nb
         self._space = space._space
+        self.impulse_fn = _chipmunk("cpConstraintGetImpulse", _IMPULSE_SIG)
+        self._joints = list(joints)  # the C objects must outlive the run
+        self.joint_ptrs = np.array([_address(j._constraint) for j in self._joints], dtype=np.int64)
         self.step_fn = _chipmunk("cpSpaceStep", _STEP_SIG)
         self.each_body_fn = _chipmunk("cpSpaceEachBody", _EACH_SIG)
         self.each_arb_fn = _chipmunk("cpSpaceEachCachedArbiter", _EACH_SIG)
@@ -263,8 +269,9 @@ class BatchIO:
 
     def advance(self, inp, wk, acc, ls):
         """Run :func:`advance` until it returns a code."""
-        return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.timed, self.ptr,
-                       self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts, inp, wk, acc, ls)
+        return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn, self.timed,
+                       self.ptr, self.joint_ptrs, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i,
+                       self.ts, inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -274,13 +281,15 @@ def _now_ns(clock, ptr_ts, ts):
 
 
 @njit(cache=True)
-def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc,
-            ls):
+def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, timed, ptr, joint_ptrs, hdr, st0, st1, arb_f,
+            arb_i, ts, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
     ``hdr`` (:class:`Headers`): the loop resets ``num`` before each batched call and stops if pymunk
-    ever grew an array (``max`` changed), which the sizes chosen in :class:`BatchIO` rule out. ``inp``,
+    ever grew an array (``max`` changed), which the sizes chosen in :class:`BatchIO` rule out.
+    ``joint_ptrs``: the rigid raceways' joints (``cpConstraint *``), whose impulses over ``h`` are the
+    outer-race forces written into ``wk.n_out`` after each step (empty with Hertz contacts). ``inp``,
     ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
@@ -304,6 +313,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, timed, ptr, hdr, st0, 
             s.pymunk_ns += _now_ns(clock_fn, ptr.timespec, ts) - t0
         else:
             step_fn(sp, h)
+        for k in range(joint_ptrs.shape[0]):
+            wk.n_out[k] = impulse_fn(joint_ptrs[k]) / h
         if cur == 0:  # the state after the step goes into the other array
             hdr.state1[0] = 0
             each_body_fn(sp, ptr.body_get, ptr.data_state1)

@@ -55,6 +55,14 @@ PENETRATION_LIMIT = 0.01  # largest roller-cage overlap accepted, as a fraction 
 LAND_OVERLAP_FRACTION = 0.01
 LAND_ORBIT_MARGIN = 0.1
 
+# rigid raceways (multibody.raceway_contact = "rigid", docs/fast_scene.md): the rollers ride on the
+# outer race held by a unilateral joint, so no raceway spring limits the step
+RIGID_IMPACT_OVERLAP_FRACTION = 0.01  # auto dt: one step's approach at the impact speed <= 1 % of s (the bound itself)
+RIGID_DT_CAP_S = 1.0e-4  # never above this
+# the roller must press on the outer race with its centrifugal load: m r omega_c^2 >= this multiple of
+# its weight, so the rollers at the top stay on the race against gravity and the cage's pushes
+RIGID_MIN_CENTRIFUGAL_RATIO = 1.5
+
 
 def land_reference_force(p) -> float:
     """Largest radial force [N] expected on a land-guided cage: the radial load, the centrifugal loads
@@ -154,6 +162,19 @@ def inner_ring_model(p):
     return mass, f"dynamic, mass {src}" + (f"; {why}" if why else "")
 
 
+def rigid(p) -> bool:
+    """True when the raceway contacts are rigid (``multibody.raceway_contact = "rigid"``)."""
+    return p.multibody.raceway_contact == "rigid"
+
+
+def rigid_speed_floor(p) -> float:
+    """Lowest inner-ring speed [rpm] the rigid raceways accept (:data:`RIGID_MIN_CENTRIFUGAL_RATIO`)."""
+    g, op = p.bearing, p.operating
+    r = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
+    omega_c = math.sqrt(RIGID_MIN_CENTRIFUGAL_RATIO * max(op.gravity, 0.0) / r)
+    return omega_c / max(op.omega_c / op.omega_i, 1e-300) * 30.0 / math.pi
+
+
 def max_roller_load(p) -> float:
     """Estimate of the largest raceway load [N]: Stribeck 5 W / Z plus the centrifugal load."""
     g = p.bearing
@@ -201,8 +222,16 @@ def impact_dt(p) -> float:
     return IMPACT_OVERLAP_FRACTION * g.pocket_clearance / v
 
 
+def land_stability_limit(p) -> float:
+    """Explicit stability limit 2/omega_n [s] of the cage on its land's penalty contact (inf: roller-guided)."""
+    land = land_params(p, active=p.multibody.scene == "full" and p.bearing.cage_guidance != "rollers")
+    return 2.0 * math.sqrt(p.bearing.cage_mass / land.stiffness) if land.active else math.inf
+
+
 def choose_dt(p, dt=None):
     """(dt [s], how it was chosen, explicit limit [s]). Raises UserError for a dt far above stable."""
+    if rigid(p):
+        return _choose_dt_rigid(p, dt)
     lim = stability_limit(p)
     largest = DT_MAX_FACTOR * lim
     if dt is None and p.numerics.dt is not None:
@@ -222,6 +251,45 @@ def choose_dt(p, dt=None):
             f"(Hertz limit 2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s "
             f"for the automatic {min(DT_FRACTION * lim, DT_CAP_S):.3g} s")
     return float(dt), how, lim
+
+
+def _choose_dt_rigid(p, dt):
+    """Rigid raceways: no raceway spring; the step resolves the roller-cage impacts (and the land's
+    penalty contact of a land-guided cage). Returns (dt, how, explicit limit [s] (the land's or inf))."""
+    lim = land_stability_limit(p)
+    largest = DT_MAX_FACTOR * lim
+    if dt is None and p.numerics.dt is not None:
+        dt, how = p.numerics.dt, "numerics.dt_s"
+    elif dt is not None:
+        how = "simulate(dt=...)"
+    else:
+        s = p.bearing.pocket_clearance
+        dti = RIGID_IMPACT_OVERLAP_FRACTION / IMPACT_OVERLAP_FRACTION * impact_dt(p)
+        dt = min(dti, DT_FRACTION * lim, RIGID_DT_CAP_S)
+        how = (f"auto (rigid raceways): min of impact resolution {RIGID_IMPACT_OVERLAP_FRACTION} s / v_impact = "
+               f"{dti:.3e} s (s = {s * 1e3:.3g} mm)"
+               + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
+                  if math.isfinite(lim) else "")
+               + f" and {RIGID_DT_CAP_S:.0e} s")
+    if dt > largest:
+        raise UserError(
+            f"numerics.dt_s = {dt:.3g} s is far above the stable time step of the cage on its land "
+            f"(2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s")
+    return float(dt), how, lim
+
+
+def check_rigid(p):
+    """Refuse (UserError) what the rigid raceways cannot represent: rollers that would leave the outer race."""
+    g, op = p.bearing, p.operating
+    r = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
+    fc = g.roller_mass * r * op.omega_c**2
+    w = g.roller_mass * op.gravity
+    if fc < RIGID_MIN_CENTRIFUGAL_RATIO * w:
+        raise UserError(
+            f"multibody.raceway_contact = 'rigid': at {op.inner_ring_speed_rpm:g} rpm a roller's centrifugal load "
+            f"({fc:.3g} N) is less than {RIGID_MIN_CENTRIFUGAL_RATIO:g} x its weight ({w:.3g} N), so the rollers at "
+            f"the top leave the outer race, which rigid raceways do not model; use raceway_contact = 'hertz' "
+            f"below {rigid_speed_floor(p):.0f} rpm")
 
 
 def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT,
@@ -245,6 +313,9 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     n = geo.roller_count
     if n < 3:
         raise UserError(f"bearing.roller_count = {n}: the multibody model needs at least 3 rollers")
+    is_rigid = rigid(p)
+    if is_rigid:
+        check_rigid(p)
     h, dt_how, dt_lim = choose_dt(p, dt)
     sign = op.sign
     e = p.contact.restitution
@@ -259,15 +330,20 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     pd = 0.0 if reduced_eq else geo.radial_clearance
     ro_race = geo.outer_race_radius + 0.25 * pd
     ri_race = geo.inner_race_radius - 0.25 * pd
+    # rigid raceways: roller centres on the outer race, at most r_c from the axis (a unilateral joint);
+    # the inner-race contact carries both contacts' compliance in series, Q = K 2^(-10/9) delta^(10/9)
+    r_c = ro_race - rr
+    K_race = K * 2.0 ** (-10.0 / 9.0) if is_rigid else K
 
     sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,
                      n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=kinematic, spin_free=not reduced_eq,
-                     flat_pockets=p.multibody.flat_pockets, centred_cage=scene_kind == "centred_cage")
+                     flat_pockets=p.multibody.flat_pockets, centred_cage=scene_kind == "centred_cage",
+                     rigid_radius=r_c if is_rigid else None)
     space = sc.space
     nb = n + 1
     # rollers start on the outer race (centrifugal), moving with the cage
     n_centrifugal = geo.roller_mass * rp * op.omega_c**2 + 1e-3
-    r0 = ro_race - rr - (n_centrifugal / K) ** 0.9
+    r0 = r_c if is_rigid else ro_race - rr - (n_centrifugal / K) ** 0.9
     omega_cage = sign * op.omega_c
     for i, b in enumerate(sc.rollers):
         a = sc.pocket_body_angle[i]
@@ -279,13 +355,14 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         roller_radius=float(rr), roller_mass=float(geo.roller_mass), roller_inertia=float(geo.roller_inertia),
         outer_race_radius=float(ro_race), inner_race_radius=float(ri_race),
         outer_race_geom_radius=float(geo.outer_race_radius), inner_race_geom_radius=float(geo.inner_race_radius),
-        palmgren_stiffness=float(K), damping_time=CONTACT_DAMPING_S, damping_fade=DAMPING_FADE_M,
+        palmgren_stiffness=float(K_race), damping_time=0.0 if is_rigid else CONTACT_DAMPING_S,
+        damping_fade=DAMPING_FADE_M,
         traction_mu_max=float(p.contact.traction_mu_max),
         traction_slip_ref=float(p.contact.traction_slip_ref), min_entrainment=MIN_ENTRAINMENT_M_S,
         drag_coefficient=float(p.contact.drag_coefficient), drag_direction_eps=DRAG_DIRECTION_EPS_M_S,
         omega_ring=float(sign * op.omega_i), radial_load=float(op.radial_load), gravity=float(op.gravity),
         inner_ring=not reduced_eq, traction=not reduced_eq, spin_free=not reduced_eq,
-        newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass))
+        newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass), rigid=is_rigid, rigid_radius=float(r_c))
     cfg = rk.RecorderConfig(sign=float(sign), roller_count=int(n), warmup_rotations=float(warm), rotations=nrot,
                             theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S)
     acc = rk.accumulators(nrot, n, THETA_BINS, IMPACT_CAPACITY)
@@ -293,6 +370,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     theta0 = np.mod(-2.0 * math.pi * np.arange(n) / n, 2.0 * math.pi)
     # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
     _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not reduced_eq else (0, 0)
+    # (the same start for rigid raceways: the continuous distribution's displacement is that of two
+    # contacts in series already)
     ids = sc.body_ids
     order = np.argsort(ids)
 
@@ -311,10 +390,11 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
         out_f=np.zeros(nb * 3) if reduced_eq else set_arr, set_arr=set_arr,
         diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
-        orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)))
+        orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)),
+        n_out=np.full(n, n_centrifugal))  # rigid: the first step's outer-race loads, before a joint has acted
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
-    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop)
+    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints)
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot
@@ -353,10 +433,12 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=out_every,
-        max_steps=int(3 * steps_est + 1000))
+        max_steps=int(3 * steps_est + 1000),
+        rigid=is_rigid)
     inp = lp.StepInputs(
         h=float(h), prm=prm, cfg=cfg, lim=lim,
-        hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi), radius=rp - (n_centrifugal / K) ** 0.9,
+        hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi),
+                              radius=r_c if is_rigid else rp - (n_centrifugal / K) ** 0.9,
                               front_offset=0.5 * s, omega_cage=float(omega_cage)),
         land=land,
         pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
@@ -395,7 +477,7 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
             raise PenetrationExceeded(g["maxpen_all"], lim.penetration, h, g["maxpen_time"], g["maxpen_approach"])
         if code == lp.CODE_BLOWUP:
             raise SimulationUnstable(
-                f"raceway approach {wk.diag['delta_out'].max():.3g} m (limit {lim.raceway_approach:.3g} m, 3x the "
+                f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if is_rigid else 0.0):.3g} m (limit {lim.raceway_approach:.3g} m, 3x the "
                 f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
                 f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); try a smaller "
                 f"numerics.dt_s than {h:.3g} s")
@@ -445,7 +527,11 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         final_state=prev.copy(), orbit=np.roll(wk.orbit, -(n_orbit % ORBIT_KEEP), axis=0),
         ring_centre_mean=(np.array([st["ring_sum_x"], st["ring_sum_y"]]) / ring_n if ring_n and not reduced_eq
                           else np.full(2, np.nan)),
-        radial_clearance=geo.radial_clearance,
+        radial_clearance=geo.radial_clearance, raceway_contact=p.multibody.raceway_contact,
+        lift_max=float(st["lift_max"]) if is_rigid else None,
+        beyond_max=float(st["beyond_max"]) if is_rigid else None, beyond_vr=float(st["beyond_vr"]) if is_rigid else None,
+        beyond_before=float(st["beyond_before"]) if is_rigid else None,
+        rigid_radius=float(r_c),
         land=(dict(win=wk.land_win.copy(), tau=float(st["land_tau"]), overlap_max=float(st["land_overlap_max"]),
                    stiffness=land.stiffness, half_clearance=land.half_clearance) if land.active else None),
     )

@@ -77,6 +77,8 @@ class RacewayParams(NamedTuple):
     spin_free: bool  #: roller spin is a degree of freedom (else fixed)
     newton_max_step: float  #: step limit of the ring-centre Newton iteration [m]
     ring_mass: float  #: 0: quasi-static (massless) inner ring; > 0: dynamic ring of this mass [kg]
+    rigid: bool = False  #: rigid raceways: the outer-race contact is a pymunk joint whose force is given
+    rigid_radius: float = 0.0  #: rigid raceways: radius of the roller centres on the outer race [m]
 
 
 #: Per-roller contact diagnostics of a step, array shape (n,).
@@ -85,6 +87,7 @@ DIAG = np.dtype([
     ("delta_out", np.float64), ("delta_in", np.float64),  # approaches [m]
     ("slip_out", np.float64), ("slip_in", np.float64),  # sliding speed / entrainment speed
     ("drag_out", np.float64), ("drag_in", np.float64),  # oil-film rolling resistance F_o [N]
+    ("lift", np.float64),  # rigid raceways: distance of the roller centre inside its outer-race circle [m]
 ], align=True)
 
 TEN_NINTHS = 10.0 / 9.0
@@ -198,6 +201,7 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
 @njit(cache=True)
 def _contact(
     px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, r_race_geom, omega_race, orbit, prm, jac, f,
+    q_given=-1.0,
 ):
     """Add one raceway contact to the generalized force ``f`` (fx, fy, torque) and its Jacobians.
 
@@ -205,6 +209,8 @@ def _contact(
     speed along the tangent ``T = rot90(N)`` at the contact [m/s], ``w_race`` the speed along T of the
     raceway material at the roller centre [m/s], ``orbit`` the roller's orbital angular speed [rad/s].
     ``jac`` is (C, K) packed as a 3x3 velocity Jacobian and 2x2 stiffness in a (3, 5) array.
+    ``q_given >= 0``: the normal force is that of a constraint (rigid raceways), known from the
+    previous step; it is not added to ``f`` (the constraint applies it) and sets traction and drag.
 
     Returns
     -------
@@ -212,13 +218,17 @@ def _contact(
     drag are 0 where the contact is open (and slip where traction is off).
     """
     rr = prm.roller_radius
-    q, dq_dd, dq_drate = _normal_force(delta, rate, prm.palmgren_stiffness, prm.damping_time, prm.damping_fade)
+    if q_given >= 0.0:
+        q = q_given
+    else:
+        q, dq_dd, dq_drate = _normal_force(delta, rate, prm.palmgren_stiffness, prm.damping_time, prm.damping_fade)
     if q <= 0.0:
         return q, delta, 0.0, 0.0
     tx = -ny
     ty = nx
-    f[0] += q * nx
-    f[1] += q * ny
+    if q_given < 0.0:
+        f[0] += q * nx
+        f[1] += q * ny
     # The normal force is explicit at the predicted position (symplectic Euler): linearising it in
     # Cartesian coordinates about v_n would turn the orbital motion (the normal turns by omega h per
     # step) into a spurious approach rate omega h v and an O(omega h)^2 k force bias.
@@ -267,7 +277,7 @@ def _contact(
 
 
 @njit(cache=True)
-def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag):
+def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag, n_out):
     """Implicitly linearised raceway forces on every roller for the coming pymunk step.
 
     Parameters
@@ -282,6 +292,20 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     hold : (n,) bool, rollers whose motion is prescribed this step (get zero force).
     out_f : (nb * 3,) flat (fx, fy, torque) per body for ``pymunk.batch.set_space_bodies`` [N, N m].
     diag : (n,) :data:`DIAG`, out: per-roller contact diagnostics (loads [N], approaches [m], slips, drags [N]).
+    n_out : (n,) rigid raceways: the outer-race normal force of each roller over the previous step, from
+        its constraint's impulse [N] (unused with Hertz contacts).
+
+    Rigid raceways (``prm.rigid``). Each roller is held on the outer race by a unilateral pymunk joint
+    (centre at most ``prm.rigid_radius`` from the axis), so no normal force is computed there: the
+    joint's force of the previous step sets that contact's traction and drag. Positions are taken on
+    the joint's circle (pymunk moves a body along its chord before the joint pulls it back, so a body
+    read after a step sits up to ``r (omega h)^2 / 2`` outside it). The inner-race contact keeps its
+    Palmgren law, with the two contacts of a roller in series (``prm.palmgren_stiffness`` is then
+    ``K 2^(-10/9)``) and no damping: the inner ring's centre, quasi-static or dynamic, shares the
+    load among the rollers as in the Hertz scene. A roller on the outer race does not move along that
+    contact's normal (the joint holds it), so the stiff spring sets no time step; a roller that the cage
+    has pulled off the outer race and onto the inner race has the inner contact's stiffness in its
+    velocity update (linearly implicit), which keeps that rare state stable at the rigid scene's step.
 
     Returns
     -------
@@ -296,13 +320,25 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     din_prev = np.empty(n)
     dout_prev = np.empty(n)
     rr = prm.roller_radius
+    rigid = prm.rigid
+    rc = prm.rigid_radius
     for i in range(n):
-        xp[i, 0] = state[i, 0] + h * state[i, 3]
-        xp[i, 1] = state[i, 1] + h * state[i, 4]
+        x0 = state[i, 0]
+        y0 = state[i, 1]
+        xp[i, 0] = x0 + h * state[i, 3]
+        xp[i, 1] = y0 + h * state[i, 4]
+        if rigid:  # on the joint's circle (see above); a roller inside it has left the outer race
+            r0 = math.sqrt(x0 * x0 + y0 * y0)
+            if r0 > rc:
+                x0 *= rc / r0
+                y0 *= rc / r0
+            r1 = math.sqrt(xp[i, 0] ** 2 + xp[i, 1] ** 2)
+            if r1 > rc:
+                xp[i, 0] *= rc / r1
+                xp[i, 1] *= rc / r1
         # approaches at the current positions: contact rates are (delta_{n+1} - delta_n) / h
-        dout_prev[i] = math.sqrt(state[i, 0] ** 2 + state[i, 1] ** 2) + rr - prm.outer_race_radius
-        din_prev[i] = prm.inner_race_radius + rr - math.sqrt((state[i, 0] - ring_c[0]) ** 2
-                                                      + (state[i, 1] - ring_c[1]) ** 2)
+        dout_prev[i] = math.sqrt(x0 ** 2 + y0 ** 2) + rr - prm.outer_race_radius
+        din_prev[i] = prm.inner_race_radius + rr - math.sqrt((x0 - ring_c[0]) ** 2 + (y0 - ring_c[1]) ** 2)
     it = 0
     inner = prm.inner_ring
     cdx = 0.0
@@ -330,7 +366,7 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     for i in range(n):
         d_i = diag[i]
         d_i.q_out = d_i.q_in = d_i.delta_out = d_i.delta_in = 0.0
-        d_i.slip_out = d_i.slip_in = d_i.drag_out = d_i.drag_in = 0.0
+        d_i.slip_out = d_i.slip_in = d_i.drag_out = d_i.drag_in = d_i.lift = 0.0
         if hold[i]:
             out_f[3 * i + 1] = m * g  # prescribed motion: cancel pymunk's gravity
             continue
@@ -346,10 +382,17 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         # outer raceway (fixed): force along N = -p/|p|
         nx = -px / r
         ny = -py / r
-        delta = r + rr - prm.outer_race_radius
-        rate = (delta - dout_prev[i]) / h
-        d_i.q_out, d_i.delta_out, d_i.slip_out, d_i.drag_out = _contact(
-            px, py, vx, vy, w, nx, ny, delta, rate, 0.0, 0.0, prm.outer_race_geom_radius, 0.0, orbit, prm, jac, f)
+        if rigid:  # the joint's force; no approach
+            d_i.lift = rc - r
+            d_i.q_out, d_i.delta_out, d_i.slip_out, d_i.drag_out = _contact(
+                px, py, vx, vy, w, nx, ny, 0.0, 0.0, 0.0, 0.0, prm.outer_race_geom_radius, 0.0, orbit, prm, jac, f,
+                n_out[i])
+        else:
+            delta = r + rr - prm.outer_race_radius
+            rate = (delta - dout_prev[i]) / h
+            d_i.q_out, d_i.delta_out, d_i.slip_out, d_i.drag_out = _contact(
+                px, py, vx, vy, w, nx, ny, delta, rate, 0.0, 0.0, prm.outer_race_geom_radius, 0.0, orbit, prm, jac,
+                f)
         if inner:
             dx = px - ring_c[0]
             dy = py - ring_c[1]
@@ -367,6 +410,14 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
             d_i.q_in, d_i.delta_in, d_i.slip_in, d_i.drag_in = _contact(
                 px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, prm.inner_race_geom_radius, omega_ring,
                 orbit, prm, jac, f)
+            if rigid and d_i.lift > 0.0 and d_i.q_in > 0.0:
+                # a roller pulled off the outer race onto the inner race sits on that contact's spring alone
+                # (2/omega_n ~ 20 us): its stiffness enters the velocity update implicitly, dF/dx = -Q' N N^T
+                kq = TEN_NINTHS * prm.palmgren_stiffness * delta ** (1.0 / 9.0)
+                jac[0, 3] -= kq * nx * nx
+                jac[0, 4] -= kq * nx * ny
+                jac[1, 3] -= kq * ny * nx
+                jac[1, 4] -= kq * ny * ny
             frx -= f[0] - f_before_x
             fry -= f[1] - f_before_y
         # implicit velocity update: (M - h C - h^2 K) dq = h (F + h K v + M g)

@@ -70,6 +70,10 @@ LOOP_STATE = np.dtype([
     ("orbit_max", np.float64),  # largest cage-centre offset in the recorded period [m]
     ("land_tau", np.float64),  # angular impulse of the land friction on the cage, recorded steps [N m s]
     ("land_overlap_max", np.float64),  # largest overlap of the cage rim with its land in the run [m]
+    ("lift_max", np.float64),  # rigid raceways: largest distance of a roller inside its outer-race circle [m]
+    ("beyond_max", np.float64),  # rigid raceways: largest distance of a roller centre outside its circle after a step [m]
+    ("beyond_before", np.float64),  # rigid raceways: that roller's distance outside it before that step [m]
+    ("beyond_vr", np.float64),  # rigid raceways: that roller's radial speed before that step [m/s]
 ], align=True)
 
 #: Time-series samples, one row every ``out_every`` steps (array shape (block,)).
@@ -95,6 +99,7 @@ class LoopLimits(NamedTuple):
     raceway_approach: float  #: largest outer-raceway approach accepted (beyond: an energy blow-up) [m]
     out_every: int  #: steps between samples and checks
     max_steps: int  #: steps after which the cage counts as stalled
+    rigid: bool = False  #: rigid raceways: the inner-race approach is watched too (a roller off the outer race)
 
 
 class HoldRule(NamedTuple):
@@ -136,6 +141,7 @@ class StepWork(NamedTuple):
     orbit: np.ndarray  #: (keep, 3) ring buffer of (t [s], x [m], y [m]) of the cage centre
     land_out: np.ndarray  #: (4,) the land contact of the step (:func:`bearingsim.multibody.forces.land_force`)
     land_win: np.ndarray  #: (R, 3) per cage rotation: land normal impulse [N s], friction impulse [N s], friction torque impulse [N m s]
+    n_out: np.ndarray  #: (n,) rigid raceways: outer-race normal force of each roller over the last step, from its joint [N]
 
 
 @njit(cache=True)
@@ -218,7 +224,7 @@ def before_step(prev, inp, wk, ls):
     if inp.hold_rule.active:
         _hold_rollers(prev, n, sign, inp.hold_rule, inp.pocket_a, wk.hold)
     if fk.raceway_forces(prev, inp.h, inp.prm, wk.ring_c, wk.ring_c_prev, wk.ring_v, wk.hold, wk.out_f,
-                         wk.diag) < 0:
+                         wk.diag, wk.n_out) < 0:
         s.newton_failures += 1
     if inp.land.active:
         _land_step(prev, travel, inp, wk, s)
@@ -274,7 +280,19 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
             return CODE_PENETRATION
         dmax = 0.0
         for i in range(n):
-            dmax = max(dmax, wk.diag[i].delta_out)
+            d_i = wk.diag[i]
+            dmax = max(dmax, d_i.delta_out)
+            if lim.rigid:
+                dmax = max(dmax, d_i.delta_in)
+                s.lift_max = max(s.lift_max, d_i.lift)
+                # how far pymunk's step left the roller outside its outer-race circle, and from what: the
+                # distance before the step and the radial speed it moved with (x_new = x + h v)
+                beyond = math.hypot(now[i, 0], now[i, 1]) - inp.prm.rigid_radius
+                if beyond > s.beyond_max:
+                    r_prev = math.hypot(prev[i, 0], prev[i, 1])
+                    s.beyond_max = beyond
+                    s.beyond_before = r_prev - inp.prm.rigid_radius
+                    s.beyond_vr = (prev[i, 0] * prev[i, 3] + prev[i, 1] * prev[i, 4]) / r_prev
         if dmax > lim.raceway_approach or abs(now[n, 5]) > lim.omega:
             return CODE_BLOWUP
         if math.hypot(now[n, 0], now[n, 1]) > lim.orbit:
@@ -313,8 +331,9 @@ class PlainLoop:
     name = "plain"
     timed = True
 
-    def __init__(self, space, nb, set_fields, set_arr):
+    def __init__(self, space, nb, set_fields, set_arr, joints=()):
         self.space = space
+        self.joints = list(joints)
         self.nb = nb
         self.set_fields = set_fields
         self.states = [np.zeros((nb, 6)), np.zeros((nb, 6))]
@@ -347,6 +366,8 @@ class PlainLoop:
             t0 = time.perf_counter_ns()
             self.space.step(h)
             ls[0]["pymunk_ns"] += time.perf_counter_ns() - t0
+            for k, j in enumerate(self.joints):  # rigid raceways: the outer-race forces of the step
+                wk.n_out[k] = j.impulse / h
             self._read_bodies(self.states[cur ^ 1])
             self._arbiters.clear()
             pb.get_space_arbiters(self.space, ARB_GET, self._arbiters)

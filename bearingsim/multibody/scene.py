@@ -28,7 +28,7 @@ the cage (pymunk multiplies them), friction likewise ``cage_friction`` and 1.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pymunk
@@ -48,6 +48,7 @@ class Scene:
     pocket_radius: float  # R = r_r + s/2 [m]
     face_vertices: list  # [pocket][face] polyline vertices (k + 1, 2) in the cage frame [m]
     body_ids: np.ndarray  # (n + 1,) pymunk body ids in batch order (rollers, then cage)
+    joints: list = field(default_factory=list)  # rigid raceways: each roller's outer-race joint, in roller order
 
 
 def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
@@ -77,7 +78,7 @@ def face_polyline(centre, e_t, e_r, radius, half_angle, n_seg):
 
 def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_angle: float,
                 n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
-                flat_pockets=(), centred_cage: bool = False) -> Scene:
+                flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
 
     Parameters
@@ -94,6 +95,11 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     flat_pockets : indices of the pockets with flat faces (one segment each).
     centred_cage : hold the (free) cage's centre on the bearing axis with a pivot joint to the static
         body at (0, 0); it still turns freely under its contact torques (the ``centred_cage`` scene).
+    rigid_radius : rigid raceways (``multibody.raceway_contact = "rigid"``): hold each roller on the
+        outer race with a unilateral joint, centre at most this far from the axis [m] (a
+        ``pymunk.SlideJoint`` from 0 to ``rigid_radius`` to a static anchor at the axis). pymunk solves it
+        with the roller-cage contacts, so a cage pushing a roller outward meets the raceway in the same
+        step; a roller pulled inward leaves it.
     """
     n = geometry.roller_count
     rr = geometry.roller_radius
@@ -169,5 +175,13 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
         # applies a force through the cage centre only, so it adds no torque about it
         pivot.error_bias = 0.0
         space.add(pivot)
+    joints = []
+    if rigid_radius is not None:
+        anchor = pymunk.Body(body_type=pymunk.Body.STATIC)  # not added to the space (as the pivot's)
+        for b in rollers:
+            j = pymunk.SlideJoint(anchor, b, (0.0, 0.0), (0.0, 0.0), 0.0, float(rigid_radius))
+            j.error_bias = 0.0  # a roller outside the circle is put back within one step
+            joints.append(j)
+        space.add(*joints)
     ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
-    return Scene(space, rollers, cage, a, R, verts, ids)
+    return Scene(space, rollers, cage, a, R, verts, ids, joints)

@@ -1,0 +1,184 @@
+"""Rigid raceways (issue 16): ``multibody.raceway_contact = "rigid"``. Each test says why its check must hold.
+
+The rigid scene holds every roller on the outer race by a unilateral pymunk joint and takes the inner-race
+loads from the quasi-static ring balance (docs/fast_scene.md). Short runs at 6000 and 3000 rpm, 970 N.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bearingsim.errors import UserError
+from bearingsim.multibody.core import RIGID_MIN_CENTRIFUGAL_RATIO, choose_dt, rigid_speed_floor
+from bearingsim.parameters import Parameters
+from bearingsim.scenario import load_scenario
+from bearingsim.simulation import run as simulate
+from bearingsim.sweeps.worker import standard_errors
+from tests.conftest import SCENARIOS
+from tests.test_cli import assert_user_error, bearingsim
+
+BASE = SCENARIOS / "multibody_6000rpm.toml"
+ROTATIONS = 12  # recorded, after one warm-up rotation
+
+
+def _scenario(contact, rpm=6000, rotations=ROTATIONS, warmup=1, extra=()):
+    return load_scenario(BASE, [f"multibody.raceway_contact={contact}", f"operating.inner_ring_speed_rpm={rpm}",
+                                f"numerics.rotations={rotations}", f"numerics.warmup_rotations={warmup}", *extra])
+
+
+@pytest.fixture(scope="module")
+def pair_6000():
+    return {c: simulate(_scenario(c)) for c in ("hertz", "rigid")}
+
+
+# ------------------------------------------------------------------------------------------------
+def test_rigid_agrees_with_the_hertz_scene_at_6000rpm(pair_6000):
+    """Issue 16's agreement criterion over 12 rotations: mean I_dec and I_acc per pocket and rotation within
+    max(3 %, 2 standard errors of the difference) of the Hertz full scene; load-zone half angle within 1 deg;
+    cage slip within 0.2 percentage points. The full scene is chaotic (runs that differ in the last bit
+    separate), so two correct scenes differ over a finite run by their statistical scatter: hence the
+    standard-error term (per-rotation means over the pockets, rotations taken as independent)."""
+    h, r = pair_6000["hertz"], pair_6000["rigid"]
+    se_h = standard_errors(h.per_rotation["I_dec"], h.per_rotation["I_acc"])
+    se_r = standard_errors(r.per_rotation["I_dec"], r.per_rotation["I_acc"])
+    for name in ("I_dec", "I_acc"):
+        mh, mr = h.summary[f"{name}_mean_Ns"], r.summary[f"{name}_mean_Ns"]
+        bound = max(0.03, 2.0 * math.hypot(se_h[f"{name}_sem_Ns"], se_r[f"{name}_sem_Ns"]) / mh)
+        assert abs(mr - mh) / mh <= bound, (name, mr, mh, bound)
+    assert abs(r.summary["load_zone_half_angle_deg"] - h.summary["load_zone_half_angle_deg"]) <= 1.0
+    assert abs(r.summary["cage_slip"] - h.summary["cage_slip"]) <= 0.002
+
+
+def test_rigid_time_step_is_set_by_the_impacts_not_the_raceway_spring(pair_6000):
+    """Without the raceway spring the automatic step resolves the roller-cage impacts at the 1 % overlap
+    bound: several times the Hertz scene's step (set by 2/omega_n ~ 8 us), and the overlap bound holds."""
+    h, r = pair_6000["hertz"], pair_6000["rigid"]
+    assert r.provenance["dt_s"] > 2.5 * h.provenance["dt_s"], (r.provenance["dt_s"], h.provenance["dt_s"])
+    assert "rigid raceways" in r.provenance["dt_choice"] and "impact resolution" in r.provenance["dt_choice"]
+    s = r.parameters.bearing.pocket_clearance
+    assert r.summary["max_penetration_all_m"] <= 0.01 * s
+
+
+def test_rollers_never_pass_the_outer_race(pair_6000):
+    """No raceway penetration accumulates: pymunk moves a body along x + h v before its joint acts, so after
+    a step a roller can be outside its outer-race circle by the chord of its orbit, r (omega h)^2 / 2
+    (omega its orbital speed: the cage's within the slip, bound taken at 1.5x), plus one step of an
+    outward radial speed it had (a roller the cage threw back onto the race); the joint then puts it back
+    within that step. Checked at the deepest excursion of the run: the roller was on its circle (to the
+    chord) before that step, and the excursion is that step's motion. (A Hertz-scene roller carrying
+    ~800 N sits ~2 um into the race, elastically.)"""
+    r = pair_6000["rigid"]
+    p, raw = r.parameters, r.raw
+    h = r.provenance["dt_s"]
+    chord = raw["rigid_radius"] * (1.5 * p.operating.omega_c * h) ** 2 / 2.0
+    assert r.summary["roller_beyond_race_max_m"] > 0.0
+    assert raw["beyond_before"] <= chord, (raw["beyond_before"], chord)
+    assert raw["beyond_max"] <= max(raw["beyond_before"], 0.0) + h * max(raw["beyond_vr"], 0.0) + chord, raw
+
+
+def test_loaded_rollers_sit_on_their_constraint(pair_6000):
+    """In the load zone the inner race pushes every roller outward against its joint: the roller centres
+    are on the outer-race circle (to the chord drift), so the rollers' inner-race loads come from the ring
+    balance alone and sum to the radial load: the mean ring displacement gives the load-zone half angle
+    through Palmgren's series law (checked against the Hertz scene above). Rollers pulled off the race by
+    the cage (no-load zone) are allowed and reported (``roller_lift_max_m``), below the radial clearance."""
+    r = pair_6000["rigid"]
+    p = r.parameters
+    n = p.bearing.roller_count
+    st = r.raw["final_state"]
+    r_c = r.raw["rigid_radius"]
+    radius = np.hypot(st[:n, 0], st[:n, 1])
+    angle_from_load = np.degrees(np.arctan2(st[:n, 0], -st[:n, 1]))  # 0 at the bottom (load-zone centre)
+    loaded = np.abs(angle_from_load) < r.summary["load_zone_half_angle_deg"] - 1.0  # a 46 deg window: >= 2 rollers
+    assert loaded.sum() >= 2
+    assert np.all(np.abs(radius[loaded] - r_c) <= r.summary["roller_beyond_race_max_m"] + 1e-12)
+    assert 0.0 <= r.summary["roller_lift_max_m"] < 0.5 * p.bearing.radial_clearance
+
+
+def test_cage_angular_momentum_balances(pair_6000):
+    """Steady state: the torque impulses of all roller contacts on the cage cancel over the recorded
+    rotations up to the change of its angular momentum (``torque_balance_residual``, the same 1 % bound as
+    the Hertz scene's test in test_multibody.py)."""
+    assert abs(pair_6000["rigid"].summary["torque_balance_residual"]) < 0.01
+
+
+def test_rigid_is_refused_where_rollers_would_leave_the_outer_race():
+    """Below the speed where a roller's centrifugal load is 1.5x its weight the top rollers leave the
+    outer race, which the rigid scene does not model: refused before anything runs, naming the key and
+    the speed to use Hertz contacts below."""
+    p = Parameters.from_scenario(_scenario("rigid", rpm=300, rotations=1))
+    floor = rigid_speed_floor(p)
+    assert 300 < floor < 500
+    with pytest.raises(UserError, match="raceway_contact") as exc:
+        simulate(_scenario("rigid", rpm=300, rotations=1))
+    assert f"{floor:.0f} rpm" in str(exc.value)
+    g, op = p.bearing, p.operating
+    r_c = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
+    omega_floor = floor * math.pi / 30.0 * op.omega_c / op.omega_i
+    assert r_c * omega_floor**2 == pytest.approx(RIGID_MIN_CENTRIFUGAL_RATIO * op.gravity, rel=1e-9)
+
+
+def test_rigid_refusal_through_the_command_line(tmp_path):
+    """A user error: one line naming the key, exit 2, no archive."""
+    out = tmp_path / "x.h5"
+    r = bearingsim("run", str(BASE), "--set", "multibody.raceway_contact=rigid", "--set",
+                   "operating.inner_ring_speed_rpm=200", "-o", str(out))
+    assert_user_error(r, "multibody.raceway_contact")
+    assert not out.exists()
+
+
+def test_unknown_raceway_contact_is_refused():
+    with pytest.raises(UserError, match="raceway_contact"):
+        _scenario("springy")
+
+
+def test_given_dt_is_used_and_limited_by_the_land_only():
+    """Rigid raceways have no raceway stability limit: a given step is used as is (roller-guided cage),
+    and for a land-guided cage refused above twice the land contact's 2/omega_n."""
+    p = Parameters.from_scenario(_scenario("rigid", extra=["numerics.dt_s=5e-5"]))
+    assert choose_dt(p)[0] == 5e-5
+    land = Parameters.from_scenario(_scenario("rigid", extra=["numerics.dt_s=5e-4", "bearing.cage_guidance=outer_land"]))
+    with pytest.raises(UserError, match="land"):
+        choose_dt(land)
+
+
+@pytest.mark.parametrize("extra", [["multibody.scene=reduced_equivalent"], ["multibody.scene=kinematic_cage"],
+                                   ["multibody.scene=centred_cage"], ["bearing.cage_guidance=outer_land"],
+                                   ["bearing.cage_guidance=inner_land"], ["multibody.inner_ring=dynamic"],
+                                   ["operating.direction=reverse"]])
+def test_every_ladder_scene_and_guidance_runs_with_rigid_raceways(extra):
+    """Every scene of the cross-check ladder, both land guidances, a dynamic inner ring and reverse rotation
+    run with rigid raceways (3000 rpm, 1 + 2 rotations): finite impulses, the overlap bound holds, and for
+    a free cage the angular-momentum balance closes as in the Hertz scene (1 %)."""
+    res = simulate(_scenario("rigid", rpm=3000, rotations=2, extra=extra))
+    s = res.summary
+    assert math.isfinite(s["I_dec_mean_Ns"]) and s["I_dec_mean_Ns"] > 0
+    assert s["max_penetration_all_m"] <= 0.01 * res.parameters.bearing.pocket_clearance
+    if not any("kinematic" in e or "reduced_equivalent" in e for e in extra):
+        assert abs(s["torque_balance_residual"]) < 0.01, s["torque_balance_residual"]
+
+
+def test_reduced_equivalent_scene_gives_the_same_impulse_with_either_raceway():
+    """The reduced-equivalent scene is deterministic (kinematic cage, rollers held in the load zone, free
+    flight in the no-load zone on the outer race): rigid and Hertz raceways differ only by the roller's
+    sub-micrometre centrifugal approach into the race and the step, so I_dec agrees to 1 %."""
+    h = simulate(_scenario("hertz", rpm=3000, rotations=1, extra=["multibody.scene=reduced_equivalent"]))
+    r = simulate(_scenario("rigid", rpm=3000, rotations=1, extra=["multibody.scene=reduced_equivalent"]))
+    assert r.summary["I_dec_mean_Ns"] == pytest.approx(h.summary["I_dec_mean_Ns"], rel=0.01)
+
+
+def test_a_sweep_runs_the_rigid_scene(tmp_path):
+    """The recommended fast path for design maps: a sweep over the rigid scene (each case's archive
+    stores the key, so the index row of a case says which raceways it ran)."""
+    r = bearingsim("sweep", str(BASE), "--set", "multibody.raceway_contact=rigid", "--set", "numerics.rotations=1",
+                   "--set", "numerics.warmup_rotations=0", "--param", "operating.inner_ring_speed_rpm=3000,6000",
+                   "-o", str(tmp_path / "sw"), "-j", "1")
+    assert r.returncode == 0, r.stderr
+    text = (tmp_path / "sw" / "sweep.csv").read_text()
+    assert text.count(",done,") == 2, text
+    from bearingsim import load
+
+    for h5 in (tmp_path / "sw" / "cases").glob("*.h5"):
+        assert load(h5).parameters.multibody.raceway_contact == "rigid"

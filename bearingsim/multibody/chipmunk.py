@@ -55,7 +55,8 @@ SUPPORTED_PYMUNK = (7,)
 PLAIN_ENV = "BEARINGSIM_PLAIN_PYMUNK"
 _FUNCTIONS = ("cpSpaceStep", "cpSpaceEachBody", "cpSpaceEachCachedArbiter", "pmSpaceBodyGetIteratorFuncBatched",
               "pmSpaceBodySetIteratorFuncBatched", "pmSpaceArbiterIteratorFuncBatched", "pmFloatArrayNew",
-              "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree", "cpConstraintGetImpulse")
+              "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree", "cpConstraintGetImpulse",
+              "cpShapeSetElasticity")
 CLOCK_MONOTONIC = 1  # Linux and macOS
 
 
@@ -89,7 +90,7 @@ def guard() -> str | None:
     return None
 
 
-def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=()):
+def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=()):
     """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
 
     Parameters
@@ -102,6 +103,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
     step_loop : "compiled", "plain" or None (compiled unless ``BEARINGSIM_PLAIN_PYMUNK=1`` or the guard fails).
     joints : rigid raceways: the rollers' outer-race joints, in roller order; after each step their
         impulses over ``h`` go into ``StepWork.n_out``.
+    roller_shapes : the rollers' circles, in roller order (their elasticity is set between steps when
+        ``StepInputs.onset_restitution``).
     """
     if step_loop not in (None, "compiled", "plain"):
         raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
@@ -120,8 +123,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
     else:
         reason = "asked for"
     if step_loop == "plain":
-        return lp.PlainLoop(space, nb, set_fields, set_arr, joints), reason
-    return BatchIO(space, nb, set_fields, set_arr, arb_cap, joints), reason
+        return lp.PlainLoop(space, nb, set_fields, set_arr, joints, roller_shapes), reason
+    return BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes), reason
 
 
 class _CFunction(types.WrapperAddressProtocol):
@@ -153,6 +156,7 @@ _STEP_SIG = types.void(types.int64, types.float64)
 _EACH_SIG = types.void(types.int64, types.int64, types.int64)
 _CLOCK_SIG = types.int32(types.int32, types.int64)
 _IMPULSE_SIG = types.float64(types.int64)
+_ELASTICITY_SIG = types.void(types.int64, types.float64)
 
 
 def _clock_function():
@@ -206,12 +210,15 @@ class BatchIO:
 
     name = "compiled"
 
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=()):
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=()):
         self.nb = nb
         self._space = space._space
         self.impulse_fn = _chipmunk("cpConstraintGetImpulse", _IMPULSE_SIG)
+        self.elasticity_fn = _chipmunk("cpShapeSetElasticity", _ELASTICITY_SIG)
         self._joints = list(joints)  # the C objects must outlive the run
+        self._shapes = list(roller_shapes)
         self.joint_ptrs = np.array([_address(j._constraint) for j in self._joints], dtype=np.int64)
+        self.shape_ptrs = np.array([_address(c._shape) for c in self._shapes], dtype=np.int64)
         self.step_fn = _chipmunk("cpSpaceStep", _STEP_SIG)
         self.each_body_fn = _chipmunk("cpSpaceEachBody", _EACH_SIG)
         self.each_arb_fn = _chipmunk("cpSpaceEachCachedArbiter", _EACH_SIG)
@@ -269,9 +276,9 @@ class BatchIO:
 
     def advance(self, inp, wk, acc, ls):
         """Run :func:`advance` until it returns a code."""
-        return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn, self.timed,
-                       self.ptr, self.joint_ptrs, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i,
-                       self.ts, inp, wk, acc, ls)
+        return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
+                       self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.hdr,
+                       self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts, inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -281,15 +288,17 @@ def _now_ns(clock, ptr_ts, ts):
 
 
 @njit(cache=True)
-def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, timed, ptr, joint_ptrs, hdr, st0, st1, arb_f,
-            arb_i, ts, inp, wk, acc, ls):
+def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
+            hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
     ``hdr`` (:class:`Headers`): the loop resets ``num`` before each batched call and stops if pymunk
     ever grew an array (``max`` changed), which the sizes chosen in :class:`BatchIO` rule out.
     ``joint_ptrs``: the rigid raceways' joints (``cpConstraint *``), whose impulses over ``h`` are the
-    outer-race forces written into ``wk.n_out`` after each step (empty with Hertz contacts). ``inp``,
+    outer-race forces written into ``wk.n_out`` after each step (empty with Hertz contacts);
+    ``shape_ptrs``: the rollers' circles (``cpShape *``), whose elasticity is set for the next step when
+    ``inp.onset_restitution`` (:func:`~bearingsim.multibody.loop.onset_elasticity`). ``inp``,
     ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
@@ -329,6 +338,12 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, timed, ptr
         code = lp.after_step(st0, st1, arb_f, arb_i, hdr.arb_i[0] // rk.ARB_I, inp, wk, acc, ls)
         if code != lp.CODE_CONTINUE:
             return code
+        if inp.onset_restitution:  # rigid raceways: elasticity of the roller shapes for the next step
+            lp.onset_elasticity(arb_i, hdr.arb_i[0] // rk.ARB_I, inp, wk)
+            for i in range(shape_ptrs.shape[0]):
+                if wk.e_want[i] != wk.e_set[i]:
+                    elasticity_fn(shape_ptrs[i], wk.e_want[i])
+                    wk.e_set[i] = wk.e_want[i]
         if s.step >= step_return:
             return lp.CODE_BLOCK_FULL
 

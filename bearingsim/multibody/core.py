@@ -391,10 +391,12 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         out_f=np.zeros(nb * 3) if reduced_eq else set_arr, set_arr=set_arr,
         diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
         orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)),
-        n_out=np.full(n, n_centrifugal))  # rigid: the first step's outer-race loads, before a joint has acted
+        n_out=np.full(n, n_centrifugal),  # rigid: the first step's outer-race loads, before a joint has acted
+        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
-    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints)
+    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
+                                           [next(iter(b.shapes)) for b in sc.rollers])
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot
@@ -442,7 +444,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
                               front_offset=0.5 * s, omega_cage=float(omega_cage)),
         land=land,
         pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
-        ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64))
+        ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64),
+        onset_restitution=is_rigid, restitution=float(e))
     ls = np.zeros(1, dtype=lp.LOOP_STATE)
     st = ls[0]
     t_loop0 = time.perf_counter()

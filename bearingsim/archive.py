@@ -7,12 +7,16 @@ Layout (format documented in ``docs/archive.md``)::
     /h5md                      attrs version; /h5md/creator attrs name, version
     /bearingsim                attrs format_version, model, scenario_name, complete
     /scenario                  resolved scenario as TOML text (dataset)
-    /provenance                attrs: package versions, git commit, created_utc, wall_time_s, ...
-    /parameters/*              derived SI quantities (scalars with units)
+    /provenance                attrs_json: package versions, git commit, created_utc, wall_time_s, ...
     /results/per_rotation/*    [rotations, pockets] arrays
     /results/impacts/*         impact table, one column dataset each
-    /results/summary           attrs
+    /results/summary           attrs_json, units_json (one JSON object each)
     /observables/<name>/{step,time,value}   time series
+
+Named scalar values (an attribute group, the provenance) are stored as one JSON attribute per group
+since format 2.0 (an HDF5 attribute costs ~50 us to write, a reduced-model archive had ~100 of them);
+format 1.x archives, one HDF5 attribute per value and ``<name>__unit`` beside it, are read as well
+(:func:`group_attrs` reads either).
 
 A run writes ``.<name>.tmp-<pid>`` beside the target and renames it when complete; on any error the
 temporary file is removed, so a file at the target name is always a complete archive. A long run
@@ -23,6 +27,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import functools
+import json
 import os
 import platform
 import subprocess
@@ -37,7 +42,10 @@ from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError
 
-FORMAT_VERSION = "1.0"
+FORMAT_VERSION = "2.0"
+READABLE_MAJORS = ("1", "2")  # 1.x: one HDF5 attribute per value; 2.x: attrs_json / units_json
+ATTRS_JSON = "attrs_json"
+UNITS_JSON = "units_json"
 _CHUNK_BYTES = 256 * 1024
 
 
@@ -262,13 +270,8 @@ def write(result, path, spool: Spool | None = None) -> Path:
                 g = f.require_group(path_)
                 if grp.description:
                     g.attrs["description"] = grp.description
-                for k, v in grp.attrs.items():
-                    g.attrs[k] = v
-                for k, u in grp.units.items():
-                    g.attrs[f"{k}__unit"] = u
-            prov = f.create_group("provenance")
-            for k, v in _provenance(result).items():
-                prov.attrs[k] = v
+                _write_group_attrs(g, grp.attrs, grp.units)
+            _write_group_attrs(f.create_group("provenance"), _provenance(result), {})
             f["bearingsim"].attrs["complete"] = True
             outputs.close_quietly(f)
             spool.f = None
@@ -298,6 +301,59 @@ def _write_header(f, result) -> None:
     ds = f.create_dataset("scenario", data=sc.to_toml())
     ds.attrs["format"] = "TOML (resolved: defaults, preset and overrides applied)"
     ds.attrs["source"] = str(sc.source)
+
+
+def _json_scalar(v):
+    """``v`` as a JSON-exact Python scalar (str, bool, int, float), or None if it is not one."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v)  # repr round-trips exactly; NaN and +-inf as NaN, Infinity
+    if isinstance(v, str):
+        return v
+    return None
+
+
+def _write_group_attrs(g, values: dict[str, Any], units: dict[str, str]) -> None:
+    """Named values and their units as the attributes ``attrs_json`` and ``units_json`` of ``g``.
+
+    Keys sorted (the order HDF5 lists attributes by name, so a format 1.x reader and this one give the
+    same dict order). A value that is not a scalar (an array) stays an HDF5 attribute of its own.
+    """
+    plain, other = {}, {}
+    for k, v in values.items():
+        j = _json_scalar(v)
+        if j is None:
+            other[k] = v
+        else:
+            plain[k] = j
+    g.attrs[ATTRS_JSON] = json.dumps(dict(sorted(plain.items())), ensure_ascii=False, allow_nan=True)
+    if units:
+        g.attrs[UNITS_JSON] = json.dumps(dict(sorted(units.items())), ensure_ascii=False)
+    for k, v in other.items():
+        g.attrs[k] = v
+
+
+def group_attrs(g) -> tuple[dict[str, Any], dict[str, str]]:
+    """(values, units) of an attribute group or ``/provenance``, either layout, keys sorted.
+
+    Format 2.x: the JSON attributes ``attrs_json`` / ``units_json`` (plus any array-valued attribute);
+    format 1.x: one attribute per value and ``<name>__unit`` beside it. ``description`` is not a value.
+    """
+    values: dict[str, Any] = {}
+    units: dict[str, str] = {}
+    for k, v in g.attrs.items():
+        if k == ATTRS_JSON:
+            values.update(json.loads(_plain(v)))
+        elif k == UNITS_JSON:
+            units.update(json.loads(_plain(v)))
+        elif k.endswith("__unit"):
+            units[k[:-6]] = str(_plain(v))
+        elif k != "description":
+            values[k] = _plain(v)
+    return dict(sorted(values.items())), dict(sorted(units.items()))
 
 
 def _write_array(f, path: str, arr) -> None:
@@ -379,17 +435,16 @@ def read(path, result_class):
                 elif "columns" in obj.attrs:
                     tables[name] = str(obj.attrs.get("description", ""))
                 else:
-                    attrs = {k: _plain(v) for k, v in obj.attrs.items() if not k.endswith("__unit") and k != "description"}
+                    attrs, units = group_attrs(obj)
                     if attrs:
-                        units = {k[:-6]: str(v) for k, v in obj.attrs.items() if k.endswith("__unit")}
-                        groups[name] = AttrGroup(attrs, units, str(obj.attrs.get("description", "")))
+                        groups[name] = AttrGroup(attrs, units, str(_plain(obj.attrs.get("description", ""))))
 
         f.visititems(visit)
         series = {}
         for name, g in f.get("observables", {}).items():
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
-        provenance = {k: _plain(v) for k, v in f["provenance"].attrs.items()} if "provenance" in f else {}
+        provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}
     except UserError:
         raise
     except (KeyError, ValueError, TypeError, OSError) as exc:
@@ -480,14 +535,14 @@ def peek(path) -> dict[str, Any] | None:
             if g is None or not bool(g.attrs.get("complete", False)):
                 return None
             text = f["scenario"][()]
-            summary = {k: _plain(v) for k, v in f["results/summary"].attrs.items() if not k.endswith("__unit")}
+            summary = group_attrs(f["results/summary"])[0]
             return {
                 "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
                 "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
-                "wall_time_s": float(f["provenance"].attrs.get("wall_time_s", float("nan"))) if "provenance" in f
-                else float("nan"),
+                "wall_time_s": float(group_attrs(f["provenance"])[0].get("wall_time_s", float("nan")))
+                if "provenance" in f else float("nan"),
             }
     except (OSError, KeyError, ValueError, TypeError):
         return None
@@ -517,8 +572,8 @@ def open_archive(path: str | Path):
             raise UserError(f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
         if not bool(g.attrs.get("complete", False)):
             raise UserError(f"{p}: incomplete bearingsim archive (the run did not finish)")
-        major = str(g.attrs["format_version"]).split(".")[0]
-        if major != FORMAT_VERSION.split(".")[0]:
+        major = str(_plain(g.attrs["format_version"])).split(".")[0]
+        if major not in READABLE_MAJORS:
             raise UserError(f"{p}: archive format {g.attrs['format_version']} not readable by this bearingsim")
     except UserError:
         f.close()
@@ -538,7 +593,7 @@ def describe(path: str | Path) -> str:
         lines.append(f"{path}: bearingsim archive, format {g.attrs['format_version']}, model {g.attrs['model']}, "
                      f"scenario {g.attrs['scenario_name']!s}")
         if "provenance" in f:
-            pv = f["provenance"].attrs
+            pv = group_attrs(f["provenance"])[0]
             keys = ["bearingsim_version", "git_commit", "created_utc", "wall_time_s"]
             lines.append("provenance: " + ", ".join(f"{k}={pv[k]}" for k in keys if k in pv))
             extra = [k for k in pv if k not in keys and not k.startswith("version_") and k not in ("platform", "command")]
@@ -546,11 +601,9 @@ def describe(path: str | Path) -> str:
                 lines.append("run: " + ", ".join(f"{k}={pv[k]}" for k in extra))
         if "results/summary" in f:
             lines.append("summary:")
-            sa = f["results/summary"].attrs
+            sa, su = group_attrs(f["results/summary"])
             for k in sorted(sa):
-                if k.endswith("__unit"):
-                    continue
-                unit = sa.get(f"{k}__unit", "")
+                unit = su.get(k, "")
                 v = sa[k]
                 vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
                 lines.append(f"  {k:32s} {vs} {unit}")

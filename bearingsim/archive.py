@@ -251,28 +251,7 @@ def write(result, path, spool: Spool | None = None) -> Path:
         with outputs.quiet_stderr():  # HDF5 prints error stacks on a full disk; the OSError says it
             for ts in spool._series:
                 ts.flush()
-            _write_header(f, result)
-            for name, s in result.series.items():
-                g = f.create_group(f"observables/{name}")
-                if s.description:
-                    g.attrs["description"] = s.description
-                ts = TimeSeries(g, s.value.shape[1:], s.unit)
-                ts.append(s.step, s.time, s.value)
-                ts.flush()
-            for path_, arr in result.data.items():
-                _write_array(f, path_, arr)
-            for path_, desc in result.tables.items():
-                g = f.require_group(path_)
-                g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
-                if desc:
-                    g.attrs["description"] = desc
-            for path_, grp in result.groups.items():
-                g = f.require_group(path_)
-                if grp.description:
-                    g.attrs["description"] = grp.description
-                _write_group_attrs(g, grp.attrs, grp.units)
-            _write_group_attrs(f.create_group("provenance"), _provenance(result), {})
-            f["bearingsim"].attrs["complete"] = True
+            _fill(f, result)
             outputs.close_quietly(f)
             spool.f = None
         os.replace(spool.tmp, spool.path)
@@ -285,22 +264,144 @@ def write(result, path, spool: Spool | None = None) -> Path:
     return spool.path
 
 
-def _write_header(f, result) -> None:
+def _fill(f, result) -> None:
+    """Write everything of ``result`` into the open file ``f`` (its streamed series are there already)
+    and mark it complete."""
+    w = _Writer(f)
+    _write_header(w, result)
+    for name, s in result.series.items():
+        g = w.group(f"observables/{name}")
+        if s.description:
+            w.attr(g, "description", s.description)
+        ts = TimeSeries(g, s.value.shape[1:], s.unit)
+        ts.append(s.step, s.time, s.value)
+        ts.flush()
+    for path_, arr in result.data.items():
+        _write_array(w, path_, arr)
+    for path_, desc in result.tables.items():
+        g = w.group(path_)
+        g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
+        if desc:
+            w.attr(g, "description", desc)
+    for path_, grp in result.groups.items():
+        g = w.group(path_)
+        if grp.description:
+            w.attr(g, "description", grp.description)
+        _write_group_attrs(w, g, grp.attrs, grp.units)
+    _write_group_attrs(w, w.group("provenance"), _provenance(result), {})
+    w.attr(w.group("bearingsim"), "complete", True, replace=True)
+
+
+_image_count = 0
+
+
+def to_bytes(result) -> bytes:
+    """``result`` as the bytes of a complete archive, built in memory (HDF5 core driver, no file):
+    the same content :func:`write` stores, for a caller that writes the file itself (a sweep's
+    worker: one write of the whole file, or bytes sent back to the sweep's client)."""
+    global _image_count
+    h5py = _lazy_h5py()
+    _image_count += 1
+    name = f"bearingsim-image-{os.getpid()}-{_image_count}.h5"  # never on disk: no backing store
+    f = h5py.File(name, "w", driver="core", backing_store=False)
+    try:
+        _fill(f, result)
+        f.flush()
+        return f.id.get_file_image()
+    finally:
+        f.close()
+
+
+class _Writer:
+    """Writes groups, datasets and scalar attributes through h5py's low-level API with the HDF5 types
+    and creation properties its high-level API uses (so files read back the same), at a fraction of
+    the cost per object: no existence checks, no property lists or types built again for every object.
+    Arrays that are compressed, and attributes that are not scalars, go through the high-level API.
+    """
+
+    _types: dict = {}  # dtype key -> (file type, memory type), shared by every writer of the process
+
+    def __init__(self, f):
+        h5py = _lazy_h5py()
+        self.f = f
+        self._h5 = h5py
+        self._groups = {"": f}
+        self._made: set[str] = set()  # groups created by this writer (nothing else is in them)
+        self._scalar = h5py.h5s.create(h5py.h5s.SCALAR)
+        self._dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        self._dcpl.set_obj_track_times(False)  # as h5py's create_dataset
+
+    def group(self, path: str):
+        """The group at ``path``, created (with its parents) if missing."""
+        g = self._groups.get(path)
+        if g is None:
+            parent, _, leaf = path.rpartition("/")
+            pg = self.group(parent)
+            if parent not in self._made and leaf in pg:  # the root or a group the spool made
+                g = pg[leaf]
+            else:
+                g = pg.create_group(leaf)
+                self._made.add(path)
+            self._groups[path] = g
+        return g
+
+    def _type(self, key, dtype):
+        t = self._types.get(key)
+        if t is None:
+            h5t = self._h5.h5t
+            t = self._types[key] = (h5t.py_create(dtype, logical=True), h5t.py_create(dtype))
+        return t
+
+    def attr(self, obj, name: str, value, replace: bool = False) -> None:
+        """``obj.attrs[name] = value`` for a str, bool, int or float (any other value: through h5py)."""
+        if isinstance(value, str):
+            data, key = np.array(value, dtype=self._h5.string_dtype()), "str"
+        elif isinstance(value, (bool, np.bool_, int, np.integer, float, np.floating)):
+            data = np.asarray(value)
+            key = data.dtype.str
+        else:
+            obj.attrs[name] = value
+            return
+        h5a = self._h5.h5a
+        htype, mtype = self._type(key, data.dtype)
+        bname = name.encode("utf-8")
+        if replace and h5a.exists(obj.id, bname):
+            h5a.delete(obj.id, bname)
+        a = h5a.create(obj.id, bname, htype, self._scalar)
+        try:
+            a.write(data, mtype=mtype)
+        finally:
+            a.close()
+
+    def dataset(self, path: str, data: np.ndarray):
+        """A contiguous dataset holding ``data`` (numbers or fixed-length bytes, at least 1-D)."""
+        h5 = self._h5
+        parent, _, leaf = path.rpartition("/")
+        g = self.group(parent)
+        data = np.ascontiguousarray(data)
+        tid = self._type(data.dtype.str, data.dtype)[0]
+        dsid = h5.h5d.create(g.id, leaf.encode("utf-8"), tid, h5.h5s.create_simple(data.shape), dcpl=self._dcpl)
+        dsid.write(h5.h5s.ALL, h5.h5s.ALL, data)
+        return h5.Dataset(dsid)
+
+
+def _write_header(w: _Writer, result) -> None:
     sc = result.scenario
-    f.attrs["title"] = f"bearingsim archive: {sc.name}"
-    h5md = f.create_group("h5md")
+    f = w.f
+    w.attr(f, "title", f"bearingsim archive: {sc.name}")
+    h5md = w.group("h5md")
     h5md.attrs["version"] = np.array([1, 1])
-    creator = h5md.create_group("creator")
-    creator.attrs["name"] = "bearingsim"
-    creator.attrs["version"] = __version__
-    g = f.create_group("bearingsim")
-    g.attrs["format_version"] = FORMAT_VERSION
-    g.attrs["model"] = result.model
-    g.attrs["scenario_name"] = sc.name
-    g.attrs["complete"] = False
+    creator = w.group("h5md/creator")
+    w.attr(creator, "name", "bearingsim")
+    w.attr(creator, "version", __version__)
+    g = w.group("bearingsim")
+    w.attr(g, "format_version", FORMAT_VERSION)
+    w.attr(g, "model", result.model)
+    w.attr(g, "scenario_name", sc.name)
+    w.attr(g, "complete", False)
     ds = f.create_dataset("scenario", data=sc.to_toml())
-    ds.attrs["format"] = "TOML (resolved: defaults, preset and overrides applied)"
-    ds.attrs["source"] = str(sc.source)
+    w.attr(ds, "format", "TOML (resolved: defaults, preset and overrides applied)")
+    w.attr(ds, "source", str(sc.source))
 
 
 def _json_scalar(v):
@@ -316,7 +417,7 @@ def _json_scalar(v):
     return None
 
 
-def _write_group_attrs(g, values: dict[str, Any], units: dict[str, str]) -> None:
+def _write_group_attrs(w: _Writer, g, values: dict[str, Any], units: dict[str, str]) -> None:
     """Named values and their units as the attributes ``attrs_json`` and ``units_json`` of ``g``.
 
     Keys sorted (the order HDF5 lists attributes by name, so a format 1.x reader and this one give the
@@ -329,9 +430,9 @@ def _write_group_attrs(g, values: dict[str, Any], units: dict[str, str]) -> None
             other[k] = v
         else:
             plain[k] = j
-    g.attrs[ATTRS_JSON] = json.dumps(dict(sorted(plain.items())), ensure_ascii=False, allow_nan=True)
+    w.attr(g, ATTRS_JSON, json.dumps(dict(sorted(plain.items())), ensure_ascii=False, allow_nan=True))
     if units:
-        g.attrs[UNITS_JSON] = json.dumps(dict(sorted(units.items())), ensure_ascii=False)
+        w.attr(g, UNITS_JSON, json.dumps(dict(sorted(units.items())), ensure_ascii=False))
     for k, v in other.items():
         g.attrs[k] = v
 
@@ -356,17 +457,19 @@ def group_attrs(g) -> tuple[dict[str, Any], dict[str, str]]:
     return dict(sorted(values.items())), dict(sorted(units.items()))
 
 
-def _write_array(f, path: str, arr) -> None:
+def _write_array(w: _Writer, path: str, arr) -> None:
     data = np.asarray(arr.data)
     if data.dtype.kind == "U":
         data = data.astype("S")
-    kw = {}
-    if data.size > 4096:
-        kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True)
-    ds = f.create_dataset(path, data=data, **kw)
-    ds.attrs["unit"] = arr.unit
+    if data.size > 4096 or data.ndim == 0 or data.dtype.kind not in "biufS":
+        kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True) if data.size > 4096 else {}
+        parent, _, leaf = path.rpartition("/")
+        ds = w.group(parent).create_dataset(leaf, data=data, **kw)
+    else:
+        ds = w.dataset(path, data)
+    w.attr(ds, "unit", arr.unit)
     if arr.description:
-        ds.attrs["description"] = arr.description
+        w.attr(ds, "description", arr.description)
 
 
 def _provenance(result) -> dict[str, Any]:

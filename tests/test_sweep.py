@@ -176,7 +176,7 @@ def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
     # forked pool workers inherit the patch: a case at 2000 rpm raises as an unstable run would
     import bearingsim.simulation as simulation
 
-    real = simulation.run_scenario
+    real = simulation.run
 
     def flaky(scenario, *a, **kw):
         if scenario.operating.inner_ring_speed_rpm == 2000:
@@ -185,7 +185,7 @@ def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
             raise ZeroDivisionError("float division by zero")
         return real(scenario, *a, **kw)
 
-    monkeypatch.setattr(simulation, "run_scenario", flaky)
+    monkeypatch.setattr(simulation, "run", flaky)  # what every case runs through, in memory or streamed
     code = run_sweep_cli(BASE, [f"{SPEED}=1000,2000,3000"], [], tmp_path, jobs=2, figures=False, quiet=True)
     assert code == 1
     rows = _rows(tmp_path)

@@ -118,26 +118,23 @@ def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2) -> float:
     writing its archive: what the engine, the solver and the index cost without ``archive.py``.
     ``python -m bearingsim.sweeps.bench map [--no-archives] OUTDIR``.
     """
-    import types
-
-    import bearingsim.simulation as simulation
+    import bearingsim.archive as archive
+    import bearingsim.sweeps.worker as worker
     from bearingsim.sweeps.engines import LocalEngine
     from bearingsim.sweeps.run import run_sweep
     from bearingsim.sweeps.spec import load_sweep_file
 
-    real = simulation.run_scenario
-    if not archives:
-        def solve_only(scenario, out=None, **kw):
-            return types.SimpleNamespace(result=simulation.run(scenario))
-
-        simulation.run_scenario = solve_only
+    real = archive.to_bytes, worker._write_file
+    if not archives:  # a reduced case's archive is built by to_bytes and written by _write_file
+        archive.to_bytes = lambda result: b""
+        worker._write_file = lambda target, data: None
     try:
         t0 = time.perf_counter()
         spec = load_sweep_file(_scenario_path().parent / "sweeps" / "map_speed_clearance.toml")
         out = run_sweep(spec, Path(outdir), engine=LocalEngine(jobs), figures=False, progress=False)
         wall = time.perf_counter() - t0
     finally:
-        simulation.run_scenario = real
+        archive.to_bytes, worker._write_file = real
     print(f"100 x 100 map, {'with' if archives else 'without'} archives, {jobs} workers: "
           f"{out.count('done')} done, {out.count('cached')} cached in {wall:.1f} s")
     return wall

@@ -255,12 +255,38 @@ def available_presets() -> list[str]:
 
 def load_preset(name: str) -> dict[str, Any]:
     """The preset's data (sections of values, ``name``, ``citation`` and per-key ``source``)."""
+    return _copy(_preset(name))
+
+
+_PRESETS: dict[str, tuple[tuple, dict]] = {}
+
+
+def _preset(name: str) -> dict[str, Any]:
+    """The parsed preset, shared: callers must not change it. Parsed again when the file changes
+    (a sweep's worker resolves thousands of cases with one preset)."""
+    if isinstance(name, str) and name and "/" not in name and "\\" not in name and not name.startswith("."):
+        path = Path(str(resources.files("bearingsim") / PRESET_DIR / f"{name}.toml"))
+        try:
+            st = path.stat()
+        except OSError:
+            st = None
+        if st is not None:
+            stamp = (st.st_mtime_ns, st.st_size, st.st_ino)
+            hit = _PRESETS.get(name)
+            if hit is not None and hit[0] == stamp:
+                return hit[1]
     if not isinstance(name, str) or name not in available_presets():
         raise UserError(
             f"bearing.preset: unknown preset {name!r} (available: {', '.join(available_presets())})"
         )
-    text = (resources.files("bearingsim") / PRESET_DIR / f"{name}.toml").read_text()
-    return tomllib.loads(text)
+    path = resources.files("bearingsim") / PRESET_DIR / f"{name}.toml"
+    data = tomllib.loads(path.read_text())
+    try:
+        st = Path(str(path)).stat()
+        _PRESETS[name] = ((st.st_mtime_ns, st.st_size, st.st_ino), data)
+    except OSError:  # not a plain file (a zipped package): parsed every time
+        pass
+    return data
 
 
 def parse_override(item: str) -> tuple[str, Any]:
@@ -309,13 +335,33 @@ def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
 
 
 def _merge(base: dict, top: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in top.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
+    """``base`` updated by ``top``, sections merged key by key; neither is changed (values copied).
+    Keys in ``base``'s order, then those only in ``top``."""
+    out = {}
+    for k, v in base.items():
+        if k in top:
+            t = top[k]
+            out[k] = _merge(v, t) if isinstance(t, dict) and isinstance(v, dict) else _copy(t)
         else:
-            out[k] = copy.deepcopy(v)
+            out[k] = _copy(v)
+    for k, t in top.items():
+        if k not in base:
+            out[k] = _copy(t)
     return out
+
+
+_IMMUTABLE = (str, int, float, bool, type(None))
+
+
+def _copy(v):
+    """A deep copy of TOML-like data (dicts, lists, immutable scalars); anything else: copy.deepcopy."""
+    if isinstance(v, _IMMUTABLE):
+        return v
+    if type(v) is dict:
+        return {k: _copy(x) for k, x in v.items()}
+    if type(v) is list:
+        return [_copy(x) for x in v]
+    return copy.deepcopy(v)
 
 
 def read_toml_file(path: str | Path) -> dict[str, Any]:
@@ -379,7 +425,7 @@ def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
     preset_name = bearing.get("preset") if isinstance(bearing, dict) else None
     if preset_name is not None:
         try:
-            preset = load_preset(preset_name)
+            preset = _preset(preset_name)  # shared: _merge copies what it keeps
         except UserError as exc:
             raise UserError(f"{source}: {exc}") from None
         for section, values in preset.items():

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.sweeps.index import read_cached, write_atomic_bytes, write_index
+from bearingsim.sweeps.index import IndexWriter, read_cached, write_atomic_bytes
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
 # how many cheap (reduced-model) cases one task runs: enough that a task lasts far longer than its
@@ -193,6 +193,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
              "wall_s": math.nan, "summary": {}} for c in cases]
     by_hash = {c.hash: i for i, c in enumerate(cases)}
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
+    index = IndexWriter(outdir, rows, keys, meta)
 
     with lock, _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
@@ -208,7 +209,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     todo.append(c)
                 else:
                     row.update(rec, archive=f"cases/{c.hash}.h5")
-            write_index(outdir, rows, keys, meta)
+            index.write()
             counts = {"done": 0, "failed": 0, "cached": len(cases) - len(todo)}
             bar = _progress(len(cases), progress, counts["cached"])
             if bar is not None:
@@ -228,6 +229,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         row.update(status=rec["status"], error=rec["error"], wall_s=rec["wall_s"],
                                    summary=rec["summary"],
                                    archive=f"cases/{rec['hash']}.h5" if rec["status"] == "done" else "")
+                        index.changed(i)
                         counts[rec["status"]] += 1
                         if rec["status"] == "failed":
                             say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
@@ -235,7 +237,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         bar.set_postfix(counts, refresh=False)
                         bar.update(len(records))
                     if time.monotonic() - last_index >= INDEX_EVERY_S:
-                        write_index(outdir, rows, keys, meta)
+                        index.write()
                         last_index = time.monotonic()
                     if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
                         raise SweepInterrupted(signals.fired)
@@ -250,7 +252,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                 if bar is not None:
                     bar.close()
                 _clean_temporaries(cases_dir)
-                write_index(outdir, rows, keys, meta)
+                index.write()
     outcome.wall_s = time.perf_counter() - t0
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index

@@ -264,9 +264,9 @@ def write(result, path, spool: Spool | None = None) -> Path:
     return spool.path
 
 
-def _fill(f, result) -> None:
+def _fill(f, result, in_memory: bool = False) -> None:
     """Write everything of ``result`` into the open file ``f`` (its streamed series are there already)
-    and mark it complete."""
+    and mark it complete (a file built in memory, never seen incomplete, is marked once at the end)."""
     w = _Writer(f)
     _write_header(w, result)
     for name, s in result.series.items():
@@ -279,17 +279,17 @@ def _fill(f, result) -> None:
     for path_, arr in result.data.items():
         _write_array(w, path_, arr)
     for path_, desc in result.tables.items():
-        g = w.group(path_)
-        g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
+        g = w.gid(path_)
+        w.attr(g, "columns", [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")])
         if desc:
             w.attr(g, "description", desc)
     for path_, grp in result.groups.items():
-        g = w.group(path_)
+        g = w.gid(path_)
         if grp.description:
             w.attr(g, "description", grp.description)
         _write_group_attrs(w, g, grp.attrs, grp.units)
-    _write_group_attrs(w, w.group("provenance"), _provenance(result), {})
-    w.attr(w.group("bearingsim"), "complete", True, replace=True)
+    _write_group_attrs(w, w.gid("provenance"), _provenance(result), {})
+    w.attr(w.gid("bearingsim"), "complete", True, replace=True)
 
 
 _image_count = 0
@@ -315,8 +315,9 @@ def to_bytes(result) -> bytes:
 class _Writer:
     """Writes groups, datasets and scalar attributes through h5py's low-level API with the HDF5 types
     and creation properties its high-level API uses (so files read back the same), at a fraction of
-    the cost per object: no existence checks, no property lists or types built again for every object.
-    Arrays that are compressed, and attributes that are not scalars, go through the high-level API.
+    the cost per object: no existence checks, no high-level wrappers, no property lists or types built
+    again for every object. Compressed arrays and attributes that are not scalars go through h5py's
+    high-level API.
     """
 
     _types: dict = {}  # dtype key -> (file type, memory type), shared by every writer of the process
@@ -325,25 +326,37 @@ class _Writer:
         h5py = _lazy_h5py()
         self.f = f
         self._h5 = h5py
-        self._groups = {"": f}
+        self._gids = {"": f.id}  # group path -> GroupID (the file's id stands for the root group)
         self._made: set[str] = set()  # groups created by this writer (nothing else is in them)
         self._scalar = h5py.h5s.create(h5py.h5s.SCALAR)
         self._dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
         self._dcpl.set_obj_track_times(False)  # as h5py's create_dataset
+        self._lcpl = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # as h5py's create_group for an ASCII name
+        self._lcpl.set_create_intermediate_group(True)
+        self._lcpl.set_char_encoding(h5py.h5t.CSET_ASCII)
+
+    def gid(self, path: str):
+        """The low-level id of the group at ``path``, created (with its parents) if missing."""
+        g = self._gids.get(path)
+        if g is None:
+            h5g = self._h5.h5g
+            parent, _, leaf = path.rpartition("/")
+            pid = self.gid(parent)
+            name = leaf.encode("utf-8")
+            if parent not in self._made and pid.links.exists(name):  # the root or a group the spool made
+                g = h5g.open(pid, name)
+            elif leaf.isascii():
+                g = h5g.create(pid, name, lcpl=self._lcpl)
+                self._made.add(path)
+            else:
+                g = self._h5.Group(pid).create_group(leaf).id
+                self._made.add(path)
+            self._gids[path] = g
+        return g
 
     def group(self, path: str):
-        """The group at ``path``, created (with its parents) if missing."""
-        g = self._groups.get(path)
-        if g is None:
-            parent, _, leaf = path.rpartition("/")
-            pg = self.group(parent)
-            if parent not in self._made and leaf in pg:  # the root or a group the spool made
-                g = pg[leaf]
-            else:
-                g = pg.create_group(leaf)
-                self._made.add(path)
-            self._groups[path] = g
-        return g
+        """The group at ``path`` as an h5py ``Group`` (created if missing)."""
+        return self._h5.Group(self.gid(path))
 
     def _type(self, key, dtype):
         t = self._types.get(key)
@@ -353,55 +366,68 @@ class _Writer:
         return t
 
     def attr(self, obj, name: str, value, replace: bool = False) -> None:
-        """``obj.attrs[name] = value`` for a str, bool, int or float (any other value: through h5py)."""
+        """``obj.attrs[name] = value`` (``obj`` an h5py object or low-level id) for a str, bool, int or
+        float; any other value through h5py's ``attrs``."""
+        oid = obj.id if hasattr(obj, "attrs") else obj
         if isinstance(value, str):
             data, key = np.array(value, dtype=self._h5.string_dtype()), "str"
         elif isinstance(value, (bool, np.bool_, int, np.integer, float, np.floating)):
             data = np.asarray(value)
             key = data.dtype.str
         else:
-            obj.attrs[name] = value
+            self._h5.AttributeManager(_IdHolder(oid))[name] = value
             return
         h5a = self._h5.h5a
         htype, mtype = self._type(key, data.dtype)
         bname = name.encode("utf-8")
-        if replace and h5a.exists(obj.id, bname):
-            h5a.delete(obj.id, bname)
-        a = h5a.create(obj.id, bname, htype, self._scalar)
+        if replace and h5a.exists(oid, bname):
+            h5a.delete(oid, bname)
+        a = h5a.create(oid, bname, htype, self._scalar)
         try:
             a.write(data, mtype=mtype)
         finally:
             a.close()
 
     def dataset(self, path: str, data: np.ndarray):
-        """A contiguous dataset holding ``data`` (numbers or fixed-length bytes, at least 1-D)."""
+        """The low-level id of a new contiguous dataset holding ``data`` (numbers or fixed-length
+        bytes, at least 1-D; or a str, stored as a scalar variable-length UTF-8 string)."""
         h5 = self._h5
         parent, _, leaf = path.rpartition("/")
-        g = self.group(parent)
-        data = np.ascontiguousarray(data)
-        tid = self._type(data.dtype.str, data.dtype)[0]
-        dsid = h5.h5d.create(g.id, leaf.encode("utf-8"), tid, h5.h5s.create_simple(data.shape), dcpl=self._dcpl)
+        pid = self.gid(parent)
+        if isinstance(data, str):
+            data = np.array(data, dtype=h5.string_dtype())
+            tid, space = self._type("str", data.dtype)[0], self._scalar
+        else:
+            data = np.ascontiguousarray(data)
+            tid, space = self._type(data.dtype.str, data.dtype)[0], h5.h5s.create_simple(data.shape)
+        dsid = h5.h5d.create(pid, leaf.encode("utf-8"), tid, space, dcpl=self._dcpl)
         dsid.write(h5.h5s.ALL, h5.h5s.ALL, data)
-        return h5.Dataset(dsid)
+        return dsid
 
 
-def _write_header(w: _Writer, result) -> None:
+class _IdHolder:
+    """What h5py's ``AttributeManager`` needs of its parent: ``.id``."""
+
+    def __init__(self, oid):
+        self.id = oid
+
+
+def _write_header(w: _Writer, result, complete: bool = False) -> None:
     sc = result.scenario
-    f = w.f
-    w.attr(f, "title", f"bearingsim archive: {sc.name}")
-    h5md = w.group("h5md")
-    h5md.attrs["version"] = np.array([1, 1])
-    creator = w.group("h5md/creator")
+    w.attr(w.f, "title", f"bearingsim archive: {sc.name}")
+    w.attr(w.gid("h5md"), "version", np.array([1, 1]))
+    creator = w.gid("h5md/creator")
     w.attr(creator, "name", "bearingsim")
     w.attr(creator, "version", __version__)
-    g = w.group("bearingsim")
+    g = w.gid("bearingsim")
     w.attr(g, "format_version", FORMAT_VERSION)
     w.attr(g, "model", result.model)
     w.attr(g, "scenario_name", sc.name)
-    w.attr(g, "complete", False)
-    ds = f.create_dataset("scenario", data=sc.to_toml())
+    w.attr(g, "complete", complete)
+    ds = w.dataset("scenario", sc.to_toml())
     w.attr(ds, "format", "TOML (resolved: defaults, preset and overrides applied)")
     w.attr(ds, "source", str(sc.source))
+    ds.close()
 
 
 def _json_scalar(v):
@@ -464,12 +490,13 @@ def _write_array(w: _Writer, path: str, arr) -> None:
     if data.size > 4096 or data.ndim == 0 or data.dtype.kind not in "biufS":
         kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True) if data.size > 4096 else {}
         parent, _, leaf = path.rpartition("/")
-        ds = w.group(parent).create_dataset(leaf, data=data, **kw)
+        ds = w.group(parent).create_dataset(leaf, data=data, **kw).id
     else:
         ds = w.dataset(path, data)
     w.attr(ds, "unit", arr.unit)
     if arr.description:
         w.attr(ds, "description", arr.description)
+    ds.close()
 
 
 def _provenance(result) -> dict[str, Any]:

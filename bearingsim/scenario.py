@@ -232,7 +232,7 @@ class Scenario:
         return _drop_none(self.model_.model_dump())
 
     def to_toml(self) -> str:
-        return tomli_w.dumps(self.raw)
+        return _dumps(self.raw)
 
     def replace(self, **dotted: Any) -> "Scenario":
         """A new scenario with dotted keys replaced, e.g. ``replace(**{"operating.direction": "reverse"})``."""
@@ -240,6 +240,49 @@ class Scenario:
         for key, value in dotted.items():
             _set_dotted(raw, key, value, origin="replace()")
         return _validate(raw, self.source)
+
+
+_TOML_TABLES: dict[tuple[str, str], str] = {}  # (table name, repr of its content) -> its TOML text
+
+
+def _dumps(raw: dict[str, Any]) -> str:
+    """``tomli_w.dumps(raw)``, each top-level table formatted once per process for a given content.
+
+    tomli_w writes the top-level values, then each table, separated by a blank line; a table's text
+    depends only on its name and its content, so thousands of sweep cases that differ in one or two
+    keys share the text of their other tables. The key is the table's ``repr`` (which tells 1, 1.0 and
+    True apart), used only for plain data (str, int, float, bool, lists and tables of them).
+    """
+    top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
+    if not all(_plain_data(v) for v in top.values()):  # e.g. an array of tables: as tomli_w does it
+        return tomli_w.dumps(raw)
+    parts = [tomli_w.dumps(top)] if top else []
+    for k, v in raw.items():
+        if isinstance(v, dict):
+            if not _plain_data(v):
+                parts.append(tomli_w.dumps({k: v}))
+                continue
+            key = (k, repr(v))
+            text = _TOML_TABLES.get(key)
+            if text is None:
+                if len(_TOML_TABLES) >= 4096:
+                    _TOML_TABLES.clear()
+                text = _TOML_TABLES[key] = tomli_w.dumps({k: v})
+            parts.append(text)
+    return "\n".join(parts)
+
+
+def _plain_data(v, depth: int = 0) -> bool:
+    """str, int, float or bool, or lists and tables of them (no table inside a list)."""
+    if isinstance(v, (str, int, float)):  # bool is an int
+        return type(v) in (str, int, float, bool)
+    if depth > MAX_NESTING_DEPTH:
+        return False
+    if type(v) is list:
+        return all(not isinstance(x, dict) and _plain_data(x, depth + 1) for x in v)
+    if type(v) is dict:
+        return all(type(k) is str and _plain_data(x, depth + 1) for k, x in v.items())
+    return False
 
 
 def _drop_none(d):

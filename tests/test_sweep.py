@@ -129,6 +129,14 @@ def test_batches_group_cheap_cases_only():
     assert sorted(h for b in batches for h, _ in b) == sorted(c.hash for c in red + mb)
 
 
+def test_last_batches_of_a_large_sweep_shrink():
+    red = [Case(f"r{i}", {}, "t", "reduced") for i in range(10_000)]
+    sizes = [len(b) for b in make_batches(red, workers=2)]
+    assert max(sizes) == 200 and sizes[:40] == [200] * 40  # full batches first
+    assert sizes[-6:-1] == sorted(sizes[-6:-1], reverse=True) and max(sizes[-6:]) <= 15  # a short tail
+    assert [h for b in make_batches(red, workers=2) for h, _ in b] == [c.hash for c in red]
+
+
 def test_standard_error_is_over_rotations_of_pocket_means():
     # two rotations of two pockets: rotation means 2 and 4 -> sample std sqrt(2), over sqrt(2) -> 1
     se = standard_errors(np.array([[1.0, 3.0], [3.0, 5.0]]), np.zeros((2, 2)))

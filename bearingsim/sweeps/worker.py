@@ -56,7 +56,7 @@ def _per_rotation(res):
     return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
 
 
-def _run_in_memory(scenario):
+def _run_in_memory(scenario, notes: bool = True):
     """Run a case that streams no time series (the reduced model) and build its archive in memory:
     what :func:`bearingsim.simulation.run_scenario` does (plausibility check and its notes included),
     with the file written in one piece by the caller. Returns (result, archive bytes)."""
@@ -64,23 +64,27 @@ def _run_in_memory(scenario):
 
     result = simulation.run(scenario)
     for note in plausibility.check(result):
-        print(note, file=sys.stderr)
+        if notes:
+            print(note, file=sys.stderr)
     return result, archive.to_bytes(result)
 
 
-def run_case(case_hash: str, toml_text: str, target: Path | None) -> dict:
+def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) -> dict:
     """Run one case into the archive ``target`` (written atomically), or with ``target`` None return
-    the archive's bytes under ``"archive"``.
+    the archive's bytes under ``"archive"``. ``model``: the validated scenario model the client wrote
+    ``toml_text`` from (a forked local worker: the same code validated it), else the text is resolved
+    again here.
 
     Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s`` and the
     summary numbers with the standard errors of :func:`standard_errors`.
     """
+    from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml
 
     t0 = time.perf_counter()
     data = None
     try:
-        scenario = scenario_from_toml(toml_text)
+        scenario = Scenario(model, "<sweep case>") if model is not None else scenario_from_toml(toml_text)
         if scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
             res, data = _run_in_memory(scenario)
             if target is not None:
@@ -122,18 +126,30 @@ def _write_file(target: Path, data: bytes) -> None:
         raise UserError(f"{target}: cannot write archive ({exc.strerror or exc}); nothing was written") from None
 
 
+def warm_up(toml_text: str) -> None:
+    """Run a reduced-model scenario once and build its archive in memory, discarding both: the first
+    case of a process loads the compiled model (~0.3 s). Errors are ignored (the cases report theirs)."""
+    from bearingsim.sweeps.spec import scenario_from_toml
+
+    try:
+        _run_in_memory(scenario_from_toml(toml_text), notes=False)
+    except Exception:  # noqa: BLE001
+        pass
+
+
 def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> list[dict]:
     """Run ``items`` (``(hash, resolved TOML)`` pairs) one after the other.
 
     Parameters
     ----------
-    items : list of (str, str)
-        Case hash and resolved scenario TOML.
+    items : list of (str, str) or (str, str, model)
+        Case hash and resolved scenario TOML, and optionally the validated scenario model of that
+        TOML (:attr:`bearingsim.sweeps.spec.Case.scenario`).
     cases_dir : str or None
         Write each archive as ``cases_dir/<hash>.h5`` (a file system the client sees). With None,
         return each archive's bytes under ``"archive"`` (dask workers on other machines): a
         reduced-model archive is built in memory, a multibody run streams into a private temporary
         folder.
     """
-    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None)
-            for h, text in items]
+    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None, *model)
+            for h, text, *model in items]

@@ -164,6 +164,11 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
+    if args.map:
+        from bearingsim.sweeps.bench import run_map_bench
+
+        run_map_bench(Path(args.output))
+        return 0
     if args.sweep:
         from bearingsim.sweeps.bench import run_sweep_bench
 
@@ -259,6 +264,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
+    b.add_argument("--map", action="store_true",
+                   help="wall time of the 100 x 100 reduced-model sweep map (2 workers), with and without archives")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 

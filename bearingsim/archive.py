@@ -427,7 +427,6 @@ def _write_header(w: _Writer, result, complete: bool = False) -> None:
     ds = w.dataset("scenario", sc.to_toml())
     w.attr(ds, "format", "TOML (resolved: defaults, preset and overrides applied)")
     w.attr(ds, "source", str(sc.source))
-    ds.close()
 
 
 def _json_scalar(v):
@@ -496,7 +495,8 @@ def _write_array(w: _Writer, path: str, arr) -> None:
     w.attr(ds, "unit", arr.unit)
     if arr.description:
         w.attr(ds, "description", arr.description)
-    ds.close()
+    # no ds.close(): closing an id makes HDF5 write there, and on a full disk that error would come as a
+    # RuntimeError from h5py; the ids go with the file, whose flush and close report an OSError
 
 
 def _provenance(result) -> dict[str, Any]:

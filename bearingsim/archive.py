@@ -268,7 +268,7 @@ def _fill(f, result, in_memory: bool = False) -> None:
     """Write everything of ``result`` into the open file ``f`` (its streamed series are there already)
     and mark it complete (a file built in memory, never seen incomplete, is marked once at the end)."""
     w = _Writer(f)
-    _write_header(w, result)
+    _write_header(w, result, complete=in_memory)
     for name, s in result.series.items():
         g = w.group(f"observables/{name}")
         if s.description:
@@ -289,7 +289,8 @@ def _fill(f, result, in_memory: bool = False) -> None:
             w.attr(g, "description", grp.description)
         _write_group_attrs(w, g, grp.attrs, grp.units)
     _write_group_attrs(w, w.gid("provenance"), _provenance(result), {})
-    w.attr(w.gid("bearingsim"), "complete", True, replace=True)
+    if not in_memory:
+        w.attr(w.gid("bearingsim"), "complete", True, replace=True)
 
 
 _image_count = 0
@@ -305,7 +306,7 @@ def to_bytes(result) -> bytes:
     name = f"bearingsim-image-{os.getpid()}-{_image_count}.h5"  # never on disk: no backing store
     f = h5py.File(name, "w", driver="core", backing_store=False)
     try:
-        _fill(f, result)
+        _fill(f, result, in_memory=True)
         f.flush()
         return f.id.get_file_image()
     finally:

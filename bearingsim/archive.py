@@ -7,12 +7,16 @@ Layout (format documented in ``docs/archive.md``)::
     /h5md                      attrs version; /h5md/creator attrs name, version
     /bearingsim                attrs format_version, model, scenario_name, complete
     /scenario                  resolved scenario as TOML text (dataset)
-    /provenance                attrs: package versions, git commit, created_utc, wall_time_s, ...
-    /parameters/*              derived SI quantities (scalars with units)
+    /provenance                attrs_json: package versions, git commit, created_utc, wall_time_s, ...
     /results/per_rotation/*    [rotations, pockets] arrays
     /results/impacts/*         impact table, one column dataset each
-    /results/summary           attrs
+    /results/summary           attrs_json, units_json (one JSON object each)
     /observables/<name>/{step,time,value}   time series
+
+Named scalar values (an attribute group, the provenance) are stored as one JSON attribute per group
+since format 2.0 (an HDF5 attribute costs ~50 us to write, a reduced-model archive had ~100 of them);
+format 1.x archives, one HDF5 attribute per value and ``<name>__unit`` beside it, are read as well
+(:func:`group_attrs` reads either).
 
 A run writes ``.<name>.tmp-<pid>`` beside the target and renames it when complete; on any error the
 temporary file is removed, so a file at the target name is always a complete archive. A long run
@@ -23,6 +27,7 @@ from __future__ import annotations
 
 import datetime as _dt
 import functools
+import json
 import os
 import platform
 import subprocess
@@ -37,7 +42,10 @@ from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError
 
-FORMAT_VERSION = "1.0"
+FORMAT_VERSION = "2.0"
+READABLE_MAJORS = ("1", "2")  # 1.x: one HDF5 attribute per value; 2.x: attrs_json / units_json
+ATTRS_JSON = "attrs_json"
+UNITS_JSON = "units_json"
 _CHUNK_BYTES = 256 * 1024
 
 
@@ -243,33 +251,7 @@ def write(result, path, spool: Spool | None = None) -> Path:
         with outputs.quiet_stderr():  # HDF5 prints error stacks on a full disk; the OSError says it
             for ts in spool._series:
                 ts.flush()
-            _write_header(f, result)
-            for name, s in result.series.items():
-                g = f.create_group(f"observables/{name}")
-                if s.description:
-                    g.attrs["description"] = s.description
-                ts = TimeSeries(g, s.value.shape[1:], s.unit)
-                ts.append(s.step, s.time, s.value)
-                ts.flush()
-            for path_, arr in result.data.items():
-                _write_array(f, path_, arr)
-            for path_, desc in result.tables.items():
-                g = f.require_group(path_)
-                g.attrs["columns"] = [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")]
-                if desc:
-                    g.attrs["description"] = desc
-            for path_, grp in result.groups.items():
-                g = f.require_group(path_)
-                if grp.description:
-                    g.attrs["description"] = grp.description
-                for k, v in grp.attrs.items():
-                    g.attrs[k] = v
-                for k, u in grp.units.items():
-                    g.attrs[f"{k}__unit"] = u
-            prov = f.create_group("provenance")
-            for k, v in _provenance(result).items():
-                prov.attrs[k] = v
-            f["bearingsim"].attrs["complete"] = True
+            _fill(f, result)
             outputs.close_quietly(f)
             spool.f = None
         os.replace(spool.tmp, spool.path)
@@ -282,35 +264,240 @@ def write(result, path, spool: Spool | None = None) -> Path:
     return spool.path
 
 
-def _write_header(f, result) -> None:
+def _fill(f, result, in_memory: bool = False) -> None:
+    """Write everything of ``result`` into the open file ``f`` (its streamed series are there already)
+    and mark it complete (a file built in memory, never seen incomplete, is marked once at the end)."""
+    w = _Writer(f)
+    _write_header(w, result, complete=in_memory)
+    for name, s in result.series.items():
+        g = w.group(f"observables/{name}")
+        if s.description:
+            w.attr(g, "description", s.description)
+        ts = TimeSeries(g, s.value.shape[1:], s.unit)
+        ts.append(s.step, s.time, s.value)
+        ts.flush()
+    for path_, arr in result.data.items():
+        _write_array(w, path_, arr)
+    for path_, desc in result.tables.items():
+        g = w.gid(path_)
+        w.attr(g, "columns", [k[len(path_) + 1:] for k in result.data if k.startswith(path_ + "/")])
+        if desc:
+            w.attr(g, "description", desc)
+    for path_, grp in result.groups.items():
+        g = w.gid(path_)
+        if grp.description:
+            w.attr(g, "description", grp.description)
+        _write_group_attrs(w, g, grp.attrs, grp.units)
+    _write_group_attrs(w, w.gid("provenance"), _provenance(result), {})
+    if not in_memory:
+        w.attr(w.gid("bearingsim"), "complete", True, replace=True)
+
+
+_image_count = 0
+
+
+def to_bytes(result) -> bytes:
+    """``result`` as the bytes of a complete archive, built in memory (HDF5 core driver, no file):
+    the same content :func:`write` stores, for a caller that writes the file itself (a sweep's
+    worker: one write of the whole file, or bytes sent back to the sweep's client)."""
+    global _image_count
+    h5py = _lazy_h5py()
+    _image_count += 1
+    name = f"bearingsim-image-{os.getpid()}-{_image_count}.h5"  # never on disk: no backing store
+    f = h5py.File(name, "w", driver="core", backing_store=False)
+    try:
+        _fill(f, result, in_memory=True)
+        f.flush()
+        return f.id.get_file_image()
+    finally:
+        f.close()
+
+
+class _Writer:
+    """Writes groups, datasets and scalar attributes through h5py's low-level API with the HDF5 types
+    and creation properties its high-level API uses (so files read back the same), at a fraction of
+    the cost per object: no existence checks, no high-level wrappers, no property lists or types built
+    again for every object. Compressed arrays and attributes that are not scalars go through h5py's
+    high-level API.
+    """
+
+    _types: dict = {}  # dtype key -> (file type, memory type), shared by every writer of the process
+
+    def __init__(self, f):
+        h5py = _lazy_h5py()
+        self.f = f
+        self._h5 = h5py
+        self._gids = {"": f.id}  # group path -> GroupID (the file's id stands for the root group)
+        self._made: set[str] = set()  # groups created by this writer (nothing else is in them)
+        self._scalar = h5py.h5s.create(h5py.h5s.SCALAR)
+        self._dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        self._dcpl.set_obj_track_times(False)  # as h5py's create_dataset
+        self._lcpl = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # as h5py's create_group for an ASCII name
+        self._lcpl.set_create_intermediate_group(True)
+        self._lcpl.set_char_encoding(h5py.h5t.CSET_ASCII)
+
+    def gid(self, path: str):
+        """The low-level id of the group at ``path``, created (with its parents) if missing."""
+        g = self._gids.get(path)
+        if g is None:
+            h5g = self._h5.h5g
+            parent, _, leaf = path.rpartition("/")
+            pid = self.gid(parent)
+            name = leaf.encode("utf-8")
+            if parent not in self._made and pid.links.exists(name):  # the root or a group the spool made
+                g = h5g.open(pid, name)
+            elif leaf.isascii():
+                g = h5g.create(pid, name, lcpl=self._lcpl)
+                self._made.add(path)
+            else:
+                g = self._h5.Group(pid).create_group(leaf).id
+                self._made.add(path)
+            self._gids[path] = g
+        return g
+
+    def group(self, path: str):
+        """The group at ``path`` as an h5py ``Group`` (created if missing)."""
+        return self._h5.Group(self.gid(path))
+
+    def _type(self, key, dtype):
+        t = self._types.get(key)
+        if t is None:
+            h5t = self._h5.h5t
+            t = self._types[key] = (h5t.py_create(dtype, logical=True), h5t.py_create(dtype))
+        return t
+
+    def attr(self, obj, name: str, value, replace: bool = False) -> None:
+        """``obj.attrs[name] = value`` (``obj`` an h5py object or low-level id) for a str, bool, int or
+        float; any other value through h5py's ``attrs``."""
+        oid = obj.id if hasattr(obj, "attrs") else obj
+        if isinstance(value, str):
+            data, key = np.array(value, dtype=self._h5.string_dtype()), "str"
+        elif isinstance(value, (bool, np.bool_, int, np.integer, float, np.floating)):
+            data = np.asarray(value)
+            key = data.dtype.str
+        else:
+            self._h5.AttributeManager(_IdHolder(oid))[name] = value
+            return
+        h5a = self._h5.h5a
+        htype, mtype = self._type(key, data.dtype)
+        bname = name.encode("utf-8")
+        if replace and h5a.exists(oid, bname):
+            h5a.delete(oid, bname)
+        a = h5a.create(oid, bname, htype, self._scalar)
+        try:
+            a.write(data, mtype=mtype)
+        finally:
+            a.close()
+
+    def dataset(self, path: str, data: np.ndarray):
+        """The low-level id of a new contiguous dataset holding ``data`` (numbers or fixed-length
+        bytes, at least 1-D; or a str, stored as a scalar variable-length UTF-8 string)."""
+        h5 = self._h5
+        parent, _, leaf = path.rpartition("/")
+        pid = self.gid(parent)
+        if isinstance(data, str):
+            data = np.array(data, dtype=h5.string_dtype())
+            tid, space = self._type("str", data.dtype)[0], self._scalar
+        else:
+            data = np.ascontiguousarray(data)
+            tid, space = self._type(data.dtype.str, data.dtype)[0], h5.h5s.create_simple(data.shape)
+        dsid = h5.h5d.create(pid, leaf.encode("utf-8"), tid, space, dcpl=self._dcpl)
+        dsid.write(h5.h5s.ALL, h5.h5s.ALL, data)
+        return dsid
+
+
+class _IdHolder:
+    """What h5py's ``AttributeManager`` needs of its parent: ``.id``."""
+
+    def __init__(self, oid):
+        self.id = oid
+
+
+def _write_header(w: _Writer, result, complete: bool = False) -> None:
     sc = result.scenario
-    f.attrs["title"] = f"bearingsim archive: {sc.name}"
-    h5md = f.create_group("h5md")
-    h5md.attrs["version"] = np.array([1, 1])
-    creator = h5md.create_group("creator")
-    creator.attrs["name"] = "bearingsim"
-    creator.attrs["version"] = __version__
-    g = f.create_group("bearingsim")
-    g.attrs["format_version"] = FORMAT_VERSION
-    g.attrs["model"] = result.model
-    g.attrs["scenario_name"] = sc.name
-    g.attrs["complete"] = False
-    ds = f.create_dataset("scenario", data=sc.to_toml())
-    ds.attrs["format"] = "TOML (resolved: defaults, preset and overrides applied)"
-    ds.attrs["source"] = str(sc.source)
+    w.attr(w.f, "title", f"bearingsim archive: {sc.name}")
+    w.attr(w.gid("h5md"), "version", np.array([1, 1]))
+    creator = w.gid("h5md/creator")
+    w.attr(creator, "name", "bearingsim")
+    w.attr(creator, "version", __version__)
+    g = w.gid("bearingsim")
+    w.attr(g, "format_version", FORMAT_VERSION)
+    w.attr(g, "model", result.model)
+    w.attr(g, "scenario_name", sc.name)
+    w.attr(g, "complete", complete)
+    ds = w.dataset("scenario", sc.to_toml())
+    w.attr(ds, "format", "TOML (resolved: defaults, preset and overrides applied)")
+    w.attr(ds, "source", str(sc.source))
 
 
-def _write_array(f, path: str, arr) -> None:
+def _json_scalar(v):
+    """``v`` as a JSON-exact Python scalar (str, bool, int, float), or None if it is not one."""
+    if isinstance(v, (bool, np.bool_)):
+        return bool(v)
+    if isinstance(v, (int, np.integer)):
+        return int(v)
+    if isinstance(v, (float, np.floating)):
+        return float(v)  # repr round-trips exactly; NaN and +-inf as NaN, Infinity
+    if isinstance(v, str):
+        return v
+    return None
+
+
+def _write_group_attrs(w: _Writer, g, values: dict[str, Any], units: dict[str, str]) -> None:
+    """Named values and their units as the attributes ``attrs_json`` and ``units_json`` of ``g``.
+
+    Keys sorted (the order HDF5 lists attributes by name, so a format 1.x reader and this one give the
+    same dict order). A value that is not a scalar (an array) stays an HDF5 attribute of its own.
+    """
+    plain, other = {}, {}
+    for k, v in values.items():
+        j = _json_scalar(v)
+        if j is None:
+            other[k] = v
+        else:
+            plain[k] = j
+    w.attr(g, ATTRS_JSON, json.dumps(dict(sorted(plain.items())), ensure_ascii=False, allow_nan=True))
+    if units:
+        w.attr(g, UNITS_JSON, json.dumps(dict(sorted(units.items())), ensure_ascii=False))
+    for k, v in other.items():
+        g.attrs[k] = v
+
+
+def group_attrs(g) -> tuple[dict[str, Any], dict[str, str]]:
+    """(values, units) of an attribute group or ``/provenance``, either layout, keys sorted.
+
+    Format 2.x: the JSON attributes ``attrs_json`` / ``units_json`` (plus any array-valued attribute);
+    format 1.x: one attribute per value and ``<name>__unit`` beside it. ``description`` is not a value.
+    """
+    values: dict[str, Any] = {}
+    units: dict[str, str] = {}
+    for k, v in g.attrs.items():
+        if k == ATTRS_JSON:
+            values.update(json.loads(_plain(v)))
+        elif k == UNITS_JSON:
+            units.update(json.loads(_plain(v)))
+        elif k.endswith("__unit"):
+            units[k[:-6]] = str(_plain(v))
+        elif k != "description":
+            values[k] = _plain(v)
+    return dict(sorted(values.items())), dict(sorted(units.items()))
+
+
+def _write_array(w: _Writer, path: str, arr) -> None:
     data = np.asarray(arr.data)
     if data.dtype.kind == "U":
         data = data.astype("S")
-    kw = {}
-    if data.size > 4096:
-        kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True)
-    ds = f.create_dataset(path, data=data, **kw)
-    ds.attrs["unit"] = arr.unit
+    if data.size > 4096 or data.ndim == 0 or data.dtype.kind not in "biufS":
+        kw = dict(compression="gzip", compression_opts=4, shuffle=True, chunks=True) if data.size > 4096 else {}
+        parent, _, leaf = path.rpartition("/")
+        ds = w.group(parent).create_dataset(leaf, data=data, **kw).id
+    else:
+        ds = w.dataset(path, data)
+    w.attr(ds, "unit", arr.unit)
     if arr.description:
-        ds.attrs["description"] = arr.description
+        w.attr(ds, "description", arr.description)
+    # no ds.close(): closing an id makes HDF5 write there, and on a full disk that error would come as a
+    # RuntimeError from h5py; the ids go with the file, whose flush and close report an OSError
 
 
 def _provenance(result) -> dict[str, Any]:
@@ -379,17 +566,16 @@ def read(path, result_class):
                 elif "columns" in obj.attrs:
                     tables[name] = str(obj.attrs.get("description", ""))
                 else:
-                    attrs = {k: _plain(v) for k, v in obj.attrs.items() if not k.endswith("__unit") and k != "description"}
+                    attrs, units = group_attrs(obj)
                     if attrs:
-                        units = {k[:-6]: str(v) for k, v in obj.attrs.items() if k.endswith("__unit")}
-                        groups[name] = AttrGroup(attrs, units, str(obj.attrs.get("description", "")))
+                        groups[name] = AttrGroup(attrs, units, str(_plain(obj.attrs.get("description", ""))))
 
         f.visititems(visit)
         series = {}
         for name, g in f.get("observables", {}).items():
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
-        provenance = {k: _plain(v) for k, v in f["provenance"].attrs.items()} if "provenance" in f else {}
+        provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}
     except UserError:
         raise
     except (KeyError, ValueError, TypeError, OSError) as exc:
@@ -480,14 +666,14 @@ def peek(path) -> dict[str, Any] | None:
             if g is None or not bool(g.attrs.get("complete", False)):
                 return None
             text = f["scenario"][()]
-            summary = {k: _plain(v) for k, v in f["results/summary"].attrs.items() if not k.endswith("__unit")}
+            summary = group_attrs(f["results/summary"])[0]
             return {
                 "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
                 "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
-                "wall_time_s": float(f["provenance"].attrs.get("wall_time_s", float("nan"))) if "provenance" in f
-                else float("nan"),
+                "wall_time_s": float(group_attrs(f["provenance"])[0].get("wall_time_s", float("nan")))
+                if "provenance" in f else float("nan"),
             }
     except (OSError, KeyError, ValueError, TypeError):
         return None
@@ -517,8 +703,8 @@ def open_archive(path: str | Path):
             raise UserError(f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
         if not bool(g.attrs.get("complete", False)):
             raise UserError(f"{p}: incomplete bearingsim archive (the run did not finish)")
-        major = str(g.attrs["format_version"]).split(".")[0]
-        if major != FORMAT_VERSION.split(".")[0]:
+        major = str(_plain(g.attrs["format_version"])).split(".")[0]
+        if major not in READABLE_MAJORS:
             raise UserError(f"{p}: archive format {g.attrs['format_version']} not readable by this bearingsim")
     except UserError:
         f.close()
@@ -538,7 +724,7 @@ def describe(path: str | Path) -> str:
         lines.append(f"{path}: bearingsim archive, format {g.attrs['format_version']}, model {g.attrs['model']}, "
                      f"scenario {g.attrs['scenario_name']!s}")
         if "provenance" in f:
-            pv = f["provenance"].attrs
+            pv = group_attrs(f["provenance"])[0]
             keys = ["bearingsim_version", "git_commit", "created_utc", "wall_time_s"]
             lines.append("provenance: " + ", ".join(f"{k}={pv[k]}" for k in keys if k in pv))
             extra = [k for k in pv if k not in keys and not k.startswith("version_") and k not in ("platform", "command")]
@@ -546,11 +732,9 @@ def describe(path: str | Path) -> str:
                 lines.append("run: " + ", ".join(f"{k}={pv[k]}" for k in extra))
         if "results/summary" in f:
             lines.append("summary:")
-            sa = f["results/summary"].attrs
+            sa, su = group_attrs(f["results/summary"])
             for k in sorted(sa):
-                if k.endswith("__unit"):
-                    continue
-                unit = sa.get(f"{k}__unit", "")
+                unit = su.get(k, "")
                 v = sa[k]
                 vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
                 lines.append(f"  {k:32s} {vs} {unit}")

@@ -164,6 +164,11 @@ def _cmd_validate(args) -> int:
 
 
 def _cmd_bench(args) -> int:
+    if args.map:
+        from bearingsim.sweeps.bench import run_map_bench
+
+        run_map_bench(Path(args.output))
+        return 0
     if args.sweep:
         from bearingsim.sweeps.bench import run_sweep_bench
 
@@ -172,7 +177,7 @@ def _cmd_bench(args) -> int:
     if args.fast_scene:
         from bearingsim.multibody.fast_bench import run_fast_scene_bench
 
-        _, comps = run_fast_scene_bench(Path(args.output), rotations=args.rotations)
+        run_fast_scene_bench(Path(args.output), rotations=args.rotations)
         print((Path(args.output) / "fast_scene.md").read_text(), end="")
         print(f"wrote {Path(args.output) / 'fast_scene.csv'}, fast_scene_comparison.csv, fast_scene.md")
         return 0
@@ -269,6 +274,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--fast-scene", action="store_true",
                    help="rigid raceways against the Hertz full scene at 500, 1000, 3000 and 6000 rpm (issue 16)")
     b.add_argument("--rotations", type=int, default=40, help="recorded rotations per run of --fast-scene")
+    b.add_argument("--map", action="store_true",
+                   help="wall time of the 100 x 100 reduced-model sweep map (2 workers), with and without archives")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 

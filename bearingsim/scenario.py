@@ -237,7 +237,7 @@ class Scenario:
         return _drop_none(self.model_.model_dump())
 
     def to_toml(self) -> str:
-        return tomli_w.dumps(self.raw)
+        return _dumps(self.raw)
 
     def replace(self, **dotted: Any) -> "Scenario":
         """A new scenario with dotted keys replaced, e.g. ``replace(**{"operating.direction": "reverse"})``."""
@@ -245,6 +245,49 @@ class Scenario:
         for key, value in dotted.items():
             _set_dotted(raw, key, value, origin="replace()")
         return _validate(raw, self.source)
+
+
+_TOML_TABLES: dict[tuple[str, str], str] = {}  # (table name, repr of its content) -> its TOML text
+
+
+def _dumps(raw: dict[str, Any]) -> str:
+    """``tomli_w.dumps(raw)``, each top-level table formatted once per process for a given content.
+
+    tomli_w writes the top-level values, then each table, separated by a blank line; a table's text
+    depends only on its name and its content, so thousands of sweep cases that differ in one or two
+    keys share the text of their other tables. The key is the table's ``repr`` (which tells 1, 1.0 and
+    True apart), used only for plain data (str, int, float, bool, lists and tables of them).
+    """
+    top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
+    if not all(_plain_data(v) for v in top.values()):  # e.g. an array of tables: as tomli_w does it
+        return tomli_w.dumps(raw)
+    parts = [tomli_w.dumps(top)] if top else []
+    for k, v in raw.items():
+        if isinstance(v, dict):
+            if not _plain_data(v):
+                parts.append(tomli_w.dumps({k: v}))
+                continue
+            key = (k, repr(v))
+            text = _TOML_TABLES.get(key)
+            if text is None:
+                if len(_TOML_TABLES) >= 4096:
+                    _TOML_TABLES.clear()
+                text = _TOML_TABLES[key] = tomli_w.dumps({k: v})
+            parts.append(text)
+    return "\n".join(parts)
+
+
+def _plain_data(v, depth: int = 0) -> bool:
+    """str, int, float or bool, or lists and tables of them (no table inside a list)."""
+    if isinstance(v, (str, int, float)):  # bool is an int
+        return type(v) in (str, int, float, bool)
+    if depth > MAX_NESTING_DEPTH:
+        return False
+    if type(v) is list:
+        return all(not isinstance(x, dict) and _plain_data(x, depth + 1) for x in v)
+    if type(v) is dict:
+        return all(type(k) is str and _plain_data(x, depth + 1) for k, x in v.items())
+    return False
 
 
 def _drop_none(d):
@@ -260,12 +303,38 @@ def available_presets() -> list[str]:
 
 def load_preset(name: str) -> dict[str, Any]:
     """The preset's data (sections of values, ``name``, ``citation`` and per-key ``source``)."""
+    return _copy(_preset(name))
+
+
+_PRESETS: dict[str, tuple[tuple, dict]] = {}
+
+
+def _preset(name: str) -> dict[str, Any]:
+    """The parsed preset, shared: callers must not change it. Parsed again when the file changes
+    (a sweep's worker resolves thousands of cases with one preset)."""
+    if isinstance(name, str) and name and "/" not in name and "\\" not in name and not name.startswith("."):
+        path = Path(str(resources.files("bearingsim") / PRESET_DIR / f"{name}.toml"))
+        try:
+            st = path.stat()
+        except OSError:
+            st = None
+        if st is not None:
+            stamp = (st.st_mtime_ns, st.st_size, st.st_ino)
+            hit = _PRESETS.get(name)
+            if hit is not None and hit[0] == stamp:
+                return hit[1]
     if not isinstance(name, str) or name not in available_presets():
         raise UserError(
             f"bearing.preset: unknown preset {name!r} (available: {', '.join(available_presets())})"
         )
-    text = (resources.files("bearingsim") / PRESET_DIR / f"{name}.toml").read_text()
-    return tomllib.loads(text)
+    path = resources.files("bearingsim") / PRESET_DIR / f"{name}.toml"
+    data = tomllib.loads(path.read_text())
+    try:
+        st = Path(str(path)).stat()
+        _PRESETS[name] = ((st.st_mtime_ns, st.st_size, st.st_ino), data)
+    except OSError:  # not a plain file (a zipped package): parsed every time
+        pass
+    return data
 
 
 def parse_override(item: str) -> tuple[str, Any]:
@@ -314,13 +383,33 @@ def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
 
 
 def _merge(base: dict, top: dict) -> dict:
-    out = copy.deepcopy(base)
-    for k, v in top.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict):
-            out[k] = _merge(out[k], v)
+    """``base`` updated by ``top``, sections merged key by key; neither is changed (values copied).
+    Keys in ``base``'s order, then those only in ``top``."""
+    out = {}
+    for k, v in base.items():
+        if k in top:
+            t = top[k]
+            out[k] = _merge(v, t) if isinstance(t, dict) and isinstance(v, dict) else _copy(t)
         else:
-            out[k] = copy.deepcopy(v)
+            out[k] = _copy(v)
+    for k, t in top.items():
+        if k not in base:
+            out[k] = _copy(t)
     return out
+
+
+_IMMUTABLE = (str, int, float, bool, type(None))
+
+
+def _copy(v):
+    """A deep copy of TOML-like data (dicts, lists, immutable scalars); anything else: copy.deepcopy."""
+    if isinstance(v, _IMMUTABLE):
+        return v
+    if type(v) is dict:
+        return {k: _copy(x) for k, x in v.items()}
+    if type(v) is list:
+        return [_copy(x) for x in v]
+    return copy.deepcopy(v)
 
 
 def read_toml_file(path: str | Path) -> dict[str, Any]:
@@ -384,7 +473,7 @@ def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
     preset_name = bearing.get("preset") if isinstance(bearing, dict) else None
     if preset_name is not None:
         try:
-            preset = load_preset(preset_name)
+            preset = _preset(preset_name)  # shared: _merge copies what it keeps
         except UserError as exc:
             raise UserError(f"{source}: {exc}") from None
         for section, values in preset.items():

@@ -37,7 +37,7 @@ def test_complete_archive_has_header_scenario_provenance_units(tmp_path, base_re
         assert f["h5md/creator"].attrs["name"] == "bearingsim"
         assert f["bearingsim"].attrs["complete"]
         assert "pocket_clearance_mm = 0.2" in f["scenario"][()].decode()
-        prov = f["provenance"].attrs
+        prov = archive.group_attrs(f["provenance"])[0]
         for key in ("bearingsim_version", "git_commit", "created_utc", "wall_time_s", "version_numpy",
                     "version_pymunk", "version_h5py", "dt_s"):
             assert key in prov, key
@@ -125,3 +125,45 @@ def test_memory_series_are_written_and_read_back(tmp_path, base_reduced):
     back = archive.read(archive.write(res, tmp_path / "s.h5"), type(res))
     s = back.series["x"]
     assert s.unit == "m" and s.value.shape == (5, 2) and np.array_equal(s.step, np.arange(5))
+
+
+def test_format_1_archive_still_reads_the_same(tmp_path):
+    """An archive of format 1.0 (one HDF5 attribute per value, written by bearingsim at commit 0921c01:
+    ``bearingsim run scenarios/paper_3000rpm.toml``, kept gzipped) reads back as the same result a run
+    of that scenario gives now, and the archive tools read it."""
+    import gzip
+    import tomllib
+    from pathlib import Path
+
+    import bearingsim
+
+    old = tmp_path / "old.h5"
+    old.write_bytes(gzip.decompress((Path(__file__).parent / "data" / "archive_v1_0_paper_3000rpm.h5.gz").read_bytes()))
+    with h5py.File(old, "r") as f:
+        assert f["bearingsim"].attrs["format_version"] == "1.0" and "attrs_json" not in f["results/summary"].attrs
+    back = bearingsim.load(old)
+    sc = resolve(tomllib.loads(back.scenario.to_toml()))
+    now = bearingsim.run(sc)
+    assert back.scenario.raw == now.scenario.raw
+    assert back.summary == now.summary
+    assert set(back.data) == set(now.data)
+    for k, v in now.data.items():
+        assert np.array_equal(back.data[k].data, v.data) and back.data[k].unit == v.unit, k
+    assert set(back.groups) == set(now.groups)
+    for k, g in now.groups.items():
+        assert back.groups[k].attrs == g.attrs and back.groups[k].units == g.units, k
+    assert back.tables == now.tables
+    assert back.provenance["solver"] == "reduced/event" and back.provenance["git_commit"].startswith("0921c01")
+    assert isinstance(back.provenance["solver_pieces"], int) and isinstance(back.provenance["dt_s"], float)
+    # the new layout gives back the same dict, types and order included
+    new = bearingsim.load(back.save(tmp_path / "new.h5"))
+    assert list(new.provenance) == list(back.provenance)
+    for k, v in back.provenance.items():
+        if k not in ("created_utc", "command", "git_commit", "bearingsim_version") and not k.startswith("version_"):
+            assert type(new.provenance[k]) is type(v) and (new.provenance[k] == v or v != v), k
+    for k, g in back.groups.items():
+        assert list(new.groups[k].attrs.items()) == list(g.attrs.items()), k
+        assert list(new.groups[k].units.items()) == list(g.units.items()), k
+    assert "I_dec_mean_Ns" in describe(old) and "git_commit=0921c01" in describe(old)
+    got = archive.peek(old)
+    assert got["summary"]["I_dec_mean_Ns"] == now.summary["I_dec_mean_Ns"] and got["wall_time_s"] > 0

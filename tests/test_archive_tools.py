@@ -69,14 +69,23 @@ def test_plot_draws_every_figure_again_from_the_archive_alone(tmp_path, multibod
     assert all((tmp_path / "figs" / n).stat().st_size > 10_000 for n in names)
 
 
+def _edit_json_attr(group, key, change):
+    """Change one value of a format-2 attribute group in place (``attrs_json``)."""
+    import json
+
+    values = json.loads(group.attrs["attrs_json"])
+    values[key] = change(values[key])
+    group.attrs["attrs_json"] = json.dumps(values)
+
+
 def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive):
     res = cli("rerun", reduced_archive)
     assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
     tampered = tmp_path / "t.h5"
     shutil.copy(reduced_archive, tampered)
     with h5py.File(tampered, "r+") as f:
-        f["results/summary"].attrs["I_dec_mean_Ns"] *= 1.0 + 1e-12
-        f["provenance"].attrs["version_numpy"] = "0.0.1"
+        _edit_json_attr(f["results/summary"], "I_dec_mean_Ns", lambda v: v * (1.0 + 1e-12))
+        _edit_json_attr(f["provenance"], "version_numpy", lambda v: "0.0.1")
     res = cli("rerun", tampered)
     assert res.returncode == 1
     assert "I_dec_mean_Ns" in res.stdout and "differs" in res.stdout and "numpy: archive 0.0.1" in res.stdout

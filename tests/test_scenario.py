@@ -142,3 +142,24 @@ def test_pocket_shape_keys_are_validated(override, words):
 def test_flat_pockets_reach_the_parameters():
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["multibody.flat_pockets=[3, 0]"])
     assert si(sc).multibody.flat_pockets == (0, 3)
+
+
+def test_toml_text_is_tomli_w_text_with_tables_cached():
+    """Scenario.to_toml formats each top-level table once per content (a sweep's thousands of cases):
+    the text is tomli_w's, cache hits included, and 1, 1.0 and True stay apart."""
+    import tomli_w
+
+    from bearingsim.scenario import _dumps
+
+    from .conftest import SCENARIOS
+
+    docs = [load_scenario(p).raw for p in sorted(SCENARIOS.glob("*.toml"))]
+    docs += [
+        {"a": 1, "t": {"x": 1}}, {"a": 1, "t": {"x": 1.0}}, {"a": 1, "t": {"x": True}},
+        {"t": {"x": 'q"uote\\back\nnl', "é": "ü", "list": [1, 2.5, "s"], "sub": {"y": []}}, "u": {}},
+        {"only": {"tables": {"deep": {"er": 1}}}},
+        {"aot": [{"a": 1}, {"b": 2}], "t": {"x": 1}},
+        {"t": {"aot": [{"a": 1}]}},
+    ]
+    for raw in docs + docs:  # the second pass hits the cache
+        assert _dumps(raw) == tomli_w.dumps(raw), raw

@@ -129,6 +129,14 @@ def test_batches_group_cheap_cases_only():
     assert sorted(h for b in batches for h, _ in b) == sorted(c.hash for c in red + mb)
 
 
+def test_last_batches_of_a_large_sweep_shrink():
+    red = [Case(f"r{i}", {}, "t", "reduced") for i in range(10_000)]
+    sizes = [len(b) for b in make_batches(red, workers=2)]
+    assert max(sizes) == 200 and sizes[:40] == [200] * 40  # full batches first
+    assert sizes[-6:-1] == sorted(sizes[-6:-1], reverse=True) and max(sizes[-6:]) <= 15  # a short tail
+    assert [h for b in make_batches(red, workers=2) for h, _ in b] == [c.hash for c in red]
+
+
 def test_standard_error_is_over_rotations_of_pocket_means():
     # two rotations of two pockets: rotation means 2 and 4 -> sample std sqrt(2), over sqrt(2) -> 1
     se = standard_errors(np.array([[1.0, 3.0], [3.0, 5.0]]), np.zeros((2, 2)))
@@ -176,7 +184,7 @@ def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
     # forked pool workers inherit the patch: a case at 2000 rpm raises as an unstable run would
     import bearingsim.simulation as simulation
 
-    real = simulation.run_scenario
+    real = simulation.run
 
     def flaky(scenario, *a, **kw):
         if scenario.operating.inner_ring_speed_rpm == 2000:
@@ -185,7 +193,7 @@ def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
             raise ZeroDivisionError("float division by zero")
         return real(scenario, *a, **kw)
 
-    monkeypatch.setattr(simulation, "run_scenario", flaky)
+    monkeypatch.setattr(simulation, "run", flaky)  # what every case runs through, in memory or streamed
     code = run_sweep_cli(BASE, [f"{SPEED}=1000,2000,3000"], [], tmp_path, jobs=2, figures=False, quiet=True)
     assert code == 1
     rows = _rows(tmp_path)

@@ -1,4 +1,5 @@
-"""``bearingsim bench --sweep``: how a multibody sweep scales over workers and engines.
+"""``bearingsim bench --sweep``: how a multibody sweep scales over workers and engines;
+``bearingsim bench --map``: what the 100 x 100 reduced-model map costs (:func:`run_map_bench`).
 
 The same sweep (``CASES`` copies of ``scenarios/multibody_6000rpm.toml`` with ``numerics.rotations =
 ROTATIONS``, differing only in ``name``, so every case does the same work) runs on a local pool and on
@@ -111,36 +112,76 @@ def run_sweep_bench(outdir: str | Path = "outputs/bench") -> list[dict]:
     return rows
 
 
-def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2) -> float:
-    """Wall time [s] of the 100 x 100 map ``scenarios/sweeps/map_speed_clearance.toml`` into ``outdir``.
+def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2, figures: bool = False,
+             quiet: bool = False) -> dict:
+    """Run the 100 x 100 map ``scenarios/sweeps/map_speed_clearance.toml`` into ``outdir`` (a fresh
+    folder: every case runs) and return what it cost: ``wall_s`` (from reading the sweep file to the
+    end, index and, with ``figures``, the heat map included), ``done``, ``cached``, ``case_ms`` (the
+    mean of the cases' own times in the workers) and ``cpu_sweep_s`` (CPU time of the sweep process
+    itself: resolving, dispatch, index).
 
     With ``archives=False`` the workers (forked, so they inherit the change) solve each case without
-    writing its archive: what the engine, the solver and the index cost without ``archive.py``.
-    ``python -m bearingsim.sweeps.bench map [--no-archives] OUTDIR``.
+    building or writing its archive: what the engine, the solver and the index cost without
+    ``archive.py``. ``python -m bearingsim.sweeps.bench map [--no-archives] OUTDIR``.
     """
-    import types
+    import resource
 
-    import bearingsim.simulation as simulation
+    import bearingsim.archive as archive
+    import bearingsim.sweeps.worker as worker
     from bearingsim.sweeps.engines import LocalEngine
     from bearingsim.sweeps.run import run_sweep
     from bearingsim.sweeps.spec import load_sweep_file
 
-    real = simulation.run_scenario
-    if not archives:
-        def solve_only(scenario, out=None, **kw):
-            return types.SimpleNamespace(result=simulation.run(scenario))
-
-        simulation.run_scenario = solve_only
+    real = archive.to_bytes, worker._write_file
+    if not archives:  # a reduced case's archive is built by to_bytes and written by _write_file
+        archive.to_bytes = lambda result: b""
+        worker._write_file = lambda target, data: None
     try:
+        cpu0 = resource.getrusage(resource.RUSAGE_SELF)
         t0 = time.perf_counter()
         spec = load_sweep_file(_scenario_path().parent / "sweeps" / "map_speed_clearance.toml")
-        out = run_sweep(spec, Path(outdir), engine=LocalEngine(jobs), figures=False, progress=False)
+        out = run_sweep(spec, Path(outdir), engine=LocalEngine(jobs), figures=figures, progress=False)
         wall = time.perf_counter() - t0
+        cpu1 = resource.getrusage(resource.RUSAGE_SELF)
     finally:
-        simulation.run_scenario = real
-    print(f"100 x 100 map, {'with' if archives else 'without'} archives, {jobs} workers: "
-          f"{out.count('done')} done, {out.count('cached')} cached in {wall:.1f} s")
-    return wall
+        archive.to_bytes, worker._write_file = real
+    walls = [r["wall_s"] for r in out.rows if r["status"] == "done"]
+    row = {"archives": archives, "workers": jobs, "cases": len(out.rows), "done": out.count("done"),
+           "cached": out.count("cached"), "wall_s": wall,
+           "case_ms": 1e3 * sum(walls) / max(1, len(walls)),
+           "cpu_sweep_s": (cpu1.ru_utime + cpu1.ru_stime) - (cpu0.ru_utime + cpu0.ru_stime)}
+    if not quiet:
+        print(f"100 x 100 map, {'with' if archives else 'without'} archives, {jobs} workers: "
+              f"{row['done']} done, {row['cached']} cached in {wall:.1f} s")
+    return row
+
+
+def run_map_bench(outdir: str | Path = "outputs/bench", jobs: int = 2) -> list[dict]:
+    """``bearingsim bench --map``: the 100 x 100 reduced-model map with its archives, index and heat map
+    (what ``bearingsim sweep scenarios/sweeps/map_speed_clearance.toml -j 2`` does), then again
+    without archives; print the table, write ``map_cost.csv`` in ``outdir``; return the rows."""
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    load_before = os.getloadavg()[0]
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bearingsim-bench-map-") as tmp:
+        rows.append(map_cost(Path(tmp) / "with", archives=True, jobs=jobs, figures=True, quiet=True))
+        rows.append(map_cost(Path(tmp) / "without", archives=False, jobs=jobs, figures=False, quiet=True))
+    path = outdir / "map_cost.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print(f"100 x 100 map of the reduced model (scenarios/sweeps/map_speed_clearance.toml), {jobs} workers; "
+          f"{os.cpu_count()} cores; 1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after "
+          f"(other users' work on the cores slows every row)")
+    print(f"{'run':34s} {'cases':>6s} {'wall [s]':>9s} {'case in worker [ms]':>19s} {'sweep process CPU [s]':>21s}")
+    names = {True: "archives, index, heat map", False: "no archives (solve, index)"}
+    for r in rows:
+        print(f"{names[r['archives']]:34s} {r['done']:6d} {r['wall_s']:9.1f} {r['case_ms']:19.2f} "
+              f"{r['cpu_sweep_s']:21.1f}")
+    print(f"wrote {path}")
+    return rows
 
 
 if __name__ == "__main__":  # pragma: no cover

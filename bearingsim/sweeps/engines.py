@@ -57,6 +57,24 @@ class LocalEngine:
             # fork: workers start in milliseconds and inherit the imported package
             self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
 
+    def warm_up(self, spec) -> None:
+        """Start the pool and, if the sweep's base scenario is a reduced-model one, have the workers run
+        it once without an archive (loading the compiled model takes ~0.3 s a process), while the
+        sweep process resolves the cases. Does nothing else: errors are left to the sweep to report."""
+        from bearingsim.scenario import load_scenario
+        from bearingsim.sweeps.worker import warm_up
+
+        try:
+            base = load_scenario(spec.scenario, spec.sets)
+        except Exception:  # noqa: BLE001 - resolve_cases names the problem
+            return
+        if base.model != "reduced":
+            return
+        self.start()
+        text = base.to_toml()
+        for _ in range(self.workers):
+            self._pool.apply_async(warm_up, (text,))
+
     def run(self, batches: list[list[tuple[str, str]]], cases_dir: str) -> Iterator[list[dict]]:
         """Yield the records of each batch as it finishes (in completion order)."""
         import queue
@@ -68,7 +86,7 @@ class LocalEngine:
         for b in batches:
             def lost(exc, b=b):  # the batch itself failed (a worker died): every case of it failed
                 done.put([{"hash": h, "status": "failed", "error": one_line_error(exc), "wall_s": float("nan"),
-                           "summary": {}} for h, _ in b])
+                           "summary": {}} for h, *_ in b])
             self._pool.apply_async(run_batch, (b, cases_dir), callback=done.put, error_callback=lost)
         for _ in batches:
             while True:
@@ -136,6 +154,8 @@ class DaskEngine:
 
         self.start()
         stamp = f"{os.getpid()}-{time.time_ns()}"
+        # the text only: a worker elsewhere resolves it with its own bearingsim (no pickled models)
+        batches = [[(h, text) for h, text, *_ in b] for b in batches]
         self._futures = [self.client.submit(run_batch, b, None, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
                          for i, b in enumerate(batches)]
         for fut in as_completed(self._futures, loop=self.client.loop):

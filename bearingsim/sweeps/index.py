@@ -15,6 +15,7 @@ swept key in ``axes``, the grid's axes in ``grid`` (JSON lists), the sweep ``mod
 from __future__ import annotations
 
 import csv
+import io
 import json
 import math
 import os
@@ -63,46 +64,96 @@ def write_index(outdir: Path, rows: list[dict], keys: list[str], meta: dict) -> 
     """Write ``sweep.csv`` and ``sweep.h5`` for ``rows`` atomically; return both paths.
 
     Each row holds ``case``, ``values`` (dict over ``keys``), ``status``, ``error``, ``archive``,
-    ``wall_s`` and ``summary`` (dict of floats).
+    ``wall_s`` and ``summary`` (dict of floats). A sweep that rewrites its index as cases finish uses
+    an :class:`IndexWriter`, which formats only the rows that changed.
     """
-    outdir = Path(outdir)
-    summ = summary_columns(rows)
-    columns = ["case", *keys, *FIXED, *summ]
-    csv_path, h5_path = outdir / "sweep.csv", outdir / "sweep.h5"
+    return IndexWriter(outdir, rows, keys, meta).write()
 
-    tmp = _tmp(csv_path)
-    try:
-        with open(tmp, "w", newline="", encoding="utf-8") as fh:
-            w = csv.writer(fh)
-            w.writerow(columns)
-            for r in rows:
-                s = r.get("summary", {})
-                w.writerow([r["case"], *[r["values"].get(k, "") for k in keys], r["status"], r.get("error", ""),
-                            r.get("archive", ""), _fmt(r.get("wall_s")), *[_fmt(s.get(k)) for k in summ]])
-        os.replace(tmp, csv_path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
-    cols = {"case": np.array([r["case"] for r in rows], dtype=object)}
-    units = {}
-    for k in keys:
-        vals = [r["values"].get(k) for r in rows]
-        if all(v is None or _is_number(v) for v in vals):
-            cols[k] = np.array([math.nan if v is None else float(v) for v in vals])
-        else:
-            cols[k] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
-        units[k] = unit_of(k)
-    for col in ("status", "error", "archive"):
-        cols[col] = np.array([r.get(col, "") for r in rows], dtype=object)
-    cols["wall_s"] = np.array([_float(r.get("wall_s")) for r in rows])
-    units["wall_s"] = "s"
-    for k in summ:
-        cols[k] = np.array([_float(r.get("summary", {}).get(k)) for r in rows])
-        units[k] = unit_of(k)
-    attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **meta}
-    archive.write_table_file(h5_path, cols, units, attrs)
-    return csv_path, h5_path
+class IndexWriter:
+    """``sweep.csv`` and ``sweep.h5`` of ``rows``, written again and again as rows change.
+
+    Each row is formatted once (its CSV line and its cells of the ``sweep.h5`` columns) and again only
+    after :meth:`changed` names it, so rewriting the index of a 10 000-case sweep costs the writing of
+    two files, not the formatting of 10 000 rows (~0.3 s each time). The files are the ones
+    :func:`write_index` writes for the same rows.
+    """
+
+    def __init__(self, outdir: Path, rows: list[dict], keys: list[str], meta: dict):
+        self.outdir, self.rows, self.keys, self.meta = Path(outdir), rows, list(keys), meta
+        self._summ: list[str] | None = None  # summary columns the cached cells are for
+        self._dirty: set[int] = set(range(len(rows)))
+        self._lines: list[str] = [""] * len(rows)
+        self._cols: dict[str, np.ndarray] = {}
+        self._units: dict[str, str] = {}
+        self._buf = io.StringIO()
+        self._csv = csv.writer(self._buf)
+
+    def changed(self, i: int) -> None:
+        """Row ``i`` was updated: format it again at the next :meth:`write`."""
+        self._dirty.add(i)
+
+    def _reset(self, summ: list[str]) -> None:
+        rows, n = self.rows, len(self.rows)
+        self._summ = summ
+        self._dirty = set(range(n))
+        cols = {"case": np.array([r["case"] for r in rows], dtype=object)}
+        units = {}
+        for k in self.keys:
+            vals = [r["values"].get(k) for r in rows]
+            if all(v is None or _is_number(v) for v in vals):
+                cols[k] = np.array([math.nan if v is None else float(v) for v in vals])
+            else:
+                cols[k] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
+            units[k] = unit_of(k)
+        for col in ("status", "error", "archive"):
+            cols[col] = np.empty(n, dtype=object)
+        cols["wall_s"] = np.full(n, math.nan)
+        units["wall_s"] = "s"
+        for k in summ:
+            cols[k] = np.full(n, math.nan)
+            units[k] = unit_of(k)
+        self._cols, self._units = cols, units
+
+    def write(self) -> tuple[Path, Path]:
+        """Write both files (atomically) with every row as it is now; return their paths."""
+        rows, keys = self.rows, self.keys
+        summ = summary_columns(rows)
+        if summ != self._summ:
+            self._reset(summ)
+        cols, buf, w = self._cols, self._buf, self._csv
+        for i in self._dirty:
+            r = rows[i]
+            s = r.get("summary", {})
+            buf.seek(0)
+            buf.truncate()
+            w.writerow([r["case"], *[r["values"].get(k, "") for k in keys], r["status"], r.get("error", ""),
+                        r.get("archive", ""), _fmt(r.get("wall_s")), *[_fmt(s.get(k)) for k in summ]])
+            self._lines[i] = buf.getvalue()
+            for col in ("status", "error", "archive"):
+                cols[col][i] = r.get(col, "")
+            cols["wall_s"][i] = _float(r.get("wall_s"))
+            for k in summ:
+                cols[k][i] = _float(s.get(k))
+        self._dirty = set()
+
+        columns = ["case", *keys, *FIXED, *summ]
+        csv_path, h5_path = self.outdir / "sweep.csv", self.outdir / "sweep.h5"
+        buf.seek(0)
+        buf.truncate()
+        w.writerow(columns)
+        text = buf.getvalue() + "".join(self._lines)
+        tmp = _tmp(csv_path)
+        try:
+            with open(tmp, "w", newline="", encoding="utf-8") as fh:
+                fh.write(text)
+            os.replace(tmp, csv_path)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+        attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **self.meta}
+        archive.write_table_file(h5_path, {c: cols[c] for c in columns}, self._units, attrs)
+        return csv_path, h5_path
 
 
 def _float(v) -> float:

@@ -17,12 +17,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.sweeps.index import read_cached, write_atomic_bytes, write_index
+from bearingsim.sweeps.index import IndexWriter, read_cached, write_atomic_bytes
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
 # how many cheap (reduced-model) cases one task runs: enough that a task lasts far longer than its
 # dispatch, few enough that every worker gets several tasks and the bar moves
 MAX_BATCH = 200
+MIN_TAIL_BATCH = 10
 INDEX_EVERY_S = 1.0
 
 
@@ -54,17 +55,34 @@ class SweepOutcome:
         return [r for r in self.rows if r["status"] == "failed"]
 
 
-def make_batches(cases: list[Case], workers: int) -> list[list[tuple[str, str]]]:
+def _item(c: Case) -> tuple:
+    """What a worker gets of a case: (hash, resolved TOML), and the validated scenario model when the
+    case has it (a local pool uses it; a dask cluster gets the text only)."""
+    return (c.hash, c.toml) if c.scenario is None else (c.hash, c.toml, c.scenario)
+
+
+def make_batches(cases: list[Case], workers: int) -> list[list[tuple]]:
     """Cases grouped into tasks: multibody cases one per task, reduced cases in batches.
 
-    A reduced case costs about a millisecond to solve and tens of milliseconds with its archive, so
+    A reduced case costs about a millisecond to solve and a few milliseconds with its archive, so
     they go in batches of up to :data:`MAX_BATCH`, small enough that each worker still gets about
-    four batches.
+    four batches; in a sweep large enough for full batches, the last ones shrink (down to
+    :data:`MIN_TAIL_BATCH`) so the workers finish together.
     """
-    reduced = [(c.hash, c.toml) for c in cases if c.model == "reduced"]
-    other = [[(c.hash, c.toml)] for c in cases if c.model != "reduced"]
-    size = max(1, min(MAX_BATCH, math.ceil(len(reduced) / (4 * max(1, workers))))) if reduced else 1
-    return other + [reduced[i:i + size] for i in range(0, len(reduced), size)]
+    reduced = [_item(c) for c in cases if c.model == "reduced"]
+    other = [[_item(c)] for c in cases if c.model != "reduced"]
+    workers = max(1, workers)
+    size = max(1, min(MAX_BATCH, math.ceil(len(reduced) / (4 * workers)))) if reduced else 1
+    batches, i = [], 0
+    while i < len(reduced):
+        left = len(reduced) - i
+        n = size
+        if size == MAX_BATCH and left <= 4 * workers * size:
+            # the last batches of a large sweep shrink, so that no worker idles long at the end
+            n = min(size, max(MIN_TAIL_BATCH, math.ceil(left / (2 * workers))))
+        batches.append(reduced[i:i + n])
+        i += n
+    return other + batches
 
 
 class _Lock:
@@ -167,8 +185,16 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     from bearingsim.sweeps.engines import LocalEngine
 
     t0 = time.perf_counter()
+    engine = engine or LocalEngine(1)
     if isinstance(spec, SweepSpec):
-        cases = resolve_cases(spec)
+        warm_up = getattr(engine, "warm_up", None)
+        try:
+            if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
+                warm_up(spec)
+            cases = resolve_cases(spec)
+        except BaseException:
+            engine.stop()
+            raise
         keys = spec.keys
         meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
                 "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
@@ -177,7 +203,6 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         keys = list(dict.fromkeys(k for c in cases for k in c.values))
         meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
                 "grid_rows": 0}
-    engine = engine or LocalEngine(1)
     engine.start()  # an unreachable scheduler stops the sweep before anything is written
     try:
         outdir = check_writable_dir(outdir)
@@ -193,6 +218,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
              "wall_s": math.nan, "summary": {}} for c in cases]
     by_hash = {c.hash: i for i, c in enumerate(cases)}
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
+    index = IndexWriter(outdir, rows, keys, meta)
 
     with lock, _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
@@ -208,7 +234,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     todo.append(c)
                 else:
                     row.update(rec, archive=f"cases/{c.hash}.h5")
-            write_index(outdir, rows, keys, meta)
+            index.write()
             counts = {"done": 0, "failed": 0, "cached": len(cases) - len(todo)}
             bar = _progress(len(cases), progress, counts["cached"])
             if bar is not None:
@@ -228,6 +254,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         row.update(status=rec["status"], error=rec["error"], wall_s=rec["wall_s"],
                                    summary=rec["summary"],
                                    archive=f"cases/{rec['hash']}.h5" if rec["status"] == "done" else "")
+                        index.changed(i)
                         counts[rec["status"]] += 1
                         if rec["status"] == "failed":
                             say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
@@ -235,7 +262,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         bar.set_postfix(counts, refresh=False)
                         bar.update(len(records))
                     if time.monotonic() - last_index >= INDEX_EVERY_S:
-                        write_index(outdir, rows, keys, meta)
+                        index.write()
                         last_index = time.monotonic()
                     if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
                         raise SweepInterrupted(signals.fired)
@@ -250,7 +277,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                 if bar is not None:
                     bar.close()
                 _clean_temporaries(cases_dir)
-                write_index(outdir, rows, keys, meta)
+                index.write()
     outcome.wall_s = time.perf_counter() - t0
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index

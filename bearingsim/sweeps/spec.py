@@ -53,12 +53,16 @@ class Case:
         The resolved scenario as TOML text (what the archive stores as ``/scenario``).
     model : str
         ``"reduced"`` or ``"multibody"`` (cheap reduced cases run in batches).
+    scenario : optional
+        The validated scenario model ``toml`` was written from (:func:`resolve_cases` keeps it, so a
+        local pool's worker need not parse and validate the text again); None if not known.
     """
 
     hash: str
     values: dict[str, Any]
     toml: str
     model: str
+    scenario: Any = field(default=None, compare=False, repr=False)
 
     def label(self) -> str:
         """``key=value, ...`` of the swept values, for messages."""
@@ -261,7 +265,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         if h in seen:
             raise UserError(f"{where}: cases {_label(points[seen[h]])} and {_label(values)} are the same scenario")
         seen[h] = i
-        cases.append(Case(hash=h, values=values, toml=text, model=sc.model))
+        cases.append(Case(hash=h, values=values, toml=text, model=sc.model, scenario=sc.model_))
     return cases
 
 

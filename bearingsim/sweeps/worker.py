@@ -6,6 +6,7 @@ no file system shared with the client: with ``return_bytes`` the archive comes b
 from __future__ import annotations
 
 import math
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -55,27 +56,85 @@ def _per_rotation(res):
     return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
 
 
-def run_case(case_hash: str, toml_text: str, target: Path) -> dict:
-    """Run one case into the archive ``target`` (written atomically by the archive writer).
+def _run_in_memory(scenario, notes: bool = True):
+    """Run a case that streams no time series (the reduced model) and build its archive in memory:
+    what :func:`bearingsim.simulation.run_scenario` does (plausibility check and its notes included),
+    with the file written in one piece by the caller. Returns (result, archive bytes)."""
+    from bearingsim import archive, plausibility, simulation
+
+    result = simulation.run(scenario)
+    for note in plausibility.check(result):
+        if notes:
+            print(note, file=sys.stderr)
+    return result, archive.to_bytes(result)
+
+
+def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) -> dict:
+    """Run one case into the archive ``target`` (written atomically), or with ``target`` None return
+    the archive's bytes under ``"archive"``. ``model``: the validated scenario model the client wrote
+    ``toml_text`` from (a forked local worker: the same code validated it), else the text is resolved
+    again here.
 
     Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s`` and the
     summary numbers with the standard errors of :func:`standard_errors`.
     """
-    from bearingsim.simulation import run_scenario
+    from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml
 
     t0 = time.perf_counter()
+    data = None
     try:
-        scenario = scenario_from_toml(toml_text)
-        out = run_scenario(scenario, target, figures=False, progress=False, exclusive=False)
-        res = out.result
+        scenario = Scenario(model, "<sweep case>") if model is not None else scenario_from_toml(toml_text)
+        if scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
+            res, data = _run_in_memory(scenario)
+            if target is not None:
+                _write_file(target, data)
+                data = None
+        elif target is not None:  # long runs stream their time series into the archive's file
+            res = _run_to_file(scenario, target)
+        else:
+            with tempfile.TemporaryDirectory(prefix="bearingsim-sweep-") as tmp:
+                path = Path(tmp) / f"{case_hash}.h5"
+                res = _run_to_file(scenario, path)
+                data = path.read_bytes()
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res)))
-        return {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
-                "summary": summary}
+        rec = {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
+               "summary": summary}
+        if data is not None:
+            rec["archive"] = data
+        return rec
     except Exception as exc:  # noqa: BLE001 - a failing case is recorded, the sweep goes on
         return {"hash": case_hash, "status": "failed", "error": one_line_error(exc),
                 "wall_s": time.perf_counter() - t0, "summary": {}}
+
+
+def _run_to_file(scenario, target: Path):
+    from bearingsim.simulation import run_scenario
+
+    return run_scenario(scenario, target, figures=False, progress=False, exclusive=False).result
+
+
+def _write_file(target: Path, data: bytes) -> None:
+    """``data`` into ``target`` through a temporary name and a rename (one line if that fails)."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.index import write_atomic_bytes
+
+    try:
+        write_atomic_bytes(Path(target), data)
+    except OSError as exc:
+        raise UserError(f"{target}: cannot write archive ({exc.strerror or exc}); nothing was written") from None
+
+
+def warm_up(toml_text: str) -> None:
+    """Run a reduced-model scenario once and build its archive in memory, discarding both: the first
+    case of a process loads the compiled model (~0.3 s). Errors are ignored (the cases report theirs)."""
+    from bearingsim.sweeps.spec import scenario_from_toml
+
+    try:
+        _run_in_memory(scenario_from_toml(toml_text), notes=False)
+    except Exception:  # noqa: BLE001
+        pass
 
 
 def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> list[dict]:
@@ -83,24 +142,14 @@ def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> lis
 
     Parameters
     ----------
-    items : list of (str, str)
-        Case hash and resolved scenario TOML.
+    items : list of (str, str) or (str, str, model)
+        Case hash and resolved scenario TOML, and optionally the validated scenario model of that
+        TOML (:attr:`bearingsim.sweeps.spec.Case.scenario`).
     cases_dir : str or None
         Write each archive as ``cases_dir/<hash>.h5`` (a file system the client sees). With None,
-        run into a private temporary folder and return each archive's bytes under ``"archive"``
-        (dask workers on other machines).
+        return each archive's bytes under ``"archive"`` (dask workers on other machines): a
+        reduced-model archive is built in memory, a multibody run streams into a private temporary
+        folder.
     """
-    records = []
-    if cases_dir is not None:
-        for h, text in items:
-            records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5"))
-        return records
-    with tempfile.TemporaryDirectory(prefix="bearingsim-sweep-") as tmp:
-        for h, text in items:
-            target = Path(tmp) / f"{h}.h5"
-            rec = run_case(h, text, target)
-            if rec["status"] == "done":
-                rec["archive"] = target.read_bytes()
-                target.unlink()
-            records.append(rec)
-    return records
+    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None, *model)
+            for h, text, *model in items]

@@ -167,6 +167,22 @@ def test_resume_runs_only_what_is_missing(tmp_path):
     assert [r["status"] for r in _rows(tmp_path)] == ["cached", "done", "done", "done"]
 
 
+def test_sweep_wall_time_covers_its_cases(tmp_path, monkeypatch):
+    """``SweepOutcome.wall_s`` is the sweep's wall time from call to return (80 %: the call's own
+    set-up and return are outside it), and on one worker at least the sum of the cases' own times (a
+    timer reused for the index rewrites once made it the time since the last rewrite; the index is
+    rewritten after every batch here)."""
+    import bearingsim.sweeps.run as sweep_run
+
+    monkeypatch.setattr(sweep_run, "INDEX_EVERY_S", 0.0)
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000])])
+    t0 = time.perf_counter()
+    out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    outside = time.perf_counter() - t0
+    assert 0.8 * outside <= out.wall_s <= outside
+    assert out.wall_s >= sum(r["wall_s"] for r in out.rows) > 0.0
+
+
 def test_failed_case_is_recorded_and_the_others_go_on(tmp_path):
     # the euler method refuses a too-large time step only when the case runs
     res = bearingsim("sweep", BASE, "--set", "reduced.method=euler", "--param", "numerics.dt_s=1e-6,0.01,2e-6",

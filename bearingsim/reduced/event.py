@@ -883,6 +883,8 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
     vo = np.empty(n)
     io = np.empty(n)
     starts = pieces[:n_pc, 0].copy()
+    fs = np.empty(10)
+    fs_piece = -1  # the piece whose flight constants fs holds (they depend on the piece only)
     for i in range(n):
         th = thetas[i]
         if left[i]:
@@ -894,7 +896,9 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
         ths = pieces[kk, 0]
         mode = int(pieces[kk, 1])
         if mode == FREE:
-            fs = _flight_start(tab, npan, omega, ths, pieces[kk, 2], pieces[kk, 3])
+            if kk != fs_piece:
+                fs = _flight_start(tab, npan, omega, ths, pieces[kk, 2], pieces[kk, 3])
+                fs_piece = kk
             l, v, _, _, _ = _flight(tab, npan, omega, g, fs, th)
             idec = pieces[kk, 4]
         else:
@@ -928,21 +932,22 @@ def _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat)
 def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, capacity):
     """Table, roots of a and the pass in one compiled call (one dispatch, few arrays to box).
 
-    Returns (status, npan, n_imp, n_pieces, totals, impacts[:n_imp], pieces[:n_pieces], roots);
+    Returns (status, npan, n_imp, n_pieces, totals, impacts[:n_imp], pieces[:n_pieces], roots, tab)
+    (``tab``: the drag table, which the trace evaluates again);
     status STATUS_TABLE_OVERFLOW when the table needs more than 65536 panels, STATUS_OVERFLOW when
     more than 67 million events would be needed.
     """
     g = par[3]
     tab, npan = _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat)
     if npan < 0:
-        return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), np.empty((0, 5)), np.empty((0, 6)), np.empty(0)
+        return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), np.empty((0, 5)), np.empty((0, 6)), np.empty(0), tab
     roots = _accel_roots(tab, npan, g)
     while True:
         status, totals, impacts, n_imp, pieces, n_pc = _event_pass(par, tab, npan, roots, capacity)
         if status != STATUS_OVERFLOW or capacity > (1 << 24):
             break
         capacity *= 4
-    return status, npan, n_imp, n_pc, totals, impacts[:n_imp].copy(), pieces[:n_pc].copy(), roots
+    return status, npan, n_imp, n_pc, totals, impacts[:n_imp].copy(), pieces[:n_pc].copy(), roots, tab
 
 
 @njit(cache=True)
@@ -1043,7 +1048,7 @@ def solve_event(
     nroots = inp.normal_load_roots()
     r = list(nroots) + [0.0, 0.0]
     par = _params(inp, zeno_height, zeno_floor)
-    status, npan, n_imp, n_pc, totals, imp, pieces, roots = _solve(
+    status, npan, n_imp, n_pc, totals, imp, pieces, roots, tab = _solve(
         par, inp.drag_scale, inp.centripetal, cheb_tol, min_width, len(nroots), r[0], r[1],
         CHEB_NODES, CHEB_COS, capacity,
     )
@@ -1081,7 +1086,6 @@ def solve_event(
                   zeno_height=zeno_height, zeno_floor=zeno_floor, min_width=min_width),
     )
     if trace_points > 0:
-        tab, _ = drag_table(inp, cheb_tol, min_width)  # deterministic: the table the pass used
         grid = np.linspace(inp.theta_start, inp.theta_end, trace_points)
         ev = theta
         th_all = np.concatenate([grid, ev, ev])

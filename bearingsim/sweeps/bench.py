@@ -23,8 +23,8 @@ import time
 import warnings
 from pathlib import Path
 
-CASES = 4
-ROTATIONS = 2
+CASES = 8
+ROTATIONS = 10
 SCENARIO = "multibody_6000rpm.toml"
 
 

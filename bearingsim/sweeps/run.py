@@ -25,6 +25,10 @@ from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 MAX_BATCH = 200
 MIN_TAIL_BATCH = 10
 INDEX_EVERY_S = 1.0
+# ... or less often when the index is large: its rewrites take at most this share of the sweep's time
+# (a 10 000-row index takes ~50-80 ms to write; every second that was ~2 s of a 30 s map, on a core the
+# workers need)
+INDEX_TIME_SHARE = 0.02
 
 
 class SweepInterrupted(Exception):
@@ -242,6 +246,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None
                           else (lambda line: print(line, file=sys.stderr)))
             last_index = time.monotonic()
+            index_s = 0.0  # how long the last rewrite took
             if todo:
                 batches = make_batches(todo, engine.workers)
                 for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None):
@@ -261,9 +266,11 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     if bar is not None:
                         bar.set_postfix(counts, refresh=False)
                         bar.update(len(records))
-                    if time.monotonic() - last_index >= INDEX_EVERY_S:
+                    if time.monotonic() - last_index >= max(INDEX_EVERY_S, index_s / INDEX_TIME_SHARE):
+                        t_index = time.monotonic()
                         index.write()
                         last_index = time.monotonic()
+                        index_s = last_index - t_index
                     if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
                         raise SweepInterrupted(signals.fired)
             if signals.fired is not None:

@@ -203,7 +203,7 @@ def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
     """Write ``crosscheck.csv`` (exactly :data:`COLUMNS`) and ``crosscheck.h5`` (the same columns and
     ``archive``, ``wall_s``, as an index table; :func:`bearingsim.archive.write_table_file`) atomically."""
     from bearingsim import archive
-    from bearingsim.sweeps.index import write_atomic_bytes
+    from bearingsim.outputs import write_atomic_bytes
 
     outdir = Path(outdir)
     buf = io.StringIO()

@@ -55,6 +55,24 @@ def _same_file(a: Path, b: Path) -> bool:
         return False
 
 
+def temporary_name(path: Path) -> Path:
+    """The name a file is written under before its rename to ``path`` (hidden, with this process's id,
+    so that :func:`clean_stale_temporaries` can tell a dead writer's from a live one's)."""
+    return path.with_name(f".{path.name}.tmp-{os.getpid()}")
+
+
+def write_atomic_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary name and a rename (never a partial file)."""
+    tmp = temporary_name(path)
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
 def write_csv(path: str | Path, header, rows) -> Path:
     """Write a CSV table (``header``, then ``rows`` of already formatted cells) through a temporary name
     and a rename, so a reader never sees half a table; return the path."""

@@ -16,12 +16,13 @@ time. Idle workers at the end of an uneven split count as overhead.
 """
 from __future__ import annotations
 
-import csv
 import os
 import tempfile
 import time
 import warnings
 from pathlib import Path
+
+from bearingsim.outputs import write_csv
 
 CASES = 8
 ROTATIONS = 10
@@ -95,11 +96,7 @@ def run_sweep_bench(outdir: str | Path = "outputs/bench") -> list[dict]:
         for r in rows:
             if r["engine"] == kind:
                 r["efficiency"] = one["wall_s"] / (r["workers"] * r["wall_s"])
-    path = outdir / "sweep_scaling.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    path = write_csv(outdir / "sweep_scaling.csv", list(rows[0]), [list(r.values()) for r in rows])
     print(f"{CASES} cases of {SCENARIO} with numerics.rotations={ROTATIONS}; {os.cpu_count()} cores; "
           f"1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after (other users' work "
           f"on the cores lowers the efficiency)")
@@ -167,11 +164,7 @@ def run_map_bench(outdir: str | Path = "outputs/bench", jobs: int = 2) -> list[d
     with tempfile.TemporaryDirectory(prefix="bearingsim-bench-map-") as tmp:
         rows.append(map_cost(Path(tmp) / "with", archives=True, jobs=jobs, figures=True, quiet=True))
         rows.append(map_cost(Path(tmp) / "without", archives=False, jobs=jobs, figures=False, quiet=True))
-    path = outdir / "map_cost.csv"
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    path = write_csv(outdir / "map_cost.csv", list(rows[0]), [list(r.values()) for r in rows])
     print(f"100 x 100 map of the reduced model (scenarios/sweeps/map_speed_clearance.toml), {jobs} workers; "
           f"{os.cpu_count()} cores; 1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after "
           f"(other users' work on the cores slows every row)")

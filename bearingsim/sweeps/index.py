@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim import archive
+from bearingsim.outputs import temporary_name as _tmp
 
 INDEX_FORMAT = "bearingsim sweep index 1"
 FIXED = ("status", "error", "archive", "wall_s")
@@ -32,20 +33,6 @@ PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "
              "first_impact_speed_m_s", "first_impact_energy_J", "cage_slip", "load_zone_half_angle_deg")
 
 
-def _tmp(path: Path) -> Path:
-    return path.with_name(f".{path.name}.tmp-{os.getpid()}")
-
-
-def write_atomic_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary name and a rename (never a partial file)."""
-    tmp = _tmp(path)
-    try:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def summary_columns(rows: list[dict]) -> list[str]:

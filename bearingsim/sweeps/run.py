@@ -17,7 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.sweeps.index import IndexWriter, read_cached, write_atomic_bytes
+from bearingsim.outputs import write_atomic_bytes
+from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
 # how many cheap (reduced-model) cases one task runs: enough that a task lasts far longer than its

@@ -118,7 +118,7 @@ def _run_to_file(scenario, target: Path):
 def _write_file(target: Path, data: bytes) -> None:
     """``data`` into ``target`` through a temporary name and a rename (one line if that fails)."""
     from bearingsim.errors import UserError
-    from bearingsim.sweeps.index import write_atomic_bytes
+    from bearingsim.outputs import write_atomic_bytes
 
     try:
         write_atomic_bytes(Path(target), data)

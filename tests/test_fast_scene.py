@@ -11,11 +11,11 @@ import numpy as np
 import pytest
 
 from bearingsim.errors import UserError
-from bearingsim.multibody.core import RIGID_MIN_CENTRIFUGAL_RATIO, choose_dt, rigid_speed_floor
+from bearingsim.multibody.core import RIGID_MIN_CENTRIFUGAL_RATIO, choose_dt, rigid_radius, rigid_speed_floor
+from bearingsim.multibody.fast_bench import scene_row, compare
 from bearingsim.parameters import Parameters
 from bearingsim.scenario import load_scenario
 from bearingsim.simulation import run as simulate
-from bearingsim.sweeps.worker import standard_errors
 from tests.conftest import SCENARIOS
 from tests.test_cli import assert_user_error, bearingsim
 
@@ -40,15 +40,14 @@ def test_rigid_agrees_with_the_hertz_scene_at_6000rpm(pair_6000):
     cage slip within 0.2 percentage points. The full scene is chaotic (runs that differ in the last bit
     separate), so two correct scenes differ over a finite run by their statistical scatter: hence the
     standard-error term (per-rotation means over the pockets, rotations taken as independent)."""
-    h, r = pair_6000["hertz"], pair_6000["rigid"]
-    se_h = standard_errors(h.per_rotation["I_dec"], h.per_rotation["I_acc"])
-    se_r = standard_errors(r.per_rotation["I_dec"], r.per_rotation["I_acc"])
+    rows = {c: scene_row(6000, c, pair_6000[c], ROTATIONS + 1) for c in ("hertz", "rigid")}
+    c = compare(rows["hertz"], rows["rigid"])  # the criterion bearingsim bench --fast-scene reports
     for name in ("I_dec", "I_acc"):
-        mh, mr = h.summary[f"{name}_mean_Ns"], r.summary[f"{name}_mean_Ns"]
-        bound = max(0.03, 2.0 * math.hypot(se_h[f"{name}_sem_Ns"], se_r[f"{name}_sem_Ns"]) / mh)
-        assert abs(mr - mh) / mh <= bound, (name, mr, mh, bound)
-    assert abs(r.summary["load_zone_half_angle_deg"] - h.summary["load_zone_half_angle_deg"]) <= 1.0
-    assert abs(r.summary["cage_slip"] - h.summary["cage_slip"]) <= 0.002
+        se = math.hypot(rows["hertz"][f"{name}_sem_Ns"], rows["rigid"][f"{name}_sem_Ns"])
+        assert c[f"{name}_bound"] == max(0.03, 2.0 * se / rows["hertz"][f"{name}_Ns"])
+        assert abs(c[f"{name}_rel_diff"]) <= c[f"{name}_bound"], (name, c)
+    assert abs(c["phi_diff_deg"]) <= 1.0 and abs(c["slip_diff"]) <= 0.002, c
+    assert c["agrees"]
 
 
 def test_rigid_time_step_is_set_by_the_impacts_not_the_raceway_spring(pair_6000):
@@ -114,10 +113,9 @@ def test_rigid_is_refused_where_rollers_would_leave_the_outer_race():
     with pytest.raises(UserError, match="raceway_contact") as exc:
         simulate(_scenario("rigid", rpm=300, rotations=1))
     assert f"{floor:.0f} rpm" in str(exc.value)
-    g, op = p.bearing, p.operating
-    r_c = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
+    op = p.operating
     omega_floor = floor * math.pi / 30.0 * op.omega_c / op.omega_i
-    assert r_c * omega_floor**2 == pytest.approx(RIGID_MIN_CENTRIFUGAL_RATIO * op.gravity, rel=1e-9)
+    assert rigid_radius(p) * omega_floor**2 == pytest.approx(RIGID_MIN_CENTRIFUGAL_RATIO * op.gravity, rel=1e-9)
 
 
 def test_rigid_refusal_through_the_command_line(tmp_path):

@@ -167,10 +167,18 @@ def rigid(p) -> bool:
     return p.multibody.raceway_contact == "rigid"
 
 
+def rigid_radius(p) -> float:
+    """Radius [m] of a roller centre on the outer race, r_c = r_o + P_d/4 - r_r (the rigid raceways'
+    joint; P_d = 0 in the reduced-equivalent scene, which keeps the paper's roller path)."""
+    g = p.bearing
+    pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
+    return g.outer_race_radius + 0.25 * pd - g.roller_radius
+
+
 def rigid_speed_floor(p) -> float:
     """Lowest inner-ring speed [rpm] the rigid raceways accept (:data:`RIGID_MIN_CENTRIFUGAL_RATIO`)."""
-    g, op = p.bearing, p.operating
-    r = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
+    op = p.operating
+    r = rigid_radius(p)
     omega_c = math.sqrt(RIGID_MIN_CENTRIFUGAL_RATIO * max(op.gravity, 0.0) / r)
     return omega_c / max(op.omega_c / op.omega_i, 1e-300) * 30.0 / math.pi
 
@@ -281,8 +289,7 @@ def _choose_dt_rigid(p, dt):
 def check_rigid(p):
     """Refuse (UserError) what the rigid raceways cannot represent: rollers that would leave the outer race."""
     g, op = p.bearing, p.operating
-    r = g.outer_race_radius + 0.25 * g.radial_clearance - g.roller_radius
-    fc = g.roller_mass * r * op.omega_c**2
+    fc = g.roller_mass * rigid_radius(p) * op.omega_c**2
     w = g.roller_mass * op.gravity
     if fc < RIGID_MIN_CENTRIFUGAL_RATIO * w:
         raise UserError(
@@ -332,7 +339,7 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     ri_race = geo.inner_race_radius - 0.25 * pd
     # rigid raceways: roller centres on the outer race, at most r_c from the axis (a unilateral joint);
     # the inner-race contact carries both contacts' compliance in series, Q = K 2^(-10/9) delta^(10/9)
-    r_c = ro_race - rr
+    r_c = rigid_radius(p)
     K_race = K * 2.0 ** (-10.0 / 9.0) if is_rigid else K
 
     sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,

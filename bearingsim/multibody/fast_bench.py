@@ -34,7 +34,7 @@ GOAL_PHI_DEG = 1.0
 GOAL_SLIP = 0.002
 
 
-def _scene_row(rpm, contact, res, total_rot):
+def scene_row(rpm, contact, res, total_rot):
     from bearingsim.sweeps.worker import standard_errors
 
     s, p = res.summary, res.provenance
@@ -87,7 +87,7 @@ def run_fast_scene_bench(outdir: Path, speeds=SPEEDS, rotations: int = ROTATIONS
             sc = reference_scenario(rpm, rotations, 1, raceway_contact=contact)
             t0 = time.perf_counter()
             res = simulate(Parameters.from_scenario(sc))
-            pair[contact] = _scene_row(rpm, contact, res, rotations + 1)
+            pair[contact] = scene_row(rpm, contact, res, rotations + 1)
             log(f"{rpm:5d} rpm {contact:5s}: {time.perf_counter() - t0:6.1f} s, dt {pair[contact]['dt_s']:.3g} s, "
                 f"{pair[contact]['wall_s_per_rotation']:.4f} s per rotation")
         rows += [pair["hertz"], pair["rigid"]]

@@ -442,8 +442,7 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=out_every,
-        max_steps=int(3 * steps_est + 1000),
-        rigid=is_rigid)
+        max_steps=int(3 * steps_est + 1000))
     inp = lp.StepInputs(
         h=float(h), prm=prm, cfg=cfg, lim=lim,
         hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi),

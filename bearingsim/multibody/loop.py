@@ -99,7 +99,6 @@ class LoopLimits(NamedTuple):
     raceway_approach: float  #: largest outer-raceway approach accepted (beyond: an energy blow-up) [m]
     out_every: int  #: steps between samples and checks
     max_steps: int  #: steps after which the cage counts as stalled
-    rigid: bool = False  #: rigid raceways: the inner-race approach is watched too (a roller off the outer race)
 
 
 class HoldRule(NamedTuple):
@@ -310,7 +309,7 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         for i in range(n):
             d_i = wk.diag[i]
             dmax = max(dmax, d_i.delta_out)
-            if lim.rigid:
+            if inp.prm.rigid:  # the inner-race approach too (a roller off the outer race), and the joint's circle
                 dmax = max(dmax, d_i.delta_in)
                 s.lift_max = max(s.lift_max, d_i.lift)
                 # how far pymunk's step left the roller outside its outer-race circle, and from what: the

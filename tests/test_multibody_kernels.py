@@ -131,12 +131,74 @@ def test_roller_on_outer_race_carries_its_centrifugal_load():
     state = _orbiting_roller(omega, r0)
     out_f = np.zeros(6)
     diag = np.zeros(1, dtype=fk.DIAG)
-    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1))
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1), np.zeros(1))
     assert diag[0]["delta_out"] == pytest.approx(delta, rel=1e-6)
     assert diag[0]["q_out"] == pytest.approx(qc, rel=1e-6)
     # force on the roller: radially inward, magnitude m r0 omega^2 (no traction, drag, gravity)
     assert out_f[0] == pytest.approx(-qc, rel=1e-6)
     assert abs(out_f[1]) < 1e-6 * qc
+
+
+# --- rigid raceways: the outer race's part in the force kernel ------------------------------------
+RC = 0.04877  # roller-centre radius on the outer race [m]
+G = 9.81
+
+
+def _rigid_roller(radius, v_radial, h):
+    """The force kernel's radial force on one roller at the bottom of the bearing (gravity outward), at
+    ``radius`` from the axis moving outward at ``v_radial``; returns (total radial force on the roller,
+    pymunk's gravity included [N, outward +], n_held [N])."""
+    prm = _params(rigid=True, rigid_radius=RC, gravity=G)
+    state = np.zeros((2, 6))
+    state[0, 1] = -radius
+    state[0, 4] = -v_radial
+    out_f = np.zeros(6)
+    n_held = np.zeros(1)
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f,
+                      np.zeros(1, dtype=fk.DIAG), np.zeros(1), n_held)
+    return -(out_f[1] - ROLLER_MASS * G), n_held[0]
+
+
+def test_rigid_race_carries_the_outward_load_of_a_roller_on_it():
+    """A roller resting on the outer race with an outward load (here its weight, at the bottom): the race
+    takes the whole load in the step, so the roller gets no outward speed (a slide joint exactly at its
+    length is slack in chipmunk, and the load would throw the roller off the race by F h / m), and the
+    race's share is the load (it adds to the joint's in the normal force for traction). Exact to rounding."""
+    f, held = _rigid_roller(RC, 0.0, 1e-5)
+    assert abs(f) < 1e-12 and held == pytest.approx(ROLLER_MASS * G, rel=1e-12)
+
+
+@pytest.mark.parametrize("gap", [1e-12, 1e-9, 1e-7])
+def test_rigid_race_lets_a_near_roller_land_on_it_not_through_it(gap):
+    """A roller ``gap`` inside the circle, at rest, under a load that would carry it through the race
+    within a step (g h^2 >> gap at h = 1 ms): it keeps only the force that brings it onto the circle at
+    the next position update, ``m gap / h^2`` (relative 1e-9: rounding of radii ~0.05 m against gaps down
+    to 1e-12 m shows at 1e-5 of the gap), and the race takes the rest."""
+    h = 1e-3
+    f, held = _rigid_roller(RC - gap, 0.0, h)
+    assert f == pytest.approx(ROLLER_MASS * gap / h**2, rel=1e-5, abs=1e-12)
+    assert f + held == pytest.approx(ROLLER_MASS * G, rel=1e-9)
+
+
+def test_rigid_race_leaves_a_lifted_roller_its_whole_load():
+    """A roller 1 mm inside the circle (the cage lifted it): the race is not reached within the step and
+    takes nothing; the roller falls back under its whole load. Exact to rounding."""
+    f, held = _rigid_roller(RC - 1e-3, 0.0, 1e-5)
+    assert f == pytest.approx(ROLLER_MASS * G, rel=1e-12) and held == 0.0
+
+
+def test_rigid_race_gives_back_the_joints_correction_speed():
+    """A roller the joint put back from u = 1 um outside the circle leaves that step with the correction
+    speed u / h inward in its real velocity (chipmunk's joints correct through velocities), plus here
+    0.5 u / h of its own. Where the joint is then slack the kernel gives the correction back (the race is
+    plastic: the roller is put back, not thrown off): the force m (u / h) / h outward, on top of the load
+    the race does not take. Relative 1e-6 (the outward load is 1e-7 of the give-back; its share is
+    checked in the sum)."""
+    u, h = 1e-6, 1e-5
+    f, held = _rigid_roller(RC + u, -1.5 * u / h, h)
+    give_back = ROLLER_MASS * u / h**2
+    assert f == pytest.approx(give_back + ROLLER_MASS * G, rel=1e-9)
+    assert held == pytest.approx(-give_back, rel=1e-9)
 
 
 @pytest.mark.parametrize("spin", [200.0, -200.0])
@@ -155,7 +217,7 @@ def test_traction_opposes_slip(spin):
     state[0, 5] = spin
     out_f = np.zeros(6)
     diag = np.zeros(1, dtype=fk.DIAG)
-    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1))
+    fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1), np.zeros(1))
     q = diag[0]["q_out"]
     # outer contact at +x: N = (-1, 0), T = rot90(N) = (0, -1); roller surface slides at s = -omega r_r along T
     slide = -spin * ROLLER_RADIUS

@@ -48,7 +48,7 @@ ARB_GET = (pb.ArbiterFields.BODY_A_ID | pb.ArbiterFields.BODY_B_ID | pb.ArbiterF
 # return codes of the step loops (CODE_CONTINUE: the step kernels have nothing to report)
 CODE_CONTINUE = -1
 CODE_DONE, CODE_BLOCK_FULL, CODE_NONFINITE, CODE_PENETRATION, CODE_BLOWUP, CODE_STALLED = range(6)
-CODE_BUFFER_GREW, CODE_CAGE_LOST = 6, 7
+CODE_BUFFER_GREW, CODE_CAGE_LOST, CODE_PHASE_END = 6, 7, 8
 CHUNK_STEPS = 20_000  # return to Python at least this often (progress bar, Ctrl-C: ~0.3 s)
 DELTA_LIMIT_M = 50e-6  # floor of LoopLimits.raceway_approach (core.raceway_approach_limit)
 
@@ -99,6 +99,7 @@ class LoopLimits(NamedTuple):
     raceway_approach: float  #: largest outer-raceway approach accepted (beyond: an energy blow-up) [m]
     out_every: int  #: steps between samples and checks
     max_steps: int  #: steps after which the cage counts as stalled
+    t_phase_end: float = math.inf  #: time at which the start phase (its own step) ends [s]
 
 
 class HoldRule(NamedTuple):
@@ -143,6 +144,7 @@ class StepWork(NamedTuple):
     land_out: np.ndarray  #: (4,) the land contact of the step (:func:`bearingsim.multibody.forces.land_force`)
     land_win: np.ndarray  #: (R, 3) per cage rotation: land normal impulse [N s], friction impulse [N s], friction torque impulse [N m s]
     n_out: np.ndarray  #: (n,) rigid raceways: outer-race normal force of each roller over the last step, from its joint [N]
+    n_held: np.ndarray  #: (n,) rigid raceways: the outer race's reaction applied by the force kernel in the last step [N]
     e_set: np.ndarray  #: (n,) elasticity each roller shape has now (onset restitution) [-]
     e_want: np.ndarray  #: (n,) elasticity each roller shape is to have in the next step [-]
 
@@ -244,6 +246,8 @@ def before_step(prev, inp, wk, ls):
         return CODE_DONE
     if s.step > lim.max_steps:
         return CODE_STALLED
+    if s.t >= lim.t_phase_end:
+        return CODE_PHASE_END
     if s.recording == 0 and travel >= lim.travel_record:
         s.recording = 1
         s.cage_w_start = prev[n, 5]
@@ -251,7 +255,7 @@ def before_step(prev, inp, wk, ls):
     if inp.hold_rule.active:
         _hold_rollers(prev, n, sign, inp.hold_rule, inp.pocket_a, wk.hold)
     if fk.raceway_forces(prev, inp.h, inp.prm, wk.ring_c, wk.ring_c_prev, wk.ring_v, wk.hold, wk.out_f,
-                         wk.diag, wk.n_out) < 0:
+                         wk.diag, wk.n_out, wk.n_held) < 0:
         s.newton_failures += 1
     if inp.land.active:
         _land_step(prev, travel, inp, wk, s)

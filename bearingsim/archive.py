@@ -442,6 +442,7 @@ class _Writer:
 
 
 def _h5base():
+    """h5py's ``_hl.base`` (its ``array_for_new_object`` is what ``attrs[name] = value`` stores)."""
     from h5py._hl import base
 
     return base

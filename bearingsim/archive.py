@@ -267,12 +267,12 @@ def write(result, path, spool: Spool | None = None) -> Path:
 def _fill(f, result, in_memory: bool = False) -> None:
     """Write everything of ``result`` into the open file ``f`` (its streamed series are there already)
     and mark it complete (a file built in memory, never seen incomplete, is marked once at the end)."""
-    w = _Writer(f)
+    w = _Writer(f, fresh=in_memory)
     _write_header(w, result, complete=in_memory)
     for name, s in result.series.items():
         g = w.group(f"observables/{name}")
         if s.description:
-            w.attr(g, "description", s.description)
+            w.attr(g.id, "description", s.description)
         ts = TimeSeries(g, s.value.shape[1:], s.unit)
         ts.append(s.step, s.time, s.value)
         ts.flush()
@@ -296,6 +296,16 @@ def _fill(f, result, in_memory: bool = False) -> None:
 _image_count = 0
 
 
+@functools.lru_cache(maxsize=1)
+def _image_plists() -> tuple:
+    """(file access, file creation) property lists of an in-memory file, built once per process: the
+    ones h5py builds for ``File(name, "w", driver="core", backing_store=False)`` (same file), which it
+    would build again for every file (~40 us of a sweep case's archive)."""
+    from h5py._hl.files import make_fapl, make_fcpl
+
+    return make_fapl("core", backing_store=False), make_fcpl()
+
+
 def to_bytes(result) -> bytes:
     """``result`` as the bytes of a complete archive, built in memory (HDF5 core driver, no file):
     the same content :func:`write` stores, for a caller that writes the file itself (a sweep's
@@ -303,8 +313,9 @@ def to_bytes(result) -> bytes:
     global _image_count
     h5py = _lazy_h5py()
     _image_count += 1
-    name = f"bearingsim-image-{os.getpid()}-{_image_count}.h5"  # never on disk: no backing store
-    f = h5py.File(name, "w", driver="core", backing_store=False)
+    name = f"bearingsim-image-{os.getpid()}-{_image_count}.h5".encode()  # never on disk: no backing store
+    fapl, fcpl = _image_plists()
+    f = h5py.File(h5py.h5f.create(name, h5py.h5f.ACC_TRUNC, fapl=fapl, fcpl=fcpl))
     try:
         _fill(f, result, in_memory=True)
         f.flush()
@@ -314,27 +325,40 @@ def to_bytes(result) -> bytes:
 
 
 class _Writer:
-    """Writes groups, datasets and scalar attributes through h5py's low-level API with the HDF5 types
-    and creation properties its high-level API uses (so files read back the same), at a fraction of
-    the cost per object: no existence checks, no high-level wrappers, no property lists or types built
-    again for every object. Compressed arrays and attributes that are not scalars go through h5py's
-    high-level API.
+    """Writes groups, datasets and attributes through h5py's low-level API with the HDF5 types and
+    creation properties its high-level API uses (so files read back the same), at a fraction of the
+    cost per object: no existence checks, no high-level wrappers, no property lists, types or
+    dataspaces built again for every object. Compressed arrays go through h5py's high-level API.
+
+    Parameters
+    ----------
+    f : h5py.File
+        The open file.
+    fresh : bool
+        The file is new and nothing else writes into it (an in-memory archive): no group can exist
+        before this writer creates it, so none is looked up.
     """
 
     _types: dict = {}  # dtype key -> (file type, memory type), shared by every writer of the process
+    _plists: tuple | None = None  # (scalar dataspace, dataset and link creation lists), built once
 
-    def __init__(self, f):
+    def __init__(self, f, fresh: bool = False):
         h5py = _lazy_h5py()
         self.f = f
         self._h5 = h5py
         self._gids = {"": f.id}  # group path -> GroupID (the file's id stands for the root group)
-        self._made: set[str] = set()  # groups created by this writer (nothing else is in them)
-        self._scalar = h5py.h5s.create(h5py.h5s.SCALAR)
-        self._dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
-        self._dcpl.set_obj_track_times(False)  # as h5py's create_dataset
-        self._lcpl = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # as h5py's create_group for an ASCII name
-        self._lcpl.set_create_intermediate_group(True)
-        self._lcpl.set_char_encoding(h5py.h5t.CSET_ASCII)
+        self._made: set[str] = {""} if fresh else set()  # groups with nothing in them but this writer's
+        self._spaces: dict[tuple, Any] = {}  # shape -> simple dataspace (HDF5 copies it into each dataset)
+        if _Writer._plists is None:  # never modified once built; HDF5 copies what it uses of them
+            scalar = h5py.h5s.create(h5py.h5s.SCALAR)
+            dcpl = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+            dcpl.set_obj_track_times(False)  # as h5py's create_dataset
+            lcpl = h5py.h5p.create(h5py.h5p.LINK_CREATE)  # as h5py's create_group for an ASCII name
+            lcpl.set_create_intermediate_group(True)
+            lcpl.set_char_encoding(h5py.h5t.CSET_ASCII)
+            _Writer._plists = (scalar, dcpl, lcpl)
+        self._scalar, self._dcpl, self._lcpl = _Writer._plists
+        self._str = h5py.string_dtype()  # variable-length UTF-8 (building it costs ~1 us a call)
 
     def gid(self, path: str):
         """The low-level id of the group at ``path``, created (with its parents) if missing."""
@@ -366,24 +390,35 @@ class _Writer:
             t = self._types[key] = (h5t.py_create(dtype, logical=True), h5t.py_create(dtype))
         return t
 
-    def attr(self, obj, name: str, value, replace: bool = False) -> None:
-        """``obj.attrs[name] = value`` (``obj`` an h5py object or low-level id) for a str, bool, int or
-        float; any other value through h5py's ``attrs``."""
-        oid = obj.id if hasattr(obj, "attrs") else obj
+    def _space(self, shape: tuple):
+        space = self._spaces.get(shape)
+        if space is None:
+            space = self._spaces[shape] = self._h5.h5s.create_simple(shape)
+        return space
+
+    def attr(self, oid, name: str, value, replace: bool = False) -> None:
+        """``attrs[name] = value`` on the object whose low-level id is ``oid``, stored as h5py's
+        ``attrs`` stores it: a str, bool, int or float as a scalar, anything else as the array h5py
+        makes of it."""
+        h5 = self._h5
         if isinstance(value, str):
-            data, key = np.array(value, dtype=self._h5.string_dtype()), "str"
+            data = np.array(value, dtype=self._str)
+            (htype, mtype), space = self._type("str", data.dtype), self._scalar
         elif isinstance(value, (bool, np.bool_, int, np.integer, float, np.floating)):
             data = np.asarray(value)
-            key = data.dtype.str
+            (htype, mtype), space = self._type(data.dtype.str, data.dtype), self._scalar
         else:
-            self._h5.AttributeManager(_IdHolder(oid))[name] = value
-            return
-        h5a = self._h5.h5a
-        htype, mtype = self._type(key, data.dtype)
+            data = _h5base().array_for_new_object(value)  # what h5py's attrs[name] = value stores
+            if not isinstance(data, np.ndarray) or data.dtype.subdtype is not None:  # h5py.Empty, ...
+                h5.AttributeManager(_IdHolder(oid))[name] = value
+                return
+            htype, mtype = h5.h5t.py_create(data.dtype, logical=True), h5.h5t.py_create(data.dtype)
+            space = h5.h5s.create_simple(data.shape)
+        h5a = h5.h5a
         bname = name.encode("utf-8")
         if replace and h5a.exists(oid, bname):
             h5a.delete(oid, bname)
-        a = h5a.create(oid, bname, htype, self._scalar)
+        a = h5a.create(oid, bname, htype, space)
         try:
             a.write(data, mtype=mtype)
         finally:
@@ -396,14 +431,21 @@ class _Writer:
         parent, _, leaf = path.rpartition("/")
         pid = self.gid(parent)
         if isinstance(data, str):
-            data = np.array(data, dtype=h5.string_dtype())
-            tid, space = self._type("str", data.dtype)[0], self._scalar
+            data = np.array(data, dtype=self._str)
+            (tid, mtype), space = self._type("str", data.dtype), self._scalar
         else:
             data = np.ascontiguousarray(data)
-            tid, space = self._type(data.dtype.str, data.dtype)[0], h5.h5s.create_simple(data.shape)
+            (tid, mtype), space = self._type(data.dtype.str, data.dtype), self._space(data.shape)
         dsid = h5.h5d.create(pid, leaf.encode("utf-8"), tid, space, dcpl=self._dcpl)
-        dsid.write(h5.h5s.ALL, h5.h5s.ALL, data)
+        dsid.write(h5.h5s.ALL, h5.h5s.ALL, data, mtype=mtype)
         return dsid
+
+
+def _h5base():
+    """h5py's ``_hl.base`` (its ``array_for_new_object`` is what ``attrs[name] = value`` stores)."""
+    from h5py._hl import base
+
+    return base
 
 
 class _IdHolder:
@@ -415,7 +457,7 @@ class _IdHolder:
 
 def _write_header(w: _Writer, result, complete: bool = False) -> None:
     sc = result.scenario
-    w.attr(w.f, "title", f"bearingsim archive: {sc.name}")
+    w.attr(w.gid(""), "title", f"bearingsim archive: {sc.name}")
     w.attr(w.gid("h5md"), "version", np.array([1, 1]))
     creator = w.gid("h5md/creator")
     w.attr(creator, "name", "bearingsim")
@@ -460,7 +502,7 @@ def _write_group_attrs(w: _Writer, g, values: dict[str, Any], units: dict[str, s
     if units:
         w.attr(g, UNITS_JSON, json.dumps(dict(sorted(units.items())), ensure_ascii=False))
     for k, v in other.items():
-        g.attrs[k] = v
+        w.attr(g, k, v)
 
 
 def group_attrs(g) -> tuple[dict[str, Any], dict[str, str]]:

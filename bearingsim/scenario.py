@@ -223,11 +223,23 @@ class ScenarioModel(_Section):
 
 
 class Scenario:
-    """A validated, fully resolved scenario. ``raw`` is the merged dictionary (the archive's copy)."""
+    """A validated, fully resolved scenario. ``raw`` is the merged dictionary (the archive's copy).
 
-    def __init__(self, model: ScenarioModel, source: str):
+    Parameters
+    ----------
+    model : ScenarioModel
+        The validated scenario (frozen).
+    source : str
+        Where it came from, for messages.
+    toml : str, optional
+        ``model``'s TOML text if the caller has it already (:meth:`to_toml` of a scenario with the same
+        model, e.g. a sweep case's text): then it is not formatted again.
+    """
+
+    def __init__(self, model: ScenarioModel, source: str, toml: str | None = None):
         self.model_ = model
         self.source = source
+        self._toml = toml
 
     def __getattr__(self, item):
         return getattr(self.model_, item)
@@ -237,7 +249,11 @@ class Scenario:
         return _drop_none(self.model_.model_dump())
 
     def to_toml(self) -> str:
-        return _dumps(self.raw)
+        """The resolved scenario as TOML text (what an archive stores), formatted once: the model is
+        frozen, so the text cannot change."""
+        if self._toml is None:
+            self._toml = _dumps(self.raw)
+        return self._toml
 
     def replace(self, **dotted: Any) -> "Scenario":
         """A new scenario with dotted keys replaced, e.g. ``replace(**{"operating.direction": "reverse"})``."""

@@ -127,6 +127,44 @@ def test_memory_series_are_written_and_read_back(tmp_path, base_reduced):
     assert s.unit == "m" and s.value.shape == (5, 2) and np.array_equal(s.step, np.arange(5))
 
 
+def test_in_memory_archive_has_the_content_of_a_written_one(tmp_path, base_reduced):
+    """to_bytes (the sweep worker's archive) stores what write stores: every object, value and HDF5
+    type; an array-valued group value stays an attribute of its own."""
+    import io
+
+    from bearingsim.datatypes import AttrGroup
+
+    res = _result(resolve(base_reduced))
+    res.groups["results/extra"] = AttrGroup({"x": 2.0, "pair": np.array([1, 2]), "names": ["a", "b"]}, {"x": "m"})
+    res.tables["results/per_rotation"] = "a table"
+
+    def content(f):
+        out = {}
+
+        def visit(name, obj):
+            for k in obj.attrs:
+                if k == archive.ATTRS_JSON and name == "provenance":
+                    continue  # created_utc differs
+                v = obj.attrs[k]
+                out[f"{name}@{k}"] = (obj.attrs.get_id(k).get_type().encode(), repr(getattr(v, "tolist", lambda: v)()))
+            if isinstance(obj, h5py.Dataset):
+                out[name] = (obj.id.get_type().encode(), obj.shape, obj[()].tobytes() if obj.shape else obj[()])
+            else:
+                out[name] = None
+
+        visit("/", f)
+        f.visititems(visit)
+        return out
+
+    with h5py.File(io.BytesIO(archive.to_bytes(res))) as f:
+        mem = content(f)
+        assert f["results/extra"].attrs["pair"].tolist() == [1, 2]
+        assert f["results/extra"].attrs["names"].tolist() == ["a", "b"]
+        assert f["results/per_rotation"].attrs["columns"].tolist() == ["I_dec"]
+    with h5py.File(archive.write(res, tmp_path / "w.h5")) as f:
+        assert content(f) == mem
+
+
 def test_format_1_archive_still_reads_the_same(tmp_path):
     """An archive of format 1.0 (one HDF5 attribute per value, written by bearingsim at commit 0921c01:
     ``bearingsim run scenarios/paper_3000rpm.toml``, kept gzipped) reads back as the same result a run

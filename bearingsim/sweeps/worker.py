@@ -84,7 +84,10 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
     t0 = time.perf_counter()
     data = None
     try:
-        scenario = Scenario(model, "<sweep case>") if model is not None else scenario_from_toml(toml_text)
+        if model is not None:  # toml_text is this model's to_toml(): the archive stores it as it is
+            scenario = Scenario(model, "<sweep case>", toml=toml_text)
+        else:
+            scenario = scenario_from_toml(toml_text)
         if scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
             res, data = _run_in_memory(scenario)
             if target is not None:

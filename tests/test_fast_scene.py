@@ -265,6 +265,8 @@ def test_rigid_at_500rpm_keeps_its_step_and_agrees_with_the_hertz_scene():
     auto, _, _ = choose_dt(rig.parameters)
     assert rig.provenance["dt_s"] == auto and "restarted" not in rig.provenance["dt_choice"]
     assert "settling" in rig.provenance["dt_choice"]
+    t0, dt0 = rigid_start(rig.parameters, auto)
+    assert rig.provenance["start_phase_s"] == t0 and rig.provenance["start_phase_dt_s"] == dt0 < auto
     rel = rig.summary["I_dec_mean_Ns"] / hz.summary["I_dec_mean_Ns"] - 1.0
     assert abs(rel) <= 0.03, rel
     assert rig.impacts["approach_speed_m_s"].max() <= hz.impacts["approach_speed_m_s"].max()

@@ -317,6 +317,8 @@ class MultibodyResult(Result):
             "solver_wall_s": float(raw["wall_s"]), "pymunk_step_s": float(raw["pymunk_step_s"]),
             "step_loop": raw["step_loop"], "step_loop_reason": raw["step_loop_reason"],
         }
+        if raw.get("t_start", 0.0) > 0.0:  # rigid raceways: the cage's settling at a step of its own
+            provenance.update(start_phase_s=float(raw["t_start"]), start_phase_dt_s=float(raw["dt_start"]))
         tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
                                      "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "
                                      "pocket centre; rotation = row of /results/per_rotation the impact counts in"}

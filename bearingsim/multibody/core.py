@@ -295,8 +295,8 @@ def rigid_start(p, dt):
     ``t_fall (1 + e) / (1 - e)`` (a bouncing ball; 58 ms on the reference bearing), at most one cage
     rotation. Those first contacts come faster than the steady impacts the automatic step is set for
     (measured on the reference bearing with the start phase off: 0.11 m/s at 500 rpm and 0.10 m/s at
-    3000 rpm within the first 10 ms, against 0.06 and 0.09 m/s for the steady impacts), and at the
-    1 % bound they would restart the whole run with a shorter step. The start phase runs at the step
+    3000 rpm within the first 10 ms, against the automatic step's estimates of 0.07 and 0.09 m/s), and
+    at the 1 % bound they would restart the whole run with a shorter step. The start phase runs at the step
     that keeps ``v_fall`` within 0.5 % of s (the Hertz scene's margin), if that is shorter.
     Returns (0, dt) when there is no fall (no gravity)."""
     g, op = p.bearing, p.operating
@@ -568,7 +568,7 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
     pymunk_s = st["pymunk_ns"] * 1e-9 if io.timed else float("nan")
     return dict(
         parameters=p, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
-        t_start=t_start, dt_start=h_start if t_start > 0.0 else h,
+        t_start=t_start, dt_start=h_start if t_start > 0.0 else h,  # rigid: the start phase (0: none)
         wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, step_loop=io.name, step_loop_reason=loop_why, t_end=t,
         t_record=t_rec, win=acc.win, first_imp=acc.first_imp, f_bin=acc.f_bin, t_bin=acc.t_bin, q_bin=acc.q_bin,
         tq_bin=acc.tq_bin, glob=acc.glob.copy()[0], impacts=imp,

@@ -309,19 +309,20 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     has pulled off the outer race and onto the inner race has the inner contact's stiffness in its
     velocity update (linearly implicit), which keeps that rare state stable at the rigid scene's step.
 
-    The outer race is plastic, and it takes what it would stop: chipmunk activates a slide joint only
-    beyond its length and corrects its error through the bodies' real velocities, so left to the
-    joint a loaded roller sitting exactly on the circle (or a few nm inside it) is free for a step and
-    leaves with ``F h / m`` (0.5 m/s at 1e-5 s in the load zone), and the joint throws a roller it puts
-    back at the speed of that correction, off the race again. Measured at 6000 rpm over 150 rotations
-    before this rule: approaches of 0.17, 0.30, 0.41, 0.55 m/s at steps of 5.4, 10, 13.6, 17.5 us on
-    slanted pocket faces, every one with zero impulse (the Hertz scene: 0.130 m/s at most). So each
-    roller's radial motion is set here for the step: the joint's correction speed of the last step,
-    ``(r - r_c) / h`` inward, is given back; of the outward load (inner-race load, gravity) the roller
-    keeps only what brings it at most onto the circle by the end of the next position update, and the
-    race takes the rest. The two go into ``n_held``, and the outer-race normal force is
-    ``n_out + n_held`` (joint and race). A roller far inside the circle (lifted by the cage) keeps its
-    whole load.
+    The race's share (what the joint cannot do). chipmunk activates a slide joint only beyond its
+    length and corrects its error through the bodies' real velocities, so left to the joint a loaded
+    roller sitting exactly on the circle (or a few nm inside it) is free for a step and leaves with
+    ``F h / m`` (0.5 m/s at 1e-5 s in the load zone), and a roller the joint has put back keeps the
+    correction speed and leaves the race inward. Measured at 6000 rpm over 150 rotations before this
+    rule: approaches of 0.17, 0.30, 0.41, 0.55 m/s at steps of 5.4, 10, 13.6, 17.5 us on slanted pocket
+    faces, every one with zero impulse (the Hertz scene: 0.130 m/s at most). So, from where pymunk's
+    position update will put the roller (``x + h v``): if that is beyond the circle (the joint holds it
+    in the step), the race takes the roller's outward load (inner-race load, gravity); if it is inside
+    (the joint is slack), the roller keeps only the outward load that brings it at most onto the circle
+    by the next position update, and gets back the joint's correction speed of the last step,
+    ``(r - r_c) / h`` (the race is plastic: a roller put back is stopped on it). A roller far inside the
+    circle (lifted by the cage) keeps its whole load. That share goes into ``n_held``, and the
+    outer-race normal force is ``n_out + n_held`` (joint and race).
 
     Returns
     -------

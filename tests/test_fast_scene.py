@@ -288,6 +288,18 @@ def test_hard_cases_run_with_rigid_raceways(name):
     assert abs(s["torque_balance_residual"]) < 0.01, s["torque_balance_residual"]
 
 
+def test_a_restart_says_how_the_first_run_chose_its_step():
+    """The 3-roller hard case restarts with a shorter step (one roller carries the load on a dynamic
+    ring: an approach of 0.40 m/s at the automatic 22 us). ``dt_choice`` gives the history: the first
+    run's choice, start phase included, then the restart; the run that was kept had a given step and no
+    start phase of its own."""
+    res = simulate(load_scenario(HARD / "multibody_rollers_3.toml",
+                                 ["multibody.raceway_contact=rigid", "numerics.rotations=1"]))
+    how = res.provenance["dt_choice"]
+    assert how.startswith("auto (rigid raceways)") and how.index("settling") < how.index("restarted at dt"), how
+    assert "start_phase_s" not in res.provenance
+
+
 def test_hard_case_with_too_long_a_given_step_stops_naming_the_step(tmp_path):
     """A given step of 1 ms (scenarios/hard/multibody_dt_too_large.toml) is not refused up front by rigid
     raceways (no raceway stability limit) but the first impact overlaps the face far beyond 1 % of s: the

@@ -106,11 +106,13 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
         sink = MemorySink()
     auto = dt is None and p.numerics.dt is None
     retries = []
+    first_how = ""  # how the first run's step was chosen (with the rigid scene's start phase, if any)
     while True:
         try:
             raw = run(p, sink=sink, progress=progress, dt=dt)
             break
         except PenetrationExceeded as exc:
+            first_how = first_how or exc.how
             new_dt = exc.suggested_dt()
             if not auto or len(retries) >= MAX_DT_RETRIES:
                 key = "numerics.dt_s" if not auto else "the automatic time step"
@@ -122,7 +124,7 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
             dt = new_dt
             sink.discard_timeseries()
     if retries:  # the last run was given its dt: describe how the first one was chosen, then the restarts
-        raw["dt_choice"] = "; ".join([choose_dt(p)[1], *retries])
+        raw["dt_choice"] = "; ".join([first_how or choose_dt(p)[1], *retries])
     res = MultibodyResult.from_raw(p, raw)
     res.series = sink.collect()
     return res

@@ -113,8 +113,9 @@ class PenetrationExceeded(Exception):
     """A roller overlapped a cage face by more than ``PENETRATION_LIMIT`` of s: the step is too long
     for the approach speeds of this scene (the run is stopped, not written)."""
 
-    def __init__(self, pen, limit, dt, t, approach):
+    def __init__(self, pen, limit, dt, t, approach, how=""):
         self.pen, self.limit, self.dt, self.t, self.approach = pen, limit, dt, t, approach
+        self.how = how  # how the stopped run's step was chosen (its dt_choice)
         super().__init__(f"roller-cage overlap {pen:.3g} m > {limit:.3g} m at t = {t:.4g} s with dt = {dt:.3g} s "
                          f"(approach speed {approach:.3g} m/s)")
 
@@ -513,7 +514,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
         if code == lp.CODE_PHASE_END:
             if acc.glob[0]["maxpen_all"] > lim.penetration:  # checked every out_every steps: the rest of the phase
                 g = acc.glob[0]
-                raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"], g["maxpen_approach"])
+                raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"],
+                                          g["maxpen_approach"], dt_how)
             inp = inp_main
             continue
         if code == lp.CODE_DONE:
@@ -525,7 +527,8 @@ def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PEN
                                      f"try a smaller numerics.dt_s than {h:.3g} s")
         if code == lp.CODE_PENETRATION:
             g = acc.glob[0]
-            raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"], g["maxpen_approach"])
+            raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"],
+                                          g["maxpen_approach"], dt_how)
         if code == lp.CODE_BLOWUP:
             raise SimulationUnstable(
                 f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if is_rigid else 0.0):.3g} m (limit {lim.raceway_approach:.3g} m, 3x the "

@@ -325,7 +325,7 @@ def check_rigid(p):
             f"below {rigid_speed_floor(p):.0f} rpm")
 
 
-def run(p, sink=None, progress=False, dt=None, _hook=None, penetration_limit=PENETRATION_LIMIT,
+def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
         step_loop=None):
     """Run the parameters ``p``; return a dict of raw accumulators (see :class:`MultibodyResult`).
 

@@ -203,9 +203,10 @@ def test_onset_restitution_sets_elasticity_from_the_step_s_contacts():
     arb_i[0:3] = (12, 99, 1)  # roller 1 touches the cage
     arb_i[3:6] = (99, 14, 2)  # roller 3, bodies the other way round
     arb_i[6:9] = (11, 99, 0)  # roller 0: cached arbiter, no contact
-    wk = type("W", (), {"e_want": np.full(n, -1.0)})()
+    wk = type("W", (), {"e_want": np.full(n, -1.0), "touched": np.ones(n, dtype=np.bool_)})()
     lp.onset_elasticity.py_func(arb_i, 3, Inp, wk)
     assert wk.e_want.tolist() == [0.8, 0.0, 0.8, 0.0]
+    assert wk.touched.tolist() == [False, True, False, True]  # the recorder's continuing contacts
 
 
 def test_rigid_scene_has_no_compounded_chatter(pair_6000):
@@ -218,6 +219,19 @@ def test_rigid_scene_has_no_compounded_chatter(pair_6000):
     vr = np.max(r.impacts["approach_speed_m_s"])
     assert vr <= 1.2 * vh, (vr, vh)
     assert "restarted" not in r.provenance["dt_choice"], r.provenance["dt_choice"]
+
+
+def test_rigid_impact_table_holds_contact_onsets(pair_6000):
+    """At the rigid scene's step a roller pressed against a face approaches it by its pressing force x h /
+    m in every step, above the 0.01 m/s impact threshold, and that approach is taken up by the step's
+    forces, often with no contact impulse. Counted as impacts, such steps made 35 % of the table's rows at
+    6000 rpm (12 791 of 36 104 over 10 rotations, zero impulse; Hertz scene: 5 of 7176). The rigid scene
+    counts a contact's first step only (the rule of its restitution): then 101 of 4040 (2.5 %). Checked:
+    at most 5 % of the rows have no impulse, and the fastest row with none stays below 0.1 m/s."""
+    imp = pair_6000["rigid"].impacts
+    none = imp["impulse_Ns"] <= 0.0
+    assert none.mean() <= 0.05, none.mean()
+    assert imp["approach_speed_m_s"][none].max(initial=0.0) < 0.1
 
 
 def test_no_approach_without_an_impulse_at_a_longer_step():

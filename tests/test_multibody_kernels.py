@@ -251,7 +251,8 @@ def _record(arbiters, prev, now, t=1e-3, h=1e-6):
     pocket_a = pocket_angles(N_POCKETS, 1)
     theta0 = np.mod(-2.0 * math.pi * np.arange(N_POCKETS) / N_POCKETS, 2.0 * math.pi)
     n_imp = rk.record_step(arb_f, arb_i, len(arbiters), IDS[order], order.astype(np.int64), prev, now, t, h, _cfg(),
-                           pocket_a, theta0, np.zeros(N_POCKETS, dtype=fk.DIAG), acc, 0)
+                           pocket_a, theta0, np.zeros(N_POCKETS, dtype=fk.DIAG), acc, 0,
+                           np.zeros(N_POCKETS, dtype=np.bool_))
     return acc, n_imp
 
 
@@ -330,7 +331,8 @@ def test_slow_contacts_are_chatter_and_empty_arbiters_are_skipped():
     acc0 = rk.accumulators(1, N_POCKETS, 360, 16)
     order = np.argsort(IDS)
     rk.record_step(arb_f, arb_i, 1, IDS[order], order.astype(np.int64), prev, now, 1e-3, 1e-6, _cfg(),
-                   pocket_angles(N_POCKETS, 1), np.zeros(N_POCKETS), np.zeros(N_POCKETS, dtype=fk.DIAG), acc0, 0)
+                   pocket_angles(N_POCKETS, 1), np.zeros(N_POCKETS), np.zeros(N_POCKETS, dtype=fk.DIAG), acc0, 0,
+                   np.zeros(N_POCKETS, dtype=np.bool_))
     assert acc0.win["I_acc"].sum() == 0.0 and acc0.glob[0]["n_chatter"] == 0.0
 
 

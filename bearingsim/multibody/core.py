@@ -432,7 +432,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)),
         n_out=np.full(n, n_centrifugal),  # rigid: the first step's outer-race loads, before a joint has acted
         n_held=np.zeros(n),
-        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)))
+        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
     io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,

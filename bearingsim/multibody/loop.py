@@ -147,6 +147,7 @@ class StepWork(NamedTuple):
     n_held: np.ndarray  #: (n,) rigid raceways: the outer race's reaction applied by the force kernel in the last step [N]
     e_set: np.ndarray  #: (n,) elasticity each roller shape has now (onset restitution) [-]
     e_want: np.ndarray  #: (n,) elasticity each roller shape is to have in the next step [-]
+    touched: np.ndarray  #: (n,) bool, rollers that touched a cage face in the last step (rigid raceways)
 
 
 @njit(cache=True)
@@ -216,6 +217,7 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
     n = wk.e_want.shape[0]
     for i in range(n):
         wk.e_want[i] = inp.restitution
+        wk.touched[i] = False
     for a in range(n_arb):
         if arb_i[a * rk.ARB_I + 2] == 0:
             continue
@@ -223,6 +225,7 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
             row = inp.ids_index[np.searchsorted(inp.ids_sorted, arb_i[a * rk.ARB_I + j])]
             if row < n:
                 wk.e_want[row] = 0.0
+                wk.touched[row] = True  # the recorder counts its next contact step as this contact
 
 
 @njit(cache=True)
@@ -298,7 +301,7 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         prev = st0
     t = s.t
     s.n_imp = rk.record_step(arb_f, arb_i, n_arb, inp.ids_sorted, inp.ids_index, prev, now, t, inp.h, inp.cfg,
-                             inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp)
+                             inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp, wk.touched)
     if s.step % lim.out_every == 0:
         ok = True
         for i in range(nb):

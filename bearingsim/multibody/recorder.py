@@ -173,7 +173,7 @@ def arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
 
 @njit(cache=True)
 def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0, diag, acc,
-                n_imp):
+                n_imp, continuing):
     """Attribute one step's roller-cage impulses and raceway loads; return the new impact count.
 
     Parameters
@@ -191,6 +191,10 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
     diag : (n,) :data:`bearingsim.multibody.forces.DIAG` raceway diagnostics of the step (loads [N]).
     acc : :class:`Accumulators`, added to.
     n_imp : rows of ``acc.impacts`` used before the step.
+    continuing : (n,) bool, rollers whose contact goes on from the previous step (rigid raceways; all
+        False otherwise): their contact steps are never impacts. At the rigid scene's step a roller
+        pressed against a face approaches it by its pressing force x h / m in every step, above the
+        impact threshold (the same reason restitution acts only at the onset of a contact there).
     """
     sign = cfg.sign
     n = cfg.roller_count
@@ -306,7 +310,7 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
                 acc.f_bin[i, b].rear += -circ
                 if pen > g.maxpen_rear:
                     g.maxpen_rear = pen
-            if approach > vthr:
+            if approach > vthr and not continuing[i]:
                 if (not front) and th < math.pi and acc.first_imp[k, i] != acc.first_imp[k, i]:
                     acc.first_imp[k, i] = approach
                 if n_imp < impacts.shape[0]:

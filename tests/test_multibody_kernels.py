@@ -401,3 +401,35 @@ def test_version_guard_falls_back_to_the_plain_loop(monkeypatch):
     assert loop.name == "plain" and reason == why
     with pytest.raises(RuntimeError, match="cannot run"):
         chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16, step_loop="compiled")
+
+
+def test_rigid_race_carries_the_inner_race_load_of_a_roller_on_it_at_every_angle():
+    """A loaded roller orbiting on the outer race (its prediction ``x + h v`` beyond the circle, so the
+    joint holds it): the race takes its whole inner-race load and the roller is not counted off the race
+    (lift 0), at every angle. The kernel projects the prediction onto the circle; the projected centre's
+    radius rounds to ~1e-17 m inside the circle at about a fifth of the angles (75 of these 401), and taking that for
+    "pulled off the outer race" put the inner contact's stiffness into the roller's velocity update
+    (h^2 k ~ 9 m at 22 us): the race's share, and with it the outer-race normal force for traction and
+    drag, was 10 % of the inner-race load in those steps (the load zone's mean outer-race normal force
+    570 N against 725 N at 3000 rpm, 22.2 us). Relative 1e-3: the ring's contact normal is not exactly
+    radial."""
+    h, omega = 2.22e-5, 138.0
+    prm = _params(rigid=True, rigid_radius=RC, inner_ring=True, ring_mass=1.0, damping_time=0.0,
+                  outer_race_radius=RC + ROLLER_RADIUS)
+    delta = 5e-6
+    held_ratio, lift = [], []
+    for a in np.linspace(-0.5, 0.5, 401) - 0.5 * math.pi:
+        state = np.zeros((2, 6))
+        state[0, :2] = RC * math.cos(a), RC * math.sin(a)
+        state[0, 3:5] = -omega * RC * math.sin(a), omega * RC * math.cos(a)
+        # ring centre on the roller's radius: the roller overlaps the inner race by delta
+        ring_c = (RC - (prm.inner_race_radius + ROLLER_RADIUS - delta)) * np.array([math.cos(a), math.sin(a)])
+        diag = np.zeros(1, dtype=fk.DIAG)
+        n_held = np.zeros(1)
+        fk.raceway_forces(state, h, prm, ring_c, np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), np.zeros(6),
+                          diag, np.zeros(1), n_held)
+        assert diag[0]["q_in"] > 100.0
+        held_ratio.append(n_held[0] / diag[0]["q_in"])
+        lift.append(diag[0]["lift"])
+    assert min(held_ratio) == pytest.approx(1.0, rel=1e-3) and max(held_ratio) == pytest.approx(1.0, rel=1e-3)
+    assert not any(lift)

@@ -339,6 +339,9 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     rr = prm.roller_radius
     rigid = prm.rigid
     rc = prm.rigid_radius
+    # rigid: the roller's predicted centre is inside the joint's circle (off the outer race); decided
+    # before the projection below, whose rounding leaves a projected centre ~1e-17 m inside the circle
+    off_race = np.zeros(n, dtype=np.bool_)
     for i in range(n):
         x0 = state[i, 0]
         y0 = state[i, 1]
@@ -353,6 +356,8 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
             if r1 > rc:
                 xp[i, 0] *= rc / r1
                 xp[i, 1] *= rc / r1
+            else:
+                off_race[i] = r1 < rc
         # approaches at the current positions: contact rates are (delta_{n+1} - delta_n) / h
         dout_prev[i] = math.sqrt(x0 ** 2 + y0 ** 2) + rr - prm.outer_race_radius
         din_prev[i] = prm.inner_race_radius + rr - math.sqrt((x0 - ring_c[0]) ** 2 + (y0 - ring_c[1]) ** 2)
@@ -400,7 +405,7 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         nx = -px / r
         ny = -py / r
         if rigid:  # the joint's force; no approach
-            d_i.lift = rc - r
+            d_i.lift = rc - r if off_race[i] else 0.0
             d_i.q_out, d_i.delta_out, d_i.slip_out, d_i.drag_out = _contact(
                 px, py, vx, vy, w, nx, ny, 0.0, 0.0, 0.0, 0.0, prm.outer_race_geom_radius, 0.0, orbit, prm, jac, f,
                 n_out[i] + n_held[i])

@@ -442,7 +442,10 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     travel_end = 2.0 * math.pi * total_rot
     omega_nom = op.omega_c
     steps_est = int(math.ceil(travel_end / omega_nom / h + t_start / h_start))
-    out_every = max(1, int(round(1.0 / (p.numerics.output_rate * h))))
+    def sample_every(step):  # steps between samples (and health checks) at numerics.output_rate
+        return max(1, int(round(1.0 / (p.numerics.output_rate * step))))
+
+    out_every = sample_every(h)
     series = None
     if sink is not None:
         series = [
@@ -488,7 +491,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     inp_main = inp
     if t_start > 0.0:  # the start phase: its own step (and samples at the same rate)
         inp = inp._replace(h=float(h_start), lim=lim._replace(
-            t_phase_end=float(t_start), out_every=max(1, int(round(1.0 / (p.numerics.output_rate * h_start))))))
+            t_phase_end=float(t_start), out_every=sample_every(h_start)))
     ls = np.zeros(1, dtype=lp.LOOP_STATE)
     st = ls[0]
     t_loop0 = time.perf_counter()
@@ -512,12 +515,11 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         if code == lp.CODE_BLOCK_FULL:
             continue
         if code == lp.CODE_PHASE_END:
-            if acc.glob[0]["maxpen_all"] > lim.penetration:  # checked every out_every steps: the rest of the phase
-                g = acc.glob[0]
-                raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"],
-                                          g["maxpen_approach"], dt_how)
-            inp = inp_main
-            continue
+            # the overlap is checked every out_every steps: the phase's last ones are checked here
+            if acc.glob[0]["maxpen_all"] <= lim.penetration:
+                inp = inp_main
+                continue
+            code = lp.CODE_PENETRATION  # stopped with the start phase's step
         if code == lp.CODE_DONE:
             break
         if bar is not None:

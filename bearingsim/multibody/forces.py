@@ -342,6 +342,7 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     # rigid: the roller's predicted centre is inside the joint's circle (off the outer race); decided
     # before the projection below, whose rounding leaves a projected centre ~1e-17 m inside the circle
     off_race = np.zeros(n, dtype=np.bool_)
+    pred = np.empty((n, 4))  # rigid: predicted centre (x, y) before that projection, its radius, the current radius
     for i in range(n):
         x0 = state[i, 0]
         y0 = state[i, 1]
@@ -353,6 +354,10 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
                 x0 *= rc / r0
                 y0 *= rc / r0
             r1 = math.sqrt(xp[i, 0] ** 2 + xp[i, 1] ** 2)
+            pred[i, 0] = xp[i, 0]
+            pred[i, 1] = xp[i, 1]
+            pred[i, 2] = r1
+            pred[i, 3] = r0
             if r1 > rc:
                 xp[i, 0] *= rc / r1
                 xp[i, 1] *= rc / r1
@@ -478,20 +483,15 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
         out_f[3 * i] = m * d0 / h
         out_f[3 * i + 1] = m * d1 / h + m * g
         if rigid:  # the outer race's part that the joint does not do (see above)
-            x0 = state[i, 0]
-            y0 = state[i, 1]
-            x1 = x0 + h * state[i, 3]  # where pymunk's position update puts it (contact corrections aside)
-            y1 = y0 + h * state[i, 4]
-            r1 = math.sqrt(x1 * x1 + y1 * y1)
-            ex = x1 / r1
-            ey = y1 / r1
+            r1 = pred[i, 2]  # where pymunk's position update puts it (contact corrections aside)
+            ex = pred[i, 0] / r1
+            ey = pred[i, 1] / r1
             f_r = out_f[3 * i] * ex + (out_f[3 * i + 1] - m * g) * ey  # outward load (gravity included)
-            if r1 < rc:  # the joint is slack in this step (chipmunk activates it only beyond its length)
+            if off_race[i]:  # the joint is slack in this step (chipmunk activates it only beyond its length)
                 v_r = state[i, 3] * ex + state[i, 4] * ey
                 # the joint's correction of the last step (a roller it put back from outside the circle
                 # left with that speed inward, in its real velocity), given back: the race is plastic
-                r0 = math.sqrt(x0 * x0 + y0 * y0)
-                dv = max(0.0, r0 - rc) / h
+                dv = max(0.0, pred[i, 3] - rc) / h
                 v_land = (rc - r1) / h  # outward speed that reaches the circle at the next update
                 held = max(0.0, f_r - m * (v_land - v_r - dv) / h) - m * dv / h  # never beyond the circle
             else:  # on the race: the race takes the outward load (the joint would, a step too late if slack)

@@ -93,7 +93,7 @@ DIAG = np.dtype([
 TEN_NINTHS = 10.0 / 9.0
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _normal_force(delta, delta_rate, K, c_r, d_fade):
     """Normal force [N], its derivative in delta [N/m] and in delta_rate [N s/m] of one contact."""
     if delta <= 0.0:
@@ -198,7 +198,7 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
     return -1, res
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _contact(
     px, py, vx, vy, w, nx, ny, delta, rate, u_race, w_race, r_race_geom, omega_race, orbit, prm, jac, f,
     q_given=-1.0,
@@ -276,7 +276,7 @@ def _contact(
     return q, delta, 0.0, fo
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag, n_out, n_held):
     """Implicitly linearised raceway forces on every roller for the coming pymunk step.
 

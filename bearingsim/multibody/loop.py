@@ -202,7 +202,7 @@ def _land_step(prev, travel, inp, wk, s):
             wk.land_win[k, 2] += out[fk.LAND_TORQUE] * h
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def onset_elasticity(arb_i, n_arb, inp, wk):
     """Rigid raceways: the roller elasticity for the next step, into ``wk.e_want``: 0 for a roller that
     touched a cage face in this step (its contact goes on: an approach within it is the step's force
@@ -228,7 +228,7 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
                 wk.touched[row] = True  # the recorder counts its next contact step as this contact
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def before_step(prev, inp, wk, ls):
     """Checks and raceway forces before a step; return ``CODE_CONTINUE`` or the code to stop with.
 
@@ -271,7 +271,7 @@ def before_step(prev, inp, wk, ls):
     return CODE_CONTINUE
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
     """Advance time and step, record the step, sample and check; return ``CODE_CONTINUE`` or a code.
 

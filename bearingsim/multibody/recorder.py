@@ -113,7 +113,7 @@ ARB_I = 3  # ints per arbiter: body a id, body b id, contact count
 TWO_PI = 2.0 * math.pi
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def pocket_theta(sign, cage_angle, pocket_angle):
     """Angle [rad, 0..2 pi) of a pocket centre from the load-zone centre in the direction of rotation."""
     th = sign * (cage_angle + pocket_angle + 0.5 * math.pi)
@@ -171,7 +171,7 @@ def arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
     return order[:m]
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0, diag, acc,
                 n_imp, continuing):
     """Attribute one step's roller-cage impulses and raceway loads; return the new impact count.

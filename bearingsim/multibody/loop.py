@@ -19,6 +19,11 @@ same numbers: it calls the same two kernels with the same inputs). Both return t
 (``CODE_*``) when the run is done, when the sample block is full or ``CHUNK_STEPS`` steps have passed
 (Python flushes the samples, moves the progress bar and sees Ctrl-C), or when a check failed (Python
 raises the matching error). State that lives across calls is one :data:`LOOP_STATE` record.
+
+The kernels of a step (these two, the force and recording kernels they call, and the helpers those
+call every step) are compiled with numba's ``inline="always"``: called as functions they took their
+parameter tuples and work arrays as arguments on every call, ~1.5 us of a 6000 rpm rigid step
+(docs/fast_scene.md); inlined, the compiled loop is one function and computes the same bytes.
 """
 from __future__ import annotations
 

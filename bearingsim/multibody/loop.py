@@ -13,7 +13,7 @@ Per time step ``h`` of :func:`bearingsim.multibody.core.run`:
    sample and the run's health checks.
 
 Step 2 is done either by the compiled loop of :mod:`bearingsim.multibody.chipmunk`, which calls
-chipmunk's C functions from numba so that no Python runs between steps, or by :func:`advance_plain`
+chipmunk's C functions from numba so that no Python runs between steps, or by :class:`PlainLoop`
 here, a Python loop over ``Space.step`` and pymunk's public ``pymunk.batch`` functions (slower, the
 same numbers: it calls the same two kernels with the same inputs). Both return to Python with a code
 (``CODE_*``) when the run is done, when the sample block is full or ``CHUNK_STEPS`` steps have passed

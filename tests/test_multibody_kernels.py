@@ -433,3 +433,84 @@ def test_rigid_race_carries_the_inner_race_load_of_a_roller_on_it_at_every_angle
         lift.append(diag[0]["lift"])
     assert min(held_ratio) == pytest.approx(1.0, rel=1e-3) and max(held_ratio) == pytest.approx(1.0, rel=1e-3)
     assert not any(lift)
+
+
+# --- rigid raceways: the race rotation (forces.race_orbit) ------------------------------------------
+def _orbit(x, y, vx, vy, h, q_in=0.0, hold=False):
+    """race_orbit on one roller (row 0; row 1 a cage left alone): (state after, n_extra)."""
+    prm = _params(rigid=True, rigid_radius=RC)
+    state = np.zeros((2, 6))
+    state[0, [0, 1, 3, 4]] = x, y, vx, vy
+    diag = np.zeros(1, dtype=fk.DIAG)
+    diag["q_in"] = q_in
+    n_extra = np.full(1, -1.0)
+    fk.race_orbit(state, h, prm, np.array([hold]), n_extra, diag)
+    return state, n_extra[0]
+
+
+@pytest.mark.parametrize("angle", [0.3, 2.0, 4.5])
+def test_race_rotation_keeps_a_rolling_roller_on_its_circle(angle):
+    """A roller rolling on the outer race (centre on the circle r_c, velocity v_t along it) is handed to
+    pymunk so that its straight-line update ``x + h v`` lands on the circle at the angle the rotation by
+    v_t h / r_c reaches, with its velocity tangent there: no chord drift and no joint correction. The race
+    carries the centripetal force m v_t^2 / r_c. Exact to rounding (relative 1e-12 on radii ~0.05 m,
+    1e-9 on the radial velocity's 1e-12 m/s against v_t = 10 m/s)."""
+    h, vt = 2e-5, 10.0
+    er = np.array([math.cos(angle), math.sin(angle)])
+    et = np.array([-er[1], er[0]])
+    st, n_extra = _orbit(*(RC * er), *(vt * et), h)
+    land = st[0, 0:2] + h * st[0, 3:5]
+    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12)
+    turned = math.atan2(land[1], land[0]) - angle
+    assert (turned + math.pi) % (2 * math.pi) - math.pi == pytest.approx(vt * h / RC, rel=1e-9)
+    e_land = land / np.hypot(*land)
+    assert abs(st[0, 3:5] @ e_land) < 1e-9 * vt and np.hypot(*st[0, 3:5]) == pytest.approx(vt, rel=1e-12)
+    assert n_extra == pytest.approx(ROLLER_MASS * vt**2 / RC, rel=1e-12)
+    assert not st[1].any()
+
+
+def test_race_rotation_stops_a_small_inward_speed_on_the_race():
+    """A roller on the race moving inward slower than the centripetal acceleration returns it within the
+    step (|v_r| < v_t^2 h / r_c) stays on the race: its radial speed is stopped, and the race's force is
+    the centripetal force less the momentum it takes, m (v_t^2 / r_c + v_r / h). Exact to rounding."""
+    h, vt = 2e-5, 10.0
+    vr = -0.5 * vt**2 * h / RC
+    st, n_extra = _orbit(RC, 0.0, vr, vt, h)
+    land = st[0, 0:2] + h * st[0, 3:5]
+    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12)
+    assert abs(st[0, 3:5] @ (land / np.hypot(*land))) < 1e-9 * vt
+    assert n_extra == pytest.approx(ROLLER_MASS * (vt**2 / RC + vr / h), rel=1e-12)
+
+
+def test_race_rotation_leaves_pymunk_the_radial_motion_of_a_roller_beyond_the_circle():
+    """A roller 2 um beyond the circle, put back by the joint at 0.1 m/s inward: only its tangential
+    motion follows the circle. It lands at r + h v_r, keeps v_r and v_t, and the race carries
+    m v_t^2 / r. Exact to rounding."""
+    h, vt, vr, r = 2e-5, 10.0, -0.1, RC + 2e-6
+    st, n_extra = _orbit(r, 0.0, vr, vt, h)
+    land = st[0, 0:2] + h * st[0, 3:5]
+    assert np.hypot(*land) == pytest.approx(r + h * vr, rel=1e-12)
+    e_land = land / np.hypot(*land)
+    assert st[0, 3:5] @ e_land == pytest.approx(vr, rel=1e-9)
+    assert e_land[0] * st[0, 4] - e_land[1] * st[0, 3] == pytest.approx(vt, rel=1e-12)
+    assert math.atan2(land[1], land[0]) == pytest.approx(vt * h / r, rel=1e-9)
+    assert n_extra == pytest.approx(ROLLER_MASS * vt**2 / r, rel=1e-12)
+
+
+@pytest.mark.parametrize("case", ["load zone", "held", "inside", "leaving"])
+def test_race_rotation_leaves_other_rollers_alone(case):
+    """Left to pymunk, state unchanged and no race force: a roller loaded by the inner race in the last
+    step (load zone), a prescribed roller (reduced-equivalent scene), one 2 nm inside the circle (off
+    the race), and one on the circle leaving inward faster than v_t^2 h / r_c."""
+    h, vt = 2e-5, 10.0
+    x, vr, q_in, hold = RC, 0.0, 0.0, False
+    if case == "load zone":
+        q_in = 100.0
+    elif case == "held":
+        hold = True
+    elif case == "inside":
+        x = RC - 2e-9
+    else:
+        vr = -2.0 * vt**2 * h / RC
+    st, n_extra = _orbit(x, 0.0, vr, vt, h, q_in=q_in, hold=hold)
+    assert list(st[0, [0, 1, 3, 4]]) == [x, 0.0, vr, vt] and n_extra == 0.0

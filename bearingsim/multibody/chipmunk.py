@@ -36,7 +36,8 @@ import numba.experimental.function_type  # noqa: F401  (registers typeof for Wra
 import numpy as np
 import pymunk
 import pymunk.batch as pb
-from numba import njit, types
+from numba import carray, njit, types
+from numba.extending import intrinsic
 
 from bearingsim import laws
 from bearingsim._jit import drop_stale_caches
@@ -90,7 +91,28 @@ def guard() -> str | None:
     return None
 
 
-def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=()):
+#: cpBody fields the compiled loop writes directly, as float64 indices into the struct: position p and
+#: velocity v (2 each), force f (2), torque t; chipmunk 7's ``struct cpBody`` (opaque in pymunk's cdef,
+#: so checked on a probe body by :func:`body_layout`)
+BODY_P, BODY_V, BODY_F, BODY_T = 8, 10, 12, 16
+_BODY_PROBE_DOUBLES = BODY_T + 1
+
+
+def body_layout() -> str | None:
+    """None when a ``cpBody`` holds p, v, f and t where :func:`advance` writes them, else why not.
+
+    Sets them on a probe body through pymunk and reads the struct's first bytes back."""
+    b = pymunk.Body(1.0, 1.0)
+    b.position, b.velocity, b.force, b.torque = (1.25, -2.5), (3.75, 4.0), (5.0, -6.0), -8.25
+    a = np.frombuffer(ffi.buffer(b._body, 8 * _BODY_PROBE_DOUBLES), dtype=np.float64)
+    want = {BODY_P: 1.25, BODY_P + 1: -2.5, BODY_V: 3.75, BODY_V + 1: 4.0, BODY_F: 5.0, BODY_F + 1: -6.0,
+            BODY_T: -8.25}
+    if any(a[k] != v for k, v in want.items()):
+        return "pymunk's cpBody does not have chipmunk 7's layout"
+    return None
+
+
+def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=(), bodies=()):
     """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
 
     Parameters
@@ -105,6 +127,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
         impulses over ``h`` go into ``StepWork.n_out``.
     roller_shapes : the rollers' circles, in roller order (their elasticity is set between steps when
         ``StepInputs.onset_restitution``).
+    bodies : the space's bodies in the order of its batched read (rollers, then the cage): the compiled
+        loop writes the set buffer into them directly (:class:`BatchIO`); empty: pymunk's batched setter.
     """
     if step_loop not in (None, "compiled", "plain"):
         raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
@@ -124,7 +148,10 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
         reason = "asked for"
     if step_loop == "plain":
         return lp.PlainLoop(space, nb, set_fields, set_arr, joints, roller_shapes), reason
-    return BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes), reason
+    io = BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes, bodies)
+    if io.direct_why is not None:
+        reason += f"; bodies set through pymunk's batched setter ({io.direct_why})"
+    return io, reason
 
 
 class _CFunction(types.WrapperAddressProtocol):
@@ -210,7 +237,7 @@ class BatchIO:
 
     name = "compiled"
 
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=()):
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=(), bodies=()):
         self.nb = nb
         self._space = space._space
         self.impulse_fn = _chipmunk("cpConstraintGetImpulse", _IMPULSE_SIG)
@@ -264,6 +291,28 @@ class BatchIO:
             _address(data[0]), _address(data[1]), _address(sd), _address(ad),
             self.ts.ctypes.data,
         )
+        self.set_stride = 7 if set_fields == lp.BODY_SET_ALL else 3
+        self.body_ptrs, self.direct_why = self._direct_bodies(bodies, set_fields)
+
+    def _direct_bodies(self, bodies, set_fields):
+        """(body addresses, None) when :func:`advance` can write the set buffer into the bodies
+        directly, else (empty, why not): :func:`body_layout` holds, the set buffer holds p, v, f, t or
+        f, t, and ``bodies`` are in the order of the batched read (checked on their p and v)."""
+        none = np.zeros(0, dtype=np.int64)
+        if set_fields not in (lp.BODY_SET_ALL, lp.BODY_SET_FORCE):
+            return none, f"set fields {set_fields!r}"
+        if len(bodies) != self.nb:
+            return none, "no bodies given"
+        why = body_layout()
+        if why is not None:
+            return none, why
+        ptrs = np.array([_address(b._body) for b in bodies], dtype=np.int64)
+        st = self.read_states()
+        for k, b in enumerate(bodies):
+            a = np.frombuffer(ffi.buffer(b._body, 8 * _BODY_PROBE_DOUBLES), dtype=np.float64)
+            if not (np.array_equal(a[BODY_P:BODY_P + 2], st[k, 0:2]) and np.array_equal(a[BODY_V:BODY_V + 2], st[k, 3:5])):
+                return none, "the bodies are not in the order of the batched read"
+        return ptrs, None
 
     def read_states(self):
         """Fill state array 0 from the space (before the first step)."""
@@ -277,8 +326,9 @@ class BatchIO:
     def advance(self, inp, wk, acc, ls):
         """Run :func:`advance` until it returns a code."""
         return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
-                       self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.hdr,
-                       self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts, inp, wk, acc, ls)
+                       self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
+                       self.set_stride, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
+                       inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -287,9 +337,41 @@ def _now_ns(clock, ptr_ts, ts):
     return ts[0] * 1_000_000_000 + ts[1]
 
 
+@intrinsic
+def _as_float_ptr(typingctx, address):
+    """An int64 address as a ``float64 *`` (for :func:`numba.carray`)."""
+    sig = types.CPointer(types.float64)(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always")
+def _write_bodies(body_ptrs, set_arr, stride):
+    """Write the set buffer into the bodies: rows of (p, v, f, t) (``stride`` 7) or (f, t) (3).
+
+    What pymunk's batched setter does through ``cpBodySetPosition`` and the others, without their
+    calls: the step's position update recomputes each body's transform from p before anything reads
+    it, and nothing in the space sleeps."""
+    for k in range(body_ptrs.shape[0]):
+        b = carray(_as_float_ptr(body_ptrs[k]), _BODY_PROBE_DOUBLES)
+        r = k * stride
+        if stride == 7:
+            b[BODY_P] = set_arr[r]
+            b[BODY_P + 1] = set_arr[r + 1]
+            b[BODY_V] = set_arr[r + 2]
+            b[BODY_V + 1] = set_arr[r + 3]
+            r += 4
+        b[BODY_F] = set_arr[r]
+        b[BODY_F + 1] = set_arr[r + 1]
+        b[BODY_T] = set_arr[r + 2]
+
+
 @njit(cache=True)
 def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
-            hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
+            body_ptrs, set_stride, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
@@ -314,16 +396,19 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
         code = lp.before_step(st0 if cur == 0 else st1, inp, wk, ls)
         if code != lp.CODE_CONTINUE:
             return code
-        hdr.set[0] = 0  # the setter reads the buffer from the start
-        each_body_fn(sp, ptr.body_set, ptr.data_set)
+        if body_ptrs.shape[0]:
+            _write_bodies(body_ptrs, wk.set_arr, set_stride)
+        else:
+            hdr.set[0] = 0  # the setter reads the buffer from the start
+            each_body_fn(sp, ptr.body_set, ptr.data_set)
         if timed:
             t0 = _now_ns(clock_fn, ptr.timespec, ts)
             step_fn(sp, h)
             s.pymunk_ns += _now_ns(clock_fn, ptr.timespec, ts) - t0
         else:
             step_fn(sp, h)
-        for k in range(joint_ptrs.shape[0]):
-            wk.n_out[k] = impulse_fn(joint_ptrs[k]) / h
+        for k in range(joint_ptrs.shape[0]):  # the race's force: the joint's and race_orbit's
+            wk.n_out[k] = impulse_fn(joint_ptrs[k]) / h + wk.n_extra[k]
         if cur == 0:  # the state after the step goes into the other array
             hdr.state1[0] = 0
             each_body_fn(sp, ptr.body_get, ptr.data_state1)

@@ -416,7 +416,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
 
     # reduced-equivalent: held rollers sit at the front of their pockets on the outer race
     phi = p.reduced.load_zone_half_angle if reduced_eq else 0.0
-    if reduced_eq:
+    if reduced_eq or is_rigid:  # held rollers (reduced-equivalent), rollers on the race (rigid): states set too
         set_fields = lp.BODY_SET_ALL
         set_arr = np.zeros(nb * 7)
     else:
@@ -427,16 +427,17 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         ring_c=np.array([0.0, -max(0.5 * pd, delta_qs)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
         hold=np.zeros(n, dtype=np.bool_),
         # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
-        out_f=np.zeros(nb * 3) if reduced_eq else set_arr, set_arr=set_arr,
+        out_f=np.zeros(nb * 3) if (reduced_eq or is_rigid) else set_arr, set_arr=set_arr,
         diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
         orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)),
         n_out=np.full(n, n_centrifugal),  # rigid: the first step's outer-race loads, before a joint has acted
         n_held=np.zeros(n),
-        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_))
+        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_),
+        n_extra=np.zeros(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
     io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
-                                           [next(iter(b.shapes)) for b in sc.rollers])
+                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage])
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot

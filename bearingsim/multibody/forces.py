@@ -505,6 +505,84 @@ def raceway_forces(state, h, prm, ring_c, ring_c_prev, ring_v, hold, out_f, diag
     return it
 
 
+#: rigid raceways: a roller centre within this distance inside its outer-race circle is on the race [m]
+RACE_ORBIT_TOL_M = 1e-9
+#: rigid raceways: a roller on the race is handed to pymunk this fraction outside its circle, so that the
+#: joint holds it in the step and the force kernel's "beyond the circle" test is not left to rounding
+RACE_ORBIT_OUTSIDE = 1e-14
+
+
+@njit(cache=True, inline="always")
+def race_orbit(state, h, prm, hold, n_extra, diag):
+    """Rigid raceways: rollers on the outer race in the no-load zone advance along it as an exact
+    rotation; returns nothing. (``docs/fast_scene.md``, *Rollers on the race move on their circle*.)
+
+    pymunk moves a body along a straight line, ``x + h v``, and the slide joint puts a roller back on
+    its circle through its real velocity: the roller then enters each contact solve moving inward at
+    ``r omega^2 h / 2`` against the cage, whose points pymunk moves on exact circles with tangent
+    velocities (at 3000 rpm and 22 us, 9 mm/s; the contact reads it as an approach or a separation on
+    the slanted face segments). Here a roller on the race is handed to pymunk with the velocity it has
+    at the point the rotation by ``v_t h / r`` reaches, from the position that pymunk's ``x + h v``
+    takes to that point: the contact solve sees the roller's velocity as it sees the cage's.
+
+    * on the circle (centre at most ``RACE_ORBIT_TOL_M`` inside it, and not leaving it faster than the
+      centripetal acceleration ``v_t^2 / r_c`` brings it back within the step): it lands on the circle
+      with its tangential speed ``v_t`` and no radial speed; the race carries the centripetal force
+      and stops the radial speed, ``m (v_t^2 / r_c + v_r / h)`` (at least 0; ``v_r`` outward positive);
+    * beyond the circle (pushed out by a contact's overlap correction, or being put back by the joint):
+      only its tangential motion is rotated, its radial position and speed stay pymunk's (it lands at
+      ``r + h v_r``), and the race carries ``m v_t^2 / r``.
+
+    That force goes into ``n_extra`` [N], added to the joint's for the normal force of the outer contact
+    (traction, drag). Left alone: rollers in ``hold`` (reduced-equivalent scene, prescribed), rollers
+    the inner race loaded in the last step (``diag.q_in``: in the load zone, rotating them made the
+    rollers at its centre rattle between their faces at 500 rpm), and rollers off the race.
+
+    state : (nb, 6) body states before the step (rows 0..n-1 the rollers), changed in place.
+    """
+    n = n_extra.shape[0]
+    rc = prm.rigid_radius
+    m = prm.roller_mass
+    r_out = rc * (1.0 + RACE_ORBIT_OUTSIDE)
+    for i in range(n):
+        n_extra[i] = 0.0
+        if hold[i] or diag[i].q_in > 0.0:
+            continue  # prescribed (reduced-equivalent scene), or in the load zone (held by both races)
+        x = state[i, 0]
+        y = state[i, 1]
+        r = math.sqrt(x * x + y * y)
+        if r < rc - RACE_ORBIT_TOL_M:
+            continue  # off the race
+        erx = x / r
+        ery = y / r
+        vr = state[i, 3] * erx + state[i, 4] * ery
+        vt = -state[i, 3] * ery + state[i, 4] * erx
+        beyond = r - rc > RACE_ORBIT_TOL_M
+        if beyond:
+            # pushed beyond the circle (a contact's overlap correction, or the joint's error): its radial
+            # motion is left to pymunk as it is (the joint puts it back through its velocity), only the
+            # tangential motion follows the circle
+            r1 = r + h * vr
+            vrn = vr
+        elif vr < -vt * vt / rc * h:
+            continue  # leaving the race faster than the centripetal acceleration returns it within the step
+        else:
+            r1 = r_out
+            vrn = 0.0
+        th = vt * h / r
+        c = math.cos(th)
+        s = math.sin(th)
+        ex = erx * c - ery * s  # e_r where the rotation takes the roller
+        ey = erx * s + ery * c
+        vx = vrn * ex - vt * ey
+        vy = vrn * ey + vt * ex
+        state[i, 0] = r1 * ex - h * vx
+        state[i, 1] = r1 * ey - h * vy
+        state[i, 3] = vx
+        state[i, 4] = vy
+        n_extra[i] = m * vt * vt / r if beyond else max(0.0, m * (vt * vt / rc + vr / h))
+
+
 class LandParams(NamedTuple):
     """Inputs of :func:`land_force` that are fixed for a run (a cage guided on a ring land). SI throughout."""
 

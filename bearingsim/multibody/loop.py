@@ -153,6 +153,7 @@ class StepWork(NamedTuple):
     e_set: np.ndarray  #: (n,) elasticity each roller shape has now (onset restitution) [-]
     e_want: np.ndarray  #: (n,) elasticity each roller shape is to have in the next step [-]
     touched: np.ndarray  #: (n,) bool, rollers that touched a cage face in the last step (rigid raceways)
+    n_extra: np.ndarray  #: (n,) rigid raceways: the outer race's force of :func:`~bearingsim.multibody.forces.race_orbit` in the step [N]
 
 
 @njit(cache=True)
@@ -262,6 +263,8 @@ def before_step(prev, inp, wk, ls):
         s.t_rec0 = s.t
     if inp.hold_rule.active:
         _hold_rollers(prev, n, sign, inp.hold_rule, inp.pocket_a, wk.hold)
+    if inp.prm.rigid:
+        fk.race_orbit(prev, inp.h, inp.prm, wk.hold, wk.n_extra, wk.diag)
     if fk.raceway_forces(prev, inp.h, inp.prm, wk.ring_c, wk.ring_c_prev, wk.ring_v, wk.hold, wk.out_f,
                          wk.diag, wk.n_out, wk.n_held) < 0:
         s.newton_failures += 1
@@ -271,7 +274,7 @@ def before_step(prev, inp, wk, ls):
         s.ring_sum_x += wk.ring_c[0]
         s.ring_sum_y += wk.ring_c[1]
         s.ring_n += 1.0
-    if inp.hold_rule.active:
+    if inp.hold_rule.active or inp.prm.rigid:  # positions and velocities set by the step's rules too
         _pack_all(prev, wk.out_f, wk.set_arr, n + 1)
     return CODE_CONTINUE
 
@@ -407,7 +410,7 @@ class PlainLoop:
             self.space.step(h)
             ls[0]["pymunk_ns"] += time.perf_counter_ns() - t0
             for k, j in enumerate(self.joints):  # rigid raceways: the outer-race forces of the step
-                wk.n_out[k] = j.impulse / h
+                wk.n_out[k] = j.impulse / h + wk.n_extra[k]
             self._read_bodies(self.states[cur ^ 1])
             self._arbiters.clear()
             pb.get_space_arbiters(self.space, ARB_GET, self._arbiters)

@@ -29,6 +29,7 @@ numbers bit for bit, slower. A run records which loop ran (``raw["step_loop"]``)
 from __future__ import annotations
 
 import ctypes
+import functools
 import os
 from typing import NamedTuple
 
@@ -98,10 +99,12 @@ BODY_P, BODY_V, BODY_F, BODY_T = 8, 10, 12, 16
 _BODY_PROBE_DOUBLES = BODY_T + 1
 
 
+@functools.lru_cache(maxsize=1)
 def body_layout() -> str | None:
     """None when a ``cpBody`` holds p, v, f and t where :func:`advance` writes them, else why not.
 
-    Sets them on a probe body through pymunk and reads the struct's first bytes back."""
+    Sets them on a probe body through pymunk and reads the struct's first bytes back; once per process
+    (no probe body is freed while a run, or a signal handler, is under way)."""
     b = pymunk.Body(1.0, 1.0)
     b.position, b.velocity, b.force, b.torque = (1.25, -2.5), (3.75, 4.0), (5.0, -6.0), -8.25
     a = np.frombuffer(ffi.buffer(b._body, 8 * _BODY_PROBE_DOUBLES), dtype=np.float64)

@@ -376,6 +376,26 @@ def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extr
         assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
 
 
+@pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
+@pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", ["multibody.raceway_contact=rigid"]),
+                                             ("multibody_reduced_equivalent_3000rpm", [])])
+def test_direct_body_writes_give_the_batched_setter_s_numbers(scenario, extra, monkeypatch):
+    """The compiled loop writes forces, positions and velocities straight into each ``cpBody``; where
+    the probe finds another struct layout it uses pymunk's batched setter and says so in the loop's
+    reason. Both give the same bytes (rigid raceways and the reduced-equivalent scene set positions and
+    velocities, not only forces). With the installed pymunk the layout holds and the direct writes run."""
+    sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
+    assert chipmunk.body_layout() is None
+    direct = run(si(sc), step_loop="compiled")
+    assert "batched setter" not in direct["step_loop_reason"]
+    monkeypatch.setattr(chipmunk, "body_layout", lambda: "a layout the probe did not find")
+    batched = run(si(sc), step_loop="compiled")
+    assert "batched setter (a layout the probe did not find)" in batched["step_loop_reason"]
+    for key in COMPARED:
+        a, b = np.asarray(direct[key]), np.asarray(batched[key])
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+
+
 def test_plain_loop_is_chosen_by_the_environment(monkeypatch):
     """``BEARINGSIM_PLAIN_PYMUNK=1`` selects the plain loop without a keyword."""
     import pymunk

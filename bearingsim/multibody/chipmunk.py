@@ -4,9 +4,11 @@ This is the only module that uses pymunk's private C interface (``pymunk._chipmu
 ``ffi`` and ``lib``, chipmunk's ``cpSpaceStep``, ``cpSpaceEachBody`` and ``cpSpaceEachCachedArbiter``,
 pymunk's batched iterator functions ``pmSpaceBody{Get,Set}IteratorFuncBatched`` and
 ``pmSpaceArbiterIteratorFuncBatched``, and its C array structs ``pmFloatArray``/``pmIntArray``/
-``pmBatchedData``). :func:`advance` calls them through their function pointers, so no Python runs
+``pmBatchedData``), and writes the bodies' forces, positions and velocities straight into chipmunk's
+``struct cpBody`` (offsets checked on a probe body, :func:`body_layout`; otherwise pymunk's batched
+setter does it). :func:`advance` calls them through their function pointers, so no Python runs
 between steps; per step it calls the same kernels as the plain loop
-(:func:`bearingsim.multibody.loop.before_step`, then the batched set, ``cpSpaceStep(h)`` timed with
+(:func:`bearingsim.multibody.loop.before_step`, then the bodies' set, ``cpSpaceStep(h)`` timed with
 ``clock_gettime(CLOCK_MONOTONIC)``, the batched reads, then
 :func:`bearingsim.multibody.loop.after_step`).
 
@@ -294,13 +296,13 @@ class BatchIO:
             _address(data[0]), _address(data[1]), _address(sd), _address(ad),
             self.ts.ctypes.data,
         )
-        self.set_stride = 7 if set_fields == lp.BODY_SET_ALL else 3
+        self.set_pv = set_fields == lp.BODY_SET_ALL  # positions and velocities set too
         self.body_ptrs, self.direct_why = self._direct_bodies(bodies, set_fields)
 
     def _direct_bodies(self, bodies, set_fields):
-        """(body addresses, None) when :func:`advance` can write the set buffer into the bodies
-        directly, else (empty, why not): :func:`body_layout` holds, the set buffer holds p, v, f, t or
-        f, t, and ``bodies`` are in the order of the batched read (checked on their p and v)."""
+        """(body addresses, None) when :func:`advance` can write the step's states and forces into the
+        bodies directly, else (empty, why not): :func:`body_layout` holds, the set fields are p, v, f, t
+        or f, t, and ``bodies`` are in the order of the batched read (checked on their p and v)."""
         none = np.zeros(0, dtype=np.int64)
         if set_fields not in (lp.BODY_SET_ALL, lp.BODY_SET_FORCE):
             return none, f"set fields {set_fields!r}"
@@ -330,7 +332,7 @@ class BatchIO:
         """Run :func:`advance` until it returns a code."""
         return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
                        self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
-                       self.set_stride, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
+                       self.set_pv, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
                        inp, wk, acc, ls)
 
 
@@ -352,29 +354,28 @@ def _as_float_ptr(typingctx, address):
 
 
 @njit(cache=True, inline="always")
-def _write_bodies(body_ptrs, set_arr, stride):
-    """Write the set buffer into the bodies: rows of (p, v, f, t) (``stride`` 7) or (f, t) (3).
+def _write_bodies(body_ptrs, state, out_f, set_pv):
+    """Write each body's force and torque (``out_f`` rows of (fx, fy, t)) and, when ``set_pv``, its
+    position and velocity (``state`` rows of (x, y, angle, vx, vy, omega)) into its ``cpBody``.
 
     What pymunk's batched setter does through ``cpBodySetPosition`` and the others, without their
-    calls: the step's position update recomputes each body's transform from p before anything reads
-    it, and nothing in the space sleeps."""
+    calls or a packed buffer: the step's position update recomputes each body's transform from p
+    before anything reads it, and nothing in the space sleeps."""
     for k in range(body_ptrs.shape[0]):
         b = carray(_as_float_ptr(body_ptrs[k]), _BODY_PROBE_DOUBLES)
-        r = k * stride
-        if stride == 7:
-            b[BODY_P] = set_arr[r]
-            b[BODY_P + 1] = set_arr[r + 1]
-            b[BODY_V] = set_arr[r + 2]
-            b[BODY_V + 1] = set_arr[r + 3]
-            r += 4
-        b[BODY_F] = set_arr[r]
-        b[BODY_F + 1] = set_arr[r + 1]
-        b[BODY_T] = set_arr[r + 2]
+        if set_pv:
+            b[BODY_P] = state[k, 0]
+            b[BODY_P + 1] = state[k, 1]
+            b[BODY_V] = state[k, 3]
+            b[BODY_V + 1] = state[k, 4]
+        b[BODY_F] = out_f[3 * k]
+        b[BODY_F + 1] = out_f[3 * k + 1]
+        b[BODY_T] = out_f[3 * k + 2]
 
 
 @njit(cache=True)
 def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
-            body_ptrs, set_stride, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
+            body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
@@ -383,8 +384,10 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     ``joint_ptrs``: the rigid raceways' joints (``cpConstraint *``), whose impulses over ``h`` are the
     outer-race forces written into ``wk.n_out`` after each step (empty with Hertz contacts);
     ``shape_ptrs``: the rollers' circles (``cpShape *``), whose elasticity is set for the next step when
-    ``inp.onset_restitution`` (:func:`~bearingsim.multibody.loop.onset_elasticity`). ``inp``,
-    ``wk``, ``acc``, ``ls``: those of the step kernels.
+    ``inp.onset_restitution`` (:func:`~bearingsim.multibody.loop.onset_elasticity`). ``body_ptrs``:
+    the bodies (``cpBody *``, state order) that :func:`_write_bodies` writes, or empty for pymunk's
+    batched setter; ``set_pv``: their positions and velocities are set too, not only their forces.
+    ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
     cap0 = hdr.state0[1]
@@ -396,12 +399,15 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     h = inp.h
     while True:
         cur = s.cur
-        code = lp.before_step(st0 if cur == 0 else st1, inp, wk, ls)
+        prev = st0 if cur == 0 else st1
+        code = lp.before_step(prev, inp, wk, ls)
         if code != lp.CODE_CONTINUE:
             return code
         if body_ptrs.shape[0]:
-            _write_bodies(body_ptrs, wk.set_arr, set_stride)
+            _write_bodies(body_ptrs, prev, wk.out_f, set_pv)
         else:
+            if set_pv:
+                lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])
             hdr.set[0] = 0  # the setter reads the buffer from the start
             each_body_fn(sp, ptr.body_set, ptr.data_set)
         if timed:

@@ -142,7 +142,7 @@ class StepWork(NamedTuple):
     ring_v: np.ndarray  #: (2,) inner-ring velocity (dynamic ring) [m/s]
     hold: np.ndarray  #: (n,) bool, rollers held this step
     out_f: np.ndarray  #: (nb * 3,) (fx, fy, torque) per body [N, N m]
-    set_arr: np.ndarray  #: the buffer pymunk's batched setter reads (is ``out_f`` in the full scene)
+    set_arr: np.ndarray  #: the buffer pymunk's batched setter reads (is ``out_f`` when only forces are set; else :func:`pack_all` fills it)
     diag: np.ndarray  #: (n,) :data:`bearingsim.multibody.forces.DIAG`
     smp: np.ndarray  #: (block,) :data:`SAMPLE`
     orbit: np.ndarray  #: (keep, 3) ring buffer of (t [s], x [m], y [m]) of the cage centre
@@ -182,7 +182,10 @@ def _hold_rollers(state, n, sign, rule, pocket_a, hold):
 
 
 @njit(cache=True)
-def _pack_all(state, out_f, set_arr, nb):
+def pack_all(state, out_f, set_arr, nb):
+    """Fill pymunk's batched setter's buffer of :data:`BODY_SET_ALL` rows (p, v, f, t) from the states
+    (positions and velocities that the step's rules set: held rollers, rollers on a rigid race) and the
+    forces."""
     a = set_arr.reshape(nb, 7)
     a[:, 0:2] = state[:, 0:2]
     a[:, 2:4] = state[:, 3:5]
@@ -243,7 +246,8 @@ def before_step(prev, inp, wk, ls):
     prev : (nb, 6) body states before the step (x [m], y [m], angle [rad], vx [m/s], vy [m/s],
         omega [rad/s]); held rollers are overwritten.
     inp : :class:`StepInputs`.
-    wk : :class:`StepWork`; ``set_arr`` receives what pymunk's batched setter reads.
+    wk : :class:`StepWork`; ``out_f`` receives the bodies' forces (the loop hands them, and ``prev``'s
+        positions and velocities where the scene sets those, to pymunk).
     ls : (1,) :data:`LOOP_STATE`.
     """
     s = ls[0]
@@ -274,8 +278,6 @@ def before_step(prev, inp, wk, ls):
         s.ring_sum_x += wk.ring_c[0]
         s.ring_sum_y += wk.ring_c[1]
         s.ring_n += 1.0
-    if inp.hold_rule.active or inp.prm.rigid:  # positions and velocities set by the step's rules too
-        _pack_all(prev, wk.out_f, wk.set_arr, n + 1)
     return CODE_CONTINUE
 
 
@@ -405,6 +407,8 @@ class PlainLoop:
             code = before_step(self.states[cur], inp, wk, ls)
             if code != CODE_CONTINUE:
                 return code
+            if self.set_fields == BODY_SET_ALL:
+                pack_all(self.states[cur], wk.out_f, wk.set_arr, self.nb)
             pb.set_space_bodies(self.space, self.set_fields, self._set)
             t0 = time.perf_counter_ns()
             self.space.step(h)

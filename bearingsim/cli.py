@@ -6,6 +6,7 @@ that goes numerically unstable exits 3 and writes no archive.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import signal
 import sys
@@ -313,6 +314,50 @@ def _raise_terminated(signum, frame):
     raise Terminated()
 
 
+#: delay before a signal whose exception could not be raised is set pending again [s] (callbacks
+#: such as weakref callbacks take microseconds; the signal tests allow a second to stop)
+REDELIVER_AFTER_S = 0.02
+
+
+@contextlib.contextmanager
+def _interrupts_redelivered():
+    """Deliver again a SIGINT or SIGTERM whose exception Python could not raise.
+
+    A signal's handler runs wherever the main thread is. If that is a weakref callback or a
+    ``__del__``, Python cannot propagate its ``KeyboardInterrupt`` (or :class:`Terminated`): the
+    exception is "unraisable", printed with a traceback, and the command would go on as if no signal had
+    come (one possible cause of a test's 200-rotation run not stopping within 30 s of SIGINT, seen once on
+    a busy machine). While the command runs,
+    ``sys.unraisablehook`` hands such an exception's signal back to the main thread: a helper thread
+    sets it pending (``_thread.interrupt_main``) ``REDELIVER_AFTER_S`` later, when the main thread has
+    left the callback (the hook runs inside it, and a signal set pending at once would raise into the
+    hook), and the handler raises it again there; a signal that lands in a callback again comes back
+    again. Every other unraisable exception goes to the previous hook."""
+    import _thread
+    import threading
+    import time
+
+    previous = sys.unraisablehook
+
+    def deliver(signum):
+        time.sleep(REDELIVER_AFTER_S)
+        _thread.interrupt_main(signum)
+
+    def hook(unraisable):
+        exc = unraisable.exc_value
+        if isinstance(exc, KeyboardInterrupt):
+            signum = signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
+            threading.Thread(target=deliver, args=(signum,), daemon=True).start()
+        else:
+            previous(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
+
+
 def _one_line(exc: BaseException) -> str:
     from bearingsim.outputs import printable
 
@@ -333,7 +378,8 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
         pass
     try:
-        return args.func(args)
+        with _interrupts_redelivered():
+            return args.func(args)
     except UserError as exc:
         line = f"bearingsim: error: {_one_line(exc)}"
         fd = getattr(exc, "stderr_fd", None)

@@ -499,6 +499,42 @@ def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     assert not obs.problems, obs.problems
 
 
+def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch):
+    """A SIGTERM whose handler runs inside a weakref callback: Python cannot raise its ``Terminated``
+    there (it is "unraisable"). While a command runs, the CLI hands the signal back to the main thread,
+    so ``Terminated`` is raised again in the command's own code, and nothing goes to the previous hook;
+    another unraisable exception does, and the hook is restored afterwards. (The handler is called
+    inside the callback directly, which is where the signal would have run it.)"""
+    import weakref
+
+    from bearingsim import cli
+
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda u: seen.append(type(u.exc_value)))
+    hook = sys.unraisablehook
+    previous = signal.signal(signal.SIGTERM, cli._raise_terminated)
+
+    class Thing:
+        pass
+
+    try:
+        with cli._interrupts_redelivered():
+            b = Thing()
+            ref_b = weakref.ref(b, lambda r: 1 / 0)
+            del b
+            with pytest.raises(cli.Terminated):
+                a = Thing()
+                ref_a = weakref.ref(a, lambda r: cli._raise_terminated(signal.SIGTERM, None))
+                del a
+                deadline = time.monotonic() + 5.0  # the helper thread runs at the next thread switch (5 ms)
+                while time.monotonic() < deadline:
+                    pass
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    assert seen == [ZeroDivisionError]
+    assert sys.unraisablehook is hook and ref_a() is None and ref_b() is None
+
+
 def _start_long_run(tmp_path):
     """A multibody run into ``tmp_path/m.h5`` long enough to be caught writing; returned once its
     temporary archive exists (or after 120 s, or if it ended)."""
@@ -634,7 +670,10 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
     lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
               "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
               "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "
-              "into that folder), and unit tests of `bearingsim/plausibility.py` (the Palmgren displacement bound, "
+              "into that folder), a SIGTERM whose handler runs inside a weakref callback (Python cannot raise "
+              "its exception there; the command gets the signal again and stops, with no traceback; "
+              "`tests/test_sweep.py` checks the same for a sweep), and unit tests of "
+              "`bearingsim/plausibility.py` (the Palmgren displacement bound, "
               "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
               "refused above)."]
     path.write_text("\n".join(lines) + "\n")

@@ -118,10 +118,17 @@ class _Lock:
 
 class _Signals:
     """SIGINT/SIGTERM raise :class:`SweepInterrupted` once in the main thread; later ones are ignored
-    while the sweep cleans up."""
+    while the sweep cleans up.
+
+    A signal can land while Python runs a callback whose exceptions it cannot propagate (a weakref
+    callback, a ``__del__``): the exception is then "unraisable", and the sweep sees ``fired`` instead
+    (the engines poll it, :func:`run_sweep` checks it after every batch). Python would print such an
+    exception with its traceback (a clean-clone CI run saw one, from ``weakref.py``); while the handlers
+    are in, ``sys.unraisablehook`` drops :class:`SweepInterrupted` and passes everything else on."""
 
     def __init__(self):
         self.old = {}
+        self.old_hook = None
         self.fired: int | None = None
 
     def _handler(self, signum, frame):
@@ -129,15 +136,24 @@ class _Signals:
             self.fired = signum
             raise SweepInterrupted(signum)
 
+    def _unraisable(self, unraisable):
+        if not isinstance(unraisable.exc_value, SweepInterrupted):
+            self.old_hook(unraisable)
+
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
             for s in (signal.SIGINT, signal.SIGTERM):
                 self.old[s] = signal.signal(s, self._handler)
+            self.old_hook = sys.unraisablehook
+            sys.unraisablehook = self._unraisable
         return self
 
     def __exit__(self, *exc):
         for s, h in self.old.items():
             signal.signal(s, h)
+        if self.old_hook is not None:
+            sys.unraisablehook = self.old_hook
+            self.old_hook = None
         return False
 
 

@@ -396,6 +396,90 @@ def test_direct_body_writes_give_the_batched_setter_s_numbers(scenario, extra, m
         assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
 
 
+@pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
+@pytest.mark.parametrize("scenario, extra", [("multibody_6000rpm", ["multibody.raceway_contact=rigid"]),
+                                             ("multibody_3000rpm", ["multibody.flat_pockets=[0, 5]"]),
+                                             ("multibody_reduced_equivalent_3000rpm", [])])
+def test_narrowed_face_masks_change_no_number(scenario, extra, monkeypatch):
+    """The compiled loop narrows each roller's collision mask, before each step, to the face segments it
+    can touch in that step (``loop.face_masks``); chipmunk then skips the narrow-phase tests of the
+    others. A segment left out could not have touched the roller, so every number is the same bytes as
+    with the full masks (rigid raceways, flat pockets, the held rollers of the reduced-equivalent scene).
+    The plain loop never narrows them: ``test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit``
+    checks the same from the other side."""
+    sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
+    assert chipmunk.mask_layout() is None
+    narrowed = run(si(sc), step_loop="compiled")
+    assert "face masks" not in narrowed["step_loop_reason"]
+    monkeypatch.setattr(chipmunk, "mask_layout", lambda: "a layout the probe did not find")
+    full = run(si(sc), step_loop="compiled")
+    assert "face masks not narrowed (a layout the probe did not find)" in full["step_loop_reason"]
+    assert len(full["impacts"]) > 0
+    for key in COMPARED:
+        a, b = np.asarray(narrowed[key]), np.asarray(full[key])
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+
+
+def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-5):
+    """face_masks for a 4-pocket scene with the roller of pocket 0 at ``q`` (cage frame, relative to its
+    pocket centre, after the step's position update), the cage at the origin turned by ``cage_angle``."""
+    from types import SimpleNamespace
+
+    from bearingsim.multibody import loop as lp
+    from bearingsim.multibody.core import face_geometry
+    from bearingsim.multibody.scene import build_scene
+
+    geo = SimpleNamespace(roller_count=4, roller_radius=0.01, pitch_radius=0.05, pocket_clearance=0.001,
+                          roller_mass=0.1, roller_inertia=1e-5, cage_mass=1.0, cage_inertia=1e-3)
+    op = SimpleNamespace(sign=1, gravity=0.0, omega_c=0.0, omega_r=0.0)
+    sc = build_scene(geo, op, 0.5, 0.1, half_angle=math.radians(45.0), n_seg=5, kinematic_cage=False,
+                     spin_free=True)
+    fm = face_geometry(sc, 0.01, lp.MASK_MARGIN_M)
+    a1 = cage_angle + cage_w * h  # where the position update turns the cage
+    c, s = math.cos(a1), math.sin(a1)
+    p_cage = sc.pocket_centres[0] + np.asarray(q)  # cage frame
+    p_world = np.array([c * p_cage[0] - s * p_cage[1], s * p_cage[0] + c * p_cage[1]])
+    state = np.zeros((5, 6))
+    for i in range(1, 4):  # the other rollers at their pocket centres (turned with the cage)
+        x, y = sc.pocket_centres[i]
+        state[i, 0:2] = (c * x - s * y, s * x + c * y)
+    # positions before the step, such that p + (v + v_bias) h lands where wanted
+    vb = np.zeros((5, 3))
+    vb[0, 0:2] = vb_roller
+    state[0, 3:5] = (0.2, -0.1)
+    state[0, 0:2] = p_world - (state[0, 3:5] + vb[0, 0:2]) * h
+    state[4, 2] = cage_angle
+    state[4, 5] = cage_w
+    want = np.zeros(4, dtype=np.uint32)
+    lp.face_masks.py_func(state, vb, h, fm, want)
+    return want, sc
+
+
+def test_face_masks_keep_exactly_the_segments_within_reach():
+    """face_masks against the geometry (R = r + s/2 = 10.5 mm, 5 segments a face, 18 deg each; the
+    central segment of the front face is tangent to the arc at R along e_t): a roller centred in its
+    pocket touches nothing (mask 0); pressed 1 um into the central front segment it has that segment's
+    bit and no other (the neighbouring segments bend away from it); 1 um short of it, nothing; the same contact
+    reached through a bias velocity, or with the cage turned and turning, is found the same way. The
+    other rollers, centred, have 0."""
+    from bearingsim.multibody.scene import segment_bit
+
+    e_t0 = np.array([1.0, 0.0])  # pocket 0 sits at the bottom: its front (e_t, sign +1) is +x
+    centre, _ = _one_pocket_masks((0.0, 0.0))
+    assert centre.tolist() == [0, 0, 0, 0]
+    gap = 0.0005  # s / 2: the roller touches the front face when moved by it along e_t
+    into, _ = _one_pocket_masks(tuple((gap + 1e-6) * e_t0))
+    assert into[0] == segment_bit(0, 2, 5) and into[1:].tolist() == [0, 0, 0]
+    short, _ = _one_pocket_masks(tuple((gap - 1e-6) * e_t0))
+    assert short[0] == 0
+    rear, _ = _one_pocket_masks(tuple(-(gap + 1e-6) * e_t0))
+    assert rear[0] == segment_bit(1, 2, 5)
+    by_bias, _ = _one_pocket_masks(tuple((gap + 1e-6) * e_t0), vb_roller=(3.0, -1.0))
+    assert by_bias[0] == segment_bit(0, 2, 5)
+    turned, _ = _one_pocket_masks(tuple((gap + 1e-6) * e_t0), cage_angle=0.7, cage_w=300.0)
+    assert turned[0] == segment_bit(0, 2, 5)
+
+
 def test_plain_loop_is_chosen_by_the_environment(monkeypatch):
     """``BEARINGSIM_PLAIN_PYMUNK=1`` selects the plain loop without a keyword."""
     import pymunk

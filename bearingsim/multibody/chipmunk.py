@@ -101,6 +101,47 @@ BODY_P, BODY_V, BODY_F, BODY_T = 8, 10, 12, 16
 _BODY_PROBE_DOUBLES = BODY_T + 1
 
 
+#: chipmunk 7's ``struct cpBody`` holds the bias velocities (v_bias (2), w_bias) of the overlap correction
+#: here (float64 indices); ``struct cpShape`` holds its filter's mask here (uint32 index); checked by :func:`mask_layout`
+BODY_VBIAS, BODY_WBIAS = 24, 26
+SHAPE_MASK = 41
+
+
+@functools.lru_cache(maxsize=1)
+def mask_layout() -> str | None:
+    """None when a ``cpShape``'s filter mask and a ``cpBody``'s bias velocities are where :func:`advance`
+    reads and writes them (for the narrowed face masks), else why not. Once per process.
+
+    The mask: set through pymunk, read back from the struct, then written into the struct and read
+    through pymunk. The bias velocities: a circle left overlapping a static segment by 0.1 m gets
+    ``v_bias = 0.1 / dt`` from chipmunk's overlap correction in one step, which the next step's position
+    update adds to its velocity (``p + (v + v_bias) dt``)."""
+    b = pymunk.Body(1.0, 1.0)
+    c = pymunk.Circle(b, 1.0)
+    c.filter = pymunk.ShapeFilter(group=0, categories=0x5A5A5A5A, mask=0x3C3C3C3C)
+    u = np.frombuffer(ffi.buffer(c._shape, 4 * (SHAPE_MASK + 1)), dtype=np.uint32)
+    if u[SHAPE_MASK - 1] != 0x5A5A5A5A or u[SHAPE_MASK] != 0x3C3C3C3C:
+        return "pymunk's cpShape does not hold its filter where chipmunk 7 does"
+    u[SHAPE_MASK] = 0x0F0F0F0F
+    if c.filter.mask != 0x0F0F0F0F or c.filter.categories != 0x5A5A5A5A:
+        return "pymunk's cpShape does not hold its filter where chipmunk 7 does"
+    space = pymunk.Space()
+    space.collision_bias = 0.0
+    space.collision_slop = 0.0
+    body = pymunk.Body(1.0, 1.0)
+    body.position = (0.0, 0.9)
+    space.add(body, pymunk.Circle(body, 1.0), pymunk.Segment(space.static_body, (-5.0, 0.0), (5.0, 0.0), 0.0))
+    dt = 0.01
+    space.step(dt)
+    d = np.frombuffer(ffi.buffer(body._body, 8 * (BODY_WBIAS + 1)), dtype=np.float64).copy()
+    p1, v1 = body.position, body.velocity
+    space.step(dt)
+    moved = (body.position.y - p1.y) / dt - v1.y
+    if not (abs(d[BODY_VBIAS + 1] - 10.0) < 1e-6 and abs(moved - d[BODY_VBIAS + 1]) < 1e-6):
+        return "pymunk's cpBody does not hold its bias velocities where chipmunk 7 does"
+    return None
+
+
 @functools.lru_cache(maxsize=1)
 def body_layout() -> str | None:
     """None when a ``cpBody`` holds p, v, f and t where :func:`advance` writes them, else why not.
@@ -117,7 +158,8 @@ def body_layout() -> str | None:
     return None
 
 
-def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=(), bodies=()):
+def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=(), bodies=(),
+                   masks=None):
     """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
 
     Parameters
@@ -134,6 +176,9 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
         ``StepInputs.onset_restitution``).
     bodies : the space's bodies in the order of its batched read (rollers, then the cage): the compiled
         loop writes the set buffer into them directly (:class:`BatchIO`); empty: pymunk's batched setter.
+    masks : :class:`bearingsim.multibody.loop.FaceMasks` of the scene: the compiled loop narrows the
+        rollers' collision masks (when it writes the bodies directly and :func:`mask_layout` holds);
+        None: it does not (the plain loop never does: the same contacts, more narrow-phase tests).
     """
     if step_loop not in (None, "compiled", "plain"):
         raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
@@ -153,9 +198,11 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
         reason = "asked for"
     if step_loop == "plain":
         return lp.PlainLoop(space, nb, set_fields, set_arr, joints, roller_shapes), reason
-    io = BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes, bodies)
+    io = BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes, bodies, masks)
     if io.direct_why is not None:
         reason += f"; bodies set through pymunk's batched setter ({io.direct_why})"
+    if io.masks_why is not None:
+        reason += f"; face masks not narrowed ({io.masks_why})"
     return io, reason
 
 
@@ -242,7 +289,7 @@ class BatchIO:
 
     name = "compiled"
 
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=(), bodies=()):
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=(), bodies=(), masks=None):
         self.nb = nb
         self._space = space._space
         self.impulse_fn = _chipmunk("cpConstraintGetImpulse", _IMPULSE_SIG)
@@ -298,6 +345,24 @@ class BatchIO:
         )
         self.set_pv = set_fields == lp.BODY_SET_ALL  # positions and velocities set too
         self.body_ptrs, self.direct_why = self._direct_bodies(bodies, set_fields)
+        self.fm, self.masks_why = self._face_masks(masks)
+        self.mask_now = np.array([c.filter.mask for c in self._shapes], dtype=np.uint32)  # as the shapes have them
+        self.mask_want = self.mask_now.copy()
+        self.vb = np.zeros((nb, 3))  # the bodies' bias velocities before a step
+
+    def _face_masks(self, masks):
+        """(masks, None) when :func:`advance` narrows the rollers' masks, else (inactive masks, why not)."""
+        off = lp.FaceMasks(False, np.zeros((0, 0, 5)), np.zeros((0, 0), dtype=np.uint32), np.zeros((0, 2)), -1.0, 0.0)
+        if masks is None or not masks.active:
+            return off, "the scene's face segments share one category"
+        if self.body_ptrs.shape[0] == 0:
+            return off, "bodies not written directly"
+        if len(self._shapes) != masks.bits.shape[0]:
+            return off, "no roller shapes given"
+        why = mask_layout()
+        if why is not None:
+            return off, why
+        return masks, None
 
     def _direct_bodies(self, bodies, set_fields):
         """(body addresses, None) when :func:`advance` can write the step's states and forces into the
@@ -333,7 +398,7 @@ class BatchIO:
         return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
                        self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
                        self.set_pv, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
-                       inp, wk, acc, ls)
+                       self.fm, self.vb, self.mask_now, self.mask_want, inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -351,6 +416,33 @@ def _as_float_ptr(typingctx, address):
         return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
 
     return sig, codegen
+
+
+@intrinsic
+def _as_u32_ptr(typingctx, address):
+    """An int64 address as a ``uint32 *`` (for :func:`numba.carray`)."""
+    sig = types.CPointer(types.uint32)(types.int64)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.uint32)))
+
+    return sig, codegen
+
+
+@njit(cache=True, inline="always")
+def _narrow_masks(body_ptrs, shape_ptrs, state, h, fm, vb, now, want):
+    """Read the bodies' bias velocities, compute the rollers' masks for the coming step
+    (:func:`bearingsim.multibody.loop.face_masks`) and write those that changed into their ``cpShape``."""
+    for k in range(body_ptrs.shape[0]):
+        b = carray(_as_float_ptr(body_ptrs[k]), BODY_WBIAS + 1)
+        vb[k, 0] = b[BODY_VBIAS]
+        vb[k, 1] = b[BODY_VBIAS + 1]
+        vb[k, 2] = b[BODY_WBIAS]
+    lp.face_masks(state, vb, h, fm, want)
+    for i in range(shape_ptrs.shape[0]):
+        if want[i] != now[i]:
+            carray(_as_u32_ptr(shape_ptrs[i]), SHAPE_MASK + 1)[SHAPE_MASK] = want[i]
+            now[i] = want[i]
 
 
 @njit(cache=True, inline="always")
@@ -375,7 +467,7 @@ def _write_bodies(body_ptrs, state, out_f, set_pv):
 
 @njit(cache=True)
 def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
-            body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, inp, wk, acc, ls):
+            body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
@@ -387,7 +479,9 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     ``inp.onset_restitution`` (:func:`~bearingsim.multibody.loop.onset_elasticity`). ``body_ptrs``:
     the bodies (``cpBody *``, state order) that :func:`_write_bodies` writes, or empty for pymunk's
     batched setter; ``set_pv``: their positions and velocities are set too, not only their forces.
-    ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
+    ``fm``: :class:`~bearingsim.multibody.loop.FaceMasks`; when active, the rollers' masks are narrowed
+    before each step (:func:`_narrow_masks`; ``vb``, ``mask_now``, ``mask_want``: its scratch and the
+    masks the shapes have). ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
     cap0 = hdr.state0[1]
@@ -405,6 +499,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             return code
         if body_ptrs.shape[0]:
             _write_bodies(body_ptrs, prev, wk.out_f, set_pv)
+            if fm.active:
+                _narrow_masks(body_ptrs, shape_ptrs, prev, h, fm, vb, mask_now, mask_want)
         else:
             if set_pv:
                 lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])

@@ -325,6 +325,22 @@ def check_rigid(p):
             f"below {rigid_speed_floor(p):.0f} rpm")
 
 
+def face_geometry(sc, rr, margin):
+    """:class:`bearingsim.multibody.loop.FaceMasks` of the scene's pocket faces for a roller of radius
+    ``rr`` [m] and a margin [m]; None when the segments share one category bit (too many for a bit each)."""
+    if sc.face_bits is None:
+        return None
+    fs = sc.face_segments
+    ends = fs[..., 2:4] - fs[..., 0:2]
+    e2 = np.sum(ends * ends, axis=-1)
+    inv = np.divide(1.0, e2, out=np.zeros_like(e2), where=e2 > 0.0)  # unused rows: bit 0, never tested
+    reach = rr + margin
+    clear = sc.pocket_radius - rr - margin
+    return lp.FaceMasks(True, np.concatenate([fs[..., 0:2], ends, inv[..., None]], axis=-1), sc.face_bits,
+                        np.ascontiguousarray(sc.pocket_centres, dtype=np.float64),
+                        clear * clear if clear > 0.0 else -1.0, reach * reach)
+
+
 def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
         step_loop=None):
     """Run the parameters ``p``; return a dict of raw accumulators (see :class:`MultibodyResult`).
@@ -436,8 +452,9 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         n_extra=np.zeros(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
+    masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
     io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
-                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage])
+                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks)
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot

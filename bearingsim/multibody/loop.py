@@ -134,6 +134,23 @@ class StepInputs(NamedTuple):
     restitution: float = 0.0  #: e of the roller shapes [-]
 
 
+#: the narrowed masks keep a face segment whose distance from the roller's circle after pymunk's position
+#: update is below this [m]: rounding of the same arithmetic is ~1e-17 m, contact needs distance < 0
+MASK_MARGIN_M = 1.0e-9
+
+
+class FaceMasks(NamedTuple):
+    """Compiled loop: each roller's collision mask narrowed, before each step, to the face segments of its
+    pocket that it can touch in that step (:func:`face_masks`)."""
+
+    active: bool  #: narrow the masks (else every roller keeps all face segments)
+    seg: np.ndarray  #: (n, S, 5) each pocket's face segments in the cage frame: start (ax, ay) [m], b - a (ex, ey) [m], 1 / |b - a|^2 [1/m^2]
+    bits: np.ndarray  #: (n, S) uint32 category bit of each segment (0: no segment)
+    centre: np.ndarray  #: (n, 2) pocket centres in the cage frame [m]
+    clear2: float  #: (R - r - margin)^2 [m^2]: a roller centre closer to its pocket centre touches no face (R: the faces' inscribed radius); -1: never
+    reach2: float  #: (r + margin)^2 [m^2]: a segment closer to the roller centre may be touched
+
+
 class StepWork(NamedTuple):
     """Arrays the step kernels write, besides the recorder's accumulators."""
 
@@ -235,6 +252,52 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
             if row < n:
                 wk.e_want[row] = 0.0
                 wk.touched[row] = True  # the recorder counts its next contact step as this contact
+
+
+@njit(cache=True, inline="always")
+def face_masks(state, vb, h, fm, want):
+    """The collision mask of each roller for the coming step, into ``want`` (uint32): the category bits
+    of the face segments of its pocket within ``MASK_MARGIN_M`` of its circle where chipmunk's position
+    update will put roller and cage, ``p + (v + v_bias) h`` and ``a + (w + w_bias) h`` (the same
+    arithmetic; ``vb``: (nb, 3) the bodies' bias velocities (vx, vy, w) left by the last step's overlap
+    correction). chipmunk finds contacts after that update and only between overlapping shapes (circle
+    to segment: distance below the radius), so a segment left out could not have touched the roller in
+    this step: the masks change no contact and no number, they only spare the narrow-phase tests.
+
+    A roller centre closer than ``R - r`` to its pocket centre touches no face (every face point is at
+    least ``R`` from it: the polyline circumscribes the arc, a flat face is a plane at ``R``), so most
+    rollers need one distance; the others are tested against each segment of their pocket. A roller
+    stays in its own pocket (it would have to pass through a face)."""
+    n = want.shape[0]
+    cx = state[n, 0] + (state[n, 3] + vb[n, 0]) * h
+    cy = state[n, 1] + (state[n, 4] + vb[n, 1]) * h
+    a = state[n, 2] + (state[n, 5] + vb[n, 2]) * h
+    c = math.cos(a)
+    s = math.sin(a)
+    seg = fm.seg
+    for i in range(n):
+        px = state[i, 0] + (state[i, 3] + vb[i, 0]) * h - cx
+        py = state[i, 1] + (state[i, 4] + vb[i, 1]) * h - cy
+        qx = c * px + s * py  # in the cage frame
+        qy = -s * px + c * py
+        dx = qx - fm.centre[i, 0]
+        dy = qy - fm.centre[i, 1]
+        m = np.uint32(0)
+        if dx * dx + dy * dy >= fm.clear2:
+            for j in range(seg.shape[1]):
+                bit = fm.bits[i, j]
+                if bit == 0:
+                    continue
+                ax = seg[i, j, 0]
+                ay = seg[i, j, 1]
+                ex = seg[i, j, 2]
+                ey = seg[i, j, 3]
+                t = min(max(((qx - ax) * ex + (qy - ay) * ey) * seg[i, j, 4], 0.0), 1.0)
+                ux = ax + t * ex - qx
+                uy = ay + t * ey - qy
+                if ux * ux + uy * uy < fm.reach2:
+                    m |= bit
+        want[i] = m
 
 
 @njit(cache=True, inline="always")

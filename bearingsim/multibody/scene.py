@@ -23,7 +23,12 @@ any radial position the roller takes (raceway clearance and cage eccentricity ar
 millimetre). It pushes only circumferentially: it does not guide the cage radially.
 
 Collision filtering: rollers collide only with the cage. Elasticities are ``e`` on the roller and 1 on
-the cage (pymunk multiplies them), friction likewise ``cage_friction`` and 1.
+the cage (pymunk multiplies them), friction likewise ``cage_friction`` and 1. Each face segment has a
+category bit of its own (the same for the same segment of every pocket: face ``f`` (0 front, 1 rear),
+segment ``k``: bit ``1 + f n_seg + k``), and a roller's mask holds all of them; the compiled step loop
+narrows a roller's mask, step by step, to the segments of its pocket that it can touch in that step
+(:func:`bearingsim.multibody.loop.face_masks`), which spares chipmunk the narrow-phase tests of the
+others and changes no contact.
 """
 from __future__ import annotations
 
@@ -34,7 +39,7 @@ import numpy as np
 import pymunk
 
 ROLLER_CATEGORY = 0b01
-CAGE_CATEGORY = 0b10
+CAGE_CATEGORY = 0b10  # every face segment when there are too many for a bit each (then no narrowed masks)
 
 
 @dataclass
@@ -49,6 +54,21 @@ class Scene:
     face_vertices: list  # [pocket][face] polyline vertices (k + 1, 2) in the cage frame [m]
     body_ids: np.ndarray  # (n + 1,) pymunk body ids in batch order (rollers, then cage)
     joints: list = field(default_factory=list)  # rigid raceways: each roller's outer-race joint, in roller order
+    #: (n, S, 4) each pocket's face segments (ax, ay, bx, by) in the cage frame [m], S = 2 n_seg (unused rows 0)
+    face_segments: np.ndarray | None = None
+    #: (n, S) uint32 category bit of each segment (0: no segment); None: the segments share ``CAGE_CATEGORY``
+    face_bits: np.ndarray | None = None
+    pocket_centres: np.ndarray | None = None  # (n, 2) pocket centres in the cage frame [m]
+
+
+def segment_bit(face: int, k: int, n_seg: int) -> int:
+    """Category bit of segment ``k`` of face ``face`` (0 front, 1 rear) of a pocket: ``1 << (1 + face n_seg + k)``."""
+    return 1 << (1 + face * n_seg + k)
+
+
+def own_bits(n_seg: int) -> bool:
+    """Whether each face segment can have a category bit of its own (chipmunk's masks are 32 bits)."""
+    return 1 + 2 * n_seg <= 32
 
 
 def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
@@ -123,7 +143,9 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     omega_cage = sign * op.omega_c
     spin = sign * (op.omega_c - op.omega_r)  # absolute roller spin in pure rolling, Eq. (11)-(12)
     rollers = []
-    roller_filter = pymunk.ShapeFilter(categories=ROLLER_CATEGORY, mask=CAGE_CATEGORY)
+    bits_each = own_bits(n_seg)
+    all_faces = sum(segment_bit(f, k, n_seg) for f in (0, 1) for k in range(n_seg)) if bits_each else CAGE_CATEGORY
+    roller_filter = pymunk.ShapeFilter(categories=ROLLER_CATEGORY, mask=all_faces)
     for i in range(n):
         moment = geometry.roller_inertia if spin_free else float("inf")
         b = pymunk.Body(geometry.roller_mass, moment)
@@ -144,16 +166,19 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     cage.position = (0.0, 0.0)
     cage.angle = 0.0
     cage.angular_velocity = float(omega_cage)
-    cage_filter = pymunk.ShapeFilter(categories=CAGE_CATEGORY, mask=ROLLER_CATEGORY)
     verts = []
     flat = set(int(i) for i in flat_pockets)
     shapes = []
+    seg_ends = np.zeros((n, 2 * n_seg, 4))
+    seg_bits = np.zeros((n, 2 * n_seg), dtype=np.uint32)
+    centres = np.zeros((n, 2))
     for i in range(n):
         c = np.array([rp * math.cos(a[i]), rp * math.sin(a[i])])
+        centres[i] = c
         e_r = np.array([math.cos(a[i]), math.sin(a[i])])
         e_t = sign * np.array([-math.sin(a[i]), math.cos(a[i])])
         verts.append([])
-        for direction in (e_t, -e_t):  # front, rear
+        for f, direction in enumerate((e_t, -e_t)):  # front, rear
             if i in flat:
                 pts = np.array([c + R * direction - R * e_r, c + R * direction + R * e_r])
             else:
@@ -163,7 +188,10 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
                 seg = pymunk.Segment(cage, tuple(pts[k]), tuple(pts[k + 1]), 0.0)
                 seg.elasticity = 1.0
                 seg.friction = 1.0
-                seg.filter = cage_filter
+                bit = segment_bit(f, k, n_seg) if bits_each else CAGE_CATEGORY
+                seg.filter = pymunk.ShapeFilter(categories=bit, mask=ROLLER_CATEGORY)
+                seg_ends[i, f * n_seg + k] = (*pts[k], *pts[k + 1])
+                seg_bits[i, f * n_seg + k] = bit
                 shapes.append(seg)
     space.add(cage, *shapes)
     if centred_cage and not kinematic_cage:
@@ -184,4 +212,4 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
             joints.append(j)
         space.add(*joints)
     ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
-    return Scene(space, rollers, cage, a, R, verts, ids, joints)
+    return Scene(space, rollers, cage, a, R, verts, ids, joints, seg_ends, seg_bits if bits_each else None, centres)

@@ -420,6 +420,65 @@ def test_narrowed_face_masks_change_no_number(scenario, extra, monkeypatch):
         assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
 
 
+@pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
+@pytest.mark.parametrize("extra", [[], ["multibody.scene=reduced_equivalent"], ["bearing.cage_guidance=inner_land",
+                                                                             "operating.inner_ring_speed_rpm=3000"]])
+def test_joints_solved_outside_pymunk_change_no_number(extra, monkeypatch):
+    """Rigid raceways: the joint of a roller that touches nothing in a step (empty mask) is left slack in
+    pymunk and solved after the step by ``chipmunk.joint_solve``, chipmunk's own arithmetic for a body
+    held by a slide joint alone. Every number is the same bytes as with every joint in pymunk's solve
+    (the full scene at 6000 rpm with its start phase, whose change of step size scales the cached
+    impulses; the reduced-equivalent scene; a land-guided cage at 3000 rpm)."""
+    sc = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0",
+                                                               "multibody.raceway_contact=rigid", *extra])
+    assert chipmunk.joint_layout() is None
+    own = run(si(sc), step_loop="compiled")
+    assert "joint" not in own["step_loop_reason"]
+    monkeypatch.setattr(chipmunk, "joint_layout", lambda: "a layout the probe did not find")
+    pymunk_joints = run(si(sc), step_loop="compiled")
+    assert "every joint left to pymunk (a layout the probe did not find)" in pymunk_joints["step_loop_reason"]
+    assert len(own["impacts"]) > 0 and own["t_start"] > 0.0
+    for key in COMPARED:
+        a, b = np.asarray(own[key]), np.asarray(pymunk_joints[key])
+        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+
+
+def test_joint_solve_is_chipmunk_s_slide_joint_bit_for_bit():
+    """``chipmunk.joint_solve`` against pymunk stepping a body on a slide joint alone: on the circle moving
+    along it (taut, warm-started from the last step's impulse), at a new step size (cached impulse scaled
+    by h / h_prev), pulled off (slack: no impulse) and pushed back out (taut again): the same velocity and
+    accumulated impulse to the last bit, with the impulse pymunk reports. (``chipmunk.joint_layout`` runs
+    this once per process before the compiled loop uses it.)"""
+    import pymunk
+
+    anchor = pymunk.Body(body_type=pymunk.Body.STATIC)
+    space = pymunk.Space()
+    space.iterations = 10
+    space.gravity = (0.0, -9.81)
+    b = pymunk.Body(0.05, 1e-6)
+    b.position = (0.061, 0.0)
+    b.velocity = (0.0, 7.0)
+    j = pymunk.SlideJoint(anchor, b, (0.0, 0.0), (0.0, 0.0), 0.0, 0.061)
+    j.error_bias = 0.0
+    space.add(b, j)
+    prev_h, jn, taut, slack = 0.0, 0.0, 0, 0
+    steps = [(1.7e-5, (2.0, 0.5))] * 5 + [(1.2e-5, (0.0, 0.0))] * 3 + [(1.2e-5, (-900.0, 0.0))] + [(1.2e-5, (900.0, 9.0))] * 3
+    for h, force in steps:
+        b.force = force
+        v0 = b.velocity
+        space.step(h)
+        m_inv = 1.0 / 0.05
+        vx = v0.x + (0.0 + force[0] * m_inv) * h
+        vy = v0.y + (-9.81 + force[1] * m_inv) * h
+        got = chipmunk.joint_solve.py_func(b.position.x, b.position.y, vx, vy, m_inv, 0.061, h,
+                                           0.0 if prev_h == 0.0 else h / prev_h, jn, 10)
+        assert got[0] == b.velocity.x and got[1] == b.velocity.y and abs(got[2]) == j.impulse
+        prev_h, jn = h, got[2]
+        taut += got[2] != 0.0
+        slack += got[2] == 0.0
+    assert taut >= 9 and slack >= 1
+
+
 def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-5):
     """face_masks for a 4-pocket scene with the roller of pocket 0 at ``q`` (cage frame, relative to its
     pocket centre, after the step's position update), the cage at the origin turned by ``cage_angle``."""

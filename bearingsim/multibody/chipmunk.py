@@ -6,7 +6,12 @@ pymunk's batched iterator functions ``pmSpaceBody{Get,Set}IteratorFuncBatched`` 
 ``pmSpaceArbiterIteratorFuncBatched``, and its C array structs ``pmFloatArray``/``pmIntArray``/
 ``pmBatchedData``), and writes the bodies' forces, positions and velocities straight into chipmunk's
 ``struct cpBody`` (offsets checked on a probe body, :func:`body_layout`; otherwise pymunk's batched
-setter does it). :func:`advance` calls them through their function pointers, so no Python runs
+setter does it). Two more struct accesses take work out of chipmunk's step and change no number
+(``docs/fast_scene.md``, *What pymunk is spared*): each roller's collision mask in its ``cpShape``,
+narrowed to the face segments it can touch in the step from the bodies' bias velocities in their
+``cpBody`` (:func:`mask_layout`); and, with rigid raceways, the length and accumulated impulse of a
+``cpSlideJoint`` whose roller touches nothing in the step: the joint is left slack in chipmunk and
+solved here, the same arithmetic (:func:`joint_solve`, checked against chipmunk by :func:`joint_layout`). :func:`advance` calls them through their function pointers, so no Python runs
 between steps; per step it calls the same kernels as the plain loop
 (:func:`bearingsim.multibody.loop.before_step`, then the bodies' set, ``cpSpaceStep(h)`` timed with
 ``clock_gettime(CLOCK_MONOTONIC)``, the batched reads, then
@@ -31,6 +36,7 @@ numbers bit for bit, slower. A run records which loop ran (``raw["step_loop"]``)
 from __future__ import annotations
 
 import ctypes
+import math
 import functools
 import os
 from typing import NamedTuple
@@ -142,6 +148,91 @@ def mask_layout() -> str | None:
     return None
 
 
+#: chipmunk 7's ``struct cpSlideJoint`` (float64 indices): its length ``max`` and accumulated impulse
+#: ``jnAcc``; ``struct cpBody``: the inverse mass; checked by :func:`joint_layout`
+SLIDE_MAX, SLIDE_JNACC = 18, 26
+BODY_MINV = 3
+_DBL_MIN = 2.2250738585072014e-308  # CPFLOAT_MIN, added to a length by chipmunk's cpvnormalize
+
+
+@njit(cache=True, inline="always")
+def joint_solve(x, y, vx, vy, m_inv, r_max, h, dt_coef, jn_acc, iterations):
+    """What chipmunk's step does to a body held by a slide joint (length 0 to ``r_max``, anchored at the
+    origin on a static body, at the body's centre, ``error_bias`` 0, no limit on force or bias) when
+    nothing else acts on it in the step: its preStep at the position after the position update
+    ``(x, y)``, the cached impulse ``jn_acc`` (of the last step) times ``dt_coef``, then ``iterations``
+    impulse iterations, on the velocity after the velocity update ``(vx, vy)``. The same operations in
+    the same order as chipmunk 7's cpSlideJoint.c (and cpvnormalize, k_scalar, relative_velocity,
+    apply_impulses with zero lever arms), so the same bytes; returns ``(vx, vy, jn_acc)``. An iteration
+    that changes nothing ends them (the next would compute the same)."""
+    dist = math.sqrt(x * x + y * y)
+    if not dist > r_max:
+        return vx, vy, 0.0  # slack: chipmunk zeroes its normal and accumulated impulse
+    pdist = dist - r_max
+    inv = 1.0 / (math.sqrt(x * x + y * y) + _DBL_MIN)
+    nx = x * inv
+    ny = y * inv
+    n_mass = 1.0 / (0.0 + m_inv)
+    bias = (-1.0 * pdist) / h
+    jc = jn_acc * dt_coef  # applyCachedImpulse
+    vx = vx + (nx * jc) * m_inv
+    vy = vy + (ny * jc) * m_inv
+    for _ in range(iterations):
+        vrn = vx * nx + vy * ny
+        jn = (bias - vrn) * n_mass
+        old = jn_acc
+        acc = old + jn
+        jn_acc = acc if acc < 0.0 else 0.0  # cpfclamp(acc, -maxForce dt = -inf, 0)
+        jn = jn_acc - old
+        if jn == 0.0:
+            break
+        vx = vx + (nx * jn) * m_inv
+        vy = vy + (ny * jn) * m_inv
+    return vx, vy, jn_acc
+
+
+@functools.lru_cache(maxsize=1)
+def joint_layout() -> str | None:
+    """None when :func:`joint_solve` reproduces chipmunk's slide joint bit for bit and the joint's
+    ``max`` and ``jnAcc`` and the body's inverse mass are where :func:`advance` reads and writes them,
+    else why not. Once per process: a body on a joint is stepped through pymunk (taut and slack, at
+    two step sizes) and each step recomputed."""
+    anchor = pymunk.Body(body_type=pymunk.Body.STATIC)
+    space = pymunk.Space()
+    space.iterations = 10
+    space.gravity = (0.0, -9.81)
+    b = pymunk.Body(0.3, 0.01)
+    b.position = (0.0599, 0.0)  # on the circle, moving along it: taut, warm-started steps
+    b.velocity = (0.0, 3.0)
+    j = pymunk.SlideJoint(anchor, b, (0.0, 0.0), (0.0, 0.0), 0.0, 0.0599)
+    j.error_bias = 0.0
+    space.add(b, j)
+    c = np.frombuffer(ffi.buffer(j._constraint, 8 * (SLIDE_JNACC + 1)), dtype=np.float64)
+    body = np.frombuffer(ffi.buffer(b._body, 8 * (BODY_MINV + 1)), dtype=np.float64)
+    if c[SLIDE_MAX] != 0.0599 or body[BODY_MINV] != 1.0 / 0.3:
+        return "pymunk's cpSlideJoint or cpBody does not have chipmunk 7's layout"
+    prev_h, jn = 0.0, 0.0
+    # taut at 10 us, taut at 20 us (a new step size: the cached impulse scaled), pulled off (slack), taut again
+    steps = [(1e-5, (30.0, 5.0))] * 4 + [(2e-5, (30.0, -5.0))] * 3 + [(2e-5, (-3000.0, 0.0))] + [(2e-5, (3000.0, 0.0))] * 3
+    taut = 0
+    for k, (h, force) in enumerate(steps):
+        b.force = force
+        v0 = b.velocity
+        space.step(h)
+        px, py = b.position
+        vx = v0.x * 1.0 + (0.0 + force[0] * body[BODY_MINV]) * h
+        vy = v0.y * 1.0 + (-9.81 + force[1] * body[BODY_MINV]) * h
+        want = joint_solve(px, py, vx, vy, body[BODY_MINV], 0.0599, h, 0.0 if prev_h == 0.0 else h / prev_h, jn, 10)
+        got = (b.velocity.x, b.velocity.y, c[SLIDE_JNACC])
+        if want != got or abs(got[2]) != j.impulse:
+            return f"chipmunk's slide joint does not compute what bearingsim reproduces (probe step {k})"
+        prev_h, jn = h, got[2]
+        taut += got[2] != 0.0
+    if taut < len(steps) - 3:
+        return "the slide-joint probe did not hold its body taut"  # pragma: no cover - a change of chipmunk's joint
+    return None
+
+
 @functools.lru_cache(maxsize=1)
 def body_layout() -> str | None:
     """None when a ``cpBody`` holds p, v, f and t where :func:`advance` writes them, else why not.
@@ -203,6 +294,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
         reason += f"; bodies set through pymunk's batched setter ({io.direct_why})"
     if io.masks_why is not None:
         reason += f"; face masks not narrowed ({io.masks_why})"
+    if joints and io.joints_why is not None:
+        reason += f"; every joint left to pymunk ({io.joints_why})"
     return io, reason
 
 
@@ -349,6 +442,23 @@ class BatchIO:
         self.mask_now = np.array([c.filter.mask for c in self._shapes], dtype=np.uint32)  # as the shapes have them
         self.mask_want = self.mask_now.copy()
         self.vb = np.zeros((nb, 3))  # the bodies' bias velocities before a step
+        self.iterations = int(space.iterations)
+        self.joints_why = self._free_joints()
+        self.free_on = self.joints_why is None
+        self.jn_acc = np.zeros(len(self._joints))  # accumulated impulse of the joints advance() solves itself
+        self.free_now = np.zeros(len(self._joints), dtype=np.bool_)  # those joints (left slack in pymunk)
+        self.prev_h = np.zeros(1)  # the step size of the last cpSpaceStep (chipmunk scales the cached impulses by h / it)
+
+    def _free_joints(self):
+        """None when :func:`advance` solves the joints of rollers that touch nothing itself, else why not."""
+        if not self._joints:
+            return "no joints"
+        if not self.fm.active:
+            return "face masks not narrowed"
+        if any(j.min != 0.0 or j.max != self._joints[0].max or j.error_bias != 0.0 or j.anchor_a != (0.0, 0.0)
+               or j.anchor_b != (0.0, 0.0) or j.a.body_type != pymunk.Body.STATIC for j in self._joints):
+            return "the joints are not the rigid raceways' (static anchor at the axis, 0 to r_c, error_bias 0)"
+        return joint_layout()
 
     def _face_masks(self, masks):
         """(masks, None) when :func:`advance` narrows the rollers' masks, else (inactive masks, why not)."""
@@ -398,7 +508,8 @@ class BatchIO:
         return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
                        self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
                        self.set_pv, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
-                       self.fm, self.vb, self.mask_now, self.mask_want, inp, wk, acc, ls)
+                       self.fm, self.vb, self.mask_now, self.mask_want, self.free_on, self.jn_acc, self.free_now,
+                       self.prev_h, self.iterations, inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -445,6 +556,44 @@ def _narrow_masks(body_ptrs, shape_ptrs, state, h, fm, vb, now, want):
             now[i] = want[i]
 
 
+#: the length a joint that :func:`advance` solves itself is given in pymunk for the step (slack there)
+FREE_JOINT_MAX = 1.0e300
+
+
+@njit(cache=True, inline="always")
+def _hand_over_joints(joint_ptrs, mask, jn_acc, free_now, r_max):
+    """Before a step: a roller whose mask is empty touches nothing in the step, so its joint's solve has
+    no other constraint in it; the joint is made slack in pymunk (length ``FREE_JOINT_MAX``) and its
+    accumulated impulse kept in ``jn_acc``; a roller that may touch a face gets its joint back, length
+    ``r_max`` and accumulated impulse restored (chipmunk's warm start)."""
+    for k in range(joint_ptrs.shape[0]):
+        fr = mask[k] == 0
+        if fr != free_now[k]:
+            c = carray(_as_float_ptr(joint_ptrs[k]), SLIDE_JNACC + 1)
+            if fr:
+                jn_acc[k] = c[SLIDE_JNACC]
+                c[SLIDE_MAX] = FREE_JOINT_MAX
+            else:
+                c[SLIDE_JNACC] = jn_acc[k]
+                c[SLIDE_MAX] = r_max
+            free_now[k] = fr
+
+
+@njit(cache=True, inline="always")
+def _solve_free_joints(body_ptrs, state, h, dt_coef, jn_acc, free_now, r_max, iterations):
+    """After a step: the joints :func:`_hand_over_joints` took out, solved on the bodies' states after
+    the step (position after the position update, velocity after the velocity update: nothing else
+    acted on them) by :func:`joint_solve`; their velocities and accumulated impulses updated."""
+    for k in range(free_now.shape[0]):
+        if free_now[k]:
+            m_inv = carray(_as_float_ptr(body_ptrs[k]), BODY_MINV + 1)[BODY_MINV]
+            vx, vy, jn = joint_solve(state[k, 0], state[k, 1], state[k, 3], state[k, 4], m_inv, r_max, h, dt_coef,
+                                     jn_acc[k], iterations)
+            state[k, 3] = vx
+            state[k, 4] = vy
+            jn_acc[k] = jn
+
+
 @njit(cache=True, inline="always")
 def _write_bodies(body_ptrs, state, out_f, set_pv):
     """Write each body's force and torque (``out_f`` rows of (fx, fy, t)) and, when ``set_pv``, its
@@ -467,7 +616,8 @@ def _write_bodies(body_ptrs, state, out_f, set_pv):
 
 @njit(cache=True)
 def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
-            body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, inp, wk, acc, ls):
+            body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, free_on, jn_acc, free_now,
+            prev_h, iterations, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
@@ -481,7 +631,11 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     batched setter; ``set_pv``: their positions and velocities are set too, not only their forces.
     ``fm``: :class:`~bearingsim.multibody.loop.FaceMasks`; when active, the rollers' masks are narrowed
     before each step (:func:`_narrow_masks`; ``vb``, ``mask_now``, ``mask_want``: its scratch and the
-    masks the shapes have). ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
+    masks the shapes have). ``free_on``: the joint of a roller whose mask is empty (it touches nothing in
+    the step) is left slack in pymunk and solved here after the step by :func:`joint_solve`, the same
+    bytes as chipmunk's (``jn_acc``, ``free_now``: those joints' accumulated impulses and which they
+    are; ``prev_h``: the last step size; ``iterations``: the space's). ``inp``, ``wk``, ``acc``, ``ls``:
+    those of the step kernels.
     """
     sp = ptr.space
     cap0 = hdr.state0[1]
@@ -501,6 +655,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             _write_bodies(body_ptrs, prev, wk.out_f, set_pv)
             if fm.active:
                 _narrow_masks(body_ptrs, shape_ptrs, prev, h, fm, vb, mask_now, mask_want)
+            if free_on:
+                _hand_over_joints(joint_ptrs, mask_want, jn_acc, free_now, inp.prm.rigid_radius)
         else:
             if set_pv:
                 lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])
@@ -512,14 +668,19 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             s.pymunk_ns += _now_ns(clock_fn, ptr.timespec, ts) - t0
         else:
             step_fn(sp, h)
-        for k in range(joint_ptrs.shape[0]):  # the race's force: the joint's and race_orbit's
-            wk.n_out[k] = impulse_fn(joint_ptrs[k]) / h + wk.n_extra[k]
         if cur == 0:  # the state after the step goes into the other array
             hdr.state1[0] = 0
             each_body_fn(sp, ptr.body_get, ptr.data_state1)
         else:
             hdr.state0[0] = 0
             each_body_fn(sp, ptr.body_get, ptr.data_state0)
+        if free_on:  # the joints pymunk left slack: their solve, on the velocities after the step
+            _solve_free_joints(body_ptrs, st1 if cur == 0 else st0, h, 0.0 if prev_h[0] == 0.0 else h / prev_h[0],
+                               jn_acc, free_now, inp.prm.rigid_radius, iterations)
+        prev_h[0] = h
+        for k in range(joint_ptrs.shape[0]):  # the race's force: the joint's and race_orbit's
+            jn = abs(jn_acc[k]) if free_on and free_now[k] else impulse_fn(joint_ptrs[k])
+            wk.n_out[k] = jn / h + wk.n_extra[k]
         hdr.arb_f[0] = 0
         hdr.arb_i[0] = 0
         each_arb_fn(sp, ptr.arbiters, ptr.data_arbiters)

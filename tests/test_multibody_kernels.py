@@ -357,6 +357,13 @@ COMPARED = ("steps", "t_end", "t_record", "win", "first_imp", "f_bin", "t_bin", 
             "lift_max", "beyond_max", "beyond_before", "beyond_vr")
 
 
+def _assert_same_bytes(a, b):
+    """Every compared result of two runs is the same bytes."""
+    for key in COMPARED:
+        x, y = np.asarray(a[key]), np.asarray(b[key])
+        assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), key
+
+
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
 @pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", []), ("multibody_reduced_equivalent_3000rpm", []),
                                              ("multibody_3000rpm", ["multibody.raceway_contact=rigid"])])
@@ -371,9 +378,7 @@ def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extr
     plain = run(si(sc), step_loop="plain")
     assert (compiled["step_loop"], plain["step_loop"]) == ("compiled", "plain")
     assert len(compiled["impacts"]) > 0
-    for key in COMPARED:
-        a, b = np.asarray(compiled[key]), np.asarray(plain[key])
-        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+    _assert_same_bytes(compiled, plain)
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -391,9 +396,7 @@ def test_direct_body_writes_give_the_batched_setter_s_numbers(scenario, extra, m
     monkeypatch.setattr(chipmunk, "body_layout", lambda: "a layout the probe did not find")
     batched = run(si(sc), step_loop="compiled")
     assert "batched setter (a layout the probe did not find)" in batched["step_loop_reason"]
-    for key in COMPARED:
-        a, b = np.asarray(direct[key]), np.asarray(batched[key])
-        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+    _assert_same_bytes(direct, batched)
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -415,9 +418,7 @@ def test_narrowed_face_masks_change_no_number(scenario, extra, monkeypatch):
     full = run(si(sc), step_loop="compiled")
     assert "face masks not narrowed (a layout the probe did not find)" in full["step_loop_reason"]
     assert len(full["impacts"]) > 0
-    for key in COMPARED:
-        a, b = np.asarray(narrowed[key]), np.asarray(full[key])
-        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+    _assert_same_bytes(narrowed, full)
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -438,9 +439,7 @@ def test_joints_solved_outside_pymunk_change_no_number(extra, monkeypatch):
     pymunk_joints = run(si(sc), step_loop="compiled")
     assert "every joint left to pymunk (a layout the probe did not find)" in pymunk_joints["step_loop_reason"]
     assert len(own["impacts"]) > 0 and own["t_start"] > 0.0
-    for key in COMPARED:
-        a, b = np.asarray(own[key]), np.asarray(pymunk_joints[key])
-        assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), key
+    _assert_same_bytes(own, pymunk_joints)
 
 
 def test_joint_solve_is_chipmunk_s_slide_joint_bit_for_bit():

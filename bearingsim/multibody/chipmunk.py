@@ -11,7 +11,9 @@ setter does it). Two more struct accesses take work out of chipmunk's step and c
 narrowed to the face segments it can touch in the step from the bodies' bias velocities in their
 ``cpBody`` (:func:`mask_layout`); and, with rigid raceways, the length and accumulated impulse of a
 ``cpSlideJoint`` whose roller touches nothing in the step: the joint is left slack in chipmunk and
-solved here, the same arithmetic (:func:`joint_solve`, checked against chipmunk by :func:`joint_layout`). :func:`advance` calls them through their function pointers, so no Python runs
+solved here, the same arithmetic (:func:`joint_solve`, checked against chipmunk by :func:`joint_layout`).
+
+:func:`advance` calls them through their function pointers, so no Python runs
 between steps; per step it calls the same kernels as the plain loop
 (:func:`bearingsim.multibody.loop.before_step`, then the bodies' set, ``cpSpaceStep(h)`` timed with
 ``clock_gettime(CLOCK_MONOTONIC)``, the batched reads, then
@@ -36,8 +38,8 @@ numbers bit for bit, slower. A run records which loop ran (``raw["step_loop"]``)
 from __future__ import annotations
 
 import ctypes
-import math
 import functools
+import math
 import os
 from typing import NamedTuple
 
@@ -108,7 +110,8 @@ _BODY_PROBE_DOUBLES = BODY_T + 1
 
 
 #: chipmunk 7's ``struct cpBody`` holds the bias velocities (v_bias (2), w_bias) of the overlap correction
-#: here (float64 indices); ``struct cpShape`` holds its filter's mask here (uint32 index); checked by :func:`mask_layout`
+#: here (float64 indices); ``struct cpShape`` holds its filter's mask here (uint32 index); checked by
+#: :func:`mask_layout`
 BODY_VBIAS, BODY_WBIAS = 24, 26
 SHAPE_MASK = 41
 
@@ -169,7 +172,7 @@ def joint_solve(x, y, vx, vy, m_inv, r_max, h, dt_coef, jn_acc, iterations):
     if not dist > r_max:
         return vx, vy, 0.0  # slack: chipmunk zeroes its normal and accumulated impulse
     pdist = dist - r_max
-    inv = 1.0 / (math.sqrt(x * x + y * y) + _DBL_MIN)
+    inv = 1.0 / (math.sqrt(x * x + y * y) + _DBL_MIN)  # cpvnormalize takes the length again
     nx = x * inv
     ny = y * inv
     n_mass = 1.0 / (0.0 + m_inv)
@@ -184,10 +187,10 @@ def joint_solve(x, y, vx, vy, m_inv, r_max, h, dt_coef, jn_acc, iterations):
         acc = old + jn
         jn_acc = acc if acc < 0.0 else 0.0  # cpfclamp(acc, -maxForce dt = -inf, 0)
         jn = jn_acc - old
-        if jn == 0.0:
-            break
         vx = vx + (nx * jn) * m_inv
         vy = vy + (ny * jn) * m_inv
+        if jn == 0.0:
+            break  # the next iteration would compute the same (even the signs of zero are settled now)
     return vx, vy, jn_acc
 
 
@@ -213,7 +216,8 @@ def joint_layout() -> str | None:
         return "pymunk's cpSlideJoint or cpBody does not have chipmunk 7's layout"
     prev_h, jn = 0.0, 0.0
     # taut at 10 us, taut at 20 us (a new step size: the cached impulse scaled), pulled off (slack), taut again
-    steps = [(1e-5, (30.0, 5.0))] * 4 + [(2e-5, (30.0, -5.0))] * 3 + [(2e-5, (-3000.0, 0.0))] + [(2e-5, (3000.0, 0.0))] * 3
+    steps = ([(1e-5, (30.0, 5.0))] * 4 + [(2e-5, (30.0, -5.0))] * 3 + [(2e-5, (-3000.0, 0.0))]
+             + [(2e-5, (3000.0, 0.0))] * 3)
     taut = 0
     for k, (h, force) in enumerate(steps):
         b.force = force
@@ -445,9 +449,10 @@ class BatchIO:
         self.iterations = int(space.iterations)
         self.joints_why = self._free_joints()
         self.free_on = self.joints_why is None
+        self.joint_max = float(self._joints[0].max) if self._joints else 0.0  # their length, r_c
         self.jn_acc = np.zeros(len(self._joints))  # accumulated impulse of the joints advance() solves itself
         self.free_now = np.zeros(len(self._joints), dtype=np.bool_)  # those joints (left slack in pymunk)
-        self.prev_h = np.zeros(1)  # the step size of the last cpSpaceStep (chipmunk scales the cached impulses by h / it)
+        self.prev_h = np.zeros(1)  # the last cpSpaceStep's step (chipmunk scales the cached impulses by h / it)
 
     def _free_joints(self):
         """None when :func:`advance` solves the joints of rollers that touch nothing itself, else why not."""
@@ -509,7 +514,7 @@ class BatchIO:
                        self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
                        self.set_pv, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
                        self.fm, self.vb, self.mask_now, self.mask_want, self.free_on, self.jn_acc, self.free_now,
-                       self.prev_h, self.iterations, inp, wk, acc, ls)
+                       self.prev_h, self.iterations, self.joint_max, inp, wk, acc, ls)
 
 
 @njit(cache=True)
@@ -518,26 +523,23 @@ def _now_ns(clock, ptr_ts, ts):
     return ts[0] * 1_000_000_000 + ts[1]
 
 
-@intrinsic
-def _as_float_ptr(typingctx, address):
-    """An int64 address as a ``float64 *`` (for :func:`numba.carray`)."""
-    sig = types.CPointer(types.float64)(types.int64)
+def _pointer_cast(item):
+    """An intrinsic that turns an int64 address into an ``item *`` (for :func:`numba.carray`)."""
 
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.float64)))
+    @intrinsic
+    def cast(typingctx, address):
+        sig = types.CPointer(item)(types.int64)
 
-    return sig, codegen
+        def codegen(context, builder, signature, args):
+            return builder.inttoptr(args[0], context.get_value_type(types.CPointer(item)))
+
+        return sig, codegen
+
+    return cast
 
 
-@intrinsic
-def _as_u32_ptr(typingctx, address):
-    """An int64 address as a ``uint32 *`` (for :func:`numba.carray`)."""
-    sig = types.CPointer(types.uint32)(types.int64)
-
-    def codegen(context, builder, signature, args):
-        return builder.inttoptr(args[0], context.get_value_type(types.CPointer(types.uint32)))
-
-    return sig, codegen
+_as_float_ptr = _pointer_cast(types.float64)
+_as_u32_ptr = _pointer_cast(types.uint32)
 
 
 @njit(cache=True, inline="always")
@@ -617,7 +619,7 @@ def _write_bodies(body_ptrs, state, out_f, set_pv):
 @njit(cache=True)
 def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
             body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, free_on, jn_acc, free_now,
-            prev_h, iterations, inp, wk, acc, ls):
+            prev_h, iterations, joint_max, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
     ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
 
@@ -634,8 +636,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     masks the shapes have). ``free_on``: the joint of a roller whose mask is empty (it touches nothing in
     the step) is left slack in pymunk and solved here after the step by :func:`joint_solve`, the same
     bytes as chipmunk's (``jn_acc``, ``free_now``: those joints' accumulated impulses and which they
-    are; ``prev_h``: the last step size; ``iterations``: the space's). ``inp``, ``wk``, ``acc``, ``ls``:
-    those of the step kernels.
+    are; ``prev_h``: the last step size; ``iterations``: the space's; ``joint_max``: the joints' length).
+    ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
     cap0 = hdr.state0[1]
@@ -656,7 +658,7 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             if fm.active:
                 _narrow_masks(body_ptrs, shape_ptrs, prev, h, fm, vb, mask_now, mask_want)
             if free_on:
-                _hand_over_joints(joint_ptrs, mask_want, jn_acc, free_now, inp.prm.rigid_radius)
+                _hand_over_joints(joint_ptrs, mask_want, jn_acc, free_now, joint_max)
         else:
             if set_pv:
                 lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])
@@ -676,7 +678,7 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             each_body_fn(sp, ptr.body_get, ptr.data_state0)
         if free_on:  # the joints pymunk left slack: their solve, on the velocities after the step
             _solve_free_joints(body_ptrs, st1 if cur == 0 else st0, h, 0.0 if prev_h[0] == 0.0 else h / prev_h[0],
-                               jn_acc, free_now, inp.prm.rigid_radius, iterations)
+                               jn_acc, free_now, joint_max, iterations)
         prev_h[0] = h
         for k in range(joint_ptrs.shape[0]):  # the race's force: the joint's and race_orbit's
             jn = abs(jn_acc[k]) if free_on and free_now[k] else impulse_fn(joint_ptrs[k])

@@ -144,10 +144,14 @@ class FaceMasks(NamedTuple):
     pocket that it can touch in that step (:func:`face_masks`)."""
 
     active: bool  #: narrow the masks (else every roller keeps all face segments)
-    seg: np.ndarray  #: (n, S, 5) each pocket's face segments in the cage frame: start (ax, ay) [m], b - a (ex, ey) [m], 1 / |b - a|^2 [1/m^2]
+    #: (n, S, 5) each pocket's face segments in the cage frame: start (ax, ay) [m], b - a (ex, ey) [m],
+    #: 1 / |b - a|^2 [1/m^2]
+    seg: np.ndarray
     bits: np.ndarray  #: (n, S) uint32 category bit of each segment (0: no segment)
     centre: np.ndarray  #: (n, 2) pocket centres in the cage frame [m]
-    clear2: float  #: (R - r - margin)^2 [m^2]: a roller centre closer to its pocket centre touches no face (R: the faces' inscribed radius); -1: never
+    #: (R - r - margin)^2 [m^2]: a roller centre closer to its pocket centre touches no face (R: the faces'
+    #: inscribed radius); -1: never
+    clear2: float
     reach2: float  #: (r + margin)^2 [m^2]: a segment closer to the roller centre may be touched
 
 

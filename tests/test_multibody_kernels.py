@@ -364,6 +364,20 @@ def _assert_same_bytes(a, b):
         assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), key
 
 
+def _same_bytes_without(probe, says, sc, monkeypatch):
+    """Run ``sc`` in the compiled loop with ``chipmunk.<probe>`` passing (its shortcut taken), then with it
+    failing: the second run's loop reason says ``<says> (...)``, the first's does not, and the two runs
+    are the same bytes. Returns the first run's results."""
+    assert getattr(chipmunk, probe)() is None
+    taken = run(si(sc), step_loop="compiled")
+    assert says not in taken["step_loop_reason"]
+    monkeypatch.setattr(chipmunk, probe, lambda: "a layout the probe did not find")
+    without = run(si(sc), step_loop="compiled")
+    assert f"{says} (a layout the probe did not find)" in without["step_loop_reason"]
+    _assert_same_bytes(taken, without)
+    return taken
+
+
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
 @pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", []), ("multibody_reduced_equivalent_3000rpm", []),
                                              ("multibody_3000rpm", ["multibody.raceway_contact=rigid"])])
@@ -390,13 +404,7 @@ def test_direct_body_writes_give_the_batched_setter_s_numbers(scenario, extra, m
     reason. Both give the same bytes (rigid raceways and the reduced-equivalent scene set positions and
     velocities, not only forces). With the installed pymunk the layout holds and the direct writes run."""
     sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
-    assert chipmunk.body_layout() is None
-    direct = run(si(sc), step_loop="compiled")
-    assert "batched setter" not in direct["step_loop_reason"]
-    monkeypatch.setattr(chipmunk, "body_layout", lambda: "a layout the probe did not find")
-    batched = run(si(sc), step_loop="compiled")
-    assert "batched setter (a layout the probe did not find)" in batched["step_loop_reason"]
-    _assert_same_bytes(direct, batched)
+    _same_bytes_without("body_layout", "bodies set through pymunk's batched setter", sc, monkeypatch)
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -411,14 +419,8 @@ def test_narrowed_face_masks_change_no_number(scenario, extra, monkeypatch):
     The plain loop never narrows them: ``test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit``
     checks the same from the other side."""
     sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
-    assert chipmunk.mask_layout() is None
-    narrowed = run(si(sc), step_loop="compiled")
-    assert "face masks" not in narrowed["step_loop_reason"]
-    monkeypatch.setattr(chipmunk, "mask_layout", lambda: "a layout the probe did not find")
-    full = run(si(sc), step_loop="compiled")
-    assert "face masks not narrowed (a layout the probe did not find)" in full["step_loop_reason"]
-    assert len(full["impacts"]) > 0
-    _assert_same_bytes(narrowed, full)
+    narrowed = _same_bytes_without("mask_layout", "face masks not narrowed", sc, monkeypatch)
+    assert len(narrowed["impacts"]) > 0
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -432,14 +434,8 @@ def test_joints_solved_outside_pymunk_change_no_number(extra, monkeypatch):
     impulses; the reduced-equivalent scene; a land-guided cage at 3000 rpm)."""
     sc = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0",
                                                                "multibody.raceway_contact=rigid", *extra])
-    assert chipmunk.joint_layout() is None
-    own = run(si(sc), step_loop="compiled")
-    assert "joint" not in own["step_loop_reason"]
-    monkeypatch.setattr(chipmunk, "joint_layout", lambda: "a layout the probe did not find")
-    pymunk_joints = run(si(sc), step_loop="compiled")
-    assert "every joint left to pymunk (a layout the probe did not find)" in pymunk_joints["step_loop_reason"]
+    own = _same_bytes_without("joint_layout", "every joint left to pymunk", sc, monkeypatch)
     assert len(own["impacts"]) > 0 and own["t_start"] > 0.0
-    _assert_same_bytes(own, pymunk_joints)
 
 
 def test_joint_solve_is_chipmunk_s_slide_joint_bit_for_bit():

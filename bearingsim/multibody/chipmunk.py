@@ -172,7 +172,7 @@ def joint_solve(x, y, vx, vy, m_inv, r_max, h, dt_coef, jn_acc, iterations):
     if not dist > r_max:
         return vx, vy, 0.0  # slack: chipmunk zeroes its normal and accumulated impulse
     pdist = dist - r_max
-    inv = 1.0 / (math.sqrt(x * x + y * y) + _DBL_MIN)  # cpvnormalize takes the length again
+    inv = 1.0 / (dist + _DBL_MIN)  # cpvnormalize (its own length is the same sqrt of the same sum)
     nx = x * inv
     ny = y * inv
     n_mass = 1.0 / (0.0 + m_inv)

@@ -543,16 +543,23 @@ def _write_array(w: _Writer, path: str, arr) -> None:
 
 
 def _provenance(result) -> dict[str, Any]:
-    """Provenance, written in this one place: the package, its versions, the machine and the run."""
-    prov = {"bearingsim_version": __version__, "git_commit": git_commit(),
+    """Provenance, written in this one place: the package, its versions, the machine and the run.
+
+    A result read back from an archive keeps the provenance of the run that made it (the code, the
+    machine, the command and the time it was computed): re-saving it elsewhere does not restamp it
+    with the machine that saves it."""
+    own = result.provenance
+    here = {"bearingsim_version": __version__, "git_commit": git_commit(),
             "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
             "platform": platform.platform(), "command": " ".join(sys.argv)}
-    for k, v in package_versions().items():
-        prov[f"version_{k}"] = v
-    for k, v in result.provenance.items():
-        if k.startswith("version_") or k in ("bearingsim_version", "git_commit", "created_utc", "platform", "command"):
-            continue  # a result read back from an archive keeps the provenance of the run that made it
-        prov[k] = v
+    prov = {k: own.get(k, v) for k, v in here.items()}
+    versions = {k: v for k, v in own.items() if k.startswith("version_")}
+    if not versions:
+        versions = {f"version_{k}": v for k, v in package_versions().items()}
+    prov.update(versions)
+    for k, v in own.items():
+        if k not in prov:
+            prov[k] = v
     return prov
 
 

@@ -1,4 +1,6 @@
 """Shared test helpers. Paths are absolute so tests run from any folder."""
+import contextlib
+import subprocess
 from pathlib import Path
 
 import pytest
@@ -26,3 +28,28 @@ def si(scenario):
     from bearingsim.parameters import Parameters
 
     return Parameters.from_scenario(scenario)
+
+
+def _default_signals():  # pragma: no cover - runs in the child between fork and exec
+    import signal
+
+    # a suite started from a background job inherits SIGINT ignored, and Python keeps an ignored SIGINT:
+    # the child must see the signals the tests send it as a terminal user's process would
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, signal.SIG_DFL)
+
+
+@contextlib.contextmanager
+def started(cmd, **kw):
+    """``subprocess.Popen(cmd, **kw)`` with SIGINT and SIGTERM at their defaults in the child, ended
+    (killed and reaped, its pipes closed) whatever happens in the ``with`` block."""
+    proc = subprocess.Popen([str(c) for c in cmd], preexec_fn=_default_signals, **kw)
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for stream in (proc.stdin, proc.stdout, proc.stderr):
+            if stream is not None:
+                stream.close()
+        proc.wait()

@@ -12,6 +12,7 @@ lock file ``.NAME.lock`` of ``bearingsim/outputs.py`` included).
 """
 from __future__ import annotations
 
+import contextlib
 import fcntl
 import os
 import shutil
@@ -24,6 +25,8 @@ from pathlib import Path
 from typing import Callable
 
 import pytest
+
+from .conftest import started
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -535,30 +538,27 @@ def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch
     assert sys.unraisablehook is hook and ref_a() is None and ref_b() is None
 
 
-def _start_long_run(tmp_path):
-    """A multibody run into ``tmp_path/m.h5`` long enough to be caught writing; returned once its
-    temporary archive exists (or after 120 s, or if it ended)."""
-    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "run", str(MB), "-o", str(tmp_path / "m.h5"),
-                             "--set", "numerics.rotations=200"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env=ENV)
-    deadline = time.monotonic() + 120
-    while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.05)
-    return proc
+@contextlib.contextmanager
+def _long_run(tmp_path):
+    """A multibody run into ``tmp_path/m.h5`` long enough to be caught writing; given once its
+    temporary archive exists (or after 120 s, or if it ended), and ended when the block is left."""
+    cmd = [sys.executable, "-m", "bearingsim", "run", MB, "-o", tmp_path / "m.h5", "--set", "numerics.rotations=200"]
+    with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV) as proc:
+        deadline = time.monotonic() + 120
+        while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+        yield proc
 
 
 def test_two_runs_to_one_archive_second_is_refused(tmp_path):
     """A real second run while the first is writing: refused (exit 2, one line); the first, then
     stopped by SIGTERM, leaves nothing; the lock is then free for a third run."""
-    first = _start_long_run(tmp_path)
-    try:
+    with _long_run(tmp_path) as first:
         second = bearingsim("run", PAPER, "-o", tmp_path / "m.h5", "--no-plots")
         assert second.returncode == 2 and "another bearingsim run" in second.stderr, second.stderr
         assert len(second.stderr.strip().splitlines()) == 1
         first.send_signal(signal.SIGTERM)
         first.communicate(timeout=30)
-    finally:
-        first.kill()
     assert first.returncode == 143
     assert list(tmp_path.iterdir()) == []
     third = bearingsim("run", PAPER, "-o", tmp_path / "m.h5", "--no-plots")
@@ -570,12 +570,9 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     """SIGKILL cannot be handled: the run leaves ``.m.h5.tmp-PID`` (and its lock file, whose lock died
     with the process); the next run into that folder removes the temporary, says so, and writes
     (taking over the lock file and removing it when done)."""
-    proc = _start_long_run(tmp_path)
-    try:
+    with _long_run(tmp_path) as proc:
         proc.send_signal(signal.SIGKILL)
         proc.communicate(timeout=30)
-    finally:
-        proc.kill()
     left = list(tmp_path.glob(".m.h5.tmp-*"))
     assert len(left) == 1
     res = bearingsim("run", PAPER, "-o", tmp_path / "m.h5", "--no-plots")
@@ -586,15 +583,12 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
 
 def signal_case(tmp: Path, sig) -> Observed:
     """Start a long multibody run, signal it once its temporary archive exists, time the exit."""
-    proc = _start_long_run(tmp)
-    time.sleep(0.5)
-    t0 = time.monotonic()
-    proc.send_signal(sig)
-    try:
+    with _long_run(tmp) as proc:
+        time.sleep(0.5)
+        t0 = time.monotonic()
+        proc.send_signal(sig)
         out, err = proc.communicate(timeout=30)
-    finally:
-        proc.kill()
-    waited = time.monotonic() - t0
+        waited = time.monotonic() - t0
     obs = Observed(proc.returncode, err, out)
     left = [p.name for p in tmp.iterdir()]
     if left:

@@ -22,7 +22,7 @@ from bearingsim.sweeps.run import make_batches, run_sweep_cli
 from bearingsim.sweeps.spec import Case, load_sweep_file, scenario_from_toml
 from bearingsim.sweeps.worker import standard_errors
 
-from .conftest import SCENARIOS
+from .conftest import SCENARIOS, started
 from .test_cli import assert_user_error, bearingsim
 
 BASE = SCENARIOS / "paper_3000rpm.toml"
@@ -235,10 +235,9 @@ def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code)
 
     # euler at dt = 2 ns: about 1 s per case, so cases are running and queued when the signal comes
     dts = ",".join(f"{2 + i / 100:.2f}e-9" for i in range(8))
-    proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "sweep", str(BASE), "--set", "reduced.method=euler",
-                             "--param", f"numerics.dt_s={dts}", "-o", str(tmp_path), "-j", "2", "--no-plots"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
+    cmd = [sys.executable, "-m", "bearingsim", "sweep", BASE, "--set", "reduced.method=euler",
+           "--param", f"numerics.dt_s={dts}", "-o", tmp_path, "-j", "2", "--no-plots"]
+    with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
             if (tmp_path / "sweep.csv").exists() and any(r["status"] == "done" for r in _rows(tmp_path)):
@@ -250,9 +249,6 @@ def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code)
         os.kill(proc.pid, signum)
         out, err = proc.communicate(timeout=10)
         took = time.monotonic() - t0
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     assert proc.returncode == code, err
     assert took < 5.0
     assert "Traceback" not in err and "resume" in err

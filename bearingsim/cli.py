@@ -12,7 +12,7 @@ import signal
 import sys
 from pathlib import Path
 
-from bearingsim import __version__
+from bearingsim import __version__, outputs
 from bearingsim.errors import SimulationUnstable, UserError
 
 
@@ -364,6 +364,19 @@ def _one_line(exc: BaseException) -> str:
     return printable(str(exc), keep_newlines=False)
 
 
+def _exit_quietly(code: int) -> None:
+    """End the process now with ``code``: stdout flushed, file descriptor 2 sent to /dev/null first, so
+    that nothing HDF5 prints while dying follows the one line already written."""
+    with contextlib.suppress(OSError, ValueError):
+        sys.stdout.flush()
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.flush()
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, 2)
+        os.close(devnull)
+    os._exit(code)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
@@ -378,16 +391,13 @@ def main(argv: list[str] | None = None) -> int:
     except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
         pass
     try:
-        with _interrupts_redelivered():
+        with _interrupts_redelivered(), outputs.command_line_owns_stderr():
             return args.func(args)
+    except outputs.ArchiveWriteError as exc:  # HDF5 cannot be torn down cleanly: the line, then out at once
+        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
+        _exit_quietly(exc.exit_code)
     except UserError as exc:
-        line = f"bearingsim: error: {_one_line(exc)}"
-        fd = getattr(exc, "stderr_fd", None)
-        if fd is not None:  # failed archive write: HDF5 cannot be torn down cleanly (outputs.ArchiveWriteError)
-            sys.stdout.flush()
-            os.write(fd, (line + "\n").encode())
-            os._exit(exc.exit_code)
-        print(line, file=sys.stderr)
+        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
     except SimulationUnstable as exc:
         print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)

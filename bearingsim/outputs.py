@@ -249,11 +249,32 @@ class OutputLock:
         return False
 
 
+#: True only while :func:`bearingsim.cli.main` runs a command (:func:`command_line_owns_stderr`): then
+#: :func:`quiet_stderr` may point file descriptor 2 at /dev/null around HDF5 writes. A library call never
+#: touches the process's file descriptors: they belong to the program that imported bearingsim.
+_command_line_owns_stderr = False
+
+
+@contextlib.contextmanager
+def command_line_owns_stderr():
+    """The block is the ``bearingsim`` command: :func:`quiet_stderr` may redirect file descriptor 2."""
+    global _command_line_owns_stderr
+    previous, _command_line_owns_stderr = _command_line_owns_stderr, True
+    try:
+        yield
+    finally:
+        _command_line_owns_stderr = previous
+
+
 @contextlib.contextmanager
 def quiet_stderr():
-    """Send file descriptor 2 to /dev/null for the block: while an archive is written, HDF5 prints its
-    error stack there for each object it fails to flush when the disk is full (and carries on); the
-    failure itself surfaces as an ``OSError`` at the latest when the file is closed."""
+    """Under the command line only (:func:`command_line_owns_stderr`), send file descriptor 2 to
+    /dev/null for the block: while an archive is written, HDF5 prints its error stack there for each
+    object it fails to flush when the disk is full (and carries on); the failure itself surfaces as an
+    ``OSError`` at the latest when the file is closed. Called from a library, it does nothing."""
+    if not _command_line_owns_stderr:
+        yield
+        return
     try:
         sys.stderr.flush()
         saved = os.dup(2)
@@ -277,13 +298,12 @@ def close_quietly(f) -> None:
 
 
 class ArchiveWriteError(UserError):
-    """The archive could not be written (full disk, I/O error). After such a failure HDF5's objects
-    cannot be released cleanly (h5py prints error stacks while freeing them and the interpreter may
-    crash at exit), so :func:`write_error` sends file descriptor 2 to /dev/null and keeps the real
-    stderr in ``stderr_fd``; :func:`bearingsim.cli.main` prints the one line there and ends the
-    process at once (the temporary file is already removed)."""
+    """The archive could not be written (full disk, I/O error); the temporary file is already removed.
 
-    stderr_fd: int | None = None
+    After such a failure HDF5's objects cannot be released cleanly (h5py prints error stacks while
+    freeing them and the interpreter may crash at exit), so :func:`bearingsim.cli.main` prints the one
+    line, sends file descriptor 2 to /dev/null and ends the process at once. The library only raises
+    it: the process's file descriptors are the caller's."""
 
 
 def write_error(path: str | Path, exc: OSError) -> ArchiveWriteError:
@@ -295,16 +315,7 @@ def write_error(path: str | Path, exc: OSError) -> ArchiveWriteError:
                 code = c
                 break
     what = os.strerror(code) if code else "write failed"
-    err = ArchiveWriteError(f"{path}: cannot write archive ({what}); nothing was written")
-    try:
-        sys.stderr.flush()
-        err.stderr_fd = os.dup(2)
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 2)
-        os.close(devnull)
-    except OSError:
-        err.stderr_fd = None
-    return err
+    return ArchiveWriteError(f"{path}: cannot write archive ({what}); nothing was written")
 
 
 _CONTROL_RE = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")

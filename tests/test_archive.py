@@ -205,3 +205,35 @@ def test_format_1_archive_still_reads_the_same(tmp_path):
     assert "I_dec_mean_Ns" in describe(old) and "git_commit=0921c01" in describe(old)
     got = archive.peek(old)
     assert got["summary"]["I_dec_mean_Ns"] == now.summary["I_dec_mean_Ns"] and got["wall_time_s"] > 0
+
+
+def test_failed_save_leaves_the_process_file_descriptors_alone(tmp_path, base_reduced, monkeypatch):
+    """A full disk met by ``Result.save`` is one exception for the caller; the library never points
+    file descriptor 2 elsewhere (neither while writing nor after), and no descriptor is left open."""
+    import errno
+    import os
+
+    def stderr_identity():
+        st = os.fstat(2)
+        return st.st_dev, st.st_ino
+
+    before = stderr_identity()
+    seen = []
+
+    def full_disk(f, result, in_memory=False):
+        seen.append(stderr_identity())
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(archive, "_fill", full_disk)
+    res = _result(resolve(base_reduced))
+    fd_probe = os.open(os.devnull, os.O_RDONLY)  # the lowest free descriptor before the save
+    os.close(fd_probe)
+    with pytest.raises(UserError, match="No space left on device") as info:
+        res.save(tmp_path / "a.h5")
+    assert seen == [before]  # while writing
+    assert stderr_identity() == before  # and after
+    assert getattr(info.value, "stderr_fd", None) is None
+    fd_after = os.open(os.devnull, os.O_RDONLY)
+    os.close(fd_after)
+    assert fd_after == fd_probe  # no descriptor kept open for a caller that never closes it
+    assert list(tmp_path.iterdir()) == []

@@ -242,7 +242,22 @@ class Scenario:
         self._toml = toml
 
     def __getattr__(self, item):
-        return getattr(self.model_, item)
+        # the model's sections and values only: no special names (copy.deepcopy would find the model's
+        # __deepcopy__ and return a ScenarioModel), and an instance not yet filled (unpickling asks for
+        # __setstate__ before __dict__ is set) has no model_ to look into (no endless recursion)
+        model = self.__dict__.get("model_")
+        if model is None or item.startswith("__"):
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {item!r}")
+        return getattr(model, item)
+
+    def __eq__(self, other) -> bool:
+        """Two scenarios are equal when they resolve to the same values (wherever they came from)."""
+        if not isinstance(other, Scenario):
+            return NotImplemented
+        return self.model_ == other.model_
+
+    def __hash__(self) -> int:
+        return hash(self.to_toml())  # equal models give the same text
 
     @property
     def raw(self) -> dict[str, Any]:

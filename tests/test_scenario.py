@@ -163,3 +163,21 @@ def test_toml_text_is_tomli_w_text_with_tables_cached():
     ]
     for raw in docs + docs:  # the second pass hits the cache
         assert _dumps(raw) == tomli_w.dumps(raw), raw
+
+
+def test_scenario_pickles_and_round_trips_equal(base_reduced):
+    """A scenario goes to worker processes (``ProcessPoolExecutor().map(bearingsim.run, scenarios)``,
+    joblib, dask): pickled and read back it is the same scenario, from the same source."""
+    import copy
+    import pickle
+
+    sc = load_scenario(SCENARIOS / "paper_3000rpm.toml", ["numerics.rotations=1"])
+    back = pickle.loads(pickle.dumps(sc))
+    assert back == sc and hash(back) == hash(sc)
+    assert back.source == sc.source and back.raw == sc.raw and back.to_toml() == sc.to_toml()
+    assert back.operating.inner_ring_speed_rpm == 3000.0
+    assert copy.deepcopy(sc) == sc and copy.copy(sc) == sc
+    assert sc != sc.replace(**{"operating.inner_ring_speed_rpm": 1000.0})
+    assert sc != resolve(base_reduced) and sc != "paper_3000rpm"
+    with pytest.raises(AttributeError):
+        sc.no_such_key

@@ -1,0 +1,55 @@
+"""Results as objects: a result travels between processes as it is (pickle), as a scenario does."""
+import multiprocessing
+import pickle
+from concurrent.futures import ProcessPoolExecutor
+
+import numpy as np
+
+import bearingsim
+from bearingsim.compare import compare_results
+
+from .conftest import SCENARIOS
+
+
+def _short_scenarios():
+    """Two one-rotation reduced-model cases (about a second each)."""
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"numerics.rotations": 1})
+    return [sc, sc.replace(**{"operating.inner_ring_speed_rpm": 1000.0})]
+
+
+def _same(a, b) -> None:
+    assert type(a) is type(b)
+    assert a.scenario == b.scenario
+    assert compare_results(a, b).identical
+    assert a.data.keys() == b.data.keys()
+    for k, v in a.data.items():
+        assert np.array_equal(v.data, b.data[k].data) and v.unit == b.data[k].unit, k
+    assert a.groups == b.groups
+
+
+def test_result_pickles_and_round_trips_equal(tmp_path):
+    sc = _short_scenarios()[0]
+    r = bearingsim.run(sc)
+    _same(pickle.loads(pickle.dumps(r)), r)
+    loaded = bearingsim.load(r.save(tmp_path / "r.h5"))  # a result read from an archive too
+    back = pickle.loads(pickle.dumps(loaded))
+    _same(back, loaded)
+    assert repr(back.provenance) == repr(loaded.provenance)  # dt_s may be nan (not equal to itself)
+
+
+def test_run_maps_over_a_process_pool():
+    """``ProcessPoolExecutor().map(bearingsim.run, scenarios)`` on the public API (spawned workers: the
+    scenarios go out and the results come back through pickle alone)."""
+    scenarios = _short_scenarios()
+    ex = ProcessPoolExecutor(max_workers=1, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        results = list(ex.map(bearingsim.run, scenarios, timeout=300))
+    except BaseException:
+        for proc in list((ex._processes or {}).values()):  # a stuck worker is ended, whatever happened
+            proc.kill()
+        raise
+    finally:
+        ex.shutdown(wait=True, cancel_futures=True)
+    assert [r.scenario for r in results] == scenarios
+    for r, sc in zip(results, scenarios):
+        _same(r, bearingsim.run(sc))  # what a run in this process gives, bit for bit

@@ -377,11 +377,21 @@ def _exit_quietly(code: int) -> None:
     os._exit(code)
 
 
+def _stdout_to_devnull() -> None:
+    """Point file descriptor 1 at /dev/null: what is still buffered for a reader that has gone (a pipe
+    into ``head``) is dropped at exit instead of failing there with "Exception ignored ... BrokenPipeError"."""
+    with contextlib.suppress(OSError, ValueError, AttributeError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
     Exit codes: 0 success, 2 bad input or an unwritable output (one line on stderr), 3 an unstable or
-    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (no archive, no temporary file).
+    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (no archive, no temporary file); 0 also when
+    the reader of the output goes away early (``bearingsim inspect x.h5 | head -1``), with nothing said.
     """
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -392,7 +402,12 @@ def main(argv: list[str] | None = None) -> int:
         pass
     try:
         with _interrupts_redelivered(), outputs.command_line_owns_stderr():
-            return args.func(args)
+            code = args.func(args)
+            sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
+            return code
+    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: stop quietly
+        _stdout_to_devnull()
+        return 0
     except outputs.ArchiveWriteError as exc:  # HDF5 cannot be torn down cleanly: the line, then out at once
         print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
         _exit_quietly(exc.exit_code)
@@ -416,9 +431,6 @@ def main(argv: list[str] | None = None) -> int:
         print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
               "interval", file=sys.stderr)
         return 2
-    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly
-        sys.stderr.close()
-        return 0
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)

@@ -99,3 +99,40 @@ def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
                       "--no-plots", "-q").returncode == 0
     with h5py.File(out2, "r") as f:
         assert np.array_equal(f["results/per_rotation/I_dec"][()], first)
+
+
+def test_inspect_into_a_pipe_closed_early_stops_quietly(tmp_path):
+    """``bearingsim inspect x.h5 | head -1``: once the reader has gone, the command stops with exit 0
+    and nothing on stderr (no "Broken pipe" error, no traceback)."""
+    import os
+
+    import numpy as np
+
+    from bearingsim import archive
+    from bearingsim.datatypes import AttrGroup, NamedArray
+    from bearingsim.reduced import ReducedResult
+    from bearingsim.scenario import load_scenario
+
+    from .conftest import started
+
+    keys = {f"quantity_{i:05d}_Ns": float(i) for i in range(6000)}  # a 260 kB listing: more than a pipe holds
+    res = ReducedResult(load_scenario(SCENARIOS / "paper_3000rpm.toml"),
+                        {"results/per_rotation/I_dec": NamedArray(np.ones((3, 2)), "N s")},
+                        {"results/summary": AttrGroup(keys, {k: "N s" for k in keys})})
+    path = archive.write(res, tmp_path / "big.h5")
+    r, w = os.pipe()
+    try:
+        import fcntl
+
+        fcntl.fcntl(w, fcntl.F_SETPIPE_SZ, 4096)  # the smallest pipe: the writer is sure to meet the closed end
+    except (ImportError, AttributeError, OSError):
+        pass
+    with open(r, "rb") as reader, open(w, "wb") as writer:
+        with started([sys.executable, "-m", "bearingsim", "inspect", path], stdout=writer,
+                     stderr=subprocess.PIPE) as proc:
+            writer.close()  # the child holds the only write end
+            first = reader.readline()
+            reader.close()  # what `head -1` does after its line
+            _, err = proc.communicate(timeout=120)
+    assert first.startswith(f"{path}: bearingsim archive".encode()), first
+    assert (proc.returncode, err.decode()) == (0, "")

@@ -703,8 +703,9 @@ def is_table_file(path, fmt: str) -> bool:
 
 def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
-    (TOML text), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``. None for a
-    missing, unreadable or incomplete file (never trusted)."""
+    (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
+    stores none), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``. None
+    for a missing, unreadable or incomplete file (never trusted)."""
     h5py = _lazy_h5py()
     path = Path(path)
     if not path.is_file():
@@ -716,13 +717,17 @@ def peek(path) -> dict[str, Any] | None:
                 return None
             text = f["scenario"][()]
             summary = group_attrs(f["results/summary"])[0]
+            prov = group_attrs(f["provenance"])[0] if "provenance" in f else {}
+            version = prov.get("model_version")
             return {
                 "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
+                "model": str(g.attrs["model"]),
+                "model_version": int(version) if isinstance(version, (int, np.integer))
+                and not isinstance(version, bool) else None,
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
                 "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
-                "wall_time_s": float(group_attrs(f["provenance"])[0].get("wall_time_s", float("nan")))
-                if "provenance" in f else float("nan"),
+                "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
             }
     except (OSError, KeyError, ValueError, TypeError):
         return None

@@ -205,6 +205,7 @@ def test_format_1_archive_still_reads_the_same(tmp_path):
     assert "I_dec_mean_Ns" in describe(old) and "git_commit=0921c01" in describe(old)
     got = archive.peek(old)
     assert got["summary"]["I_dec_mean_Ns"] == now.summary["I_dec_mean_Ns"] and got["wall_time_s"] > 0
+    assert got["model_version"] is None and now.provenance["model_version"] >= 1  # a sweep reruns it (stale)
 
 
 def test_failed_save_leaves_the_process_file_descriptors_alone(tmp_path, base_reduced, monkeypatch):

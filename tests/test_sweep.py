@@ -167,6 +167,51 @@ def test_resume_runs_only_what_is_missing(tmp_path):
     assert [r["status"] for r in _rows(tmp_path)] == ["cached", "done", "done", "done"]
 
 
+def _set_provenance(path, **changes):
+    """Rewrite an archive's provenance as an older bearingsim would have written it (None: key absent)."""
+    import json
+
+    with h5py.File(path, "a") as f:
+        g = f["provenance"]
+        prov = json.loads(g.attrs["attrs_json"])
+        for k, v in changes.items():
+            if v is None:
+                prov.pop(k, None)
+            else:
+                prov[k] = v
+        g.attrs["attrs_json"] = json.dumps(prov, sort_keys=True)
+
+
+def test_resume_reruns_archives_of_another_model_version(tmp_path):
+    """A case is ``cached`` only when its archive was computed by the same version of the model
+    (``bearingsim.model_versions``); an archive of the same scenario from another version, or from a
+    bearingsim that stored none, is ``stale``: run again, replaced, and the index says so."""
+    from bearingsim.archive import peek
+    from bearingsim.model_versions import MODEL_VERSIONS
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000])])
+    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    cases = tmp_path / "cases"
+    archives = [cases / f"{r['case']}.h5" for r in first.rows]
+    assert [peek(a)["model_version"] for a in archives] == [MODEL_VERSIONS["reduced"]] * 3
+    _set_provenance(archives[1], model_version=MODEL_VERSIONS["reduced"] + 1)  # another model's numbers
+    _set_provenance(archives[2], model_version=None)  # written before models had a version
+    kept = archives[0].stat().st_mtime_ns
+
+    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert [r["status"] for r in again.rows] == ["cached", "stale", "stale"]
+    assert again.count("stale") == 2
+    assert archives[0].stat().st_mtime_ns == kept
+    assert [peek(a)["model_version"] for a in archives] == [MODEL_VERSIONS["reduced"]] * 3  # replaced
+    for a, b in zip(first.rows, again.rows):
+        assert a["summary"]["I_dec_mean_Ns"] == b["summary"]["I_dec_mean_Ns"]
+    assert [r["status"] for r in _rows(tmp_path)] == ["cached", "stale", "stale"]
+    index, _ = read_index(tmp_path / "sweep.h5")
+    assert [str(s) for s in index["status"]] == ["cached", "stale", "stale"]
+    third = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert [r["status"] for r in third.rows] == ["cached"] * 3
+
+
 def test_sweep_wall_time_covers_its_cases(tmp_path, monkeypatch):
     """``SweepOutcome.wall_s`` is the sweep's wall time from call to return (80 %: the call's own
     set-up and return are outside it), and on one worker at least the sum of the cases' own times (a

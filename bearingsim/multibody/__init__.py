@@ -69,9 +69,14 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, choose_dt, paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
+from bearingsim.model_versions import MODEL_VERSIONS
 from bearingsim.results import MemorySink, Result
 
-__all__ = ["simulate", "MultibodyResult"]
+__all__ = ["simulate", "MultibodyResult", "MODEL_VERSION"]
+
+#: version of this model's numbers, stored in each result's provenance (:mod:`bearingsim.model_versions`:
+#: bumped when a change moves numbers)
+MODEL_VERSION = MODEL_VERSIONS["multibody"]
 
 SUMMARY_UNITS = {
     "I_dec_mean_Ns": "N s", "I_dec_std_Ns": "N s", "I_acc_mean_Ns": "N s", "I_acc_std_Ns": "N s",
@@ -313,7 +318,7 @@ class MultibodyResult(Result):
                                                 "last recorded samples of the cage centre: columns time, x, y")
         groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count}, units)}
         provenance = {
-            "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
+            "model_version": MODEL_VERSION, "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
             "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),
             "ring_newton_failures": int(raw["newton_failures"]), "inner_ring": raw["inner_ring"],
             "solver_wall_s": float(raw["wall_s"]), "pymunk_step_s": float(raw["pymunk_step_s"]),

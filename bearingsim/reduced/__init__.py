@@ -33,9 +33,14 @@ from bearingsim.reduced.core import FACE_REAR, PassInputs
 from bearingsim.reduced.euler import default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
 from bearingsim.datatypes import AttrGroup, NamedArray
+from bearingsim.model_versions import MODEL_VERSIONS
 from bearingsim.results import Result
 
-__all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolution"]
+__all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolution", "MODEL_VERSION"]
+
+#: version of this model's numbers, stored in each result's provenance (:mod:`bearingsim.model_versions`:
+#: bumped when a change moves numbers)
+MODEL_VERSION = MODEL_VERSIONS["reduced"]
 
 FACE_NAMES = np.array(["rear", "front"])  # indexed by the face codes of reduced/core.py
 
@@ -134,7 +139,7 @@ class ReducedResult(Result):
             "results/summary": AttrGroup(summary, dict(SUMMARY_UNITS)),
             "results/wear": AttrGroup(wear, {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in wear}),
         }
-        provenance = {"solver": f"reduced/{sol.method}", "solver_wall_s": sol.wall_s,
+        provenance = {"model_version": MODEL_VERSION, "solver": f"reduced/{sol.method}", "solver_wall_s": sol.wall_s,
                       "dt_s": sol.dt if sol.dt is not None else float("nan"), "dt_choice": dt_choice}
         for k, v in sol.info.items():
             if np.isscalar(v):

@@ -1,8 +1,10 @@
 """The sweep's index (``sweep.csv`` and ``sweep.h5``) and the resume check of case archives.
 
 One row per case, in the sweep's case order: ``case`` (content hash), the swept keys, ``status``
-(``done``: run now; ``cached``: a complete archive of the same scenario was already there;
-``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
+(``done``: run now; ``cached``: a complete archive of the same scenario, computed by the same version
+of its model (:mod:`bearingsim.model_versions`), was already there; ``stale``: run now because the
+archive of the same scenario there was computed by another version of the model, or by a bearingsim
+that stored none; ``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
 ``archive`` (path relative to the sweep folder), ``wall_s`` (seconds the case took; for a cached case
 the stored run's own wall time) and the summary numbers (SI, as in the archives' ``/results/summary``,
 plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.sweeps.worker.standard_errors`).
@@ -197,13 +199,19 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     """The record of a case whose archive is complete and stores exactly ``toml_text``, else None.
 
     Only a file at the final name is considered (temporary files are never trusted); an unreadable,
-    incomplete or different archive gives None and the case runs again.
+    incomplete or different archive gives None and the case runs again. An archive of the case's
+    scenario computed by another version of its model than this one (``model_version`` in its
+    provenance against :data:`bearingsim.model_versions.MODEL_VERSIONS`; none stored counts as
+    another) gives ``{"status": "stale"}`` without its numbers: the case runs again too.
     """
+    from bearingsim.model_versions import MODEL_VERSIONS
     from bearingsim.sweeps.worker import standard_errors
 
     got = archive.peek(archive_path)
     if got is None or got["scenario"] != toml_text:
         return None
+    if got["model_version"] is None or got["model_version"] != MODEL_VERSIONS.get(got["model"]):
+        return {"status": "stale"}
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
     summary.update(standard_errors(got["I_dec"], got["I_acc"]))
     wall = got["wall_time_s"]

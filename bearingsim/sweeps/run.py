@@ -247,16 +247,19 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         try:
             _clean_temporaries(cases_dir)
             todo = []
+            stale = set()  # hashes of cases whose archive came from another version of the model
             for c, row in zip(cases, rows):
                 rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
-                if rec is None:
-                    # the sweep's own file, incomplete or damaged: it is run again and replaced
+                if rec is None or rec["status"] == "stale":
+                    # the sweep's own file, incomplete, damaged or stale: it is run again and replaced
                     (cases_dir / f"{c.hash}.h5").unlink(missing_ok=True)
                     todo.append(c)
+                    if rec is not None:
+                        stale.add(c.hash)
                 else:
                     row.update(rec, archive=f"cases/{c.hash}.h5")
             index.write()
-            counts = {"done": 0, "failed": 0, "cached": len(cases) - len(todo)}
+            counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
             bar = _progress(len(cases), progress, counts["cached"])
             if bar is not None:
                 bar.set_postfix(counts, refresh=True)
@@ -273,11 +276,12 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         data = rec.pop("archive", None)
                         if rec["status"] == "done" and data is not None:
                             write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
-                        row.update(status=rec["status"], error=rec["error"], wall_s=rec["wall_s"],
+                        status = "stale" if rec["status"] == "done" and rec["hash"] in stale else rec["status"]
+                        row.update(status=status, error=rec["error"], wall_s=rec["wall_s"],
                                    summary=rec["summary"],
                                    archive=f"cases/{rec['hash']}.h5" if rec["status"] == "done" else "")
                         index.changed(i)
-                        counts[rec["status"]] += 1
+                        counts[status] += 1
                         if rec["status"] == "failed":
                             say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
                     if bar is not None:
@@ -314,7 +318,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
                   scheduler: str | None = None, figures: bool = True, quiet: bool = False) -> int:
     """``bearingsim sweep``: run, print what was written and return the exit code.
 
-    0: every case done or cached; 1: some case failed (named on stderr); 130/143: interrupted by
+    0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
     SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
     """
     from bearingsim.sweeps.engines import DaskEngine, LocalEngine
@@ -328,6 +332,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     out = run_sweep(spec, outdir, engine=engine, figures=figures)
     n = len(out.rows)
     counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
+    if out.count("stale"):
+        counts += f", {out.count('stale')} stale (computed by another model version: run again)"
     if out.interrupted is not None:
         print(f"bearingsim: sweep interrupted ({signal.Signals(out.interrupted).name}): {counts}, "
               f"{out.count('pending')} not run, of {n}; index {out.h5}; run the same command again to resume",

@@ -92,6 +92,20 @@ def _setup_figure_dir(tmp):
     (tmp / "out_pass.png").mkdir()
 
 
+def _setup_figure_symlink(tmp):
+    """``out_pass.png`` a link to a user's file in another folder (``elsewhere/victim.txt``)."""
+    (tmp / "elsewhere").mkdir()
+    (tmp / "elsewhere" / "victim.txt").write_text("notes\n")
+    (tmp / "out_pass.png").symlink_to(Path("elsewhere") / "victim.txt")
+
+
+def _setup_archive_and_figure_symlink(tmp):
+    """A real archive ``out.h5`` (a reduced run) and ``out_pass.png`` a link to a user's file."""
+    res = bearingsim("run", PAPER, "-o", tmp / "out.h5", "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    _setup_figure_symlink(tmp)
+
+
 def _setup_text(name, text="my notes\n"):
     return lambda tmp: (tmp / name).write_text(text)
 
@@ -268,6 +282,13 @@ CASES: list[Case] = [
          setup=_setup_text("blocker")),
     Case("out-figure-path-is-dir", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
          ("out_pass.png", "figure path is a directory"), setup=_setup_figure_dir),
+    # figures (issue 30): a link, a user's file or a folder at a figure path is refused before the run
+    Case("out-figure-path-is-symlink", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_figure_symlink),
+    Case("out-figure-path-is-not-png", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "not a figure", "not replaced"), setup=_setup_text("out_pass.png")),
+    Case("plot-figure-path-is-symlink", "archive tools", ["plot", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_archive_and_figure_symlink),
     Case("out-locked", "output path", run(), 2, ("another bearingsim run",), setup="lock"),
     Case("out-stale-tmp-cleaned", "output path", run(), 0, ("removed stale temporary file",),
          setup=_setup_dead_tmp, gone=(".out.h5.tmp-*",), allow_new=("out.h5",)),

@@ -9,7 +9,8 @@ Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) 
 * a figure path of the run (``<stem>_<name>.png``) that is a symbolic link, a directory or not a PNG
   file is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
   to a temporary name and renamed over the target (:func:`atomic_file`), never through a link;
-* one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target, held from
+* one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target (an empty
+  regular file, opened with ``O_NOFOLLOW``: a link or a user's file there is refused), held from
   the start of the run until its archive and figures are written, then removed; a second run to the
   same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
   the next run takes over: the lock dies with its process);
@@ -120,17 +121,18 @@ def write_csv(path: str | Path, header, rows) -> Path:
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
-def check_replaceable(path: str | Path, signature: bytes, what: str) -> Path:
+def check_replaceable(path: str | Path, signature, what: str) -> Path:
     """Refuse (one-line :class:`UserError`) to replace ``path`` unless it is absent or a regular file
-    that starts with ``signature`` (one bearingsim could have written: a PNG for a figure, HDF5 for an
-    archive). A symbolic link, a directory, a FIFO or a file of another kind is the user's: not
-    replaced, not followed. Returns ``path``.
+    bearingsim could have written there (a PNG for a figure, its own index for ``sweep.csv``). A
+    symbolic link, a directory, a FIFO or a file of another kind is the user's: not replaced, not
+    followed. Returns ``path``.
 
     Parameters
     ----------
     path : file bearingsim is about to write
-    signature : first bytes of the files it writes there
-    what : what the file is, for the message ("figure", "table")
+    signature : bytes the files it writes there start with, or ``signature(path) -> bool`` for a
+        regular file (e.g. :func:`bearingsim.archive.is_table_file` of the right format)
+    what : what the file is, for the message ("figure", "sweep index")
     """
     p = Path(path)
     try:
@@ -145,6 +147,10 @@ def check_replaceable(path: str | Path, signature: bytes, what: str) -> Path:
         kind = "a directory"
     elif not stat.S_ISREG(st.st_mode):
         kind = "not a regular file"
+    elif callable(signature):
+        if signature(p):
+            return p
+        kind = f"a file that is not a {what} bearingsim wrote"
     else:
         try:
             fd = os.open(p, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
@@ -267,6 +273,31 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
     return removed
 
 
+def open_lock_file(lock_path: str | Path, guarded: str | Path) -> int:
+    """Open (creating it if needed) the lock file ``lock_path`` for ``flock``; return its descriptor.
+
+    Never through a symbolic link (``O_NOFOLLOW``: a planted ``.sweep.lock -> ~/notes`` neither truncates
+    nor creates its target) and never a file bearingsim did not make: a lock file is an empty regular
+    file, anything else there is refused with one line naming it (``guarded``: what the lock protects).
+    """
+    lock_path = Path(lock_path)
+    flags = (os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+             | getattr(os, "O_NONBLOCK", 0))
+    try:
+        fd = os.open(lock_path, flags, 0o644)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise UserError(f"{lock_path}: lock file of {guarded} is a symbolic link; not followed "
+                            "(remove it)") from None
+        raise UserError(f"{guarded}: output is not writable ({exc.strerror or exc})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_size > 0:
+        os.close(fd)
+        kind = "not a regular file" if not stat.S_ISREG(st.st_mode) else "not empty"
+        raise UserError(f"{lock_path}: lock file of {guarded} is {kind}, not bearingsim's; not replaced (remove it)")
+    return fd
+
+
 class OutputLock:
     """Exclusive, non-blocking ``fcntl.flock`` on ``.<name>.lock`` beside an archive path.
 
@@ -287,9 +318,9 @@ class OutputLock:
         for _ in range(10):  # the holder may unlink the lock file between our open and flock: retry
             try:
                 self.path.parent.mkdir(parents=True, exist_ok=True)
-                fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
             except OSError as exc:
                 raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
+            fd = open_lock_file(self.lock_path, self.path)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as exc:

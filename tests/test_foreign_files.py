@@ -98,3 +98,88 @@ def test_a_figure_is_written_whole_or_not_at_all(tmp_path):
         save_figure(fig, path)
     assert path.read_bytes() == old
     assert [p.name for p in tmp_path.iterdir()] == ["f.png"]
+
+
+# --- lock files (item 5) -------------------------------------------------------------------------
+def test_run_lock_file_is_never_followed(tmp_path):
+    """A planted ``.o.h5.lock`` link is refused (was: followed, creating its target outside the folder)."""
+    out = tmp_path / "out"
+    out.mkdir()
+    target = tmp_path / "created-outside"
+    (out / ".o.h5.lock").symlink_to(target)
+    res = cli("run", PAPER, "-o", out / "o.h5", "--no-plots")
+    _one_line_refusal(res, ".o.h5.lock", "symbolic link")
+    assert not target.exists() and (out / ".o.h5.lock").is_symlink()
+    assert sorted(p.name for p in out.iterdir()) == [".o.h5.lock"]
+
+
+def test_run_lock_file_that_is_a_users_file_is_kept(tmp_path):
+    """A non-empty ``.o.h5.lock`` is not bearingsim's (its lock files are empty): refused and kept
+    (was: taken as the lock and deleted when the run ended)."""
+    (tmp_path / ".o.h5.lock").write_text("my notes\n")
+    res = cli("run", PAPER, "-o", tmp_path / "o.h5", "--no-plots")
+    _one_line_refusal(res, ".o.h5.lock", "not empty")
+    assert (tmp_path / ".o.h5.lock").read_text() == "my notes\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".o.h5.lock"]
+
+
+# --- sweep and cross-check folders (item 5) ------------------------------------------------------
+def _sweep(out):
+    return cli("sweep", PAPER, "--param", "contact.restitution=0.5,0.6", "-o", out, "-j", "1")
+
+
+def test_sweep_lock_link_does_not_truncate_its_target(tmp_path):
+    out = tmp_path / "sw"
+    out.mkdir()
+    victim = tmp_path / "victim.txt"
+    _plant_link(out, ".sweep.lock", victim)
+    res = _sweep(out)
+    _one_line_refusal(res, ".sweep.lock", "symbolic link")
+    assert victim.read_text() == "notes\n"
+    assert sorted(p.name for p in out.iterdir()) == [".sweep.lock"]
+
+
+@pytest.mark.parametrize("name, kind", [("sweep.csv", "text"), ("sweep.h5", "text"), ("sweep_I.png", "symlink"),
+                                        ("sweep_map.png", "text"), ("cases", "symlink")])
+def test_sweep_refuses_a_folder_holding_a_users_file(tmp_path, name, kind):
+    """Before any case runs: a user's file or a link at a path the sweep writes is refused and kept."""
+    out = tmp_path / "sw"
+    out.mkdir()
+    if kind == "text":
+        (out / name).write_text("my notes\n")
+    elif name == "cases":
+        (tmp_path / "elsewhere").mkdir()
+        (out / name).symlink_to(tmp_path / "elsewhere")
+    else:
+        _plant_link(out, name, tmp_path / "victim.txt")
+    res = _sweep(out)
+    _one_line_refusal(res, name, "not")
+    if kind == "text":
+        assert (out / name).read_text() == "my notes\n"
+    elif name == "cases":
+        assert list((tmp_path / "elsewhere").iterdir()) == []
+    else:
+        assert (tmp_path / "victim.txt").read_text() == "notes\n" and (out / name).is_symlink()
+    assert sorted(p.name for p in out.iterdir()) == sorted({name, ".sweep.lock"})
+
+
+def test_sweep_rewrites_its_own_files(tmp_path):
+    """Its own index and figure are replaced by the next sweep into the folder (resume)."""
+    out = tmp_path / "sw"
+    for _ in range(2):
+        res = _sweep(out)
+        assert res.returncode == 0, res.stderr
+    assert {"sweep.csv", "sweep.h5", "sweep_I.png", "cases", ".sweep.lock"} == {p.name for p in out.iterdir()}
+
+
+@pytest.mark.parametrize("name", ["crosscheck.csv", "crosscheck.h5", "crosscheck.png"])
+def test_crosscheck_refuses_a_folder_holding_a_users_file(tmp_path, name):
+    """Before any rung runs (the refusal takes no simulation time)."""
+    out = tmp_path / "cc"
+    out.mkdir()
+    (out / name).write_text("my notes\n")
+    res = cli("crosscheck", SCENARIOS / "multibody_3000rpm.toml", "--speeds", "3000", "--rotations", "1",
+              "-o", out, "-j", "1")
+    _one_line_refusal(res, name, "not replaced")
+    assert (out / name).read_text() == "my notes\n"
+    assert sorted(p.name for p in out.iterdir()) == [name]

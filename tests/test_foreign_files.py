@@ -183,3 +183,13 @@ def test_crosscheck_refuses_a_folder_holding_a_users_file(tmp_path, name):
     _one_line_refusal(res, name, "not replaced")
     assert (out / name).read_text() == "my notes\n"
     assert sorted(p.name for p in out.iterdir()) == [name]
+
+
+def test_validate_figure_is_never_written_through_a_link(tmp_path):
+    """``validate`` (reduced Fig. 9 only) writes its figure through ``save_figure`` too."""
+    out = tmp_path / "v"
+    out.mkdir()
+    link = _plant_link(out, "fig9_idec_vs_speed.png", tmp_path / "victim.txt")
+    res = cli("validate", "--rig-rotations", "0", "-o", out)
+    _one_line_refusal(res, "fig9_idec_vs_speed.png", "symbolic link")
+    assert (tmp_path / "victim.txt").read_text() == "notes\n" and link.is_symlink()

@@ -213,8 +213,9 @@ def _plot(rows: list[dict], path: Path) -> None:
     ax.legend(fontsize=7, ncol=2)
     ax.set_title("bearingsim: speed against error (medians of repeats, one core)", fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    from bearingsim.plotting import save_figure
+
+    save_figure(fig, path, dpi=130, tight=False)
 
 
 def machine_info() -> dict:

@@ -170,6 +170,7 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     if jobs < 1:
         raise UserError(f"-j {jobs}: give at least 1 worker process")
     outdir = check_writable_dir(outdir)
+    check_crosscheck_outputs(outdir)
     (outdir / "rungs").mkdir(exist_ok=True)
     work = []
     for rpm in speeds:
@@ -189,6 +190,22 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     write_table(outdir, rows, scenario)
     plot_crosscheck(outdir / "crosscheck.h5", outdir)
     return rows
+
+
+def check_crosscheck_outputs(outdir: Path) -> None:
+    """Refuse, before any rung runs, an output folder whose ``crosscheck.csv``, ``crosscheck.h5``,
+    ``crosscheck.png`` or ``rungs`` hold what the cross-check did not write (a user's file, a link, a
+    folder): one line naming it, nothing replaced (:func:`bearingsim.outputs.check_replaceable`)."""
+    from bearingsim import archive
+    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
+
+    check_replaceable(outdir / "crosscheck.csv", ",".join(COLUMNS).encode(), "cross-check table")
+    check_replaceable(outdir / "crosscheck.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "cross-check table")
+    check_replaceable(outdir / "crosscheck.png", PNG_SIGNATURE, "figure")
+    rungs = outdir / "rungs"
+    if rungs.is_symlink() or (rungs.exists() and not rungs.is_dir()):
+        raise UserError(f"{rungs}: the cross-check's folder of rung archives is "
+                        f"{'a symbolic link' if rungs.is_symlink() else 'not a folder'}; not used (remove it)")
 
 
 def _fmt(v) -> str:

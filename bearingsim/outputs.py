@@ -6,8 +6,11 @@ Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) 
 * an archive path ends in ``.h5`` / ``.hdf5`` (so ``-o my.toml`` or ``-o notes.txt`` is refused);
 * the target is never the input scenario file;
 * an existing target that is not a bearingsim archive is not replaced;
-* a figure path of the run (``<stem>_*.png``) that is a directory is refused before the run;
-* one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target, held from
+* a figure path of the run (``<stem>_<name>.png``) that is a symbolic link, a directory or not a PNG
+  file is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
+  to a temporary name and renamed over the target (:func:`atomic_file`), never through a link;
+* one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target (an empty
+  regular file, opened with ``O_NOFOLLOW``: a link or a user's file there is refused), held from
   the start of the run until its archive and figures are written, then removed; a second run to the
   same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
   the next run takes over: the lock dies with its process);
@@ -21,6 +24,7 @@ import errno
 import fcntl
 import os
 import re
+import stat
 import sys
 from pathlib import Path
 
@@ -61,35 +65,105 @@ def temporary_name(path: Path) -> Path:
     return path.with_name(f".{path.name}.tmp-{os.getpid()}")
 
 
-def write_atomic_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary name and a rename (never a partial file)."""
-    tmp = temporary_name(path)
+def _create_new(path: Path) -> int:
+    """Open ``path`` for writing as a new file, never through a symbolic link (``O_EXCL|O_NOFOLLOW``);
+    a leftover of this process's id (a symbolic link planted there included) is removed first."""
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
     try:
-        with open(tmp, "wb") as fh:
-            fh.write(data)
+        return os.open(path, flags, 0o644)
+    except FileExistsError:
+        os.unlink(path)  # removes a link itself, never its target
+        return os.open(path, flags, 0o644)
+
+
+@contextlib.contextmanager
+def atomic_file(path: str | Path):
+    """``with atomic_file(path) as fh: fh.write(...)``: the one way bearingsim writes a whole file.
+
+    The data goes to a new temporary file in the same folder (:func:`temporary_name`), which replaces
+    ``path`` by ``os.replace`` only when the block ends without an error: a reader never sees a partial
+    file, and a symbolic link at ``path`` is replaced, never written through. On any error (a signal
+    included) the temporary file is removed and ``path`` is untouched.
+    """
+    path = Path(path)
+    tmp = temporary_name(path)
+    fd = _create_new(tmp)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            yield fh
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
 
 
+def write_atomic_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through :func:`atomic_file` (never a partial file)."""
+    with atomic_file(path) as fh:
+        fh.write(data)
+
+
 def write_csv(path: str | Path, header, rows) -> Path:
-    """Write a CSV table (``header``, then ``rows`` of already formatted cells) through a temporary name
-    and a rename, so a reader never sees half a table; return the path."""
+    """Write a CSV table (``header``, then ``rows`` of already formatted cells) through
+    :func:`atomic_file`, so a reader never sees half a table; return the path."""
     import csv
+    import io
 
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    try:
-        with open(tmp, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows(rows)
-        tmp.replace(path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    buf = io.StringIO(newline="")
+    w = csv.writer(buf)
+    w.writerow(header)
+    w.writerows(rows)
+    write_atomic_bytes(path, buf.getvalue().encode("utf-8"))
     return path
+
+
+PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+
+
+def check_replaceable(path: str | Path, signature, what: str) -> Path:
+    """Refuse (one-line :class:`UserError`) to replace ``path`` unless it is absent or a regular file
+    bearingsim could have written there (a PNG for a figure, its own index for ``sweep.csv``). A
+    symbolic link, a directory, a FIFO or a file of another kind is the user's: not replaced, not
+    followed. Returns ``path``.
+
+    Parameters
+    ----------
+    path : file bearingsim is about to write
+    signature : bytes the files it writes there start with, or ``signature(path) -> bool`` for a
+        regular file (e.g. :func:`bearingsim.archive.is_table_file` of the right format)
+    what : what the file is, for the message ("figure", "sweep index")
+    """
+    p = Path(path)
+    try:
+        st = os.lstat(p)
+    except FileNotFoundError:
+        return p
+    except OSError as exc:
+        raise UserError(f"{p}: cannot check the {what} path ({exc.strerror or exc})") from None
+    if stat.S_ISLNK(st.st_mode):
+        kind = "a symbolic link"
+    elif stat.S_ISDIR(st.st_mode):
+        kind = "a directory"
+    elif not stat.S_ISREG(st.st_mode):
+        kind = "not a regular file"
+    elif callable(signature):
+        if signature(p):
+            return p
+        kind = f"a file that is not a {what} bearingsim wrote"
+    else:
+        try:
+            fd = os.open(p, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+            try:
+                head = os.read(fd, len(signature))
+            finally:
+                os.close(fd)
+        except OSError as exc:
+            raise UserError(f"{p}: cannot read the existing {what} ({exc.strerror or exc}); not replaced") from None
+        if head == signature:
+            return p
+        kind = f"a file that is not a {what} bearingsim wrote"
+    raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another output)")
 
 
 def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True) -> Path:
@@ -101,7 +175,9 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     inputs : files the run reads (the scenario file); the target may not be one of them
     is_archive : ``is_archive(path) -> bool``, what may be replaced (:func:`bearingsim.archive.is_archive`);
         None: the file signature of HDF5
-    figures : the run also writes ``<stem>_*.png`` beside the archive (check that none of them is a folder)
+    figures : names of the figures the run also writes beside the archive (``<stem>_<name>.png``): each
+        must be absent or a PNG file (:func:`check_replaceable`); True: only check that no
+        ``<stem>_*.png`` is a folder; False or empty: no figures
 
     Returns
     -------
@@ -125,11 +201,19 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     if p.exists() and not is_archive(p):
         raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another -o)")
     stem = p.with_suffix("")
-    if figures and p.parent.is_dir():
+    if figures is True and p.parent.is_dir():
         for fig in p.parent.glob(f"{_glob_escape(stem.name)}_*.png"):
             if fig.is_dir():
                 raise UserError(f"{fig}: figure path is a directory")
+    elif figures:
+        for name in figures:
+            check_replaceable(figure_path(stem, name), PNG_SIGNATURE, "figure")
     return p
+
+
+def figure_path(stem: str | Path, name: str) -> Path:
+    """Where a run's figure ``name`` goes: ``<stem>_<name>.png``."""
+    return Path(f"{stem}_{name}.png")
 
 
 def _glob_escape(s: str) -> str:
@@ -189,6 +273,31 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
     return removed
 
 
+def open_lock_file(lock_path: str | Path, guarded: str | Path) -> int:
+    """Open (creating it if needed) the lock file ``lock_path`` for ``flock``; return its descriptor.
+
+    Never through a symbolic link (``O_NOFOLLOW``: a planted ``.sweep.lock -> ~/notes`` neither truncates
+    nor creates its target) and never a file bearingsim did not make: a lock file is an empty regular
+    file, anything else there is refused with one line naming it (``guarded``: what the lock protects).
+    """
+    lock_path = Path(lock_path)
+    flags = (os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+             | getattr(os, "O_NONBLOCK", 0))
+    try:
+        fd = os.open(lock_path, flags, 0o644)
+    except OSError as exc:
+        if exc.errno == errno.ELOOP:
+            raise UserError(f"{lock_path}: lock file of {guarded} is a symbolic link; not followed "
+                            "(remove it)") from None
+        raise UserError(f"{guarded}: output is not writable ({exc.strerror or exc})") from None
+    st = os.fstat(fd)
+    if not stat.S_ISREG(st.st_mode) or st.st_size > 0:
+        os.close(fd)
+        kind = "not a regular file" if not stat.S_ISREG(st.st_mode) else "not empty"
+        raise UserError(f"{lock_path}: lock file of {guarded} is {kind}, not bearingsim's; not replaced (remove it)")
+    return fd
+
+
 class OutputLock:
     """Exclusive, non-blocking ``fcntl.flock`` on ``.<name>.lock`` beside an archive path.
 
@@ -209,9 +318,9 @@ class OutputLock:
         for _ in range(10):  # the holder may unlink the lock file between our open and flock: retry
             try:
                 self.path.parent.mkdir(parents=True, exist_ok=True)
-                fd = os.open(self.lock_path, os.O_RDWR | os.O_CREAT, 0o644)
             except OSError as exc:
                 raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
+            fd = open_lock_file(self.lock_path, self.path)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as exc:

@@ -17,10 +17,23 @@ def legend_outside(ax, **kw) -> None:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8, **kw)
 
 
-def save_figure(fig, path) -> Path:
-    """Lay out, write (120 dpi) and close one report figure; return its path."""
+def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
+    """Lay out, write and close one report figure; return its path.
+
+    Written atomically (:func:`bearingsim.outputs.atomic_file`); an existing ``path`` that is not a PNG
+    file (a symbolic link, a directory, a user's file) is refused with a one-line error and kept
+    (:func:`bearingsim.outputs.check_replaceable`). ``tight``: ``tight_layout`` and a bounding box
+    that keeps a legend placed outside the axes.
+    """
+    from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
+
     path = Path(path)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120, bbox_inches="tight")  # keeps a legend placed outside the axes
-    plt.close(fig)
+    try:
+        check_replaceable(path, PNG_SIGNATURE, "figure")
+        if tight:
+            fig.tight_layout()
+        with atomic_file(path) as fh:
+            fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
+    finally:
+        plt.close(fig)
     return path

@@ -107,14 +107,16 @@ class Result:
         return {name: getattr(self, f"plot_{name}")() for name in self.FIGURES}
 
     def save_figures(self, stem) -> list[Path]:
-        """Write every figure as ``<stem>_<name>.png``; return the paths."""
+        """Write every figure as ``<stem>_<name>.png``; return the paths. Every path is checked before
+        any figure is drawn: one that is not a PNG file (a link, a folder, a user's file) is refused
+        with a one-line error and nothing is written (:func:`bearingsim.outputs.check_replaceable`)."""
+        from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
         from bearingsim.plotting import save_figure
 
-        stem = Path(stem)
-        out = []
-        for name in self.FIGURES:
-            out.append(save_figure(getattr(self, f"plot_{name}")(), Path(f"{stem}_{name}.png")))
-        return out
+        paths = {name: figure_path(stem, name) for name in self.FIGURES}
+        for path in paths.values():
+            check_replaceable(path, PNG_SIGNATURE, "figure")
+        return [save_figure(getattr(self, f"plot_{name}")(), path) for name, path in paths.items()]
 
     def title(self) -> str:
         """``<scenario>: <what ran>, <speed> rpm <direction>``: names the run as it was actually made."""

@@ -99,7 +99,8 @@ def run_scenario(
     from bearingsim.errors import UserError
 
     out = Path(out) if out is not None else default_output(scenario)
-    outputs.check_target(out, [scenario.source], archive.is_archive, figures=figures)  # before the lock
+    names = model_module(scenario.model).RESULT.FIGURES if figures else ()
+    outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
     lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
     try:
         if exclusive:

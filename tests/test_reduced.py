@@ -156,6 +156,46 @@ def test_euler_refuses_a_step_that_is_too_large():
         solve_euler(inp, 10 * max_stable_dt(inp))
 
 
+@pytest.mark.parametrize("dt", [-1.0, 0.0, float("nan")])
+def test_euler_refuses_a_step_that_is_not_positive(dt):
+    """A zero, negative or NaN step is no step (dt = -1 returned zero impulses; issue 30)."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match=r"numerics\.dt_s"):
+        solve_euler(_inputs(3000), dt)
+
+
+def test_euler_refuses_a_pass_of_too_many_steps_before_running():
+    """The step count of a pass is bounded up front, naming numerics.dt_s for a given step and the
+    pocket clearance for the automatic one (1e-10 s at 3000 rpm: 4e8 steps; issue 30)."""
+    from dataclasses import replace
+
+    from bearingsim.errors import UserError
+    from bearingsim.reduced import solve_pass
+    from bearingsim.reduced.euler import MAX_STEPS_PER_PASS, steps_per_pass
+
+    inp = _inputs(3000)
+    assert steps_per_pass(inp, 1e-10) > MAX_STEPS_PER_PASS
+    with pytest.raises(UserError, match=r"numerics\.dt_s.*steps"):
+        solve_euler(inp, 1e-10)
+    tight = replace(inp, pocket_clearance=1e-12)
+    with pytest.raises(UserError, match=r"bearing\.pocket_clearance_mm.*automatic"):
+        solve_pass(tight, "euler")
+
+
+def test_euler_impact_buffer_grows_without_changing_a_number():
+    """A full impact buffer is grown between compiled chunks: the same pass as with room to spare."""
+    inp = _inputs(500)
+    a = solve_euler(inp, 1e-6, capacity=1)
+    b = solve_euler(inp, 1e-6)
+    assert a.impacts["theta"].size > 1
+    assert (a.I_dec, a.I_acc, a.l_end, a.v_end) == (b.I_dec, b.I_acc, b.l_end, b.v_end)
+    for k in a.impacts:
+        assert np.array_equal(a.impacts[k], b.impacts[k])
+    for k in a.trace:
+        assert np.array_equal(a.trace[k], b.trace[k])
+
+
 def test_roller_leaves_outer_race_without_nan():
     """Below ~313 rpm N = m r_p ω_c² + m g cos θ < 0 near the top (Eq. 3): the drag must be zero there,
     not NaN, and the pass must finish with finite impulses bounded by the impulse gravity and drag can

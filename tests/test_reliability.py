@@ -92,6 +92,20 @@ def _setup_figure_dir(tmp):
     (tmp / "out_pass.png").mkdir()
 
 
+def _setup_figure_symlink(tmp):
+    """``out_pass.png`` a link to a user's file in another folder (``elsewhere/victim.txt``)."""
+    (tmp / "elsewhere").mkdir()
+    (tmp / "elsewhere" / "victim.txt").write_text("notes\n")
+    (tmp / "out_pass.png").symlink_to(Path("elsewhere") / "victim.txt")
+
+
+def _setup_archive_and_figure_symlink(tmp):
+    """A real archive ``out.h5`` (a reduced run) and ``out_pass.png`` a link to a user's file."""
+    res = bearingsim("run", PAPER, "-o", tmp / "out.h5", "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    _setup_figure_symlink(tmp)
+
+
 def _setup_text(name, text="my notes\n"):
     return lambda tmp: (tmp / name).write_text(text)
 
@@ -268,6 +282,13 @@ CASES: list[Case] = [
          setup=_setup_text("blocker")),
     Case("out-figure-path-is-dir", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
          ("out_pass.png", "figure path is a directory"), setup=_setup_figure_dir),
+    # figures (issue 30): a link, a user's file or a folder at a figure path is refused before the run
+    Case("out-figure-path-is-symlink", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_figure_symlink),
+    Case("out-figure-path-is-not-png", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "not a figure", "not replaced"), setup=_setup_text("out_pass.png")),
+    Case("plot-figure-path-is-symlink", "archive tools", ["plot", "{tmp}/out.h5"], 2,
+         ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_archive_and_figure_symlink),
     Case("out-locked", "output path", run(), 2, ("another bearingsim run",), setup="lock"),
     Case("out-stale-tmp-cleaned", "output path", run(), 0, ("removed stale temporary file",),
          setup=_setup_dead_tmp, gone=(".out.h5.tmp-*",), allow_new=("out.h5",)),
@@ -323,6 +344,12 @@ CASES: list[Case] = [
          ("contact.restitution",)),
     Case("sweep-missing-scenario", "sweep", ["sweep", "{tmp}/nope.toml", "--param", "contact.restitution=0.5",
                                              "-o", "{tmp}/sw"], 2, ("nope.toml",)),
+    # the euler method's step count is bounded before the run (issue 30): ~4e8 and ~2.6e9 steps asked
+    Case("euler-dt-1e-10", "--set", run(*S("reduced.method=euler", "numerics.dt_s=1e-10")), 2,
+         ("numerics.dt_s", "steps", "more than 1e+08")),
+    Case("euler-pocket-clearance-1e-9-automatic-step", "--set",
+         run(*S("reduced.method=euler", "bearing.pocket_clearance_mm=1e-9")), 2,
+         ("bearing.pocket_clearance_mm", "automatic", "more than 1e+08")),
     # runs that work
     Case("works-reduced", "works", run(), 0, ("wrote",), allow_new=("out.h5",)),
     Case("note-ring-newton-failures", "works", run(*S("numerics.rotations=2"), scenario=SCENARIOS / "multibody_6000rpm.toml"),
@@ -502,6 +529,47 @@ def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     assert not obs.problems, obs.problems
 
 
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
+def test_signal_stops_the_euler_pass_within_a_second_leaving_nothing(tmp_path, sig, code):
+    """The euler method's compiled loop returns to Python every ``CHUNK_STEPS`` steps, and returns no
+    array (numba boxed its arrays by calling Python, which ran the pending signal's handler inside the
+    boxing: SIGSEGV, exit 139, temporary archive and lock left; issue 30)."""
+    obs = signal_case(tmp_path, sig, "euler")
+    assert obs.code == code and not obs.problems, (obs.code, obs.problems, obs.err)
+
+
+_EULER_SIGNAL_SCRIPT = """
+import os, signal, threading, time
+from bearingsim import cli
+from bearingsim.scenario import load_scenario
+from bearingsim.parameters import Parameters
+from bearingsim.reduced.core import PassInputs
+from bearingsim.reduced.euler import solve_euler
+inp = PassInputs.from_parameters(Parameters.from_scenario(load_scenario(PAPER, [])))
+solve_euler(inp, 1e-5)  # compiled (or loaded from the cache) before the timed call
+signal.signal(signal.SIGTERM, cli._raise_terminated)
+threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGTERM)).start()
+t0 = time.monotonic()
+try:
+    solve_euler(inp, 4.02e-10)  # 1e8 steps in the compiled loop (seconds)
+    print("finished")
+except cli.Terminated:
+    print(f"terminated after {time.monotonic() - t0:.2f} s")
+"""
+
+
+def test_sigterm_inside_the_compiled_euler_loop_raises_cleanly():
+    """A SIGTERM landing in the euler method's compiled loop: its handler's exception comes out of
+    ``solve_euler`` within a chunk of steps. Before issue 30 the kernel returned arrays, numba ran the
+    pending handler while boxing them, ignored its exception and the process died of SIGSEGV."""
+    script = _EULER_SIGNAL_SCRIPT.replace("PAPER", repr(str(PAPER)))
+    with started([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                 env=ENV) as proc:
+        out, err = proc.communicate(timeout=120)
+    assert proc.returncode == 0 and out.startswith("terminated after"), (proc.returncode, out, err)
+    assert float(out.split()[2]) < 1.5, out
+
+
 def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch):
     """A SIGTERM whose handler runs inside a weakref callback: Python cannot raise its ``Terminated``
     there (it is "unraisable"). While a command runs, the CLI hands the signal back to the main thread,
@@ -538,11 +606,23 @@ def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch
     assert sys.unraisablehook is hook and ref_a() is None and ref_b() is None
 
 
+#: a run long enough to be caught writing: 200 multibody rotations, or one euler pass of 1e8 steps (the
+#: most the euler method takes; ~6 s at ~60 ns a step) spent in one compiled loop
+LONG_RUNS = {
+    "multibody": [MB, "--set", "numerics.rotations=200"],
+    "euler": [PAPER, "--no-plots", "--set", "reduced.method=euler", "--set", "numerics.dt_s=4.02e-10"],
+}
+#: seconds from the temporary archive's creation to the signal: past the imports and the compiled
+#: code's loading from numba's cache, into the run's main loop
+SETTLE_S = {"multibody": 0.5, "euler": 2.0}
+
+
 @contextlib.contextmanager
-def _long_run(tmp_path):
-    """A multibody run into ``tmp_path/m.h5`` long enough to be caught writing; given once its
-    temporary archive exists (or after 120 s, or if it ended), and ended when the block is left."""
-    cmd = [sys.executable, "-m", "bearingsim", "run", MB, "-o", tmp_path / "m.h5", "--set", "numerics.rotations=200"]
+def _long_run(tmp_path, kind="multibody"):
+    """A long run (:data:`LONG_RUNS`) into ``tmp_path/m.h5``; given once its temporary archive exists
+    (or after 120 s, or if it ended), and ended when the block is left."""
+    scenario, *extra = LONG_RUNS[kind]
+    cmd = [sys.executable, "-m", "bearingsim", "run", scenario, "-o", tmp_path / "m.h5", *extra]
     with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=ENV) as proc:
         deadline = time.monotonic() + 120
         while not list(tmp_path.glob(".m.h5.tmp-*")) and time.monotonic() < deadline and proc.poll() is None:
@@ -581,10 +661,10 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]  # the dead run's lock file is gone too
 
 
-def signal_case(tmp: Path, sig) -> Observed:
-    """Start a long multibody run, signal it once its temporary archive exists, time the exit."""
-    with _long_run(tmp) as proc:
-        time.sleep(0.5)
+def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
+    """Start a long run (:data:`LONG_RUNS`), signal it once its temporary archive exists, time the exit."""
+    with _long_run(tmp, kind) as proc:
+        time.sleep(SETTLE_S[kind])
         t0 = time.monotonic()
         proc.send_signal(sig)
         out, err = proc.communicate(timeout=30)

@@ -50,12 +50,17 @@ SUMMARY_UNITS = {
 }
 
 
-def solve_pass(inp: PassInputs, method: str = "event", dt: float | None = None, trace_points: int = 2000):
+def solve_pass(inp: PassInputs, method: str = "event", dt: float | None = None, trace_points: int = 2000,
+               automatic: bool | None = None):
     """Solve one no-load pass with ``method`` (``"event"`` or ``"euler"``; euler needs ``dt`` or uses
-    :func:`bearingsim.reduced.euler.default_dt`)."""
+    :func:`bearingsim.reduced.euler.default_dt`; ``automatic``: ``dt`` is that default, default
+    ``dt is None``, which only changes which key a refused step's message names)."""
     if method == "event":
         return solve_event(inp, trace_points=trace_points)
-    return solve_euler(inp, dt if dt is not None else default_dt(inp), trace_points=trace_points)
+    if automatic is None:
+        automatic = dt is None
+    return solve_euler(inp, dt if dt is not None else default_dt(inp), trace_points=trace_points,
+                       automatic=automatic)
 
 
 class ReducedResult(Result):
@@ -200,6 +205,6 @@ def simulate(p, sink=None, progress: bool = False, dt: float | None = None) -> R
         if dt is None:
             dt = default_dt(inp)
             dt_choice = "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
-    sol = solve_pass(inp, method, dt)
+    sol = solve_pass(inp, method, dt, automatic=dt_choice.startswith("automatic"))
     return ReducedResult.from_solution(p, inp, sol, dt_choice)
 RESULT = ReducedResult

@@ -42,31 +42,52 @@ from bearingsim.reduced.event import PassSolution
 
 MIN_STEPS_PER_PASS = 100
 MAX_TRAVEL_FRACTION = 0.1  # the fastest possible approach may cross at most 10 % of s in one step
+# Steps of one pass: the compiled loop takes ~60 ns a step (3000 rpm, one core of a 2020s x86 machine),
+# so 1e8 steps is ~6 s. The automatic step needs ~2e5 at 3000 rpm and ~4e7 at 150 rpm with a 0.001 mm
+# pocket clearance; a run that would need more is refused before it starts (the event method solves
+# the same pass in milliseconds whatever the clearance).
+MAX_STEPS_PER_PASS = 100_000_000
+# The compiled loop returns to Python at least every CHUNK_STEPS steps (~0.1 s), so that a pending
+# SIGINT/SIGTERM is raised there and the run's clean-up paths run (as the multibody loop does).
+CHUNK_STEPS = 2_000_000
+# return codes of _euler_steps
+CODE_DONE, CODE_CHUNK_END, CODE_IMPACTS_FULL = 0, 1, 2
+# the loop state carried between calls of _euler_steps
+F_T, F_L, F_V, F_IDEC, F_IACC, F_IDEC_REST, F_IACC_REST = range(7)
+I_STEP, I_MODE, I_NIMP, I_NTRACE, I_STARTED = range(5)
 
 
 @njit(cache=True)
-def _euler_pass(par, dt, cap, stride):
+def _euler_steps(par, dt, nsteps, stride, fst, ist, impacts, trace, max_steps):
+    """Advance the pass by at most ``max_steps`` steps from the state in ``fst``/``ist``.
+
+    Returns a code only (``CODE_*``): everything else is written into the arrays passed in. Numba boxes
+    a returned array by calling Python code, which runs a pending signal's handler; the exception it
+    raises there is not checked and the process dies of SIGSEGV, so a kernel that may run while a
+    signal arrives must return no array.
+    """
     m, s, omega, g, e = par[0], par[1], par[2], par[3], par[4]
     th0, th1, K, A = par[5], par[6], par[7], par[8]
     resting = par[9] > 0.5
     duration = (th1 - th0) / omega
-    nsteps = int(math.ceil(duration / dt - 1e-9))
-    impacts = np.zeros((cap, 5))
-    ntr = nsteps // stride + 2
-    trace = np.zeros((ntr, 4))  # theta, l, v, I_dec cumulative
-    n_imp = 0
-    ntrace = 0
-    I_dec = 0.0
-    I_acc = 0.0
-    I_dec_rest = 0.0
-    I_acc_rest = 0.0
-    l = s
-    v = 0.0
-    a0 = net_accel(th0, K, A, g)
-    mode = REST_FRONT if a0 > 0.0 else FREE
-    overflow = False
-    t = 0.0
-    for n in range(nsteps):
+    cap = impacts.shape[0]
+    ntr = trace.shape[0]
+    if ist[I_STARTED] == 0:
+        fst[F_L] = s
+        fst[F_V] = 0.0
+        a0 = net_accel(th0, K, A, g)
+        ist[I_MODE] = REST_FRONT if a0 > 0.0 else FREE
+        ist[I_STARTED] = 1
+    t, l, v = fst[F_T], fst[F_L], fst[F_V]
+    I_dec, I_acc, I_dec_rest, I_acc_rest = fst[F_IDEC], fst[F_IACC], fst[F_IDEC_REST], fst[F_IACC_REST]
+    mode, n_imp, ntrace = ist[I_MODE], ist[I_NIMP], ist[I_NTRACE]
+    n = ist[I_STEP]
+    n_stop = min(nsteps, n + max_steps)
+    code = CODE_CHUNK_END
+    while n < n_stop:
+        if n_imp >= cap:  # a step makes at most one impact: stop before it, with the state of its start
+            code = CODE_IMPACTS_FULL
+            break
         h = dt if t + dt <= duration else duration - t
         th = th0 + omega * t
         if n % stride == 0 and ntrace < ntr:
@@ -75,6 +96,7 @@ def _euler_pass(par, dt, cap, stride):
             trace[ntrace, 2] = v
             trace[ntrace, 3] = I_dec
             ntrace += 1
+        n += 1
         a = net_accel(th, K, A, g)
         if mode == REST_REAR:
             if a < 0.0:
@@ -117,15 +139,12 @@ def _euler_pass(par, dt, cap, stride):
                 J = m * u
             else:
                 J = m * u * (1.0 + e) / (1.0 - e)
-        if n_imp < cap:
-            impacts[n_imp, 0] = th0 + omega * t
-            impacts[n_imp, 1] = u
-            impacts[n_imp, 2] = J
-            impacts[n_imp, 3] = face
-            impacts[n_imp, 4] = kind
-            n_imp += 1
-        else:
-            overflow = True
+        impacts[n_imp, 0] = th0 + omega * t
+        impacts[n_imp, 1] = u
+        impacts[n_imp, 2] = J
+        impacts[n_imp, 3] = face
+        impacts[n_imp, 4] = kind
+        n_imp += 1
         if face == FACE_REAR:
             I_dec += J
             v = 0.0 if rest_now else e * u
@@ -134,14 +153,18 @@ def _euler_pass(par, dt, cap, stride):
             I_acc += J
             v = 0.0 if rest_now else -e * u
             mode = REST_FRONT if rest_now else FREE
-    if ntrace < ntr:
-        trace[ntrace, 0] = th1
-        trace[ntrace, 1] = l
-        trace[ntrace, 2] = v
-        trace[ntrace, 3] = I_dec
-        ntrace += 1
-    totals = np.array([I_dec, I_acc, I_dec_rest, I_acc_rest, l, v, float(mode), float(n_imp)])
-    return overflow, totals, impacts, n_imp, trace[:ntrace], nsteps
+    if n >= nsteps and code == CODE_CHUNK_END:
+        code = CODE_DONE
+        if ntrace < ntr:
+            trace[ntrace, 0] = th1
+            trace[ntrace, 1] = l
+            trace[ntrace, 2] = v
+            trace[ntrace, 3] = I_dec
+            ntrace += 1
+    fst[F_T], fst[F_L], fst[F_V] = t, l, v
+    fst[F_IDEC], fst[F_IACC], fst[F_IDEC_REST], fst[F_IACC_REST] = I_dec, I_acc, I_dec_rest, I_acc_rest
+    ist[I_MODE], ist[I_NIMP], ist[I_NTRACE], ist[I_STEP] = mode, n_imp, ntrace, n
+    return code
 
 
 def max_stable_dt(inp: PassInputs) -> float:
@@ -161,37 +184,86 @@ def default_dt(inp: PassInputs) -> float:
     return max_stable_dt(inp) / 1000.0
 
 
-def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacity: int = 4096) -> PassSolution:
-    """Integrate one no-load pass with the paper's scheme at step ``dt`` [s].
+def steps_per_pass(inp: PassInputs, dt: float) -> int:
+    """Number of steps of size ``dt`` [s] the scheme takes for one pass (the last one shortened)."""
+    duration = (inp.theta_end - inp.theta_start) / inp.omega_c
+    return int(math.ceil(duration / dt - 1e-9))
 
-    Raises :class:`UserError` (naming ``numerics.dt_s``) when ``dt`` exceeds :func:`max_stable_dt`.
+
+def check_step(inp: PassInputs, dt: float, automatic: bool = False) -> int:
+    """Refuse a step the scheme cannot take (one line naming the key); return the number of steps.
+
+    ``dt`` must be positive, at most :func:`max_stable_dt`, and need at most ``MAX_STEPS_PER_PASS``
+    steps for the pass. ``automatic``: ``dt`` is :func:`default_dt` (``numerics.dt_s`` left out), whose
+    size is set by the pocket clearance, so the message names that key.
     """
     dt_max = max_stable_dt(inp)
+    try:
+        step = float(dt)
+    except (TypeError, ValueError):
+        step = math.nan
+    if not (math.isfinite(step) and step > 0.0):
+        raise UserError(f"numerics.dt_s: {dt!r} s is not a time step; give a positive number of seconds "
+                        f"(at most {dt_max:.3g} s for the euler method here) or leave dt_s out")
+    dt = step
     if not dt <= dt_max:
         raise UserError(
             f"numerics.dt_s: {dt:.3g} s is too large for the euler method at this speed; "
             f"use at most {dt_max:.3g} s (or leave dt_s out for the automatic choice)"
         )
+    nsteps = steps_per_pass(inp, dt)
+    if nsteps > MAX_STEPS_PER_PASS:
+        if automatic:
+            raise UserError(
+                f"bearing.pocket_clearance_mm: {inp.pocket_clearance * 1e3:.3g} mm makes the euler method's automatic "
+                f"step (numerics.dt_s left out) {dt:.3g} s, {nsteps:.3g} steps for one pass, more than "
+                f"{MAX_STEPS_PER_PASS:.0e}; use reduced.method = \"event\" or a larger clearance")
+        raise UserError(
+            f"numerics.dt_s: {dt:.3g} s needs {nsteps:.3g} euler steps for one pass, more than "
+            f"{MAX_STEPS_PER_PASS:.0e}; use at least {1.01 * inp.pass_duration / MAX_STEPS_PER_PASS:.3g} s "
+            f"(or reduced.method = \"event\")")
+    return nsteps
+
+
+def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacity: int = 4096,
+                automatic: bool = False) -> PassSolution:
+    """Integrate one no-load pass with the paper's scheme at step ``dt`` [s].
+
+    Raises :class:`UserError` (naming ``numerics.dt_s``, or ``bearing.pocket_clearance_mm`` for the
+    ``automatic`` step) when ``dt`` is not positive, exceeds :func:`max_stable_dt` or needs more than
+    ``MAX_STEPS_PER_PASS`` steps (:func:`check_step`). The compiled loop runs in chunks of
+    ``CHUNK_STEPS`` steps, so SIGINT/SIGTERM stop it within a chunk.
+    """
+    nsteps = check_step(inp, dt, automatic)
+    dt = float(dt)
+    dt_max = max_stable_dt(inp)
     from bearingsim.reduced.event import _params
 
     par = _params(inp, 0.0, 0.0)
-    nsteps = int(math.ceil(inp.pass_duration / dt))
-    stride = max(1, nsteps // max(trace_points, 1))
+    stride = max(1, int(math.ceil(inp.pass_duration / dt)) // max(trace_points, 1))
+    impacts = np.zeros((max(int(capacity), 1), 5))
+    trace = np.zeros((nsteps // stride + 2, 4))  # theta, l, v, I_dec cumulative
+    fst = np.zeros(7)
+    ist = np.zeros(5, dtype=np.int64)
     t0 = time.perf_counter()
     while True:
-        overflow, totals, impacts, n_imp, trace, nsteps = _euler_pass(par, float(dt), capacity, stride)
-        if not overflow:
+        code = _euler_steps(par, float(dt), nsteps, stride, fst, ist, impacts, trace, CHUNK_STEPS)
+        if code == CODE_DONE:
             break
-        capacity *= 8
+        if code == CODE_IMPACTS_FULL:
+            impacts = np.concatenate([impacts, np.zeros((7 * impacts.shape[0], 5))])
+    totals = fst
+    n_imp = int(ist[I_NIMP])
+    trace = trace[: int(ist[I_NTRACE])]
     wall = time.perf_counter() - t0
     imp = impacts[:n_imp]
     theta = imp[:, 0].copy()
     sol = PassSolution(
         method="euler",
-        I_dec=float(totals[0]),
-        I_acc=float(totals[1]),
-        I_dec_resting=float(totals[2]),
-        I_acc_resting=float(totals[3]),
+        I_dec=float(totals[F_IDEC]),
+        I_acc=float(totals[F_IACC]),
+        I_dec_resting=float(totals[F_IDEC_REST]),
+        I_acc_resting=float(totals[F_IACC_REST]),
         impacts=dict(
             theta=theta,
             time=(theta - inp.theta_start) / inp.omega_c,
@@ -200,8 +272,8 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
             face=imp[:, 3].astype(np.int64),
             kind=imp[:, 4].astype(np.int64),
         ),
-        l_end=float(totals[4]),
-        v_end=float(totals[5]),
+        l_end=float(totals[F_L]),
+        v_end=float(totals[F_V]),
         trace=None,
         wall_s=wall,
         termination="end of the no-load pass reached (theta = 2*pi - phi)",

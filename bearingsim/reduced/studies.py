@@ -75,6 +75,7 @@ def save_fig9(outdir: str | Path) -> list[Path]:
     ax.legend(fontsize=8)
     fig.tight_layout()
     png = outdir / "fig9_idec_vs_speed.png"
-    fig.savefig(png, dpi=130)
-    plt.close(fig)
+    from bearingsim.plotting import save_figure
+
+    save_figure(fig, png, dpi=130, tight=False)  # atomic; a link or a user's file there is refused
     return [csv_path, png]

@@ -26,9 +26,10 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim import archive
-from bearingsim.outputs import temporary_name as _tmp
+from bearingsim.outputs import write_atomic_bytes
 
 INDEX_FORMAT = "bearingsim sweep index 1"
+CSV_SIGNATURE = b"case,"  # the first bytes of every sweep.csv bearingsim writes (its header)
 FIXED = ("status", "error", "archive", "wall_s")
 # summary numbers shown first when present; any others follow in name order
 PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
@@ -132,14 +133,7 @@ class IndexWriter:
         buf.truncate()
         w.writerow(columns)
         text = buf.getvalue() + "".join(self._lines)
-        tmp = _tmp(csv_path)
-        try:
-            with open(tmp, "w", newline="", encoding="utf-8") as fh:
-                fh.write(text)
-            os.replace(tmp, csv_path)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
+        write_atomic_bytes(csv_path, text.encode("utf-8"))
         attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **self.meta}
         archive.write_table_file(h5_path, {c: cols[c] for c in columns}, self._units, attrs)
         return csv_path, h5_path

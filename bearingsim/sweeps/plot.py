@@ -18,6 +18,9 @@ import numpy as np
 
 from bearingsim.sweeps.index import name_of, read_index, unit_of
 
+#: every figure a sweep may draw into its folder (a sweep checks them before it starts)
+FIGURE_NAMES = ("sweep_I.png", "sweep_map.png")
+
 MAX_LINES = 8
 
 
@@ -98,9 +101,9 @@ def _lines(plt, cols, axes, path: Path, title: str) -> Path:
     ax.set_title(title, fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="best")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    from bearingsim.plotting import save_figure
+
+    return save_figure(fig, path, tight=False)
 
 
 def _show(v) -> str:
@@ -125,9 +128,9 @@ def _heat_map(plt, cols, axes, path: Path, title: str) -> Path:
     ax.set_ylabel(axis_label(yk))
     n_gap = int(np.isnan(grid).sum())
     ax.set_title(title + (f" ({n_gap} cells failed or not run: blank)" if n_gap else ""), fontsize=9)
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    from bearingsim.plotting import save_figure
+
+    return save_figure(fig, path, tight=False)
 
 
 def _edges(v: np.ndarray) -> np.ndarray:

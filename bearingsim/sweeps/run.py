@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.outputs import write_atomic_bytes
+from bearingsim.outputs import open_lock_file, write_atomic_bytes
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
@@ -100,18 +100,18 @@ class _Lock:
 
         if self.fh is not None:  # already held (taken before the signal handlers go in)
             return self
-        self.fh = open(self.path, "w")
+        fd = open_lock_file(self.path, self.path.parent)  # never through a link, never a user's file
         try:
-            fcntl.flock(self.fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
-            self.fh.close()
-            self.fh = None
+            os.close(fd)
             raise UserError(f"{self.path.parent}: another sweep is writing this folder") from None
+        self.fh = fd
         return self
 
     def __exit__(self, *exc):
         if self.fh is not None:
-            self.fh.close()
+            os.close(self.fh)
             self.fh = None
         return False
 
@@ -155,6 +155,25 @@ class _Signals:
             sys.unraisablehook = self.old_hook
             self.old_hook = None
         return False
+
+
+def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
+    """Refuse, before any case runs, a sweep folder whose index, figure or ``cases`` paths hold what
+    the sweep did not write (a user's ``sweep.csv``, a link, a folder): one line naming the file, and
+    nothing in the folder is replaced (:func:`bearingsim.outputs.check_replaceable`)."""
+    from bearingsim import archive
+    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
+    from bearingsim.sweeps.index import CSV_SIGNATURE, INDEX_FORMAT
+    from bearingsim.sweeps.plot import FIGURE_NAMES
+
+    check_replaceable(outdir / "sweep.csv", CSV_SIGNATURE, "sweep index")
+    check_replaceable(outdir / "sweep.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sweep index")
+    for name in FIGURE_NAMES if figures else ():
+        check_replaceable(outdir / name, PNG_SIGNATURE, "figure")
+    cases = outdir / "cases"
+    if cases.is_symlink() or (cases.exists() and not cases.is_dir()):
+        raise UserError(f"{cases}: the sweep's folder of case archives is "
+                        f"{'a symbolic link' if cases.is_symlink() else 'not a folder'}; not used (remove it)")
 
 
 def _clean_temporaries(cases_dir: Path) -> None:
@@ -228,8 +247,13 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     try:
         outdir = check_writable_dir(outdir)
         cases_dir = outdir / "cases"
-        cases_dir.mkdir(exist_ok=True)
         lock = _Lock(outdir).__enter__()
+        try:
+            check_sweep_outputs(outdir, figures)
+            cases_dir.mkdir(exist_ok=True)
+        except BaseException:
+            lock.__exit__(None, None, None)
+            raise
     except BaseException:
         engine.stop()
         raise

@@ -175,10 +175,15 @@ def _cmd_bench(args) -> int:
 
         run_sweep_bench(Path(args.output))
         return 0
+    if args.geometry:
+        from bearingsim.multibody.bench import run_geometry_bench
+
+        run_geometry_bench(Path(args.output), rotations=args.rotations or 30)
+        return 0
     if args.fast_scene:
         from bearingsim.multibody.fast_bench import run_fast_scene_bench
 
-        run_fast_scene_bench(Path(args.output), rotations=args.rotations)
+        run_fast_scene_bench(Path(args.output), rotations=args.rotations or 40)
         print((Path(args.output) / "fast_scene.md").read_text(), end="")
         print(f"wrote {Path(args.output) / 'fast_scene.csv'}, fast_scene_comparison.csv, fast_scene.md")
         return 0
@@ -274,7 +279,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
     b.add_argument("--fast-scene", action="store_true",
                    help="rigid raceways against the Hertz full scene at 500, 1000, 3000 and 6000 rpm (issue 16)")
-    b.add_argument("--rotations", type=int, default=40, help="recorded rotations per run of --fast-scene")
+    b.add_argument("--geometry", action="store_true",
+                   help="pocket-face geometry: exact faces against polylines of 3 to 63 segments at 2000 and 3000 rpm "
+                        "(1 warm-up + 30 rotations each, or --rotations)")
+    b.add_argument("--rotations", type=int, default=None,
+                   help="recorded rotations per run of --fast-scene (default 40) or --geometry (default 30)")
     b.add_argument("--map", action="store_true",
                    help="wall time of the 100 x 100 reduced-model sweep map (2 workers), with and without archives")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")

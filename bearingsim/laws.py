@@ -121,6 +121,24 @@ def load_zone_half_angle(given_deg, radial_load, roller_count, roller_length, ra
     return float(phi)
 
 
+def pocket_face_extent(pitch_radius, pocket_radius, wall_inner_radius, wall_outer_radius):
+    """Angular extent ``(psi_in, psi_out)`` [rad] of an arc pocket face that the cage wall allows.
+
+    A face is the arc ``c + R (cos psi u + sin psi e_r)`` of the pocket circle (centre ``c`` on the pitch
+    circle ``r_p``, radius ``R``; ``u`` = +-e_t, along the circumference; ``psi`` > 0 outward). Its
+    distance from the bearing axis is ``sqrt(r_p^2 + R^2 + 2 r_p R sin psi)``, and the cage material
+    exists only between ``wall_inner_radius`` and ``wall_outer_radius``: the face ends where that
+    distance reaches them, ``sin psi = (r_wall^2 - r_p^2 - R^2) / (2 r_p R)`` (clipped to +-90 deg: the
+    wall then holds the whole half circle). ``psi_in`` <= 0 <= ``psi_out``; the extent is not symmetric
+    (the ring's curvature: the same wall thickness spans a wider angle inside the pitch circle)."""
+    den = 2.0 * pitch_radius * pocket_radius
+
+    def edge(r_wall):
+        return math.asin(min(1.0, max(-1.0, (r_wall * r_wall - pitch_radius**2 - pocket_radius**2) / den)))
+
+    return edge(wall_inner_radius), edge(wall_outer_radius)
+
+
 def palmgren_stiffness(roller_length: float) -> float:
     """Palmgren line-contact constant K of Q = K delta^(10/9), in SI (N / m^(10/9)).
 

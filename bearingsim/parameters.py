@@ -123,7 +123,11 @@ class MultibodyOptions:
     scene: str  # "full", "reduced_equivalent", "kinematic_cage" or "centred_cage" (README: Cross-check)
     inner_ring: str  # "auto", "quasi_static" or "dynamic"
     inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
-    pocket_face_half_angle: float  # angular half-width of each pocket face arc [rad]
+    #: angular extent (psi_in, psi_out) of each arc pocket face from the pocket's circumferential centre
+    #: line, inward negative [rad] (:func:`bearingsim.laws.pocket_face_extent`)
+    pocket_face_extent: tuple[float, float]
+    pocket_face_rule: str  # how the extent was obtained: "cage wall" or "given"
+    pocket_face_segments: int  # 0: exact arc faces; N: each arc face a circumscribed polyline of N segments
     flat_pockets: tuple[int, ...]  # pockets with two plane faces D + s apart (the rig's instrumented pocket)
     raceway_contact: str = "hertz"  # "hertz" (Palmgren springs) or "rigid" (rollers held on the outer race)
 
@@ -213,11 +217,22 @@ class Parameters:
             load_zone_rule="quasi-static" if given is None else "given",
             resting_contact=bool(r.resting_contact),
         )
+        if mb.pocket_face_half_angle_deg != "auto":
+            half = math.radians(float(mb.pocket_face_half_angle_deg))
+            face_extent = (-half, half)
+        elif bearing.cage_inner_radius is not None and bearing.cage_outer_radius is not None:
+            face_extent = laws.pocket_face_extent(bearing.pitch_radius,
+                                                  bearing.roller_radius + 0.5 * bearing.pocket_clearance,
+                                                  bearing.cage_inner_radius, bearing.cage_outer_radius)
+        else:  # a reduced-model scenario whose preset has no cage ring: the faces are not used
+            face_extent = (math.nan, math.nan)
         multibody = MultibodyOptions(
             scene=mb.scene,
             inner_ring=mb.inner_ring,
             inner_ring_mass=None if mb.inner_ring_mass_kg == "auto" else float(mb.inner_ring_mass_kg),
-            pocket_face_half_angle=math.radians(float(mb.pocket_face_half_angle_deg)),
+            pocket_face_extent=face_extent,
+            pocket_face_rule="given" if mb.pocket_face_half_angle_deg != "auto" else "cage wall",
+            pocket_face_segments=int(mb.pocket_face_segments),
             flat_pockets=(tuple(range(bearing.roller_count)) if mb.pocket_shape == "flat"
                           else tuple(sorted(mb.flat_pockets))),
             raceway_contact=mb.raceway_contact,

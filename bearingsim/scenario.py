@@ -19,6 +19,7 @@ from typing import Any, Literal
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
+from bearingsim import laws
 from bearingsim.errors import UserError
 
 SCHEMA_VERSION = 1
@@ -48,10 +49,15 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # dynamic with the rotor's mass (docs/stability.md); the radial load is the rotor's weight
         "inner_ring": "auto",
         "inner_ring_mass_kg": "auto",
-        # pocket faces: arcs about the pocket centre within +-45 deg of the circumferential direction
-        # (the paper gives no pocket drawing; a cylindrical-roller cage pocket wraps the roller enough
-        # to guide it radially). Narrower arcs guide the cage less (README: the cage whirls more).
-        "pocket_face_half_angle_deg": 45.0,
+        # pocket faces: arcs of the pocket circle about its centre. "auto": each face spans what the
+        # cage wall allows, from the cage's inner to its outer diameter (bearing.cage_inner_diameter_mm,
+        # cage_outer_diameter_mm): the material of the cage exists nowhere else. A number A [deg]: the
+        # faces span +-A about the circumferential direction instead (refused if wider than the wall).
+        "pocket_face_half_angle_deg": "auto",
+        # 0: the arc faces are exact (contact with the true circle of the pocket); N >= 1: each arc face
+        # is a circumscribed polyline of N straight segments (only to measure that approximation's
+        # error: bearingsim bench, docs/geometry.md)
+        "pocket_face_segments": 0,
         # pocket shape: "arc" (the cage's own pockets wrap the roller) or "flat" (two plane faces D + s
         # apart, as the paper's instrumented pocket, machined flat for its load cells, Sec. 2.1);
         # flat_pockets lists pockets that are flat whatever pocket_shape says (the rig's pocket 0)
@@ -180,7 +186,8 @@ class MultibodySection(_Section):
     traction_slip_ref: float = Field(gt=0.0)
     inner_ring: Literal["auto", "quasi_static", "dynamic"]
     inner_ring_mass_kg: float | Literal["auto"]
-    pocket_face_half_angle_deg: float = Field(gt=0.0, lt=90.0)
+    pocket_face_half_angle_deg: float | Literal["auto"]
+    pocket_face_segments: int = Field(ge=0, le=1000)
     pocket_shape: Literal["arc", "flat"]
     flat_pockets: list[int]
     raceway_contact: Literal["hertz", "rigid"]
@@ -190,6 +197,13 @@ class MultibodySection(_Section):
     def _ring_mass(cls, v):
         if v != "auto" and not v > 0.0:
             raise ValueError("must be 'auto' or a positive mass in kg")
+        return v
+
+    @field_validator("pocket_face_half_angle_deg")
+    @classmethod
+    def _face_half_angle(cls, v):
+        if v != "auto" and not 0.0 < v < 90.0:
+            raise ValueError("must be 'auto' (the cage wall's extent) or an angle in deg between 0 and 90")
         return v
 
 
@@ -638,6 +652,8 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
     land = b.cage_guidance != "rollers"
     if land:
         _check_land(m, source)
+    if m.model == "multibody":
+        _check_pocket_faces(m, source)
     if m.model == "multibody" and not land and (m.multibody.pocket_shape == "flat" or len(set(flat)) == b.roller_count):
         raise UserError(
             f"{source}: multibody.pocket_shape: with every pocket flat nothing guides the roller-guided cage "
@@ -647,6 +663,33 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
     if m.reduced.load_zone_half_angle_deg != "auto" and m.model == "reduced":
         if m.reduced.load_zone_half_angle_deg >= 180.0:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")
+
+
+def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
+    """The arc pocket faces fit the cage wall: "auto" needs the cage's diameters and a wall that holds
+    the pocket centre; a given half angle may not reach past the wall (bearingsim.laws.pocket_face_extent)."""
+    b = m.bearing
+    mb = m.multibody
+    wall = (b.cage_inner_diameter_mm, b.cage_outer_diameter_mm)
+    if None in wall:
+        if mb.pocket_face_half_angle_deg == "auto":
+            key = "cage_inner_diameter_mm" if wall[0] is None else "cage_outer_diameter_mm"
+            raise UserError(f"{source}: bearing.{key}: missing; the pocket faces span the cage wall "
+                            f"(multibody.pocket_face_half_angle_deg = 'auto'): give the cage's diameters or a "
+                            f"half angle")
+        return
+    if not wall[0] < b.pitch_diameter_mm < wall[1]:
+        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage ({wall[0]:g}..{wall[1]:g} mm, "
+                        f"bearing.cage_inner_diameter_mm..cage_outer_diameter_mm) must straddle the pitch "
+                        f"diameter {b.pitch_diameter_mm:g} mm")
+    lo, hi = laws.pocket_face_extent(0.5e-3 * b.pitch_diameter_mm, 0.5e-3 * (b.roller_diameter_mm + b.pocket_clearance_mm),
+                                     0.5e-3 * wall[0], 0.5e-3 * wall[1])
+    a = mb.pocket_face_half_angle_deg
+    if a != "auto" and a > min(-lo, hi) * 180.0 / math.pi * (1.0 + 1e-12):
+        raise UserError(f"{source}: multibody.pocket_face_half_angle_deg: {a:g} deg is wider than the cage wall "
+                        f"allows ({lo * 180.0 / math.pi:.1f} to +{hi * 180.0 / math.pi:.1f} deg from the pocket's "
+                        f"centre line between bearing.cage_inner_diameter_mm and cage_outer_diameter_mm); use "
+                        f"'auto' or at most {min(-lo, hi) * 180.0 / math.pi:.1f}")
 
 
 def _check_land(m: ScenarioModel, source: str) -> None:

@@ -56,7 +56,7 @@ def test_rebound_ratio_equals_restitution():
     sc = _scenario()
     geo, op = si(sc).bearing, si(sc).operating
     e = sc.contact.restitution
-    s = build_scene(geo, op, e, 0.0, half_angle=math.radians(45), n_seg=3, kinematic_cage=True,
+    s = build_scene(geo, op, e, 0.0, extent=(-math.radians(45), math.radians(45)), n_seg=3, kinematic_cage=True,
                     spin_free=True)
     s.space.gravity = (0.0, 0.0)
     s.cage.angular_velocity = 0.0

@@ -486,7 +486,7 @@ def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-
     geo = SimpleNamespace(roller_count=4, roller_radius=0.01, pitch_radius=0.05, pocket_clearance=0.001,
                           roller_mass=0.1, roller_inertia=1e-5, cage_mass=1.0, cage_inertia=1e-3)
     op = SimpleNamespace(sign=1, gravity=0.0, omega_c=0.0, omega_r=0.0)
-    sc = build_scene(geo, op, 0.5, 0.1, half_angle=math.radians(45.0), n_seg=5, kinematic_cage=False,
+    sc = build_scene(geo, op, 0.5, 0.1, extent=(-math.radians(45.0), math.radians(45.0)), n_seg=5, kinematic_cage=False,
                      spin_free=True)
     fm = face_geometry(sc, 0.01, lp.MASK_MARGIN_M)
     a1 = cage_angle + cage_w * h  # where the position update turns the cage

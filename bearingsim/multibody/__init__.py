@@ -66,7 +66,7 @@ import numpy as np
 from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
-from bearingsim.multibody.core import (IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
+from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, choose_dt, paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_VERSIONS
@@ -390,7 +390,7 @@ class MultibodyResult(Result):
         ax.plot(o[:, 1] * 1e6, o[:, 2] * 1e6, lw=0.6, label="cage centre")
         ax.plot([0.0], [0.0], "k+", ms=12, label="bearing axis")
         p = self.parameters
-        reach = (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(p.multibody.pocket_face_half_angle)
+        reach = face_radial_reach(p)
         circ = np.linspace(0.0, 2.0 * math.pi, 361)
         r_max = float(np.max(np.hypot(o[:, 1], o[:, 2]))) if len(o) else 0.0
         if r_max > 0.0:

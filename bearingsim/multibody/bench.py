@@ -14,11 +14,20 @@ pymunk_step_s`` is the rest of the step (force kernel, recording, batched copies
   automatic step, error against the same Hertz reference (so it holds the chaotic scatter too;
   ``bearingsim bench --fast-scene`` compares the two scenes over 40 rotations with standard errors);
 * ``scene = reduced_equivalent``: deterministic, at 3000 rpm over dt; ``rel_error`` against the exact
-  event solution of the reduced model, whose assumptions this scene makes (so it also holds the small
-  modelling difference of the polyline pocket faces).
+  event solution of the reduced model, whose assumptions this scene makes;
+* ``scene = full_polyline_N``: the geometric error. The full scene at 3000 rpm at its automatic step with
+  each arc pocket face drawn as a circumscribed polyline of N = 3, 5, 9, 17, 33 segments, against the
+  exact faces over the same rotations (``rel_error``; ``sem_rel``: the exact run's standard error of the
+  mean I_dec from its rotation-to-rotation scatter, relative, the scale below which a difference is not
+  resolved); and the cost of the exact faces against the 3-segment polyline at 1000 and 6000 rpm, Hertz
+  (4 us) and rigid raceways, repeats interleaved (``cost_ratio`` on the exact rows).
+
+Every ``full`` row is computed on the exact faces (the default scene); its dt rows are the exact faces'
+own time-step convergence.
 """
 from __future__ import annotations
 
+import math
 import statistics
 
 from bearingsim.multibody import simulate
@@ -31,7 +40,7 @@ GOAL_ERROR = 0.01
 
 
 def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "full", load: float = 970.0,
-                       phi="auto", source: str = "<bench>", raceway_contact: str = "hertz"):
+                       phi="auto", source: str = "<bench>", raceway_contact: str = "hertz", pocket_face_segments: int = 0):
     """The reference bearing (NU214) in the multibody model at one speed and load; ``phi`` is the
     reduced-equivalent scene's load-zone half angle [deg] or "auto"."""
     doc = {
@@ -40,7 +49,7 @@ def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "fu
         "model": "multibody",
         "bearing": {"preset": "NU214-Suzuki2023"},
         "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": float(load)},
-        "multibody": {"scene": scene, "raceway_contact": raceway_contact},
+        "multibody": {"scene": scene, "raceway_contact": raceway_contact, "pocket_face_segments": pocket_face_segments},
         "numerics": {"rotations": rotations, "warmup_rotations": warmup},
         "reduced": {"load_zone_half_angle_deg": phi},
     }
@@ -99,17 +108,67 @@ def bench_cases(quick: bool) -> list[dict]:
     for f in (0.5, 0.25, 0.125) if quick else (1.0, 0.5, 0.25, 0.125, 0.0625):
         runs = [simulate(sc, dt=f * lim) for _ in range(repeats)]
         rows.append(_row("reduced_equivalent", 3000, f * lim, runs, 2, exact, "reduced event model (exact)"))
+    return rows + geometry_cases(quick)
+
+
+GEOMETRY_SEGMENTS = (3, 5, 9, 17, 33)
+GOAL_COST_RATIO = 1.2  # exact faces against the 3-segment polyline, per cage rotation
+
+
+def idec_sem(result) -> float:
+    """Standard error [N s] of a run's mean I_dec from its rotation-to-rotation scatter: the per-rotation
+    means over the pockets, std / sqrt(R) (rotations taken as independent)."""
+    import numpy as np
+
+    per_rot = np.asarray(result.get("per_rotation/I_dec")).mean(axis=1)
+    return float(per_rot.std(ddof=1) / math.sqrt(len(per_rot))) if len(per_rot) > 1 else float("nan")
+
+
+def geometry_cases(quick: bool) -> list[dict]:
+    """The geometric error of polyline pocket faces against the exact faces, and the exact faces' cost."""
+    rows = []
+    nrot = 2 if quick else 10
+    exact = simulate(Parameters.from_scenario(reference_scenario(3000, nrot, 1)))
+    ref = exact.summary["I_dec_mean_Ns"]
+    sem = idec_sem(exact) / ref
+    row = _row("full", 3000, exact.provenance["dt_s"], [exact], nrot + 1, ref, "itself")
+    rows.append({**row, "notes": "exact faces (geometric reference)", "sem_rel": sem})
+    for n_seg in GEOMETRY_SEGMENTS:
+        run = simulate(Parameters.from_scenario(reference_scenario(3000, nrot, 1, pocket_face_segments=n_seg)))
+        row = _row(f"full_polyline_{n_seg}", 3000, run.provenance["dt_s"], [run], nrot + 1, ref,
+                   f"exact faces, same dt and {nrot + 1} rotations")
+        rows.append({**row, "sem_rel": sem, "signed_error": (row["I_dec_Ns"] - ref) / ref})
+    repeats = 1 if quick else 3
+    cost_rot = 1 if quick else 2
+    for raceway in ("hertz", "rigid"):
+        for rpm in (1000, 6000):
+            dt = 4e-6 if raceway == "hertz" else None
+            runs = {0: [], 3: []}
+            for _ in range(repeats):  # interleaved: the machine's load drifts
+                for n_seg in (0, 3):
+                    p = Parameters.from_scenario(reference_scenario(rpm, cost_rot, 1, raceway_contact=raceway,
+                                                                    pocket_face_segments=n_seg))
+                    runs[n_seg].append(simulate(p, dt=dt))
+            walls = {k: statistics.median(r.provenance["solver_wall_s"] for r in v) for k, v in runs.items()}
+            scene = "full" if raceway == "hertz" else "full_rigid_raceways"
+            for n_seg, v in runs.items():
+                r = _row(scene if n_seg == 0 else f"{scene}_polyline_3", rpm, v[0].provenance["dt_s"], v, cost_rot + 1,
+                         runs[0][0].summary["I_dec_mean_Ns"], "itself" if n_seg == 0 else "exact faces, same run")
+                r["cost_ratio"] = walls[0] / walls[3] if n_seg == 0 else float("nan")
+                r["notes"] = "cost of the exact faces against the 3-segment polyline"
+                rows.append(r)
     return rows
 
 
 def goal_lines(rows: list[dict]) -> list[str]:
-    """Issue 3's speed goal, read off the full-scene rows at 6000 rpm."""
-    full = [r for r in rows if r["scene"] == "full" and r["rpm"] == 6000]
+    """The speed goal (full scene at 6000 rpm), the geometric error of polyline faces and the exact faces'
+    cost, read off the rows."""
+    lines = geometry_lines(rows)
+    full = [r for r in rows if r["scene"] == "full" and r["rpm"] == 6000 and "cost_ratio" not in r]
     if not full:
-        return []
+        return lines
     ok = [r for r in full if r["rel_error"] <= GOAL_ERROR]  # NaN (the reference row) compares False
     best = min(ok, key=lambda r: r["wall_s"]) if ok else None
-    lines = []
     for r in sorted(full, key=lambda r: -r["dt_s"]):
         py = r["wall_s"] - r["pymunk_step_s"]
         lines.append(f"6000 rpm full scene, dt = {r['dt_s']:.1e} s: {r['wall_s']:.3f} s per cage rotation, of which "
@@ -124,3 +183,90 @@ def goal_lines(rows: list[dict]) -> list[str]:
                      f"at dt = {best['dt_s']:.1e} s -> {'met' if met else 'not met'}; goal (rest of the step, i.e. the issue's 'Python side', <= pymunk "
                      f"step): {ratio:.2f} -> {'met' if ratio <= 1.0 else 'not met'}")
     return lines
+
+
+def geometry_lines(rows: list[dict]) -> list[str]:
+    """The polyline faces' I_dec error against the exact faces, and the exact faces' cost ratio."""
+    lines = []
+    for r in rows:
+        if r["scene"].startswith("full_polyline_"):
+            n_seg = r["scene"].rsplit("_", 1)[1]
+            lines.append(f"3000 rpm, {n_seg:>2} segments per face: I_dec {r['I_dec_Ns'] * 1e3:.2f} mN s, "
+                         f"{r['signed_error']:+.1%} off the exact faces' (their standard error {r['sem_rel']:.1%}), "
+                         f"{r['wall_s']:.3f} s per rotation")
+    for r in rows:
+        if r.get("cost_ratio", float("nan")) == r.get("cost_ratio"):
+            met = r["cost_ratio"] <= GOAL_COST_RATIO
+            lines.append(f"{r['rpm']} rpm {r['scene'].replace('_', ' ')}: exact faces {r['wall_s']:.3f} s per rotation, "
+                         f"{r['cost_ratio']:.2f} x the 3-segment polyline (goal <= {GOAL_COST_RATIO}: "
+                         f"{'met' if met else 'not met'})")
+    return lines
+
+
+GOAL_GEOMETRY_ERROR = 0.03  # exact faces against the 63-segment polyline: within 3 % (or 2 standard errors)
+
+
+def geometry_study(rpms=(2000, 3000), segments=(3, 5, 9, 17, 33, 63), rotations=30, warmup=1) -> list[dict]:
+    """I_dec of the full scene with exact pocket faces and with polylines of ``segments`` per face, at each
+    speed over the same ``warmup`` + ``rotations`` (automatic step), with standard errors and time per
+    rotation. The exact row of each speed carries the goal check against the finest polyline."""
+    rows = []
+    for rpm in rpms:
+        res = {}
+        for n_seg in (0, *segments):
+            r = simulate(Parameters.from_scenario(reference_scenario(rpm, rotations, warmup, pocket_face_segments=n_seg)))
+            res[n_seg] = r
+            print(f"  {rpm} rpm, {'exact faces' if n_seg == 0 else f'{n_seg} segments'}: "
+                  f"I_dec {r.summary['I_dec_mean_Ns'] * 1e3:.3f} mN s", flush=True)
+        ref = res[0].summary["I_dec_mean_Ns"]
+        finest = res[max(segments)]
+        for n_seg, r in res.items():
+            idec = r.summary["I_dec_mean_Ns"]
+            row = dict(rpm=rpm, faces="exact" if n_seg == 0 else f"polyline {n_seg}", segments=n_seg,
+                       I_dec_Ns=idec, sem_Ns=idec_sem(r), rel_to_exact=(idec - ref) / ref,
+                       wall_s_per_rotation=r.provenance["solver_wall_s"] / (rotations + warmup),
+                       dt_s=r.provenance["dt_s"], rotations=rotations, warmup=warmup,
+                       orbit_max_m=r.summary["cage_orbit_max_m"])
+            if n_seg == 0:
+                diff = idec - finest.summary["I_dec_mean_Ns"]
+                se = math.hypot(idec_sem(r), idec_sem(finest))
+                row["vs_finest"] = diff / finest.summary["I_dec_mean_Ns"]
+                row["vs_finest_in_se"] = diff / se
+                row["goal_met"] = abs(row["vs_finest"]) <= GOAL_GEOMETRY_ERROR or abs(diff) <= 2.0 * se
+            rows.append(row)
+    return rows
+
+
+def run_geometry_bench(outdir, rotations: int = 30) -> list[dict]:
+    """``bearingsim bench --geometry``: :func:`geometry_study` at 2000 and 3000 rpm; writes
+    ``geometry.csv`` and prints the table and the goal."""
+    import csv
+    import io
+    from pathlib import Path
+
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.outputs import atomic_file
+
+    outdir = check_writable_dir(Path(outdir))
+    print(f"pocket-face geometry: exact faces against polylines, 1 warm-up + {rotations} rotations ...", flush=True)
+    rows = geometry_study(rotations=rotations)
+    cols = ["rpm", "faces", "segments", "I_dec_Ns", "sem_Ns", "rel_to_exact", "wall_s_per_rotation", "dt_s",
+            "rotations", "warmup", "orbit_max_m", "vs_finest", "vs_finest_in_se", "goal_met"]
+    text = io.StringIO()
+    w = csv.DictWriter(text, fieldnames=cols)
+    w.writeheader()
+    for r in rows:
+        w.writerow(r)
+    with atomic_file(outdir / "geometry.csv") as fh:
+        fh.write(text.getvalue().encode())
+    print("| rpm | faces | I_dec [mN s] | s.e. [mN s] | vs exact | s per rotation |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['rpm']} | {r['faces']} | {r['I_dec_Ns'] * 1e3:.3f} | {r['sem_Ns'] * 1e3:.3f} | "
+              f"{r['rel_to_exact']:+.1%} | {r['wall_s_per_rotation']:.3f} |")
+    for r in rows:
+        if "goal_met" in r:
+            print(f"goal at {r['rpm']} rpm (exact within {GOAL_GEOMETRY_ERROR:.0%} or 2 s.e. of the finest polyline): "
+                  f"{r['vs_finest']:+.2%} = {r['vs_finest_in_se']:+.2f} s.e. -> {'met' if r['goal_met'] else 'not met'}")
+    print(f"wrote {outdir / 'geometry.csv'}")
+    return rows

@@ -68,7 +68,7 @@ PLAIN_ENV = "BEARINGSIM_PLAIN_PYMUNK"
 _FUNCTIONS = ("cpSpaceStep", "cpSpaceEachBody", "cpSpaceEachCachedArbiter", "pmSpaceBodyGetIteratorFuncBatched",
               "pmSpaceBodySetIteratorFuncBatched", "pmSpaceArbiterIteratorFuncBatched", "pmFloatArrayNew",
               "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree", "cpConstraintGetImpulse",
-              "cpShapeSetElasticity")
+              "cpShapeSetElasticity", "cpSegmentShapeSetEndpoints")
 CLOCK_MONOTONIC = 1  # Linux and macOS
 
 
@@ -237,6 +237,28 @@ def joint_layout() -> str | None:
     return None
 
 
+@njit(cache=True)
+def _set_endpoints(fn, ptr, ax, ay, bx, by):
+    fn(ptr, ax, ay, bx, by)
+
+
+@functools.lru_cache(maxsize=1)
+def endpoints_layout() -> str | None:
+    """None when ``cpSegmentShapeSetEndpoints`` called from numba with four doubles (:data:`_ENDPOINTS_SIG`)
+    sets a segment's ends as pymunk's own call does (exact arc faces), else why not. Once per process."""
+    b = pymunk.Body(1.0, 1.0)
+    seg = pymunk.Segment(b, (0.0, 0.0), (1.0, 0.0), 0.0)
+    want = ((0.125, -2.5), (3.75, 0.0625))
+    _set_endpoints(_chipmunk("cpSegmentShapeSetEndpoints", _ENDPOINTS_SIG), _address(seg._shape),
+                   want[0][0], want[0][1], want[1][0], want[1][1])
+    got = (tuple(seg.a), tuple(seg.b))
+    ref = pymunk.Segment(b, (0.0, 0.0), (1.0, 0.0), 0.0)
+    ref.unsafe_set_endpoints(*want)
+    if got != want or (tuple(seg.normal) != tuple(ref.normal)):
+        return f"cpSegmentShapeSetEndpoints through numba set {got}, not {want}"
+    return None
+
+
 @functools.lru_cache(maxsize=1)
 def body_layout() -> str | None:
     """None when a ``cpBody`` holds p, v, f and t where :func:`advance` writes them, else why not.
@@ -254,7 +276,7 @@ def body_layout() -> str | None:
 
 
 def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, joints=(), roller_shapes=(), bodies=(),
-                   masks=None):
+                   masks=None, arc_shapes=None):
     """(loop, reason): the compiled loop (:class:`BatchIO`) or the plain one (``PlainLoop``).
 
     Parameters
@@ -274,6 +296,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
     masks : :class:`bearingsim.multibody.loop.FaceMasks` of the scene: the compiled loop narrows the
         rollers' collision masks (when it writes the bodies directly and :func:`mask_layout` holds);
         None: it does not (the plain loop never does: the same contacts, more narrow-phase tests).
+    arc_shapes : exact arc faces: [pocket][face] the segments placed before each step
+        (:func:`bearingsim.multibody.loop.arc_faces`; None for a flat pocket's); None: static faces.
     """
     if step_loop not in (None, "compiled", "plain"):
         raise ValueError(f"step_loop = {step_loop!r}: 'compiled', 'plain' or None")
@@ -283,6 +307,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
             step_loop, reason = "plain", f"{PLAIN_ENV}={os.environ[PLAIN_ENV]}"
         elif why_not is not None:
             step_loop, reason = "plain", why_not
+        elif arc_shapes is not None and endpoints_layout() is not None:
+            step_loop, reason = "plain", endpoints_layout()
         else:
             step_loop, reason = "compiled", f"pymunk {pymunk.version}"
     elif step_loop == "compiled":
@@ -292,8 +318,8 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
     else:
         reason = "asked for"
     if step_loop == "plain":
-        return lp.PlainLoop(space, nb, set_fields, set_arr, joints, roller_shapes), reason
-    io = BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes, bodies, masks)
+        return lp.PlainLoop(space, nb, set_fields, set_arr, joints, roller_shapes, arc_shapes), reason
+    io = BatchIO(space, nb, set_fields, set_arr, arb_cap, joints, roller_shapes, bodies, masks, arc_shapes)
     if io.direct_why is not None:
         reason += f"; bodies set through pymunk's batched setter ({io.direct_why})"
     if io.masks_why is not None:
@@ -333,6 +359,10 @@ _EACH_SIG = types.void(types.int64, types.int64, types.int64)
 _CLOCK_SIG = types.int32(types.int32, types.int64)
 _IMPULSE_SIG = types.float64(types.int64)
 _ELASTICITY_SIG = types.void(types.int64, types.float64)
+#: cpSegmentShapeSetEndpoints(cpShape *, cpVect a, cpVect b): a cpVect (two doubles) passed by value goes in
+#: two floating-point registers on x86-64 (System V) and AArch64, as two double arguments would; checked
+#: on a probe segment by :func:`endpoints_layout`
+_ENDPOINTS_SIG = types.void(types.int64, types.float64, types.float64, types.float64, types.float64)
 
 
 def _clock_function():
@@ -386,9 +416,17 @@ class BatchIO:
 
     name = "compiled"
 
-    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=(), bodies=(), masks=None):
+    def __init__(self, space, nb, set_fields, set_arr, arb_cap, joints=(), roller_shapes=(), bodies=(), masks=None,
+                 arc_shapes=None):
         self.nb = nb
         self._space = space._space
+        self.endpoints_fn = _chipmunk("cpSegmentShapeSetEndpoints", _ENDPOINTS_SIG)
+        self._arc = [sh for pair in (arc_shapes or ()) for sh in pair if sh is not None]  # must outlive the run
+        self.arc_ptrs = np.zeros((len(arc_shapes or ()), 2), dtype=np.int64)  # 0: a flat pocket's (never placed)
+        for i, pair in enumerate(arc_shapes or ()):
+            for f, sh in enumerate(pair):
+                if sh is not None:
+                    self.arc_ptrs[i, f] = _address(sh._shape)
         self.impulse_fn = _chipmunk("cpConstraintGetImpulse", _IMPULSE_SIG)
         self.elasticity_fn = _chipmunk("cpShapeSetElasticity", _ELASTICITY_SIG)
         self._joints = list(joints)  # the C objects must outlive the run
@@ -511,7 +549,7 @@ class BatchIO:
     def advance(self, inp, wk, acc, ls):
         """Run :func:`advance` until it returns a code."""
         return advance(self.step_fn, self.each_body_fn, self.each_arb_fn, self.clock_fn, self.impulse_fn,
-                       self.elasticity_fn, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
+                       self.elasticity_fn, self.endpoints_fn, self.arc_ptrs, self.timed, self.ptr, self.joint_ptrs, self.shape_ptrs, self.body_ptrs,
                        self.set_pv, self.hdr, self.states[0], self.states[1], self.arb_f, self.arb_i, self.ts,
                        self.fm, self.vb, self.mask_now, self.mask_want, self.free_on, self.jn_acc, self.free_now,
                        self.prev_h, self.iterations, self.joint_max, inp, wk, acc, ls)
@@ -617,7 +655,8 @@ def _write_bodies(body_ptrs, state, out_f, set_pv):
 
 
 @njit(cache=True)
-def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, timed, ptr, joint_ptrs, shape_ptrs,
+def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity_fn, endpoints_fn, arc_ptrs, timed, ptr,
+            joint_ptrs, shape_ptrs,
             body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, free_on, jn_acc, free_now,
             prev_h, iterations, joint_max, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
@@ -637,6 +676,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     the step) is left slack in pymunk and solved here after the step by :func:`joint_solve`, the same
     bytes as chipmunk's (``jn_acc``, ``free_now``: those joints' accumulated impulses and which they
     are; ``prev_h``: the last step size; ``iterations``: the space's; ``joint_max``: the joints' length).
+    ``endpoints_fn``, ``arc_ptrs``: exact arc faces (``inp.arc.active``): each pocket's (front, rear) segment
+    (``cpShape *``) placed before each step where :func:`~bearingsim.multibody.loop.arc_faces` says.
     ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
@@ -664,6 +705,13 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
                 lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])
             hdr.set[0] = 0  # the setter reads the buffer from the start
             each_body_fn(sp, ptr.body_set, ptr.data_set)
+        if inp.arc.active:
+            lp.arc_faces(prev, h, inp.arc, wk.arc_ends, wk.arc_todo)
+            for i in range(arc_ptrs.shape[0]):
+                for f in range(2):
+                    if wk.arc_todo[i, f]:
+                        e = wk.arc_ends[i, f]
+                        endpoints_fn(arc_ptrs[i, f], e[0], e[1], e[2], e[3])
         if timed:
             t0 = _now_ns(clock_fn, ptr.timespec, ts)
             step_fn(sp, h)

@@ -32,7 +32,9 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
-POCKET_FACE_SEGMENTS = 3  # pymunk segments per face (odd: a central segment tangent at e_t)
+# exact arc faces: a roller further than this fraction of the play R - r from its pocket centre has its faces
+# placed for the step (closer, it cannot reach them: chipmunk's overlap correction moves it by far less)
+ARC_NEAR_FRACTION = 0.5
 CONTACT_DAMPING_S = 2.5e-6  # c = c_r k_lin [s]; lower end of the range 0.25e-5..2.5e-5 s of Kraemer (1993) / Sopanen & Mikkola (2003): the normal force is explicit
 DAMPING_FADE_M = 5.0e-9  # fade-in depth of the contact damping (continuity of Q at delta = 0)
 MIN_ENTRAINMENT_M_S = 0.1  # floor of the entrainment speed in the traction slip ratio
@@ -336,9 +338,36 @@ def face_geometry(sc, rr, margin):
     inv = np.divide(1.0, e2, out=np.zeros_like(e2), where=e2 > 0.0)  # unused rows: bit 0, never tested
     reach = rr + margin
     clear = sc.pocket_radius - rr - margin
+    arc = np.array([pair[0] is not None for pair in sc.arc_shapes], dtype=np.bool_) if sc.arc_shapes is not None \
+        else np.zeros(len(fs), dtype=np.bool_)
     return lp.FaceMasks(True, np.concatenate([fs[..., 0:2], ends, inv[..., None]], axis=-1), sc.face_bits,
                         np.ascontiguousarray(sc.pocket_centres, dtype=np.float64),
-                        clear * clear if clear > 0.0 else -1.0, reach * reach)
+                        clear * clear if clear > 0.0 else -1.0, reach * reach, arc)
+
+
+def arc_faces(sc, rr, sign) -> "lp.ArcFaces":
+    """:class:`bearingsim.multibody.loop.ArcFaces` of a scene with exact arc faces (roller radius ``rr`` [m],
+    ``sign`` of the rotation)."""
+    n = len(sc.arc_shapes)
+    a = np.asarray(sc.pocket_body_angle, dtype=np.float64)
+    sign = 1.0 if sign > 0 else -1.0
+    e_r = np.stack([np.cos(a), np.sin(a)], axis=1)
+    e_t = sign * np.stack([-np.sin(a), np.cos(a)], axis=1)
+    play = sc.pocket_radius - rr
+    near = ARC_NEAR_FRACTION * play
+    from bearingsim.multibody.scene import TANGENT_HALF_LENGTH
+
+    return lp.ArcFaces(True, np.array([pair[0] is not None for pair in sc.arc_shapes], dtype=np.bool_),
+                       np.ascontiguousarray(sc.pocket_centres, dtype=np.float64), np.ascontiguousarray(e_t),
+                       np.ascontiguousarray(e_r), float(sc.pocket_radius), float(sc.extent[0]), float(sc.extent[1]),
+                       float(TANGENT_HALF_LENGTH * sc.pocket_radius), float(near * near))
+
+
+def face_radial_reach(p) -> float:
+    """How far [m] the cage centre can move off the axis while the rollers still hold it: the radial reach
+    of the arc faces from the pocket centre, ``R sin(min(-psi_in, psi_out))``."""
+    lo, hi = p.multibody.pocket_face_extent
+    return (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(min(-lo, hi))
 
 
 def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
@@ -390,8 +419,9 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     r_c = rigid_radius(p)
     K_race = K * 2.0 ** (-10.0 / 9.0) if is_rigid else K
 
-    sc = build_scene(geo, op, e, mu_c, half_angle=p.multibody.pocket_face_half_angle,
-                     n_seg=POCKET_FACE_SEGMENTS, kinematic_cage=kinematic, spin_free=not reduced_eq,
+    n_seg = p.multibody.pocket_face_segments
+    sc = build_scene(geo, op, e, mu_c, extent=p.multibody.pocket_face_extent,
+                     n_seg=n_seg, kinematic_cage=kinematic, spin_free=not reduced_eq,
                      flat_pockets=p.multibody.flat_pockets, centred_cage=scene_kind == "centred_cage",
                      rigid_radius=r_c if is_rigid else None)
     space = sc.space
@@ -449,12 +479,16 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         n_out=np.full(n, n_centrifugal),  # rigid: the first step's outer-race loads, before a joint has acted
         n_held=np.zeros(n),
         e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_),
-        n_extra=np.zeros(n))
+        n_extra=np.zeros(n),
+        arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
+        arc_todo=np.zeros((n, 2), dtype=np.bool_))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
-    arb_cap = max(4096, 2 * POCKET_FACE_SEGMENTS * n * n + 64)
+    arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
+    arc = arc_faces(sc, rr, sign) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
     io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
-                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks)
+                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks,
+                                           sc.arc_shapes)
 
     total_rot = warm + nrot
     travel_end = 2.0 * math.pi * total_rot
@@ -484,7 +518,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     bar_done = 0
     io.read_states()
     # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
-    face_reach = (rr + 0.5 * s) * math.sin(p.multibody.pocket_face_half_angle)
+    face_reach = face_radial_reach(p)
     # a land-guided cage is held by its land (the full scene's free cage only)
     land = land_params(p, active=scene_kind == "full" and geo.cage_guidance != "rollers")
     orbit_limit = face_reach
@@ -505,7 +539,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         land=land,
         pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
         ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64),
-        onset_restitution=is_rigid, restitution=float(e))
+        onset_restitution=is_rigid, restitution=float(e), arc=arc)
     inp_main = inp
     if t_start > 0.0:  # the start phase: its own step (and samples at the same rate)
         inp = inp._replace(h=float(h_start), lim=lim._replace(
@@ -569,8 +603,8 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
             raise SimulationUnstable(
                 f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
                 f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({face_reach * 1e3:.4g} mm): the rollers no "
-                f"longer hold it; this pocket shape needs a land-guided cage, which the model does not have: use a "
-                f"larger multibody.pocket_face_half_angle_deg")
+                f"longer hold it; widen the faces (multibody.pocket_face_half_angle_deg, at most what the cage wall "
+                f"allows) or guide the cage on a ring land (bearing.cage_guidance)")
         raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
     if bar is not None:
         bar.update(total_rot - bar_done)

@@ -117,6 +117,29 @@ class HoldRule(NamedTuple):
     omega_cage: float  #: signed angular speed of the kinematic cage [rad/s]
 
 
+class ArcFaces(NamedTuple):
+    """Exact arc pocket faces (:mod:`bearingsim.multibody.scene`): what :func:`arc_faces` needs to place
+    each face's tangent segment before a step. Cage frame, SI."""
+
+    active: bool  #: exact faces (else every face is a static segment and nothing is placed)
+    arc: np.ndarray  #: (n,) bool, pocket with arc faces (False: a flat pocket, static segments)
+    centre: np.ndarray  #: (n, 2) pocket centres [m]
+    e_t: np.ndarray  #: (n, 2) unit vector along the cage's rotation at each pocket centre (the front face's side)
+    e_r: np.ndarray  #: (n, 2) outward radial unit vector at each pocket centre
+    radius: float  #: R = r_r + s/2, the pocket circle's radius [m]
+    psi_lo: float  #: the faces' inner end, angle from the circumferential direction (<= 0) [rad]
+    psi_hi: float  #: their outer end (>= 0) [rad]
+    half_length: float  #: largest half length of a tangent segment [m]
+    #: squared offset from the pocket centre below which a roller's faces are left where they are: a
+    #: roller that far inside its pocket cannot reach either face in the step [m^2]
+    near2: float
+
+
+#: inactive :class:`ArcFaces` (polyline or flat faces: every segment static)
+ARC_FACES_OFF = ArcFaces(False, np.zeros(0, dtype=np.bool_), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 2)),
+                         0.0, 0.0, 0.0, 0.0, 0.0)
+
+
 class StepInputs(NamedTuple):
     """Everything the step kernels read and never change during a run."""
 
@@ -132,6 +155,95 @@ class StepInputs(NamedTuple):
     ids_index: np.ndarray  #: (nb,) batch row of each sorted id
     onset_restitution: bool = False  #: rigid raceways: restitution only in the first step of a roller's contact
     restitution: float = 0.0  #: e of the roller shapes [-]
+    arc: ArcFaces = ARC_FACES_OFF  #: exact arc faces (placed before each step by :func:`arc_faces`)
+
+
+@njit(cache=True, inline="always")
+def arc_faces(state, h, af, ends, todo):
+    """Place the exact arc faces for the coming step: each face's segment on the arc's tangent at the
+    direction of its roller's centre from the pocket centre, clamped to the face's extent.
+
+    The roller and the cage are taken where chipmunk's position update puts them, ``p + v h`` and
+    ``angle + omega h`` (chipmunk then finds the contacts there): the tangent point is the point of the
+    true circle nearest to the roller's centre, so chipmunk's closest point on the segment, its normal and
+    its distance are those of the exact arc. (The update also adds the last step's overlap-correction
+    velocity, which moves a body along the normal of the contact it corrects: it shifts the roller's
+    direction by the correction over its offset, a change of the gap of second order, ~1e-14 m here.)
+
+    No trigonometry: in each face's frame (``u`` = +-e_t along the face's middle, ``e_r`` outward) the
+    roller's direction ``(x, y)`` is inside the extent when ``sin(psi - psi_in) >= 0`` and
+    ``sin(psi_out - psi) >= 0`` (cross products with the ends' unit vectors), else it is moved to the end
+    nearer in angle (larger cosine). The segment runs along the tangent ``(-y, x)`` from the tangent
+    point, at most ``half_length`` either way and never past the rays of the face's ends
+    (``R tan(psi - psi_in)``, ``R tan(psi_out - psi)``), so a clamped face's segment ends at the arc's end.
+
+    ``ends``: (n, 2, 4) each pocket's (front, rear) segment ends (ax, ay, bx, by) in the cage frame, updated;
+    ``todo``: (n, 2) bool, set where a segment moved (the loop hands those to chipmunk). A roller within
+    ``near2`` of its pocket centre leaves its faces as they are: every point of a tangent segment is at
+    least R from the pocket centre, out of its reach."""
+    n = todo.shape[0]
+    cx = state[n, 0] + state[n, 3] * h
+    cy = state[n, 1] + state[n, 4] * h
+    a = state[n, 2] + state[n, 5] * h
+    c = math.cos(a)
+    s = math.sin(a)
+    R = af.radius
+    ell = af.half_length
+    cl = math.cos(af.psi_lo)
+    sl = math.sin(af.psi_lo)
+    ch = math.cos(af.psi_hi)
+    sh = math.sin(af.psi_hi)
+    for i in range(n):
+        todo[i, 0] = False
+        todo[i, 1] = False
+        if not af.arc[i]:
+            continue
+        px = state[i, 0] + state[i, 3] * h - cx
+        py = state[i, 1] + state[i, 4] * h - cy
+        dx = c * px + s * py - af.centre[i, 0]  # roller centre from the pocket centre, cage frame
+        dy = -s * px + c * py - af.centre[i, 1]
+        d2 = dx * dx + dy * dy
+        if d2 < af.near2 or d2 == 0.0:
+            continue
+        inv = 1.0 / math.sqrt(d2)
+        erx = af.e_r[i, 0]
+        ery = af.e_r[i, 1]
+        y0 = (dx * erx + dy * ery) * inv
+        for f in range(2):
+            ux = af.e_t[i, 0] if f == 0 else -af.e_t[i, 0]
+            uy = af.e_t[i, 1] if f == 0 else -af.e_t[i, 1]
+            x = (dx * ux + dy * uy) * inv  # the roller's direction in this face's frame
+            y = y0
+            s_lo = y * cl - x * sl  # sin(psi - psi_lo)
+            s_hi = x * sh - y * ch  # sin(psi_hi - psi)
+            if s_lo < 0.0 or s_hi < 0.0:  # past an end: the end nearer in angle
+                if x * cl + y * sl >= x * ch + y * sh:
+                    x = cl
+                    y = sl
+                else:
+                    x = ch
+                    y = sh
+                s_lo = y * cl - x * sl
+                s_hi = x * sh - y * ch
+            c_lo = x * cl + y * sl  # cos(psi - psi_lo)
+            c_hi = x * ch + y * sh  # cos(psi_hi - psi)
+            l_lo = R * s_lo / c_lo if c_lo > 0.0 and R * s_lo < ell * c_lo else ell
+            l_hi = R * s_hi / c_hi if c_hi > 0.0 and R * s_hi < ell * c_hi else ell
+            qx = af.centre[i, 0] + R * (x * ux + y * erx)  # tangent point
+            qy = af.centre[i, 1] + R * (x * uy + y * ery)
+            tx = -y * ux + x * erx  # tangent, toward larger psi
+            ty = -y * uy + x * ery
+            e = ends[i, f]
+            ax_ = qx - l_lo * tx
+            ay_ = qy - l_lo * ty
+            bx_ = qx + l_hi * tx
+            by_ = qy + l_hi * ty
+            if e[0] != ax_ or e[1] != ay_ or e[2] != bx_ or e[3] != by_:
+                e[0] = ax_
+                e[1] = ay_
+                e[2] = bx_
+                e[3] = by_
+                todo[i, f] = True
 
 
 #: the narrowed masks keep a face segment whose distance from the roller's circle after pymunk's position
@@ -153,6 +265,9 @@ class FaceMasks(NamedTuple):
     #: inscribed radius); -1: never
     clear2: float
     reach2: float  #: (r + margin)^2 [m^2]: a segment closer to the roller centre may be touched
+    #: (n,) bool, pocket with exact arc faces: its two segments move (:func:`arc_faces`), so a roller
+    #: beyond ``clear2`` keeps both in its mask
+    arc: np.ndarray = np.zeros(0, dtype=np.bool_)
 
 
 class StepWork(NamedTuple):
@@ -175,6 +290,8 @@ class StepWork(NamedTuple):
     e_want: np.ndarray  #: (n,) elasticity each roller shape is to have in the next step [-]
     touched: np.ndarray  #: (n,) bool, rollers that touched a cage face in the last step (rigid raceways)
     n_extra: np.ndarray  #: (n,) rigid raceways: the outer race's force of :func:`~bearingsim.multibody.forces.race_orbit` in the step [N]
+    arc_ends: np.ndarray  #: (n, 2, 4) exact faces: each pocket's (front, rear) segment as placed (ax, ay, bx, by), cage frame [m]
+    arc_todo: np.ndarray  #: (n, 2) bool, exact faces: the segments :func:`arc_faces` moved for the coming step
 
 
 @njit(cache=True)
@@ -287,7 +404,9 @@ def face_masks(state, vb, h, fm, want):
         dx = qx - fm.centre[i, 0]
         dy = qy - fm.centre[i, 1]
         m = np.uint32(0)
-        if dx * dx + dy * dy >= fm.clear2:
+        if dx * dx + dy * dy >= fm.clear2 and fm.arc.shape[0] and fm.arc[i]:
+            m = fm.bits[i, 0] | fm.bits[i, 1]  # an exact face's segment is placed where the roller is
+        elif dx * dx + dy * dy >= fm.clear2:
             for j in range(seg.shape[1]):
                 bit = fm.bits[i, j]
                 if bit == 0:
@@ -442,8 +561,9 @@ class PlainLoop:
     name = "plain"
     timed = True
 
-    def __init__(self, space, nb, set_fields, set_arr, joints=(), roller_shapes=()):
+    def __init__(self, space, nb, set_fields, set_arr, joints=(), roller_shapes=(), arc_shapes=None):
         self.space = space
+        self.arc_shapes = arc_shapes  # exact faces: [pocket][face] segments placed before each step
         self.joints = list(joints)
         self.roller_shapes = list(roller_shapes)
         self.nb = nb
@@ -474,6 +594,11 @@ class PlainLoop:
             code = before_step(self.states[cur], inp, wk, ls)
             if code != CODE_CONTINUE:
                 return code
+            if inp.arc.active:  # the same C call as the compiled loop's (cpSegmentShapeSetEndpoints)
+                arc_faces(self.states[cur], h, inp.arc, wk.arc_ends, wk.arc_todo)
+                for i, f in zip(*np.nonzero(wk.arc_todo)):
+                    e = wk.arc_ends[i, f]
+                    self.arc_shapes[i][f].unsafe_set_endpoints((e[0], e[1]), (e[2], e[3]))
             if self.set_fields == BODY_SET_ALL:
                 pack_all(self.states[cur], wk.out_f, wk.set_arr, self.nb)
             pb.set_space_bodies(self.space, self.set_fields, self._set)

@@ -3,17 +3,27 @@
 Frame: x to the right, y up; the radial load on the inner ring points down (-y), so the load-zone
 centre is at the bottom. ``sign`` = +1 is counter-clockwise (forward) inner-ring rotation, -1 reverse.
 
-Pocket faces. A pocket is a circle of diameter ``2 r_r + s`` around the pocket centre on the pitch
-circle. The cage material only exists within its radial wall, so each face is the arc of that circle
-within ``+-multibody.pocket_face_half_angle_deg`` (default 45 deg) of the circumferential direction: the *front* face lies ahead of
-the pocket centre in the direction of cage rotation, the *rear* face behind it. Each arc is replaced
-by ``pocket_face_segments`` pymunk segments that are *tangent* to the true arc at their midpoints
-(circumscribed polyline): the circumferential clearance at the pocket centre line is exactly ``s``
-and the polyline never intrudes into the pocket, at the cost of up to ``R (1/cos(beta/n) - 1)`` extra
-play at the vertices. The roller is in contact with the central segment of a face as long as its
-radial offset from the pocket centre is below ``R tan(beta/n)`` (0.68 mm for 5 segments), which
-covers the circumferential impacts; the slanted outer segments give the radial guidance of a
-roller-guided cage.
+Pocket faces. A pocket is a circle of diameter ``2 r_r + s`` (radius ``R``) around the pocket centre on
+the pitch circle. The cage material only exists within its radial wall, so each face is the arc of that
+circle over ``psi`` in ``[psi_in, psi_out]`` from the circumferential direction (``multibody.pocket_face_extent``,
+by default what the cage wall allows: :func:`bearingsim.laws.pocket_face_extent`): the *front* face lies
+ahead of the pocket centre in the direction of cage rotation, the *rear* face behind it.
+
+Exact faces (``n_seg`` = 0, the default). Each arc face is one pymunk segment that the step loop places,
+before every step, on the tangent of the arc at the direction of the roller's centre from the pocket
+centre where chipmunk's position update will put it (:func:`bearingsim.multibody.loop.arc_faces`),
+with that direction clamped to the face's extent. Chipmunk's circle-to-segment test then finds the
+closest point of the segment to the roller's centre: the tangent point, whose normal is the pocket
+radius through the roller's centre and whose gap is ``R - |d| - r_r = s/2 - |d|`` (``d``: the roller
+centre's offset from the pocket centre), the contact with the true circle. A roller whose direction
+lies past the face's end meets the segment's end point, which is the end of the arc: the face's edge,
+a point contact. No other point of a tangent segment is nearer than ``R`` to the pocket centre, so a
+segment left where it was cannot touch a roller that is nowhere near its face.
+
+Polyline faces (``n_seg`` = N >= 1: ``multibody.pocket_face_segments``, to measure that approximation).
+Each arc is replaced by ``N`` pymunk segments that are *tangent* to the true arc at their midpoints
+(circumscribed polyline): the polyline never intrudes into the pocket, at the cost of up to
+``R (1/cos(beta/N) - 1)`` extra play at the vertices (``beta``: the face's angular span).
 
 Flat pockets (``multibody.flat_pockets``): the paper's instrumented pocket, whose curved faces "were
 machined flat to mount the load cells" set "to match the diameter of the cage pocket" (Sec. 2.1). Each
@@ -25,7 +35,7 @@ millimetre). It pushes only circumferentially: it does not guide the cage radial
 Collision filtering: rollers collide only with the cage. Elasticities are ``e`` on the roller and 1 on
 the cage (pymunk multiplies them), friction likewise ``cage_friction`` and 1. Each face segment has a
 category bit of its own (the same for the same segment of every pocket: face ``f`` (0 front, 1 rear),
-segment ``k``: bit ``1 + f n_seg + k``), and a roller's mask holds all of them; the compiled step loop
+segment ``k``: bit ``1 + f n_seg + k``; exact faces are one segment each), and a roller's mask holds all of them; the compiled step loop
 narrows a roller's mask, step by step, to the segments of its pocket that it can touch in that step
 (:func:`bearingsim.multibody.loop.face_masks`), which spares chipmunk the narrow-phase tests of the
 others and changes no contact.
@@ -59,6 +69,9 @@ class Scene:
     #: (n, S) uint32 category bit of each segment (0: no segment); None: the segments share ``CAGE_CATEGORY``
     face_bits: np.ndarray | None = None
     pocket_centres: np.ndarray | None = None  # (n, 2) pocket centres in the cage frame [m]
+    #: exact faces: [pocket][face] the pymunk segment of each arc face (None: a flat pocket's); None: polyline faces
+    arc_shapes: list | None = None
+    extent: tuple[float, float] = (0.0, 0.0)  # (psi_in, psi_out) of the arc faces [rad]
 
 
 def segment_bit(face: int, k: int, n_seg: int) -> int:
@@ -82,21 +95,37 @@ def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
     return -0.5 * math.pi - sign * 2.0 * math.pi * i / roller_count
 
 
-def face_polyline(centre, e_t, e_r, radius, half_angle, n_seg):
+def face_polyline(centre, e_t, e_r, radius, extent, n_seg):
     """Vertices of a polyline circumscribing the arc ``centre + R (cos psi e_t + sin psi e_r)``.
 
-    ``psi`` spans ``[-half_angle, half_angle]``; each of the ``n_seg`` segments touches the arc at its
+    ``psi`` spans ``extent = (psi_lo, psi_hi)``; each of the ``n_seg`` segments touches the arc at its
     midpoint. Returns an ``(n_seg + 1, 2)`` array [m].
     """
-    dpsi = 2.0 * half_angle / n_seg
+    lo, hi = extent
+    dpsi = (hi - lo) / n_seg
     r_v = radius / math.cos(0.5 * dpsi)
-    psi = -half_angle + dpsi * np.arange(n_seg + 1)
+    psi = lo + dpsi * np.arange(n_seg + 1)
     # the two end vertices lie on the extension of the end segments, at the arc's angular limits
     pts = centre[None, :] + r_v * (np.cos(psi)[:, None] * e_t[None, :] + np.sin(psi)[:, None] * e_r[None, :])
     return pts
 
 
-def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_angle: float,
+def face_tangent(centre, e_t, e_r, radius, extent):
+    """The exact face's segment before the first step: tangent to the arc at ``psi`` = 0 (the face's
+    middle on the pocket's circumferential centre line), as :func:`bearingsim.multibody.loop.arc_faces`
+    places it for a roller there. Returns a ``(2, 2)`` array [m]."""
+    lo, hi = extent
+    half = TANGENT_HALF_LENGTH * radius
+    p = centre + radius * e_t
+    return np.array([p - min(half, radius * math.tan(-lo)) * e_r, p + min(half, radius * math.tan(hi)) * e_r])
+
+
+#: half length of an exact face's tangent segment, as a fraction of R (chipmunk only ever meets the segment
+#: at its tangent point, or at an end that is the arc's end; the length only has to be more than 0)
+TANGENT_HALF_LENGTH = 0.05
+
+
+def build_scene(geometry, op, restitution: float, cage_friction: float, *, extent: tuple[float, float],
                 n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
                 flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
@@ -107,8 +136,8 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     op : :class:`bearingsim.scenario.OperatingPoint` (SI).
     restitution : roller-cage coefficient of restitution e [-].
     cage_friction : roller-cage Coulomb friction coefficient [-].
-    half_angle : angular half-width of each pocket face about the circumferential direction [rad].
-    n_seg : segments per arc face.
+    extent : angular extent ``(psi_in, psi_out)`` of each arc face from the circumferential direction [rad].
+    n_seg : segments per arc face; 0: exact arc faces (one tangent segment each, placed by the step loop).
     kinematic_cage : cage turned at the epicyclic speed (reduced-equivalent scene) instead of free.
     spin_free : rollers may change their spin (False: infinite moment of inertia).
     spatial_hash : use pymunk's spatial-hash broadphase (faster than the default tree here).
@@ -143,6 +172,8 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     omega_cage = sign * op.omega_c
     spin = sign * (op.omega_c - op.omega_r)  # absolute roller spin in pure rolling, Eq. (11)-(12)
     rollers = []
+    exact = n_seg == 0
+    n_seg = max(n_seg, 1)  # an exact face is one segment
     bits_each = own_bits(n_seg)
     all_faces = sum(segment_bit(f, k, n_seg) for f in (0, 1) for k in range(n_seg)) if bits_each else CAGE_CATEGORY
     roller_filter = pymunk.ShapeFilter(categories=ROLLER_CATEGORY, mask=all_faces)
@@ -172,6 +203,7 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
     seg_ends = np.zeros((n, 2 * n_seg, 4))
     seg_bits = np.zeros((n, 2 * n_seg), dtype=np.uint32)
     centres = np.zeros((n, 2))
+    arc_shapes = [[None, None] for _ in range(n)]  # exact faces: each arc pocket's (front, rear) segment
     for i in range(n):
         c = np.array([rp * math.cos(a[i]), rp * math.sin(a[i])])
         centres[i] = c
@@ -181,11 +213,15 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
         for f, direction in enumerate((e_t, -e_t)):  # front, rear
             if i in flat:
                 pts = np.array([c + R * direction - R * e_r, c + R * direction + R * e_r])
+            elif exact:
+                pts = face_tangent(c, direction, e_r, R, extent)
             else:
-                pts = face_polyline(c, direction, e_r, R, half_angle, n_seg)
+                pts = face_polyline(c, direction, e_r, R, extent, n_seg)
             verts[i].append(pts)
             for k in range(len(pts) - 1):
                 seg = pymunk.Segment(cage, tuple(pts[k]), tuple(pts[k + 1]), 0.0)
+                if exact and i not in flat:
+                    arc_shapes[i][f] = seg
                 seg.elasticity = 1.0
                 seg.friction = 1.0
                 bit = segment_bit(f, k, n_seg) if bits_each else CAGE_CATEGORY
@@ -212,4 +248,5 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, half_
             joints.append(j)
         space.add(*joints)
     ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
-    return Scene(space, rollers, cage, a, R, verts, ids, joints, seg_ends, seg_bits if bits_each else None, centres)
+    return Scene(space, rollers, cage, a, R, verts, ids, joints, seg_ends, seg_bits if bits_each else None, centres,
+                 arc_shapes if exact else None, tuple(float(x) for x in extent))

@@ -1,0 +1,84 @@
+"""Whole-bearing numbers the README and docs/geometry.md quote, measured on the default (exact-face) scene.
+
+    python benchmarks/whole_bearing.py whatif   # the what-if table: cage guidance, rig (1 warm-up + 20 rotations)
+    python benchmarks/whole_bearing.py orbit    # cage whirl against pocket clearance and speed (1 warm-up + 10 rotations)
+    python benchmarks/whole_bearing.py wear     # the wear-test scene: front / rear wear totals (1 warm-up + 40 rotations)
+
+Each prints a markdown table; every run is an ordinary ``bearingsim.run`` of a scenario in ``scenarios/``
+with the ``--set`` overrides shown in its row.
+"""
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+
+import bearingsim
+from bearingsim.scenario import load_scenario
+
+SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+
+
+def _run(name, sets):
+    return bearingsim.run(load_scenario(SCENARIOS / f"{name}.toml", list(sets)))
+
+
+def _orbit(r):
+    """(mean, max) distance of the cage centre from the axis over the recorded samples [m]."""
+    o = np.asarray(r.get("cage_orbit"))
+    o = o[np.isfinite(o[:, 1])]
+    rad = np.hypot(o[:, 1], o[:, 2])
+    return float(rad.mean()), float(r.summary["cage_orbit_max_m"])
+
+
+def whatif():
+    print("| rpm | cage | I_dec [mN s] | I_acc [mN s] | orbit mean / max [µm] | cage slip | land [mN s] |")
+    print("|---|---|---|---|---|---|---|")
+    for rpm in (3000, 6000):
+        for guidance in ("rollers", "outer_land", "inner_land"):
+            r = _run(f"multibody_{rpm}rpm", ["numerics.rotations=20", f"bearing.cage_guidance={guidance}"])
+            _row(rpm, guidance, r)
+    for guidance in ("rollers", "outer_land"):
+        r = _run("rig_3000rpm", ["numerics.rotations=20", f"bearing.cage_guidance={guidance}"])
+        per = np.asarray(r.get("per_rotation/I_dec"))
+        print(f"| 3000 | rig, {guidance}: pocket 0 (flat) / the 15 arc pockets | {per[:, 0].mean() * 1e3:.2f} ± "
+              f"{per[:, 0].std() * 1e3:.2f} / {per[:, 1:].mean() * 1e3:.2f} | | | | |")
+        _row(3000, f"rig, {guidance}, all 16 pockets", r)
+
+
+def _row(rpm, label, r):
+    s = r.summary
+    land = s.get("land_normal_impulse_mean_Ns", s.get("land_normal_impulse_Ns"))
+    land_txt = "–" if land is None or not math.isfinite(land) else f"{land * 1e3:.1f}"
+    om, ox = _orbit(r)
+    print(f"| {rpm} | {label} | {s['I_dec_mean_Ns'] * 1e3:.2f} ± {s['I_dec_std_Ns'] * 1e3:.2f} | "
+          f"{s['I_acc_mean_Ns'] * 1e3:.2f} ± {s['I_acc_std_Ns'] * 1e3:.2f} | {om * 1e6:.0f} / {ox * 1e6:.0f} | "
+          f"{s['cage_slip'] * 100:.3f} % | {land_txt} |", flush=True)
+
+
+def orbit():
+    print("| rpm | pocket clearance s [mm] | orbit mean / max [µm] | max / s | I_dec [mN s] | cage slip |")
+    print("|---|---|---|---|---|---|")
+    cases = [(rpm, 0.2) for rpm in (500, 1000, 2000, 3000, 4000, 6000)]
+    cases += [(rpm, s) for rpm in (1000, 3000, 6000) for s in (0.1, 0.3, 0.4)]
+    for rpm, s in cases:
+        r = _run("multibody_3000rpm", ["numerics.rotations=10", f"operating.inner_ring_speed_rpm={rpm}",
+                                        f"bearing.pocket_clearance_mm={s}"])
+        om, ox = _orbit(r)
+        print(f"| {rpm} | {s} | {om * 1e6:.0f} / {ox * 1e6:.0f} | {ox / (s * 1e-3):.2f} | "
+              f"{r.summary['I_dec_mean_Ns'] * 1e3:.2f} | {r.summary['cage_slip'] * 100:.3f} % |", flush=True)
+
+
+def wear():
+    r = _run("wear_test_6000rpm", [])
+    w = {k: float(np.sum(np.asarray(r.get(f"wear/{k}")))) for k in
+         ("paper_index_front", "paper_index_rear", "sliding_work_front", "sliding_work_rear")}
+    print(f"front / rear wear totals, impulse index (Eq. 16): {w['paper_index_front'] / w['paper_index_rear']:.3f}; "
+          f"sliding work: {w['sliding_work_front'] / w['sliding_work_rear']:.3f}; I_dec {r.summary['I_dec_mean_Ns'] * 1e3:.2f} "
+          f"mN s, I_acc {r.summary['I_acc_mean_Ns'] * 1e3:.2f} mN s")
+
+
+if __name__ == "__main__":
+    {"whatif": whatif, "orbit": orbit, "wear": wear}[sys.argv[1]]()

@@ -2,10 +2,12 @@
 
 The sweep folder ``DIR`` holds ``cases/<hash>.h5`` (one archive per case), ``sweep.csv`` and
 ``sweep.h5`` (the index, :mod:`bearingsim.sweeps.index`) and, with figures, the sweep's PNGs.
-A lock file ``DIR/.sweep.lock`` keeps two sweeps from writing the same folder at once.
+A lock file ``DIR/.sweep.lock`` (:class:`bearingsim.outputs.FolderLock`) keeps two sweeps or studies
+from writing the same folder at once.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -17,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.outputs import open_lock_file, write_atomic_bytes
+from bearingsim.outputs import FolderLock, write_atomic_bytes
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
@@ -88,32 +90,6 @@ def make_batches(cases: list[Case], workers: int) -> list[list[tuple]]:
         batches.append(reduced[i:i + n])
         i += n
     return other + batches
-
-
-class _Lock:
-    def __init__(self, outdir: Path):
-        self.path = outdir / ".sweep.lock"
-        self.fh = None
-
-    def __enter__(self):
-        import fcntl
-
-        if self.fh is not None:  # already held (taken before the signal handlers go in)
-            return self
-        fd = open_lock_file(self.path, self.path.parent)  # never through a link, never a user's file
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            raise UserError(f"{self.path.parent}: another sweep is writing this folder") from None
-        self.fh = fd
-        return self
-
-    def __exit__(self, *exc):
-        if self.fh is not None:
-            os.close(self.fh)
-            self.fh = None
-        return False
 
 
 class _Signals:
@@ -196,7 +172,7 @@ def _progress(total: int, enabled: bool, initial: int):
 
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
-              progress: bool | None = None, log=None) -> SweepOutcome:
+              progress: bool | None = None, log=None, lock: FolderLock | None = None) -> SweepOutcome:
     """Run every case of ``spec`` that has no valid archive yet, and index them all.
 
     Parameters
@@ -214,6 +190,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         Show a progress bar on stderr; default: when stderr is a terminal.
     log : callable, optional
         Receives one line per failed case (default: stderr).
+    lock : FolderLock, optional
+        The folder's lock, already held by the caller (a study holds it until its table is written);
+        default: taken here and released when the sweep ends.
 
     Returns
     -------
@@ -247,12 +226,17 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     try:
         outdir = check_writable_dir(outdir)
         cases_dir = outdir / "cases"
-        lock = _Lock(outdir).__enter__()
+        own = lock is None
+        if own:
+            lock = FolderLock(outdir).acquire()
+        elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
+            raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
         try:
             check_sweep_outputs(outdir, figures)
             cases_dir.mkdir(exist_ok=True)
         except BaseException:
-            lock.__exit__(None, None, None)
+            if own:
+                lock.release()
             raise
     except BaseException:
         engine.stop()
@@ -265,7 +249,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
     index = IndexWriter(outdir, rows, keys, meta)
 
-    with lock, _Signals() as signals:
+    with (lock if own else contextlib.nullcontext()), _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
         bar = None
         try:

@@ -54,7 +54,7 @@ def reduced_rows(quick: bool) -> list[dict]:
     from bearingsim.reduced.core import PassInputs
     from bearingsim.reduced.euler import max_stable_dt, solve_euler
     from bearingsim.reduced.event import solve_event
-    from bearingsim.reduced.studies import paper_scenario
+    from bearingsim.studies.fig9 import paper_scenario
 
     rows = []
     for rpm in REDUCED_SPEEDS:

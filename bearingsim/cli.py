@@ -189,25 +189,40 @@ def _cmd_validate(args) -> int:
     return _report_study(outcome, "validate")
 
 
+def _benchmarks_root() -> Path:
+    """The source checkout holding ``benchmarks/`` beside this package, put first on ``sys.path``.
+
+    The benchmarks and goal checks are not part of the installed package: ``bearingsim bench`` runs
+    from a checkout (a one-line UserError otherwise)."""
+    root = Path(__file__).resolve().parents[1]
+    if not (root / "benchmarks" / "__init__.py").is_file():
+        raise UserError("bench: the benchmarks are not installed with bearingsim; run 'bearingsim bench' from a "
+                        "source checkout of bearingsim (its benchmarks/ folder)")
+    if sys.path[:1] != [str(root)]:
+        sys.path.insert(0, str(root))
+    return root
+
+
 def _cmd_bench(args) -> int:
+    _benchmarks_root()
     if args.map:
-        from bearingsim.sweeps.bench import run_map_bench
+        from benchmarks.sweep_bench import run_map_bench
 
         run_map_bench(Path(args.output))
         return 0
     if args.sweep:
-        from bearingsim.sweeps.bench import run_sweep_bench
+        from benchmarks.sweep_bench import run_sweep_bench
 
         run_sweep_bench(Path(args.output))
         return 0
     if args.fast_scene:
-        from bearingsim.multibody.fast_bench import run_fast_scene_bench
+        from benchmarks.fast_scene_bench import run_fast_scene_bench
 
         run_fast_scene_bench(Path(args.output), rotations=args.rotations)
         print((Path(args.output) / "fast_scene.md").read_text(), end="")
         print(f"wrote {Path(args.output) / 'fast_scene.csv'}, fast_scene_comparison.csv, fast_scene.md")
         return 0
-    from bearingsim.bench import run_bench
+    from benchmarks.bench import run_bench
 
     run_bench(Path(args.output), quick=args.quick)
     return 0
@@ -299,7 +314,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run the cases on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     v.set_defaults(func=_cmd_validate)
 
-    b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot)")
+    b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot); from a source "
+                                     "checkout (benchmarks/)")
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")

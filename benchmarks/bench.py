@@ -129,7 +129,7 @@ def reduced_goal(rows: list[dict]) -> list[str]:
 
 
 def multibody_rows(quick: bool) -> list[dict]:
-    from bearingsim.multibody.bench import bench_cases
+    from benchmarks.multibody_bench import bench_cases
 
     return bench_cases(quick)
 
@@ -252,7 +252,7 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
         try:
             mrows = multibody_rows(quick)
             rows += mrows
-            from bearingsim.multibody.bench import goal_lines
+            from benchmarks.multibody_bench import goal_lines
 
             meta["multibody_goal"] = goal_lines(mrows)
         except ImportError as exc:  # pragma: no cover - reported, not hidden

@@ -174,3 +174,21 @@ def test_rig_study_gives_the_row_of_before(tmp_path):
         else:
             assert row[k] == v, k
     assert (tmp_path / "rig_idec_vs_speed.csv").is_file() and (tmp_path / "rig_pocket0_forces.png").is_file()
+
+
+def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
+    """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come
+    back as archives and give the very table the local pool gives."""
+    pytest.importorskip("distributed")
+    from distributed import LocalCluster
+
+    from bearingsim.sweeps.engines import DaskEngine
+
+    scenario = load_scenario(REFERENCE)
+    local, _ = cc.run_crosscheck(scenario, tmp_path / "local", (RPM,), 1, jobs=1, progress=False)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        remote, outcome = cc.run_crosscheck(scenario, tmp_path / "dask", (RPM,), 1,
+                                            engine=DaskEngine(cluster=cluster), progress=False)
+    assert outcome.count("done") == 5
+    assert (tmp_path / "local" / "crosscheck.csv").read_bytes() == (tmp_path / "dask" / "crosscheck.csv").read_bytes()
+    assert [r["archive"] for r in local] == [r["archive"] for r in remote]

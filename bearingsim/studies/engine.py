@@ -164,7 +164,8 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         engine.stop()
         raise
     with FolderLock(outdir) as lock:
-        sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock)
+        sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock,
+                          desc="+".join(s.name for s in studies))
         out = StudiesOutcome(sweep)
         if sweep.interrupted is None:
             records = {r["case"]: r for r in sweep.rows}

@@ -158,7 +158,7 @@ def _clean_temporaries(cases_dir: Path) -> None:
         p.unlink(missing_ok=True)
 
 
-def _progress(total: int, enabled: bool, initial: int):
+def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
     if not enabled:
         return None
     from tqdm import tqdm
@@ -167,12 +167,13 @@ def _progress(total: int, enabled: bool, initial: int):
 
     tqdm.monitor_interval = 0  # no monitor thread
     size = shutil.get_terminal_size((100, 24))  # a terminal that reports no size (a bare pty) gets 100 x 24
-    return tqdm(total=total, desc="sweep", unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
+    return tqdm(total=total, desc=desc, unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
                 nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
-              progress: bool | None = None, log=None, lock: FolderLock | None = None) -> SweepOutcome:
+              progress: bool | None = None, log=None, lock: FolderLock | None = None,
+              desc: str = "sweep") -> SweepOutcome:
     """Run every case of ``spec`` that has no valid archive yet, and index them all.
 
     Parameters
@@ -193,6 +194,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     lock : FolderLock, optional
         The folder's lock, already held by the caller (a study holds it until its table is written);
         default: taken here and released when the sweep ends.
+    desc : str
+        The progress bar's label (a study's name).
 
     Returns
     -------
@@ -268,7 +271,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     row.update(rec, archive=f"cases/{c.hash}.h5")
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
-            bar = _progress(len(cases), progress, counts["cached"])
+            bar = _progress(len(cases), progress, counts["cached"], desc)
             if bar is not None:
                 bar.set_postfix(counts, refresh=True)
             say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None

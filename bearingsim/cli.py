@@ -71,7 +71,7 @@ def _cmd_plot(args) -> int:
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT
 
-    from bearingsim import crosscheck
+    from bearingsim.studies import crosscheck
 
     if archive.is_table_file(path, crosscheck.INDEX_FORMAT):  # a cross-check's index: its figure
         folder = check_writable_dir(args.output) if args.output else path.parent
@@ -143,35 +143,75 @@ def _cmd_compare(args) -> int:
     return 0 if c.identical else 1
 
 
+def _report_study(outcome, command: str) -> int:
+    """The end of a study command: exit 0, 1 if a case failed (named on stderr), 128 + signal if
+    interrupted (finished cases kept: the same command resumes)."""
+    n = len(outcome.sweep.rows)
+    if outcome.interrupted is not None:
+        print(f"bearingsim: {command} interrupted ({signal.Signals(outcome.interrupted).name}): {outcome.counts()}, "
+              f"{outcome.count('pending')} not run, of {n} cases; run the same command again to resume",
+              file=sys.stderr)
+        return 128 + outcome.interrupted
+    if outcome.failed:
+        names = "; ".join(f"{', '.join(f'{k}={v}' for k, v in r['values'].items())}: {r['error']}"
+                          for r in outcome.failed[:10])
+        print(f"bearingsim: {len(outcome.failed)} of {n} cases of the {command} failed ({names}); the other "
+              f"cases' numbers are kept (errors in {outcome.sweep.csv})", file=sys.stderr)
+        return 1
+    return 0
+
+
 def _cmd_validate(args) -> int:
-    from bearingsim.reduced.studies import save_fig9
+    from bearingsim.studies import make_engine, run_studies
+    from bearingsim.studies.fig9 import Fig9
 
-    paths = save_fig9(Path(args.output))
-    for p in paths:
-        print(f"wrote {p}")
+    studies = [Fig9()]
     if args.rig_rotations > 0:
-        from bearingsim.multibody.studies import save_rig, rig_table
+        from bearingsim.studies.rig import Rig
 
-        rows = rig_table(rotations=args.rig_rotations, jobs=args.jobs)
+        studies.append(Rig(rotations=args.rig_rotations))
+    engine = make_engine(args.jobs, args.scheduler)
+    outcome = run_studies(studies, Path(args.output), engine=engine)
+    for p in outcome.written[:2]:
+        print(f"wrote {p}")
+    if args.rig_rotations > 0 and outcome.interrupted is None:
+        rows = studies[1].rows
         print(f"rig scene (pocket 0 flat), 1 warm-up + {args.rig_rotations} rotations, against the reduced model:")
         print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
         for r in rows:
             print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:5.2f} (std) "
                   f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
                   f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
-        for p in save_rig(Path(args.output), rows):
+        for p in outcome.written[2:]:
             print(f"wrote {p}")
-    return 0
+    if outcome.interrupted is None:
+        print(f"{len(outcome.sweep.rows)} cases: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+    return _report_study(outcome, "validate")
+
+
+def _benchmarks_root() -> Path:
+    """The source checkout holding ``benchmarks/`` beside this package, put first on ``sys.path``.
+
+    The benchmarks and goal checks are not part of the installed package: ``bearingsim bench`` runs
+    from a checkout (a one-line UserError otherwise)."""
+    root = Path(__file__).resolve().parents[1]
+    if not (root / "benchmarks" / "__init__.py").is_file():
+        raise UserError("bench: the benchmarks are not installed with bearingsim; run 'bearingsim bench' from a "
+                        "source checkout of bearingsim (its benchmarks/ folder)")
+    if sys.path[:1] != [str(root)]:
+        sys.path.insert(0, str(root))
+    return root
 
 
 def _cmd_bench(args) -> int:
+    _benchmarks_root()
     if args.map:
-        from bearingsim.sweeps.bench import run_map_bench
+        from benchmarks.sweep_bench import run_map_bench
 
         run_map_bench(Path(args.output))
         return 0
     if args.sweep:
-        from bearingsim.sweeps.bench import run_sweep_bench
+        from benchmarks.sweep_bench import run_sweep_bench
 
         run_sweep_bench(Path(args.output))
         return 0
@@ -181,13 +221,13 @@ def _cmd_bench(args) -> int:
         run_geometry_bench(Path(args.output), rotations=args.rotations or 30)
         return 0
     if args.fast_scene:
-        from bearingsim.multibody.fast_bench import run_fast_scene_bench
+        from benchmarks.fast_scene_bench import run_fast_scene_bench
 
         run_fast_scene_bench(Path(args.output), rotations=args.rotations or 40)
         print((Path(args.output) / "fast_scene.md").read_text(), end="")
         print(f"wrote {Path(args.output) / 'fast_scene.csv'}, fast_scene_comparison.csv, fast_scene.md")
         return 0
-    from bearingsim.bench import run_bench
+    from benchmarks.bench import run_bench
 
     run_bench(Path(args.output), quick=args.quick)
     return 0
@@ -203,28 +243,32 @@ def _cmd_sweep(args) -> int:
 def _cmd_crosscheck(args) -> int:
     import time
 
-    from bearingsim import crosscheck as cc
     from bearingsim.scenario import load_scenario
+    from bearingsim.studies import crosscheck as cc
+    from bearingsim.studies import make_engine
 
     _refuse_archive_as_scenario(args.scenario)
     speeds = cc.parse_speeds(args.speeds)
     if args.rotations < 1:
         raise UserError(f"--rotations {args.rotations}: give at least 1 recorded rotation")
+    engine = make_engine(args.jobs, args.scheduler)
     scenario = load_scenario(args.scenario, args.set)
     cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
-    rows = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, args.jobs)
+    rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine)
     wall = time.perf_counter() - t0
-    print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
-          f"{args.rotations} rotations each, {args.jobs} process(es), {wall:.1f} s; impulses per pocket and cage "
-          f"rotation, mean over all pockets ± batch-means standard error")
-    print(cc.format_table(rows))
-    for line in cc.verdicts(rows):
-        print(line)
-    for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
-        print(f"wrote {Path(args.output) / name}")
-    print(f"wrote {len(rows)} rung archives in {Path(args.output) / 'rungs'}")
-    return 0
+    if outcome.interrupted is None:
+        where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
+        print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
+              f"{args.rotations} rotations each, {where}, {wall:.1f} s; impulses per pocket and cage "
+              f"rotation, mean over all pockets ± batch-means standard error")
+        print(cc.format_table(rows))
+        for line in cc.verdicts(rows):
+            print(line)
+        for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
+            print(f"wrote {Path(args.output) / name}")
+        print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+    return _report_study(outcome, "cross-check")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -266,14 +310,17 @@ def build_parser() -> argparse.ArgumentParser:
     cp.set_defaults(func=_cmd_compare)
 
     v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
-                                        "(pocket 0 flat) against it (tables and PNGs)")
+                                        "(pocket 0 flat) against it (tables and PNGs; run again to resume)")
     v.add_argument("-o", "--output", default="outputs/validate", help="output folder")
     v.add_argument("--rig-rotations", type=int, default=20,
                    help="recorded rotations of each rig run (after 1 warm-up); 0 skips the rig (default 20)")
-    v.add_argument("-j", "--jobs", type=int, default=2, help="parallel rig runs")
+    v.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
+    v.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run the cases on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     v.set_defaults(func=_cmd_validate)
 
-    b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot)")
+    b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot); from a source "
+                                     "checkout (benchmarks/)")
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
@@ -302,14 +349,16 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-plots", action="store_true", help="index only, no figures")
     s.set_defaults(func=_cmd_sweep)
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
-                                           "(README: Cross-check)")
+                                           "(README: Cross-check; run again to resume)")
     cc.add_argument("scenario", help="multibody scenario TOML, full scene")
     cc.add_argument("--speeds", default="1000,3000,6000", help="inner-ring speeds in rpm (default 1000,3000,6000)")
     cc.add_argument("--rotations", type=int, default=10, help="recorded cage rotations of every rung (default 10)")
     cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario key (repeatable)")
     cc.add_argument("-o", "--output", default="outputs/crosscheck", help="output folder")
-    cc.add_argument("-j", "--jobs", type=int, default=2, help="parallel runs (default 2)")
+    cc.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
+    cc.add_argument("--scheduler", metavar="ADDRESS",
+                    help="run the rungs on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     cc.set_defaults(func=_cmd_crosscheck)
     return p
 

@@ -298,6 +298,54 @@ def open_lock_file(lock_path: str | Path, guarded: str | Path) -> int:
     return fd
 
 
+class FolderLock:
+    """One writer per folder of many outputs (a sweep's or a study's): an exclusive, non-blocking
+    ``fcntl.flock`` on ``DIR/.sweep.lock`` (:func:`open_lock_file`: never a link, never a user's file).
+
+    The lock file stays (it is empty); the lock itself dies with its process. A second writer, in this
+    process or another, is refused with one line. Held across a whole study (its cases and then its
+    table and figures), it is passed to :func:`bearingsim.sweeps.run_sweep` as ``lock=``.
+
+    Parameters
+    ----------
+    folder : the folder the lock guards (must exist)
+    """
+
+    NAME = ".sweep.lock"
+
+    def __init__(self, folder: str | Path):
+        self.path = Path(folder) / self.NAME
+        self.fh: int | None = None
+
+    def acquire(self) -> "FolderLock":
+        if self.fh is not None:  # already held by this object
+            return self
+        fd = open_lock_file(self.path, self.path.parent)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise UserError(f"{self.path.parent}: another sweep or study is writing this folder") from None
+        self.fh = fd
+        return self
+
+    def release(self) -> None:
+        if self.fh is not None:
+            os.close(self.fh)
+            self.fh = None
+
+    @property
+    def held(self) -> bool:
+        return self.fh is not None
+
+    def __enter__(self) -> "FolderLock":
+        return self.acquire()
+
+    def __exit__(self, *exc) -> bool:
+        self.release()
+        return False
+
+
 class OutputLock:
     """Exclusive, non-blocking ``fcntl.flock`` on ``.<name>.lock`` beside an archive path.
 

@@ -558,7 +558,7 @@ def check_run_request(scenario: "Scenario") -> None:
     ``numerics.warmup_rotations = 0`` with the multibody model: every pocket's first window then
     starts from the assembled state, and the means over rotations are biased (issue 14 measured the
     mean I_dec of the reduced-equivalent scene 21 % low). The Python API still accepts it, because a
-    stability scan (``bearingsim.multibody.stability``) and the robustness tests want exactly one
+    stability scan (``benchmarks.stability`` of a source checkout) and the robustness tests want exactly one
     rotation from the start state; a user asking the CLI for results is refused.
     """
     if scenario.model == "multibody" and scenario.numerics.warmup_rotations < 1:

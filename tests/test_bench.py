@@ -1,5 +1,5 @@
 """The benchmark's read-off of issue 2's goal (pure bookkeeping on given rows; no timing here)."""
-from bearingsim.bench import reduced_goal
+from benchmarks.bench import reduced_goal
 
 
 def _rows(rpm, event_wall, euler):
@@ -40,3 +40,22 @@ def test_euler_never_within_1e_4_is_reported():
     for rpm in (500, 2000, 6000):
         rows += _rows(rpm, 2e-5, [(1e-4, 1e-4, 5e-3), (3e-5, 3e-4, 2e-3)])
     assert "euler does not reach 1e-4" in reduced_goal(rows)[0]
+
+
+def test_bench_is_not_in_the_installed_package_and_runs_from_a_checkout(tmp_path, monkeypatch, capsys):
+    """The benchmarks live in the checkout's benchmarks/ (not in the wheel: pyproject installs bearingsim*);
+    `bearingsim bench` finds them beside the package, and says so in one line where they are absent."""
+    from pathlib import Path
+
+    import bearingsim
+    from bearingsim import cli
+
+    pkg = Path(bearingsim.__file__).parent
+    assert not any((pkg / p).exists() for p in ("bench.py", "sweeps/bench.py", "multibody/bench.py",
+                                                 "multibody/fast_bench.py", "multibody/stability.py"))
+    assert (cli._benchmarks_root() / "benchmarks" / "bench.py").is_file()
+    monkeypatch.setattr(cli, "__file__", str(tmp_path / "site-packages" / "bearingsim" / "cli.py"))
+    assert cli.main(["bench", "--quick", "-o", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "source checkout" in err
+    assert not (tmp_path / "b").exists()

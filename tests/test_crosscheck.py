@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import bearingsim
-from bearingsim import crosscheck as cc
+from bearingsim.studies import crosscheck as cc
 from bearingsim.cli import main
 from bearingsim.compare import compare_results
 from bearingsim.scenario import load_scenario
@@ -43,9 +43,15 @@ def _rows(out):
         return list(csv.DictReader(fh))
 
 
+def _archive(out, rung):
+    """The path of a rung's archive, as the index names it."""
+    rows, _ = cc.read_table(out / "crosscheck.h5")
+    (row,) = [r for r in rows if r["rung"] == rung and r["rpm"] == RPM]
+    return out / row["archive"]
+
+
 def _rung(out, rung):
-    scene = cc.RUNGS[rung - 1][1]
-    return bearingsim.load(out / "rungs" / f"{RPM:g}rpm_{rung}_{scene}.h5")
+    return bearingsim.load(_archive(out, rung))
 
 
 def test_command_succeeds_and_reports(ladder):
@@ -95,7 +101,7 @@ def test_rung3_cage_speed_is_prescribed(ladder):
     out = ladder[0]
     r = _rung(out, 3)
     p = r.parameters
-    with h5py.File(out / "rungs" / f"{RPM:g}rpm_3_kinematic_cage.h5", "r") as f:
+    with h5py.File(_archive(out, 3), "r") as f:
         w = f["observables/cage_angular_speed/value"][()]
     assert np.allclose(w, p.operating.omega_c, rtol=1e-12, atol=0)
     assert r.summary["cage_orbit_max_m"] == 0.0
@@ -134,6 +140,7 @@ def test_index_and_plot(ladder, tmp_path):
     out = ladder[0]
     rows, meta = cc.read_table(out / "crosscheck.h5")
     assert [r["rung"] for r in rows] == [1, 2, 3, 4, 5]
+    assert {r["status"] for r in rows} == {"done"} and {r["error"] for r in rows} == {""}
     for r in rows:
         res = bearingsim.load(out / r["archive"])
         assert res.summary["I_dec_mean_Ns"] == r["I_dec_mean_Ns"]
@@ -170,4 +177,4 @@ def test_refusals(argv, words, capsys, tmp_path):
     err = capsys.readouterr().err
     assert rc == 2
     assert err.count("\n") == 1 and words in err
-    assert not (tmp_path / "cc" / "rungs").exists()
+    assert not (tmp_path / "cc" / "cases").exists()

@@ -13,7 +13,7 @@ import pytest
 from bearingsim.errors import UserError
 from bearingsim.multibody.core import (RIGID_MIN_CENTRIFUGAL_RATIO, choose_dt, rigid_radius, rigid_speed_floor,
                                       rigid_start)
-from bearingsim.multibody.fast_bench import scene_row, compare
+from benchmarks.fast_scene_bench import scene_row, compare
 from bearingsim.parameters import Parameters
 from bearingsim.scenario import load_scenario
 from bearingsim.simulation import run as simulate

@@ -15,7 +15,7 @@ from bearingsim.simulation import run as simulate
 from bearingsim.reduced.core import PassInputs
 from bearingsim.reduced.euler import max_stable_dt, solve_euler
 from bearingsim.reduced.event import solve_event
-from bearingsim.reduced.studies import idec_per_rotation, paper_scenario
+from bearingsim.studies.fig9 import idec_per_rotation, paper_scenario
 
 
 def _inputs(rpm, **kw):

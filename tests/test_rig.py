@@ -1,7 +1,7 @@
 """The paper's measurement rig as a scene (issue 12): pocket 0 flat, the rest of the cage as built."""
 import pytest
 
-from bearingsim.multibody.studies import batch_sem, rig_scenario, rig_table
+from bearingsim.studies.rig import batch_sem, rig_scenario, rig_table
 from bearingsim.scenario import load_scenario
 
 from .conftest import SCENARIOS

@@ -393,12 +393,12 @@ def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
     import psutil
 
     from bearingsim.errors import UserError
-    from bearingsim.sweeps.run import _Lock
+    from bearingsim.outputs import FolderLock
 
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000])])
     before = {p.pid for p in psutil.Process().children(recursive=True)}  # e.g. multiprocessing's resource tracker
-    with _Lock(tmp_path):  # another sweep holds the folder
-        with pytest.raises(UserError, match="another sweep is writing"):
+    with FolderLock(tmp_path):  # another sweep holds the folder
+        with pytest.raises(UserError, match="another sweep or study is writing"):
             run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
     assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()  # its pool is gone
     assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1

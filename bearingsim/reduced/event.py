@@ -1101,7 +1101,7 @@ def solve_event(
 def closed_form_evaluator(inp: PassInputs):
     """``evaluate(n)``: the closed form of one flight of this pass (its own drag table) evaluated at n
     angles in one compiled call; ``evaluate(0)`` is a bare call into compiled code. For the benchmark's
-    cost floor (:func:`bearingsim.bench.reduced_rows`)."""
+    cost floor (``benchmarks.bench.reduced_rows`` of a source checkout)."""
     tab, npan = drag_table(inp)
     par = _params(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR)
     omega, g, th0, th1 = float(par[2]), float(par[3]), float(par[5]), float(par[6])

@@ -2,10 +2,12 @@
 
 The sweep folder ``DIR`` holds ``cases/<hash>.h5`` (one archive per case), ``sweep.csv`` and
 ``sweep.h5`` (the index, :mod:`bearingsim.sweeps.index`) and, with figures, the sweep's PNGs.
-A lock file ``DIR/.sweep.lock`` keeps two sweeps from writing the same folder at once.
+A lock file ``DIR/.sweep.lock`` (:class:`bearingsim.outputs.FolderLock`) keeps two sweeps or studies
+from writing the same folder at once.
 """
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -17,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.outputs import open_lock_file, write_atomic_bytes
+from bearingsim.outputs import FolderLock, write_atomic_bytes
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
@@ -90,32 +92,6 @@ def make_batches(cases: list[Case], workers: int) -> list[list[tuple]]:
     return other + batches
 
 
-class _Lock:
-    def __init__(self, outdir: Path):
-        self.path = outdir / ".sweep.lock"
-        self.fh = None
-
-    def __enter__(self):
-        import fcntl
-
-        if self.fh is not None:  # already held (taken before the signal handlers go in)
-            return self
-        fd = open_lock_file(self.path, self.path.parent)  # never through a link, never a user's file
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            raise UserError(f"{self.path.parent}: another sweep is writing this folder") from None
-        self.fh = fd
-        return self
-
-    def __exit__(self, *exc):
-        if self.fh is not None:
-            os.close(self.fh)
-            self.fh = None
-        return False
-
-
 class _Signals:
     """SIGINT/SIGTERM raise :class:`SweepInterrupted` once in the main thread; later ones are ignored
     while the sweep cleans up.
@@ -182,7 +158,7 @@ def _clean_temporaries(cases_dir: Path) -> None:
         p.unlink(missing_ok=True)
 
 
-def _progress(total: int, enabled: bool, initial: int):
+def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
     if not enabled:
         return None
     from tqdm import tqdm
@@ -191,12 +167,13 @@ def _progress(total: int, enabled: bool, initial: int):
 
     tqdm.monitor_interval = 0  # no monitor thread
     size = shutil.get_terminal_size((100, 24))  # a terminal that reports no size (a bare pty) gets 100 x 24
-    return tqdm(total=total, desc="sweep", unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
+    return tqdm(total=total, desc=desc, unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
                 nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
-              progress: bool | None = None, log=None) -> SweepOutcome:
+              progress: bool | None = None, log=None, lock: FolderLock | None = None,
+              desc: str = "sweep") -> SweepOutcome:
     """Run every case of ``spec`` that has no valid archive yet, and index them all.
 
     Parameters
@@ -214,6 +191,11 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         Show a progress bar on stderr; default: when stderr is a terminal.
     log : callable, optional
         Receives one line per failed case (default: stderr).
+    lock : FolderLock, optional
+        The folder's lock, already held by the caller (a study holds it until its table is written);
+        default: taken here and released when the sweep ends.
+    desc : str
+        The progress bar's label (a study's name).
 
     Returns
     -------
@@ -247,12 +229,17 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     try:
         outdir = check_writable_dir(outdir)
         cases_dir = outdir / "cases"
-        lock = _Lock(outdir).__enter__()
+        own = lock is None
+        if own:
+            lock = FolderLock(outdir).acquire()
+        elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
+            raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
         try:
             check_sweep_outputs(outdir, figures)
             cases_dir.mkdir(exist_ok=True)
         except BaseException:
-            lock.__exit__(None, None, None)
+            if own:
+                lock.release()
             raise
     except BaseException:
         engine.stop()
@@ -265,7 +252,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
     index = IndexWriter(outdir, rows, keys, meta)
 
-    with lock, _Signals() as signals:
+    with (lock if own else contextlib.nullcontext()), _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
         bar = None
         try:
@@ -284,7 +271,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     row.update(rec, archive=f"cases/{c.hash}.h5")
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
-            bar = _progress(len(cases), progress, counts["cached"])
+            bar = _progress(len(cases), progress, counts["cached"], desc)
             if bar is not None:
                 bar.set_postfix(counts, refresh=True)
             say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None

@@ -23,7 +23,7 @@ import math
 import time
 from pathlib import Path
 
-from bearingsim.multibody.bench import reference_scenario
+from benchmarks.multibody_bench import reference_scenario
 from bearingsim.parameters import Parameters
 
 SPEEDS = (500, 1000, 3000, 6000)

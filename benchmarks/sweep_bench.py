@@ -30,7 +30,7 @@ SCENARIO = "multibody_6000rpm.toml"
 
 
 def _scenario_path() -> Path:
-    return Path(__file__).resolve().parents[2] / "scenarios" / SCENARIO
+    return Path(__file__).resolve().parents[1] / "scenarios" / SCENARIO
 
 
 def _warm() -> bool:
@@ -119,7 +119,7 @@ def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2, figures: 
 
     With ``archives=False`` the workers (forked, so they inherit the change) solve each case without
     building or writing its archive: what the engine, the solver and the index cost without
-    ``archive.py``. ``python -m bearingsim.sweeps.bench map [--no-archives] OUTDIR``.
+    ``archive.py``. ``python -m benchmarks.sweep_bench map [--no-archives] OUTDIR``.
     """
     import resource
 

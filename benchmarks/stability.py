@@ -1,6 +1,6 @@
 """Stability scan of the multi-pocket model: the largest time step per scene, speed and load.
 
-``python -m bearingsim.multibody.stability [--quick]`` bisects, for each scene, inner-ring speed and
+``python -m benchmarks.stability [--quick]`` bisects, for each scene, inner-ring speed and
 radial load, the largest dt at which one cage rotation (after none of warm-up, from the start state)
 
 * **runs**: finishes without a blow-up (non-finite state, raceway approach > 50 um, cage faster than
@@ -21,7 +21,7 @@ import time
 
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.multibody.core import PenetrationExceeded, choose_dt, run
-from bearingsim.multibody.bench import reference_scenario
+from benchmarks.multibody_bench import reference_scenario
 from bearingsim.parameters import Parameters
 
 

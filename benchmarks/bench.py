@@ -54,7 +54,7 @@ def reduced_rows(quick: bool) -> list[dict]:
     from bearingsim.reduced.core import PassInputs
     from bearingsim.reduced.euler import max_stable_dt, solve_euler
     from bearingsim.reduced.event import solve_event
-    from bearingsim.reduced.studies import paper_scenario
+    from bearingsim.studies.fig9 import paper_scenario
 
     rows = []
     for rpm in REDUCED_SPEEDS:
@@ -129,7 +129,7 @@ def reduced_goal(rows: list[dict]) -> list[str]:
 
 
 def multibody_rows(quick: bool) -> list[dict]:
-    from bearingsim.multibody.bench import bench_cases
+    from benchmarks.multibody_bench import bench_cases
 
     return bench_cases(quick)
 
@@ -252,7 +252,7 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
         try:
             mrows = multibody_rows(quick)
             rows += mrows
-            from bearingsim.multibody.bench import goal_lines
+            from benchmarks.multibody_bench import goal_lines
 
             meta["multibody_goal"] = goal_lines(mrows)
         except ImportError as exc:  # pragma: no cover - reported, not hidden

@@ -3,23 +3,26 @@
 The paper validated its reduced model against impulses measured by load cells in one pocket of a
 running bearing (Suzuki et al. 2023, Sec. 2.1, Table 2, Fig. 9: 970 N, forward, up to 4000 rpm). That
 pocket's faces were machined flat; the other 15 were the cage's own. :func:`rig_scenario` is that
-bearing in the full multibody scene (pocket 0 flat, ``scenarios/rig_<rpm>rpm.toml``), and
-:func:`rig_table` compares pocket 0's I_dec per cage rotation with the reduced model's at the same
-speed (the paper's conditions, phi = 23.5 deg).
+bearing in the full multibody scene (pocket 0 flat, ``scenarios/rig_<rpm>rpm.toml``), and the study
+:class:`Rig` compares pocket 0's I_dec per cage rotation with the reduced model's at the same speed (the
+paper's conditions, phi = 23.5 deg: the Fig. 9 study's case at c = 0.02, which runs once when both
+studies run together).
 """
 from __future__ import annotations
 
-import math
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
-from bearingsim.outputs import write_csv
+from bearingsim.outputs import PNG_SIGNATURE, write_csv
 from bearingsim.scenario import resolve
+from bearingsim.studies.engine import FINISHED, Study, batch_sem, case_of, load_result
+from bearingsim.studies.fig9 import reference_case
 
 RIG_SPEEDS_RPM = (500, 1000, 2000, 3000, 4000)
 RIG_ROTATIONS = 20
+
+__all__ = ["RIG_ROTATIONS", "RIG_SPEEDS_RPM", "Rig", "batch_sem", "rig_scenario", "rig_table", "save_rig"]
 
 
 def rig_scenario(rpm: float, rotations: int = RIG_ROTATIONS, warmup: int = 1):
@@ -31,50 +34,64 @@ def rig_scenario(rpm: float, rotations: int = RIG_ROTATIONS, warmup: int = 1):
         "multibody": {"scene": "full", "flat_pockets": [0]},
         "numerics": {"rotations": rotations, "warmup_rotations": warmup},
     }
-    return resolve(raw, "bearingsim.multibody.studies")
+    return resolve(raw, "bearingsim.studies.rig")
 
 
-def batch_sem(x: np.ndarray, batches: int = 5) -> float:
-    """Standard error of the mean of a correlated series from ``batches`` batch means [same unit as x].
-
-    Rotations of a chaotic scene are correlated; the means of contiguous batches are close to
-    independent, so their scatter / sqrt(batches) estimates the error of the overall mean."""
-    x = np.asarray(x, float)
-    b = min(batches, len(x))
-    if b < 2:
-        return float("nan")
-    means = np.array([c.mean() for c in np.array_split(x, b)])
-    return float(means.std(ddof=1) / math.sqrt(b))
-
-
-def _rig_point(args):
-    import bearingsim
-    from bearingsim.reduced.studies import idec_per_rotation
-
-    rpm, rotations = args
-    r = bearingsim.run(rig_scenario(rpm, rotations))
-    d = r.per_rotation["I_dec"]
-    a = r.per_rotation["I_acc"]
+def rig_row(rpm: float, rotations: int, result, reduced_I_dec_Ns: float) -> dict:
+    """One speed's row of the rig table from the rig scene's result and the reduced model's I_dec."""
+    d = result.per_rotation["I_dec"]
+    a = result.per_rotation["I_acc"]
     return {
         "rpm": rpm, "rotations": rotations,
         "pocket0_I_dec_mean_Ns": float(d[:, 0].mean()), "pocket0_I_dec_std_Ns": float(d[:, 0].std()),
         "pocket0_I_dec_sem_Ns": batch_sem(d[:, 0]),
         "pocket0_I_acc_mean_Ns": float(a[:, 0].mean()),
         "arc_pockets_I_dec_mean_Ns": float(d[:, 1:].mean()), "arc_pockets_I_dec_std_Ns": float(d[:, 1:].std()),
-        "reduced_I_dec_Ns": idec_per_rotation(rpm),
-        "theta_deg": r.get("theta_deg"), "F_acc_pocket0": r.get("force_vs_theta_acc")[:, 0],
-        "F_dec_pocket0": r.get("force_vs_theta_dec")[:, 0],
-        "load_zone_half_angle_deg": r.summary["load_zone_half_angle_deg"],
+        "reduced_I_dec_Ns": reduced_I_dec_Ns,
+        "theta_deg": result.get("theta_deg"), "F_acc_pocket0": result.get("force_vs_theta_acc")[:, 0],
+        "F_dec_pocket0": result.get("force_vs_theta_dec")[:, 0],
+        "load_zone_half_angle_deg": result.summary["load_zone_half_angle_deg"],
     }
 
 
-def rig_table(speeds=RIG_SPEEDS_RPM, rotations: int = RIG_ROTATIONS, jobs: int = 2) -> list[dict]:
-    """Run the rig scene at each speed (``jobs`` processes) beside the reduced model; one dict per speed."""
-    args = [(float(n), int(rotations)) for n in speeds]
-    if jobs <= 1:
-        return [_rig_point(a) for a in args]
-    with ProcessPoolExecutor(max_workers=jobs) as ex:
-        return list(ex.map(_rig_point, args))
+class Rig(Study):
+    """The rig scene at each speed beside the reduced model: two cases per speed. :attr:`rows` holds
+    one dict per speed after :meth:`finish`; a speed whose rig or reduced case failed has no row
+    (:attr:`missing` names it)."""
+
+    name = "rig"
+
+    def __init__(self, speeds=RIG_SPEEDS_RPM, rotations: int = RIG_ROTATIONS):
+        self.speeds, self.rotations = [float(n) for n in speeds], int(rotations)
+        self.pairs = [(case_of(rig_scenario(n, self.rotations), {"study": "rig", "rpm": n}), reference_case(n))
+                      for n in self.speeds]
+        self.cases = [c for pair in self.pairs for c in pair]
+        self.outputs = [("rig_idec_vs_speed.csv", b"rpm,rotations,", "rig table"),
+                        ("rig_idec_vs_speed.png", PNG_SIGNATURE, "figure"),
+                        ("rig_pocket0_forces.png", PNG_SIGNATURE, "figure")]
+        self.rows: list[dict] = []
+        self.missing: list[float] = []
+
+    def finish(self, outdir, records) -> list[Path]:
+        self.rows, self.missing = [], []
+        for n, (rig, ref) in zip(self.speeds, self.pairs):
+            r, q = records[rig.hash], records[ref.hash]
+            if r["status"] not in FINISHED or q["status"] not in FINISHED:
+                self.missing.append(n)
+                continue
+            self.rows.append(rig_row(n, self.rotations, load_result(outdir, r), float(q["summary"]["I_dec_mean_Ns"])))
+        return save_rig(outdir, self.rows) if self.rows else []
+
+
+def rig_table(speeds=RIG_SPEEDS_RPM, rotations: int = RIG_ROTATIONS, jobs: int = 2, *, outdir=None,
+              engine=None) -> list[dict]:
+    """Run the :class:`Rig` study (``jobs`` local processes or ``engine``; in ``outdir``, default a
+    temporary folder) and return one dict per speed."""
+    from bearingsim.studies.engine import in_folder
+
+    study = Rig(speeds, rotations)
+    in_folder([study], outdir, jobs=jobs, engine=engine)
+    return study.rows
 
 
 CSV_COLUMNS = ("rpm", "rotations", "pocket0_I_dec_mean_Ns", "pocket0_I_dec_std_Ns", "pocket0_I_dec_sem_Ns",

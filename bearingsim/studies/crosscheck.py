@@ -14,14 +14,20 @@ Five rungs at each speed; each drops one assumption of the paper's model and kee
    makes of the scenario at that speed (and with ``--rotations``, that many rotations).
 
 Numbers per rung: the mean impulses per pocket and cage rotation over all pockets (SI), their standard
-error from batch means (:func:`bearingsim.multibody.studies.batch_sem`) of the pocket-mean series over
+error from batch means (:func:`bearingsim.studies.batch_sem`) of the pocket-mean series over
 rotations (rotations of a chaotic scene are correlated), the mean first rear-impact speed and the cage
 slip. ``change_from_previous`` is the change of ``I_dec_mean_Ns`` from the rung before, so the changes
 add up to full minus reduced exactly.
 
+The rungs are the cases of a study (:class:`CrossCheck`) run on the sweep engine
+(:func:`bearingsim.studies.run_studies`): in parallel on local processes or a dask cluster; a rung that
+fails is kept in the table with empty numbers and its error (``status``/``error`` in the index), the
+other rungs go on; an interrupted or failed cross-check run again reuses every finished rung's archive.
+
 Outputs in ``DIR``: ``crosscheck.csv``, ``crosscheck.h5`` (the same table as an index, one dataset per
-column, ``archive`` naming each rung's archive), ``crosscheck.png`` (drawn from the index:
-:func:`plot_crosscheck`) and ``rungs/<rpm>rpm_<rung>_<scene>.h5`` (ordinary archives).
+column, ``archive`` naming each rung's archive, ``status`` and ``error`` each rung's outcome),
+``crosscheck.png`` (drawn from the index: :func:`plot_crosscheck`), ``cases/<hash>.h5`` (the rungs'
+ordinary archives) and ``sweep.csv``/``sweep.h5`` (the engine's index of the cases).
 """
 from __future__ import annotations
 
@@ -29,12 +35,12 @@ import csv
 import io
 import json
 import math
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.studies.engine import Study, case_of, load_result
 
 INDEX_FORMAT = "bearingsim crosscheck index 1"
 DEFAULT_SPEEDS_RPM = (1000.0, 3000.0, 6000.0)
@@ -114,7 +120,7 @@ def rung_numbers(result, reduced: bool) -> dict:
     model repeats one no-load pass every rotation, so its scatter is zero by construction, and its cage
     turns at the epicyclic speed by assumption (cage slip 0).
     """
-    from bearingsim.multibody.studies import batch_sem
+    from bearingsim.studies.engine import batch_sem
 
     s = result.summary
     d = result.per_rotation["I_dec"].mean(axis=1)
@@ -125,20 +131,6 @@ def rung_numbers(result, reduced: bool) -> dict:
         "first_impact_speed_m_s": float(s["first_impact_speed_m_s"]),
         "cage_slip": 0.0 if reduced else float(s["cage_slip"]),
     }
-
-
-def _run_rung(job):
-    """Worker: resolve the rung's scenario, run it as ``bearingsim run`` does (archive written, no
-    figures) and return its numbers."""
-    from bearingsim.scenario import resolve
-    from bearingsim.simulation import run_scenario
-
-    rpm, rung, scene, relaxed, raw, source, path = job
-    sc = resolve(raw, source)
-    out = run_scenario(sc, path, figures=False)
-    return {"rpm": rpm, "rung": rung, "scene": scene, "relaxed": relaxed, "archive": path,
-            "wall_s": float(out.result.provenance.get("wall_time_s", math.nan)),
-            **rung_numbers(out.result, scene == "reduced")}
 
 
 def add_changes(rows: list[dict]) -> list[dict]:
@@ -152,10 +144,67 @@ def add_changes(rows: list[dict]) -> list[dict]:
     return rows
 
 
+NUMBERS = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "first_impact_speed_m_s", "cage_slip")
+
+
+class CrossCheck(Study):
+    """The ladder as a study: five rungs at each speed (:func:`rung_scenarios`); its table is
+    ``crosscheck.csv``/``crosscheck.h5`` and its figure ``crosscheck.png``.
+
+    Parameters
+    ----------
+    scenario : resolved multibody scenario, full scene.
+    speeds : inner-ring speeds [rpm].
+    rotations : recorded cage rotations of every rung (None: the scenario's ``numerics.rotations``).
+    """
+
+    name = "crosscheck"
+
+    def __init__(self, scenario, speeds=DEFAULT_SPEEDS_RPM, rotations: int | None = DEFAULT_ROTATIONS):
+        from bearingsim import archive
+        from bearingsim.outputs import PNG_SIGNATURE
+
+        self.scenario = scenario
+        self.rungs = {}  # case hash -> (rpm, rung, scene, relaxed)
+        cases = []
+        for rpm in speeds:
+            for rung, scene, relaxed, sc in rung_scenarios(scenario, rpm, rotations):
+                c = case_of(sc, {"rpm": float(rpm), "rung": rung, "scene": scene})
+                self.rungs[c.hash] = (float(rpm), rung, scene, relaxed)
+                cases.append(c)
+        # the longest runs first (low speed, multibody) so that the workers finish together
+        cases.sort(key=lambda c: (c.values["scene"] == "reduced", c.values["rpm"], -c.values["rung"]))
+        self.cases = cases
+        self.outputs = [("crosscheck.csv", ",".join(COLUMNS).encode(), "cross-check table"),
+                        ("crosscheck.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "cross-check table"),
+                        ("crosscheck.png", PNG_SIGNATURE, "figure")]
+        self.rows: list[dict] = []
+
+    def finish(self, outdir, records) -> list[Path]:
+        """The table from the rungs' archives (a failed rung: NaN numbers, its status and error),
+        written with its figure."""
+        rows = []
+        for c in self.cases:
+            rec = records[c.hash]
+            rpm, rung, scene, relaxed = self.rungs[c.hash]
+            result = load_result(outdir, rec)
+            numbers = (rung_numbers(result, scene == "reduced") if result is not None
+                       else dict.fromkeys(NUMBERS, math.nan))
+            rows.append({"rpm": rpm, "rung": rung, "scene": scene, "relaxed": relaxed,
+                         "archive": rec["archive"], "wall_s": float(rec["wall_s"]),
+                         "status": rec["status"], "error": rec["error"], **numbers})
+        self.rows = add_changes(rows)
+        paths = write_table(outdir, self.rows, self.scenario)
+        return [*paths, *plot_crosscheck(outdir / "crosscheck.h5", outdir)]
+
+
 def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int | None = DEFAULT_ROTATIONS,
-                   jobs: int = 2) -> list[dict]:
-    """Run every rung at every speed (``jobs`` processes), write the rung archives, the CSV, the index
-    and the figure into ``outdir``; return the table's rows (sorted by speed and rung).
+                   jobs: int = 2, *, engine=None, progress: bool | None = None, log=None):
+    """Run every rung at every speed on the sweep engine (``jobs`` local processes, or ``engine``),
+    write the rung archives, the CSV, the index and the figure into ``outdir``.
+
+    Archives already in ``outdir`` from an earlier run of the same rungs (same scenario, same model
+    version) are reused; a rung that fails is kept in the table (NaN numbers, its error).
 
     Parameters
     ----------
@@ -163,49 +212,21 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     outdir : output folder (created).
     speeds : inner-ring speeds [rpm].
     rotations : recorded cage rotations of every rung (None: the scenario's ``numerics.rotations``).
-    jobs : worker processes (1: run here).
+    jobs : local worker processes (ignored when ``engine`` is given).
+
+    Returns
+    -------
+    (rows, outcome)
+        The table's rows sorted by speed and rung (empty if interrupted) and the
+        :class:`bearingsim.studies.StudiesOutcome` (counts, failed cases, interruption).
     """
-    from bearingsim.archive import check_writable_dir
+    from bearingsim.studies.engine import make_engine, run_studies
 
-    if jobs < 1:
-        raise UserError(f"-j {jobs}: give at least 1 worker process")
-    outdir = check_writable_dir(outdir)
-    check_crosscheck_outputs(outdir)
-    (outdir / "rungs").mkdir(exist_ok=True)
-    work = []
-    for rpm in speeds:
-        for rung, scene, relaxed, sc in rung_scenarios(scenario, rpm, rotations):
-            path = str(outdir / "rungs" / f"{rpm:g}rpm_{rung}_{scene}.h5")
-            work.append((float(rpm), rung, scene, relaxed, sc.raw, sc.source, path))
-    # the longest runs first (low speed, multibody) so that the workers finish together
-    work.sort(key=lambda j: (j[2] == "reduced", j[0], -j[1]))
-    if jobs == 1:
-        rows = [_run_rung(j) for j in work]
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as ex:
-            rows = list(ex.map(_run_rung, work))
-    rows = add_changes(rows)
-    for r in rows:
-        r["archive"] = str(Path(r["archive"]).relative_to(outdir))
-    write_table(outdir, rows, scenario)
-    plot_crosscheck(outdir / "crosscheck.h5", outdir)
-    return rows
-
-
-def check_crosscheck_outputs(outdir: Path) -> None:
-    """Refuse, before any rung runs, an output folder whose ``crosscheck.csv``, ``crosscheck.h5``,
-    ``crosscheck.png`` or ``rungs`` hold what the cross-check did not write (a user's file, a link, a
-    folder): one line naming it, nothing replaced (:func:`bearingsim.outputs.check_replaceable`)."""
-    from bearingsim import archive
-    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
-
-    check_replaceable(outdir / "crosscheck.csv", ",".join(COLUMNS).encode(), "cross-check table")
-    check_replaceable(outdir / "crosscheck.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "cross-check table")
-    check_replaceable(outdir / "crosscheck.png", PNG_SIGNATURE, "figure")
-    rungs = outdir / "rungs"
-    if rungs.is_symlink() or (rungs.exists() and not rungs.is_dir()):
-        raise UserError(f"{rungs}: the cross-check's folder of rung archives is "
-                        f"{'a symbolic link' if rungs.is_symlink() else 'not a folder'}; not used (remove it)")
+    if engine is None:
+        engine = make_engine(jobs)
+    study = CrossCheck(scenario, speeds, rotations)
+    outcome = run_studies([study], outdir, engine=engine, progress=progress, log=log)
+    return study.rows, outcome
 
 
 def _fmt(v) -> str:
@@ -217,8 +238,9 @@ def _fmt(v) -> str:
 
 
 def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
-    """Write ``crosscheck.csv`` (exactly :data:`COLUMNS`) and ``crosscheck.h5`` (the same columns and
-    ``archive``, ``wall_s``, as an index table; :func:`bearingsim.archive.write_table_file`) atomically."""
+    """Write ``crosscheck.csv`` (exactly :data:`COLUMNS`; a failed rung's numbers empty) and
+    ``crosscheck.h5`` (the same columns and ``archive``, ``wall_s``, ``status``, ``error``, as an index
+    table; :func:`bearingsim.archive.write_table_file`) atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
 
@@ -230,7 +252,7 @@ def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
         w.writerow([_fmt(r[c]) for c in COLUMNS])
     csv_path = outdir / "crosscheck.csv"
     write_atomic_bytes(csv_path, buf.getvalue().encode("utf-8"))
-    columns = (*COLUMNS, "archive", "wall_s")
+    columns = (*COLUMNS, "archive", "wall_s", "status", "error")
     cols = {}
     for c in columns:
         vals = [r[c] for r in rows]
@@ -292,20 +314,32 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
 
 def verdicts(rows: list[dict]) -> list[str]:
     """One sentence per speed: the rung whose I_dec change is largest, and each change against two
-    standard errors of the difference, sqrt(sem_a^2 + sem_b^2)."""
+    standard errors of the difference, sqrt(sem_a^2 + sem_b^2). A change next to a failed rung (NaN)
+    is not judged; the failed rungs are named."""
     out = []
     for rpm in sorted({r["rpm"] for r in rows}):
         rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
         parts = []
         for a, b in zip(rs, rs[1:]):
             d = b["I_dec_mean_Ns"] - a["I_dec_mean_Ns"]
+            if math.isnan(d):
+                continue
             se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
             sig = "significant" if abs(d) > 2.0 * se else "not significant"
             parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig}: 2 SE = {2 * se * 1e3:.2g})")
-        big = max(rs[1:], key=lambda r: abs(r["change_from_previous"]))
-        out.append(f"{rpm:g} rpm: the largest change of I_dec is at rung {big['rung']} {big['scene']} "
-                   f"({big['change_from_previous'] * 1e3:+.2f} mN s; full - reduced = "
-                   f"{(rs[-1]['I_dec_mean_Ns'] - rs[0]['I_dec_mean_Ns']) * 1e3:+.2f} mN s); " + "; ".join(parts) + ".")
+        failed = [f"{r['rung']} {r['scene']}" for r in rs if r.get("status", "done") == "failed"]
+        changes = [r for r in rs[1:] if not math.isnan(r["change_from_previous"])]
+        if not changes:
+            out.append(f"{rpm:g} rpm: no change of I_dec to compare (failed rungs: {', '.join(failed)}).")
+            continue
+        big = max(changes, key=lambda r: abs(r["change_from_previous"]))
+        total = rs[-1]["I_dec_mean_Ns"] - rs[0]["I_dec_mean_Ns"]
+        total_text = "n/a" if math.isnan(total) else f"{total * 1e3:+.2f} mN s"
+        line = (f"{rpm:g} rpm: the largest change of I_dec is at rung {big['rung']} {big['scene']} "
+                f"({big['change_from_previous'] * 1e3:+.2f} mN s; full - reduced = {total_text}); " + "; ".join(parts))
+        if failed:
+            line += f"; failed rungs: {', '.join(failed)}"
+        out.append(line + ".")
     return out
 
 

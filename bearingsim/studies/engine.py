@@ -1,0 +1,201 @@
+"""Running studies: their cases on the sweep engine, then each study's table and figures.
+
+A study (:class:`Study`) is a list of cases (resolved scenarios, :class:`bearingsim.sweeps.spec.Case`)
+plus what it makes of their archives: a table and figures. :func:`run_studies` runs the cases of one or
+more studies in one folder on the one sweep engine (:func:`bearingsim.sweeps.run_sweep`: a local pool of
+processes or a dask cluster, resume from the archives already there, failures kept, SIGINT/SIGTERM,
+progress), holding the folder's lock (:class:`bearingsim.outputs.FolderLock`) until every table and
+figure is written (atomically, :func:`bearingsim.outputs.atomic_file`).
+
+The folder then holds ``cases/<hash>.h5`` (one archive per case, named by the content hash of its
+scenario), ``sweep.csv``/``sweep.h5`` (the index of the cases: status, error, summary numbers) and the
+studies' own tables and figures. Running the same command again reuses every archive computed by the
+same model version (``cached``) and runs only what is missing, failed or stale.
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+from bearingsim.sweeps.spec import Case, case_hash
+
+#: statuses of a case whose archive holds its numbers
+FINISHED = ("done", "cached", "stale")
+
+
+def batch_sem(x: np.ndarray, batches: int = 5) -> float:
+    """Standard error of the mean of a correlated series from ``batches`` batch means [same unit as x].
+
+    Rotations of a chaotic scene are correlated; the means of contiguous batches are close to
+    independent, so their scatter / sqrt(batches) estimates the error of the overall mean."""
+    x = np.asarray(x, float)
+    b = min(batches, len(x))
+    if b < 2:
+        return float("nan")
+    means = np.array([c.mean() for c in np.array_split(x, b)])
+    return float(means.std(ddof=1) / math.sqrt(b))
+
+
+def case_of(scenario, values: dict) -> Case:
+    """The case of a resolved scenario; ``values`` label it in messages and in the case index."""
+    text = scenario.to_toml()
+    return Case(hash=case_hash(text), values=dict(values), toml=text, model=scenario.model,
+                scenario=scenario.model_)
+
+
+class Study:
+    """A list of cases plus a table and figures.
+
+    Subclasses set :attr:`cases` and :attr:`outputs` and define :meth:`finish`.
+
+    Attributes
+    ----------
+    cases : list of Case
+        What to run (each case once; two studies may share a case).
+    outputs : list of (file name, signature, what)
+        The files the study writes into the folder, checked before anything runs
+        (:func:`bearingsim.outputs.check_replaceable`: a user's file or a link there is refused).
+    """
+
+    name = "study"
+    cases: list[Case]
+    outputs: list[tuple[str, object, str]]
+
+    def finish(self, outdir: Path, records: dict[str, dict]) -> list[Path]:
+        """Build the table from the cases' records (``records[hash]``: a row of the case index with
+        ``status``, ``error``, ``archive`` relative to ``outdir``, ``summary``), write it and the
+        figures into ``outdir`` and return the paths written. Failed cases are kept in the table as
+        the study sees fit (NaN numbers or a missing row), never an exception."""
+        raise NotImplementedError
+
+
+@dataclass
+class StudiesOutcome:
+    """What :func:`run_studies` did: the engine's outcome (rows of every case, counts, interruption)
+    and the files each study wrote (none if interrupted)."""
+
+    sweep: object  # bearingsim.sweeps.SweepOutcome
+    written: list[Path] = field(default_factory=list)
+
+    @property
+    def interrupted(self) -> int | None:
+        return self.sweep.interrupted
+
+    @property
+    def failed(self) -> list[dict]:
+        return self.sweep.failed
+
+    def count(self, status: str) -> int:
+        return self.sweep.count(status)
+
+    def counts(self) -> str:
+        """``"3 done, 2 cached, 0 failed"`` (and stale cases when there are)."""
+        text = f"{self.count('done')} done, {self.count('cached')} cached, {self.count('failed')} failed"
+        if self.count("stale"):
+            text += f", {self.count('stale')} stale (computed by another model version: run again)"
+        return text
+
+
+def make_engine(jobs: int | None = None, scheduler: str | None = None, option: str = "-j"):
+    """The engine of a command's ``-j N`` / ``--scheduler ADDRESS`` (a one-line UserError for ``-j 0``)."""
+    from bearingsim.sweeps.engines import DaskEngine, LocalEngine
+
+    if scheduler:
+        return DaskEngine(scheduler)
+    jobs = jobs if jobs is not None else (os.cpu_count() or 1)
+    if jobs < 1:
+        raise UserError(f"{option} {jobs}: give at least 1 worker process")
+    return LocalEngine(jobs)
+
+
+def check_outputs(outdir: Path, studies) -> None:
+    """Refuse, before any case runs, a study output that is a link, a folder or a user's file."""
+    from bearingsim.outputs import check_replaceable
+
+    for study in studies:
+        for name, signature, what in study.outputs:
+            check_replaceable(outdir / name, signature, what)
+
+
+def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, log=None) -> StudiesOutcome:
+    """Run the cases of ``studies`` in ``outdir`` on ``engine``, then let each study write its table
+    and figures.
+
+    Parameters
+    ----------
+    studies : list of Study
+    outdir : path
+        The folder (created); it may hold the archives of an earlier, interrupted or failed, run of
+        the same studies: those are reused.
+    engine : LocalEngine or DaskEngine, optional
+        Default: a local pool of one process.
+    progress : bool, optional
+        Progress bar on stderr; default when stderr is a terminal.
+    log : callable, optional
+        Receives one line per failed case (default: stderr).
+
+    Returns
+    -------
+    StudiesOutcome
+        ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the cases (finished archives
+        and the case index are kept; no table is written; run again to resume).
+    """
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.outputs import FolderLock
+    from bearingsim.sweeps.engines import LocalEngine
+    from bearingsim.sweeps.run import run_sweep
+
+    engine = engine or LocalEngine(1)
+    try:
+        outdir = check_writable_dir(outdir)
+        check_outputs(outdir, studies)  # before the lock file: a refusal leaves the folder as it was
+        cases, seen = [], set()
+        for study in studies:
+            for c in study.cases:
+                if c.hash not in seen:
+                    seen.add(c.hash)
+                    cases.append(c)
+    except BaseException:
+        engine.stop()
+        raise
+    with FolderLock(outdir) as lock:
+        sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock,
+                          desc="+".join(s.name for s in studies))
+        out = StudiesOutcome(sweep)
+        if sweep.interrupted is None:
+            records = {r["case"]: r for r in sweep.rows}
+            for study in studies:
+                out.written += study.finish(outdir, records)
+    return out
+
+
+def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: bool = False) -> StudiesOutcome:
+    """:func:`run_studies` for the Python API: in ``outdir`` or, with None, a temporary folder removed
+    afterwards; ``jobs`` local processes unless ``engine`` is given. SIGINT/SIGTERM during the cases
+    raise KeyboardInterrupt (finished archives in ``outdir`` are kept)."""
+    import signal
+    import tempfile
+
+    engine = engine or make_engine(jobs)
+    if outdir is None:
+        with tempfile.TemporaryDirectory(prefix="bearingsim-study-") as tmp:
+            out = run_studies(studies, tmp, engine=engine, progress=progress)
+    else:
+        out = run_studies(studies, outdir, engine=engine, progress=progress)
+    if out.interrupted is not None:
+        raise KeyboardInterrupt(signal.Signals(out.interrupted).name)
+    return out
+
+
+def load_result(outdir: Path, record: dict):
+    """The result stored in a finished case's archive, or None for a failed or pending case."""
+    import bearingsim
+
+    if record["status"] not in FINISHED:
+        return None
+    return bearingsim.load(Path(outdir) / record["archive"])

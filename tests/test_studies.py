@@ -1,0 +1,194 @@
+"""Studies on one engine (issue 29, item 1): the cross-check, the rig and Fig. 9 run their cases on the
+sweep engine; a failing rung is kept and reported, an interrupted study resumes from its archives, and
+the tables are the numbers the studies gave before they moved onto the engine."""
+from __future__ import annotations
+
+import csv
+import hashlib
+import math
+import os
+import signal
+
+import numpy as np
+import pytest
+
+import bearingsim
+from bearingsim.scenario import load_scenario
+from bearingsim.studies import crosscheck as cc
+from bearingsim.sweeps.engines import LocalEngine
+
+from .conftest import SCENARIOS
+
+REFERENCE = SCENARIOS / "multibody_3000rpm.toml"
+RPM = 6000.0  # the cheapest speed of the ladder: one rotation of every rung takes about a second
+
+
+def _archives(out):
+    return {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "cases").glob("*.h5")}
+
+
+def test_a_failing_rung_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
+    """Rung 3 given an impossible time step (1 ms, far above the bearing's stable step) fails at run
+    time: the other four rungs' numbers are in the table, rung 3 has empty numbers, its status and
+    error, and so has the change after it; the failure is reported, nothing raised. Run again without
+    the override, the four finished rungs come from their archives (the files untouched) and only
+    rung 3 runs."""
+    scenario = load_scenario(REFERENCE)
+    real = cc.rung_scenarios
+
+    def broken(sc, rpm, rotations=None):
+        return [(r, s, why, x.replace(**{"numerics.dt_s": 1e-3}) if s == "kinematic_cage" else x)
+                for r, s, why, x in real(sc, rpm, rotations)]
+
+    monkeypatch.setattr(cc, "rung_scenarios", broken)
+    said = []
+    rows, outcome = cc.run_crosscheck(scenario, tmp_path, (RPM,), 1, jobs=1, progress=False, log=said.append)
+    assert outcome.interrupted is None
+    assert [r["rung"] for r in rows] == [1, 2, 3, 4, 5]
+    assert [r["status"] for r in rows] == ["done", "done", "failed", "done", "done"]
+    assert "numerics.dt_s" in rows[2]["error"] and rows[2]["archive"] == ""
+    assert len(said) == 1 and "numerics.dt_s" in said[0] and "kinematic_cage" in said[0]
+    assert [r["values"]["rung"] for r in outcome.failed] == [3]
+    for r in rows[:2] + rows[3:]:
+        assert math.isfinite(r["I_dec_mean_Ns"])
+        assert bearingsim.load(tmp_path / r["archive"]).summary["I_dec_mean_Ns"] == r["I_dec_mean_Ns"]
+    assert math.isnan(rows[2]["I_dec_mean_Ns"])
+    assert math.isnan(rows[2]["change_from_previous"]) and math.isnan(rows[3]["change_from_previous"])
+    assert rows[4]["change_from_previous"] == rows[4]["I_dec_mean_Ns"] - rows[3]["I_dec_mean_Ns"]
+    with open(tmp_path / "crosscheck.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    assert table[2]["I_dec_mean_Ns"] == "" and table[3]["I_dec_mean_Ns"] != ""
+    stored, _ = cc.read_table(tmp_path / "crosscheck.h5")
+    assert [r["status"] for r in stored] == ["done", "done", "failed", "done", "done"]
+    assert "numerics.dt_s" in stored[2]["error"]
+    assert any("failed rungs: 3 kinematic_cage" in line for line in cc.verdicts(rows))
+
+    before = _archives(tmp_path)
+    assert len(before) == 4
+    monkeypatch.setattr(cc, "rung_scenarios", real)
+    again, outcome = cc.run_crosscheck(scenario, tmp_path, (RPM,), 1, jobs=1, progress=False, log=said.append)
+    assert [r["status"] for r in again] == ["cached", "cached", "done", "cached", "cached"]
+    assert outcome.count("cached") == 4 and outcome.count("done") == 1 and not outcome.failed
+    after = _archives(tmp_path)
+    assert {k: v for k, v in after.items() if k in before} == before  # reused, not written again
+    for a, b in zip(rows, again):
+        if a["rung"] != 3:
+            assert a["I_dec_mean_Ns"] == b["I_dec_mean_Ns"] and a["I_acc_mean_Ns"] == b["I_acc_mean_Ns"]
+    assert all(math.isfinite(r["change_from_previous"]) for r in again[1:])
+
+
+class _InterruptedAfterFirstCase(LocalEngine):
+    """A local engine that receives SIGINT right after the first finished case is handed over: an
+    interruption at a known point, whatever the machine's speed."""
+
+    def run(self, batches, cases_dir):
+        for records in super().run(batches, cases_dir):
+            yield records
+            os.kill(os.getpid(), signal.SIGINT)
+
+
+def test_an_interrupted_crosscheck_resumes_from_the_finished_rungs(tmp_path):
+    """SIGINT after the first rung: the cross-check stops (no table), the finished rung's archive and
+    the case index stay. The same cross-check again takes that archive as it is (cached, the file
+    untouched) and runs the four others; the CLI then reports the counts."""
+    scenario = load_scenario(REFERENCE)
+    rows, outcome = cc.run_crosscheck(scenario, tmp_path, (RPM,), 1, engine=_InterruptedAfterFirstCase(1),
+                                      progress=False)
+    assert outcome.interrupted == signal.SIGINT and rows == []
+    assert outcome.count("done") == 1 and outcome.count("pending") == 4
+    assert not (tmp_path / "crosscheck.csv").exists() and (tmp_path / "sweep.csv").exists()
+    kept = _archives(tmp_path)
+    assert len(kept) == 1
+
+    from bearingsim.cli import main
+
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        rc = main(["crosscheck", str(REFERENCE), "--speeds", f"{RPM:g}", "--rotations", "1", "-j", "1",
+                   "-o", str(tmp_path)])
+    assert rc == 0
+    assert "rungs: 4 done, 1 cached, 0 failed" in buf.getvalue()
+    assert {k: v for k, v in _archives(tmp_path).items() if k in kept} == kept
+    table, _ = cc.read_table(tmp_path / "crosscheck.h5")
+    assert sorted(r["status"] for r in table) == ["cached", "done", "done", "done", "done"]
+    assert all(math.isfinite(r["I_dec_mean_Ns"]) for r in table)
+
+
+# Computed at commit 2e9b5c4 (before the studies moved onto the engine), with
+# bearingsim.reduced.studies.fig9_table() and bearingsim.multibody.studies.rig_table(speeds=(1000, 4000),
+# rotations=2, jobs=2) (its 4000 rpm row), numbers printed with repr, arrays as SHA-256 of their bytes.
+FIG9_AT_2E9B5C4 = {
+    "speed_rpm": [500.0, 750.0, 1000.0, 1500.0, 2000.0, 3000.0, 4000.0, 5000.0, 6000.0],
+    "I_dec_c0.01_Ns": [0.011817955077465213, 0.008312956172646617, 0.006578007907950572, 0.00497125847390182,
+                       0.004206586324025872, 0.0035256228105165696, 0.003125623564406289, 0.0031766311373143817,
+                       0.0031765845505256985],
+    "I_dec_c0.02_Ns": [0.012885341390878656, 0.009486037567340662, 0.007832783677204178, 0.006304848714071719,
+                       0.005549834752222626, 0.005280209299758883, 0.005751033240934162, 0.005337738307837762,
+                       0.005747669652105256],
+    "I_dec_c0.03_Ns": [0.013973924291281508, 0.010701143741814259, 0.009152620536543145, 0.008262257163220406,
+                       0.007725904618515982, 0.008267922442827261, 0.008448005962176283, 0.008641295924524976,
+                       0.008392487073122621],
+    "I_dec_previous_c0.02_Ns": [0.002721000111101033, 0.003428471764733687, 0.004039388800608723,
+                                0.004946386314805308, 0.0051917221680597946, 0.005575019430990997,
+                                0.0059850238146818835, 0.005968633447537131, 0.00547370883070177],
+}
+RIG_4000RPM_2ROT_AT_2E9B5C4 = {
+    "rpm": 4000.0, "rotations": 2,
+    "pocket0_I_dec_mean_Ns": 0.006923549385424761, "pocket0_I_dec_std_Ns": 0.00020258036996474325,
+    "pocket0_I_dec_sem_Ns": 0.00020258036996474325, "pocket0_I_acc_mean_Ns": 0.0019190052086187615,
+    "arc_pockets_I_dec_mean_Ns": 0.015446211753382707, "arc_pockets_I_dec_std_Ns": 0.009175358450057706,
+    "reduced_I_dec_Ns": 0.005751033240934162, "load_zone_half_angle_deg": 24.093411732575277,
+    "theta_deg": "0f333afbe2c993a69e7a4a8153120244", "F_acc_pocket0": "dfc31663f400c011872769f0e86ec6a8",
+    "F_dec_pocket0": "b14652ab57e71f53f5f0f24a00968c66",
+}
+
+
+def test_fig9_study_gives_the_table_of_before(tmp_path):
+    """Every number of the Fig. 9 table, bit for bit, as computed before the study ran on the engine;
+    and the same study run again is all cached."""
+    from bearingsim.studies.fig9 import fig9_table
+
+    table = fig9_table(outdir=tmp_path, jobs=2)
+    assert list(table) == list(FIG9_AT_2E9B5C4)
+    for k, v in FIG9_AT_2E9B5C4.items():
+        assert table[k].tolist() == v, k
+    assert (tmp_path / "fig9_idec_vs_speed.csv").is_file()
+    with open(tmp_path / "sweep.csv", newline="") as fh:
+        assert {r["status"] for r in csv.DictReader(fh)} == {"done"}
+    assert fig9_table(outdir=tmp_path)["I_dec_c0.02_Ns"].tolist() == FIG9_AT_2E9B5C4["I_dec_c0.02_Ns"]
+    with open(tmp_path / "sweep.csv", newline="") as fh:
+        assert {r["status"] for r in csv.DictReader(fh)} == {"cached"}
+
+
+def test_rig_study_gives_the_row_of_before(tmp_path):
+    """The rig study's row at 4000 rpm (2 rotations), every number and array bit for bit as before."""
+    from bearingsim.studies.rig import rig_table
+
+    (row,) = rig_table(speeds=(4000,), rotations=2, jobs=1, outdir=tmp_path)
+    for k, v in RIG_4000RPM_2ROT_AT_2E9B5C4.items():
+        if isinstance(v, str):
+            assert hashlib.sha256(np.asarray(row[k]).tobytes()).hexdigest()[:32] == v, k
+        else:
+            assert row[k] == v, k
+    assert (tmp_path / "rig_idec_vs_speed.csv").is_file() and (tmp_path / "rig_pocket0_forces.png").is_file()
+
+
+def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
+    """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come
+    back as archives and give the very table the local pool gives."""
+    pytest.importorskip("distributed")
+    from distributed import LocalCluster
+
+    from bearingsim.sweeps.engines import DaskEngine
+
+    scenario = load_scenario(REFERENCE)
+    local, _ = cc.run_crosscheck(scenario, tmp_path / "local", (RPM,), 1, jobs=1, progress=False)
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        remote, outcome = cc.run_crosscheck(scenario, tmp_path / "dask", (RPM,), 1,
+                                            engine=DaskEngine(cluster=cluster), progress=False)
+    assert outcome.count("done") == 5
+    assert (tmp_path / "local" / "crosscheck.csv").read_bytes() == (tmp_path / "dask" / "crosscheck.csv").read_bytes()
+    assert [r["archive"] for r in local] == [r["archive"] for r in remote]

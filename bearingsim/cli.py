@@ -216,7 +216,7 @@ def _cmd_bench(args) -> int:
         run_sweep_bench(Path(args.output))
         return 0
     if args.geometry:
-        from bearingsim.multibody.bench import run_geometry_bench
+        from benchmarks.multibody_bench import run_geometry_bench
 
         run_geometry_bench(Path(args.output), rotations=args.rotations or 30)
         return 0

@@ -3,6 +3,9 @@
     python benchmarks/whole_bearing.py whatif   # the what-if table: cage guidance, rig (1 warm-up + 20 rotations)
     python benchmarks/whole_bearing.py orbit    # cage whirl against pocket clearance and speed (1 warm-up + 10 rotations)
     python benchmarks/whole_bearing.py wear     # the wear-test scene: front / rear wear totals (1 warm-up + 40 rotations)
+    python benchmarks/whole_bearing.py extent   # I_dec against the pocket faces' extent at 3000 rpm (1 warm-up + 20 rotations)
+    python benchmarks/whole_bearing.py checks   # the numbers of tests/test_multibody.py's fixtures (3000 rpm, 970 N)
+    python benchmarks/whole_bearing.py rig      # the rig's flat pocket 0 against the reduced model between the scenario files' speeds
 
 Each prints a markdown table; every run is an ordinary ``bearingsim.run`` of a scenario in ``scenarios/``
 with the ``--set`` overrides shown in its row.
@@ -58,16 +61,26 @@ def _row(rpm, label, r):
           f"{s['cage_slip'] * 100:.3f} % | {land_txt} |", flush=True)
 
 
+def _whirl(r):
+    """The cage centre's mean angular speed about the axis over the kept samples, as a fraction of the
+    cage's own speed (1: whirl with the cage, forward; 0: a centre that stays at one angle)."""
+    o = np.asarray(r.get("cage_orbit"))
+    o = o[np.isfinite(o[:, 1])]
+    ang = np.unwrap(np.arctan2(o[:, 2], o[:, 1]))
+    rate = (ang[-1] - ang[0]) / (o[-1, 0] - o[0, 0])
+    return float(rate / (r.parameters.operating.sign * r.parameters.operating.omega_c))
+
+
 def orbit():
-    print("| rpm | pocket clearance s [mm] | orbit mean / max [µm] | max / s | I_dec [mN s] | cage slip |")
-    print("|---|---|---|---|---|---|")
+    print("| rpm | pocket clearance s [mm] | orbit mean / max [µm] | max / s | whirl rate / cage speed | I_dec [mN s] | cage slip |")
+    print("|---|---|---|---|---|---|---|")
     cases = [(rpm, 0.2) for rpm in (500, 1000, 2000, 3000, 4000, 6000)]
     cases += [(rpm, s) for rpm in (1000, 3000, 6000) for s in (0.1, 0.3, 0.4)]
     for rpm, s in cases:
         r = _run("multibody_3000rpm", ["numerics.rotations=10", f"operating.inner_ring_speed_rpm={rpm}",
                                         f"bearing.pocket_clearance_mm={s}"])
         om, ox = _orbit(r)
-        print(f"| {rpm} | {s} | {om * 1e6:.0f} / {ox * 1e6:.0f} | {ox / (s * 1e-3):.2f} | "
+        print(f"| {rpm} | {s} | {om * 1e6:.0f} / {ox * 1e6:.0f} | {ox / (s * 1e-3):.2f} | {_whirl(r):+.3f} | "
               f"{r.summary['I_dec_mean_Ns'] * 1e3:.2f} | {r.summary['cage_slip'] * 100:.3f} % |", flush=True)
 
 
@@ -80,5 +93,43 @@ def wear():
           f"mN s, I_acc {r.summary['I_acc_mean_Ns'] * 1e3:.2f} mN s")
 
 
+def extent():
+    print("| faces | I_dec mean ± std [mN s] | orbit mean / max [µm] | whirl rate / cage speed | cage slip |")
+    print("|---|---|---|---|---|")
+    for a in ("auto", 20.0, 26.0):
+        r = _run("multibody_3000rpm", ["numerics.rotations=20", f"multibody.pocket_face_half_angle_deg={a!r}"
+                                       if a == "auto" else f"multibody.pocket_face_half_angle_deg={a}"])
+        om, ox = _orbit(r)
+        label = "cage wall (-32.9 / +26.2 deg)" if a == "auto" else f"+-{a:g} deg"
+        print(f"| {label} | {r.summary['I_dec_mean_Ns'] * 1e3:.2f} ± {r.summary['I_dec_std_Ns'] * 1e3:.2f} | "
+              f"{om * 1e6:.0f} / {ox * 1e6:.0f} | {_whirl(r):+.3f} | {r.summary['cage_slip'] * 100:.3f} % |", flush=True)
+
+
+def checks():
+    base = ["reduced.load_zone_half_angle_deg=23.5", "numerics.warmup_rotations=1"]
+    fwd = _run("multibody_3000rpm", [*base, "numerics.rotations=20"])
+    rev = _run("multibody_3000rpm", [*base, "numerics.rotations=20", "operating.direction=reverse"])
+    fr = _run("multibody_3000rpm", [*base, "numerics.rotations=10", "contact.cage_friction=0"])
+    s = fwd.summary
+    print(f"deepest overlap {s['max_penetration_all_m'] / fwd.parameters.bearing.pocket_clearance:.2%} of s; "
+          f"angular-momentum residual {s['torque_balance_residual']:.2e}; frictionless I_acc / I_dec "
+          f"{fr.summary['I_acc_mean_Ns'] / fr.summary['I_dec_mean_Ns']:.4f}; reverse / forward I_dec "
+          f"{rev.summary['I_dec_mean_Ns'] / s['I_dec_mean_Ns']:.4f}; load-zone half angle "
+          f"{s['load_zone_half_angle_deg']:.2f} deg, contact extent {s['load_zone_contact_half_angle_deg']:.2f} deg; "
+          f"I_dec {s['I_dec_mean_Ns'] * 1e3:.2f} ± {s['I_dec_std_Ns'] * 1e3:.2f} mN s, slip {s['cage_slip']:.3%}")
+
+
+def rig():
+    """The rig study of ``bearingsim validate`` (bearingsim.studies.rig) at speeds between the scenario files'."""
+    from bearingsim.studies.rig import rig_table
+
+    print("| rpm | rig pocket 0 I_dec mean ± std [mN s] | reduced [mN s] | ratio | the 15 arc pockets [mN s] |")
+    print("|---|---|---|---|---|")
+    for r in rig_table(speeds=(750, 1500, 2500, 3500), rotations=20, jobs=2):
+        print(f"| {r['rpm']:g} | {r['pocket0_I_dec_mean_Ns'] * 1e3:.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:.2f} | "
+              f"{r['reduced_I_dec_Ns'] * 1e3:.2f} | {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:.2f} | "
+              f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:.2f} |", flush=True)
+
+
 if __name__ == "__main__":
-    {"whatif": whatif, "orbit": orbit, "wear": wear}[sys.argv[1]]()
+    {"whatif": whatif, "orbit": orbit, "wear": wear, "extent": extent, "checks": checks, "rig": rig}[sys.argv[1]]()

@@ -15,9 +15,10 @@ def test_rig_scenario_files_are_the_rig_scene(rpm):
 
 def test_flat_rig_pocket_against_the_reduced_model_at_1000_rpm():
     """Goal of issue 12 (paper Fig. 9: the reduced model agreed with the measured pocket): pocket 0's mean
-    I_dec per rotation within +-25 % of the reduced model's. Measured (bearingsim validate, 1 warm-up +
-    20 rotations): 8.96 mN s against 7.83 (ratio 1.14); the arc pockets of the same cage see 26.5 mN s.
-    The run is deterministic, so the tolerance is the issue's goal, not scatter."""
+    I_dec per rotation within +-25 % of the reduced model's. Measured on the exact pocket faces
+    (bearingsim validate, 1 warm-up + 20 rotations): 8.86 mN s against 7.83 (ratio 1.13); the arc pockets
+    of the same cage see 29.1 mN s. The run is deterministic, so the tolerance is the goal, not scatter.
+    (At 2000-4000 rpm the ratio is 1.26-1.27, just outside the goal: docs/geometry.md.)"""
     (row,) = rig_table(speeds=(1000,), rotations=20, jobs=1)
     ratio = row["pocket0_I_dec_mean_Ns"] / row["reduced_I_dec_Ns"]
     assert 0.75 <= ratio <= 1.25, ratio

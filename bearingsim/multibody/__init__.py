@@ -10,8 +10,8 @@ Scenes (``[multibody] scene``)
     clearance, EHL traction ``mu_max tanh(slip/slip_ref)`` (Johnson & Tevaarwerk 1977), the oil-film
     resistance ``F_o = c N^0.246 V^0.648`` (Eq. 2) at each contact with its own N and V, gravity.
     The load zone emerges from the contact mechanics. Roller-cage contacts are pymunk contacts
-    (restitution e, friction mu) on pocket faces that are arcs around the pocket centre (pocket
-    diameter D + s), front and rear faces as separate polylines of a few segments.
+    (restitution e, friction mu) on pocket faces that are exact arcs around the pocket centre (pocket
+    diameter D + s) over what the cage wall allows (:mod:`bearingsim.multibody.scene`, docs/geometry.md).
 ``"centred_cage"``
     As ``"full"``, but the cage centre is held on the bearing axis by a pivot joint (the cage still
     turns freely under its contact torques): rung 4 of ``bearingsim crosscheck``.

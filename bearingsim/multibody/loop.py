@@ -386,7 +386,8 @@ def face_masks(state, vb, h, fm, want):
     this step: the masks change no contact and no number, they only spare the narrow-phase tests.
 
     A roller centre closer than ``R - r`` to its pocket centre touches no face (every face point is at
-    least ``R`` from it: the polyline circumscribes the arc, a flat face is a plane at ``R``), so most
+    least ``R`` from it: the polyline circumscribes the arc, an exact face's tangent segment touches it
+    at one point, a flat face is a plane at ``R``), so most
     rollers need one distance; the others are tested against each segment of their pocket. A roller
     stays in its own pocket (it would have to pass through a face)."""
     n = want.shape[0]

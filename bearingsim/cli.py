@@ -40,7 +40,7 @@ def _cmd_run(args) -> int:
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
     progress = not args.quiet and sys.stderr.isatty()
-    out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress)
+    out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet)
     if not args.quiet:
         print(f"wrote {out.archive}")
         for png in out.figures:

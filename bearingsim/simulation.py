@@ -82,6 +82,7 @@ def run_scenario(
     figures: bool = True,
     progress: bool = False,
     exclusive: bool = True,
+    notes: bool = True,
 ) -> RunOutput:
     """Run ``scenario``, write its archive (atomically, time series streamed into it) and, optionally,
     its PNG figures, drawn from the archive as written.
@@ -94,6 +95,8 @@ def run_scenario(
     progress : show a progress bar (multibody runs)
     exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
         temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
+    notes : print the plausibility notes of the run (:func:`bearingsim.plausibility.check`) on stderr;
+        ``bearingsim run -q`` and sweep cases pass False (the counts stay in the archive's provenance)
     """
     from bearingsim import archive, outputs, plausibility
     from bearingsim.errors import UserError
@@ -108,7 +111,8 @@ def run_scenario(
         with archive.Spool(out) as spool:
             result = run(scenario, progress=progress, sink=spool)
             for note in plausibility.check(result):  # exit 3 before anything is written
-                print(note, file=sys.stderr)
+                if notes:
+                    print(note, file=sys.stderr)
             archive.write(result, out, spool)
         pngs = []
         if figures:

@@ -15,6 +15,37 @@ BASE = SCENARIOS / "paper_3000rpm.toml"
 SPEED = "operating.inner_ring_speed_rpm"
 
 
+# --- defect 2: --set must not silently replace another scenario's archive --------------------------------
+def test_run_refuses_to_replace_an_archive_of_another_scenario(tmp_path):
+    out = tmp_path / "a.h5"
+    assert bearingsim("run", BASE, "-o", out, "--no-plots", "-q").returncode == 0
+    before = out.read_bytes()
+    res = bearingsim("run", BASE, "--set", f"{SPEED}=500", "-o", out, "--no-plots", "-q")
+    assert_user_error(res, str(out), SPEED, "--force", "-o")
+    assert out.read_bytes() == before  # nothing replaced
+    # a rerun of the same scenario may replace it; --force replaces a different one
+    assert bearingsim("run", BASE, "-o", out, "--no-plots", "-q").returncode == 0
+    res = bearingsim("run", BASE, "--set", f"{SPEED}=500", "-o", out, "--no-plots", "-q", "--force")
+    assert res.returncode == 0, res.stderr
+    assert load_scenario(BASE, [f"{SPEED}=500"]) == __import__("bearingsim").load(out).scenario
+
+
+def test_sweep_folder_of_another_sweep_is_refused_resume_and_force_work(tmp_path):
+    first = ("sweep", BASE, "--param", f"{SPEED}=1000,2000", "-o", tmp_path, "-j", "1", "--no-plots")
+    assert bearingsim(*first).returncode == 0
+    cases = sorted(p.name for p in (tmp_path / "cases").glob("*.h5"))
+    res = bearingsim("sweep", BASE, "--param", f"{SPEED}=3000,4000", "-o", tmp_path, "-j", "1", "--no-plots")
+    assert_user_error(res, str(tmp_path), "--force")
+    assert sorted(p.name for p in (tmp_path / "cases").glob("*.h5")) == cases  # nothing added or removed
+    res = bearingsim(*first)  # the same sweep again: resumed (all cached)
+    assert res.returncode == 0 and "2 cached" in res.stdout, res.stderr
+    res = bearingsim("sweep", BASE, "--param", f"{SPEED}=3000,4000", "-o", tmp_path, "-j", "1", "--no-plots",
+                     "--force")
+    assert res.returncode == 0, res.stderr
+    now = sorted(p.name for p in (tmp_path / "cases").glob("*.h5"))
+    assert len(now) == 2 and not set(now) & set(cases)  # the first sweep's archives are gone, not mixed in
+
+
 # --- defect 6: notes are silenced by -q and not printed per sweep case -----------------------------------
 NOTE = "bearingsim: note: test note"
 

@@ -115,7 +115,8 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
 def _run_to_file(scenario, target: Path):
     from bearingsim.simulation import run_scenario
 
-    return run_scenario(scenario, target, figures=False, progress=False, exclusive=False, notes=False).result
+    return run_scenario(scenario, target, figures=False, progress=False, exclusive=False, notes=False,
+                        force=True).result  # the sweep owns its folder (case archives named by scenario hash)
 
 
 def _write_file(target: Path, data: bytes) -> None:

@@ -46,6 +46,25 @@ def test_sweep_folder_of_another_sweep_is_refused_resume_and_force_work(tmp_path
     assert len(now) == 2 and not set(now) & set(cases)  # the first sweep's archives are gone, not mixed in
 
 
+# --- defect 3: figure titles name what differs from the preset ---------------------------------------------
+def test_title_names_what_differs_from_the_preset():
+    plain = simulate(load_scenario(BASE))
+    assert plain.title().endswith("\nload zone ±23.5°")  # the paper scenario's own setting
+    changed = simulate(load_scenario(BASE, ["bearing.pocket_clearance_mm=0.3", "bearing.roller_count=14"]))
+    assert changed.title().endswith("\n14 rollers, s = 0.3 mm, load zone ±23.5°")
+
+
+def test_multibody_differences_are_named_compactly():
+    from bearingsim.scenario import differences_from_preset
+
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml",
+                       ["multibody.raceway_contact=rigid", "bearing.cage_guidance=outer_land",
+                        "bearing.radial_clearance_mm=0.1"])
+    text = ", ".join(differences_from_preset(sc))
+    assert "raceway rigid" in text and "outer-land cage" in text and "0.1 mm" in text
+    assert differences_from_preset(load_scenario(SCENARIOS / "multibody_3000rpm.toml")) == []
+
+
 # --- defect 6: notes are silenced by -q and not printed per sweep case -----------------------------------
 NOTE = "bearingsim: note: test note"
 

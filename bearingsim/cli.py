@@ -40,7 +40,8 @@ def _cmd_run(args) -> int:
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
     progress = not args.quiet and sys.stderr.isatty()
-    out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress)
+    out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
+                       force=args.force)
     if not args.quiet:
         print(f"wrote {out.archive}")
         for png in out.figures:
@@ -171,7 +172,7 @@ def _cmd_validate(args) -> int:
 
         studies.append(Rig(rotations=args.rig_rotations))
     engine = make_engine(args.jobs, args.scheduler)
-    outcome = run_studies(studies, Path(args.output), engine=engine)
+    outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force)
     for p in outcome.written[:2]:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:
@@ -237,7 +238,7 @@ def _cmd_sweep(args) -> int:
     from bearingsim.sweeps import run_sweep_cli
 
     return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
-                         scheduler=args.scheduler, figures=not args.no_plots)
+                         scheduler=args.scheduler, figures=not args.no_plots, force=args.force)
 
 
 def _cmd_crosscheck(args) -> int:
@@ -255,7 +256,8 @@ def _cmd_crosscheck(args) -> int:
     scenario = load_scenario(args.scenario, args.set)
     cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
-    rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine)
+    rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine,
+                                      force=args.force)
     wall = time.perf_counter() - t0
     if outcome.interrupted is None:
         where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
@@ -282,6 +284,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key, e.g. operating.inner_ring_speed_rpm=3000 (repeatable)")
     r.add_argument("--no-plots", action="store_true", help="write the archive only")
+    r.add_argument("--force", action="store_true",
+                   help="replace an archive of a different scenario at the output path (default: refused)")
     r.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     r.set_defaults(func=_cmd_run)
 
@@ -317,6 +321,8 @@ def build_parser() -> argparse.ArgumentParser:
     v.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
     v.add_argument("--scheduler", metavar="ADDRESS",
                    help="run the cases on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
+    v.add_argument("--force", action="store_true",
+                   help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     v.set_defaults(func=_cmd_validate)
 
     b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot); from a source "
@@ -347,6 +353,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     s.add_argument("--no-plots", action="store_true", help="index only, no figures")
+    s.add_argument("--force", action="store_true",
+                   help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     s.set_defaults(func=_cmd_sweep)
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
                                            "(README: Cross-check; run again to resume)")
@@ -359,6 +367,8 @@ def build_parser() -> argparse.ArgumentParser:
     cc.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
     cc.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the rungs on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
+    cc.add_argument("--force", action="store_true",
+                   help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     cc.set_defaults(func=_cmd_crosscheck)
     return p
 

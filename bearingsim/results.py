@@ -118,12 +118,25 @@ class Result:
             check_replaceable(path, PNG_SIGNATURE, "figure")
         return [save_figure(getattr(self, f"plot_{name}")(), path) for name, path in paths.items()]
 
+    #: at most this many differences from the preset are named in a title (then "+N more")
+    TITLE_DIFFERENCES = 6
+
     def title(self) -> str:
-        """``<scenario>: <what ran>, <speed> rpm <direction>``: names the run as it was actually made."""
+        """``<scenario>: <what ran>, <speed> rpm <direction>, <load> N``: names the run as it was actually
+        made; a second line names what the scenario sets differently from its preset and the defaults
+        (:func:`bearingsim.scenario.differences_from_preset`), so that two runs' figures differ."""
+        from bearingsim.scenario import differences_from_preset
+
         sc = self.scenario
         op = sc.operating
-        return (f"{sc.name}: {self.description()}, {op.inner_ring_speed_rpm:g} rpm {op.direction}, "
+        head = (f"{sc.name}: {self.description()}, {op.inner_ring_speed_rpm:g} rpm {op.direction}, "
                 f"{op.radial_load_N:g} N")
+        diffs = differences_from_preset(sc)
+        if not diffs:
+            return head
+        n = self.TITLE_DIFFERENCES
+        more = f", +{len(diffs) - n} more" if len(diffs) > n else ""
+        return f"{head}\n{', '.join(diffs[:n])}{more}"
 
     def description(self) -> str:  # pragma: no cover - overridden
         return self.model

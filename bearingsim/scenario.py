@@ -528,6 +528,83 @@ def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
     return _validate(merged, source)
 
 
+# keys a figure title shows already (speed, direction, load) or that set only how long and how often
+# a run records, and keys a model does not use: not named as differences from the preset
+_TITLE_SKIP = ("schema_version", "name", "model", "bearing.preset", "operating.inner_ring_speed_rpm",
+               "operating.direction", "operating.radial_load_N", "numerics.", "multibody.scene")
+_TITLE_SKIP_MODEL = {
+    "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
+                "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction"),
+    "multibody": ("reduced.",),
+}
+# compact wording of the differences most often made (others: ``key = value`` by the key's last part)
+_TITLE_LABELS = {
+    "multibody.raceway_contact": lambda v: f"raceway {v}",
+    "bearing.cage_guidance": lambda v: "roller-guided cage" if v == "rollers" else f"{str(v).replace('_', '-')} cage",
+    "bearing.pocket_clearance_mm": lambda v: f"s = {v:g} mm",
+    "bearing.radial_clearance_mm": lambda v: f"radial clearance {v:g} mm",
+    "bearing.cage_land_clearance_mm": lambda v: f"land clearance {v:g} mm",
+    "bearing.roller_count": lambda v: f"{v} rollers",
+    "multibody.inner_ring": lambda v: f"{str(v).replace('_', '-')} inner ring",
+    "operating.gravity": lambda v: "gravity" if v else "no gravity",
+    "reduced.load_zone_half_angle_deg": lambda v: f"load zone ±{v:g}°",
+}
+
+
+def _flat(d: dict, prefix: str = "") -> dict:
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flat(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+def _title_value(key: str, v) -> str:
+    label = _TITLE_LABELS.get(key)
+    if label is not None:
+        try:
+            return label(v)
+        except (TypeError, ValueError):
+            pass
+    text = f"{v:g}" if isinstance(v, float) else ("[" + ", ".join(map(str, v)) + "]" if isinstance(v, list) else str(v))
+    return f"{key.rsplit('.', 1)[-1]} = {text}"
+
+
+def differences_from_preset(scenario: "Scenario") -> list[str]:
+    """What a scenario sets differently from its preset and the package defaults, in a few words each
+    (``["raceway rigid", "outer-land cage", "s = 0.3 mm"]``), for figure titles: two runs that differ
+    show it. Speed, direction and load (in every title), run length and keys the scenario's model does
+    not use are left out."""
+    raw = scenario.raw
+    ref = copy.deepcopy(DEFAULTS)
+    preset = raw.get("bearing", {}).get("preset")
+    if preset is not None:
+        try:
+            for section, values in _preset(preset).items():
+                if section in ScenarioModel.model_fields and isinstance(values, dict):
+                    ref = _merge(ref, {section: values})
+        except UserError:
+            pass
+    ref = _merge(ref, {k: raw[k] for k in ("schema_version", "name", "model", "operating", "numerics") if k in raw})
+    try:
+        ref = _drop_none(ScenarioModel.model_validate(ref).model_dump())
+    except ValidationError:  # no preset: compare with what the defaults set
+        pass
+    have, base = _flat(raw), _flat(ref)
+    skip = _TITLE_SKIP + _TITLE_SKIP_MODEL.get(raw.get("model"), ())
+    out = []
+    for key, v in have.items():
+        if key.startswith(skip) or key not in base:
+            continue
+        b = base[key]
+        same = v == b if not (isinstance(v, bool) or isinstance(b, bool)) else v is b
+        if not same:
+            out.append(_title_value(key, v))
+    return out
+
+
 def _loc(err) -> str:
     return ".".join(str(p) for p in err["loc"] if not str(p).startswith(("function-", "literal[")))
 

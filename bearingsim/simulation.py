@@ -75,6 +75,37 @@ def default_output(scenario: Scenario, root: str | Path = "outputs") -> Path:
     return outputs.default_output(scenario.name, root)
 
 
+def check_same_scenario(out: Path, scenario: Scenario) -> None:
+    """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
+    ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
+    that differ, and ``-o`` / ``--force``. A rerun of the same scenario, an unreadable or incomplete
+    archive (never a result) and no file at all pass."""
+    import tomllib
+
+    from bearingsim import archive
+    from bearingsim.compare import _flatten, _same
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import resolve
+
+    got = archive.peek(out) if out.is_file() else None
+    if got is None:
+        return
+    try:
+        old = resolve(tomllib.loads(got["scenario"]), f"{out}:/scenario")
+    except Exception:  # noqa: BLE001 - a scenario this version cannot read is not this run's
+        old = None
+    if old is not None and old == scenario:
+        return
+    keys = []
+    if old is not None:
+        fa, fb = _flatten(old.raw), _flatten(scenario.raw)
+        keys = [f"{k} {fa.get(k, '(unset)')} -> {fb.get(k, '(unset)')}" for k in sorted(set(fa) | set(fb))
+                if not _same(fa.get(k, "(unset)"), fb.get(k, "(unset)"))]
+    what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
+    raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: write this run elsewhere "
+                    f"with -o, or add --force to replace it")
+
+
 def run_scenario(
     scenario: Scenario,
     out: str | Path | None = None,
@@ -82,6 +113,8 @@ def run_scenario(
     figures: bool = True,
     progress: bool = False,
     exclusive: bool = True,
+    notes: bool = True,
+    force: bool = False,
 ) -> RunOutput:
     """Run ``scenario``, write its archive (atomically, time series streamed into it) and, optionally,
     its PNG figures, drawn from the archive as written.
@@ -94,6 +127,10 @@ def run_scenario(
     progress : show a progress bar (multibody runs)
     exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
         temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
+    notes : print the plausibility notes of the run (:func:`bearingsim.plausibility.check`) on stderr;
+        ``bearingsim run -q`` and sweep cases pass False (the counts stay in the archive's provenance)
+    force : replace an archive of a different scenario at ``out`` (default: refused,
+        :func:`check_same_scenario`; a rerun of the same scenario replaces its archive)
     """
     from bearingsim import archive, outputs, plausibility
     from bearingsim.errors import UserError
@@ -103,12 +140,15 @@ def run_scenario(
     outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
     lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
     try:
+        if not force:
+            check_same_scenario(out, scenario)
         if exclusive:
             outputs.clean_stale_temporaries(out.parent)
         with archive.Spool(out) as spool:
             result = run(scenario, progress=progress, sink=spool)
             for note in plausibility.check(result):  # exit 3 before anything is written
-                print(note, file=sys.stderr)
+                if notes:
+                    print(note, file=sys.stderr)
             archive.write(result, out, spool)
         pngs = []
         if figures:

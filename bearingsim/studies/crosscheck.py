@@ -199,7 +199,7 @@ class CrossCheck(Study):
 
 
 def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int | None = DEFAULT_ROTATIONS,
-                   jobs: int = 2, *, engine=None, progress: bool | None = None, log=None):
+                   jobs: int = 2, *, engine=None, progress: bool | None = None, log=None, force: bool = False):
     """Run every rung at every speed on the sweep engine (``jobs`` local processes, or ``engine``),
     write the rung archives, the CSV, the index and the figure into ``outdir``.
 
@@ -213,6 +213,7 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     speeds : inner-ring speeds [rpm].
     rotations : recorded cage rotations of every rung (None: the scenario's ``numerics.rotations``).
     jobs : local worker processes (ignored when ``engine`` is given).
+    force : replace another study or sweep in ``outdir`` (default: refused).
 
     Returns
     -------
@@ -225,7 +226,7 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     if engine is None:
         engine = make_engine(jobs)
     study = CrossCheck(scenario, speeds, rotations)
-    outcome = run_studies([study], outdir, engine=engine, progress=progress, log=log)
+    outcome = run_studies([study], outdir, engine=engine, progress=progress, log=log, force=force)
     return study.rows, outcome
 
 

@@ -122,7 +122,8 @@ def check_outputs(outdir: Path, studies) -> None:
             check_replaceable(outdir / name, signature, what)
 
 
-def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, log=None) -> StudiesOutcome:
+def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, log=None,
+                force: bool = False) -> StudiesOutcome:
     """Run the cases of ``studies`` in ``outdir`` on ``engine``, then let each study write its table
     and figures.
 
@@ -138,6 +139,9 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         Progress bar on stderr; default when stderr is a terminal.
     log : callable, optional
         Receives one line per failed case (default: stderr).
+    force : bool
+        Replace another sweep or study in ``outdir`` (default: refused,
+        :func:`bearingsim.sweeps.run.check_same_sweep`).
 
     Returns
     -------
@@ -165,7 +169,7 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         raise
     with FolderLock(outdir) as lock:
         sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock,
-                          desc="+".join(s.name for s in studies))
+                          desc="+".join(s.name for s in studies), force=force)
         out = StudiesOutcome(sweep)
         if sweep.interrupted is None:
             records = {r["case"]: r for r in sweep.rows}

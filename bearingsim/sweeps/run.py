@@ -152,6 +152,38 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
                         f"{'a symbolic link' if cases.is_symlink() else 'not a folder'}; not used (remove it)")
 
 
+def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figures=()) -> None:
+    """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``) or archives
+    in ``cases/`` that the new one does not have. Resuming the same sweep (or one that only adds cases)
+    passes. With ``force`` the other sweep's case archives and the sweep figures ``figures`` are removed
+    instead, so that nothing of it is mixed into the new one (the index is rewritten by the sweep)."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import INDEX_FORMAT, read_index
+
+    new = {c.hash for c in cases}
+    old = set()
+    index = outdir / "sweep.h5"
+    if archive.is_table_file(index, INDEX_FORMAT):
+        with contextlib.suppress(UserError, OSError, KeyError, ValueError):
+            old |= {str(h) for h in read_index(index)[0].get("case", [])}
+    cases_dir = outdir / "cases"
+    if cases_dir.is_dir() and not cases_dir.is_symlink():
+        old |= {p.stem for p in cases_dir.glob("*.h5")}
+    other = old - new
+    if not other:
+        return
+    if not force:
+        raise UserError(f"{outdir}: holds another sweep or study ({len(other)} of its {len(old)} cases are not in "
+                        f"this one); not mixed in: give another -o folder, or add --force to replace it (the same "
+                        f"command as before resumes it)")
+    for h in other:
+        (cases_dir / f"{h}.h5").unlink(missing_ok=True)
+    for name in figures:
+        p = outdir / name
+        if p.is_file() and not p.is_symlink():
+            p.unlink()
+
+
 def _clean_temporaries(cases_dir: Path) -> None:
     """Remove temporary archives left by workers ended mid-write (this sweep holds the folder's lock)."""
     for p in cases_dir.glob(".*.h5.tmp-*"):
@@ -173,7 +205,7 @@ def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
               progress: bool | None = None, log=None, lock: FolderLock | None = None,
-              desc: str = "sweep") -> SweepOutcome:
+              desc: str = "sweep", force: bool = False) -> SweepOutcome:
     """Run every case of ``spec`` that has no valid archive yet, and index them all.
 
     Parameters
@@ -196,6 +228,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         default: taken here and released when the sweep ends.
     desc : str
         The progress bar's label (a study's name).
+    force : bool
+        Replace another sweep or study in ``outdir`` (default: refused, :func:`check_same_sweep`).
 
     Returns
     -------
@@ -236,6 +270,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
         try:
             check_sweep_outputs(outdir, figures)
+            from bearingsim.sweeps.plot import FIGURE_NAMES
+
+            check_same_sweep(outdir, cases, force, FIGURE_NAMES)
             cases_dir.mkdir(exist_ok=True)
         except BaseException:
             if own:
@@ -326,7 +363,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
 
 def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: int | None = None,
-                  scheduler: str | None = None, figures: bool = True, quiet: bool = False) -> int:
+                  scheduler: str | None = None, figures: bool = True, quiet: bool = False,
+                  force: bool = False) -> int:
     """``bearingsim sweep``: run, print what was written and return the exit code.
 
     0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
@@ -340,7 +378,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")
     engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
-    out = run_sweep(spec, outdir, engine=engine, figures=figures)
+    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force)
     n = len(out.rows)
     counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
     if out.count("stale"):

@@ -89,7 +89,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
         else:
             scenario = scenario_from_toml(toml_text)
         if scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
-            res, data = _run_in_memory(scenario)
+            res, data = _run_in_memory(scenario, notes=False)  # per-case notes: not on the sweep's terminal
             if target is not None:
                 _write_file(target, data)
                 data = None
@@ -115,7 +115,8 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
 def _run_to_file(scenario, target: Path):
     from bearingsim.simulation import run_scenario
 
-    return run_scenario(scenario, target, figures=False, progress=False, exclusive=False).result
+    return run_scenario(scenario, target, figures=False, progress=False, exclusive=False, notes=False,
+                        force=True).result  # the sweep owns its folder (case archives named by scenario hash)
 
 
 def _write_file(target: Path, data: bytes) -> None:

@@ -475,13 +475,22 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
         raise UserError(f"{p}: is a directory, not a scenario file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise UserError(f"{p}: cannot read scenario file ({exc.__class__.__name__})") from None
+    return parse_toml_text(text, str(p))
+
+
+def parse_toml_text(text: str, where: str) -> dict[str, Any]:
+    """The scenario dictionary of TOML ``text`` (a file's, or an archive's ``/scenario``), read with the
+    limits of a scenario file: one-line :class:`UserError` naming ``where`` for text that is longer than
+    :data:`MAX_SCENARIO_BYTES`, not TOML, or nested deeper than :data:`MAX_NESTING_DEPTH`."""
+    if len(text) > MAX_SCENARIO_BYTES:
+        raise UserError(f"{where}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{p}: not valid TOML ({exc})") from None
+        raise UserError(f"{where}: not valid TOML ({exc})") from None
     except RecursionError:
-        raise UserError(f"{p}: nested too deeply to be a scenario") from None
-    _check_depth(raw, str(p))
+        raise UserError(f"{where}: nested too deeply to be a scenario") from None
+    _check_depth(raw, where)
     return raw
 
 

@@ -20,6 +20,10 @@ from bearingsim.parameters import Parameters
 from bearingsim.scenario import Scenario
 
 
+#: the models, by the name a scenario and an archive give
+MODELS = ("reduced", "multibody")
+
+
 def model_module(name: str):
     """The module of a model: ``simulate(parameters, sink=None, progress=False, dt=None)`` and its
     result class ``RESULT``."""

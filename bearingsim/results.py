@@ -67,6 +67,7 @@ class Result:
         self.series = dict(series or {})
         self.provenance = dict(provenance or {})
         self.tables = dict(tables or {})
+        self.notes: list[str] = []  # one-line notes of a run that is plausible but not clean (simulation.run)
         self._parameters = None
 
     # --- the API ---------------------------------------------------------------------------

@@ -55,13 +55,24 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     scenario : resolved scenario (:func:`bearingsim.load_scenario`).
     progress : show a progress bar on stderr (multibody runs).
     sink : where time series are streamed (default: kept in memory with the result).
-    dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice.
+    dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice; it becomes the scenario's
+        ``numerics.dt_s`` (validated as that key, and stored with the result, so its archive reruns it).
+
+    The checks are those of ``bearingsim run``: the step is validated as a scenario key, and a finished
+    run that is not plausible (:func:`bearingsim.plausibility.check`) raises
+    :class:`bearingsim.errors.SimulationUnstable`; the one-line notes of a plausible run that is not
+    clean are in ``result.notes`` (the command line prints them).
     """
+    from bearingsim import plausibility
+
     t0 = time.perf_counter()
+    if dt is not None:
+        scenario = scenario.replace(**{"numerics.dt_s": dt})
     params = Parameters.from_scenario(scenario)
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
     result.provenance["wall_time_s"] = time.perf_counter() - t0
+    result.notes = plausibility.check(result)
     return result
 
 
@@ -99,7 +110,7 @@ def run_scenario(
     exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
         temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
     """
-    from bearingsim import archive, outputs, plausibility
+    from bearingsim import archive, outputs
     from bearingsim.errors import UserError
 
     out = Path(out) if out is not None else default_output(scenario)
@@ -110,8 +121,8 @@ def run_scenario(
         if exclusive:
             outputs.clean_stale_temporaries(out.parent)
         with archive.Spool(out) as spool:
-            result = run(scenario, progress=progress, sink=spool)
-            for note in plausibility.check(result):  # exit 3 before anything is written
+            result = run(scenario, progress=progress, sink=spool)  # checked: exit 3 before anything is written
+            for note in result.notes:
                 print(note, file=sys.stderr)
             archive.write(result, out, spool)
         pngs = []

@@ -582,7 +582,7 @@ def is_archive(path) -> bool:
     """True when ``path`` is an HDF5 file written by bearingsim (complete or not)."""
     try:
         h5py = _lazy_h5py()
-        if not h5py.is_hdf5(path):
+        if not Path(path).is_file() or not h5py.is_hdf5(path):  # a FIFO is never opened: it would block
             return False
         with h5py.File(path, "r") as f:
             return "bearingsim" in f and "format_version" in f["bearingsim"].attrs
@@ -780,6 +780,7 @@ def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, An
     (columns, root attributes). One-line UserError for anything else."""
     h5py = _lazy_h5py()
     p = Path(path)
+    _check_regular(p)
     try:
         f = h5py.File(p, "r")
     except (OSError, FileNotFoundError) as exc:
@@ -833,6 +834,23 @@ def peek(path) -> dict[str, Any] | None:
         return None
 
 
+def _check_regular(p: Path) -> None:
+    """Refuse a path that is not a regular file (a FIFO would block the reader forever, a device is
+    not a file to read), checked with ``stat`` before anything opens it."""
+    import stat
+
+    try:
+        mode = p.stat().st_mode
+    except FileNotFoundError:
+        raise UserError(f"{p}: file not found") from None
+    except OSError as exc:
+        raise UserError(f"{p}: cannot open ({exc.strerror or exc.__class__.__name__})") from None
+    if stat.S_ISDIR(mode):
+        raise UserError(f"{p}: is a directory, not an archive")
+    if not stat.S_ISREG(mode):
+        raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not an archive")
+
+
 def open_archive(path: str | Path):
     """Open a complete bearingsim archive read-only, or raise a one-line :class:`UserError`."""
     h5py = _lazy_h5py()
@@ -841,6 +859,7 @@ def open_archive(path: str | Path):
         raise UserError(f"{p}: file not found")
     if p.is_dir():
         raise UserError(f"{p}: is a directory, not an archive")
+    _check_regular(p)
     try:
         ok = h5py.is_hdf5(p)
     except OSError:

@@ -10,6 +10,8 @@ offending key (dotted, e.g. ``bearing.pocket_clearance_mm``) and the file it cam
 from __future__ import annotations
 
 import copy
+import os
+import stat
 import math
 import tomllib
 from importlib import resources
@@ -473,7 +475,15 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
     try:
         if "\x00" in str(path):
             raise UserError(f"{str(path)!r}: file name contains a NUL byte")
-        with open(p, "rb") as fh:  # bounded: /dev/zero or a huge file stops at once
+        # opened without blocking and refused unless a regular file: a FIFO would wait for a writer
+        # forever, a device (/dev/zero) is not a scenario; the read is bounded (a huge file stops at once)
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
+        with open(fd, "rb") as fh:
+            mode = os.fstat(fd).st_mode
+            if stat.S_ISDIR(mode):
+                raise IsADirectoryError
+            if not stat.S_ISREG(mode):
+                raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not a scenario file")
             data = fh.read(MAX_SCENARIO_BYTES + 1)
         if len(data) > MAX_SCENARIO_BYTES:
             raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")

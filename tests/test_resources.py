@@ -1,0 +1,57 @@
+"""Resources (issue 30, item 6): nothing waits forever on a FIFO given as an input file."""
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+from .conftest import SCENARIOS, started
+
+PAPER = SCENARIOS / "paper_3000rpm.toml"
+HANG_TIMEOUT_S = 120  # ends a hang; a refusal takes the time of an import
+
+
+@pytest.mark.parametrize("args, what", [
+    (["run", "{fifo}", "-o", "{tmp}/o.h5"], "scenario file"),
+    (["sweep", "{fifo}", "--param", "contact.restitution=0.5,0.6", "-o", "{tmp}/sw"], "scenario file"),
+    (["crosscheck", "{fifo}", "--speeds", "3000", "-o", "{tmp}/cc"], "scenario file"),
+    (["show", "{fifo}"], "archive"),
+    (["inspect", "{fifo}"], "archive"),
+    (["plot", "{fifo}"], "archive"),
+    (["compare", "{fifo}", "{fifo}"], "archive"),
+    (["rerun", "{fifo}"], "archive"),
+], ids=lambda v: v[0] if isinstance(v, list) else None)
+def test_a_fifo_is_refused_not_waited_on(tmp_path, args, what):
+    """Was: ``bearingsim run FIFO`` hung forever (opening a FIFO blocks until a writer comes). Now every
+    input path is checked to be a regular file before it is opened: exit 2, one line. (The timeout only
+    ends a hang; a run that is refused takes the time of an import.)"""
+    fifo = tmp_path / "in.toml"
+    os.mkfifo(fifo)
+    cmd = [sys.executable, "-m", "bearingsim", *(a.format(fifo=fifo, tmp=tmp_path) for a in args)]
+    with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+        try:
+            out, err = proc.communicate(timeout=HANG_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"{args[0]} waits on a FIFO")
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert proc.returncode == 2 and len(lines) == 1 and "Traceback" not in err, err
+    assert "in.toml" in lines[0] and "not a regular file" in lines[0] and what in lines[0], lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.toml"]
+
+
+@pytest.mark.parametrize("call", ["load_scenario", "load"])
+def test_the_api_refuses_a_fifo_too(tmp_path, call):
+    """``bearingsim.load_scenario`` and ``bearingsim.load`` of a FIFO: a UserError (run in a child, so
+    that a hang ends with the test)."""
+    fifo = tmp_path / "in.toml"
+    os.mkfifo(fifo)
+    code = (f"import bearingsim\ntry:\n    bearingsim.{call}({str(fifo)!r})\n"
+            f"except bearingsim.UserError as e:\n    print('UserError', e)")
+    with started([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+        try:
+            out, err = proc.communicate(timeout=HANG_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            pytest.fail(f"bearingsim.{call} waits on a FIFO")
+    assert out.startswith("UserError") and "not a regular file" in out, (out, err)

@@ -55,3 +55,36 @@ def test_the_api_refuses_a_fifo_too(tmp_path, call):
         except subprocess.TimeoutExpired:
             pytest.fail(f"bearingsim.{call} waits on a FIFO")
     assert out.startswith("UserError") and "not a regular file" in out, (out, err)
+
+
+def _sweep_file(tmp_path, axes: str):
+    path = tmp_path / "big.toml"
+    path.write_text(f'scenario = "{PAPER}"\n[axes]\n{axes}\n')
+    return path
+
+
+def test_a_sweep_range_of_a_trillion_values_is_refused_at_once(tmp_path):
+    """Was: ``num = 1000000000000`` accepted (then numpy's linspace ran out of memory, with advice
+    about numerics.rotations)."""
+    from .test_cli import assert_user_error, bearingsim as cli
+
+    path = _sweep_file(tmp_path, '"operating.inner_ring_speed_rpm" = { start = 500, stop = 6000, num = 1000000000000 }')
+    assert_user_error(cli("sweep", path, "-o", tmp_path / "sw"), "big.toml", "num = 1000000000000", "100000")
+    assert not (tmp_path / "sw").exists()
+
+
+def test_a_sweep_of_too_many_cases_is_refused_before_any_is_built(tmp_path):
+    """4 million cases of two ranges, 120000 of two --param axes: refused before a case is resolved
+    (was: every case resolved, then a MemoryError)."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.spec import resolve_cases, spec_from_args
+
+    path = _sweep_file(tmp_path, '"operating.inner_ring_speed_rpm" = { start = 500, stop = 6000, num = 2000 }\n'
+                                 '"bearing.pocket_clearance_mm" = { start = 0.05, stop = 0.5, num = 2000 }')
+    with pytest.raises(UserError, match="4000000 cases"):
+        resolve_cases(spec_from_args(path, [], []))
+    speeds = ",".join(str(500 + i) for i in range(400))
+    restitutions = ",".join(str(0.1 + i / 1000) for i in range(300))
+    spec = spec_from_args(PAPER, [f"operating.inner_ring_speed_rpm={speeds}", f"contact.restitution={restitutions}"], [])
+    with pytest.raises(UserError, match="120000 cases .* more than the 100000"):
+        resolve_cases(spec)

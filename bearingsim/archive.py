@@ -599,10 +599,18 @@ def model_of(path) -> str:
         f.close()
 
 
-def read(path, result_class):
+def _wanted(name: str, only) -> bool:
+    return only is None or any(name == p or name.startswith(p + "/") for p in only)
+
+
+def read(path, result_class, only=None):
     """Read a complete archive back into ``result_class`` (one-line UserError for a bad file).
 
     ``bearingsim.load`` picks the class of the archive's model (:func:`bearingsim.simulation.load`).
+    ``only``: the archive paths (``"results/per_rotation"``, ``"observables"`` ...) whose datasets are
+    read, each with everything under it; None reads every dataset. The scenario, the attribute groups
+    (the summary) and the provenance are always read, and the layout is always checked (metadata only):
+    a command that needs a few arrays does not decompress the others.
     """
     f = open_archive(path)
     try:
@@ -618,6 +626,8 @@ def read(path, result_class):
         def visit(name, obj):
             if name.startswith("results"):
                 if hasattr(obj, "shape"):
+                    if not _wanted(name, only):
+                        return
                     v = obj[()]
                     if v.dtype.kind == "S":
                         v = v.astype("U")
@@ -631,7 +641,7 @@ def read(path, result_class):
 
         f.visititems(visit)
         series = {}
-        for name, g in (f["observables"].items() if "observables" in f else ()):
+        for name, g in (f["observables"].items() if "observables" in f and _wanted("observables", only) else ()):
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
         provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}

@@ -50,6 +50,8 @@ class Result:
     OPTIONAL: tuple[frozenset, ...] = ()
     #: arrays of :attr:`LAYOUT` that hold text (the others hold numbers)
     TEXT_ARRAYS: frozenset = frozenset()
+    #: the archive paths of the arrays the figures draw (``bearingsim plot`` reads only these)
+    FIGURE_DATA: tuple[str, ...] = ()
     #: the keys of ``/results/summary`` that must be numbers (the figures and the CLI print them)
     SUMMARY_NUMBERS: tuple[str, ...] = ()
 

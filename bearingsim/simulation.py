@@ -40,11 +40,18 @@ def model_module(name: str):
     raise UserError(f"model {name!r}: unknown (reduced, multibody)")
 
 
-def load(path):
-    """Read an archive back into the result class of its model."""
+def load(path, only=None):
+    """Read an archive back into the result class of its model (``only``: the datasets to read, see
+    :func:`bearingsim.archive.read`; None: all)."""
     from bearingsim import archive
 
-    return archive.read(path, model_module(archive.model_of(path)).RESULT)
+    return archive.read(path, model_module(archive.model_of(path)).RESULT, only=only)
+
+
+#: what each archive command reads besides the scenario, the summary and the provenance
+#: (``show`` prints the scenario; ``compare`` and ``rerun`` compare summaries and per-rotation arrays)
+SCENARIO_ONLY: tuple[str, ...] = ()
+COMPARED = ("results/per_rotation",)
 
 
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):

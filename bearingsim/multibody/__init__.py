@@ -186,6 +186,8 @@ class MultibodyResult(Result):
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}))  # a scene with a ring
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m")  # no ring: absent
+    FIGURE_DATA = ("results/theta_deg", "results/force_vs_theta_acc", "results/force_vs_theta_dec",
+                   "results/per_rotation/I_acc", "results/per_rotation/I_dec", "results/cage_orbit", "results/wear")
 
     @classmethod
     def archive_dims(cls, scenario) -> dict[str, int]:

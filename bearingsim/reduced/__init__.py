@@ -84,6 +84,7 @@ class ReducedResult(Result):
     OPTIONAL = (frozenset(f"results/trace/{c}" for c in _TRACE),)
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(SUMMARY_UNITS)
+    FIGURE_DATA = ("results/trace",)
 
     @classmethod
     def archive_dims(cls, scenario) -> dict[str, int]:

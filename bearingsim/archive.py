@@ -515,14 +515,29 @@ def group_attrs(g) -> tuple[dict[str, Any], dict[str, str]]:
     units: dict[str, str] = {}
     for k, v in g.attrs.items():
         if k == ATTRS_JSON:
-            values.update(json.loads(_plain(v)))
+            values.update(_json_object(v, g.name, k))
         elif k == UNITS_JSON:
-            units.update(json.loads(_plain(v)))
+            units.update({u: str(w) for u, w in _json_object(v, g.name, k).items()})
         elif k.endswith("__unit"):
             units[k[:-6]] = str(_plain(v))
         elif k != "description":
             values[k] = _plain(v)
     return dict(sorted(values.items())), dict(sorted(units.items()))
+
+
+def _json_object(v, where: str, name: str) -> dict[str, Any]:
+    """The JSON attribute ``name`` of ``where`` as a dict of scalars (ValueError for anything else: not
+    text, not JSON, nested, or too deep for the parser)."""
+    v = _plain(v)
+    if not isinstance(v, str):
+        raise ValueError(f"{where}@{name} is not text")
+    try:
+        d = json.loads(v)
+    except RecursionError:
+        raise ValueError(f"{where}@{name} is nested too deeply") from None
+    if not isinstance(d, dict) or not all(v is None or isinstance(v, (str, int, float)) for v in d.values()):
+        raise ValueError(f"{where}@{name} is not a JSON object of named scalars")
+    return d
 
 
 def _write_array(w: _Writer, path: str, arr) -> None:
@@ -567,7 +582,7 @@ def is_archive(path) -> bool:
     """True when ``path`` is an HDF5 file written by bearingsim (complete or not)."""
     try:
         h5py = _lazy_h5py()
-        if not h5py.is_hdf5(path):
+        if not Path(path).is_file() or not h5py.is_hdf5(path):  # a FIFO is never opened: it would block
             return False
         with h5py.File(path, "r") as f:
             return "bearingsim" in f and "format_version" in f["bearingsim"].attrs
@@ -579,28 +594,31 @@ def model_of(path) -> str:
     """The model name an archive was written by (one-line UserError for a bad file)."""
     f = open_archive(path)
     try:
-        return str(f["bearingsim"].attrs["model"])
-    except KeyError:
-        raise UserError(f"{path}: damaged archive (no /bearingsim@model: which model wrote it is unknown)") from None
+        return _model_attr(f, path)
     finally:
         f.close()
 
 
-def read(path, result_class):
+def _wanted(name: str, only) -> bool:
+    return only is None or any(name == p or name.startswith(p + "/") for p in only)
+
+
+def read(path, result_class, only=None):
     """Read a complete archive back into ``result_class`` (one-line UserError for a bad file).
 
     ``bearingsim.load`` picks the class of the archive's model (:func:`bearingsim.simulation.load`).
+    ``only``: the archive paths (``"results/per_rotation"``, ``"observables"`` ...) whose datasets are
+    read, each with everything under it; None reads every dataset. The scenario, the attribute groups
+    (the summary) and the provenance are always read, and the layout is always checked (metadata only):
+    a command that needs a few arrays does not decompress the others.
     """
-    import tomllib
-
-    from bearingsim.scenario import resolve
-
     f = open_archive(path)
     try:
-        model = str(f["bearingsim"].attrs["model"])
-        text = f["scenario"][()]
-        text = text.decode() if isinstance(text, bytes) else str(text)
-        scenario = resolve(tomllib.loads(text), f"{path}:/scenario")
+        model = _model_attr(f, path)
+        scenario = _read_scenario(f, path)
+        if model != result_class.model:
+            raise UserError(f"{path}: archive of the {model!r} model, not {result_class.model!r}")
+        check_layout(f, path, result_class, scenario)
         data: dict[str, NamedArray] = {}
         groups: dict[str, AttrGroup] = {}
         tables: dict[str, str] = {}
@@ -608,6 +626,8 @@ def read(path, result_class):
         def visit(name, obj):
             if name.startswith("results"):
                 if hasattr(obj, "shape"):
+                    if not _wanted(name, only):
+                        return
                     v = obj[()]
                     if v.dtype.kind == "S":
                         v = v.astype("U")
@@ -621,7 +641,7 @@ def read(path, result_class):
 
         f.visititems(visit)
         series = {}
-        for name, g in f.get("observables", {}).items():
+        for name, g in (f["observables"].items() if "observables" in f and _wanted("observables", only) else ()):
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
         provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}
@@ -631,9 +651,99 @@ def read(path, result_class):
         raise UserError(f"{path}: damaged archive ({exc.__class__.__name__}: {exc})") from None
     finally:
         f.close()
-    if model != result_class.model:
-        raise UserError(f"{path}: archive of the {model!r} model, not {result_class.model!r}")
     return result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
+
+
+def _damaged(path, what: str) -> UserError:
+    return UserError(f"{path}: damaged archive ({what})")
+
+
+def _model_attr(f, path) -> str:
+    """``/bearingsim@model``: the name of a known model, else a one-line UserError."""
+    from bearingsim.simulation import MODELS
+
+    model = _plain(f["bearingsim"].attrs.get("model"))
+    if model is None:
+        raise _damaged(path, "no /bearingsim@model: which model wrote it is unknown")
+    if not isinstance(model, str) or model not in MODELS:
+        raise _damaged(path, f"/bearingsim@model is {outputs.printable(repr(model))[:60]}, not one of "
+                             f"{', '.join(MODELS)}")
+    return model
+
+
+def _read_scenario(f, path):
+    """The resolved scenario stored at ``/scenario``: a scalar text dataset read with the limits of a
+    scenario file (size, nesting: :func:`bearingsim.scenario.parse_toml_text`) and validated like one."""
+    from bearingsim.scenario import MAX_SCENARIO_BYTES, parse_toml_text, resolve
+
+    h5py = _lazy_h5py()
+    ds = f.get("scenario")
+    if not isinstance(ds, h5py.Dataset):
+        raise _damaged(path, "/scenario is missing or not a dataset")
+    kind = ds.dtype.kind
+    if ds.shape != () or kind not in "OS" or (kind == "O" and h5py.check_string_dtype(ds.dtype) is None):
+        raise _damaged(path, f"/scenario is not a text (shape {ds.shape}, type {ds.dtype})")
+    if kind == "S" and ds.dtype.itemsize > MAX_SCENARIO_BYTES:
+        raise _damaged(path, f"/scenario is larger than {MAX_SCENARIO_BYTES} bytes")
+    text = ds[()]
+    try:
+        text = text.decode("utf-8") if isinstance(text, bytes) else str(text)
+    except UnicodeDecodeError:
+        raise _damaged(path, "/scenario is not UTF-8 text") from None
+    where = f"{path}:/scenario"
+    return resolve(parse_toml_text(text, where), where)
+
+
+def check_layout(f, path, result_class, scenario) -> None:
+    """Refuse, with a one-line UserError naming ``path`` and what is wrong, an archive whose structure is
+    not what ``result_class`` reads and draws: ``/results/summary`` a group holding the model's summary
+    numbers (:attr:`Result.SUMMARY_NUMBERS`), every array of :attr:`Result.LAYOUT` a numeric (or text)
+    dataset of its declared dimensions, consistent with each other and with the scenario
+    (:meth:`Result.archive_dims`), ``/observables`` groups of ``step``, ``time`` and ``value`` datasets of
+    one length. Only metadata is read (shapes and types): nothing is decompressed."""
+    h5py = _lazy_h5py()
+    scenario_model = scenario.model
+    if scenario_model != result_class.model:
+        raise _damaged(path, f"/bearingsim@model {result_class.model!r} contradicts the model of its /scenario "
+                             f"({scenario_model!r})")
+    for name in ("results", "results/summary"):
+        if not isinstance(f.get(name), h5py.Group):
+            raise _damaged(path, f"/{name} is missing or not a group")
+    if "provenance" in f and not isinstance(f["provenance"], h5py.Group):
+        raise _damaged(path, "/provenance is not a group")
+    summary = group_attrs(f["results/summary"])[0]
+    for key in result_class.SUMMARY_NUMBERS:
+        v = summary.get(key)
+        if isinstance(v, bool) or not isinstance(v, (int, float)):
+            raise _damaged(path, f"/results/summary: {key} is {outputs.printable(repr(v))[:40]}, not a number")
+    dims = dict(result_class.archive_dims(scenario))
+    for path_, shape in result_class.LAYOUT.items():
+        group = next((g for g in result_class.OPTIONAL if path_ in g), None)
+        if group is not None and not any(p in f for p in group):
+            continue  # an optional set of arrays (all or none), absent
+        ds = f.get(path_)
+        if not isinstance(ds, h5py.Dataset):
+            raise _damaged(path, f"/{path_} is missing or not a dataset ({result_class.model} model)")
+        text = path_ in result_class.TEXT_ARRAYS
+        if ds.dtype.kind not in ("SOU" if text else "biuf") or ds.dtype.subdtype is not None:
+            raise _damaged(path, f"/{path_} has type {ds.dtype}, expected {'text' if text else 'numbers'}")
+        if len(ds.shape) != len(shape):
+            raise _damaged(path, f"/{path_} has {len(ds.shape)} dimension(s) {ds.shape}, expected "
+                                 f"{len(shape)} ({', '.join(map(str, shape))})")
+        for name, n in zip(shape, ds.shape):
+            want = name if isinstance(name, int) else dims.setdefault(name, n)
+            if n != want:
+                raise _damaged(path, f"/{path_} has shape {ds.shape}: {name} = {n}, expected {want}")
+    obs = f.get("observables")
+    if obs is not None:
+        if not isinstance(obs, h5py.Group):
+            raise _damaged(path, "/observables is not a group")
+        for name, g in obs.items():
+            parts = [g.get(k) if isinstance(g, h5py.Group) else None for k in ("step", "time", "value")]
+            if not all(isinstance(d, h5py.Dataset) and d.dtype.kind in "biuf" and d.ndim >= 1 for d in parts):
+                raise _damaged(path, f"/observables/{name} is not a time series (step, time, value datasets)")
+            if parts[0].ndim != 1 or parts[1].ndim != 1 or not parts[0].shape[0] == parts[1].shape[0] == parts[2].shape[0]:
+                raise _damaged(path, f"/observables/{name}: step, time and value differ in length")
 
 
 def _plain(v):
@@ -680,6 +790,7 @@ def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, An
     (columns, root attributes). One-line UserError for anything else."""
     h5py = _lazy_h5py()
     p = Path(path)
+    _check_regular(p)
     try:
         f = h5py.File(p, "r")
     except (OSError, FileNotFoundError) as exc:
@@ -713,7 +824,7 @@ def peek(path) -> dict[str, Any] | None:
     try:
         with h5py.File(path, "r") as f:
             g = f.get("bearingsim")
-            if g is None or not bool(g.attrs.get("complete", False)):
+            if g is None or _plain(g.attrs.get("complete", False)) is not True:  # a boolean True, not "false"
                 return None
             text = f["scenario"][()]
             summary = group_attrs(f["results/summary"])[0]
@@ -733,6 +844,23 @@ def peek(path) -> dict[str, Any] | None:
         return None
 
 
+def _check_regular(p: Path) -> None:
+    """Refuse a path that is not a regular file (a FIFO would block the reader forever, a device is
+    not a file to read), checked with ``stat`` before anything opens it."""
+    import stat
+
+    try:
+        mode = p.stat().st_mode
+    except FileNotFoundError:
+        raise UserError(f"{p}: file not found") from None
+    except OSError as exc:
+        raise UserError(f"{p}: cannot open ({exc.strerror or exc.__class__.__name__})") from None
+    if stat.S_ISDIR(mode):
+        raise UserError(f"{p}: is a directory, not an archive")
+    if not stat.S_ISREG(mode):
+        raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not an archive")
+
+
 def open_archive(path: str | Path):
     """Open a complete bearingsim archive read-only, or raise a one-line :class:`UserError`."""
     h5py = _lazy_h5py()
@@ -741,6 +869,7 @@ def open_archive(path: str | Path):
         raise UserError(f"{p}: file not found")
     if p.is_dir():
         raise UserError(f"{p}: is a directory, not an archive")
+    _check_regular(p)
     try:
         ok = h5py.is_hdf5(p)
     except OSError:
@@ -755,7 +884,10 @@ def open_archive(path: str | Path):
         g = f.get("bearingsim")
         if g is None or "format_version" not in g.attrs:
             raise UserError(f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
-        if not bool(g.attrs.get("complete", False)):
+        complete = _plain(g.attrs.get("complete", False))
+        if not isinstance(complete, bool):
+            raise _damaged(p, f"/bearingsim@complete is {outputs.printable(repr(complete))[:40]}, not a boolean")
+        if not complete:
             raise UserError(f"{p}: incomplete bearingsim archive (the run did not finish)")
         major = str(_plain(g.attrs["format_version"])).split(".")[0]
         if major not in READABLE_MAJORS:

@@ -58,9 +58,9 @@ def _cmd_inspect(args) -> int:
 
 
 def _cmd_show(args) -> int:
-    from bearingsim.simulation import load as read
+    from bearingsim.simulation import SCENARIO_ONLY, load as read
 
-    sys.stdout.write(read(args.archive).scenario.to_toml())
+    sys.stdout.write(read(args.archive, only=SCENARIO_ONLY).scenario.to_toml())
     return 0
 
 
@@ -86,7 +86,9 @@ def _cmd_plot(args) -> int:
         for png in plot_sweep_index(path, folder):
             print(f"wrote {png}")
         return 0
-    result = read(path)
+    from bearingsim.simulation import model_module
+
+    result = read(path, only=model_module(archive.model_of(path)).RESULT.FIGURE_DATA)
     folder = check_writable_dir(args.output) if args.output else path.parent
     for png in result.save_figures(folder / path.stem):
         print(f"wrote {png}")
@@ -97,9 +99,9 @@ def _cmd_rerun(args) -> int:
     from bearingsim.archive import Spool, package_versions, write
     from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
-    from bearingsim.simulation import run
+    from bearingsim.simulation import COMPARED, run
 
-    old = read(args.archive)
+    old = read(args.archive, only=COMPARED)
     progress = sys.stderr.isatty()
     if args.output:
         with Spool(args.output) as spool:
@@ -126,10 +128,10 @@ def _cmd_rerun(args) -> int:
 
 
 def _cmd_compare(args) -> int:
-    from bearingsim.simulation import load as read
+    from bearingsim.simulation import COMPARED, load as read
     from bearingsim.compare import compare_results
 
-    a, b = read(args.a), read(args.b)
+    a, b = read(args.a, only=COMPARED), read(args.b, only=COMPARED)
     c = compare_results(a, b)
     if c.scenario_keys:
         print("scenario keys that differ (A -> B):")

@@ -33,6 +33,11 @@ NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converg
                "({share:.2%}; provenance ring_newton_failures): in those isolated steps the quasi-static ring "
                "solve cycled where a roller's contact opens and kept its last iterate for that step's raceway "
                "forces; runs with more than 1 % such steps are refused (docs/archive.md, provenance)")
+# A statistically steady multibody run: the cage speed fluctuates about its mean (roller impacts move
+# it by < 1 % at 3000 rpm), it does not drift. A change from the start to the end of the recorded
+# rotations of more than this fraction of the mean cage speed is a trend (a cage still accelerating
+# or decelerating): the run's means describe a transient, which a note says.
+MAX_CAGE_SPEED_DRIFT = 0.2
 
 
 def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
@@ -106,6 +111,9 @@ def check(result) -> list[str]:
         if samples < MIN_ORBIT_SAMPLES:
             raise SimulationUnstable(
                 f"{samples} time-series samples recorded; raise numerics.output_rate_hz or numerics.rotations")
+        drift = cage_speed_drift(result)
+        if drift is not None:
+            notes.append(drift)
         fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
         steps = int(summary.get("steps", 0) or 0)
         if fails and steps:
@@ -116,6 +124,22 @@ def check(result) -> list[str]:
                     "multibody.inner_ring=dynamic")
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def cage_speed_drift(result) -> str | None:
+    """A note when the cage speed of a fresh multibody run drifted over its recorded rotations by more
+    than :data:`MAX_CAGE_SPEED_DRIFT` of its mean (not statistically steady), else None."""
+    raw = getattr(result, "raw", None)
+    if not raw or raw.get("cage_w_start") is None:  # read back from an archive, or never recorded
+        return None
+    ws, we = float(raw["cage_w_start"]), float(raw["cage_w_end"])
+    mean = abs(float(result.summary.get("cage_speed_mean_rad_s", float("nan"))))
+    if not (math.isfinite(ws) and math.isfinite(we) and mean > 0) or abs(we - ws) <= MAX_CAGE_SPEED_DRIFT * mean:
+        return None
+    return (f"bearingsim: note: not statistically steady: the cage speed went from {ws:.4g} to {we:.4g} rad/s over "
+            f"the recorded rotations ({(we - ws) / mean:+.0%} of its mean {mean:.4g} rad/s); cage_slip and the "
+            f"impulses are means over a transient (more numerics.warmup_rotations, or check "
+            f"multibody.traction_mu_max and lubrication.drag_coefficient)")
 
 
 def _advice(p) -> str:

@@ -42,6 +42,24 @@ class Result:
 
     model = "?"
 
+    #: what an archive of this model holds, checked on read (:func:`bearingsim.archive.check_layout`):
+    #: archive path -> its dimensions, each a length or a name; arrays sharing a name share its length,
+    #: and :meth:`archive_dims` fixes some names from the scenario
+    LAYOUT: dict[str, tuple] = {}
+    #: sets of arrays of :attr:`LAYOUT` that are optional: all of a set or none
+    OPTIONAL: tuple[frozenset, ...] = ()
+    #: arrays of :attr:`LAYOUT` that hold text (the others hold numbers)
+    TEXT_ARRAYS: frozenset = frozenset()
+    #: the archive paths of the arrays the figures draw (``bearingsim plot`` reads only these)
+    FIGURE_DATA: tuple[str, ...] = ()
+    #: the keys of ``/results/summary`` that must be numbers (the figures and the CLI print them)
+    SUMMARY_NUMBERS: tuple[str, ...] = ()
+
+    @classmethod
+    def archive_dims(cls, scenario) -> dict[str, int]:
+        """The lengths of named dimensions of :attr:`LAYOUT` that ``scenario`` fixes."""
+        return {"rotations": scenario.numerics.rotations}
+
     def __init__(self, scenario, data: dict[str, NamedArray], groups: dict[str, AttrGroup],
                  series: dict[str, Series] | None = None, provenance: dict[str, Any] | None = None,
                  tables: dict[str, str] | None = None):
@@ -51,6 +69,7 @@ class Result:
         self.series = dict(series or {})
         self.provenance = dict(provenance or {})
         self.tables = dict(tables or {})
+        self.notes: list[str] = []  # one-line notes of a run that is plausible but not clean (simulation.run)
         self._parameters = None
 
     # --- the API ---------------------------------------------------------------------------

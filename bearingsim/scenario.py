@@ -10,6 +10,8 @@ offending key (dotted, e.g. ``bearing.pocket_clearance_mm``) and the file it cam
 from __future__ import annotations
 
 import copy
+import os
+import stat
 import math
 import tomllib
 from importlib import resources
@@ -109,6 +111,17 @@ MAX_DRAG_TO_LOAD = 1.0
 # i Z Lwe D cos a [N, mm], the load giving 4000 MPa at the most loaded contact. Beyond it the raceways
 # deform permanently (> 1e-4 D) and the elastic Palmgren contact law of both models does not hold.
 ISO76_C0_FACTOR = 44.0
+# Archard's wear coefficient k (Eq. 16) is dimensionless: the probability that an asperity contact
+# makes a wear particle, so below 1. The largest measured values, unlubricated mild steel on mild
+# steel, are ~1e-2 (Archard 1953, J. Appl. Phys. 24:981, Table 1: 7e-3); lubricated contacts are
+# 1e-6..1e-9. 0.1 leaves an order of magnitude above any measurement.
+MAX_WEAR_COEFFICIENT = 0.1
+# Radial (diametral, operating) clearance: the largest standard group of a cylindrical roller bearing,
+# ISO 5753-1 C5, is a few tenths of a per cent of the bore, 1..2 % of the roller diameter (0.1..0.2 mm
+# for the NU214's 13 mm rollers). 5 % of the roller diameter leaves room for a worn or special bearing;
+# beyond it the rings no longer hold the rollers (the load zone shrinks to one roller) and the models'
+# contact laws and steps are not made for it.
+MAX_RADIAL_CLEARANCE_TO_ROLLER = 0.05
 
 
 class _Section(BaseModel):
@@ -462,7 +475,15 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
     try:
         if "\x00" in str(path):
             raise UserError(f"{str(path)!r}: file name contains a NUL byte")
-        with open(p, "rb") as fh:  # bounded: /dev/zero or a huge file stops at once
+        # opened without blocking and refused unless a regular file: a FIFO would wait for a writer
+        # forever, a device (/dev/zero) is not a scenario; the read is bounded (a huge file stops at once)
+        fd = os.open(p, os.O_RDONLY | os.O_NONBLOCK)
+        with open(fd, "rb") as fh:
+            mode = os.fstat(fd).st_mode
+            if stat.S_ISDIR(mode):
+                raise IsADirectoryError
+            if not stat.S_ISREG(mode):
+                raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not a scenario file")
             data = fh.read(MAX_SCENARIO_BYTES + 1)
         if len(data) > MAX_SCENARIO_BYTES:
             raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")
@@ -475,13 +496,22 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
         raise UserError(f"{p}: is a directory, not a scenario file") from None
     except (OSError, UnicodeDecodeError) as exc:
         raise UserError(f"{p}: cannot read scenario file ({exc.__class__.__name__})") from None
+    return parse_toml_text(text, str(p))
+
+
+def parse_toml_text(text: str, where: str) -> dict[str, Any]:
+    """The scenario dictionary of TOML ``text`` (a file's, or an archive's ``/scenario``), read with the
+    limits of a scenario file: one-line :class:`UserError` naming ``where`` for text that is longer than
+    :data:`MAX_SCENARIO_BYTES`, not TOML, or nested deeper than :data:`MAX_NESTING_DEPTH`."""
+    if len(text) > MAX_SCENARIO_BYTES:
+        raise UserError(f"{where}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"{p}: not valid TOML ({exc})") from None
+        raise UserError(f"{where}: not valid TOML ({exc})") from None
     except RecursionError:
-        raise UserError(f"{p}: nested too deeply to be a scenario") from None
-    _check_depth(raw, str(p))
+        raise UserError(f"{where}: nested too deeply to be a scenario") from None
+    _check_depth(raw, where)
     return raw
 
 
@@ -661,6 +691,16 @@ def _check_limits(m: ScenarioModel, source: str) -> None:
     if not lo <= rho <= hi:
         raise UserError(f"{source}: bearing.roller_mass_kg: {b.roller_mass_kg:g} kg gives a roller density of "
                         f"{rho:.3g} kg/m^3, outside any roller material ({lo:g}..{hi:g} kg/m^3)")
+    if m.wear.wear_coefficient > MAX_WEAR_COEFFICIENT:
+        raise UserError(f"{source}: wear.wear_coefficient: {m.wear.wear_coefficient:g} is not an Archard wear "
+                        f"coefficient (dimensionless, a probability per asperity contact; measured values are "
+                        f"1e-9..1e-2, at most {MAX_WEAR_COEFFICIENT:g} accepted)")
+    limit = MAX_RADIAL_CLEARANCE_TO_ROLLER * b.roller_diameter_mm
+    if b.radial_clearance_mm > limit:
+        raise UserError(f"{source}: bearing.radial_clearance_mm: {b.radial_clearance_mm:g} mm is more than "
+                        f"{MAX_RADIAL_CLEARANCE_TO_ROLLER:.0%} of the roller diameter ({limit:.3g} mm); the largest "
+                        f"standard clearance (ISO 5753-1 C5) is 1..2 % of it")
+    _check_cage_inertia(b, source)
     lo, hi = HARDNESS_RANGE_PA
     if not lo <= m.wear.hardness_Pa <= hi:
         raise UserError(f"{source}: wear.hardness_Pa: {m.wear.hardness_Pa:g} Pa is outside the hardness of "
@@ -690,6 +730,18 @@ def _check_limits(m: ScenarioModel, source: str) -> None:
             raise UserError(f"{source}: numerics.output_rate_hz: {n.output_rate_hz:g} Hz gives {per_rotation:.3g} "
                             f"samples per cage rotation; at least {need} (2 per roller pass) are needed, use "
                             f">= {need / period:.3g} Hz")
+
+
+def _check_cage_inertia(b: "BearingSection", source: str) -> None:
+    """The cage is a ring between the raceways (or between its given diameters): the moment of inertia of
+    a ring of mass m between radii r_in and r_out lies between m r_in^2 and m r_out^2."""
+    r_out = 0.5e-3 * (b.cage_outer_diameter_mm or b.pitch_diameter_mm + b.roller_diameter_mm)
+    r_in = 0.5e-3 * (b.cage_inner_diameter_mm or b.pitch_diameter_mm - b.roller_diameter_mm)
+    lo, hi = b.cage_mass_kg * r_in**2, b.cage_mass_kg * r_out**2
+    if not lo <= b.cage_inertia_kgm2 <= hi:
+        raise UserError(f"{source}: bearing.cage_inertia_kgm2: {b.cage_inertia_kgm2:g} kg m^2 is impossible for a "
+                        f"{b.cage_mass_kg:g} kg cage ring between radii {r_in * 1e3:.4g} and {r_out * 1e3:.4g} mm "
+                        f"(m r_in^2 = {lo:.3g} .. m r_out^2 = {hi:.3g} kg m^2)")
 
 
 def _check_geometry(m: ScenarioModel, source: str) -> None:

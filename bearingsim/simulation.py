@@ -20,6 +20,10 @@ from bearingsim.parameters import Parameters
 from bearingsim.scenario import Scenario
 
 
+#: the models, by the name a scenario and an archive give
+MODELS = ("reduced", "multibody")
+
+
 def model_module(name: str):
     """The module of a model: ``simulate(parameters, sink=None, progress=False, dt=None)`` and its
     result class ``RESULT``."""
@@ -36,11 +40,18 @@ def model_module(name: str):
     raise UserError(f"model {name!r}: unknown (reduced, multibody)")
 
 
-def load(path):
-    """Read an archive back into the result class of its model."""
+def load(path, only=None):
+    """Read an archive back into the result class of its model (``only``: the datasets to read, see
+    :func:`bearingsim.archive.read`; None: all)."""
     from bearingsim import archive
 
-    return archive.read(path, model_module(archive.model_of(path)).RESULT)
+    return archive.read(path, model_module(archive.model_of(path)).RESULT, only=only)
+
+
+#: what each archive command reads besides the scenario, the summary and the provenance
+#: (``show`` prints the scenario; ``compare`` and ``rerun`` compare summaries and per-rotation arrays)
+SCENARIO_ONLY: tuple[str, ...] = ()
+COMPARED = ("results/per_rotation",)
 
 
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):
@@ -51,13 +62,24 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     scenario : resolved scenario (:func:`bearingsim.load_scenario`).
     progress : show a progress bar on stderr (multibody runs).
     sink : where time series are streamed (default: kept in memory with the result).
-    dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice.
+    dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice; it becomes the scenario's
+        ``numerics.dt_s`` (validated as that key, and stored with the result, so its archive reruns it).
+
+    The checks are those of ``bearingsim run``: the step is validated as a scenario key, and a finished
+    run that is not plausible (:func:`bearingsim.plausibility.check`) raises
+    :class:`bearingsim.errors.SimulationUnstable`; the one-line notes of a plausible run that is not
+    clean are in ``result.notes`` (the command line prints them).
     """
+    from bearingsim import plausibility
+
     t0 = time.perf_counter()
+    if dt is not None:
+        scenario = scenario.replace(**{"numerics.dt_s": dt})
     params = Parameters.from_scenario(scenario)
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
     result.provenance["wall_time_s"] = time.perf_counter() - t0
+    result.notes = plausibility.check(result)
     return result
 
 
@@ -132,7 +154,7 @@ def run_scenario(
     force : replace an archive of a different scenario at ``out`` (default: refused,
         :func:`check_same_scenario`; a rerun of the same scenario replaces its archive)
     """
-    from bearingsim import archive, outputs, plausibility
+    from bearingsim import archive, outputs
     from bearingsim.errors import UserError
 
     out = Path(out) if out is not None else default_output(scenario)
@@ -145,9 +167,9 @@ def run_scenario(
         if exclusive:
             outputs.clean_stale_temporaries(out.parent)
         with archive.Spool(out) as spool:
-            result = run(scenario, progress=progress, sink=spool)
-            for note in plausibility.check(result):  # exit 3 before anything is written
-                if notes:
+            result = run(scenario, progress=progress, sink=spool)  # checked: exit 3 before anything is written
+            if notes:
+                for note in result.notes:
                     print(note, file=sys.stderr)
             archive.write(result, out, spool)
         pngs = []

@@ -166,6 +166,33 @@ class MultibodyResult(Result):
 
     model = "multibody"
     FIGURES = ("forces", "impulses", "orbit", "wear")
+    _PER_ROTATION = ("I_acc", "I_dec", "Jn_front", "Jn_rear", "Jf_front", "Jf_rear", "slide_work_front",
+                     "slide_work_rear", "first_impact_speed")
+    _LAND = ("land_normal", "land_friction", "land_torque")
+    _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation")
+    LAYOUT = {
+        **{f"results/per_rotation/{c}": ("rotations", "pockets") for c in _PER_ROTATION},
+        **{f"results/per_rotation/{c}": ("rotations",) for c in _LAND},
+        "results/theta_deg": ("theta bins",),
+        **{f"results/{c}": ("theta bins", "pockets") for c in ("force_vs_theta", "force_vs_theta_acc",
+                                                                "force_vs_theta_dec")},
+        "results/raceway_load_inner": ("theta bins",), "results/raceway_load_outer": ("theta bins",),
+        **{f"results/wear/{c}": ("pockets",) for c in ("paper_index_front", "paper_index_rear",
+                                                       "sliding_work_front", "sliding_work_rear")},
+        "results/cage_orbit": ("orbit samples", 3),
+        **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
+    }
+    OPTIONAL = (frozenset(f"results/per_rotation/{c}" for c in _LAND),  # a land-guided cage
+                frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}))  # a scene with a ring
+    TEXT_ARRAYS = frozenset({"results/impacts/face"})
+    SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m")  # no ring: absent
+    FIGURE_DATA = ("results/theta_deg", "results/force_vs_theta_acc", "results/force_vs_theta_dec",
+                   "results/per_rotation/I_acc", "results/per_rotation/I_dec", "results/cage_orbit", "results/wear")
+
+    @classmethod
+    def archive_dims(cls, scenario) -> dict[str, int]:
+        return {"rotations": scenario.numerics.rotations, "pockets": scenario.bearing.roller_count,
+                "theta bins": THETA_BINS}
 
     def __init__(self, *args, raw=None, **kw):
         super().__init__(*args, **kw)

@@ -72,6 +72,23 @@ class ReducedResult(Result):
 
     model = "reduced"
     FIGURES = ("pass",)
+    _TRACE = ("theta_deg", "l_r", "dl_r_dt", "I_dec_cumulative")
+    _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation",
+                "zeno_closure")
+    LAYOUT = {
+        "results/per_rotation/I_dec": ("rotations", "pockets"),
+        "results/per_rotation/I_acc": ("rotations", "pockets"),
+        **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
+        **{f"results/trace/{c}": ("trace points",) for c in _TRACE},
+    }
+    OPTIONAL = (frozenset(f"results/trace/{c}" for c in _TRACE),)
+    TEXT_ARRAYS = frozenset({"results/impacts/face"})
+    SUMMARY_NUMBERS = tuple(SUMMARY_UNITS)
+    FIGURE_DATA = ("results/trace",)
+
+    @classmethod
+    def archive_dims(cls, scenario) -> dict[str, int]:
+        return {"rotations": scenario.numerics.rotations, "pockets": 1}  # one pocket, its pass repeated
 
     def __init__(self, *args, inputs: PassInputs | None = None, solution: PassSolution | None = None, **kw):
         super().__init__(*args, **kw)

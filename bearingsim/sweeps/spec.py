@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -37,6 +38,10 @@ from bearingsim.errors import UserError
 from bearingsim.scenario import load_scenario, parse_override, read_toml_file
 
 SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
+# Most cases in one sweep: ten times the 100 x 100 map of scenarios/sweeps/. Each case is resolved and
+# held as a row before the first runs, and writes an archive (~90 kB for the reduced model: 100000 cases
+# are ~9 GB on disk and ~1 GB of resolved scenarios in memory); more is a run to split into sweeps.
+MAX_SWEEP_CASES = 100_000
 
 
 @dataclass(frozen=True)
@@ -147,6 +152,9 @@ class _Range:
         ends_ok = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop))
         if not (num_ok and ends_ok):
             raise UserError(f"{where}: {{ start, stop, num }} needs numbers and an integer num >= 1")
+        if num > MAX_SWEEP_CASES:
+            raise UserError(f"{where}: num = {num} is more than the {MAX_SWEEP_CASES} cases a sweep may have; "
+                            "split it into several sweeps")
         return [float(x) for x in np.linspace(float(start), float(stop), num)]
 
 
@@ -240,6 +248,13 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
                 raise UserError(f"{where}: cases[{i}]: {k}: given both as an override and in an extra case")
     if not spec.axes and not spec.extra:
         raise UserError(f"{where}: nothing to sweep (no axes and no cases)")
+    sizes = [len(v) for _, v in spec.axes]
+    total = (math.prod(sizes) if spec.mode != "zip" else max(sizes)) if sizes else 0
+    total += len(spec.extra)
+    if total > MAX_SWEEP_CASES:  # counted before any case is built
+        shape = (" x " if spec.mode != "zip" else ", ").join(f"{k} ({n})" for (k, _), n in zip(spec.axes, sizes))
+        raise UserError(f"{where}: {total} cases ({shape or 'extra cases'}) are more than the {MAX_SWEEP_CASES} a "
+                        "sweep may have; split it into several sweeps")
     points: list[dict[str, Any]] = []
     if spec.axes:
         if spec.mode == "zip":

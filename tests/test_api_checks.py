@@ -1,0 +1,53 @@
+"""The Python API accepts and refuses what ``bearingsim run`` accepts and refuses (issue 30, item 10):
+``bearingsim.run`` validates its ``dt`` as the scenario key ``numerics.dt_s`` and applies the
+plausibility checks of a finished run (:mod:`bearingsim.plausibility`) itself; the command line
+only prints what it raises."""
+from __future__ import annotations
+
+import pytest
+
+import bearingsim
+
+from .conftest import SCENARIOS
+from .test_cli import bearingsim as cli
+
+PAPER = SCENARIOS / "paper_3000rpm.toml"
+MULTIBODY = SCENARIOS / "multibody_3000rpm.toml"
+RIGID = ["multibody.raceway_contact=rigid", "numerics.rotations=1"]
+
+
+@pytest.mark.parametrize("dt", [-1.0, 0.0, 0, "x"])
+def test_run_refuses_a_step_the_scenario_key_refuses(dt):
+    """Was: euler with dt=-1.0 returned zero impulses and a NaN first impact; dt=0 ZeroDivisionError."""
+    sc = bearingsim.load_scenario(PAPER, set={"reduced.method": "euler"})
+    with pytest.raises(bearingsim.UserError, match="numerics.dt_s"):
+        bearingsim.run(sc, dt=dt)
+
+
+@pytest.mark.parametrize("dt", [-1.0, 0.0])
+def test_multibody_run_refuses_a_step_the_scenario_key_refuses(dt):
+    """Was: dt=-1.0 ran backwards in time and stopped with "the cage centre moved 9807 mm off the bearing
+    axis at t = -2 s ... widen the faces" (SimulationUnstable naming the wrong key)."""
+    sc = bearingsim.load_scenario(MULTIBODY, overrides=RIGID)
+    with pytest.raises(bearingsim.UserError, match="numerics.dt_s"):
+        bearingsim.run(sc, dt=dt)
+
+
+def test_run_with_dt_stores_it_in_the_scenario():
+    """The step a run was given is the scenario's ``numerics.dt_s``: its archive reruns the same run."""
+    sc = bearingsim.load_scenario(PAPER, set={"reduced.method": "euler"})
+    r = bearingsim.run(sc, dt=2e-6)
+    assert r.scenario.numerics.dt_s == 2e-6 and r.provenance["dt_s"] == 2e-6
+    same = bearingsim.run(bearingsim.load_scenario(PAPER, set={"reduced.method": "euler", "numerics.dt_s": 2e-6}))
+    assert same.summary == r.summary
+
+
+def test_an_implausible_run_is_refused_by_the_api_as_by_the_cli(tmp_path):
+    """Rigid raceways at dt = 10 s: was I_dec = 0 from the API while the CLI exits 3."""
+    sc = bearingsim.load_scenario(MULTIBODY, overrides=RIGID)
+    with pytest.raises(bearingsim.SimulationUnstable) as api:
+        bearingsim.run(sc, dt=10.0)
+    res = cli("run", MULTIBODY, *[a for s in RIGID for a in ("--set", s)], "--set", "numerics.dt_s=10",
+              "-o", tmp_path / "o.h5", "--no-plots")
+    assert res.returncode == 3 and str(api.value) in res.stderr, res.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -146,15 +146,15 @@ def test_cage_that_escapes_its_pockets_is_stopped_and_not_written(tmp_path):
 
 
 def test_automatic_dt_restart_is_recorded():
-    """The 0.02 mm pocket at 6000 rpm needs a shorter step than the automatic estimate (an approach of
-    ~0.16 m/s against a 20 um clearance overlaps the face by 0.42 um at the automatic 2.7 us, twice the
+    """The 0.02 mm pocket at 20000 rpm needs a shorter step than the automatic estimate (an approach
+    overlaps the 20 um clearance's face by 0.67 um at the automatic step, more than three times the
     1 % bound; at 3000 rpm the exact pocket faces keep it within the bound): the run restarts at a step
     scaled to the measured overlap, ends within the 1 % bound, and the archive's dt_choice says how the
     first step was chosen and why it was shortened."""
     from bearingsim.simulation import run as simulate
 
     sc = load_scenario(SCENARIOS / "hard" / "multibody_clearance_0.02mm.toml",
-                       [*REDUCED_LENGTH, "operating.inner_ring_speed_rpm=6000"])
+                       [*REDUCED_LENGTH, "operating.inner_ring_speed_rpm=20000"])
     r = simulate(sc)
     how = r.provenance["dt_choice"]
     assert how.startswith("auto:") and "restarted at dt" in how, how

@@ -153,8 +153,8 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
 
 
 def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figures=()) -> None:
-    """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``) or archives
-    in ``cases/`` that the new one does not have. Resuming the same sweep (or one that only adds cases)
+    """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``; failed ones,
+    which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same sweep (or one that only adds cases)
     passes. With ``force`` the other sweep's case archives and the sweep figures ``figures`` are removed
     instead, so that nothing of it is mixed into the new one (the index is rewritten by the sweep)."""
     from bearingsim import archive
@@ -165,7 +165,11 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figur
     index = outdir / "sweep.h5"
     if archive.is_table_file(index, INDEX_FORMAT):
         with contextlib.suppress(UserError, OSError, KeyError, ValueError):
-            old |= {str(h) for h in read_index(index)[0].get("case", [])}
+            cols = read_index(index)[0]
+            status = [str(x) for x in cols.get("status", [])]
+            # a failed case left no result to mix in: the same study run again with it mended resumes
+            old |= {str(h) for k, h in enumerate(cols.get("case", []))
+                    if not (k < len(status) and status[k] == "failed")}
     cases_dir = outdir / "cases"
     if cases_dir.is_dir() and not cases_dir.is_symlink():
         old |= {p.stem for p in cases_dir.glob("*.h5")}

@@ -203,7 +203,7 @@ def geometry_lines(rows: list[dict]) -> list[str]:
     """The polyline faces' I_dec error against the exact faces, and the exact faces' cost ratio."""
     lines = []
     for r in rows:
-        if r["scene"].startswith("full_polyline_"):
+        if r["scene"].startswith("full_polyline_") and "signed_error" in r:  # (not the cost rows)
             n_seg = r["scene"].rsplit("_", 1)[1]
             lines.append(f"3000 rpm, {n_seg:>2} segments per face: I_dec {r['I_dec_Ns'] * 1e3:.2f} mN s, "
                          f"{r['signed_error']:+.1%} off the exact faces' (their standard error {r['sem_rel']:.1%}), "

@@ -59,3 +59,26 @@ def test_bench_is_not_in_the_installed_package_and_runs_from_a_checkout(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "source checkout" in err
     assert not (tmp_path / "b").exists()
+
+
+def test_geometry_and_cost_lines_read_their_own_rows():
+    """The multibody bench's goal lines: a polyline row says its signed error against the exact faces and
+    their standard error; the cost rows give the exact faces' ratio against the 3-segment polyline and
+    judge it against 1.2 (met at 1.1, not met at 1.3); the cost rows' own polyline twin and a row stopped
+    at too long a step are not read as geometric rows."""
+    from benchmarks.multibody_bench import geometry_lines, goal_lines
+
+    nan = float("nan")
+    base = dict(model="multibody", method="pymunk", dt_s=4e-6, pymunk_step_s=0.05, rel_error=nan)
+    rows = [dict(base, scene="full_polyline_5", rpm=3000, I_dec_Ns=0.0183, wall_s=0.2, signed_error=0.274,
+                 sem_rel=0.004),
+            dict(base, scene="full", rpm=1000, I_dec_Ns=0.027, wall_s=0.55, cost_ratio=1.1),
+            dict(base, scene="full_polyline_3", rpm=1000, I_dec_Ns=0.037, wall_s=0.5, cost_ratio=nan),
+            dict(base, scene="full_rigid_raceways", rpm=6000, I_dec_Ns=0.018, wall_s=0.026, cost_ratio=1.3),
+            dict(base, scene="full", rpm=6000, I_dec_Ns=nan, wall_s=nan, notes="stopped: overlap")]
+    lines = geometry_lines(rows)
+    assert len(lines) == 3
+    assert "5 segments per face" in lines[0] and "+27.4% off the exact faces'" in lines[0] and "0.4%" in lines[0]
+    assert "1.10 x the 3-segment polyline" in lines[1] and "met" in lines[1] and "not met" not in lines[1]
+    assert "1.30 x" in lines[2] and "not met" in lines[2]
+    assert goal_lines(rows)[:3] == lines

@@ -83,8 +83,14 @@ def _cmd_plot(args) -> int:
         from bearingsim.sweeps import plot_sweep_index
 
         folder = check_writable_dir(args.output) if args.output else path.parent
-        for png in plot_sweep_index(path, folder):
+        notes: list[str] = []
+        written = plot_sweep_index(path, folder, notes=notes)
+        for png in written:
             print(f"wrote {png}")
+        if not written:  # nothing drawn: say why, in one line, and fail
+            raise UserError(f"{path}: no figure written: " + "; ".join(notes))
+        for line in notes:
+            print(f"bearingsim: note: {line}", file=sys.stderr)
         return 0
     from bearingsim.simulation import model_module
 

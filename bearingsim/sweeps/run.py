@@ -53,6 +53,7 @@ class SweepOutcome:
     interrupted: int | None = None  # the signal number, if interrupted
     wall_s: float = 0.0
     figures: list[Path] = field(default_factory=list)
+    figure_notes: list[str] = field(default_factory=list)  # why a figure was not drawn, one line each
 
     def count(self, status: str) -> int:
         return sum(r["status"] == status for r in self.rows)
@@ -362,7 +363,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
 
-        outcome.figures = plot_sweep_index(outcome.h5, outdir)
+        outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
     return outcome
 
 
@@ -397,6 +398,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
         print(f"wrote {out.h5}")
         for p in out.figures:
             print(f"wrote {p}")
+        for line in out.figure_notes:
+            print(f"bearingsim: note: {line}", file=sys.stderr)
         print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
     if out.failed:
         names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"

@@ -39,6 +39,12 @@ def _cmd_run(args) -> int:
     _refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
+    if not args.quiet:
+        from bearingsim.scenario import given_keys, unused_note
+
+        note = unused_note(scenario.model, given_keys(args.scenario, args.set))
+        if note:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force)

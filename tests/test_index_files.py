@@ -88,3 +88,29 @@ def test_param_inline_table_is_not_split_at_its_commas(tmp_path):
     res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "contact={restitution = 0.5, friction = 0.1}",
                      "-o", tmp_path, "-j", "1")
     assert_user_error(res, "contact={'restitution': 0.5, 'friction': 0.1}")  # the table whole, not '{restitution = 0.5'
+
+
+def test_keys_the_reduced_model_does_not_use_are_noted(tmp_path):
+    base = SCENARIOS / "paper_3000rpm.toml"
+    res = bearingsim("run", base, "--set", "bearing.cage_guidance=outer_land", "--set", "numerics.rotations=1",
+                     "--set", "bearing.cage_land_clearance_mm=0.5", "--no-plots", "-o", tmp_path / "a.h5")
+    assert res.returncode == 0, res.stderr
+    notes = [line for line in res.stderr.splitlines() if line.strip()]
+    assert notes == ["bearingsim: note: bearing.cage_guidance, bearing.cage_land_clearance_mm: not used by the "
+                     "reduced model (no effect on the run)"]
+    res = bearingsim("sweep", base, "--param", "multibody.raceway_contact=rigid,hertz", "--set", "numerics.rotations=1",
+                     "--no-plots", "-o", tmp_path / "s", "-j", "1")
+    assert res.returncode == 0, res.stderr
+    assert [line for line in res.stderr.splitlines() if "note" in line] == [
+        "bearingsim: note: multibody.raceway_contact: not used by the reduced model (no effect on the run)"]
+    # keys the model uses: no note
+    res = bearingsim("run", base, "--set", "numerics.rotations=1", "--no-plots", "-o", tmp_path / "b.h5")
+    assert res.returncode == 0 and "note" not in res.stderr, res.stderr
+
+
+def test_unused_keys_per_model():
+    from bearingsim.scenario import unused_keys
+
+    keys = ["multibody.scene", "bearing.cage_guidance", "bearing.pocket_clearance_mm", "reduced.load_zone_half_angle_deg"]
+    assert unused_keys("reduced", keys) == ["multibody.scene", "bearing.cage_guidance"]
+    assert unused_keys("multibody", keys) == []  # its reduced-equivalent scene reads reduced.*

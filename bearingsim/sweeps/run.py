@@ -379,6 +379,13 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     from bearingsim.sweeps.spec import spec_from_args
 
     spec = spec_from_args(target, params, sets)
+    if not quiet:  # keys that change nothing in the base scenario's model (unless the model is swept too)
+        from bearingsim.scenario import given_keys, load_scenario, unused_note
+
+        keys = given_keys(spec.scenario, spec.sets) + spec.keys
+        note = None if "model" in spec.keys else unused_note(load_scenario(spec.scenario, spec.sets).model, keys)
+        if note:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")

@@ -114,3 +114,27 @@ def test_unused_keys_per_model():
     keys = ["multibody.scene", "bearing.cage_guidance", "bearing.pocket_clearance_mm", "reduced.load_zone_half_angle_deg"]
     assert unused_keys("reduced", keys) == ["multibody.scene", "bearing.cage_guidance"]
     assert unused_keys("multibody", keys) == []  # its reduced-equivalent scene reads reduced.*
+
+
+def test_every_summary_key_is_documented_with_its_unit():
+    import re
+
+    from bearingsim import multibody, reduced
+    from bearingsim.sweeps.worker import standard_errors
+    from .conftest import ROOT
+
+    text = (ROOT / "docs" / "archive.md").read_text()
+    table = text[text.index("### Summary attributes"):text.index("## Sign conventions")]
+    rows = {}
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3:
+            for name in re.findall(r"`([a-zA-Z_]+)`", cells[0]):
+                rows[name] = cells[1]
+    units = {**reduced.SUMMARY_UNITS, **multibody.SUMMARY_UNITS, **multibody.RIGID_SUMMARY_UNITS,
+             **multibody.LAND_SUMMARY_UNITS, **{k: "N s" for k in standard_errors([1.0, 2.0], [1.0, 2.0])}}
+    missing = [k for k in [*units, "scene", "pockets"] if k not in rows and k not in table]
+    assert missing == []
+    wrong = {k: (rows[k], u) for k, u in units.items() if k in rows and rows[k] != u}
+    assert wrong == {}
+    assert "total over all recorded steps" in table  # land_torque_impulse_Nms is a run total, unlike the others

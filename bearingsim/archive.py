@@ -803,6 +803,32 @@ def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, An
     return cols, attrs
 
 
+def table_units(path) -> dict[str, str]:
+    """The ``unit`` of every column of a table file (:func:`write_table_file`) that has one."""
+    h5py = _lazy_h5py()
+    with h5py.File(Path(path), "r") as f:
+        return {name: _plain(ds.attrs["unit"]) for name, ds in f["index"].items() if "unit" in ds.attrs}
+
+
+def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[str], lines: list[str]) -> str:
+    """Listing of an index table (a sweep's ``sweep.h5``, a cross-check's ``crosscheck.h5``): what it is,
+    how many rows and by status, the ``lines`` the caller adds, then every column with its unit."""
+    n = len(cols[columns[0]]) if columns else 0
+    status = cols.get("status")
+    by = {}
+    for v in (status if status is not None else []):
+        by[str(v)] = by.get(str(v), 0) + 1
+    counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
+    units = table_units(path)
+    out = [f"{path}: {what}: {n} cases{counts}", *lines, "columns:"]
+    for c in columns:
+        arr = np.asarray(cols[c])
+        kind = "text" if arr.dtype.kind in "OUS" else "number"
+        unit = units.get(c, "")
+        out.append(f"  {c:32s} {kind}" + (f" [{unit}]" if unit and unit != "1" else ""))
+    return "\n".join(out)
+
+
 def is_table_file(path, fmt: str) -> bool:
     """True when ``path`` is a table of format ``fmt`` (:func:`write_table_file`)."""
     try:

@@ -39,6 +39,12 @@ def _cmd_run(args) -> int:
     _refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
+    if not args.quiet:
+        from bearingsim.scenario import given_keys, unused_note
+
+        note = unused_note(scenario.model, given_keys(args.scenario, args.set))
+        if note:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force)
@@ -50,16 +56,51 @@ def _cmd_run(args) -> int:
     return 0
 
 
+def _describe_index(path) -> tuple[str, str | None] | None:
+    """(description, scenario TOML or None) of bearingsim's own index files (``sweep.h5``,
+    ``crosscheck.h5``); None for any other file."""
+    import json
+
+    from bearingsim import archive
+    from bearingsim.studies import crosscheck
+    from bearingsim.sweeps.index import INDEX_FORMAT, read_index
+
+    if archive.is_table_file(path, INDEX_FORMAT):
+        cols, meta = read_index(path)
+        n, total = meta["grid_rows"], len(cols["case"])
+        lines = [f"sweep mode {meta.get('mode', '?')}; base scenario {meta.get('scenario') or '(none)'}",
+                 "swept keys: " + (", ".join(meta["axes"]) or "(none)"),
+                 f"grid of {', '.join(meta['grid']) or '(no axes)'}: {n} cases; extra cases: {total - n}",
+                 "each case's archive: the 'archive' column (relative to this folder); "
+                 "'bearingsim show' of a case archive gives its scenario"]
+        return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
+                                      meta["columns"], lines), None
+    if archive.is_table_file(path, crosscheck.INDEX_FORMAT):
+        cols, meta = archive.read_table_file(path, crosscheck.INDEX_FORMAT)
+        columns = json.loads(meta["columns"])
+        lines = [f"scenario {meta.get('scenario_name', '?')} (its TOML: 'bearingsim show {path}')",
+                 "speeds [rpm]: " + ", ".join(f"{v:g}" for v in sorted(set(cols["rpm"].tolist())))]
+        return archive.describe_table(path, "bearingsim cross-check table (one row per rung and speed)", cols,
+                                      columns, lines), meta.get("scenario")
+    return None
+
+
 def _cmd_inspect(args) -> int:
     from bearingsim.archive import describe
 
-    print(describe(args.archive))
+    index = _describe_index(args.archive)
+    print(index[0] if index is not None else describe(args.archive))
     return 0
 
 
 def _cmd_show(args) -> int:
     from bearingsim.simulation import SCENARIO_ONLY, load as read
 
+    index = _describe_index(args.archive)
+    if index is not None:  # an index file: its scenario if it stores one, else what it is (as TOML comments)
+        text, toml = index
+        sys.stdout.write(toml if toml else "".join(f"# {line}\n" for line in text.splitlines()))
+        return 0
     sys.stdout.write(read(args.archive, only=SCENARIO_ONLY).scenario.to_toml())
     return 0
 
@@ -83,8 +124,14 @@ def _cmd_plot(args) -> int:
         from bearingsim.sweeps import plot_sweep_index
 
         folder = check_writable_dir(args.output) if args.output else path.parent
-        for png in plot_sweep_index(path, folder):
+        notes: list[str] = []
+        written = plot_sweep_index(path, folder, notes=notes)
+        for png in written:
             print(f"wrote {png}")
+        if not written:  # nothing drawn: say why, in one line, and fail
+            raise UserError(f"{path}: no figure written: " + "; ".join(notes))
+        for line in notes:
+            print(f"bearingsim: note: {line}", file=sys.stderr)
         return 0
     from bearingsim.simulation import model_module
 
@@ -291,11 +338,12 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     r.set_defaults(func=_cmd_run)
 
-    i = sub.add_parser("inspect", help="print what an archive holds")
+    i = sub.add_parser("inspect", help="print what an archive, a sweep.h5 or a crosscheck.h5 holds")
     i.add_argument("archive")
     i.set_defaults(func=_cmd_inspect)
 
-    sh = sub.add_parser("show", help="print the scenario stored in an archive as TOML (a runnable scenario file)")
+    sh = sub.add_parser("show", help="print the scenario stored in an archive or crosscheck.h5 as TOML (a runnable "
+                                     "scenario file); for a sweep.h5, what it holds as TOML comments")
     sh.add_argument("archive")
     sh.set_defaults(func=_cmd_show)
 
@@ -346,8 +394,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("sweep", help="what-if sweep: resumable, failures recorded, local pool or dask cluster")
     s.add_argument("scenario", help="scenario TOML (with --param) or sweep file (README: Sweeps)")
-    s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...",
-                   help="key and the values to sweep (repeatable: the grid is the product)")
+    s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...|KEY=START:STOP:NUM",
+                   help="key and the values to sweep, as a list (values as TOML; commas inside [ ], { } or "
+                        "quotes do not split) or as a range START:STOP:NUM of NUM evenly spaced numbers, both "
+                        "ends included, e.g. operating.inner_ring_speed_rpm=500:6000:12 (repeatable: the grid "
+                        "is the product)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key in every case (repeatable)")
     s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, cases/, figures)")

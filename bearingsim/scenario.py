@@ -567,6 +567,39 @@ _TITLE_SKIP_MODEL = {
                 "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction"),
     "multibody": ("reduced.",),
 }
+# keys a model reads nothing of (set in a scenario of that model they change nothing): the reduced model
+# has no multibody scene, no cage rim and no lands. (The multibody model reads reduced.* in its
+# reduced-equivalent scene, so nothing is listed for it.)
+UNUSED_BY_MODEL = {
+    "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
+                "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction"),
+}
+
+
+def unused_keys(model: str, keys) -> list[str]:
+    """The keys among ``keys`` (dotted) that ``model`` does not use, in order, each once."""
+    prefixes = UNUSED_BY_MODEL.get(model, ())
+    out = []
+    for k in keys:
+        if k not in out and any(k == p or (p.endswith(".") and k.startswith(p)) for p in prefixes):
+            out.append(k)
+    return out
+
+
+def unused_note(model: str, keys) -> str | None:
+    """One line saying which of ``keys`` have no effect in ``model`` (None if all are used)."""
+    unused = unused_keys(model, keys)
+    if not unused:
+        return None
+    return f"{', '.join(unused)}: not used by the {model} model (no effect on the run)"
+
+
+def given_keys(path, overrides=()) -> list[str]:
+    """Every dotted key a scenario file and its ``KEY=VALUE`` overrides set (not its preset's or the
+    defaults': those are the model's own)."""
+    return list(_flat(read_toml_file(path))) + [parse_override(o)[0] for o in overrides]
+
+
 # compact wording of the differences most often made (others: ``key = value`` by the key's last part)
 _TITLE_LABELS = {
     "multibody.raceway_contact": lambda v: f"raceway {v}",

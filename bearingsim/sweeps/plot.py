@@ -1,13 +1,22 @@
 """Figures of a sweep, drawn from its index (``sweep.h5``) alone.
 
-* one numeric axis: I_dec and I_acc per cage rotation against the swept value, with error bars of one
-  standard error (``I_*_sem_Ns``; see :func:`bearingsim.sweeps.worker.standard_errors`);
-* two numeric axes (a product grid): a heat map of I_dec per cage rotation;
-* more axes: one line per combination of the other axes (at most 8), else no figure;
-* zipped axes: a line plot against the first of them. Explicit extra cases are not drawn.
+Every sweep draws something, or says in one line (the ``notes``) why a figure could not be drawn:
 
-Axes are labelled with the parameter's name and unit, read from the key's unit suffix.
-Failed and not-run cases are gaps (NaN), never zeros.
+* the grid of its axes (``sweep_I.png`` or ``sweep_map.png``), I_dec and I_acc per cage rotation in two
+  panels, error bars of one standard error (``I_*_sem_Ns``; see
+  :func:`bearingsim.sweeps.worker.standard_errors`):
+
+  - one axis, or zipped axes: a line plot against the (first numeric) axis;
+  - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
+    sampled pair, the sampled values ticked and each cell's value written in it;
+  - otherwise: one line per combination of the other axes (at most 8).
+
+  A text key (``bearing.cage_guidance``) is a categorical axis: its values in the order swept.
+* explicit extra ``[[cases]]`` (or a sweep of cases alone): a per-case chart of every case
+  (``sweep_cases.png``), each labelled with its swept values.
+
+Titles name the sweep by its varied keys. Axes are labelled with the parameter's name and unit, read
+from the key's unit suffix. Failed and not-run cases are gaps (NaN), never zeros.
 """
 from __future__ import annotations
 
@@ -19,9 +28,12 @@ import numpy as np
 from bearingsim.sweeps.index import name_of, read_index, unit_of
 
 #: every figure a sweep may draw into its folder (a sweep checks them before it starts)
-FIGURE_NAMES = ("sweep_I.png", "sweep_map.png")
+FIGURE_NAMES = ("sweep_I.png", "sweep_map.png", "sweep_cases.png")
 
 MAX_LINES = 8
+MAX_CASES = 60  # most cases a per-case chart labels one by one
+QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
+Y_LABEL = "per pocket and cage rotation [mN s]"
 
 
 def axis_label(key: str) -> str:
@@ -34,7 +46,35 @@ def _numeric(col) -> bool:
     return np.asarray(col).dtype.kind == "f"
 
 
-def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None) -> list[Path]:
+def _present(col) -> np.ndarray:
+    """Rows where a key has a value (numbers: finite; text: non-empty)."""
+    col = np.asarray(col)
+    return np.isfinite(col) if _numeric(col) else np.array([str(v) != "" for v in col], dtype=bool)
+
+
+def _sampled(col, rows) -> list:
+    """The distinct values of a key over ``rows``: sorted numbers, or text in the order swept."""
+    vals = [col[i] for i in rows]
+    if _numeric(col):
+        return sorted({float(v) for v in vals if math.isfinite(v)})
+    return list(dict.fromkeys(str(v) for v in vals if str(v) != ""))
+
+
+def sweep_title(meta: dict, n_cases: int) -> str:
+    """``sweep of inner ring speed × pocket clearance (12 cases)``: the sweep's varied keys."""
+    keys = list(meta.get("axes", []))
+    grid = list(meta.get("grid", []))
+    sep = " × " if meta.get("mode") == "product" else ", "
+    names = sep.join(name_of(k) for k in grid) if grid else ""
+    extra = [k for k in keys if k not in grid]
+    if extra:
+        names = (names + "; " if names else "") + "cases over " + ", ".join(name_of(k) for k in extra)
+    zipped = " (zipped)" if meta.get("mode") == "zip" and len(grid) > 1 else ""
+    return f"sweep of {names or 'cases'}{zipped} ({n_cases} cases)"
+
+
+def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
+                     notes: list[str] | None = None) -> list[Path]:
     """Draw the sweep's figures from its index and return the PNG paths written.
 
     Parameters
@@ -42,65 +82,95 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None) -
     index_path : path
         The sweep's ``sweep.h5``.
     outdir : path, optional
-        Folder for the PNGs (default: the index's folder). Files are ``sweep_I.png`` (line plot)
-        or ``sweep_map.png`` (heat map).
+        Folder for the PNGs (default: the index's folder): ``sweep_I.png`` (lines), ``sweep_map.png``
+        (heat maps) and, with extra cases, ``sweep_cases.png`` (per-case chart).
+    notes : list, optional
+        Receives one line for each figure that could not be drawn, and why.
     """
     from bearingsim.plotting import plt
 
+    notes = notes if notes is not None else []
     index_path = Path(index_path)
     outdir = Path(outdir) if outdir is not None else index_path.parent
     outdir.mkdir(parents=True, exist_ok=True)
     cols, meta = read_index(index_path)
-    n = meta["grid_rows"]
-    cols = {k: v[:n] for k, v in cols.items()}  # the grid only; explicit extra cases are not on it
-    numeric = [k for k in meta["grid"] if _numeric(cols[k]) and np.isfinite(cols[k]).any()]
-    if not numeric or "I_dec_mean_Ns" not in cols or n == 0:
+    total = len(cols["case"])
+    n = min(meta["grid_rows"], total)
+    if "I_dec_mean_Ns" not in cols or not np.isfinite(cols["I_dec_mean_Ns"]).any():
+        notes.append("no figure: no case has a result (every case failed or was not run)")
         return []
-    title = f"sweep of {Path(str(meta.get('scenario', ''))).stem or 'cases'}"
-    if meta.get("mode") == "zip":  # zipped axes move together: the first numeric one is the abscissa
-        title += " (zipped with " + ", ".join(
-            f"{name_of(k)} {np.nanmin(cols[k]):g}–{np.nanmax(cols[k]):g}" for k in numeric[1:]) + ")" \
-            if len(numeric) > 1 else ""
-        axes = numeric[:1]
-    elif len(meta["grid"]) == 2 and len(numeric) == 2:
-        return [_heat_map(plt, cols, numeric, outdir / "sweep_map.png", title)]
-    else:  # abscissa: the first numeric axis; one line per value of the others (text values too)
-        axes = numeric[:1] + [k for k in meta["grid"] if k != numeric[0]]
-    return [_lines(plt, cols, axes, outdir / "sweep_I.png", title)] if _line_groups(cols, axes) else []
+    title = sweep_title(meta, total)
+    written: list[Path] = []
+    grid = [k for k in meta["grid"] if k in cols]
+    if n and grid:
+        path = _grid_figure(plt, cols, meta, grid, range(n), outdir, title, notes)
+        if path is not None:
+            written.append(path)
+    if n < total:  # extra cases (or cases alone): not on a grid
+        if total > MAX_CASES:
+            notes.append(f"no per-case figure: {total} cases are more than the {MAX_CASES} one chart labels")
+        else:
+            written.append(_cases_chart(plt, cols, meta, outdir / "sweep_cases.png", title))
+    return written
 
 
-def _line_groups(cols, axes) -> dict | None:
-    others = axes[1:]
+def _grid_figure(plt, cols, meta, grid, rows, outdir, title, notes) -> Path | None:
+    rows = list(rows)
+    numeric = [k for k in grid if _numeric(cols[k]) and np.isfinite(cols[k][rows]).any()]
+    if meta.get("mode") == "zip":  # zipped axes move together: one abscissa
+        return _lines(plt, cols, (numeric or grid)[:1], rows, outdir / "sweep_I.png", title, notes)
+    if len(grid) == 2 and len(numeric) != 1:  # both numeric or both text: a map of the pairs
+        return _heat_map(plt, cols, grid, rows, outdir / "sweep_map.png", title)
+    axes = numeric[:1] + [k for k in grid if k not in numeric[:1]]  # numeric abscissa when there is one
+    return _lines(plt, cols, axes, rows, outdir / "sweep_I.png", title, notes)
+
+
+def _positions(cols, key, rows):
+    """(abscissa per row, tick positions, tick labels or None): numbers as they are, text by rank."""
+    if _numeric(cols[key]):
+        return np.asarray(cols[key], dtype=float), None, None
+    cats = _sampled(cols[key], rows)
+    pos = {c: float(i) for i, c in enumerate(cats)}
+    x = np.array([pos.get(str(v), math.nan) for v in cols[key]])
+    return x, list(range(len(cats))), cats
+
+
+def _lines(plt, cols, axes, rows, path: Path, title: str, notes) -> Path | None:
+    x_key, others = axes[0], axes[1:]
+    x_all, ticks, tick_labels = _positions(cols, x_key, rows)
     groups: dict[tuple, list[int]] = {}
-    for i in range(len(cols["case"])):
-        if not math.isfinite(cols[axes[0]][i]):
-            continue
-        groups.setdefault(tuple(cols[k][i] for k in others), []).append(i)
-    return groups if len(groups) <= MAX_LINES else None
-
-
-def _lines(plt, cols, axes, path: Path, title: str) -> Path:
-    x_key = axes[0]
-    groups = _line_groups(cols, axes)
-    fig, ax = plt.subplots(figsize=(6.5, 4.2), constrained_layout=True)
-    for gi, (other, idx) in enumerate(sorted(groups.items())):
-        idx = sorted(idx, key=lambda i: cols[x_key][i])
-        x = np.asarray(cols[x_key])[idx]
-        extra = ", ".join(f"{name_of(k)} = {_show(v)} {unit_of(k) if unit_of(k) != '1' else ''}".strip()
-                          for k, v in zip(axes[1:], other))
-        for name, style in (("I_dec", "-o"), ("I_acc", "--s")):
+    for i in rows:
+        if math.isfinite(x_all[i]):
+            groups.setdefault(tuple(_show(cols[k][i]) for k in others), []).append(i)
+    if len(groups) > MAX_LINES:
+        notes.append(f"no line figure: {len(groups)} combinations of "
+                     + ", ".join(name_of(k) for k in others) + f" are more than the {MAX_LINES} lines one figure shows")
+        return None
+    fig, panels = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, constrained_layout=True)
+    for gi, (other, idx) in enumerate(groups.items()):
+        idx = sorted(idx, key=lambda i: x_all[i])
+        x = x_all[idx]
+        extra = ", ".join(f"{name_of(k)} = {v} {unit_of(k) if unit_of(k) != '1' else ''}".strip()
+                          for k, v in zip(others, other))
+        for ax, (name, sym) in zip(panels, QUANTITIES):
             if f"{name}_mean_Ns" not in cols:
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             sem = cols.get(f"{name}_sem_Ns")
             err = np.nan_to_num(np.asarray(sem)[idx] * 1e3) if sem is not None else None
-            label = f"$I_{{{name[2:]}}}$" + (f" ({extra})" if extra else "")
-            ax.errorbar(x, y, yerr=err, fmt=style, color=f"C{gi}", capsize=3, ms=4, label=label)
-    ax.set_xlabel(axis_label(x_key))
-    ax.set_ylabel("impulse per pocket and cage rotation [mN s]\n(error bars: ±1 standard error)")
-    ax.set_title(title, fontsize=9)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="best")
+            ax.errorbar(x, y, yerr=err, fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
+    for ax, (name, sym) in zip(panels, QUANTITIES):
+        ax.set_xlabel(axis_label(x_key))
+        ax.set_ylabel(f"{sym} {Y_LABEL}")
+        ax.set_title(f"{sym} (error bars: ±1 standard error)", fontsize=9)
+        if ticks is not None:
+            ax.set_xticks(ticks, tick_labels)
+        ax.grid(alpha=0.3)
+    for ax in panels[::-1]:  # one legend, on the last panel with lines
+        if others and ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=7, loc="best")
+            break
+    fig.suptitle(title, fontsize=10)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
@@ -110,32 +180,70 @@ def _show(v) -> str:
     return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)
 
 
-def _heat_map(plt, cols, axes, path: Path, title: str) -> Path:
+def _heat_map(plt, cols, axes, rows, path: Path, title: str) -> Path:
+    """One cell per sampled pair, centred on its tick (sampled values only: no extrapolated edges),
+    equal cells, each with its value written; I_dec and I_acc in two panels with their own scales."""
     xk, yk = axes
-    x = np.asarray(cols[xk])
-    y = np.asarray(cols[yk])
-    z = np.asarray(cols["I_dec_mean_Ns"]) * 1e3
-    xs = np.unique(x[np.isfinite(x)])
-    ys = np.unique(y[np.isfinite(y)])
-    grid = np.full((ys.size, xs.size), np.nan)
-    for xi, yi, zi in zip(x, y, z):
-        if math.isfinite(xi) and math.isfinite(yi):
-            grid[np.searchsorted(ys, yi), np.searchsorted(xs, xi)] = zi
-    fig, ax = plt.subplots(figsize=(6.5, 4.8), constrained_layout=True)
-    mesh = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
-    fig.colorbar(mesh, ax=ax, label="$I_{dec}$ per pocket and cage rotation [mN s]")
-    ax.set_xlabel(axis_label(xk))
-    ax.set_ylabel(axis_label(yk))
-    n_gap = int(np.isnan(grid).sum())
-    ax.set_title(title + (f" ({n_gap} cells failed or not run: blank)" if n_gap else ""), fontsize=9)
+    xs, ys = _sampled(cols[xk], rows), _sampled(cols[yk], rows)
+    xpos = {_show(v): j for j, v in enumerate(xs)}
+    ypos = {_show(v): j for j, v in enumerate(ys)}
+    fig, panels = plt.subplots(1, 2, figsize=(max(9.0, 1.2 * len(xs) * 2 + 3), max(4.2, 0.45 * len(ys) + 2.5)),
+                               constrained_layout=True)
+    n_gap = 0
+    for ax, (name, sym) in zip(panels, QUANTITIES):
+        grid = np.full((len(ys), len(xs)), np.nan)
+        col = cols.get(f"{name}_mean_Ns")
+        for i in rows:
+            xi, yi = xpos.get(_show(cols[xk][i])), ypos.get(_show(cols[yk][i]))
+            if xi is not None and yi is not None and col is not None:
+                grid[yi, xi] = col[i] * 1e3
+        n_gap = max(n_gap, int(np.isnan(grid).sum()))
+        mesh = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
+                             np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
+        fig.colorbar(mesh, ax=ax, label=f"{sym} {Y_LABEL}")
+        finite = grid[np.isfinite(grid)]
+        mid = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
+        if len(xs) * len(ys) <= 400:  # values written in the cells while they fit
+            for (yi, xi), z in np.ndenumerate(grid):
+                ax.text(xi, yi, f"{z:.3g}" if math.isfinite(z) else "–", ha="center", va="center", fontsize=7,
+                        color="black" if not math.isfinite(z) or z > mid else "white")
+        ax.set_xticks(range(len(xs)), [_show(v) for v in xs])
+        ax.set_yticks(range(len(ys)), [_show(v) for v in ys])
+        ax.set_xlabel(axis_label(xk))
+        ax.set_ylabel(axis_label(yk))
+        ax.set_title(sym, fontsize=9)
+    fig.suptitle(title + (f" ({n_gap} cells failed or not run: blank)" if n_gap else ""), fontsize=10)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
 
 
-def _edges(v: np.ndarray) -> np.ndarray:
-    """Cell edges around sorted centres (half-way between neighbours)."""
-    if v.size == 1:
-        return np.array([v[0] - 0.5, v[0] + 0.5]) if v[0] == 0 else np.array([v[0] * 0.95, v[0] * 1.05])
-    mid = 0.5 * (v[1:] + v[:-1])
-    return np.concatenate([[v[0] - (mid[0] - v[0])], mid, [v[-1] + (v[-1] - mid[-1])]])
+def _cases_chart(plt, cols, meta, path: Path, title: str) -> Path:
+    """Every case of the index as one bar, labelled by its swept values; I_dec and I_acc in two panels."""
+    keys = [k for k in meta["axes"] if k in cols]
+    total = len(cols["case"])
+    labels = []
+    for i in range(total):
+        parts = [f"{name_of(k)} = {_show(cols[k][i])}" for k in keys if _present(cols[k])[i]]
+        status = str(cols["status"][i]) if "status" in cols else ""
+        if status in ("failed", "pending"):
+            parts.append("(failed)" if status == "failed" else "(not run)")
+        labels.append(", ".join(parts) or "(base scenario)")
+    pos = np.arange(total)
+    fig, panels = plt.subplots(1, 2, figsize=(11, 1.5 + 0.32 * total), sharey=True, constrained_layout=True)
+    for k, (ax, (name, sym)) in enumerate(zip(panels, QUANTITIES)):
+        if f"{name}_mean_Ns" in cols:
+            y = np.asarray(cols[f"{name}_mean_Ns"]) * 1e3
+            sem = cols.get(f"{name}_sem_Ns")
+            err = np.nan_to_num(np.asarray(sem) * 1e3) if sem is not None else None
+            ok = np.isfinite(y)  # failed or not run: no bar (a gap, not a zero)
+            ax.barh(pos[ok], y[ok], xerr=None if err is None else err[ok], color=f"C{k}", capsize=3)
+        ax.set_xlabel(f"{sym} {Y_LABEL}")
+        ax.set_title(f"{sym} (error bars: ±1 standard error)", fontsize=9)
+        ax.grid(alpha=0.3, axis="x")
+    panels[0].set_yticks(pos, labels, fontsize=7)
+    panels[0].invert_yaxis()
+    fig.suptitle(title, fontsize=10)
+    from bearingsim.plotting import save_figure
+
+    return save_figure(fig, path, tight=False)

@@ -53,6 +53,7 @@ class SweepOutcome:
     interrupted: int | None = None  # the signal number, if interrupted
     wall_s: float = 0.0
     figures: list[Path] = field(default_factory=list)
+    figure_notes: list[str] = field(default_factory=list)  # why a figure was not drawn, one line each
 
     def count(self, status: str) -> int:
         return sum(r["status"] == status for r in self.rows)
@@ -362,7 +363,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
 
-        outcome.figures = plot_sweep_index(outcome.h5, outdir)
+        outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
     return outcome
 
 
@@ -378,6 +379,13 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     from bearingsim.sweeps.spec import spec_from_args
 
     spec = spec_from_args(target, params, sets)
+    if not quiet:  # keys that change nothing in the base scenario's model (unless the model is swept too)
+        from bearingsim.scenario import given_keys, load_scenario, unused_note
+
+        keys = given_keys(spec.scenario, spec.sets) + spec.keys
+        note = None if "model" in spec.keys else unused_note(load_scenario(spec.scenario, spec.sets).model, keys)
+        if note:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")
@@ -397,6 +405,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
         print(f"wrote {out.h5}")
         for p in out.figures:
             print(f"wrote {p}")
+        for line in out.figure_notes:
+            print(f"bearingsim: note: {line}", file=sys.stderr)
         print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
     if out.failed:
         names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"

@@ -106,15 +106,61 @@ def toml_value(value: Any) -> str:
     return tomli_w.dumps({"v": value})[4:].strip()
 
 
+PARAM_HELP = ("KEY=V1,V2,... (values as TOML; commas inside [ ], { } or quotes do not split) or "
+              "KEY=START:STOP:NUM (NUM evenly spaced numbers, both ends included)")
+
+
+def _split_top_level(text: str) -> list[str]:
+    """``text`` split at the commas outside brackets, braces and quoted strings."""
+    parts, depth, quote, cur = [], 0, "", []
+    for ch in text:
+        if quote:
+            if ch == quote:
+                quote = ""
+        elif ch in "\"'":
+            quote = ch
+        elif ch in "[{":
+            depth += 1
+        elif ch in "]}":
+            depth -= 1
+        elif ch == "," and depth == 0:
+            parts.append("".join(cur))
+            cur = []
+            continue
+        cur.append(ch)
+    parts.append("".join(cur))
+    return parts
+
+
+def _range_values(item: str, text: str) -> list[float] | None:
+    """``START:STOP:NUM`` as :class:`_Range` values; None if ``text`` is not of that form."""
+    parts = text.split(":")
+    if len(parts) != 3 or any(c in text for c in "[]{}\"'"):
+        return None
+    try:
+        start, stop = float(parts[0]), float(parts[1])
+    except ValueError:
+        return None
+    try:
+        num = int(parts[2])
+    except ValueError:
+        raise UserError(f"--param {item!r}: START:STOP:NUM needs an integer NUM >= 1") from None
+    return _Range({"start": start, "stop": stop, "num": num}).values(f"--param {item!r}")
+
+
 def parse_param(item: str) -> tuple[str, list]:
-    """``KEY=V1,V2,...`` into (key, values), each value read as a TOML value (a bare word is a string)."""
+    """``KEY=V1,V2,...`` into (key, values), each value read as a TOML value (a bare word is a string;
+    commas inside brackets, braces or quotes do not split), or ``KEY=START:STOP:NUM`` into ``NUM``
+    evenly spaced values from START to STOP, both included."""
     if "=" not in item:
-        raise UserError(f"--param {item!r}: expected KEY=V1,V2,...")
+        raise UserError(f"--param {item!r}: expected {PARAM_HELP}")
     key, text = item.split("=", 1)
     key = key.strip()
-    values = [parse_override(f"{key}={v}")[1] for v in text.split(",") if v.strip()]
+    values = _range_values(item, text.strip())
+    if values is None:
+        values = [parse_override(f"{key}={v}")[1] for v in _split_top_level(text) if v.strip()]
     if not key or not values:
-        raise UserError(f"--param {item!r}: expected KEY=V1,V2,... with at least one value")
+        raise UserError(f"--param {item!r}: expected {PARAM_HELP}, with at least one value")
     return key, values
 
 

@@ -1,0 +1,140 @@
+"""Issue 28, defect 5: inspect/show describe bearingsim's own index files; --param lists split only at
+top-level commas, and a START:STOP:NUM range; keys the chosen model does not use are noted.
+
+Nothing here is simulated: the index files are written directly."""
+import json
+
+import pytest
+
+from bearingsim.errors import UserError
+from bearingsim.scenario import load_scenario
+from bearingsim.sweeps.index import write_index
+from bearingsim.sweeps.spec import parse_param
+
+from .conftest import SCENARIOS
+from .test_cli import assert_user_error, bearingsim
+
+SPEED = "operating.inner_ring_speed_rpm"
+
+
+def _sweep_index(folder):
+    rows = [{"case": f"c{i}", "values": {SPEED: s}, "status": st, "error": "", "archive": f"cases/c{i}.h5",
+             "wall_s": 0.1, "summary": {"I_dec_mean_Ns": 0.005} if st == "done" else {}}
+            for i, (s, st) in enumerate(((1000.0, "done"), (2000.0, "failed"), (3000.0, "done")))]
+    write_index(folder, rows, [SPEED], {"mode": "product", "grid": json.dumps([SPEED]), "grid_rows": 3,
+                                       "scenario": "paper_3000rpm.toml"})
+    return folder / "sweep.h5"
+
+
+def _crosscheck_index(folder):
+    from bearingsim.studies.crosscheck import COLUMNS, write_table
+
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml")
+    rows = []
+    for rung in (1, 2):
+        row = {c: 0.001 * rung for c in COLUMNS}
+        row.update(rpm=3000.0, rung=rung, scene="full", relaxed="none", archive=f"r{rung}.h5", wall_s=1.0,
+                   status="done", error="")
+        rows.append(row)
+    return write_table(folder, rows, sc)[1], sc
+
+
+def test_inspect_and_show_describe_a_sweep_index(tmp_path):
+    h5 = _sweep_index(tmp_path)
+    res = bearingsim("inspect", h5)
+    assert res.returncode == 0, res.stderr
+    assert "bearingsim sweep index" in res.stdout and "3 cases (done 2, failed 1)" in res.stdout
+    assert "I_dec_mean_Ns" in res.stdout and "[N s]" in res.stdout and f"swept keys: {SPEED}" in res.stdout
+    res = bearingsim("show", h5)
+    assert res.returncode == 0, res.stderr
+    assert all(line.startswith("# ") for line in res.stdout.splitlines()) and "3 cases" in res.stdout
+
+
+def test_inspect_and_show_describe_a_crosscheck_table(tmp_path):
+    h5, sc = _crosscheck_index(tmp_path)
+    res = bearingsim("inspect", h5)
+    assert res.returncode == 0, res.stderr
+    assert "bearingsim cross-check table" in res.stdout and "2 cases (done 2)" in res.stdout
+    assert "change_from_previous" in res.stdout and "speeds [rpm]: 3000" in res.stdout
+    res = bearingsim("show", h5)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout == sc.to_toml()  # the cross-check's scenario, runnable
+
+
+@pytest.mark.parametrize("item, values", [
+    ("bearing.pocket_clearance_mm=0.1:0.4:4", [0.1, 0.2, 0.30000000000000004, 0.4]),
+    (f"{SPEED}=500:6000:12", [500.0 + 500.0 * i for i in range(12)]),
+    ("k=1,2,3", [1, 2, 3]),
+    ("k=[1, 2],[3, 4]", [[1, 2], [3, 4]]),
+    ("k={a = 1, b = 2},{a = 3, b = 4}", [{"a": 1, "b": 2}, {"a": 3, "b": 4}]),
+    ('k="x,y",z', ["x,y", "z"]),
+])
+def test_param_lists_and_ranges(item, values):
+    key, got = parse_param(item)
+    assert key == item.split("=", 1)[0] and got == pytest.approx(values) if isinstance(values[0], float) else got == values
+
+
+def test_param_range_needs_an_integer_count():
+    with pytest.raises(UserError, match="integer NUM"):
+        parse_param("k=1:2:2.5")
+
+
+def test_sweep_help_documents_the_range():
+    res = bearingsim("sweep", "--help")
+    assert "START:STOP:NUM" in res.stdout
+
+
+def test_param_inline_table_is_not_split_at_its_commas(tmp_path):
+    res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "contact={restitution = 0.5, friction = 0.1}",
+                     "-o", tmp_path, "-j", "1")
+    assert_user_error(res, "contact={'restitution': 0.5, 'friction': 0.1}")  # the table whole, not '{restitution = 0.5'
+
+
+def test_keys_the_reduced_model_does_not_use_are_noted(tmp_path):
+    base = SCENARIOS / "paper_3000rpm.toml"
+    res = bearingsim("run", base, "--set", "bearing.cage_guidance=outer_land", "--set", "numerics.rotations=1",
+                     "--set", "bearing.cage_land_clearance_mm=0.5", "--no-plots", "-o", tmp_path / "a.h5")
+    assert res.returncode == 0, res.stderr
+    notes = [line for line in res.stderr.splitlines() if line.strip()]
+    assert notes == ["bearingsim: note: bearing.cage_guidance, bearing.cage_land_clearance_mm: not used by the "
+                     "reduced model (no effect on the run)"]
+    res = bearingsim("sweep", base, "--param", "multibody.raceway_contact=rigid,hertz", "--set", "numerics.rotations=1",
+                     "--no-plots", "-o", tmp_path / "s", "-j", "1")
+    assert res.returncode == 0, res.stderr
+    assert [line for line in res.stderr.splitlines() if "note" in line] == [
+        "bearingsim: note: multibody.raceway_contact: not used by the reduced model (no effect on the run)"]
+    # keys the model uses: no note
+    res = bearingsim("run", base, "--set", "numerics.rotations=1", "--no-plots", "-o", tmp_path / "b.h5")
+    assert res.returncode == 0 and "note" not in res.stderr, res.stderr
+
+
+def test_unused_keys_per_model():
+    from bearingsim.scenario import unused_keys
+
+    keys = ["multibody.scene", "bearing.cage_guidance", "bearing.pocket_clearance_mm", "reduced.load_zone_half_angle_deg"]
+    assert unused_keys("reduced", keys) == ["multibody.scene", "bearing.cage_guidance"]
+    assert unused_keys("multibody", keys) == []  # its reduced-equivalent scene reads reduced.*
+
+
+def test_every_summary_key_is_documented_with_its_unit():
+    import re
+
+    from bearingsim import multibody, reduced
+    from bearingsim.sweeps.worker import standard_errors
+    from .conftest import ROOT
+
+    text = (ROOT / "docs" / "archive.md").read_text()
+    table = text[text.index("### Summary attributes"):text.index("## Sign conventions")]
+    rows = {}
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3:
+            for name in re.findall(r"`([a-zA-Z_]+)`", cells[0]):
+                rows[name] = cells[1]
+    units = {**reduced.SUMMARY_UNITS, **multibody.SUMMARY_UNITS, **multibody.RIGID_SUMMARY_UNITS,
+             **multibody.LAND_SUMMARY_UNITS, **{k: "N s" for k in standard_errors([1.0, 2.0], [1.0, 2.0])}}
+    missing = [k for k in [*units, "scene", "pockets"] if k not in rows and k not in table]
+    assert missing == []
+    wrong = {k: (rows[k], u) for k, u in units.items() if k in rows and rows[k] != u}
+    assert wrong == {}
+    assert "total over all recorded steps" in table  # land_torque_impulse_Nms is a run total, unlike the others

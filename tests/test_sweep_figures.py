@@ -1,0 +1,120 @@
+"""Sweep figures drawn from a sweep index (issue 28, defect 4): every sweep draws something meaningful
+or says in one line why not; heat maps of sampled cells only; I_dec and I_acc apart; the sweep's title.
+
+The indexes are written directly (:func:`bearingsim.sweeps.index.write_index`): nothing is simulated."""
+import json
+
+import pytest
+
+from bearingsim.sweeps.index import write_index
+from bearingsim.sweeps.plot import plot_sweep_index
+
+from .test_cli import assert_user_error, bearingsim
+
+SPEED = "operating.inner_ring_speed_rpm"
+GUIDE = "bearing.cage_guidance"
+CLEAR = "bearing.pocket_clearance_mm"
+
+
+def _index(folder, points, keys, *, grid=None, grid_rows=None, mode="product", failed=(), results=True):
+    rows = []
+    for i, values in enumerate(points):
+        ok = results and i not in failed
+        rows.append({"case": f"c{i}", "values": values, "status": "done" if ok else "failed", "error": "",
+                     "archive": "", "wall_s": 0.1,
+                     "summary": {"I_dec_mean_Ns": 0.005 + 0.001 * i, "I_dec_sem_Ns": 1e-4,
+                                 "I_acc_mean_Ns": 0.002 + 0.0005 * i, "I_acc_sem_Ns": 5e-5} if ok else {}})
+    grid = keys if grid is None else grid
+    meta = {"mode": mode, "grid": json.dumps(grid), "grid_rows": len(points) if grid_rows is None else grid_rows,
+            "scenario": "scenarios/paper_3000rpm.toml"}
+    write_index(folder, rows, keys, meta)
+    return folder / "sweep.h5"
+
+
+@pytest.fixture
+def figures(monkeypatch):
+    """The matplotlib figures the sweep plot saves, by file name (captured before they are closed)."""
+    import bearingsim.plotting as plotting
+
+    seen = {}
+    real = plotting.save_figure
+
+    def capture(fig, path, **kw):
+        seen[path.name] = {"title": fig._suptitle.get_text() if fig._suptitle else "",
+                           "axes": [{"title": ax.get_title(), "ylabel": ax.get_ylabel(), "xlim": ax.get_xlim(),
+                                     "ylim": ax.get_ylim(),
+                                     "xticks": [t.get_text() for t in ax.get_xticklabels()],
+                                     "yticks": [t.get_text() for t in ax.get_yticklabels()],
+                                     "texts": [t.get_text() for t in ax.texts],
+                                     "colours": {tuple(line.get_color()) if not isinstance(line.get_color(), str)
+                                                 else line.get_color() for line in ax.lines}}
+                                    for ax in fig.axes if ax.get_label() != "<colorbar>"]}
+        return real(fig, path, **kw)
+
+    monkeypatch.setattr(plotting, "save_figure", capture)
+    return seen
+
+
+def test_a_text_key_is_a_categorical_axis(tmp_path, figures):
+    h5 = _index(tmp_path, [{GUIDE: g} for g in ("rollers", "outer_land", "inner_land")], [GUIDE])
+    notes = []
+    out = plot_sweep_index(h5, tmp_path / "f", notes=notes)
+    assert [p.name for p in out] == ["sweep_I.png"] and notes == []
+    panels = figures["sweep_I.png"]["axes"]
+    assert [a["xticks"] for a in panels] == [["rollers", "outer_land", "inner_land"]] * 2
+
+
+def test_extra_cases_get_a_per_case_chart(tmp_path, figures):
+    points = [{SPEED: 1000.0}, {SPEED: 2000.0}, {SPEED: 3000.0, "contact.restitution": 0.6}]
+    h5 = _index(tmp_path, points, [SPEED, "contact.restitution"], grid=[SPEED], grid_rows=2)
+    out = plot_sweep_index(h5, tmp_path / "f")
+    assert [p.name for p in out] == ["sweep_I.png", "sweep_cases.png"]
+    labels = figures["sweep_cases.png"]["axes"][0]["yticks"]
+    assert labels[2] == "inner ring speed = 3000, restitution = 0.6" and len(labels) == 3
+    # a sweep of extra cases alone
+    h5 = _index(tmp_path, points, [SPEED, "contact.restitution"], grid=[], grid_rows=0)
+    assert [p.name for p in plot_sweep_index(h5, tmp_path / "g")] == ["sweep_cases.png"]
+
+
+def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
+    xs, ys = (1000.0, 2000.0, 6000.0), (0.1, 0.2)  # unequal steps: cells equal, centred on the ticks
+    points = [{SPEED: s, CLEAR: c} for s in xs for c in ys]
+    h5 = _index(tmp_path, points, [SPEED, CLEAR], failed=(1,))
+    assert [p.name for p in plot_sweep_index(h5, tmp_path / "f")] == ["sweep_map.png"]
+    panels = figures["sweep_map.png"]["axes"]
+    assert [a["title"] for a in panels] == ["$I_{dec}$", "$I_{acc}$"]  # apart, each with its own scale
+    for a in panels:
+        assert a["xticks"] == ["1000", "2000", "6000"] and a["yticks"] == ["0.1", "0.2"]
+        assert a["xlim"] == (-0.5, 2.5) and a["ylim"] == (-0.5, 1.5)  # no edge beyond a sampled value
+        assert len(a["texts"]) == 6 and "–" in a["texts"]  # every cell's value written; the failed one a gap
+    assert set(panels[0]["texts"]) == {"5", "–", "7", "8", "9", "10"}  # mN s, case i: 5 + i
+    assert set(panels[1]["texts"]) == {"2", "–", "3", "3.5", "4", "4.5"}  # case i: 2 + i / 2
+
+
+def test_i_dec_and_i_acc_in_separate_panels(tmp_path, figures):
+    h5 = _index(tmp_path, [{SPEED: s} for s in (1000.0, 2000.0)], [SPEED])
+    plot_sweep_index(h5, tmp_path / "f")
+    panels = figures["sweep_I.png"]["axes"]
+    assert len(panels) == 2 and "I_{dec}" in panels[0]["ylabel"] and "I_{acc}" in panels[1]["ylabel"]
+
+
+def test_title_names_the_swept_keys_not_the_base_scenario(tmp_path, figures):
+    points = [{SPEED: s, CLEAR: c} for s in (1000.0, 2000.0) for c in (0.1, 0.2)]
+    plot_sweep_index(_index(tmp_path, points, [SPEED, CLEAR]), tmp_path / "f")
+    title = figures["sweep_map.png"]["title"]
+    assert "inner ring speed × pocket clearance" in title and "4 cases" in title and "paper_3000rpm" not in title
+
+
+def test_plot_says_why_and_fails_when_it_draws_nothing(tmp_path):
+    h5 = _index(tmp_path, [{SPEED: s} for s in (1000.0, 2000.0)], [SPEED], results=False)
+    assert plot_sweep_index(h5, tmp_path / "f", notes=(notes := [])) == [] and len(notes) == 1
+    res = bearingsim("plot", h5, "-o", tmp_path / "g")
+    assert_user_error(res, "no figure written", "no case has a result")
+
+
+def test_too_many_lines_is_said(tmp_path):
+    points = [{SPEED: s, CLEAR: c, GUIDE: g} for s in (1000.0, 2000.0) for c in (0.1, 0.2, 0.3)
+              for g in ("rollers", "outer_land", "inner_land")]
+    notes = []
+    assert plot_sweep_index(_index(tmp_path, points, [SPEED, CLEAR, GUIDE]), tmp_path / "f", notes=notes) == []
+    assert len(notes) == 1 and "9 combinations" in notes[0]

@@ -96,17 +96,16 @@ def _cmd_plot(args) -> int:
 
 
 def _cmd_rerun(args) -> int:
-    from bearingsim.archive import Spool, package_versions, write
+    from bearingsim.archive import package_versions
     from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
-    from bearingsim.simulation import COMPARED, run
+    from bearingsim.simulation import COMPARED, run, run_scenario
 
     old = read(args.archive, only=COMPARED)
     progress = sys.stderr.isatty()
-    if args.output:
-        with Spool(args.output) as spool:
-            new = run(old.scenario, progress=progress, sink=spool)
-            write(new, args.output, spool)
+    if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
+        new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
+                           force=args.force).result
         print(f"wrote {args.output}")
     else:
         new = run(old.scenario, progress=progress)
@@ -307,6 +306,8 @@ def build_parser() -> argparse.ArgumentParser:
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
     rr.add_argument("archive")
     rr.add_argument("-o", "--output", help="also write the new run's archive here")
+    rr.add_argument("--force", action="store_true",
+                    help="with -o: replace an archive of a different scenario there (default: refused)")
     rr.set_defaults(func=_cmd_rerun)
 
     cp = sub.add_parser("compare", help="scenario keys and summary numbers of two archives side by side "

@@ -759,3 +759,27 @@ if __name__ == "__main__":
         write_doc()
     else:
         print(__doc__)
+
+
+def test_rerun_output_takes_the_run_lock_and_cleans_dead_temporaries(tmp_path):
+    """Issue 30, item 8: ``rerun -o`` writes through the path of ``run``: a temporary archive of a dead
+    run in the target folder is removed (with a note), and a target whose lock another run holds is
+    refused with one line, nothing written (it bypassed both)."""
+    res = bearingsim("run", PAPER, "-o", tmp_path / "a.h5", "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    _setup_dead_tmp(tmp_path)
+    stale = list(tmp_path.glob(".out.h5.tmp-*"))
+    res = bearingsim("rerun", tmp_path / "a.h5", "-o", tmp_path / "out.h5")
+    assert res.returncode == 0, res.stderr
+    assert f"removed stale temporary file {stale[0]}" in res.stderr
+    assert not stale[0].exists() and (tmp_path / "out.h5").is_file()
+    holder = os.open(tmp_path / ".held.h5.lock", os.O_RDWR | os.O_CREAT)
+    try:
+        fcntl.flock(holder, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        res = bearingsim("rerun", tmp_path / "a.h5", "-o", tmp_path / "held.h5")
+    finally:
+        os.close(holder)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "held.h5" in lines[0] and "another bearingsim run" in lines[0], res.stderr
+    assert not (tmp_path / "held.h5").exists()

@@ -488,12 +488,15 @@ def main(argv: list[str] | None = None) -> int:
     except SimulationUnstable as exc:
         print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    except Terminated:
-        print("bearingsim: terminated (SIGTERM), no archive written", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print("bearingsim: interrupted, no archive written", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated)
+        what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
+        if written is not None:
+            print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
+                  f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
+        else:
+            print(f"bearingsim: {what}, no archive written", file=sys.stderr)
+        return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
     except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
         where = exc.filename or "bearingsim"
         print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)

@@ -179,6 +179,9 @@ def run_scenario(
             except OSError as exc:
                 raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
                                 f"({exc.strerror or exc}); the archive {out} is complete") from None
+            except KeyboardInterrupt as exc:  # SIGINT/SIGTERM while drawing: the archive is a result, kept
+                exc.archive_written = out  # the command line says so (not "no archive written")
+                raise
     finally:
         if lock is not None:
             lock.release()

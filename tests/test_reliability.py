@@ -783,3 +783,29 @@ def test_rerun_output_takes_the_run_lock_and_cleans_dead_temporaries(tmp_path):
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and "held.h5" in lines[0] and "another bearingsim run" in lines[0], res.stderr
     assert not (tmp_path / "held.h5").exists()
+
+
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
+                                             (signal.SIGINT, 130, "interrupted")])
+def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path, monkeypatch, capsys, sig, code,
+                                                                        word):
+    """Issue 30, item 4: a signal that lands while the figures are drawn (the archive is written and
+    complete) printed "no archive written". The archive is a result: kept, and the one line says it
+    is complete and figures were not all written; exit 128 + signal."""
+    from bearingsim import archive, cli
+    from bearingsim.results import Result
+
+    def signalled(self, stem):
+        os.kill(os.getpid(), sig)
+        for _ in range(1000):  # the handler raises here
+            time.sleep(0.01)
+        raise AssertionError("signal not delivered")
+
+    monkeypatch.setattr(Result, "save_figures", signalled)
+    out = tmp_path / "out.h5"
+    assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and word in err[0] and "no archive written" not in err[0], err
+    assert f"the archive {out} is complete" in err[0] and "figures not all written" in err[0]
+    assert archive.peek(out) is not None and archive.is_archive(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary

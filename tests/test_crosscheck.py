@@ -219,3 +219,15 @@ def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_p
     late = [p.name for p in (out / "cases").iterdir() if p.stat().st_mtime > t_signal + 0.5]
     assert late == []  # no rung archive written after the signal (0.5 s: one rename already under way)
     assert not list((out / "cases").glob(".*")) and not (out / "crosscheck.csv").exists()
+
+
+def test_one_rotation_prints_no_nan_standard_error():
+    """Issue 30, Low: ``crosscheck --rotations 1`` printed "not significant: 2 SE = nan" and "± nan":
+    one rotation gives no batch-means error, so the change is not judged and the table says n/a."""
+    nan = math.nan
+    rows = [dict(rpm=3000.0, rung=k, scene=s, I_dec_mean_Ns=m, I_dec_sem_Ns=e, I_acc_mean_Ns=0.0, I_acc_sem_Ns=e,
+                 first_impact_speed_m_s=0.08, cage_slip=0.0, change_from_previous=c, status="done")
+             for k, s, m, e, c in ((1, "reduced", 5e-3, 0.0, nan), (2, "full", 6e-3, nan, 1e-3))]
+    text = " ".join(cc.verdicts(rows)) + "\n" + cc.format_table(rows)
+    assert "nan" not in text.lower(), text
+    assert "not judged" in text and "n/a" in text

@@ -60,7 +60,13 @@ def _cmd_inspect(args) -> int:
 def _cmd_show(args) -> int:
     from bearingsim.simulation import SCENARIO_ONLY, load as read
 
-    sys.stdout.write(read(args.archive, only=SCENARIO_ONLY).scenario.to_toml())
+    text = read(args.archive, only=SCENARIO_ONLY).scenario.to_toml()
+    buffer = getattr(sys.stdout, "buffer", None)
+    if buffer is None:  # a text stream without bytes underneath (main() called with stdout replaced)
+        sys.stdout.write(text)
+        return 0
+    sys.stdout.flush()
+    buffer.write(text.encode("utf-8"))  # a TOML file is UTF-8 whatever the locale (a C locale: ASCII)
     return 0
 
 
@@ -471,6 +477,12 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, _raise_terminated)
     except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
         pass
+    errors = {}
+    for name in ("stdout", "stderr"):  # a C locale's ASCII stdout: a non-ASCII name is escaped, not a traceback
+        stream = getattr(sys, name)
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            errors[name] = stream.errors
+            stream.reconfigure(errors="backslashreplace")
     try:
         with _interrupts_redelivered(), outputs.command_line_owns_stderr():
             code = args.func(args)
@@ -508,6 +520,9 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        for name, err in errors.items():
+            with contextlib.suppress(AttributeError, ValueError, OSError):
+                getattr(sys, name).reconfigure(errors=err)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -429,7 +429,29 @@ def _check_depth(node: Any, where: str, depth: int = 0) -> None:
             stack.extend((v, d + 1) for v in item)
 
 
+def _plain(value: Any) -> Any:
+    """``value`` with numpy scalars as the Python numbers they hold (``np.int64(2)`` -> ``2``,
+    ``np.float64`` -> float, ``np.bool_`` -> bool), inside dicts and lists too: a value computed with
+    numpy is the number it holds, validated as such (an integer key still refuses ``np.float64(2.0)``,
+    as it refuses ``2.0``). Anything else is returned as it is."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        if isinstance(value, np.bool_):
+            return bool(value)
+        if isinstance(value, np.integer):
+            return int(value)
+        if isinstance(value, np.floating):
+            return float(value)
+    return value
+
+
 def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
+    value = _plain(value)
     parts = key.split(".")
     node = raw
     for p in parts[:-1]:
@@ -538,6 +560,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
 
 def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
     """Merge a scenario dictionary with its preset and the package defaults, then validate."""
+    raw = _plain(raw) if isinstance(raw, dict) else raw
     version = raw.get("schema_version")
     if version is None:
         raise UserError(f"{source}: schema_version: missing (this bearingsim reads schema_version = 1)")

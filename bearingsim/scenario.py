@@ -544,6 +544,13 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line);
     ``values`` maps dotted keys to Python values; both name keys as ``section.key``.
     """
+    from collections.abc import Mapping
+
+    if values is not None and not isinstance(values, Mapping):
+        raise UserError(f"set: expected a dict of dotted keys and values such as {{'numerics.rotations': 10}} "
+                        f"(got {type(values).__name__})")
+    if overrides is not None and (isinstance(overrides, (str, bytes)) or not isinstance(overrides, (list, tuple))):
+        raise UserError(f"overrides: expected a list of 'KEY=VALUE' strings (got {type(overrides).__name__})")
     raw = read_toml_file(path)
     if not isinstance(raw.get("name", ""), str):
         raise UserError(f"{path}: name: must be a string")

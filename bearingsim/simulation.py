@@ -72,6 +72,11 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     """
     from bearingsim import plausibility
 
+    if not isinstance(scenario, Scenario):
+        from bearingsim.errors import UserError
+
+        raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
+                        f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
     t0 = time.perf_counter()
     if dt is not None:
         scenario = scenario.replace(**{"numerics.dt_s": dt})

@@ -71,3 +71,16 @@ def test_numpy_numbers_are_the_numbers_they_hold(base_reduced):
     assert resolve({**base_reduced, "numerics": {"rotations": np.int64(3)}}).numerics.rotations == 3
     with pytest.raises(UserError, match="numerics.rotations"):
         sc.replace(**{"numerics.rotations": np.float64(2.0)})
+
+
+def test_wrong_argument_types_are_one_line_errors(base_reduced):
+    """Issue 30, Low: ``bearingsim.run(dict)`` and ``load_scenario(path, set=[...])`` (or a string of
+    overrides) ended in AttributeError tracebacks; now one UserError naming the argument."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match=r"run\(\): scenario: expected a Scenario .*got dict"):
+        bearingsim.run(base_reduced)
+    with pytest.raises(UserError, match=r"^set: expected a dict .*got list"):
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set=["numerics.rotations=2"])
+    with pytest.raises(UserError, match=r"^overrides: expected a list .*got str"):
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", overrides="numerics.rotations=2")

@@ -42,6 +42,7 @@ def _cmd_run(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force)
+    args.written = out.archive  # from here an error of standard output is not "no archive" (main)
     if not args.quiet:
         print(f"wrote {out.archive}")
         for png in out.figures:
@@ -112,6 +113,7 @@ def _cmd_rerun(args) -> int:
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
         new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
                            force=args.force).result
+        args.written = Path(args.output)
         print(f"wrote {args.output}")
     else:
         new = run(old.scenario, progress=progress)
@@ -463,6 +465,15 @@ def _stdout_to_devnull() -> None:
         os.close(devnull)
 
 
+def _stdout_lost(exc: OSError, written) -> None:
+    """Standard output failed (``> /dev/full``) after the command wrote its archive: exit 2 means "no
+    archive", so say on stderr that the archive is complete and keep the command's exit code."""
+    _stdout_to_devnull()
+    with contextlib.suppress(OSError, ValueError):
+        print(f"bearingsim: cannot write to standard output ({_one_line(exc.strerror or exc)}); the archive "
+              f"{written} is complete", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
@@ -486,7 +497,14 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with _interrupts_redelivered(), outputs.command_line_owns_stderr():
             code = args.func(args)
-            sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
+            try:
+                sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
+            except BrokenPipeError:
+                raise
+            except OSError as exc:
+                if getattr(args, "written", None) is None:
+                    raise
+                _stdout_lost(exc, args.written)
             return code
     except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: stop quietly
         _stdout_to_devnull()
@@ -510,6 +528,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"bearingsim: {what}, no archive written", file=sys.stderr)
         return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
     except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
+        if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
+            _stdout_lost(exc, args.written)
+            return 0
         where = exc.filename or "bearingsim"
         print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
         return 2

@@ -162,3 +162,22 @@ def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_r
         assert tomllib.loads(out.decode("utf-8"))["name"] == "café"
     else:
         assert "scenario caf\\xe9" in out.decode("ascii")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_stdout_on_a_full_device_after_the_archive_is_not_exit_2(tmp_path):
+    """Issue 30, Low: ``bearingsim run ... > /dev/full`` wrote its archive, then exited 2 ("bad input,
+    no archive") with "bearingsim: error: bearingsim: No space left on device". Now exit 0 with one line
+    saying standard output failed and the archive is complete."""
+    from .conftest import ROOT, started
+
+    out = tmp_path / "out.h5"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    with open("/dev/full", "w") as full, started([sys.executable, "-m", "bearingsim", "run",
+                                                 SCENARIOS / "paper_3000rpm.toml", "-o", out, "--no-plots"],
+                                                env=env, stdout=full, stderr=subprocess.PIPE, text=True) as proc:
+        _, err = proc.communicate(timeout=120)
+    lines = err.strip().splitlines()
+    assert proc.returncode == 0 and len(lines) == 1, err
+    assert "standard output" in lines[0] and f"the archive {out} is complete" in lines[0]
+    assert out.is_file()

@@ -14,6 +14,7 @@ import os
 import stat
 import math
 import tomllib
+import unicodedata
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -88,6 +89,9 @@ MAX_NESTING_DEPTH = 8
 # short enough that the longest name a run derives from it (".<name>.h5.tmp-<pid>", name + 16 bytes)
 # fits the 255-byte file-name limit of ext4, XFS, btrfs and APFS.
 MAX_NAME_BYTES = 200
+# Unicode's bidirectional controls (embeddings, overrides, isolates, marks): in a name they make a
+# terminal or a file listing show the characters in another order than they are (U+202E "RLO")
+_BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
 # Per-rotation arrays, the impact table and the run time grow with the number of rotations: the
 # multibody model takes ~0.2 s per cage rotation (README), so 1e5 rotations is ~6 h; the reduced
 # model's impact table is ~1e2 rows per rotation, so 1e5 rotations is ~1e7 rows (~0.6 GB in memory).
@@ -232,11 +236,12 @@ class ScenarioModel(_Section):
     @field_validator("name")
     @classmethod
     def _plain_file_name(cls, v):
-        bad = [c for c in v if ord(c) < 32 or ord(c) == 127 or c in "/\\"]
+        bad = [c for c in v if c in "/\\" or c in _BIDI_CONTROLS or unicodedata.category(c) in ("Cc", "Cs", "Zl", "Zp")]
         if bad or v in (".", "..") or v.startswith(".") or len(v.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES:
             raise ValueError(
                 f"must be a plain file name (it names the archive outputs/<name>.h5): no '/', '\\', "
-                f"control characters or leading '.', at most {MAX_NAME_BYTES} bytes")
+                f"control characters (C0, C1), bidirectional overrides or line separators, no leading '.', "
+                f"at most {MAX_NAME_BYTES} bytes")
         return v
     model: Literal["reduced", "multibody"]
     bearing: BearingSection

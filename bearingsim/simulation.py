@@ -165,7 +165,13 @@ def run_scenario(
     out = Path(out) if out is not None else default_output(scenario)
     names = model_module(scenario.model).RESULT.FIGURES if figures else ()
     outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
-    lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
+    made = _missing_folders(out.parent)  # created for this run: removed again if it writes no archive
+    try:
+        lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
+    except BaseException:
+        _remove_empty(made)
+        raise
+    written = False
     try:
         if not force:
             check_same_scenario(out, scenario)
@@ -177,6 +183,7 @@ def run_scenario(
                 for note in result.notes:
                     print(note, file=sys.stderr)
             archive.write(result, out, spool)
+        written = True
         pngs = []
         if figures:
             try:
@@ -190,4 +197,28 @@ def run_scenario(
     finally:
         if lock is not None:
             lock.release()
+        if not written:  # refused (exit 2/3), interrupted or failed: no folder of its own left behind
+            _remove_empty(made)
     return RunOutput(archive=out, figures=list(pngs), result=result)
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, deepest first."""
+    missing = []
+    for p in (folder, *folder.parents):
+        if p.exists() or p.is_symlink():
+            break
+        missing.append(p)
+    return missing
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (deepest first) while they are empty: never a file, never a folder someone
+    has put something into meanwhile."""
+    import os
+
+    for p in folders:
+        try:
+            os.rmdir(p)
+        except OSError:
+            return

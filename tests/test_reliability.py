@@ -809,3 +809,15 @@ def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path
     assert f"the archive {out} is complete" in err[0] and "figures not all written" in err[0]
     assert archive.peek(out) is not None and archive.is_archive(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary
+
+
+def test_a_refused_run_leaves_no_folder_it_created(tmp_path):
+    """Issue 30, Low: a run refused after it took its output lock (here a step too long for the euler
+    method, found when the run starts) left the folders it had created for ``-o new/deeper/out.h5``.
+    Folders that existed before stay."""
+    (tmp_path / "kept").mkdir()
+    for target in ("new/deeper/out.h5", "kept/out.h5"):
+        res = bearingsim("run", PAPER, "-o", tmp_path / target, "--no-plots", "--set", "reduced.method=euler",
+                         "--set", "numerics.dt_s=2e-2")
+        assert res.returncode == 2 and "numerics.dt_s" in res.stderr, res.stderr
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["kept"]

@@ -273,6 +273,16 @@ class Scenario:
         self.source = source
         self._toml = toml
 
+    _OWN = frozenset({"model_", "source", "_toml"})
+
+    def __setattr__(self, item, value):
+        """Only the constructor sets attributes: a scenario is validated once and frozen (``sc.name =
+        "../x"`` would bypass that validation, and an archive would store what no check saw)."""
+        if item not in self._OWN or "model_" in self.__dict__ and item == "model_":
+            raise AttributeError(f"Scenario is frozen: {item} cannot be assigned; use "
+                                 f"scenario.replace(**{{{item!r}: value}}) (validated) for a changed copy")
+        object.__setattr__(self, item, value)
+
     def __getattr__(self, item):
         # the model's sections and values only: no special names (copy.deepcopy would find the model's
         # __deepcopy__ and return a ScenarioModel), and an instance not yet filled (unpickling asks for

@@ -197,3 +197,20 @@ def test_a_name_with_c1_controls_or_bidi_overrides_is_refused(base_reduced, name
     assert str(info.value).isprintable()
     for fine in ("café", "軸受", "Ωmega-2"):
         assert resolve({**base_reduced, "name": fine}).name == fine
+
+
+def test_a_scenario_is_frozen(base_reduced):
+    """Issue 30, Low: ``sc.name = "../../x"`` was accepted, bypassing the name check (the name is the
+    default archive path), and ``sc.operating = None`` too. Assignment is refused with a message naming
+    the attribute and ``replace()``; pickling and copies still work."""
+    import copy
+    import pickle
+
+    sc = resolve(base_reduced)
+    for item, value in (("name", "../../x"), ("operating", None), ("model_", None)):
+        with pytest.raises(AttributeError, match=rf"frozen: {item} cannot be assigned; use scenario.replace"):
+            setattr(sc, item, value)
+    assert sc.name == "t" and sc.raw["name"] == "t"
+    assert pickle.loads(pickle.dumps(sc)) == sc and copy.deepcopy(sc) == sc
+    with pytest.raises(UserError, match="name"):
+        sc.replace(name="../../x")

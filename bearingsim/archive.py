@@ -241,11 +241,20 @@ def write(result, path, spool: Spool | None = None) -> Path:
     """Write ``result`` as a complete archive at ``path`` (atomically); return the path.
 
     With ``spool`` (the sink the run streamed into), its temporary file is completed and renamed;
-    otherwise a new file is written, time series included from ``result.series``.
+    otherwise the archive is built in memory (:func:`to_bytes`, time series included from
+    ``result.series``) and written with plain file writes through :func:`bearingsim.outputs.atomic_file`:
+    a full disk or an I/O error is then an ``OSError`` of this process, raised as one
+    :class:`bearingsim.outputs.ArchiveWriteError` naming ``path``, with no temporary file left and no
+    HDF5 file left open in an error state (h5py would print error stacks while freeing it, and the
+    interpreter could crash at exit).
     """
     if spool is None:
-        with Spool(path) as sp:
-            return write(result, path, sp)
+        path = _prepare_target(path)
+        try:
+            outputs.write_atomic_bytes(path, to_bytes(result))
+        except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file
+            raise outputs.write_error(path, exc) from None
+        return path
     f = spool.f
     try:
         with outputs.quiet_stderr():  # HDF5 prints error stacks on a full disk; the OSError says it

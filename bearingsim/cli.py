@@ -48,6 +48,7 @@ def _cmd_run(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force)
+    args.written = out.archive  # from here an error of standard output is not "no archive" (main)
     if not args.quiet:
         print(f"wrote {out.archive}")
         for png in out.figures:
@@ -98,10 +99,16 @@ def _cmd_show(args) -> int:
 
     index = _describe_index(args.archive)
     if index is not None:  # an index file: its scenario if it stores one, else what it is (as TOML comments)
-        text, toml = index
-        sys.stdout.write(toml if toml else "".join(f"# {line}\n" for line in text.splitlines()))
+        idx_text, toml = index
+        text = toml if toml else "".join(f"# {line}\n" for line in idx_text.splitlines())
+    else:
+        text = read(args.archive, only=SCENARIO_ONLY).scenario.to_toml()
+    buffer = getattr(sys.stdout, "buffer", None)
+    if buffer is None:  # a text stream without bytes underneath (main() called with stdout replaced)
+        sys.stdout.write(text)
         return 0
-    sys.stdout.write(read(args.archive, only=SCENARIO_ONLY).scenario.to_toml())
+    sys.stdout.flush()
+    buffer.write(text.encode("utf-8"))  # a TOML file is UTF-8 whatever the locale (a C locale: ASCII)
     return 0
 
 
@@ -143,17 +150,17 @@ def _cmd_plot(args) -> int:
 
 
 def _cmd_rerun(args) -> int:
-    from bearingsim.archive import Spool, package_versions, write
+    from bearingsim.archive import package_versions
     from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
-    from bearingsim.simulation import COMPARED, run
+    from bearingsim.simulation import COMPARED, run, run_scenario
 
     old = read(args.archive, only=COMPARED)
     progress = sys.stderr.isatty()
-    if args.output:
-        with Spool(args.output) as spool:
-            new = run(old.scenario, progress=progress, sink=spool)
-            write(new, args.output, spool)
+    if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
+        new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
+                           force=args.force).result
+        args.written = Path(args.output)
         print(f"wrote {args.output}")
     else:
         new = run(old.scenario, progress=progress)
@@ -355,6 +362,8 @@ def build_parser() -> argparse.ArgumentParser:
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
     rr.add_argument("archive")
     rr.add_argument("-o", "--output", help="also write the new run's archive here")
+    rr.add_argument("--force", action="store_true",
+                    help="with -o: replace an archive of a different scenario there (default: refused)")
     rr.set_defaults(func=_cmd_rerun)
 
     cp = sub.add_parser("compare", help="scenario keys and summary numbers of two archives side by side "
@@ -507,6 +516,15 @@ def _stdout_to_devnull() -> None:
         os.close(devnull)
 
 
+def _stdout_lost(exc: OSError, written) -> None:
+    """Standard output failed (``> /dev/full``) after the command wrote its archive: exit 2 means "no
+    archive", so say on stderr that the archive is complete and keep the command's exit code."""
+    _stdout_to_devnull()
+    with contextlib.suppress(OSError, ValueError):
+        print(f"bearingsim: cannot write to standard output ({_one_line(exc.strerror or exc)}); the archive "
+              f"{written} is complete", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
@@ -521,10 +539,23 @@ def main(argv: list[str] | None = None) -> int:
         previous = signal.signal(signal.SIGTERM, _raise_terminated)
     except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
         pass
+    errors = {}
+    for name in ("stdout", "stderr"):  # a C locale's ASCII stdout: a non-ASCII name is escaped, not a traceback
+        stream = getattr(sys, name)
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            errors[name] = stream.errors
+            stream.reconfigure(errors="backslashreplace")
     try:
         with _interrupts_redelivered(), outputs.command_line_owns_stderr():
             code = args.func(args)
-            sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
+            try:
+                sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
+            except BrokenPipeError:
+                raise
+            except OSError as exc:
+                if getattr(args, "written", None) is None:
+                    raise
+                _stdout_lost(exc, args.written)
             return code
     except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: stop quietly
         _stdout_to_devnull()
@@ -538,13 +569,19 @@ def main(argv: list[str] | None = None) -> int:
     except SimulationUnstable as exc:
         print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    except Terminated:
-        print("bearingsim: terminated (SIGTERM), no archive written", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print("bearingsim: interrupted, no archive written", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated)
+        what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
+        if written is not None:
+            print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
+                  f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
+        else:
+            print(f"bearingsim: {what}, no archive written", file=sys.stderr)
+        return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
     except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
+        if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
+            _stdout_lost(exc, args.written)
+            return 0
         where = exc.filename or "bearingsim"
         print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
         return 2
@@ -555,6 +592,9 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+        for name, err in errors.items():
+            with contextlib.suppress(AttributeError, ValueError, OSError):
+                getattr(sys, name).reconfigure(errors=err)
 
 
 if __name__ == "__main__":  # pragma: no cover

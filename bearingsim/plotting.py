@@ -27,13 +27,19 @@ def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
     """
     from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
 
+    import warnings
+
     path = Path(path)
     try:
         check_replaceable(path, PNG_SIGNATURE, "figure")
-        if tight:
-            fig.tight_layout()
-        with atomic_file(path) as fh:
-            fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
+        with warnings.catch_warnings():
+            # a scenario name in a script the font lacks (CJK with DejaVu Sans) is drawn as boxes; matplotlib
+            # would also warn once per glyph and layout pass, dozens of lines for one name
+            warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from (current )?font", category=UserWarning)
+            if tight:
+                fig.tight_layout()
+            with atomic_file(path) as fh:
+                fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
     finally:
         plt.close(fig)
     return path

@@ -14,6 +14,7 @@ import os
 import stat
 import math
 import tomllib
+import unicodedata
 from importlib import resources
 from pathlib import Path
 from typing import Any, Literal
@@ -88,6 +89,9 @@ MAX_NESTING_DEPTH = 8
 # short enough that the longest name a run derives from it (".<name>.h5.tmp-<pid>", name + 16 bytes)
 # fits the 255-byte file-name limit of ext4, XFS, btrfs and APFS.
 MAX_NAME_BYTES = 200
+# Unicode's bidirectional controls (embeddings, overrides, isolates, marks): in a name they make a
+# terminal or a file listing show the characters in another order than they are (U+202E "RLO")
+_BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
 # Per-rotation arrays, the impact table and the run time grow with the number of rotations: the
 # multibody model takes ~0.2 s per cage rotation (README), so 1e5 rotations is ~6 h; the reduced
 # model's impact table is ~1e2 rows per rotation, so 1e5 rotations is ~1e7 rows (~0.6 GB in memory).
@@ -232,11 +236,12 @@ class ScenarioModel(_Section):
     @field_validator("name")
     @classmethod
     def _plain_file_name(cls, v):
-        bad = [c for c in v if ord(c) < 32 or ord(c) == 127 or c in "/\\"]
+        bad = [c for c in v if c in "/\\" or c in _BIDI_CONTROLS or unicodedata.category(c) in ("Cc", "Cs", "Zl", "Zp")]
         if bad or v in (".", "..") or v.startswith(".") or len(v.encode("utf-8", "surrogatepass")) > MAX_NAME_BYTES:
             raise ValueError(
                 f"must be a plain file name (it names the archive outputs/<name>.h5): no '/', '\\', "
-                f"control characters or leading '.', at most {MAX_NAME_BYTES} bytes")
+                f"control characters (C0, C1), bidirectional overrides or line separators, no leading '.', "
+                f"at most {MAX_NAME_BYTES} bytes")
         return v
     model: Literal["reduced", "multibody"]
     bearing: BearingSection
@@ -267,6 +272,16 @@ class Scenario:
         self.model_ = model
         self.source = source
         self._toml = toml
+
+    _OWN = frozenset({"model_", "source", "_toml"})
+
+    def __setattr__(self, item, value):
+        """Only the constructor sets attributes: a scenario is validated once and frozen (``sc.name =
+        "../x"`` would bypass that validation, and an archive would store what no check saw)."""
+        if item not in self._OWN or "model_" in self.__dict__ and item == "model_":
+            raise AttributeError(f"Scenario is frozen: {item} cannot be assigned; use "
+                                 f"scenario.replace(**{{{item!r}: value}}) (validated) for a changed copy")
+        object.__setattr__(self, item, value)
 
     def __getattr__(self, item):
         # the model's sections and values only: no special names (copy.deepcopy would find the model's
@@ -429,7 +444,29 @@ def _check_depth(node: Any, where: str, depth: int = 0) -> None:
             stack.extend((v, d + 1) for v in item)
 
 
+def _plain(value: Any) -> Any:
+    """``value`` with numpy scalars as the Python numbers they hold (``np.int64(2)`` -> ``2``,
+    ``np.float64`` -> float, ``np.bool_`` -> bool), inside dicts and lists too: a value computed with
+    numpy is the number it holds, validated as such (an integer key still refuses ``np.float64(2.0)``,
+    as it refuses ``2.0``). Anything else is returned as it is."""
+    import numpy as np
+
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.generic):
+        if isinstance(value, np.bool_):
+            return bool(value)
+        if isinstance(value, np.integer):
+            return int(value)
+        if isinstance(value, np.floating):
+            return float(value)
+    return value
+
+
 def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
+    value = _plain(value)
     parts = key.split(".")
     node = raw
     for p in parts[:-1]:
@@ -522,6 +559,13 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line);
     ``values`` maps dotted keys to Python values; both name keys as ``section.key``.
     """
+    from collections.abc import Mapping
+
+    if values is not None and not isinstance(values, Mapping):
+        raise UserError(f"set: expected a dict of dotted keys and values such as {{'numerics.rotations': 10}} "
+                        f"(got {type(values).__name__})")
+    if overrides is not None and (isinstance(overrides, (str, bytes)) or not isinstance(overrides, (list, tuple))):
+        raise UserError(f"overrides: expected a list of 'KEY=VALUE' strings (got {type(overrides).__name__})")
     raw = read_toml_file(path)
     if not isinstance(raw.get("name", ""), str):
         raise UserError(f"{path}: name: must be a string")
@@ -538,6 +582,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
 
 def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
     """Merge a scenario dictionary with its preset and the package defaults, then validate."""
+    raw = _plain(raw) if isinstance(raw, dict) else raw
     version = raw.get("schema_version")
     if version is None:
         raise UserError(f"{source}: schema_version: missing (this bearingsim reads schema_version = 1)")

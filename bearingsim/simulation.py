@@ -72,6 +72,11 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     """
     from bearingsim import plausibility
 
+    if not isinstance(scenario, Scenario):
+        from bearingsim.errors import UserError
+
+        raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
+                        f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
     t0 = time.perf_counter()
     if dt is not None:
         scenario = scenario.replace(**{"numerics.dt_s": dt})
@@ -160,7 +165,13 @@ def run_scenario(
     out = Path(out) if out is not None else default_output(scenario)
     names = model_module(scenario.model).RESULT.FIGURES if figures else ()
     outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
-    lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
+    made = _missing_folders(out.parent)  # created for this run: removed again if it writes no archive
+    try:
+        lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
+    except BaseException:
+        _remove_empty(made)
+        raise
+    written = False
     try:
         if not force:
             check_same_scenario(out, scenario)
@@ -172,6 +183,7 @@ def run_scenario(
                 for note in result.notes:
                     print(note, file=sys.stderr)
             archive.write(result, out, spool)
+        written = True
         pngs = []
         if figures:
             try:
@@ -179,7 +191,34 @@ def run_scenario(
             except OSError as exc:
                 raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
                                 f"({exc.strerror or exc}); the archive {out} is complete") from None
+            except KeyboardInterrupt as exc:  # SIGINT/SIGTERM while drawing: the archive is a result, kept
+                exc.archive_written = out  # the command line says so (not "no archive written")
+                raise
     finally:
         if lock is not None:
             lock.release()
+        if not written:  # refused (exit 2/3), interrupted or failed: no folder of its own left behind
+            _remove_empty(made)
     return RunOutput(archive=out, figures=list(pngs), result=result)
+
+
+def _missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, deepest first."""
+    missing = []
+    for p in (folder, *folder.parents):
+        if p.exists() or p.is_symlink():
+            break
+        missing.append(p)
+    return missing
+
+
+def _remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (deepest first) while they are empty: never a file, never a folder someone
+    has put something into meanwhile."""
+    import os
+
+    for p in folders:
+        try:
+            os.rmdir(p)
+        except OSError:
+            return

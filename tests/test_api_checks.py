@@ -51,3 +51,36 @@ def test_an_implausible_run_is_refused_by_the_api_as_by_the_cli(tmp_path):
               "-o", tmp_path / "o.h5", "--no-plots")
     assert res.returncode == 3 and str(api.value) in res.stderr, res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_numpy_numbers_are_the_numbers_they_hold(base_reduced):
+    """Issue 30, Low: ``replace(**{"numerics.rotations": np.int64(2)})`` (and a dict given to resolve
+    with numpy values) were refused: "must be a valid integer (got np.int64(2))". A numpy scalar is
+    the Python number it holds; a float for an integer key is still refused."""
+    import numpy as np
+
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import resolve
+
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")
+    for v in (np.int64(2), np.int32(2), np.uint8(2)):
+        got = sc.replace(**{"numerics.rotations": v})
+        assert got.numerics.rotations == 2 and type(got.raw["numerics"]["rotations"]) is int
+    got = sc.replace(**{"operating.inner_ring_speed_rpm": np.float32(2500.0)})
+    assert got.operating.inner_ring_speed_rpm == 2500.0
+    assert resolve({**base_reduced, "numerics": {"rotations": np.int64(3)}}).numerics.rotations == 3
+    with pytest.raises(UserError, match="numerics.rotations"):
+        sc.replace(**{"numerics.rotations": np.float64(2.0)})
+
+
+def test_wrong_argument_types_are_one_line_errors(base_reduced):
+    """Issue 30, Low: ``bearingsim.run(dict)`` and ``load_scenario(path, set=[...])`` (or a string of
+    overrides) ended in AttributeError tracebacks; now one UserError naming the argument."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match=r"run\(\): scenario: expected a Scenario .*got dict"):
+        bearingsim.run(base_reduced)
+    with pytest.raises(UserError, match=r"^set: expected a dict .*got list"):
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set=["numerics.rotations=2"])
+    with pytest.raises(UserError, match=r"^overrides: expected a list .*got str"):
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", overrides="numerics.rotations=2")

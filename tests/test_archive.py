@@ -243,3 +243,42 @@ def test_failed_save_leaves_the_process_file_descriptors_alone(tmp_path, base_re
     os.close(fd_after)
     assert fd_after == fd_probe  # no descriptor kept open for a caller that never closes it
     assert list(tmp_path.iterdir()) == []
+
+
+_FULL_DISK_CHILD = r"""
+import resource, signal, sys
+from bearingsim import run
+from bearingsim.outputs import ArchiveWriteError
+from bearingsim.scenario import resolve
+
+res = run(resolve({"schema_version": 1, "name": "t", "model": "reduced",
+                   "bearing": {"preset": "NU214-Suzuki2023"},
+                   "operating": {"inner_ring_speed_rpm": 3000.0, "radial_load_N": 970.0},
+                   "reduced": {"load_zone_half_angle_deg": 23.5}, "numerics": {"rotations": 1}}))
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # writes past the limit fail with EFBIG, as on a full disk
+resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+try:
+    res.save(sys.argv[1])
+except ArchiveWriteError as exc:
+    print(f"refused: {exc}")
+"""
+
+
+def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
+    """Issue 30, item 9: writes failing past 4 KiB during ``Result.save`` (in a child process: the
+    limit is per process) raise one ArchiveWriteError naming the path (not h5py's raw RuntimeError
+    "Set slist enabled failed"), leave no temporary file, and the interpreter exits cleanly (it died
+    of SIGSEGV at exit, after h5py's error stacks for the objects it could not free)."""
+    import subprocess
+    import sys
+
+    from .conftest import ROOT, started
+
+    out = tmp_path / "out" / "a.h5"
+    with started([sys.executable, "-c", _FULL_DISK_CHILD, out], cwd=tmp_path, env={**__import__("os").environ,
+                 "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+        stdout, stderr = proc.communicate(timeout=300)
+    assert proc.returncode == 0, stderr[-2000:]
+    assert stdout.startswith(f"refused: {out}: cannot write archive (File too large)"), stdout
+    assert stderr == ""
+    assert list((tmp_path / "out").iterdir()) == []

@@ -1,4 +1,5 @@
 """CLI contract: user errors are one line on stderr, exit code 2, no traceback, no archive."""
+import os
 import subprocess
 import sys
 
@@ -136,3 +137,47 @@ def test_inspect_into_a_pipe_closed_early_stops_quietly(tmp_path):
             _, err = proc.communicate(timeout=120)
     assert first.startswith(f"{path}: bearingsim archive".encode()), first
     assert (proc.returncode, err.decode()) == (0, "")
+
+
+@pytest.mark.parametrize("command", ["show", "inspect"])
+def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_reduced, command):
+    """Issue 30, Low: under a C locale (stdout ASCII, strict) a scenario named "café" made ``show`` and
+    ``inspect`` die of UnicodeEncodeError. ``show`` writes its TOML as UTF-8 (what a TOML file is:
+    ``show a.h5 > s.toml`` runs again); other output escapes what the terminal cannot show."""
+    import tomllib
+
+    import bearingsim
+    from bearingsim.scenario import resolve
+
+    from .conftest import ROOT, started
+
+    path = bearingsim.run(resolve({**base_reduced, "name": "café"})).save(tmp_path / "a.h5")
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "LC_ALL": "C", "PYTHONIOENCODING": "ascii",
+           "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
+    with started([sys.executable, "-m", "bearingsim", command, path], env=env, stdout=subprocess.PIPE,
+                 stderr=subprocess.PIPE) as proc:
+        out, err = proc.communicate(timeout=120)
+    assert (proc.returncode, err.decode("ascii", "replace")) == (0, "")
+    if command == "show":
+        assert tomllib.loads(out.decode("utf-8"))["name"] == "café"
+    else:
+        assert "scenario caf\\xe9" in out.decode("ascii")
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_stdout_on_a_full_device_after_the_archive_is_not_exit_2(tmp_path):
+    """Issue 30, Low: ``bearingsim run ... > /dev/full`` wrote its archive, then exited 2 ("bad input,
+    no archive") with "bearingsim: error: bearingsim: No space left on device". Now exit 0 with one line
+    saying standard output failed and the archive is complete."""
+    from .conftest import ROOT, started
+
+    out = tmp_path / "out.h5"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    with open("/dev/full", "w") as full, started([sys.executable, "-m", "bearingsim", "run",
+                                                 SCENARIOS / "paper_3000rpm.toml", "-o", out, "--no-plots"],
+                                                env=env, stdout=full, stderr=subprocess.PIPE, text=True) as proc:
+        _, err = proc.communicate(timeout=120)
+    lines = err.strip().splitlines()
+    assert proc.returncode == 0 and len(lines) == 1, err
+    assert "standard output" in lines[0] and f"the archive {out} is complete" in lines[0]
+    assert out.is_file()

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import csv
 import math
+import signal
 from pathlib import Path
 
 import h5py
@@ -178,3 +179,55 @@ def test_refusals(argv, words, capsys, tmp_path):
     assert rc == 2
     assert err.count("\n") == 1 and words in err
     assert not (tmp_path / "cc" / "cases").exists()
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_path, signum, code):
+    """Issue 30, item 4: ``crosscheck -j 2`` took 7-15 s to stop after SIGINT/SIGTERM and wrote rung
+    archives after the signal. On the sweep engine: stopped within a generous bound, its worker
+    processes ended, no archive written after the signal, no table, exit 128 + signal."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    import psutil
+
+    from .conftest import ROOT, started
+
+    out = tmp_path / "cc"
+    cmd = [sys.executable, "-m", "bearingsim", "crosscheck", REFERENCE, "--speeds", f"{RPM:g}", "--rotations", "2",
+           "-j", "2", "-o", out]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env) as proc:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:  # a rung finished, others running
+            if list((out / "cases").glob("[!.]*.h5")):
+                break
+            time.sleep(0.02)
+        children = psutil.Process(proc.pid).children(recursive=True)
+        assert proc.poll() is None and len(children) >= 2, "the cross-check ended before the signal"
+        t_signal = time.time()
+        os.kill(proc.pid, signum)
+        _, err = proc.communicate(timeout=30)
+        took = time.time() - t_signal
+    assert proc.returncode == code, err
+    assert took < 5.0, took  # about a second; generous for a loaded machine
+    assert "Traceback" not in err and "interrupted" in err and "resume" in err
+    _, alive = psutil.wait_procs(children, timeout=5)
+    assert alive == []
+    late = [p.name for p in (out / "cases").iterdir() if p.stat().st_mtime > t_signal + 0.5]
+    assert late == []  # no rung archive written after the signal (0.5 s: one rename already under way)
+    assert not list((out / "cases").glob(".*")) and not (out / "crosscheck.csv").exists()
+
+
+def test_one_rotation_prints_no_nan_standard_error():
+    """Issue 30, Low: ``crosscheck --rotations 1`` printed "not significant: 2 SE = nan" and "± nan":
+    one rotation gives no batch-means error, so the change is not judged and the table says n/a."""
+    nan = math.nan
+    rows = [dict(rpm=3000.0, rung=k, scene=s, I_dec_mean_Ns=m, I_dec_sem_Ns=e, I_acc_mean_Ns=0.0, I_acc_sem_Ns=e,
+                 first_impact_speed_m_s=0.08, cage_slip=0.0, change_from_previous=c, status="done")
+             for k, s, m, e, c in ((1, "reduced", 5e-3, 0.0, nan), (2, "full", 6e-3, nan, 1e-3))]
+    text = " ".join(cc.verdicts(rows)) + "\n" + cc.format_table(rows)
+    assert "nan" not in text.lower(), text
+    assert "not judged" in text and "n/a" in text

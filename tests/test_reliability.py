@@ -759,3 +759,65 @@ if __name__ == "__main__":
         write_doc()
     else:
         print(__doc__)
+
+
+def test_rerun_output_takes_the_run_lock_and_cleans_dead_temporaries(tmp_path):
+    """Issue 30, item 8: ``rerun -o`` writes through the path of ``run``: a temporary archive of a dead
+    run in the target folder is removed (with a note), and a target whose lock another run holds is
+    refused with one line, nothing written (it bypassed both)."""
+    res = bearingsim("run", PAPER, "-o", tmp_path / "a.h5", "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    _setup_dead_tmp(tmp_path)
+    stale = list(tmp_path.glob(".out.h5.tmp-*"))
+    res = bearingsim("rerun", tmp_path / "a.h5", "-o", tmp_path / "out.h5")
+    assert res.returncode == 0, res.stderr
+    assert f"removed stale temporary file {stale[0]}" in res.stderr
+    assert not stale[0].exists() and (tmp_path / "out.h5").is_file()
+    holder = os.open(tmp_path / ".held.h5.lock", os.O_RDWR | os.O_CREAT)
+    try:
+        fcntl.flock(holder, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        res = bearingsim("rerun", tmp_path / "a.h5", "-o", tmp_path / "held.h5")
+    finally:
+        os.close(holder)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "held.h5" in lines[0] and "another bearingsim run" in lines[0], res.stderr
+    assert not (tmp_path / "held.h5").exists()
+
+
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
+                                             (signal.SIGINT, 130, "interrupted")])
+def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path, monkeypatch, capsys, sig, code,
+                                                                        word):
+    """Issue 30, item 4: a signal that lands while the figures are drawn (the archive is written and
+    complete) printed "no archive written". The archive is a result: kept, and the one line says it
+    is complete and figures were not all written; exit 128 + signal."""
+    from bearingsim import archive, cli
+    from bearingsim.results import Result
+
+    def signalled(self, stem):
+        os.kill(os.getpid(), sig)
+        for _ in range(1000):  # the handler raises here
+            time.sleep(0.01)
+        raise AssertionError("signal not delivered")
+
+    monkeypatch.setattr(Result, "save_figures", signalled)
+    out = tmp_path / "out.h5"
+    assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and word in err[0] and "no archive written" not in err[0], err
+    assert f"the archive {out} is complete" in err[0] and "figures not all written" in err[0]
+    assert archive.peek(out) is not None and archive.is_archive(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary
+
+
+def test_a_refused_run_leaves_no_folder_it_created(tmp_path):
+    """Issue 30, Low: a run refused after it took its output lock (here a step too long for the euler
+    method, found when the run starts) left the folders it had created for ``-o new/deeper/out.h5``.
+    Folders that existed before stay."""
+    (tmp_path / "kept").mkdir()
+    for target in ("new/deeper/out.h5", "kept/out.h5"):
+        res = bearingsim("run", PAPER, "-o", tmp_path / target, "--no-plots", "--set", "reduced.method=euler",
+                         "--set", "numerics.dt_s=2e-2")
+        assert res.returncode == 2 and "numerics.dt_s" in res.stderr, res.stderr
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["kept"]

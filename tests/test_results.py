@@ -53,3 +53,20 @@ def test_run_maps_over_a_process_pool():
     assert [r.scenario for r in results] == scenarios
     for r, sc in zip(results, scenarios):
         _same(r, bearingsim.run(sc))  # what a run in this process gives, bit for bit
+
+
+def test_a_title_in_a_script_the_font_lacks_gives_no_warnings(tmp_path):
+    """Issue 30, Low: a scenario named in CJK printed matplotlib's "Glyph ... missing from font(s)"
+    warning for every character and layout pass. The figure is written (the missing glyphs drawn as
+    boxes) without them. A private-use character stands for a glyph no font has."""
+    import warnings
+
+    from bearingsim.plotting import plt, save_figure
+
+    fig, ax = plt.subplots()
+    ax.set_title("name \ue000\ue001")
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        save_figure(fig, tmp_path / "f.png")
+    assert [str(w.message) for w in seen if "Glyph" in str(w.message)] == []
+    assert (tmp_path / "f.png").read_bytes().startswith(b"\x89PNG")

@@ -181,3 +181,36 @@ def test_scenario_pickles_and_round_trips_equal(base_reduced):
     assert sc != resolve(base_reduced) and sc != "paper_3000rpm"
     with pytest.raises(AttributeError):
         sc.no_such_key
+
+
+@pytest.mark.parametrize("name", ["a\x9b31mb", "invoice\u202egnp.exe", "x\u2066y", "a\u200fb", "a\u2028b", "a\x85b"])
+def test_a_name_with_c1_controls_or_bidi_overrides_is_refused(base_reduced, name):
+    """Issue 30, Low: a scenario name could hold C1 control characters (``\\x9b`` is a terminal's CSI)
+    and bidirectional overrides (U+202E shows "invoice<RLO>gnp.exe" as "invoiceexe.png"), printed raw
+    by every command and used as the archive's file name. Refused like C0 controls, naming ``name``;
+    other non-ASCII names stay valid."""
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import resolve
+
+    with pytest.raises(UserError, match=r"name: must be a plain file name") as info:
+        resolve({**base_reduced, "name": name})
+    assert str(info.value).isprintable()
+    for fine in ("café", "軸受", "Ωmega-2"):
+        assert resolve({**base_reduced, "name": fine}).name == fine
+
+
+def test_a_scenario_is_frozen(base_reduced):
+    """Issue 30, Low: ``sc.name = "../../x"`` was accepted, bypassing the name check (the name is the
+    default archive path), and ``sc.operating = None`` too. Assignment is refused with a message naming
+    the attribute and ``replace()``; pickling and copies still work."""
+    import copy
+    import pickle
+
+    sc = resolve(base_reduced)
+    for item, value in (("name", "../../x"), ("operating", None), ("model_", None)):
+        with pytest.raises(AttributeError, match=rf"frozen: {item} cannot be assigned; use scenario.replace"):
+            setattr(sc, item, value)
+    assert sc.name == "t" and sc.raw["name"] == "t"
+    assert pickle.loads(pickle.dumps(sc)) == sc and copy.deepcopy(sc) == sc
+    with pytest.raises(UserError, match="name"):
+        sc.replace(name="../../x")

@@ -326,8 +326,11 @@ def verdicts(rows: list[dict]) -> list[str]:
             if math.isnan(d):
                 continue
             se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
-            sig = "significant" if abs(d) > 2.0 * se else "not significant"
-            parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig}: 2 SE = {2 * se * 1e3:.2g})")
+            if math.isnan(se):  # a rung of fewer than 2 recorded rotations has no batch-means error
+                sig = "not judged: no standard error from fewer than 2 rotations"
+            else:
+                sig = ("significant" if abs(d) > 2.0 * se else "not significant") + f": 2 SE = {2 * se * 1e3:.2g}"
+            parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig})")
         failed = [f"{r['rung']} {r['scene']}" for r in rs if r.get("status", "done") == "failed"]
         changes = [r for r in rs[1:] if not math.isnan(r["change_from_previous"])]
         if not changes:
@@ -351,8 +354,11 @@ def format_table(rows: list[dict]) -> str:
     lines = [head]
     for r in rows:
         ch = "" if math.isnan(r["change_from_previous"]) else f"{r['change_from_previous'] * 1e3:+.3f}"
+        def sem(v):  # NaN: fewer than 2 rotations, no standard error
+            return f"{'n/a':>6s}" if math.isnan(v) else f"{v * 1e3:6.3f}"
+
         lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
-                     f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {r['I_dec_sem_Ns'] * 1e3:6.3f} "
-                     f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {r['I_acc_sem_Ns'] * 1e3:6.3f} "
+                     f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_dec_sem_Ns'])} "
+                     f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_acc_sem_Ns'])} "
                      f"{r['first_impact_speed_m_s']:9.4f} {r['cage_slip']:10.2e} {ch:>13s}")
     return "\n".join(lines)

@@ -803,7 +803,13 @@ def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path
 
     monkeypatch.setattr(Result, "save_figures", signalled)
     out = tmp_path / "out.h5"
-    assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
+    # a suite started as a background job inherits SIGINT ignored, and Python then keeps it ignored: give
+    # this process the handler a terminal user's Python has (SIGTERM's is the CLI's own)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
+    finally:
+        signal.signal(signal.SIGINT, previous)
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and word in err[0] and "no archive written" not in err[0], err
     assert f"the archive {out} is complete" in err[0] and "figures not all written" in err[0]

@@ -120,7 +120,7 @@ class ReducedOptions:
 class MultibodyOptions:
     """Options of the multi-pocket model."""
 
-    scene: str  # "full", "reduced_equivalent", "kinematic_cage" or "centred_cage" (README: Cross-check)
+    scene: str  # "full", "reduced_equivalent", "kinematic_cage" or "centred_cage" (docs/crosscheck.md)
     inner_ring: str  # "auto", "quasi_static" or "dynamic"
     inner_ring_mass: float | None  # [kg]; None: the rotor's mass W / g
     #: angular extent (psi_in, psi_out) of each arc pocket face from the pocket's circumferential centre

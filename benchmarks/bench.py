@@ -7,7 +7,7 @@ Writes to the output folder:
   multibody model; ``rel_error`` = error of the mean I_dec against the converged reference);
 * ``bench.png``: wall time against error, log-log;
 * ``bench_meta.json``: machine, package versions, date, command, and the long-run check;
-* ``bench.md``: the same table as markdown (what the README shows).
+* ``bench.md``: the same table as markdown (what docs/bench.md shows).
 
 Times are medians of repeats, measured in the same process one after the other, so ratios between
 rows are meaningful even on a noisy machine; absolute times are not.

@@ -106,7 +106,7 @@ def run_fast_scene_bench(outdir: Path, speeds=SPEEDS, rotations: int = ROTATIONS
 
 
 def markdown(rows, comps) -> str:
-    """The README's tables."""
+    """The tables of docs/multibody.md (Rigid raceways) and docs/fast_scene.md."""
     lines = ["| rpm | raceways | dt [us] | s per rotation | pymunk s | I_dec [mN s] | I_acc [mN s] | half angle [deg] | cage slip [%] |",
              "|---|---|---|---|---|---|---|---|---|"]
     for r in rows:

@@ -1,4 +1,4 @@
-"""Whole-bearing numbers the README and docs/geometry.md quote, measured on the default (exact-face) scene.
+"""Whole-bearing numbers docs/multibody.md, docs/whatif.md and docs/geometry.md quote, measured on the default (exact-face) scene.
 
     python benchmarks/whole_bearing.py whatif   # the what-if table: cage guidance, rig (1 warm-up + 20 rotations)
     python benchmarks/whole_bearing.py orbit    # cage whirl against pocket clearance and speed (1 warm-up + 10 rotations)

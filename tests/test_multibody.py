@@ -96,7 +96,7 @@ def test_cage_angular_momentum_balance(full_3000):
 
 def test_frictionless_acc_dec_balance(full_3000_frictionless):
     """With frictionless pockets the only torques on the cage are the circumferential pocket forces;
-    at steady cage speed their long-run mean cancels: I_acc / I_dec -> 1 (PHYSICS Sec. 4).
+    at steady cage speed their long-run mean cancels: I_acc / I_dec -> 1 (docs/physics.md).
     Tolerance 3 % (issue): residual cage acceleration over 10 rotations and the radial component
     of arc-face contacts away from the centre line."""
     r = full_3000_frictionless
@@ -214,7 +214,7 @@ def test_inner_ring_auto_choice():
 
 @pytest.mark.parametrize("rpm", [1000, 3000, 6000])
 def test_reduced_equivalent_matches_event_model(rpm):
-    """The reduced-equivalent scene makes the reduced model's assumptions (PHYSICS Sec. 4), so its mean
+    """The reduced-equivalent scene makes the reduced model's assumptions (docs/physics.md), so its mean
     I_dec per no-load pass must equal the exact event solution within 2 % (issue)."""
     from bearingsim.reduced.core import PassInputs
     from bearingsim.reduced.event import solve_event

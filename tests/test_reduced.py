@@ -1,4 +1,4 @@
-"""Physics tests of the reduced single-pocket model (Suzuki et al. 2023, §2.3; shared/PHYSICS.md §2-3).
+"""Physics tests of the reduced single-pocket model (Suzuki et al. 2023, §2.3; docs/physics.md).
 
 Paper numbers are cited where they are used. The event solver is the reference; the euler solver is
 the paper's own scheme (Eqs. 7-8) and must converge to it.
@@ -29,7 +29,7 @@ def pass_6000():
 
 def test_first_rear_impact_speed_table4(pass_6000):
     """Table 4: first rear impact at 6000 rpm hits at 0.112 m/s. Tolerance 2 %: the paper prints three
-    digits and s = 0.20 mm was reconstructed from this very number (PHYSICS.md §3)."""
+    digits and s = 0.20 mm was reconstructed from this very number (docs/physics.md, reference bearing)."""
     rear = pass_6000.impacts["face"] == 0
     u = pass_6000.impacts["approach_speed"][rear][0]
     assert u == pytest.approx(0.112, rel=0.02)

@@ -383,7 +383,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     geo = p.bearing
     op = p.operating
     scene_kind = p.multibody.scene
-    # two separate choices of the scene (README: Cross-check): the paper's assumptions (no inner ring,
+    # two separate choices of the scene (docs/crosscheck.md): the paper's assumptions (no inner ring,
     # no traction, fixed spin, rollers held at the front of their pockets in the load zone, roller path
     # on the pitch circle) and a kinematic cage turning at the epicyclic speed
     reduced_eq = paper_assumptions(scene_kind)

@@ -2,7 +2,7 @@
 
 One roller in one pocket of a cage turning at the epicyclic speed (Eq. 11), from the no-load-zone
 entrance θ = φ to its exit θ = 2π − φ, starting at the front face at rest relative to the cage.
-Two solvers of the same equations (Eqs. 1–9, corrected as in ``shared/PHYSICS.md`` §2):
+Two solvers of the same equations (Eqs. 1–9, corrected as in ``docs/physics.md``):
 
 * ``event`` (:mod:`bearingsim.reduced.event`): closed form between contacts, impact instants by root
   finding, Zeno sequences closed exactly; the validated reference;

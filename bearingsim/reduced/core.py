@@ -1,6 +1,6 @@
 """Pure kernels of the reduced single-pocket model (paper Sec. 2.3, Eqs. 1-13). SI throughout.
 
-Frame and sign conventions (shared ``PHYSICS.md`` Sec. 2):
+Frame and sign conventions (``docs/physics.md``):
 
 * θ is the roller's angle from the load-zone centre (bottom of the bearing) measured in the direction
   of cage rotation; θ = ω_c t + φ (Eq. 13). One no-load pass runs from θ = φ to θ = 2π − φ.

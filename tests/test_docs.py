@@ -1,0 +1,39 @@
+"""The user's pages stand alone: every relative link resolves inside the repository, and nothing the
+code, preset, scenarios or docs rely on points outside it."""
+import re
+
+from .conftest import ROOT
+
+PAGES = [ROOT / "README.md", ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+
+def test_every_relative_link_resolves():
+    broken = []
+    for page in PAGES:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text()):
+            if re.match(r"[a-z]+:", target) or target.startswith("#"):
+                continue
+            path = (page.parent / target.split("#", 1)[0]).resolve()
+            if not path.exists():
+                broken.append(f"{page.relative_to(ROOT)} -> {target}")
+    assert not broken, broken
+
+
+def test_nothing_cites_a_file_outside_the_repository():
+    roots = [ROOT / "bearingsim", ROOT / "scenarios", ROOT / "docs", ROOT / "benchmarks", ROOT / "tests"]
+    files = [p for r in roots for p in r.rglob("*") if p.suffix in {".py", ".toml", ".md"}]
+    files += [ROOT / "README.md"]
+    pattern = re.compile(r"PHYSICS\.md|shared/(?:seed|tools|PHYSICS)|\.\./shared")
+    offenders = [str(p.relative_to(ROOT)) for p in files
+                 if p.name != "test_docs.py" and pattern.search(p.read_text(errors="replace"))]
+    assert not offenders, offenders
+
+
+def test_readme_is_a_users_page():
+    """The README says what bearingsim is, shows it, starts it, and points onward (docs/ for the rest)."""
+    text = (ROOT / "README.md").read_text()
+    for heading in ("## Quick start", "## What it finds", "## Where to go next"):
+        assert heading in text
+    assert "![" in text                                   # a picture
+    assert not re.search(r"\bissue \d+", text, re.I)       # no development log
+    assert len(text.splitlines()) < 150

@@ -10,8 +10,7 @@ The Python API::
     r.save("x.h5")
     r2 = bearingsim.load("x.h5")      # the same result, read back from the archive
 """
-__version__ = "0.1.0"
-
+from bearingsim._version import __version__  # noqa: E402
 from bearingsim.errors import SimulationUnstable, UserError  # noqa: E402
 
 

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from bearingsim import __version__
+from bearingsim._version import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError

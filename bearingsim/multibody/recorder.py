@@ -27,7 +27,7 @@ from numba import njit
 
 from bearingsim._jit import drop_stale_caches
 from bearingsim.reduced import core as _reduced_core
-from bearingsim.reduced.core import FACE_FRONT, FACE_REAR  # one meaning of the face codes in both models
+from bearingsim.codes import FACE_FRONT, FACE_REAR  # one meaning of the face codes in both models
 
 
 class RecorderConfig(NamedTuple):

@@ -29,6 +29,7 @@ import math
 import numpy as np
 
 from bearingsim import laws
+from bearingsim.codes import FACE_NAMES as CODE_FACE_NAMES
 from bearingsim.reduced.core import FACE_REAR, PassInputs
 from bearingsim.reduced.euler import default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
@@ -42,7 +43,7 @@ __all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolutio
 #: bumped when a change moves numbers)
 MODEL_VERSION = MODEL_VERSIONS["reduced"]
 
-FACE_NAMES = np.array(["rear", "front"])  # indexed by the face codes of reduced/core.py
+FACE_NAMES = np.array(CODE_FACE_NAMES)  # indexed by the face codes (bearingsim/codes.py)
 
 SUMMARY_UNITS = {
     "I_dec_mean_Ns": "N s", "I_dec_std_Ns": "N s", "I_acc_mean_Ns": "N s", "I_acc_std_Ns": "N s",

@@ -23,20 +23,38 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
 from bearingsim import laws
+from bearingsim.codes import FACE_FRONT, FACE_REAR  # noqa: F401  (the solvers' face codes)
 
 # Mode codes shared by the solvers (numba kernels cannot use enums cheaply).
 FREE = 0
 REST_REAR = 1
 REST_FRONT = 2
-FACE_REAR = 0
-FACE_FRONT = 1
 KIND_IMPACT = 0
 KIND_ZENO = 1  # an impact that closes a Zeno bounce sequence (see event.py)
+
+
+class PassConstants(NamedTuple):
+    """The constants of one no-load pass as the compiled solvers take them (SI; one named tuple, no
+    slot vector). ``zeno_height`` and ``zeno_floor`` are fractions of the pocket clearance."""
+
+    mass: float
+    clearance: float
+    omega_c: float
+    gravity: float
+    restitution: float
+    theta_start: float
+    theta_end: float
+    drag_scale: float
+    centripetal: float
+    resting_contact: bool
+    zeno_height: float
+    zeno_floor: float
 
 
 @dataclass(frozen=True)

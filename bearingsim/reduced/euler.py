@@ -66,9 +66,9 @@ def _euler_steps(par, dt, nsteps, stride, fst, ist, impacts, trace, max_steps):
     raises there is not checked and the process dies of SIGSEGV, so a kernel that may run while a
     signal arrives must return no array.
     """
-    m, s, omega, g, e = par[0], par[1], par[2], par[3], par[4]
-    th0, th1, K, A = par[5], par[6], par[7], par[8]
-    resting = par[9] > 0.5
+    m, s, omega, g, e = par.mass, par.clearance, par.omega_c, par.gravity, par.restitution
+    th0, th1, K, A = par.theta_start, par.theta_end, par.drag_scale, par.centripetal
+    resting = par.resting_contact
     duration = (th1 - th0) / omega
     cap = impacts.shape[0]
     ntr = trace.shape[0]
@@ -237,9 +237,9 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
     nsteps = check_step(inp, dt, automatic)
     dt = float(dt)
     dt_max = max_stable_dt(inp)
-    from bearingsim.reduced.event import _params
+    from bearingsim.reduced.event import pass_constants
 
-    par = _params(inp, 0.0, 0.0)
+    par = pass_constants(inp, 0.0, 0.0)
     stride = max(1, int(math.ceil(inp.pass_duration / dt)) // max(trace_points, 1))
     impacts = np.zeros((max(int(capacity), 1), 5))
     trace = np.zeros((nsteps // stride + 2, 4))  # theta, l, v, I_dec cumulative

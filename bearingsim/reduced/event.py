@@ -64,6 +64,7 @@ from bearingsim.reduced import core as _core
 from bearingsim.reduced.core import (
     FACE_FRONT,
     FACE_REAR,
+    PassConstants,
     FREE,
     KIND_IMPACT,
     KIND_ZENO,
@@ -683,11 +684,11 @@ def _zeno_credit(m, u, e, resting, omega, amag, th, wend):
 @njit(cache=True)
 def _event_pass(par, tab, npan, roots, cap):
     """Solve one pass. Returns (status, totals[8], impacts[cap, 5], n_imp, pieces[cap, 6], n_pieces)."""
-    m, s, omega, g, e = par[0], par[1], par[2], par[3], par[4]
-    th0, th1 = par[5], par[6]
-    resting = par[9] > 0.5
-    zeno_h = par[10] * s
-    zeno_floor = par[11] * s
+    m, s, omega, g, e = par.mass, par.clearance, par.omega_c, par.gravity, par.restitution
+    th0, th1 = par.theta_start, par.theta_end
+    resting = par.resting_contact
+    zeno_h = par.zeno_height * s
+    zeno_floor = par.zeno_floor * s
     impacts = np.zeros((cap, 5))  # theta, approach speed, impulse, face, kind
     pieces = np.zeros((cap, 6))  # theta, mode, l, v, I_dec, I_acc (cumulative at piece start)
     totals = np.zeros(8)  # I_dec, I_acc, I_dec_rest, I_acc_rest, l_end, v_end, mode_end, n_events
@@ -876,8 +877,8 @@ def _event_pass(par, tab, npan, roots, cap):
 @njit(cache=True)
 def _trace(par, tab, npan, pieces, n_pc, thetas, left):
     """l, v and cumulative I_dec at sorted θ (left[i]: take the limit from the left at θ)."""
-    m, omega, g = par[0], par[2], par[3]
-    resting = par[9] > 0.5
+    m, omega, g = par.mass, par.omega_c, par.gravity
+    resting = par.resting_contact
     n = thetas.shape[0]
     lo = np.empty(n)
     vo = np.empty(n)
@@ -917,7 +918,7 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
 def _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat):
     """The drag table of the pass (see :func:`_build_table`), grown until its panels fit; returns
     ``(tab, npan)`` with npan < 0 if more than 65536 panels would be needed."""
-    omega, g, th0, th1 = par[2], par[3], par[5], par[6]
+    omega, g, th0, th1 = par.omega_c, par.gravity, par.theta_start, par.theta_end
     cap = 64
     while True:
         t = _build_table(th0, th1, omega, K, A, g, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat, cap)
@@ -937,7 +938,7 @@ def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat,
     status STATUS_TABLE_OVERFLOW when the table needs more than 65536 panels, STATUS_OVERFLOW when
     more than 67 million events would be needed.
     """
-    g = par[3]
+    g = par.gravity
     tab, npan = _table(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat)
     if npan < 0:
         return STATUS_TABLE_OVERFLOW, npan, 0, 0, np.zeros(8), np.empty((0, 5)), np.empty((0, 6)), np.empty(0), tab
@@ -996,12 +997,13 @@ class PassSolution:
     info: dict = field(default_factory=dict)
 
 
-def _params(inp: PassInputs, zeno_height: float, zeno_floor: float) -> np.ndarray:
-    return np.array([
-        inp.mass, inp.pocket_clearance, inp.omega_c, inp.gravity, inp.restitution,
-        inp.theta_start, inp.theta_end, inp.drag_scale, inp.centripetal,
-        1.0 if inp.resting_contact else 0.0, zeno_height, zeno_floor,
-    ])
+def pass_constants(inp: PassInputs, zeno_height: float, zeno_floor: float) -> PassConstants:
+    """The compiled solvers' constants of the pass ``inp``."""
+    return PassConstants(
+        float(inp.mass), float(inp.pocket_clearance), float(inp.omega_c), float(inp.gravity),
+        float(inp.restitution), float(inp.theta_start), float(inp.theta_end), float(inp.drag_scale),
+        float(inp.centripetal), bool(inp.resting_contact), float(zeno_height), float(zeno_floor),
+    )
 
 
 def drag_table(inp: PassInputs, cheb_tol: float = DEFAULT_CHEB_TOL, min_width: float = DEFAULT_MIN_WIDTH):
@@ -1012,7 +1014,7 @@ def drag_table(inp: PassInputs, cheb_tol: float = DEFAULT_CHEB_TOL, min_width: f
     """
     nroots = inp.normal_load_roots()
     r = list(nroots) + [0.0, 0.0]
-    tab, npan = _table(_params(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR), inp.drag_scale, inp.centripetal,
+    tab, npan = _table(pass_constants(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR), inp.drag_scale, inp.centripetal,
                        cheb_tol, min_width, len(nroots), r[0], r[1], CHEB_NODES, CHEB_COS)
     if npan < 0:
         raise SimulationUnstable(TABLE_OVERFLOW_MESSAGE)
@@ -1047,7 +1049,7 @@ def solve_event(
     t0 = time.perf_counter()
     nroots = inp.normal_load_roots()
     r = list(nroots) + [0.0, 0.0]
-    par = _params(inp, zeno_height, zeno_floor)
+    par = pass_constants(inp, zeno_height, zeno_floor)
     status, npan, n_imp, n_pc, totals, imp, pieces, roots, tab = _solve(
         par, inp.drag_scale, inp.centripetal, cheb_tol, min_width, len(nroots), r[0], r[1],
         CHEB_NODES, CHEB_COS, capacity,
@@ -1103,9 +1105,9 @@ def closed_form_evaluator(inp: PassInputs):
     angles in one compiled call; ``evaluate(0)`` is a bare call into compiled code. For the benchmark's
     cost floor (``benchmarks.bench.reduced_rows`` of a source checkout)."""
     tab, npan = drag_table(inp)
-    par = _params(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR)
-    omega, g, th0, th1 = float(par[2]), float(par[3]), float(par[5]), float(par[6])
-    fs = _flight_start(tab, npan, omega, th0, float(par[1]), 0.0)
+    par = pass_constants(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR)
+    omega, g, th0, th1 = par.omega_c, par.gravity, par.theta_start, par.theta_end
+    fs = _flight_start(tab, npan, omega, th0, par.clearance, 0.0)
 
     def evaluate(n: int) -> float:
         return _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, n)

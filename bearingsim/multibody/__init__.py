@@ -491,4 +491,29 @@ class MultibodyResult(Result):
                      f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
         legend_outside(ax)
         return fig
+    def wear_report(self, *, hours=None, rotations=None):
+        """Worn depth profile and volume of every face after ``hours`` or inner-ring ``rotations``
+        (:func:`bearingsim.wear.wear_report`)."""
+        from bearingsim.wear import wear_report
+
+        return wear_report(self, hours=hours, rotations=rotations)
+
+    def plot_wear_profile(self, *, hours=None, rotations=None):
+        """Fig. 13 analog: worn depth against the position on the face (psi), front and rear, the mean over
+        pockets and their spread, after ``hours`` or inner-ring ``rotations`` (default one hour)."""
+        from bearingsim.wear import plot_wear_profile
+
+        if hours is None and rotations is None:
+            hours = 1.0
+        return plot_wear_profile(self.wear_report(hours=hours, rotations=rotations), self.title())
+
+    def plot_wear_volume(self, *, hours=None, rotations=None):
+        """Fig. 14 analog: worn volume per pocket, front and rear, with the spread over pockets."""
+        from bearingsim.wear import plot_wear_volume
+
+        if hours is None and rotations is None:
+            hours = 1.0
+        return plot_wear_volume(self.wear_report(hours=hours, rotations=rotations), self.title())
+
+
 RESULT = MultibodyResult

@@ -99,6 +99,12 @@ def archard_wear_volume(wear_coefficient, impulse, roller_radius, omega_r, hardn
     return wear_coefficient * impulse * (roller_radius * omega_r) / hardness
 
 
+def archard_volume_from_work(wear_coefficient, sliding_work, hardness):
+    """Archard wear volume [m^3] from the sliding work ``W L_s = sum F_c |v_slide| dt`` [J] (may be an
+    array): V = k W L_s / H, the law of Eq. (16) before the paper's impulse approximation. k [-], H [Pa]."""
+    return wear_coefficient * sliding_work / hardness
+
+
 def load_zone_from_displacement(ring_displacement, radial_clearance):
     """Load-zone half angle [rad] of a ring displaced by ``delta_r`` along the load (Harris & Kotzalas,
     Sec. 7.2): ``psi_l = arccos(P_d / (2 delta_r))``; 0 when ``delta_r <= P_d / 2`` (no roller loaded),

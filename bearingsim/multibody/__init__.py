@@ -96,6 +96,11 @@ LAND_SUMMARY_UNITS = {
 
 MAX_DT_RETRIES = 4
 
+#: the wear profile's quantities (docs/wear.md): normal impulse [N s], sliding work [J], contact steps [1]
+PROFILE_QUANTITIES = {"impulse": ("impulse", "N s"), "work": ("work", "J"), "hits": ("hits", "1")}
+PROFILE_PATHS = frozenset({"results/wear/profile_psi_deg"} | {
+    f"results/wear/profile_{q}_{f}" for q in PROFILE_QUANTITIES for f in ("front", "rear")})
+
 
 def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     """Run the multi-pocket model for the SI parameters ``p``. ``dt`` [s] overrides ``numerics.dt``
@@ -133,6 +138,25 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     res = MultibodyResult.from_raw(p, raw)
     res.series = sink.collect()
     return res
+
+
+def _profile_arrays(prof, extent) -> dict:
+    """The wear profile (:data:`bearingsim.multibody.recorder.PROFILE`, (n, 2, bins)) as archive arrays
+    ``[face bin, pocket]`` per face, summed over the recorded rotations, with the bins' centres in psi."""
+    lo, hi = extent
+    nfb = prof.shape[2]
+    psi = np.degrees(lo + (np.arange(nfb) + 0.5) * (hi - lo) / nfb)
+    where = ("summed over the recorded rotations, per bin of psi (rows, /results/wear/profile_psi_deg) and "
+             "pocket (columns)")
+    out = {"results/wear/profile_psi_deg": NamedArray(
+        psi, "deg", "bin centres of psi, the contact point's angle seen from the pocket centre, from the face's "
+                    "middle (0) towards the cage rim (> 0) or bore (< 0); equal bins over the faces' extent")}
+    for q, (field, unit) in PROFILE_QUANTITIES.items():
+        what = {"impulse": "normal impulse", "work": "sliding work J_n |v_slide|", "hits": "contact steps"}[q]
+        for f, code in (("front", rk.FACE_FRONT), ("rear", rk.FACE_REAR)):
+            out[f"results/wear/profile_{q}_{f}"] = NamedArray(
+                np.ascontiguousarray(prof[:, code, :][field].T), unit, f"{what} on the {f} face, {where}")
+    return out
 
 
 def _load_zone_half_angle(q_bin, tq_bin):
@@ -179,11 +203,14 @@ class MultibodyResult(Result):
         "results/raceway_load_inner": ("theta bins",), "results/raceway_load_outer": ("theta bins",),
         **{f"results/wear/{c}": ("pockets",) for c in ("paper_index_front", "paper_index_rear",
                                                        "sliding_work_front", "sliding_work_rear")},
+        "results/wear/profile_psi_deg": ("face bins",),
+        **{f"results/wear/profile_{q}_{f}": ("face bins", "pockets") for q in PROFILE_QUANTITIES for f in ("front", "rear")},
         "results/cage_orbit": ("orbit samples", 3),
         **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
     }
     OPTIONAL = (frozenset(f"results/per_rotation/{c}" for c in _LAND),  # a land-guided cage
-                frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}))  # a scene with a ring
+                frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
+                PROFILE_PATHS)  # archives written before the wear profile
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m")  # no ring: absent
     FIGURE_DATA = ("results/theta_deg", "results/force_vs_theta_acc", "results/force_vs_theta_dec",
@@ -340,6 +367,7 @@ class MultibodyResult(Result):
         }
         for k, v in wear.items():
             data[f"results/wear/{k}"] = NamedArray(v, "m^3", wear_desc[k])
+        data.update(_profile_arrays(raw["prof"], p.multibody.pocket_face_extent))
         orbit = raw["orbit"]
         data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
                                                 "last recorded samples of the cage centre: columns time, x, y")
@@ -463,4 +491,29 @@ class MultibodyResult(Result):
                      f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
         legend_outside(ax)
         return fig
+    def wear_report(self, *, hours=None, rotations=None):
+        """Worn depth profile and volume of every face after ``hours`` or inner-ring ``rotations``
+        (:func:`bearingsim.wear.wear_report`)."""
+        from bearingsim.wear import wear_report
+
+        return wear_report(self, hours=hours, rotations=rotations)
+
+    def plot_wear_profile(self, *, hours=None, rotations=None):
+        """Fig. 13 analog: worn depth against the position on the face (psi), front and rear, the mean over
+        pockets and their spread, after ``hours`` or inner-ring ``rotations`` (default one hour)."""
+        from bearingsim.wear import plot_wear_profile
+
+        if hours is None and rotations is None:
+            hours = 1.0
+        return plot_wear_profile(self.wear_report(hours=hours, rotations=rotations), self.title())
+
+    def plot_wear_volume(self, *, hours=None, rotations=None):
+        """Fig. 14 analog: worn volume per pocket, front and rear, with the spread over pockets."""
+        from bearingsim.wear import plot_wear_volume
+
+        if hours is None and rotations is None:
+            hours = 1.0
+        return plot_wear_volume(self.wear_report(hours=hours, rotations=rotations), self.title())
+
+
 RESULT = MultibodyResult

@@ -449,7 +449,10 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         inner_ring=not reduced_eq, traction=not reduced_eq, spin_free=not reduced_eq,
         newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass), rigid=is_rigid, rigid_radius=float(r_c))
     cfg = rk.RecorderConfig(sign=float(sign), roller_count=int(n), warmup_rotations=float(warm), rotations=nrot,
-                            theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S)
+                            theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S,
+                            pocket_centre_radius=float(geo.pitch_radius),
+                            psi_lo=float(p.multibody.pocket_face_extent[0]),
+                            psi_hi=float(p.multibody.pocket_face_extent[1]))
     acc = rk.accumulators(nrot, n, THETA_BINS, IMPACT_CAPACITY)
     # pocket angles from the load-zone centre at t = 0, in [0, 2 pi)
     theta0 = np.mod(-2.0 * math.pi * np.arange(n) / n, 2.0 * math.pi)
@@ -628,7 +631,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         t_start=t_start, dt_start=h_start if t_start > 0.0 else h,  # rigid: the start phase (0: none)
         wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, step_loop=io.name, step_loop_reason=loop_why, t_end=t,
         t_record=t_rec, win=acc.win, first_imp=acc.first_imp, f_bin=acc.f_bin, t_bin=acc.t_bin, q_bin=acc.q_bin,
-        tq_bin=acc.tq_bin, glob=acc.glob.copy()[0], impacts=imp,
+        tq_bin=acc.tq_bin, glob=acc.glob.copy()[0], impacts=imp, prof=acc.prof,
         impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=st["cage_w_start"] if rec_started else None,
         cage_w_end=prev[n, 5],
         cage_inertia=geo.cage_inertia, newton_failures=int(st["newton_failures"]), orbit_max=st["orbit_max"],

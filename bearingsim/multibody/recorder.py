@@ -15,7 +15,14 @@ package docstring of :mod:`bearingsim.multibody`):
   step (the speed pymunk's restitution acts on); a contact step whose approach speed exceeds
   ``impact_speed_threshold`` is an impact, anything slower is resting-contact chatter;
 * sliding work ``sum J_n |v_slide|`` uses the tangential relative speed of the contact points after
-  the step.
+  the step;
+* where a contact lands on its face (wear profile, :data:`PROFILE`): the angle ``psi`` of the cage's
+  contact point seen from the pocket centre, from the face's middle (the circumferential direction,
+  ``psi`` = 0) towards the cage's rim (``psi`` > 0) or bore (< 0), ``psi = atan2(d . e_r, |d . e_t|)``
+  (``d``: the contact point's offset from the pocket centre); on an arc face it is the angle on the arc,
+  on a flat face ``atan(radial position / R)``. Each contact step of the recorded rotations adds its
+  normal impulse and sliding work to one of ``face_bins`` equal bins of ``psi`` over the arc faces'
+  extent ``[psi_lo, psi_hi]`` (a contact beyond an end counts in the end bin).
 """
 from __future__ import annotations
 
@@ -39,6 +46,9 @@ class RecorderConfig(NamedTuple):
     rotations: int  #: R, recorded rotations
     theta_bins: int  #: number of bins of theta over 2 pi
     impact_speed_threshold: float  #: approach speed above which a contact step is an impact [m/s]
+    pocket_centre_radius: float = 0.0  #: distance of the pocket centres from the cage centre [m]
+    psi_lo: float = 0.0  #: inner end of the wear profile's range of psi [rad]
+    psi_hi: float = 0.0  #: outer end (no profile is recorded unless psi_hi > psi_lo) [rad]
 
 
 #: Per rotation and pocket accumulators, array shape (R, n) [N s] and [J].
@@ -78,6 +88,14 @@ IMPACT = np.dtype([
 
 #: Circumferential contact impulse by theta bin, array shape (n, bins) [N s].
 FACE_BIN = np.dtype([("front", np.float64), ("rear", np.float64)], align=True)
+#: Wear profile: per pocket, face (FACE_REAR, FACE_FRONT) and bin of psi, array shape (n, 2, face_bins).
+PROFILE = np.dtype([
+    ("impulse", np.float64),  # normal impulse J_n [N s]
+    ("work", np.float64),  # sliding work J_n |v_slide| [J]
+    ("hits", np.float64),  # contact steps
+], align=True)
+#: bins of psi of the wear profile over a face's extent (~1.8 deg, ~0.2 mm of the reference pocket's arc)
+FACE_BINS = 32
 #: Raceway load x time by theta bin, array shape (bins,) [N s].
 RACE_BIN = np.dtype([("inner", np.float64), ("outer", np.float64)], align=True)
 
@@ -94,9 +112,11 @@ class Accumulators(NamedTuple):
     j_int: np.ndarray  #: (n,) FACE_BIN, circumferential impulses since the last output sample [N s]
     glob: np.ndarray  #: (1,) GLOBALS
     impacts: np.ndarray  #: (capacity,) IMPACT
+    prof: np.ndarray  #: (n, 2, face_bins) PROFILE, recorded rotations
 
 
-def accumulators(rotations: int, roller_count: int, theta_bins: int, impact_capacity: int) -> Accumulators:
+def accumulators(rotations: int, roller_count: int, theta_bins: int, impact_capacity: int,
+                 face_bins: int = FACE_BINS) -> Accumulators:
     """Zeroed accumulators (``first_imp`` NaN) for a run."""
     r, n = rotations, roller_count
     return Accumulators(
@@ -104,7 +124,7 @@ def accumulators(rotations: int, roller_count: int, theta_bins: int, impact_capa
         f_bin=np.zeros((n, theta_bins), dtype=FACE_BIN), t_bin=np.zeros((n, theta_bins)),
         q_bin=np.zeros(theta_bins, dtype=RACE_BIN), tq_bin=np.zeros(theta_bins),
         j_int=np.zeros(n, dtype=FACE_BIN), glob=np.zeros(1, dtype=GLOBALS),
-        impacts=np.zeros(impact_capacity, dtype=IMPACT))
+        impacts=np.zeros(impact_capacity, dtype=IMPACT), prof=np.zeros((n, 2, face_bins), dtype=PROFILE))
 
 
 ARB_F = 9  # floats per arbiter: total impulse (2), normal (2), point a (2), point b (2), distance
@@ -172,6 +192,26 @@ def arbiter_order(arb_f, arb_i, n_arb, ids_sorted, ids_index, n):
 
 
 @njit(cache=True, inline="always")
+def _profile_add(prof, i, face, dx, dy, alpha, etx, ety, jn, work, cfg):
+    """Add a contact's normal impulse ``jn`` [N s] and sliding work [J] to the wear-profile bin of its
+    ``psi`` (module docstring); ``(dx, dy)``: the cage's contact point from the cage centre, ``alpha``:
+    the pocket centre's angle, ``(etx, ety)``: e_t, all in the world frame."""
+    rho = dx * math.cos(alpha) + dy * math.sin(alpha) - cfg.pocket_centre_radius
+    along = abs(dx * etx + dy * ety)
+    psi = math.atan2(rho, along)
+    nfb = prof.shape[2]
+    b = int(math.floor((psi - cfg.psi_lo) / (cfg.psi_hi - cfg.psi_lo) * nfb))
+    if b < 0:
+        b = 0
+    elif b >= nfb:
+        b = nfb - 1
+    r = prof[i, face, b]
+    r.impulse += jn
+    r.work += work
+    r.hits += 1.0
+
+
+@njit(cache=True, inline="always")
 def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg, pocket_a, theta0, diag, acc,
                 n_imp, continuing):
     """Attribute one step's roller-cage impulses and raceway loads; return the new impact count.
@@ -210,6 +250,7 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
     yc = now[n, 1]
     travel = sign * phic
     rec_on = travel >= TWO_PI * warm
+    prof_on = cfg.psi_hi > cfg.psi_lo
     # raceway loads and residence time by theta (recorded period only)
     for i in range(n):
         th = pocket_theta(sign, phic, pocket_a[i])
@@ -310,6 +351,8 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
                 acc.f_bin[i, b].rear += -circ
                 if pen > g.maxpen_rear:
                     g.maxpen_rear = pen
+            if prof_on:
+                _profile_add(acc.prof, i, face, pcx - xc, pcy - yc, alpha, etx, ety, jn, jn * vslide, cfg)
             if approach > vthr and not continuing[i]:
                 if (not front) and th < math.pi and acc.first_imp[k, i] != acc.first_imp[k, i]:
                     acc.first_imp[k, i] = approach

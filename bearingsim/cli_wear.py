@@ -1,0 +1,82 @@
+"""``bearingsim wear`` and ``bearingsim life``: the wear subcommands (docs/wear.md), registered by
+:func:`bearingsim.cli.build_parser` through :func:`add_commands`."""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+from bearingsim.errors import UserError
+
+
+def _cmd_wear(args) -> int:
+    from bearingsim import wear
+    from bearingsim.archive import check_writable_dir, is_archive
+    from bearingsim.plotting import save_figure
+    from bearingsim.simulation import load
+
+    path = Path(args.archive)
+    if not is_archive(path):
+        raise UserError(f"{path}: not a bearingsim archive")
+    result = load(path)
+    if result.model != "multibody":
+        raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
+    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
+    print(f"{path}: " + wear.format_report(rep))
+    if not args.no_plots:
+        folder = check_writable_dir(args.output) if args.output else path.parent
+        title = result.title()
+        for name, fig in (("wear_profile", wear.plot_wear_profile(rep, title)),
+                          ("wear_volume", wear.plot_wear_volume(rep, title))):
+            print(f"wrote {save_figure(fig, folder / f'{path.stem}_{name}.png')}")
+    return 0
+
+
+def _cmd_life(args) -> int:
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.plotting import save_figure
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies import life
+
+    limit = life.parse_limit(args.limit)
+    scenario = load_scenario(args.scenario, args.set)
+    folder = check_writable_dir(args.output or Path("outputs") / f"{scenario.name}_life")
+    say = None if args.quiet else (lambda line: print(line, file=sys.stderr))
+    cols = life.run_life(scenario, folder, limit, stages=args.stages, rotations=args.rotations, force=args.force,
+                         progress=say)
+    cols_, attrs = life.read_life(folder / "life.h5")
+    png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
+    print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
+          f"inner-ring rotations in {len(cols['stage'])} stages")
+    print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
+          f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}")
+    for i in range(len(cols["stage"])):
+        print(f"{cols['stage'][i]:>5} {cols['pocket_clearance_mm'][i]:>8.4f} {cols['stage_rotations'][i]:>11.4g} "
+              f"{cols['hours_end'][i]:>9.4g} {cols['max_depth_rate_um_per_h'][i]:>18.4g} "
+              f"{cols['max_depth_um'][i]:>13.4g} {cols['I_dec_mean_mNs'][i]:>13.4g} {cols['reused'][i]:>6}")
+    print(f"wrote {folder / 'life.h5'}")
+    print(f"wrote {png}")
+    return 0
+
+
+def add_commands(sub) -> None:
+    """Register ``wear`` and ``life`` on the subparsers ``sub``."""
+    w = sub.add_parser("wear", help="worn depth profile and volume of every pocket face after a running time "
+                                    "(from a multibody archive's wear profile)")
+    w.add_argument("archive", help="multibody archive (.h5)")
+    t = w.add_mutually_exclusive_group(required=True)
+    t.add_argument("--hours", type=float, help="running time [h] at the archive's speed")
+    t.add_argument("--rotations", type=float, help="running time as inner-ring (shaft) rotations")
+    w.add_argument("-o", "--output", help="folder for the figures (default: the archive's)")
+    w.add_argument("--no-plots", action="store_true", help="print only")
+    w.set_defaults(func=_cmd_wear)
+    li = sub.add_parser("life", help="stages of simulate / wear the pockets / simulate again until a wear limit")
+    li.add_argument("scenario", help="multibody scenario TOML file")
+    li.add_argument("--limit", required=True, help="depth=<x>mm (deepest worn point), clearance=<x>mm (pocket "
+                                                   "clearance), or volume=<x>mm3 (worn volume of one face)")
+    li.add_argument("--stages", type=int, default=10, help="stages (default 10)")
+    li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")
+    li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
+    li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
+    li.add_argument("--force", action="store_true", help="replace a life study of another scenario or limit")
+    li.add_argument("-q", "--quiet", action="store_true", help="no line per stage run")
+    li.set_defaults(func=_cmd_life)

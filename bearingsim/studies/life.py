@@ -1,0 +1,228 @@
+"""Cage life with the clearance it wears: simulate, wear the pockets, simulate again (docs/wear.md).
+
+A life study is a sequence of ``stages``. Stage ``j`` runs the scenario at the pocket clearance the wear
+of the stages before it left, reads the wear rate of every face from its wear profile
+(:func:`bearingsim.wear.wear_report` per inner-ring rotation), and runs it on for as many rotations as
+bring the limited quantity from ``j / stages`` to ``(j + 1) / stages`` of the limit at that rate (so the
+last stage ends at the limit). The rates can change from stage to stage: the wear acts back through the
+clearance.
+
+How the worn shape maps onto the model's geometry (a first model, stated): the whole bearing's pockets
+stay arcs, and every pocket's clearance ``s`` grows by the worn depth of the **worst pocket** (largest
+worn volume), front plus rear, each face's depth taken as its **mean over the face** (worn volume /
+face area, so the model's pocket removes as much brass as wore). The shape of the wear (deeper at the
+faces' ends) is reported but not fed back. Limits: ``depth`` (the deepest point of any face),
+``clearance`` (the grown pocket clearance ``s``), ``volume`` (the largest worn volume of one face).
+
+Stages run in sequence in one folder under :class:`bearingsim.outputs.FolderLock`: ``stages/stage_NN.h5``
+(each a normal archive) and ``life.h5`` (the history, written atomically at the end). A stage archive
+that stores exactly its stage's scenario is reused: an interrupted study resumes where it stopped.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+
+LIFE_FORMAT = "bearingsim life"
+#: limit kinds and the unit of each in the --limit text (SI factor)
+LIMIT_UNITS = {"depth": {"mm": 1e-3, "um": 1e-6}, "clearance": {"mm": 1e-3, "um": 1e-6},
+               "volume": {"mm3": 1e-9}}
+
+
+@dataclass(frozen=True)
+class Limit:
+    kind: str  #: "depth", "clearance" or "volume"
+    value: float  #: SI [m] or [m^3]
+    text: str  #: as given
+
+
+def parse_limit(text: str) -> Limit:
+    """``depth=0.1mm``, ``clearance=0.5mm`` or ``volume=2mm3`` (also ``um`` for lengths)."""
+    m = re.fullmatch(r"\s*(\w+)\s*=\s*([0-9.eE+-]+)\s*(\w+)\s*", text or "")
+    if not m or m.group(1) not in LIMIT_UNITS:
+        raise UserError(f"--limit {text!r}: give depth=<x>mm, clearance=<x>mm or volume=<x>mm3")
+    kind, num, unit = m.groups()
+    if unit not in LIMIT_UNITS[kind]:
+        raise UserError(f"--limit {text!r}: the unit of {kind} is one of {', '.join(LIMIT_UNITS[kind])}")
+    try:
+        value = float(num) * LIMIT_UNITS[kind][unit]
+    except ValueError:
+        raise UserError(f"--limit {text!r}: {num!r} is not a number") from None
+    if not (math.isfinite(value) and value > 0):
+        raise UserError(f"--limit {text!r}: must be positive")
+    return Limit(kind, value, text.strip())
+
+
+class _State:
+    """The wear accumulated up to a stage: depth profiles and volumes of every face, running time."""
+
+    def __init__(self, s0: float):
+        self.s0 = s0
+        self.depth = None  # (2, bins, pockets) front, rear [m]
+        self.volume = None  # (2, pockets) [m^3]
+        self.shaft = 0.0
+        self.hours = 0.0
+        self.area = 0.0  # one face's area [m^2]
+
+    def quantity(self, kind: str, depth, volume):
+        """The limited quantity of a (depth, volume) state: per element, the one that reaches it first."""
+        if kind == "depth":
+            return depth.reshape(-1)
+        if kind == "volume":
+            return volume.reshape(-1)
+        return self.s0 + volume.sum(axis=0) / self.area  # clearance of each pocket worn so
+
+    def clearance(self) -> float:
+        if self.volume is None:
+            return self.s0
+        return float(self.s0 + self.volume.sum(axis=0).max() / self.area)
+
+
+def _stage_length(q_now, q_rate, target) -> float:
+    """Inner-ring rotations until the first element of ``q_now + q_rate N`` reaches ``target``."""
+    grow = q_rate > 0
+    if not grow.any():
+        raise UserError("no wear at this stage (no sliding work on any face): the limit is never reached")
+    return float(np.min((target - q_now[grow]) / q_rate[grow]))
+
+
+def stage_scenario(scenario, clearance: float, index: int, rotations: int | None):
+    """The scenario of stage ``index``: ``scenario`` at pocket clearance ``clearance`` [m]."""
+    over = {"bearing.pocket_clearance_mm": float(round(clearance * 1e3, 9)), "name": f"{scenario.name}_stage{index:02d}"}
+    if rotations is not None:
+        over["numerics.rotations"] = int(rotations)
+    return scenario.replace(**over)
+
+
+def _run_stage(sc, path: Path, progress):
+    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` (resume),
+    else a new run."""
+    from bearingsim import archive
+    from bearingsim.simulation import load, run_scenario
+
+    got = archive.peek(path) if path.exists() else None
+    if got is not None and got["scenario"] == sc.to_toml():
+        return load(path), True
+    if progress:
+        progress(f"stage {path.stem}: running {sc.numerics.rotations} rotations at pocket clearance "
+                 f"{sc.bearing.pocket_clearance_mm:.4g} mm")
+    run_scenario(sc, path, figures=False, exclusive=False, notes=False, force=True)
+    return load(path), False
+
+
+def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int | None = None,
+             force: bool = False, progress=None) -> dict:
+    """Run a life study (module docstring) into ``folder``; return the history's columns (also written
+    as ``folder/life.h5``). ``progress``: a callable given one line per stage run (the CLI prints them)."""
+    from bearingsim import archive
+    from bearingsim.outputs import FolderLock
+    from bearingsim.wear import wear_report
+
+    if scenario.model != "multibody":
+        raise UserError(f"{scenario.source}: model = {scenario.model!r}: wear profiles need the whole bearing "
+                        f"(model = \"multibody\")")
+    if not 1 <= stages <= 100:
+        raise UserError(f"--stages {stages}: give 1 to 100 stages")
+    if rotations is not None and rotations < 1:
+        raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation per stage")
+    s0 = scenario.bearing.pocket_clearance_mm * 1e-3
+    if limit.kind == "clearance" and limit.value <= s0:
+        raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
+                        f"(bearing.pocket_clearance_mm); give a larger one")
+    folder = Path(folder)
+    (folder / "stages").mkdir(parents=True, exist_ok=True)
+    _check_folder(folder, scenario, limit, force)
+    rows = []
+    with FolderLock(folder):
+        st = _State(s0)
+        for j in range(stages):
+            sc = stage_scenario(scenario, st.clearance(), j, rotations)
+            res, reused = _run_stage(sc, folder / "stages" / f"stage_{j:02d}.h5", progress)
+            rate = wear_report(res, rotations=1.0)
+            d_rate = np.stack([rate.depth_front, rate.depth_rear])
+            v_rate = np.stack([rate.volume_front, rate.volume_rear])
+            if st.depth is None:
+                st.depth, st.volume = np.zeros_like(d_rate), np.zeros_like(v_rate)
+                st.area = rate.bin_area * len(rate.psi_deg)
+            start = st.s0 if limit.kind == "clearance" else 0.0
+            goal = start + (limit.value - start) * (j + 1) / stages
+            q_now = st.quantity(limit.kind, st.depth, st.volume)
+            q_rate = st.quantity(limit.kind, d_rate, v_rate) - (st.s0 if limit.kind == "clearance" else 0.0)
+            n_stage = _stage_length(q_now, q_rate, goal)
+            st.depth = st.depth + d_rate * n_stage
+            st.volume = st.volume + v_rate * n_stage
+            st.shaft += n_stage
+            st.hours += n_stage * rate.hours
+            rows.append(_row(j, sc, res, rate, n_stage, st, reused))
+        cols = {k: np.array([r[k] for r in rows]) for k in rows[0]}
+        archive.write_table_file(folder / "life.h5", cols, LIFE_UNITS, {
+            "format": LIFE_FORMAT, "limit": limit.text, "stages": stages, "scenario": scenario.to_toml(),
+            "mapping": "every pocket's clearance grows by the worst pocket's mean worn depth, front + rear"})
+    return cols
+
+
+LIFE_UNITS = {"stage": "1", "pocket_clearance_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
+              "hours_end": "h", "max_depth_rate_um_per_h": "um/h", "max_volume_rate_mm3_per_h": "mm^3/h",
+              "max_depth_um": "um", "max_volume_mm3": "mm^3", "clearance_end_mm": "mm", "I_dec_mean_mNs": "mN s",
+              "reused": "1"}
+
+
+def _row(j, sc, res, rate, n_stage, st, reused) -> dict:
+    per_hour = 1.0 / rate.hours  # rate report is for one rotation
+    return {
+        "stage": j, "pocket_clearance_mm": sc.bearing.pocket_clearance_mm, "stage_rotations": n_stage,
+        "rotations_end": st.shaft, "hours_end": st.hours,
+        "max_depth_rate_um_per_h": rate.max_depth * per_hour * 1e6,
+        "max_volume_rate_mm3_per_h": float(max(rate.volume_front.max(), rate.volume_rear.max())) * per_hour * 1e9,
+        "max_depth_um": float(st.depth.max()) * 1e6, "max_volume_mm3": float(st.volume.max()) * 1e9,
+        "clearance_end_mm": st.clearance() * 1e3, "I_dec_mean_mNs": res.summary["I_dec_mean_Ns"] * 1e3,
+        "reused": int(reused),
+    }
+
+
+def _check_folder(folder: Path, scenario, limit: Limit, force: bool) -> None:
+    """Refuse a folder that holds another life study (another scenario or limit) unless ``force``."""
+    from bearingsim import archive
+
+    path = folder / "life.h5"
+    if not path.exists() or force:
+        return
+    _, attrs = archive.read_table_file(path, LIFE_FORMAT)
+    if attrs.get("scenario") != scenario.to_toml() or attrs.get("limit") != limit.text:
+        raise UserError(f"{path}: holds a life study of another scenario or limit; give another folder or --force")
+
+
+def read_life(path) -> tuple[dict, dict]:
+    """The history's columns and attributes of a ``life.h5``."""
+    from bearingsim import archive
+
+    return archive.read_table_file(path, LIFE_FORMAT)
+
+
+def plot_life(cols: dict, attrs: dict):
+    """Worn depth, pocket clearance and wear rate against running time, stage by stage."""
+    from bearingsim.plotting import plt
+
+    h_end = cols["hours_end"]
+    h_start = np.concatenate([[0.0], h_end[:-1]])
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
+    axes[0].plot(np.concatenate([[0.0], h_end]), np.concatenate([[0.0], cols["max_depth_um"]]), "o-")
+    axes[0].set_ylabel("deepest worn point [µm]")
+    axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["pocket_clearance_mm"][0]],
+                                                                   cols["clearance_end_mm"]]), "o-", color="C2")
+    axes[1].set_ylabel("pocket clearance s [mm]")
+    axes[2].hlines(cols["max_depth_rate_um_per_h"], h_start, h_end, color="C3")
+    axes[2].set_ylabel("deepest point's wear rate [µm/h]")
+    axes[2].set_ylim(bottom=0.0)
+    for ax in axes:
+        ax.set_xlabel("running time [h]")
+    fig.suptitle(f"life to {attrs.get('limit', '?')}: {h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} inner-ring "
+                 f"rotations, {len(h_end)} stages", fontsize=9)
+    fig.tight_layout()
+    return fig

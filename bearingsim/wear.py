@@ -1,0 +1,172 @@
+"""Worn shape and volume of the pocket faces from a multibody result's wear profile (docs/wear.md).
+
+The step loop records, per pocket, face and bin of ``psi`` (the angle of the contact point seen from the
+pocket centre, from the face's middle towards the cage rim), the normal impulse and the sliding work
+``sum J_n |v_slide|`` of the recorded rotations (:mod:`bearingsim.multibody.recorder`). Archard's law
+(:func:`bearingsim.laws.archard_volume_from_work`) turns the sliding work of a bin into a worn volume,
+and that volume spread over the bin's face area (arc length ``R dpsi`` times the roller length ``l``,
+the axial width of the line contact) into a worn depth. The recorded rotations are scaled to a running
+time: ``rotations`` counts **inner-ring (shaft) rotations**, what a test rig counts (the paper's
+1.6e5 in Table 3); the cage turns ``cage speed / inner-ring speed`` times as often (the measured mean
+cage speed of the run).
+
+Results only: a result read from an archive is enough (every number here is drawn from the archive).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bearingsim import laws
+from bearingsim.errors import UserError
+
+
+@dataclass(frozen=True)
+class WearReport:
+    """Worn depth profile and volume of every pocket face after a running time. SI."""
+
+    psi_deg: np.ndarray  #: (bins,) bin centres of psi [deg]
+    depth_front: np.ndarray  #: (bins, pockets) worn depth, front face [m]
+    depth_rear: np.ndarray  #: (bins, pockets) worn depth, rear face [m]
+    volume_front: np.ndarray  #: (pockets,) worn volume, front face [m^3]
+    volume_rear: np.ndarray  #: (pockets,) worn volume, rear face [m^3]
+    shaft_rotations: float  #: inner-ring rotations of the running time
+    hours: float  #: running time [h]
+    cage_rotations: float  #: cage rotations of the running time
+    wear_coefficient: float  #: Archard's k [-]
+    hardness: float  #: H [Pa]
+    bin_area: float  #: face area of one bin [m^2]
+
+    @property
+    def max_depth(self) -> float:
+        """The deepest worn point of any face [m]."""
+        return float(max(self.depth_front.max(), self.depth_rear.max()))
+
+    def cov(self, face: str) -> float:
+        """Coefficient of variation (std / mean) of the worn volume over the pockets of one face [-]."""
+        v = self.volume_front if face == "front" else self.volume_rear
+        return float(v.std() / v.mean()) if v.mean() > 0 else float("nan")
+
+    def mean_depth(self, face: str) -> np.ndarray:
+        """(pockets,) worn depth averaged over the face's extent (volume / face area) [m]."""
+        v = self.volume_front if face == "front" else self.volume_rear
+        return v / (self.bin_area * len(self.psi_deg))
+
+
+def has_profile(result) -> bool:
+    """True when ``result`` holds a wear profile (multibody archives written since it exists)."""
+    return "results/wear/profile_work_front" in result.data
+
+
+def running_time(result, *, hours: float | None = None, rotations: float | None = None) -> tuple[float, float, float]:
+    """(shaft rotations, hours, cage rotations) of a running time given as ``hours`` or inner-ring
+    ``rotations`` (exactly one); the cage rotations at the run's measured mean cage speed."""
+    if (hours is None) == (rotations is None):
+        raise UserError("give the running time as hours or as inner-ring rotations (exactly one)")
+    value, name = (hours, "--hours") if hours is not None else (rotations, "--rotations")
+    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+        raise UserError(f"{name} {value}: must be a positive number")
+    op = result.parameters.operating
+    rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
+    shaft = float(rotations) if rotations is not None else float(hours) * rot_per_hour
+    cage_speed = result.summary.get("cage_speed_mean_rad_s", float("nan"))
+    if not (math.isfinite(cage_speed) and cage_speed > 0):
+        raise UserError("the run has no measured cage speed (no recorded rotation): no running time can be scaled")
+    return shaft, shaft / rot_per_hour, shaft * cage_speed / op.omega_i
+
+
+def wear_report(result, *, hours: float | None = None, rotations: float | None = None,
+                wear_coefficient: float | None = None, hardness: float | None = None) -> WearReport:
+    """The :class:`WearReport` of ``result`` after a running time (``hours`` or inner-ring ``rotations``),
+    with Archard's k and H of the result's scenario (``[wear]``) unless given."""
+    if not has_profile(result):
+        raise UserError("this archive has no wear profile (written before bearingsim recorded one, or not a "
+                        "multibody run): run its scenario again ('bearingsim rerun' or 'bearingsim run')")
+    p = result.parameters
+    k = p.wear.wear_coefficient if wear_coefficient is None else wear_coefficient
+    h = p.wear.hardness if hardness is None else hardness
+    shaft, hrs, cage_rot = running_time(result, hours=hours, rotations=rotations)
+    recorded = result.per_rotation["I_dec"].shape[0]
+    scale = cage_rot / recorded
+    psi = result.get("wear/profile_psi_deg")
+    lo, hi = p.multibody.pocket_face_extent
+    pocket_radius = p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance
+    area = pocket_radius * (hi - lo) / len(psi) * p.bearing.roller_length
+    vols = {f: laws.archard_volume_from_work(k, result.get(f"wear/profile_work_{f}") * scale, h)
+            for f in ("front", "rear")}
+    return WearReport(psi, vols["front"] / area, vols["rear"] / area, vols["front"].sum(axis=0),
+                      vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area)
+
+
+def format_report(rep: WearReport) -> str:
+    """The report as text: running time, k and H, per pocket the worn volumes and deepest points, the
+    spread over pockets, and the mean depth profile at the face's ends and middle."""
+    lines = [f"running time: {rep.hours:.4g} h = {rep.shaft_rotations:.4g} inner-ring rotations = "
+             f"{rep.cage_rotations:.4g} cage rotations; Archard k = {rep.wear_coefficient:.3g}, H = {rep.hardness:.3g} Pa",
+             f"{'pocket':>6} {'V front [mm^3]':>15} {'V rear [mm^3]':>14} {'max depth front [um]':>21} "
+             f"{'max depth rear [um]':>20}"]
+    for i in range(len(rep.volume_front)):
+        lines.append(f"{i:>6} {rep.volume_front[i] * 1e9:>15.4g} {rep.volume_rear[i] * 1e9:>14.4g} "
+                     f"{rep.depth_front[:, i].max() * 1e6:>21.4g} {rep.depth_rear[:, i].max() * 1e6:>20.4g}")
+    for f in ("front", "rear"):
+        v = rep.volume_front if f == "front" else rep.volume_rear
+        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, coefficient of variation "
+                     f"{rep.cov(f):.3f}")
+    ratio = rep.volume_front / np.where(rep.volume_rear > 0, rep.volume_rear, np.nan)
+    lines.append(f"front / rear volume per pocket: {np.nanmin(ratio):.3g} .. {np.nanmax(ratio):.3g} "
+                 f"(mean {np.nanmean(ratio):.3g})")
+    for f in ("front", "rear"):
+        d = (rep.depth_front if f == "front" else rep.depth_rear).mean(axis=1)
+        ends = shape_of(rep.psi_deg, d)
+        lines.append(f"{f}: mean depth over pockets at the bore end {ends['bore'] * 1e6:.4g} um, middle "
+                     f"{ends['middle'] * 1e6:.4g} um, rim end {ends['rim'] * 1e6:.4g} um")
+    lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um")
+    return "\n".join(lines)
+
+
+def shape_of(psi_deg, depth) -> dict[str, float]:
+    """The depth profile's bore end (first bin), rim end (last bin) and middle (the mean of the bins
+    within +-5 deg of psi = 0, the face's middle) [m]."""
+    mid = np.abs(psi_deg) <= 5.0
+    return {"bore": float(depth[0]), "rim": float(depth[-1]),
+            "middle": float(depth[mid].mean()) if mid.any() else float("nan")}
+
+
+def plot_wear_profile(rep: WearReport, title: str = ""):
+    """Fig. 13 analog: worn depth against psi on the front and the rear face, the mean over pockets and
+    the band from the least to the most worn pocket at each psi."""
+    from bearingsim.plotting import legend_outside, plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    for ax, f, c in ((axes[0], "front", "C0"), (axes[1], "rear", "C3")):
+        d = (rep.depth_front if f == "front" else rep.depth_rear) * 1e6
+        ax.fill_between(rep.psi_deg, d.min(axis=1), d.max(axis=1), step="mid", color=c, alpha=0.25,
+                        label="least to most worn pocket")
+        ax.step(rep.psi_deg, d.mean(axis=1), where="mid", color=c, lw=1.5, label="mean over pockets")
+        ax.set_xlabel("ψ on the face: bore end ← 0 (middle) → rim end [deg]")
+        ax.set_title(f"{f} face", fontsize=9)
+        ax.set_ylim(bottom=0.0)
+    axes[0].set_ylabel("worn depth [µm]")
+    legend_outside(axes[1])
+    fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
+                 f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa", fontsize=9)
+    return fig
+
+
+def plot_wear_volume(rep: WearReport, title: str = ""):
+    """Fig. 14 analog: worn volume of the front and the rear face of every pocket, with the spread."""
+    from bearingsim.plotting import legend_outside, plt
+
+    x = np.arange(len(rep.volume_front))
+    fig, ax = plt.subplots(figsize=(9, 4))
+    ax.bar(x - 0.2, rep.volume_front * 1e9, 0.4, color="C0", label=f"front face (CV {rep.cov('front'):.2f})")
+    ax.bar(x + 0.2, rep.volume_rear * 1e9, 0.4, color="C3", label=f"rear face (CV {rep.cov('rear'):.2f})")
+    ax.set_xticks(x)
+    ax.set_xlabel("pocket")
+    ax.set_ylabel("worn volume [mm³]")
+    ax.set_title(f"{title}\nworn volume after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations); "
+                 f"CV: coefficient of variation over pockets", fontsize=9)
+    legend_outside(ax)
+    return fig

@@ -1,0 +1,202 @@
+"""Wear profile bookkeeping, Archard's law on it, and the life study (docs/wear.md)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from bearingsim import laws
+from bearingsim.errors import UserError
+from bearingsim.multibody import forces as fk
+from bearingsim.multibody import recorder as rk
+from bearingsim.multibody.scene import pocket_angles
+from bearingsim.reduced.core import FACE_FRONT, FACE_REAR
+from bearingsim.scenario import load_scenario
+
+N = 4
+IDS = np.array([10, 11, 12, 13, 20], dtype=np.uint64)
+RP = 0.04875  # pocket centres' radius [m]
+R = 0.0066  # pocket circle radius [m]
+LO, HI = math.radians(-32.9), math.radians(26.2)
+
+
+def _record(arbiters, vx=0.1):
+    """record_step with the wear profile on; arbiters (impulse on the roller, normal roller -> cage,
+    cage contact point), roller 0 (pocket 0 at the bottom: e_t = +x, e_r = -y) sliding at vx."""
+    arb_f = np.zeros(rk.ARB_F * len(arbiters))
+    arb_i = np.zeros(rk.ARB_I * len(arbiters), dtype=np.uint64)
+    for k, (jimp, nrm, pc) in enumerate(arbiters):
+        arb_f[k * rk.ARB_F:(k + 1) * rk.ARB_F] = [*jimp, *nrm, *pc, *pc, 0.0]
+        arb_i[k * rk.ARB_I:(k + 1) * rk.ARB_I] = [10, 20, 1]
+    cfg = rk.RecorderConfig(sign=1.0, roller_count=N, warmup_rotations=0.0, rotations=1, theta_bins=360,
+                            impact_speed_threshold=0.01, pocket_centre_radius=RP, psi_lo=LO, psi_hi=HI)
+    acc = rk.accumulators(1, N, 360, 16)
+    st = np.zeros((N + 1, 6))
+    st[0, 0:2] = (0.0, -RP)
+    st[0, 4] = vx  # roller 0 moving at vx along y
+    order = np.argsort(IDS)
+    rk.record_step(arb_f, arb_i, len(arbiters), IDS[order], order.astype(np.int64), st, st.copy(), 1e-3, 1e-6, cfg,
+                   pocket_angles(N, 1), np.mod(-2.0 * math.pi * np.arange(N) / N, 2.0 * math.pi),
+                   np.zeros(N, dtype=fk.DIAG), acc, 0, np.zeros(N, dtype=np.bool_))
+    return acc
+
+
+def _contact(face_sign, psi_deg, jn):
+    """A contact on pocket 0's front (face_sign +1) or rear (-1) face at psi, normal impulse jn on the cage."""
+    psi = math.radians(psi_deg)
+    n = (face_sign * math.cos(psi), -math.sin(psi))  # d / |d| = cos psi (+-e_t) + sin psi e_r, e_r = -y
+    pc = (R * n[0], -RP + R * n[1])
+    return (-jn * n[0], -jn * n[1]), n, pc
+
+
+def _bin(psi_deg):
+    return int(math.floor((math.radians(psi_deg) - LO) / (HI - LO) * rk.FACE_BINS))
+
+
+def test_profile_bins_each_contact_at_its_psi_and_sums_the_normal_impulse():
+    """Contacts at psi = -30, 0, +20 deg on the front face and their mirror images on the rear face land
+    in the bins of their psi, and the profile's impulse per face is the face's recorded normal
+    impulse (the same additions in another grouping: 1e-18 N s on 1e-4)."""
+    js = (1e-4, 2e-4, 3e-4)
+    arbs = [_contact(s, p, j) for s in (1, -1) for p, j in zip((-30.0, 0.0, 20.0), js)]
+    acc = _record(arbs)
+    for face in (FACE_FRONT, FACE_REAR):
+        got = acc.prof[0, face]["impulse"]
+        want = np.zeros(rk.FACE_BINS)
+        for p, j in zip((-30.0, 0.0, 20.0), js):
+            want[_bin(p)] += j
+        np.testing.assert_allclose(got, want, rtol=0, atol=1e-18)
+        assert acc.prof[0, face]["hits"].sum() == 3.0
+    assert acc.prof[0, FACE_FRONT]["impulse"].sum() == pytest.approx(acc.win[0, 0]["Jn_front"], abs=1e-18)
+    assert acc.prof[0, FACE_REAR]["impulse"].sum() == pytest.approx(acc.win[0, 0]["Jn_rear"], abs=1e-18)
+    # mirror-symmetric contacts (front and rear at the same psi) give the same profile on both faces
+    np.testing.assert_array_equal(acc.prof[0, FACE_FRONT], acc.prof[0, FACE_REAR])
+    assert np.all(acc.prof[1:] ["impulse"] == 0.0)
+
+
+def test_contacts_past_the_faces_ends_count_in_the_end_bins():
+    """A contact at the arc's end or beyond it (a roller on the face's edge) counts in the end bin."""
+    acc = _record([_contact(1, -40.0, 1e-4), _contact(1, 30.0, 2e-4), _contact(-1, 26.2, 3e-4)])
+    # (the impulse's normal component of a vector built from cos and sin: 1e-18 on 1e-4)
+    assert acc.prof[0, FACE_FRONT]["impulse"][0] == pytest.approx(1e-4, abs=1e-18)
+    assert acc.prof[0, FACE_FRONT]["impulse"][-1] == pytest.approx(2e-4, abs=1e-18)
+    assert acc.prof[0, FACE_REAR]["impulse"][-1] == pytest.approx(3e-4, abs=1e-18)
+    assert acc.prof[0]["hits"].sum() == 3.0
+
+
+# --- a short whole-bearing run (fast scene, 6000 rpm, 1 warm-up + 2 rotations: ~2 s) ------------------------
+@pytest.fixture(scope="module")
+def fast_run(tmp_path_factory):
+    from bearingsim.simulation import load, run_scenario
+
+    sc = load_scenario("scenarios/wear_test_6000rpm.toml", ["numerics.rotations=2", "multibody.raceway_contact=rigid"])
+    path = tmp_path_factory.mktemp("wear") / "w.h5"
+    run_scenario(sc, path, figures=False, notes=False)
+    return load(path), path
+
+
+def test_profile_impulse_and_work_equal_the_recorded_totals(fast_run):
+    """Conservation of the bookkeeping over a whole run: each pocket face's profile sums to its recorded
+    normal impulse and sliding work over the recorded rotations (same additions regrouped: 1e-12)."""
+    res, _ = fast_run
+    for f in ("front", "rear"):
+        np.testing.assert_allclose(res.get(f"wear/profile_impulse_{f}").sum(axis=0),
+                                   res.per_rotation[f"Jn_{f}"].sum(axis=0), rtol=1e-12)
+        np.testing.assert_allclose(res.get(f"wear/profile_work_{f}").sum(axis=0),
+                                   res.per_rotation[f"slide_work_{f}"].sum(axis=0), rtol=1e-12)
+        assert res.data[f"results/wear/profile_work_{f}"].unit == "J"
+    assert res.get("wear/profile_impulse_front").sum() > 0.0
+
+
+def test_archard_volume_is_k_W_over_H(fast_run):
+    """The worn volume of a face after N inner-ring rotations is k W / H with W the recorded sliding work
+    scaled to the cage rotations of N (cage speed / inner-ring speed, measured); the depth profile
+    integrates back to it over the bins' face area."""
+    res, _ = fast_run
+    rep = res.wear_report(rotations=1.6e5)
+    p = res.parameters
+    cage_rot = 1.6e5 * res.summary["cage_speed_mean_rad_s"] / p.operating.omega_i
+    w = res.per_rotation["slide_work_rear"].sum(axis=0) / res.per_rotation["I_dec"].shape[0] * cage_rot
+    np.testing.assert_allclose(rep.volume_rear, p.wear.wear_coefficient * w / p.wear.hardness, rtol=1e-12)
+    np.testing.assert_allclose(rep.depth_rear.sum(axis=0) * rep.bin_area, rep.volume_rear, rtol=1e-12)
+    assert rep.hours == pytest.approx(1.6e5 / 6000 / 60, rel=1e-12)
+    assert laws.archard_volume_from_work(1e-5, 3.0, 1.5e9) == pytest.approx(2e-14, rel=1e-15)
+
+
+def test_archive_without_profile_reads_and_wear_says_why(fast_run, tmp_path):
+    """An archive written before the profile existed (its datasets removed) still reads; the wear report
+    refuses it in one line."""
+    import h5py
+    import shutil
+
+    from bearingsim.simulation import load
+
+    _, path = fast_run
+    old = tmp_path / "old.h5"
+    shutil.copy(path, old)
+    with h5py.File(old, "a") as f:
+        for k in list(f["results/wear"]):
+            if k.startswith("profile_"):
+                del f[f"results/wear/{k}"]
+    res = load(old)
+    assert "results/wear/profile_work_front" not in res.data
+    with pytest.raises(UserError, match="no wear profile"):
+        res.wear_report(hours=1.0)
+
+
+@pytest.mark.parametrize("kw", [{"hours": -1.0}, {"rotations": 0.0}, {}, {"hours": 1.0, "rotations": 2.0},
+                                {"hours": float("nan")}])
+def test_bad_running_time_is_refused(fast_run, kw):
+    with pytest.raises(UserError):
+        fast_run[0].wear_report(**kw)
+
+
+# --- life ---------------------------------------------------------------------------------------------
+@pytest.mark.parametrize("text", ["depth=0.1", "depth=-1mm", "width=1mm", "volume=2mm", "depth=xmm", ""])
+def test_bad_limit_is_refused(text):
+    from bearingsim.studies.life import parse_limit
+
+    with pytest.raises(UserError, match="--limit"):
+        parse_limit(text)
+
+
+def test_limit_parsing():
+    from bearingsim.studies.life import parse_limit
+
+    assert parse_limit("depth=0.1mm").value == pytest.approx(1e-4)
+    assert parse_limit("clearance=300um").value == pytest.approx(3e-4)
+    assert parse_limit("volume=2mm3").value == pytest.approx(2e-9)
+
+
+def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
+    """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the clearance
+    grows stage by stage, the running time grows, the last stage ends at the limit; the same command
+    again reuses every stage's archive and gives the same history bit for bit."""
+    from bearingsim.studies.life import parse_limit, run_life
+
+    sc = load_scenario("scenarios/wear_test_6000rpm.toml", ["multibody.raceway_contact=rigid"])
+    lim = parse_limit("clearance=0.203mm")
+    cols = run_life(sc, tmp_path, lim, stages=3, rotations=1)
+    assert np.all(np.diff(cols["pocket_clearance_mm"]) > 0) and np.all(np.diff(cols["hours_end"]) > 0)
+    assert np.all(cols["stage_rotations"] > 0)
+    assert cols["clearance_end_mm"][-1] == pytest.approx(0.203, rel=1e-9)
+    assert np.all(cols["reused"] == 0)
+    again = run_life(sc, tmp_path, lim, stages=3, rotations=1)
+    assert np.all(again["reused"] == 1)
+    for k in cols:
+        if k != "reused":
+            np.testing.assert_array_equal(again[k], cols[k])
+    with pytest.raises(UserError, match="another scenario or limit"):
+        run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1)
+
+
+def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
+    from bearingsim.cli import main
+
+    code = main(["life", "scenarios/wear_test_6000rpm.toml", "--limit", "depth=1furlong", "-o", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and "--limit" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    code = main(["life", "scenarios/paper_6000rpm.toml", "--limit", "depth=0.1mm", "-o", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and "multibody" in err and len(err.strip().splitlines()) == 1

@@ -432,6 +432,9 @@ def build_parser() -> argparse.ArgumentParser:
     cc.add_argument("--force", action="store_true",
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     cc.set_defaults(func=_cmd_crosscheck)
+    from bearingsim.cli_sensitivity import add_parsers as _add_sensitivity_parsers
+
+    _add_sensitivity_parsers(sub)
     return p
 
 

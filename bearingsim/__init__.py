@@ -42,4 +42,23 @@ def load(path):
     return _load(path)
 
 
-__all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load"]
+def sensitivity(scenario, outdir=None, *, keys=None, step: float = 0.10, jobs: int = 1, engine=None):
+    """Normalised sensitivities of I_dec, I_acc, cage slip and eccentricity to every ranged key
+    (:func:`bearingsim.studies.sensitivity.run_sensitivity`, docs/sensitivity.md): ``.table``,
+    ``.plot_tornado()``. ``outdir`` keeps the case archives (None: a temporary folder)."""
+    from bearingsim.studies.sensitivity import run_sensitivity
+
+    return run_sensitivity(scenario, outdir, keys, step, jobs=jobs, engine=engine)
+
+
+def uncertainty(scenario, samples: int, outdir=None, *, seed: int = 0, keys=None, jobs: int = 1, engine=None):
+    """Every ranged key sampled over its range (Sobol' design, N (k + 2) runs): median and 5-95 %
+    interval of each headline number and first-order and total Sobol indices with bootstrap intervals
+    (:func:`bearingsim.studies.uncertainty.run_uncertainty`): ``.table``, ``.spread``, ``.plot_indices()``."""
+    from bearingsim.studies.uncertainty import run_uncertainty
+
+    return run_uncertainty(scenario, outdir, samples, seed, keys, jobs=jobs, engine=engine)
+
+
+__all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load", "sensitivity",
+           "uncertainty"]

@@ -435,6 +435,9 @@ def build_parser() -> argparse.ArgumentParser:
     from bearingsim import cli_wear
 
     cli_wear.add_commands(sub)  # wear, life (bearingsim/cli_wear.py)
+    from bearingsim.cli_sensitivity import add_parsers as _add_sensitivity_parsers
+
+    _add_sensitivity_parsers(sub)
     return p
 
 

@@ -229,6 +229,14 @@ class WearSection(_Section):
     hardness_Pa: float = Field(gt=0.0)
 
 
+class RangeEntry(_Section):
+    """A plausible range of one numeric key (``[ranges.<section>.<key>]``): ``range = [low, high]`` in the
+    key's unit and the ``reason`` for it (:mod:`bearingsim.ranges`)."""
+
+    range: list[float] = Field(min_length=2, max_length=2)
+    reason: str = Field(min_length=1)
+
+
 class ScenarioModel(_Section):
     schema_version: int
     name: str = Field(min_length=1)
@@ -252,6 +260,8 @@ class ScenarioModel(_Section):
     numerics: NumericsSection
     multibody: MultibodySection
     wear: WearSection
+    # plausible ranges of uncertain keys, by section and key (bearingsim.ranges; the preset's are merged in)
+    ranges: dict[str, dict[str, RangeEntry]] | None = None
 
 
 class Scenario:
@@ -599,6 +609,9 @@ def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
         for section, values in preset.items():
             if section in ScenarioModel.model_fields and isinstance(values, dict):
                 merged = _merge(merged, {section: values})
+        from bearingsim.ranges import preset_ranges
+
+        merged = _merge(merged, preset_ranges(preset))
     merged = _merge(merged, raw)
     return _validate(merged, source)
 
@@ -734,6 +747,10 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
         raise UserError(f"{source}: {key}: {msg}") from None
     _check_geometry(model, source)
     _check_limits(model, source)
+    if model.ranges:
+        from bearingsim.ranges import check_ranges
+
+        check_ranges(model, source)
     return Scenario(model, source)
 
 

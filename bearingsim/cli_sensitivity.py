@@ -1,0 +1,97 @@
+"""``bearingsim sensitivity`` and ``bearingsim uncertainty`` (issue 25): their parsers and commands,
+kept beside :mod:`bearingsim.cli`, which adds them with :func:`add_parsers`."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from bearingsim.errors import UserError
+
+
+def _keys(text):
+    if text is None:
+        return None
+    keys = [k.strip() for k in text.split(",") if k.strip()]
+    if not keys:
+        raise UserError(f"--keys {text!r}: give dotted keys separated by commas, e.g. bearing.pocket_clearance_mm")
+    return keys
+
+
+def _cmd_sensitivity(args) -> int:
+    from bearingsim.cli import _refuse_archive_as_scenario, _report_study
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies import make_engine, run_studies
+    from bearingsim.studies.sensitivity import Sensitivity, parse_step
+
+    _refuse_archive_as_scenario(args.scenario)
+    step = parse_step(args.step)
+    scenario = load_scenario(args.scenario, args.set)
+    study = Sensitivity(scenario, _keys(args.keys), step)  # bad keys refused before any run
+    engine = make_engine(args.jobs, args.scheduler)
+    t0 = time.perf_counter()
+    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force)
+    if outcome.interrupted is None:
+        print(f"sensitivity of {args.scenario}: {len(study.keys)} keys x 2 runs at x (1 ± {step:.0%}) within each "
+              f"key's range, {time.perf_counter() - t0:.1f} s")
+        print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
+        for r in study.rows:
+            print(f"{r['key']:34s} {r['quantity']:18s} {r['sensitivity']:+9.3f} {r['sensitivity_se']:8.3f} "
+                  f"{r['over_range']:+10.3f}")
+        for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
+            print(f"wrote {Path(args.output) / name}")
+        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+    return _report_study(outcome, "sensitivity")
+
+
+def _cmd_uncertainty(args) -> int:
+    from bearingsim.cli import _refuse_archive_as_scenario, _report_study
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies import make_engine, run_studies
+    from bearingsim.studies.uncertainty import Uncertainty
+
+    _refuse_archive_as_scenario(args.scenario)
+    scenario = load_scenario(args.scenario, args.set)
+    study = Uncertainty(scenario, args.samples, args.seed, _keys(args.keys))
+    engine = make_engine(args.jobs, args.scheduler)
+    t0 = time.perf_counter()
+    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force)
+    if outcome.interrupted is None:
+        print(f"uncertainty of {args.scenario}: {len(study.keys)} keys, N = {args.samples} ({len(study.cases)} runs), "
+              f"seed {args.seed}, {time.perf_counter() - t0:.1f} s")
+        for s in study.spreads:
+            print(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
+                  f"({int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0} runs)")
+        print(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
+        for r in study.indices:
+            print(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "
+                  f"{r['ST']:+6.3f} [{r['ST_low']:+.3f}, {r['ST_high']:+.3f}]")
+        for name in ("uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png"):
+            print(f"wrote {Path(args.output) / name}")
+        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+    return _report_study(outcome, "uncertainty")
+
+
+def _common(p, default_out):
+    p.add_argument("scenario", help="scenario TOML (either model) whose keys carry ranges (its preset's or its own)")
+    p.add_argument("--keys", metavar="K1,K2,...", help="dotted keys to vary (default: every ranged key the model reads)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key (repeatable)")
+    p.add_argument("-o", "--output", default=default_out, help="output folder")
+    p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster")
+    p.add_argument("--force", action="store_true",
+                   help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
+
+
+def add_parsers(sub) -> None:
+    """Add ``sensitivity`` and ``uncertainty`` to the ``bearingsim`` subcommands."""
+    s = sub.add_parser("sensitivity", help="d ln y / d ln x of I_dec, I_acc, cage slip and eccentricity for every "
+                                           "ranged key (docs/sensitivity.md; run again to resume)")
+    _common(s, "outputs/sensitivity")
+    s.add_argument("--step", default="10%", help="relative step, e.g. 10%% or 0.1 (held within each key's range)")
+    s.set_defaults(func=_cmd_sensitivity)
+    u = sub.add_parser("uncertainty", help="every ranged key sampled over its range: median, 5-95 %% interval and "
+                                           "Sobol indices (docs/sensitivity.md; run again to resume)")
+    _common(u, "outputs/uncertainty")
+    u.add_argument("--samples", type=int, required=True, help="base sample N (N (keys + 2) runs; a power of 2 is best)")
+    u.add_argument("--seed", type=int, default=0, help="seed of the Sobol' scrambling and the bootstrap (default 0)")
+    u.set_defaults(func=_cmd_uncertainty)

@@ -1,0 +1,388 @@
+"""Which unknowns matter: the normalised sensitivity of the headline numbers to every ranged key
+(``bearingsim sensitivity``, issue 25).
+
+For each key, two runs: the key at x (1 - step) and at x (1 + step), each held within the key's
+plausible range (:func:`perturbed_values`), everything else as the scenario says (the same start, the
+same warm-up and recorded rotations). From each run's archive, the headline
+numbers y and their standard errors (:func:`headline_numbers`); then per key and number
+
+    S = (ln y+ - ln y-) / (ln x+ - ln x-)          (d ln y / d ln x: +1 means y grows as x)
+
+for the mean impulses ``I_dec``, ``I_acc`` and the cage's mean eccentricity, and
+``(y+ - y-) / (ln x+ - ln x-)`` (d y / d ln x) for the cage slip, a signed number near zero whose
+logarithm has no meaning. ``over_range`` = S ln(high / low): the change of ln y (or of y) across the key's plausible range, if
+it were linear there: what ranks the keys (a key with a wide range matters more than its S says).
+The standard error of S comes from the rotation-to-rotation scatter of each
+run (batch means, :func:`bearingsim.studies.batch_sem`): SE(ln y) = SE(y) / y, the two runs taken as
+independent (a chaotic scene forgets its start within the warm-up), so
+SE(S) = sqrt(SE(ln y+)^2 + SE(ln y-)^2) / |ln x+ - ln x-|.
+
+The reduced model repeats one no-load pass every rotation: its sensitivities have no scatter (SE 0)
+and it has neither cage slip nor eccentricity (only ``I_dec`` and ``I_acc`` rows).
+
+Outputs in ``DIR``: ``sensitivity.csv`` (:data:`COLUMNS`), ``sensitivity.h5`` (the same table as an
+index, with each run's archive, status and error), ``sensitivity.png`` (tornado chart), ``cases/``
+(every run's ordinary archive) and ``sweep.{csv,h5}`` (the engine's index).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+from bearingsim.studies.engine import Study, batch_sem, case_of, load_result
+
+INDEX_FORMAT = "bearingsim sensitivity index 1"
+DEFAULT_STEP = 0.10
+
+#: headline numbers: (name, unit, what the sensitivity is: "log" d ln y / d ln x, "lin" d y / d ln x)
+QUANTITIES = (("I_dec", "N s", "log"), ("I_acc", "N s", "log"), ("cage_slip", "1", "lin"),
+              ("cage_eccentricity", "m", "log"))
+REDUCED_QUANTITIES = ("I_dec", "I_acc")
+
+COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y_minus_se", "y_plus", "y_plus_se",
+           "sensitivity", "sensitivity_se", "over_range")
+UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
+         "over_range": "as sensitivity"}
+
+# ranged keys a model does not read (their paired runs would be identical): left out of the default keys
+_UNUSED = {
+    "reduced": ("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "bearing.cage_outer_diameter_mm",
+                "bearing.cage_inner_diameter_mm", "bearing.cage_land_clearance_mm", "contact.cage_friction",
+                "contact.land_friction", "multibody."),
+}
+_LAND_KEYS = ("bearing.cage_land_clearance_mm", "contact.land_friction")
+
+
+def parse_step(text) -> float:
+    """``"10%"`` or ``"0.1"`` -> 0.1; a one-line UserError naming ``--step`` unless 0 < step < 1."""
+    raw = str(text).strip()
+    try:
+        step = float(raw[:-1]) / 100.0 if raw.endswith("%") else float(raw)
+    except ValueError:
+        raise UserError(f"--step {text!r}: give a relative step such as 10% or 0.1") from None
+    if not (math.isfinite(step) and 0.0 < step < 1.0):
+        raise UserError(f"--step {text!r}: the relative step must be above 0 and below 100 % (runs at x (1 - step) "
+                        f"and x (1 + step))")
+    return step
+
+
+def default_keys(scenario) -> list[str]:
+    """Every ranged key the scenario's model reads: the land keys only with a land-guided cage, the
+    reduced model without the cage's mass, inertia, diameters, frictions and the multibody keys, and
+    without the radial clearance when its load zone is given."""
+    from bearingsim.ranges import ranged_keys
+
+    skip = list(_UNUSED.get(scenario.model, ()))
+    if scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
+        skip += _LAND_KEYS
+    if scenario.model == "reduced" and scenario.reduced.load_zone_half_angle_deg != "auto":
+        skip.append("bearing.radial_clearance_mm")
+    return [k for k in ranged_keys(scenario)
+            if not any(k == p or (p.endswith(".") and k.startswith(p)) for p in skip)]
+
+
+def check_keys(scenario, keys) -> list[str]:
+    """``keys`` (None: :func:`default_keys`) checked: each must have a range (one-line UserError
+    naming it otherwise) and a nonzero numeric value."""
+    from bearingsim.ranges import ranged_keys, value_of
+
+    have = ranged_keys(scenario)
+    keys = default_keys(scenario) if keys is None else list(dict.fromkeys(keys))
+    if not keys:
+        raise UserError(f"{scenario.source}: no key has a range ([ranges.<section>.<key>] or the preset's); "
+                        f"nothing to vary")
+    for k in keys:
+        if k not in have:
+            raise UserError(f"--keys {k}: no range for this key in {scenario.source} or its preset (give "
+                            f"[ranges.{k}] range = [low, high] and reason)")
+        x = value_of(scenario, k)
+        if not isinstance(x, (int, float)) or isinstance(x, bool) or x == 0:
+            raise UserError(f"--keys {k}: its value ({x!r}) has no relative step; give the key a nonzero number")
+    return keys
+
+
+def perturbed_values(scenario, key: str, step: float) -> tuple[float, float]:
+    """(x-, x+) of ``key``: x (1 - step) and x (1 + step), each held within the key's plausible range
+    when x lies in it (a 10 % step of the pitch diameter would leave the bearing; its range is
+    +-0.5 mm): a side clipped to x itself makes the difference one-sided."""
+    from bearingsim.ranges import ranged_keys, value_of
+
+    x = float(value_of(scenario, key))
+    lo, hi, _ = ranged_keys(scenario)[key]
+    xm, xp = x * (1.0 - step), x * (1.0 + step)
+    if x < 0.0:
+        xm, xp = xp, xm
+    if lo <= x <= hi:
+        xm, xp = max(xm, lo), min(xp, hi)
+    if not xm < xp:
+        raise UserError(f"sensitivity: {key}: its range [{lo:g}, {hi:g}] leaves no room around {x:g} to vary it")
+    return xm, xp
+
+
+def perturbed_scenarios(scenario, keys, step: float) -> list[tuple[str, str, float, object]]:
+    """``[(key, "-" or "+", value, Scenario), ...]``: each key at its two values (:func:`perturbed_values`),
+    the scenario otherwise unchanged. A value the scenario refuses is a one-line UserError naming the key."""
+    out = []
+    for k in keys:
+        for side, v in zip("-+", perturbed_values(scenario, k, step)):
+            try:
+                sc = scenario.replace(**{k: v})
+            except UserError as exc:
+                raise UserError(f"sensitivity: {k} = {v:g} (the {side} side) is refused: {exc}") from None
+            out.append((k, side, v, sc))
+    return out
+
+
+def _recorded_windows(result) -> list[np.ndarray] | None:
+    """Indices of the cage-centre samples of each recorded rotation (None without the series).
+
+    The run ends when the cage has turned through warm-up + recorded rotations; the recorded part is
+    the last t_rec = 2 pi R / (mean cage speed) of the series, split into R windows of equal time (one
+    cage rotation each, the cage speed varying by its slip of ~1e-3)."""
+    s = result.series.get("cage_centre")
+    rot = result.per_rotation["I_dec"].shape[0]
+    w = float(result.summary.get("cage_speed_mean_rad_s", float("nan")))
+    if s is None or not len(s.time) or not (w > 0.0):
+        return None
+    t = np.asarray(s.time, float)
+    t_end = t[-1]
+    edges = t_end - 2.0 * math.pi * rot / w + np.arange(rot + 1) * (2.0 * math.pi / w)
+    k = np.searchsorted(t, edges)
+    return [np.arange(k[i], max(k[i + 1], k[i] + 1)) for i in range(rot) if k[i] < len(t)]
+
+
+def headline_numbers(result) -> dict[str, tuple[float, float]]:
+    """``{quantity: (mean, standard error)}`` of one run (SI), means as the archive's summary gives
+    them; standard errors from batch means (:func:`batch_sem`) of the per-rotation values.
+
+    ``I_dec``, ``I_acc``: per pocket and cage rotation (summary means; per-rotation pocket means for
+    the error). ``cage_slip``: the summary's; per-rotation slips from the ``cage_slip`` series.
+    ``cage_eccentricity``: mean distance of the cage centre from the bearing axis over the recorded
+    rotations (``cage_centre`` series). The reduced model: ``I_dec``, ``I_acc``, SE 0."""
+    s = result.summary
+    d = result.per_rotation["I_dec"].mean(axis=1)
+    a = result.per_rotation["I_acc"].mean(axis=1)
+    if "cage_slip" not in s:  # the reduced model: one pass repeated
+        return {"I_dec": (float(s["I_dec_mean_Ns"]), 0.0), "I_acc": (float(s["I_acc_mean_Ns"]), 0.0)}
+    out = {"I_dec": (float(s["I_dec_mean_Ns"]), batch_sem(d)), "I_acc": (float(s["I_acc_mean_Ns"]), batch_sem(a))}
+    windows = _recorded_windows(result)
+    slip_se = ecc = ecc_se = float("nan")
+    if windows:
+        slip = np.asarray(result.series["cage_slip"].value, float)
+        slip_se = batch_sem(np.array([slip[w].mean() for w in windows]))
+        c = np.asarray(result.series["cage_centre"].value, float)
+        r = np.hypot(c[:, 0], c[:, 1])
+        per = np.array([r[w].mean() for w in windows])
+        ecc, ecc_se = float(r[np.concatenate(windows)].mean()), batch_sem(per)
+    out["cage_slip"] = (float(s["cage_slip"]), slip_se)
+    out["cage_eccentricity"] = (ecc, ecc_se)
+    return out
+
+
+def sensitivity_of(measure: str, x_minus, x_plus, y_minus, se_minus, y_plus, se_plus) -> tuple[float, float]:
+    """(S, SE) of one key and one number: ``measure`` "log" (d ln y / d ln x) or "lin" (d y / d ln x)."""
+    dlx = math.log(x_plus) - math.log(x_minus)
+    if measure == "lin":
+        return (y_plus - y_minus) / dlx, math.hypot(se_plus, se_minus) / abs(dlx)
+    if not (y_minus > 0.0 and y_plus > 0.0):
+        return float("nan"), float("nan")
+    return ((math.log(y_plus) - math.log(y_minus)) / dlx,
+            math.hypot(se_plus / y_plus, se_minus / y_minus) / abs(dlx))
+
+
+class Sensitivity(Study):
+    """Paired runs of every key (:func:`perturbed_scenarios`); table ``sensitivity.{csv,h5}``, figure
+    ``sensitivity.png``.
+
+    Parameters
+    ----------
+    scenario : resolved scenario (either model) with ranges.
+    keys : dotted keys (None: :func:`default_keys`).
+    step : relative step (0.1: runs at 0.9 x and 1.1 x).
+    """
+
+    name = "sensitivity"
+
+    def __init__(self, scenario, keys=None, step: float = DEFAULT_STEP):
+        from bearingsim import archive
+        from bearingsim.outputs import PNG_SIGNATURE
+
+        if not (isinstance(step, (int, float)) and 0.0 < step < 1.0):
+            raise UserError(f"step {step!r}: the relative step must be above 0 and below 1 (0.1 = 10 %)")
+        self.scenario, self.step = scenario, float(step)
+        self.keys = check_keys(scenario, keys)
+        self.runs = {}  # (key, side) -> (value, case)
+        cases = []
+        for k, side, v, sc in perturbed_scenarios(scenario, self.keys, self.step):
+            c = case_of(sc, {"key": k, "side": side, "value": v})
+            self.runs[(k, side)] = (v, c)
+            cases.append(c)
+        self.cases = cases
+        self.outputs = [("sensitivity.csv", ",".join(COLUMNS).encode(), "sensitivity table"),
+                        ("sensitivity.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sensitivity table"),
+                        ("sensitivity.png", PNG_SIGNATURE, "figure")]
+        self.rows: list[dict] = []
+
+    def finish(self, outdir, records) -> list[Path]:
+        from bearingsim.ranges import value_of
+
+        quantities = [q for q in QUANTITIES if self.scenario.model == "multibody" or q[0] in REDUCED_QUANTITIES]
+        from bearingsim.ranges import ranged_keys
+
+        ranges = ranged_keys(self.scenario)
+        rows = []
+        for k in self.keys:
+            lo, hi, _ = ranges[k]
+            (xm, cm), (xp, cp) = self.runs[(k, "-")], self.runs[(k, "+")]
+            rm, rp = records[cm.hash], records[cp.hash]
+            res_m, res_p = load_result(outdir, rm), load_result(outdir, rp)
+            hm = headline_numbers(res_m) if res_m is not None else {}
+            hp = headline_numbers(res_p) if res_p is not None else {}
+            failed = [r for r in (rm, rp) if r["status"] == "failed"]
+            for q, _, measure in quantities:
+                ym, sm = hm.get(q, (math.nan, math.nan))
+                yp, sp = hp.get(q, (math.nan, math.nan))
+                s, se = sensitivity_of(measure, xm, xp, ym, sm, yp, sp)
+                rows.append({"key": k, "quantity": q, "measure": measure, "x": float(value_of(self.scenario, k)),
+                             "x_minus": xm, "x_plus": xp, "y_minus": ym, "y_minus_se": sm, "y_plus": yp,
+                             "y_plus_se": sp, "sensitivity": s, "sensitivity_se": se,
+                             "over_range": s * math.log(hi / lo) if lo > 0 else math.nan,
+                             "archive_minus": rm["archive"], "archive_plus": rp["archive"],
+                             "status": "failed" if failed else "done",
+                             "error": "; ".join(r["error"] for r in failed)})
+        self.rows = rows
+        paths = write_table(outdir, rows, self.scenario, self.step)
+        return [*paths, *plot_sensitivity(outdir / "sensitivity.h5", outdir)]
+
+
+def _fmt(v) -> str:
+    if isinstance(v, str):
+        return v
+    return "" if math.isnan(v) else repr(float(v))
+
+
+def write_table(outdir, rows, scenario, step) -> tuple[Path, Path]:
+    """``sensitivity.csv`` (exactly :data:`COLUMNS`, a failed pair's numbers empty) and
+    ``sensitivity.h5`` (those columns and each pair's archives, status and error) atomically."""
+    from bearingsim import archive
+    from bearingsim.outputs import write_atomic_bytes
+
+    outdir = Path(outdir)
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for r in rows:
+        w.writerow([_fmt(r[c]) for c in COLUMNS])
+    csv_path = outdir / "sensitivity.csv"
+    write_atomic_bytes(csv_path, buf.getvalue().encode("utf-8"))
+    columns = (*COLUMNS, "archive_minus", "archive_plus", "status", "error")
+    cols = {c: (np.array([r[c] for r in rows], dtype=object) if isinstance(rows[0][c], str)
+                else np.array([r[c] for r in rows], dtype=float)) for c in columns}
+    attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
+             "scenario_name": scenario.name, "step": float(step)}
+    h5_path = archive.write_table_file(outdir / "sensitivity.h5", cols, UNITS, attrs)
+    return csv_path, h5_path
+
+
+def read_table(path) -> tuple[list[dict], dict]:
+    """Read ``sensitivity.h5``: (rows as dicts, root attributes); one-line UserError if it is not one."""
+    from bearingsim import archive
+
+    cols, meta = archive.read_table_file(path, INDEX_FORMAT)
+    names = json.loads(meta["columns"])
+    rows = [{c: (cols[c][i] if isinstance(cols[c][i], str) else float(cols[c][i])) for c in names}
+            for i in range(len(cols[names[0]]))]
+    return rows, meta
+
+
+def plot_tornado(rows, title: str = ""):
+    """A tornado chart: one panel per headline number, one bar per key, ± 1 SE; keys ordered by the
+    change of ln I_dec across their plausible range (``over_range``), the largest on top."""
+    from bearingsim.plotting import plt
+
+    quantities = [q for q in QUANTITIES if any(r["quantity"] == q[0] for r in rows)]
+    fig, axes = plt.subplots(1, len(quantities), figsize=(3.6 * len(quantities) + 1.5, 0.35 * len(
+        {r["key"] for r in rows}) + 1.8), squeeze=False)
+    order = sorted({r["key"] for r in rows if r["quantity"] == "I_dec"},
+                   key=lambda k: -abs(np.nan_to_num(next(r["over_range"] for r in rows
+                                                        if r["key"] == k and r["quantity"] == "I_dec"))))
+    for ax, (q, unit, measure) in zip(axes[0], quantities):
+        by = {r["key"]: r for r in rows if r["quantity"] == q}
+        y = np.arange(len(order))[::-1]
+        s = np.array([by[k]["sensitivity"] for k in order])
+        se = np.array([by[k]["sensitivity_se"] for k in order])
+        ax.barh(y, np.nan_to_num(s), xerr=np.nan_to_num(se), color=np.where(s >= 0, "C3", "C0"), capsize=2)
+        ax.axvline(0.0, color="0.3", lw=0.6)
+        ax.set_yticks(y)
+        ax.set_yticklabels(order if ax is axes[0][0] else [""] * len(order), fontsize=8)
+        ax.set_xlabel("d ln y / d ln x" if measure == "log" else "d y / d ln x")
+        ax.set_title(q.replace("_", " "), fontsize=9)
+        ax.grid(axis="x", alpha=0.3)
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def plot_sensitivity(index_path, outdir) -> list[Path]:
+    """Draw ``sensitivity.png`` from the index alone."""
+    from bearingsim.plotting import save_figure
+
+    rows, meta = read_table(index_path)
+    fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {meta['step']:.0%}) within each key's "
+                             "range, "
+                             "bars ± 1 standard error (batch means over rotations)")
+    return [save_figure(fig, Path(outdir) / "sensitivity.png")]
+
+
+class SensitivityResult:
+    """What :func:`bearingsim.sensitivity` returns: ``table`` (rows of :data:`COLUMNS` and each pair's
+    ``status``/``error``), ``outcome`` (the engine's counts) and :meth:`plot_tornado`."""
+
+    def __init__(self, study: Sensitivity, outcome):
+        self.table, self.outcome, self.step, self.keys = study.rows, outcome, study.step, study.keys
+        self.scenario = study.scenario
+
+    def plot_tornado(self):
+        """The tornado chart (a matplotlib figure)."""
+        return plot_tornado(self.table, f"Sensitivity of {self.scenario.name}: x (1 ± {self.step:.0%}) within each "
+                                       "key's range")
+
+    def __repr__(self) -> str:
+        return f"SensitivityResult({len(self.keys)} keys, {len(self.table)} rows, {self.outcome.counts()})"
+
+
+def run_sensitivity(scenario, outdir=None, keys=None, step: float = DEFAULT_STEP, *, jobs: int = 1, engine=None,
+                    progress: bool | None = False, log=None, force: bool = False) -> SensitivityResult:
+    """Run the paired cases on the sweep engine into ``outdir`` (None: a temporary folder) and return
+    the table. Archives already in ``outdir`` from the same cases are reused; a failed case leaves its
+    key's rows with NaN numbers, its status and error."""
+    study = Sensitivity(scenario, keys, step)
+    return SensitivityResult(study, run_study(study, outdir, jobs=jobs, engine=engine, progress=progress, log=log,
+                                              force=force))
+
+
+def run_study(study, outdir=None, *, jobs: int = 1, engine=None, progress=False, log=None, force=False):
+    """:func:`bearingsim.studies.run_studies` of one study for the Python API: in ``outdir`` or a temporary
+    folder; failed cases' lines go to ``log`` (default: nowhere, the table has them); SIGINT/SIGTERM
+    during the cases raise KeyboardInterrupt (finished archives in ``outdir`` are kept)."""
+    import signal
+    import tempfile
+
+    from bearingsim.studies.engine import make_engine, run_studies
+
+    engine = engine or make_engine(jobs)
+    log = log if log is not None else (lambda line: None)
+    if outdir is None:
+        with tempfile.TemporaryDirectory(prefix="bearingsim-study-") as tmp:
+            out = run_studies([study], tmp, engine=engine, progress=progress, log=log, force=force)
+    else:
+        out = run_studies([study], outdir, engine=engine, progress=progress, log=log, force=force)
+    if out.interrupted is not None:
+        raise KeyboardInterrupt(signal.Signals(out.interrupted).name)
+    return out

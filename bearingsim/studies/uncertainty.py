@@ -1,0 +1,311 @@
+"""How wide is the answer: every ranged key sampled over its range (``bearingsim uncertainty``, issue 25).
+
+Design (Saltelli 2010): a scrambled Sobol' sequence (``scipy.stats.qmc.Sobol``, seeded) of N points in
+2k dimensions (k ranged keys) gives two independent quasi-random matrices A and B (N x k, uniform over
+the box of the ranges: the keys are taken independent and uniform within their plausible ranges, the
+least informative assumption a range allows); AB_i is A with column i from B. The model runs N (k + 2)
+times. For each headline number y:
+
+* median and 5-95 % interval over the 2N independent points of A and B;
+* first-order Sobol index, Saltelli (2010) Eq. (b): S_i = mean(f(B) (f(AB_i) - f(A))) / V, with f
+  centred on its mean over A and B (same expectation, much smaller scatter when mean(f) >> std(f));
+* total index, Jansen (1999): ST_i = mean((f(A) - f(AB_i))^2) / (2 V);
+
+V the variance of f over A and B. Both estimators are the ones Saltelli et al. (2010, Comput. Phys.
+Commun. 181:259, Table 2) recommend. 95 % confidence intervals by bootstrap over the N rows (seeded).
+A row with a failed run is dropped from A, B and every AB_i (rows are independent draws).
+
+:func:`design` and :func:`sobol_indices` are the whole method; the study only runs the cases between
+them (the Ishigami test goes through the same two functions).
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+from bearingsim.studies.engine import Study, case_of, load_result
+
+INDEX_FORMAT = "bearingsim uncertainty index 1"
+BOOTSTRAP = 1000
+CONFIDENCE = 0.95
+QUANTITIES = (("I_dec", "I_dec_mean_Ns", "N s"), ("I_acc", "I_acc_mean_Ns", "N s"), ("cage_slip", "cage_slip", "1"))
+COLUMNS = ("quantity", "key", "S1", "S1_low", "S1_high", "ST", "ST_low", "ST_high")
+SPREAD_COLUMNS = ("quantity", "median", "p05", "p95", "mean", "std", "runs_used")
+
+
+def design(bounds: np.ndarray, n: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(A, B, AB): A and B [n, k] and AB [k, n, k] (AB[i] = A with column i from B), in the units of
+    ``bounds`` [k, 2] (low, high per key). Scrambled Sobol' points, seeded: the same seed gives the same
+    design. n need not be a power of 2 (the points are then less balanced)."""
+    from scipy.stats import qmc
+
+    bounds = np.asarray(bounds, float)
+    k = len(bounds)
+    sampler = qmc.Sobol(d=2 * k, scramble=True, seed=np.random.default_rng(seed))
+    with warnings.catch_warnings():  # "balance properties ... power of 2": said in the docs
+        warnings.simplefilter("ignore", UserWarning)
+        u = sampler.random(n)
+    x = bounds[:, 0] + u.reshape(n, 2, k) * (bounds[:, 1] - bounds[:, 0])
+    a, b = x[:, 0, :].copy(), x[:, 1, :].copy()
+    ab = np.repeat(a[None, :, :], k, axis=0)
+    for i in range(k):
+        ab[i, :, i] = b[:, i]
+    return a, b, ab
+
+
+def _indices(fa, fb, fab):
+    # centred on the mean of A and B: the estimators' expectations are unchanged (E[f(AB_i) - f(A)] = 0)
+    # and the first-order estimator's variance no longer grows with mean(f)^2 / V (an impulse's mean is
+    # several times its spread)
+    c = np.mean(np.concatenate([fa, fb]))
+    fa, fb, fab = fa - c, fb - c, fab - c
+    v = np.var(np.concatenate([fa, fb]), ddof=1)
+    with np.errstate(invalid="ignore", divide="ignore"):  # a resample where nothing varies: NaN
+        s1 = np.mean(fb[None, :] * (fab - fa[None, :]), axis=1) / v
+        st = 0.5 * np.mean((fa[None, :] - fab) ** 2, axis=1) / v
+    return s1, st
+
+
+def sobol_indices(fa, fb, fab, seed: int = 0, bootstrap: int = BOOTSTRAP, confidence: float = CONFIDENCE) -> dict:
+    """First-order (Saltelli 2010) and total (Jansen 1999) Sobol indices of one output.
+
+    Parameters
+    ----------
+    fa, fb : [n] outputs at A and B;  fab : [k, n] outputs at AB_i.
+    seed : the bootstrap's seed.
+
+    Returns
+    -------
+    dict of arrays [k]: ``S1``, ``ST``, their bootstrap percentile intervals ``S1_low``/``S1_high``,
+    ``ST_low``/``ST_high`` (``confidence``) and bootstrap standard errors ``S1_se``/``ST_se``.
+    """
+    fa, fb, fab = np.asarray(fa, float), np.asarray(fb, float), np.asarray(fab, float)
+    s1, st = _indices(fa, fb, fab)
+    rng = np.random.default_rng(seed)
+    n = len(fa)
+    boot1, boott = np.empty((bootstrap, len(s1))), np.empty((bootstrap, len(st)))
+    for j in range(bootstrap):
+        r = rng.integers(0, n, n)
+        boot1[j], boott[j] = _indices(fa[r], fb[r], fab[:, r])
+    q = [50.0 * (1.0 - confidence), 50.0 * (1.0 + confidence)]
+    l1, h1 = np.nanpercentile(boot1, q, axis=0)
+    lt, ht = np.nanpercentile(boott, q, axis=0)
+    return {"S1": s1, "ST": st, "S1_low": l1, "S1_high": h1, "ST_low": lt, "ST_high": ht,
+            "S1_se": np.nanstd(boot1, axis=0, ddof=1), "ST_se": np.nanstd(boott, axis=0, ddof=1)}
+
+
+def spread(fa, fb) -> dict:
+    """Median, 5 % and 95 % points, mean and standard deviation of an output over A and B."""
+    y = np.concatenate([np.asarray(fa, float), np.asarray(fb, float)])
+    p05, med, p95 = np.percentile(y, [5.0, 50.0, 95.0])
+    return {"median": float(med), "p05": float(p05), "p95": float(p95), "mean": float(y.mean()),
+            "std": float(y.std(ddof=1)), "runs_used": float(len(y))}
+
+
+class Uncertainty(Study):
+    """The Saltelli design of a scenario's ranged keys as cases; tables ``uncertainty.csv``
+    (Sobol indices), ``uncertainty_spread.csv`` (median and interval), ``uncertainty.h5``; figure
+    ``uncertainty.png``.
+
+    Parameters
+    ----------
+    scenario : resolved scenario with ranges.
+    samples : N, the base sample (N (k + 2) runs).
+    seed : seed of the Sobol' scrambling and the bootstrap.
+    keys : dotted keys (None: every ranged key the model reads, as the sensitivity study's default).
+    """
+
+    name = "uncertainty"
+
+    def __init__(self, scenario, samples: int, seed: int = 0, keys=None):
+        from bearingsim import archive
+        from bearingsim.outputs import PNG_SIGNATURE
+        from bearingsim.ranges import ranged_keys
+        from bearingsim.studies.sensitivity import check_keys
+
+        if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
+            raise UserError(f"--samples {samples!r}: give at least 2 base samples (a power of 2 such as 64 is best)")
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise UserError(f"--seed {seed!r}: give a non-negative integer")
+        self.scenario, self.samples, self.seed = scenario, samples, seed
+        self.keys = check_keys(scenario, keys)
+        r = ranged_keys(scenario)
+        self.bounds = np.array([r[k][:2] for k in self.keys])
+        self.a, self.b, self.ab = design(self.bounds, samples, seed)
+        self.grid = {}  # (block, row) -> case; block "A", "B" or key index i for AB_i
+        blocks = [("A", self.a), ("B", self.b)] + [(i, self.ab[i]) for i in range(len(self.keys))]
+        cases = []
+        for block, x in blocks:
+            for j in range(samples):
+                c = self._case(block, j, x[j])
+                self.grid[(block, j)] = c
+                cases.append(c)
+        self.cases = cases
+        self.outputs = [("uncertainty.csv", ",".join(COLUMNS).encode(), "uncertainty table"),
+                        ("uncertainty_spread.csv", ",".join(SPREAD_COLUMNS).encode(), "uncertainty table"),
+                        ("uncertainty.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "uncertainty table"),
+                        ("uncertainty.png", PNG_SIGNATURE, "figure")]
+        self.indices: list[dict] = []
+        self.spreads: list[dict] = []
+
+    def _case(self, block, j, x):
+        values = {k: float(v) for k, v in zip(self.keys, x)}
+        try:
+            sc = self.scenario.replace(**values)
+        except UserError as exc:
+            raise UserError(f"uncertainty: sample {j} ({', '.join(f'{k}={v:g}' for k, v in values.items())}) is "
+                            f"refused: {exc}; narrow the ranges so that every combination is a valid bearing") from None
+        label = "A" if block == "A" else "B" if block == "B" else f"AB{block}"
+        return case_of(sc, {"block": label, "sample": j})
+
+    def outputs_of(self, outdir, records) -> dict[str, np.ndarray]:
+        """``{quantity: f}`` with f [k + 2, N] (rows A, B, AB_0..AB_k-1), NaN where a run failed."""
+        k, n = len(self.keys), self.samples
+        quantities = [q for q in QUANTITIES if self.scenario.model == "multibody" or q[0] != "cage_slip"]
+        out = {q: np.full((k + 2, n), np.nan) for q, _, _ in quantities}
+        for (block, j), c in self.grid.items():
+            res = load_result(outdir, records[c.hash])
+            if res is None:
+                continue
+            row = 0 if block == "A" else 1 if block == "B" else 2 + block
+            for q, name, _ in quantities:
+                out[q][row, j] = float(res.summary[name])
+        return out
+
+    def finish(self, outdir, records) -> list[Path]:
+        f = self.outputs_of(outdir, records)
+        self.indices, self.spreads = analyse(f, self.keys, self.seed)
+        paths = write_tables(outdir, self.indices, self.spreads, self)
+        return [*paths, *plot_uncertainty(outdir / "uncertainty.h5", outdir)]
+
+
+def analyse(f: dict[str, np.ndarray], keys, seed: int) -> tuple[list[dict], list[dict]]:
+    """Sobol indices (rows of :data:`COLUMNS`) and spreads (rows of :data:`SPREAD_COLUMNS`) of every
+    output ``f[q]`` [k + 2, N]; a sample row with any NaN is left out of that output."""
+    indices, spreads = [], []
+    for q, y in f.items():
+        ok = np.all(np.isfinite(y), axis=0)
+        fa, fb, fab = y[0, ok], y[1, ok], y[2:, ok]
+        spreads.append({"quantity": q, **(spread(fa, fb) if ok.sum() >= 2 else dict.fromkeys(SPREAD_COLUMNS[1:], math.nan))})
+        if ok.sum() >= 2 and np.var(np.concatenate([fa, fb])) > 0:
+            s = sobol_indices(fa, fb, fab, seed)
+        else:  # nothing varies (or too few runs): no shares
+            s = {c: np.full(len(keys), math.nan) for c in COLUMNS[2:]}
+        for i, key in enumerate(keys):
+            indices.append({"quantity": q, "key": key, **{c: float(s[c][i]) for c in COLUMNS[2:]}})
+    return indices, spreads
+
+
+def _csv(rows, columns) -> bytes:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    for r in rows:
+        w.writerow([r[c] if isinstance(r[c], str) else ("" if math.isnan(r[c]) else repr(float(r[c])))
+                    for c in columns])
+    return buf.getvalue().encode("utf-8")
+
+
+def write_tables(outdir, indices, spreads, study) -> list[Path]:
+    """``uncertainty.csv``, ``uncertainty_spread.csv`` and ``uncertainty.h5`` (the index table plus the
+    spreads and the design in its attributes), atomically."""
+    from bearingsim import archive
+    from bearingsim.outputs import write_atomic_bytes
+
+    outdir = Path(outdir)
+    p1, p2 = outdir / "uncertainty.csv", outdir / "uncertainty_spread.csv"
+    write_atomic_bytes(p1, _csv(indices, COLUMNS))
+    write_atomic_bytes(p2, _csv(spreads, SPREAD_COLUMNS))
+    cols = {c: (np.array([r[c] for r in indices], dtype=object) if isinstance(indices[0][c], str)
+                else np.array([r[c] for r in indices], dtype=float)) for c in COLUMNS}
+    attrs = {"format": INDEX_FORMAT, "columns": json.dumps(COLUMNS), "scenario": study.scenario.to_toml(),
+             "scenario_name": study.scenario.name, "samples": study.samples, "seed": study.seed,
+             "keys": json.dumps(study.keys), "bounds": json.dumps(study.bounds.tolist()),
+             "spread": json.dumps(spreads), "runs": study.samples * (len(study.keys) + 2)}
+    p3 = archive.write_table_file(outdir / "uncertainty.h5", cols, {c: "1" for c in COLUMNS[2:]}, attrs)
+    return [p1, p2, p3]
+
+
+def plot_indices(indices, spreads, title: str = ""):
+    """One panel per output: S1 and ST of every key with their confidence intervals, and the output's
+    median and 5-95 % interval in the panel's title."""
+    from bearingsim.plotting import plt
+
+    qs = list(dict.fromkeys(r["quantity"] for r in indices))
+    keys = list(dict.fromkeys(r["key"] for r in indices))
+    fig, axes = plt.subplots(1, len(qs), figsize=(3.8 * len(qs) + 1.5, 0.35 * len(keys) + 2.0), squeeze=False)
+    y = np.arange(len(keys))[::-1]
+    for ax, q in zip(axes[0], qs):
+        rows = {r["key"]: r for r in indices if r["quantity"] == q}
+        for off, name, color in ((0.18, "S1", "C0"), (-0.18, "ST", "C3")):
+            v = np.array([rows[k][name] for k in keys])
+            err = np.abs(np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]]) - v)
+            ax.barh(y + off, np.nan_to_num(v), 0.36, xerr=np.nan_to_num(err), color=color, capsize=2,
+                    label="first order" if name == "S1" else "total")
+        sp = next(s for s in spreads if s["quantity"] == q)
+        ax.set_title(f"{q.replace('_', ' ')}: median {sp['median']:.4g}\n5-95 %: {sp['p05']:.4g} .. {sp['p95']:.4g}",
+                     fontsize=8)
+        ax.set_yticks(y)
+        ax.set_yticklabels(keys if ax is axes[0][0] else [""] * len(keys), fontsize=8)
+        ax.set_xlabel("Sobol index (share of the variance)")
+        ax.grid(axis="x", alpha=0.3)
+    axes[0][0].legend(fontsize=8, loc="lower right")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def read_table(path):
+    """(index rows, spreads, root attributes) of ``uncertainty.h5``; one-line UserError if not one."""
+    from bearingsim import archive
+
+    cols, meta = archive.read_table_file(path, INDEX_FORMAT)
+    names = json.loads(meta["columns"])
+    rows = [{c: (cols[c][i] if isinstance(cols[c][i], str) else float(cols[c][i])) for c in names}
+            for i in range(len(cols[names[0]]))]
+    return rows, json.loads(meta["spread"]), meta
+
+
+def plot_uncertainty(index_path, outdir) -> list[Path]:
+    """Draw ``uncertainty.png`` from the index alone."""
+    from bearingsim.plotting import save_figure
+
+    rows, spreads, meta = read_table(index_path)
+    fig = plot_indices(rows, spreads, f"Uncertainty of {meta.get('scenario_name', '?')}: {meta['samples']} base samples "
+                                      f"({meta['runs']} runs), seed {meta['seed']}; bars: {CONFIDENCE:.0%} bootstrap intervals")
+    return [save_figure(fig, Path(outdir) / "uncertainty.png")]
+
+
+class UncertaintyResult:
+    """What :func:`bearingsim.uncertainty` returns: ``table`` (Sobol indices, rows of :data:`COLUMNS`),
+    ``spread`` (median, 5 and 95 % points of each output), ``outcome`` and :meth:`plot_indices`."""
+
+    def __init__(self, study: Uncertainty, outcome):
+        self.table, self.spread, self.outcome = study.indices, study.spreads, outcome
+        self.scenario, self.samples, self.seed, self.keys = study.scenario, study.samples, study.seed, study.keys
+
+    def plot_indices(self):
+        """First-order and total Sobol indices with their intervals (a matplotlib figure)."""
+        return plot_indices(self.table, self.spread, f"Uncertainty of {self.scenario.name}: N = {self.samples}, "
+                                                     f"seed {self.seed}")
+
+    def __repr__(self) -> str:
+        return f"UncertaintyResult({len(self.keys)} keys, N = {self.samples}, {self.outcome.counts()})"
+
+
+def run_uncertainty(scenario, outdir=None, samples: int = 64, seed: int = 0, keys=None, *, jobs: int = 1,
+                    engine=None, progress: bool | None = False, log=None, force: bool = False) -> UncertaintyResult:
+    """Run the design's cases on the sweep engine into ``outdir`` (None: a temporary folder) and return
+    the indices and spreads (archives in ``outdir`` reused; failed rows left out, counted in ``runs_used``)."""
+    from bearingsim.studies.sensitivity import run_study
+
+    study = Uncertainty(scenario, samples, seed, keys)
+    return UncertaintyResult(study, run_study(study, outdir, jobs=jobs, engine=engine, progress=progress, log=log,
+                                              force=force))

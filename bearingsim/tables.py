@@ -132,7 +132,7 @@ def table_of(paths) -> Table:
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT
 
-    paths = [Path(p) for p in paths]
+    paths = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
     if len(paths) == 1 and paths[0].is_dir():
         index = paths[0] / "sweep.h5"
         if not index.is_file():

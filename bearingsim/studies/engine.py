@@ -18,8 +18,6 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from bearingsim.errors import UserError
 from bearingsim.stats import batch_sem  # noqa: F401 - the studies' estimator, re-exported
 from bearingsim.sweeps.spec import Case, case_hash

@@ -39,6 +39,8 @@ def _cmd_run(args) -> int:
     _refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
+    if args.dry_run:
+        return _dry_run(scenario, args)
     if not args.quiet:
         from bearingsim.scenario import given_keys, unused_note
 
@@ -94,21 +96,70 @@ def _cmd_inspect(args) -> int:
     return 0
 
 
+def _is_scenario_file(path) -> bool:
+    """``show``'s argument is a scenario to resolve: a regular ``.toml`` file that is not HDF5 (an archive
+    is read as one whatever its name; a FIFO or a missing file goes to the archive reader's refusal)."""
+    from bearingsim.archive import is_archive
+
+    p = Path(path)
+    return p.suffix.lower() == ".toml" and p.is_file() and not is_archive(p)
+
+
+def _write_toml(text: str) -> None:
+    """A TOML text to stdout as UTF-8 whatever the locale (a C locale: ASCII)."""
+    buffer = getattr(sys.stdout, "buffer", None)
+    if buffer is None:  # a text stream without bytes underneath (main() called with stdout replaced)
+        sys.stdout.write(text)
+        return
+    sys.stdout.flush()
+    buffer.write(text.encode("utf-8"))
+
+
+def _resolved_text(scenario, out=None) -> str:
+    """The resolved scenario as TOML, with what differs from its preset (and the archive a run would
+    write) as comments above it."""
+    from bearingsim.scenario import differences_from_preset
+
+    head = [f"# resolved from {scenario.source}: every key, defaults < preset < file < --set"]
+    diffs = differences_from_preset(scenario)
+    head.append("# differs from the preset: " + (", ".join(diffs) if diffs else "nothing"))
+    if out is not None:
+        head.append(f"# 'bearingsim run' would write {out} (and its figures beside it); nothing was run")
+    return "\n".join(head) + "\n" + scenario.to_toml()
+
+
+def _dry_run(scenario, args) -> int:
+    """``run --dry-run``: the resolved scenario and the archive it would write; nothing run or written."""
+    from bearingsim.simulation import default_output
+
+    out = Path(args.output) if args.output else default_output(scenario)
+    _write_toml(_resolved_text(scenario, out))
+    if not args.quiet:
+        from bearingsim.scenario import given_keys, unused_note
+
+        note = unused_note(scenario.model, given_keys(args.scenario, args.set))
+        if note:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
+    return 0
+
+
 def _cmd_show(args) -> int:
     from bearingsim.simulation import SCENARIO_ONLY, load as read
 
+    if _is_scenario_file(args.archive):
+        from bearingsim.scenario import load_scenario
+
+        _write_toml(_resolved_text(load_scenario(args.archive, args.set)))
+        return 0
+    if args.set:
+        raise UserError(f"show {args.archive}: --set applies to a scenario file (.toml), not to an archive")
     index = _describe_index(args.archive)
     if index is not None:  # an index file: its scenario if it stores one, else what it is (as TOML comments)
         idx_text, toml = index
         text = toml if toml else "".join(f"# {line}\n" for line in idx_text.splitlines())
     else:
         text = read(args.archive, only=SCENARIO_ONLY).scenario.to_toml()
-    buffer = getattr(sys.stdout, "buffer", None)
-    if buffer is None:  # a text stream without bytes underneath (main() called with stdout replaced)
-        sys.stdout.write(text)
-        return 0
-    sys.stdout.flush()
-    buffer.write(text.encode("utf-8"))  # a TOML file is UTF-8 whatever the locale (a C locale: ASCII)
+    _write_toml(text)
     return 0
 
 
@@ -185,6 +236,11 @@ def _cmd_compare(args) -> int:
     from bearingsim.simulation import COMPARED, load as read
     from bearingsim.compare import compare_results
 
+    if len(args.archives) < 2:
+        raise UserError("compare: give at least two archives")
+    if len(args.archives) > 2:
+        return _compare_many(args.archives)
+    args.a, args.b = args.archives
     a, b = read(args.a, only=COMPARED), read(args.b, only=COMPARED)
     c = compare_results(a, b)
     if c.scenario_keys:
@@ -198,6 +254,52 @@ def _cmd_compare(args) -> int:
         print(f"  differs: {name}")
     print("results: identical" if c.identical else "results: differ")
     return 0 if c.identical else 1
+
+
+def _compare_many(paths) -> int:
+    """``compare`` of three or more archives: the scenario keys that differ, then the summary table
+    with standard errors and significance marks against the first (:mod:`bearingsim.tables`); exit 0
+    when every archive's results are bit-identical to the first's, else 1."""
+    from bearingsim import tables
+    from bearingsim.compare import _flatten, compare_results
+    from bearingsim.simulation import COMPARED, load as read
+
+    results = [read(p, only=COMPARED) for p in paths]
+    flat = [_flatten(r.scenario.raw) for r in results]
+    keys = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    if keys:
+        print("scenario keys that differ (archive 1, 2, ...):")
+        for k in keys:
+            print(f"  {k}: " + ", ".join(repr(f.get(k, "(unset)")) for f in flat))
+    else:
+        print("scenarios: identical")
+    print(tables.format_table(tables.table_of_archives(paths)))
+    differ = [Path(p).name for p, r in zip(paths[1:], results[1:]) if not compare_results(results[0], r).identical]
+    print("results: identical" if not differ else f"results: differ from {Path(paths[0]).name}: {', '.join(differ)}")
+    return 1 if differ else 0
+
+
+def _cmd_table(args) -> int:
+    """``bearingsim table DIR|FILES...``: summary numbers side by side (:mod:`bearingsim.tables`)."""
+    from bearingsim import tables
+
+    columns = [c.strip() for c in args.columns.split(",") if c.strip()] if args.columns else None
+    print(tables.format_table(tables.table_of(args.paths), columns=columns))
+    return 0
+
+
+def _cmd_keys(args) -> int:
+    """``bearingsim keys``: every scenario key with unit, bounds, default and source (:mod:`bearingsim.keys`)."""
+    from bearingsim.keys import format_keys, list_keys
+    from bearingsim.scenario import available_presets
+
+    if args.preset not in available_presets():
+        raise UserError(f"--preset {args.preset!r}: unknown preset (available: {', '.join(available_presets())})")
+    text = format_keys(list_keys(args.preset), args.pattern, why=args.why)
+    if text.count("\n") == 0:
+        raise UserError(f"keys {args.pattern!r}: no scenario key contains it ('bearingsim keys' lists them all)")
+    print(text)
+    return 0
 
 
 def _report_study(outcome, command: str) -> int:
@@ -218,6 +320,11 @@ def _report_study(outcome, command: str) -> int:
     return 0
 
 
+def _progress(args) -> bool:
+    """A progress bar on stderr: only on a terminal, and not with -q."""
+    return not getattr(args, "quiet", False) and sys.stderr.isatty()
+
+
 def _cmd_validate(args) -> int:
     from bearingsim.studies import make_engine, run_studies
     from bearingsim.studies.fig9 import Fig9
@@ -228,7 +335,13 @@ def _cmd_validate(args) -> int:
 
         studies.append(Rig(rotations=args.rig_rotations))
     engine = make_engine(args.jobs, args.scheduler)
-    outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force)
+    outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force, progress=_progress(args))
+    if not args.quiet:
+        _print_validate(args, studies, outcome)
+    return _report_study(outcome, "validate")
+
+
+def _print_validate(args, studies, outcome) -> None:
     for p in outcome.written[:2]:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:
@@ -243,7 +356,6 @@ def _cmd_validate(args) -> int:
             print(f"wrote {p}")
     if outcome.interrupted is None:
         print(f"{len(outcome.sweep.rows)} cases: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
-    return _report_study(outcome, "validate")
 
 
 def _benchmarks_root() -> Path:
@@ -294,7 +406,8 @@ def _cmd_sweep(args) -> int:
     from bearingsim.sweeps import run_sweep_cli
 
     return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
-                         scheduler=args.scheduler, figures=not args.no_plots, force=args.force)
+                         scheduler=args.scheduler, figures=not args.no_plots, force=args.force, quiet=args.quiet,
+                         progress=_progress(args))
 
 
 def _cmd_crosscheck(args) -> int:
@@ -313,9 +426,9 @@ def _cmd_crosscheck(args) -> int:
     cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
     rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine,
-                                      force=args.force)
+                                      force=args.force, progress=_progress(args))
     wall = time.perf_counter() - t0
-    if outcome.interrupted is None:
+    if outcome.interrupted is None and not args.quiet:
         where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
         print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
               f"{args.rotations} rotations each, {where}, {wall:.1f} s; impulses per pocket and cage "
@@ -343,6 +456,8 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--force", action="store_true",
                    help="replace an archive of a different scenario at the output path (default: refused)")
     r.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    r.add_argument("--dry-run", action="store_true",
+                   help="print the resolved scenario (every key, as TOML) and the archive it would write; run nothing")
     r.set_defaults(func=_cmd_run)
 
     i = sub.add_parser("inspect", help="print what an archive, a sweep.h5 or a crosscheck.h5 holds")
@@ -350,8 +465,11 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(func=_cmd_inspect)
 
     sh = sub.add_parser("show", help="print the scenario stored in an archive or crosscheck.h5 as TOML (a runnable "
-                                     "scenario file); for a sweep.h5, what it holds as TOML comments")
-    sh.add_argument("archive")
+                                     "scenario file); for a sweep.h5, what it holds as TOML comments; for a "
+                                     "scenario file (.toml), the resolved scenario: every key, before any run")
+    sh.add_argument("archive", help="archive, sweep.h5, crosscheck.h5 or scenario .toml file")
+    sh.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="with a scenario file: override a key, as 'run --set' does (repeatable)")
     sh.set_defaults(func=_cmd_show)
 
     pl = sub.add_parser("plot", help="draw every figure of a run again from its archive alone")
@@ -366,11 +484,25 @@ def build_parser() -> argparse.ArgumentParser:
                     help="with -o: replace an archive of a different scenario there (default: refused)")
     rr.set_defaults(func=_cmd_rerun)
 
-    cp = sub.add_parser("compare", help="scenario keys and summary numbers of two archives side by side "
-                                        "(exit 0 identical, 1 different, 2 bad file)")
-    cp.add_argument("a")
-    cp.add_argument("b")
+    cp = sub.add_parser("compare", help="scenario keys and summary numbers of two or more archives side by side "
+                                        "(exit 0 identical, 1 different, 2 bad file); two: bit for bit, every "
+                                        "number; more: a table with standard errors and significance marks")
+    cp.add_argument("archives", nargs="+", metavar="ARCHIVE")
     cp.set_defaults(func=_cmd_compare)
+
+    tb = sub.add_parser("table", help="summary numbers of a sweep, cross-check or validate folder (its index), or of "
+                                      "archives, as aligned columns with units, standard errors and significance marks")
+    tb.add_argument("paths", nargs="+", metavar="DIR|FILE", help="one folder or sweep.h5, or run archives")
+    tb.add_argument("--columns", metavar="KEY,...",
+                    help="summary keys to show (default: I_dec_mean_Ns, I_acc_mean_Ns, first_impact_speed_m_s, "
+                         "cage_slip, load_zone_half_angle_deg, those present)")
+    tb.set_defaults(func=_cmd_table)
+
+    ks = sub.add_parser("keys", help="every scenario key with its unit, type and bounds, default and source")
+    ks.add_argument("pattern", nargs="?", help="only keys containing this text, e.g. land or numerics.")
+    ks.add_argument("--preset", default="NU214-Suzuki2023", help="the preset whose values are the defaults shown")
+    ks.add_argument("--why", action="store_true", help="each preset value's reasoning or reference below it")
+    ks.set_defaults(func=_cmd_keys)
 
     v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
                                         "(pocket 0 flat) against it (tables and PNGs; run again to resume)")
@@ -382,6 +514,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run the cases on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     v.add_argument("--force", action="store_true",
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
+    v.add_argument("-q", "--quiet", action="store_true", help="no progress bar and nothing printed on success")
     v.set_defaults(func=_cmd_validate)
 
     b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot); from a source "
@@ -417,6 +550,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-plots", action="store_true", help="index only, no figures")
     s.add_argument("--force", action="store_true",
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
     s.set_defaults(func=_cmd_sweep)
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
                                            "(README: Cross-check; run again to resume)")
@@ -431,6 +565,7 @@ def build_parser() -> argparse.ArgumentParser:
                     help="run the rungs on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     cc.add_argument("--force", action="store_true",
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
+    cc.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
     cc.set_defaults(func=_cmd_crosscheck)
     from bearingsim import cli_wear
 

@@ -111,6 +111,30 @@ class Result:
         p = prefix + "/"
         return {k[len(p):]: v.data for k, v in self.data.items() if k.startswith(p) and "/" not in k[len(p):]}
 
+    def to_dataframe(self, what: str = "per_rotation", units_in_names: bool = False):
+        """A pandas DataFrame of ``what`` (needs the extra ``bearingsim[frames]``):
+
+        * ``"per_rotation"``: one row per (rotation, pocket) (a MultiIndex), one column per
+          per-rotation array (``I_dec``, ``I_acc``, ...);
+        * ``"impacts"``: one row per roller-cage impact (``time_s``, ``theta_deg``, ``face`` ...);
+        * ``"observables"``: the time series, indexed by ``time_s`` (vectors split into ``_x``, ``_y``);
+        * ``"summary"``: one row of the summary numbers.
+
+        Units (SI) in ``df.attrs["units"]``; ``units_in_names=True`` also puts them in the column names
+        (``"I_dec [N s]"``). :mod:`bearingsim.frames`."""
+        from bearingsim.frames import result_dataframe
+
+        return result_dataframe(self, what, units_in_names)
+
+    def to_xarray(self):
+        """An xarray Dataset (needs the extra ``bearingsim[frames]``): per-rotation arrays on
+        ``(rotation, pocket)``, the impacts as ``impact_<column>`` on ``impact``, the time series on
+        ``time``; each variable's unit in its ``attrs["units"]``, the summary numbers (and their
+        ``units_<key>``), the scenario's name, model and TOML in the Dataset's attrs."""
+        from bearingsim.frames import result_xarray
+
+        return result_xarray(self)
+
     def save(self, path) -> Path:
         """Write this result as an archive at ``path`` (atomically); return the path."""
         from bearingsim import archive

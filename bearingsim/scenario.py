@@ -730,6 +730,35 @@ def _loc(err) -> str:
     return ".".join(str(p) for p in err["loc"] if not str(p).startswith(("function-", "literal[")))
 
 
+def known_keys() -> list[str]:
+    """Every dotted key a scenario accepts, and its section names (the schema's own list)."""
+    out = []
+    for name, field in ScenarioModel.model_fields.items():
+        sub = field.annotation
+        if isinstance(sub, type) and issubclass(sub, BaseModel):
+            out.append(name)
+            out.extend(f"{name}.{k}" for k in sub.model_fields)
+        else:
+            out.append(name)
+    return out
+
+
+def did_you_mean(key: str) -> str:
+    """`` (did you mean X?)`` for the accepted key closest to an unknown ``key`` (difflib), or ``""``."""
+    import difflib
+
+    known = known_keys()
+    section, _, leaf = key.rpartition(".")
+    same = [k for k in known if k.rpartition(".")[0] == section]  # the keys beside it (or the top level)
+    close = [f"{section}.{m}" if section else m for m in difflib.get_close_matches(
+        leaf, [k.rpartition(".")[2] for k in same], n=1, cutoff=0.6)]
+    if not close:  # the right name in the wrong section
+        by_leaf = {k.rpartition(".")[2]: k for k in known if "." in k}
+        hit = difflib.get_close_matches(leaf, list(by_leaf), n=1, cutoff=0.8)
+        close = [by_leaf[hit[0]]] if hit else []
+    return f" (did you mean {close[0]}?)" if close else ""
+
+
 def _validate(merged: dict[str, Any], source: str) -> Scenario:
     try:
         model = ScenarioModel.model_validate(merged)
@@ -739,7 +768,7 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
         if err["type"] == "missing":
             msg = "missing (set it in the scenario or name a [bearing] preset)"
         elif err["type"] == "extra_forbidden":
-            msg = "unknown key"
+            msg = "unknown key" + did_you_mean(key)
         else:
             msg = err["msg"].replace("Input should be", "must be").replace("Value error, ", "")
             if "input" in err and not isinstance(err["input"], dict):

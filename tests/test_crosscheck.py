@@ -231,3 +231,22 @@ def test_one_rotation_prints_no_nan_standard_error():
     text = " ".join(cc.verdicts(rows)) + "\n" + cc.format_table(rows)
     assert "nan" not in text.lower(), text
     assert "not judged" in text and "n/a" in text
+
+
+def test_crosscheck_index_and_table_give_each_rung_one_standard_error(ladder):
+    """Issue 28, item 5: the cross-check's table, the engine's case index in the same folder and
+    ``bearingsim table`` of a rung's archive report the same standard error, bit for bit."""
+    from bearingsim import tables
+    from bearingsim.sweeps.index import read_index
+
+    out, rc, _ = ladder
+    rows, _ = cc.read_table(out / "crosscheck.h5")
+    cols, _ = read_index(out / "sweep.h5")
+    by_archive = {str(a): i for i, a in enumerate(cols["archive"])}
+    for row in rows:
+        i = by_archive[str(row["archive"])]
+        table = tables.table_of_archives([out / row["archive"]])
+        for k in ("I_dec_sem_Ns", "I_acc_sem_Ns"):
+            assert row[k] == cols[k][i] == table.numbers[k][0], (row["scene"], k)
+    text = tables.format_table(tables.table_of(out))
+    assert "rung" in text.splitlines()[1] and text.splitlines()[-1] == tables.RULE

@@ -14,7 +14,7 @@ Five rungs at each speed; each drops one assumption of the paper's model and kee
    makes of the scenario at that speed (and with ``--rotations``, that many rotations).
 
 Numbers per rung: the mean impulses per pocket and cage rotation over all pockets (SI), their standard
-error from batch means (:func:`bearingsim.studies.batch_sem`) of the pocket-mean series over
+error from batch means (:func:`bearingsim.stats.impulse_standard_errors`) of the pocket-mean series over
 rotations (rotations of a chaotic scene are correlated), the mean first rear-impact speed and the cage
 slip. ``change_from_previous`` is the change of ``I_dec_mean_Ns`` from the rung before, so the changes
 add up to full minus reduced exactly.
@@ -116,18 +116,19 @@ def rung_scenarios(scenario, rpm: float, rotations: int | None = None) -> list[t
 def rung_numbers(result, reduced: bool) -> dict:
     """The table's numbers of one rung's result (SI).
 
-    The standard errors are batch-means errors of the per-rotation pocket-mean impulses; the reduced
-    model repeats one no-load pass every rotation, so its scatter is zero by construction, and its cage
-    turns at the epicyclic speed by assumption (cage slip 0).
+    The standard errors are :func:`bearingsim.stats.impulse_standard_errors` (batch means over rotations
+    of the pocket-mean impulses: the same numbers ``bearingsim sweep`` and ``bearingsim table`` give for
+    the rung's archive); the reduced model repeats one no-load pass every rotation, so its scatter is
+    zero by construction, and its cage turns at the epicyclic speed by assumption (cage slip 0).
     """
-    from bearingsim.studies.engine import batch_sem
+    from bearingsim.stats import impulse_standard_errors
 
     s = result.summary
-    d = result.per_rotation["I_dec"].mean(axis=1)
-    a = result.per_rotation["I_acc"].mean(axis=1)
+    se = impulse_standard_errors(result.per_rotation["I_dec"], result.per_rotation["I_acc"],
+                                 "reduced" if reduced else result.scenario.model)
     return {
-        "I_dec_mean_Ns": float(s["I_dec_mean_Ns"]), "I_dec_sem_Ns": 0.0 if reduced else batch_sem(d),
-        "I_acc_mean_Ns": float(s["I_acc_mean_Ns"]), "I_acc_sem_Ns": 0.0 if reduced else batch_sem(a),
+        "I_dec_mean_Ns": float(s["I_dec_mean_Ns"]), "I_dec_sem_Ns": se["I_dec_sem_Ns"],
+        "I_acc_mean_Ns": float(s["I_acc_mean_Ns"]), "I_acc_sem_Ns": se["I_acc_sem_Ns"],
         "first_impact_speed_m_s": float(s["first_impact_speed_m_s"]),
         "cage_slip": 0.0 if reduced else float(s["cage_slip"]),
     }

@@ -14,31 +14,16 @@ same model version (``cached``) and runs only what is missing, failed or stale.
 """
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from bearingsim.errors import UserError
+from bearingsim.stats import batch_sem  # noqa: F401 - the studies' estimator, re-exported
 from bearingsim.sweeps.spec import Case, case_hash
 
 #: statuses of a case whose archive holds its numbers
 FINISHED = ("done", "cached", "stale")
-
-
-def batch_sem(x: np.ndarray, batches: int = 5) -> float:
-    """Standard error of the mean of a correlated series from ``batches`` batch means [same unit as x].
-
-    Rotations of a chaotic scene are correlated; the means of contiguous batches are close to
-    independent, so their scatter / sqrt(batches) estimates the error of the overall mean."""
-    x = np.asarray(x, float)
-    b = min(batches, len(x))
-    if b < 2:
-        return float("nan")
-    means = np.array([c.mean() for c in np.array_split(x, b)])
-    return float(means.std(ddof=1) / math.sqrt(b))
 
 
 def case_of(scenario, values: dict) -> Case:

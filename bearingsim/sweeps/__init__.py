@@ -5,10 +5,10 @@
 (:mod:`bearingsim.sweeps.index`); ``plot_sweep_index`` draws the sweep's figures from the index.
 """
 from bearingsim.sweeps.engines import DaskEngine, LocalEngine
-from bearingsim.sweeps.index import read_index
+from bearingsim.sweeps.index import index_dataframe, read_index
 from bearingsim.sweeps.plot import plot_sweep_index
 from bearingsim.sweeps.run import SweepOutcome, run_sweep, run_sweep_cli
 from bearingsim.sweeps.spec import Case, SweepSpec, case_hash, load_sweep_file, resolve_cases, spec_from_args
 
-__all__ = ["Case", "DaskEngine", "LocalEngine", "SweepOutcome", "SweepSpec", "case_hash", "load_sweep_file",
+__all__ = ["Case", "DaskEngine", "LocalEngine", "SweepOutcome", "SweepSpec", "case_hash", "index_dataframe", "load_sweep_file",
            "plot_sweep_index", "read_index", "resolve_cases", "run_sweep", "run_sweep_cli", "spec_from_args"]

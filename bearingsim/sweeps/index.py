@@ -7,7 +7,7 @@ archive of the same scenario there was computed by another version of the model,
 that stored none; ``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
 ``archive`` (path relative to the sweep folder), ``wall_s`` (seconds the case took; for a cached case
 the stored run's own wall time) and the summary numbers (SI, as in the archives' ``/results/summary``,
-plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.sweeps.worker.standard_errors`).
+plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.stats.impulse_standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
 NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every
@@ -164,6 +164,14 @@ def read_index(path: str | Path) -> tuple[dict[str, np.ndarray], dict]:
     return cols, meta
 
 
+def index_dataframe(path, units_in_names: bool = False):
+    """The index of a sweep or study folder (``DIR`` or ``DIR/sweep.h5``) as a pandas DataFrame, one
+    row per case (needs the extra ``bearingsim[frames]``; :func:`bearingsim.frames.index_dataframe`)."""
+    from bearingsim.frames import index_dataframe as frame
+
+    return frame(path, units_in_names)
+
+
 # unit suffixes of scenario and summary keys -> unit text for labels
 UNITS = (("_kgm2", "kg m²"), ("_Ns", "N s"), ("_m_s", "m/s"), ("_rad_s", "rad/s"), ("_mm", "mm"),
          ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"), ("_hz", "Hz"), ("_N", "N"),
@@ -207,6 +215,6 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     if got["model_version"] is None or got["model_version"] != MODEL_VERSIONS.get(got["model"]):
         return {"status": "stale"}
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
-    summary.update(standard_errors(got["I_dec"], got["I_acc"]))
+    summary.update(standard_errors(got["I_dec"], got["I_acc"], got["model"]))
     wall = got["wall_time_s"]
     return {"status": "cached", "error": "", "wall_s": wall, "summary": summary}

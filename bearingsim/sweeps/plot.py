@@ -4,7 +4,7 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
 
 * the grid of its axes (``sweep_I.png`` or ``sweep_map.png``), I_dec and I_acc per cage rotation in two
   panels, error bars of one standard error (``I_*_sem_Ns``; see
-  :func:`bearingsim.sweeps.worker.standard_errors`):
+  :func:`bearingsim.stats.impulse_standard_errors`):
 
   - one axis, or zipped axes: a line plot against the (first numeric) axis;
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per

@@ -32,6 +32,8 @@ INDEX_EVERY_S = 1.0
 # (a 10 000-row index takes ~50-80 ms to write; every second that was ~2 s of a 30 s map, on a core the
 # workers need)
 INDEX_TIME_SHARE = 0.02
+#: rows of the table printed at the end of a sweep ('bearingsim table DIR' prints them all)
+TABLE_ROWS = 40
 
 
 class SweepInterrupted(Exception):
@@ -369,8 +371,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
 def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: int | None = None,
                   scheduler: str | None = None, figures: bool = True, quiet: bool = False,
-                  force: bool = False) -> int:
-    """``bearingsim sweep``: run, print what was written and return the exit code.
+                  force: bool = False, progress: bool | None = None) -> int:
+    """``bearingsim sweep``: run, print what was written and the table of the cases (unless ``quiet``)
+    and return the exit code. ``progress``: the bar on stderr (default: when stderr is a terminal).
 
     0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
     SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
@@ -390,7 +393,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")
     engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
-    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force)
+    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force,
+                    progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))
     n = len(out.rows)
     counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
     if out.count("stale"):
@@ -407,6 +411,9 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
             print(f"wrote {p}")
         for line in out.figure_notes:
             print(f"bearingsim: note: {line}", file=sys.stderr)
+        from bearingsim import tables
+
+        print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
         print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
     if out.failed:
         names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"

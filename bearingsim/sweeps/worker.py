@@ -5,7 +5,6 @@ no file system shared with the client: with ``return_bytes`` the archive comes b
 """
 from __future__ import annotations
 
-import math
 import sys
 import tempfile
 import time
@@ -23,22 +22,12 @@ def one_line_error(exc: BaseException) -> str:
     return text[:500] or exc.__class__.__name__
 
 
-def standard_errors(per_rotation_I_dec, per_rotation_I_acc) -> dict[str, float]:
-    """Standard error of the per-rotation mean impulses.
+def standard_errors(per_rotation_I_dec, per_rotation_I_acc, model: str | None = None) -> dict[str, float]:
+    """Standard errors of the mean impulses: :func:`bearingsim.stats.impulse_standard_errors` (batch
+    means over rotations of the pocket-mean series; the one estimator of every command)."""
+    from bearingsim.stats import impulse_standard_errors
 
-    Each rotation's impulse is averaged over the pockets (pockets of one rotation share the cage's
-    motion, so they are not independent samples); the standard error is the sample standard deviation
-    of those per-rotation means over sqrt(rotations). Rotations are treated as independent, which the
-    cage's whirl can make optimistic. NaN with fewer than 2 rotations; 0 for the reduced model, whose
-    rotations repeat one pass by construction.
-    """
-    out = {}
-    for name, arr in (("I_dec_sem_Ns", per_rotation_I_dec), ("I_acc_sem_Ns", per_rotation_I_acc)):
-        a = np.asarray(arr, dtype=float)
-        series = a.reshape(a.shape[0], -1).mean(axis=1) if a.ndim >= 1 and a.size else np.array([])
-        n = series.size
-        out[name] = float(series.std(ddof=1) / math.sqrt(n)) if n >= 2 else math.nan
-    return out
+    return impulse_standard_errors(per_rotation_I_dec, per_rotation_I_acc, model)
 
 
 def _numbers(summary: dict) -> dict[str, float]:
@@ -101,7 +90,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
                 res = _run_to_file(scenario, path)
                 data = path.read_bytes()
         summary = _numbers(res.summary)
-        summary.update(standard_errors(*_per_rotation(res)))
+        summary.update(standard_errors(*_per_rotation(res), scenario.model))
         rec = {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
                "summary": summary}
         if data is not None:

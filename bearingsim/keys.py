@@ -1,0 +1,155 @@
+"""Every scenario key with its unit, bounds, default and source (``bearingsim keys``).
+
+Read from the scenario schema itself (:class:`bearingsim.scenario.ScenarioModel`: the types and bounds
+that validation enforces), the package defaults (:data:`bearingsim.scenario.DEFAULTS`) and a preset's
+values with their ``[source.<section>.<key>]`` entries, so the list cannot drift from what a scenario
+accepts.
+"""
+from __future__ import annotations
+
+import typing
+from dataclasses import dataclass
+
+from pydantic import BaseModel
+
+from bearingsim.sweeps.index import unit_of
+
+#: the sources of the package defaults that have one (bearingsim/scenario.py DEFAULTS, beside each value)
+DEFAULT_SOURCES = {
+    "multibody.traction_mu_max": "EHL traction of mineral oils (Johnson & Tevaarwerk 1977)",
+    "multibody.traction_slip_ref": "EHL traction of mineral oils (Johnson & Tevaarwerk 1977)",
+    "wear.wear_coefficient": "Archard & Hirst 1956, 60/40 brass on tool steel",
+    "wear.hardness_Pa": "high-strength brass, ~HV 150",
+    "contact.land_friction": "reconstructed: equal to the roller-cage friction (brass on steel)",
+    "bearing.cage_guidance": "the paper's roller-guided cage",
+}
+#: longest preset reference shown in the table (the whole of it with --why)
+WHERE_CHARS = 60
+
+_OPS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="))
+
+
+@dataclass(frozen=True)
+class KeyInfo:
+    """One scenario key: ``key`` (dotted), ``unit``, ``kind`` (type and bounds as text), ``default`` (the
+    value a scenario gets when it does not set the key, as TOML text, or ``"(required)"``), ``source``
+    (where that value comes from), ``why`` (the preset's reference or reasoning, may be empty),
+    ``unused_by`` (models that read nothing of the key)."""
+
+    key: str
+    unit: str
+    kind: str
+    default: str
+    source: str
+    why: str
+    unused_by: tuple[str, ...]
+
+
+def _kind(field) -> str:
+    """Type and bounds of a pydantic field: ``int >= 1``, ``"full" | "rigid"``, ``float > 0 | "auto"``."""
+    parts = []
+    for arg in _flat_args(field.annotation):
+        if typing.get_origin(arg) is typing.Literal:
+            parts.extend(f'"{v}"' for v in typing.get_args(arg))
+        elif arg is type(None):
+            continue  # optional: said by the default "(unset)"
+        else:
+            parts.append(getattr(arg, "__name__", str(arg)).replace("list", "list of int"))
+    bounds = [f"{op} {getattr(m, name):g}" for m in field.metadata for name, op in _OPS
+              if getattr(m, name, None) is not None]
+    if bounds:
+        num = next((i for i, p in enumerate(parts) if p in ("int", "float")), None)
+        if num is not None:
+            parts[num] += " " + ", ".join(bounds)
+    return " | ".join(parts) or "?"
+
+
+def _flat_args(annotation):
+    if typing.get_origin(annotation) in (typing.Union, getattr(__import__("types"), "UnionType", None)):
+        out = []
+        for a in typing.get_args(annotation):
+            out.extend(_flat_args(a))
+        return out
+    return [annotation]
+
+
+def _toml_value(v) -> str:
+    import tomli_w
+
+    return tomli_w.dumps({"v": v}).split("=", 1)[1].strip()
+
+
+def _bounds_note(section: str, name: str) -> str:
+    """Bounds that validators (not field metadata) enforce, from the validator's own wording."""
+    return {
+        ("bearing", "cage_land_clearance_mm"): "> 0, needed with a land-guided cage",
+        ("reduced", "load_zone_half_angle_deg"): "in [0, 180)",
+        ("multibody", "inner_ring_mass_kg"): "> 0",
+        ("multibody", "pocket_face_half_angle_deg"): "in (0, 90)",
+    }.get((section, name), "")
+
+
+def list_keys(preset: str = "NU214-Suzuki2023") -> list[KeyInfo]:
+    """Every key a scenario accepts, in schema order, with the defaults of the package and ``preset``."""
+    from bearingsim.scenario import DEFAULTS, UNUSED_BY_MODEL, ScenarioModel, load_preset
+
+    values = load_preset(preset) if preset else {}
+    sources = values.get("source", {}) if isinstance(values.get("source"), dict) else {}
+    out = []
+    for section, field in ScenarioModel.model_fields.items():
+        ann = field.annotation
+        if isinstance(ann, type) and issubclass(ann, BaseModel):
+            for name, sub in ann.model_fields.items():
+                out.append(_info(f"{section}.{name}", sub, section, name, DEFAULTS, values, sources, preset,
+                                 UNUSED_BY_MODEL))
+        else:
+            out.append(_info(section, field, None, section, DEFAULTS, values, sources, preset, UNUSED_BY_MODEL))
+    return out
+
+
+def _info(key, field, section, name, defaults, preset_values, sources, preset, unused) -> KeyInfo:
+    kind = _kind(field)
+    extra = _bounds_note(section, name) if section else ""
+    if extra:
+        kind = kind.replace("float", f"float {extra}", 1)
+    why = ""
+    if section and name in preset_values.get(section, {}):
+        default = _toml_value(preset_values[section][name])
+        src = sources.get(section, {}).get(name, {}) if isinstance(sources.get(section), dict) else {}
+        where = src.get("where") or ""
+        short = where if len(where) <= WHERE_CHARS else where[:WHERE_CHARS - 1].rstrip() + "..."
+        source = f"preset {preset}: {src.get('kind', 'no source entry')}" + (f" ({short})" if short else "")
+        why = src.get("reason", "") or (where if short != where else "")
+    elif section and name in defaults.get(section, {}):
+        default = _toml_value(defaults[section][name])
+        source = "package default" + (f": {DEFAULT_SOURCES[key]}" if key in DEFAULT_SOURCES else "")
+    elif key == "schema_version":
+        default, source = "1", "the only schema this bearingsim reads (required)"
+    elif key == "name":
+        default, source = "the file's name", "scenario file"
+    elif not field.is_required():
+        default, source = "(unset)", "optional"
+    else:
+        default, source = "(required)", "the scenario or its preset"
+    if section == "bearing" and name == "preset":
+        default, source = "(none)", "a file in bearingsim/params"
+    models = tuple(m for m, prefixes in unused.items()
+                   if any(key == p or (p.endswith(".") and key.startswith(p)) for p in prefixes))
+    return KeyInfo(key, unit_of(key) if section else "1", kind, default, source, why, models)
+
+
+def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
+    """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, each
+    preset value's reasoning on the line below it."""
+    rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
+    head = ("key", "unit", "type and bounds", "default", "source")
+    cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,
+              k.source + (f"; not used by the {', '.join(k.unused_by)} model" if k.unused_by else ""))
+             for k in rows]
+    widths = [max([len(h)] + [len(c[j]) for c in cells]) for j, h in enumerate(head[:-1])]
+    lines = ["  ".join(h.ljust(w) for h, w in zip(head[:-1], widths)) + "  " + head[-1]]
+    for k, c in zip(rows, cells):
+        lines.append("  ".join(v.ljust(w) for v, w in zip(c[:-1], widths)) + "  " + c[-1])
+        if why and k.why:
+            lines.append(" " * 4 + k.why)
+    return "\n".join(lines)

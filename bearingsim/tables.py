@@ -1,0 +1,219 @@
+"""Tables for the terminal: summary numbers of several runs side by side, with units, standard errors
+and significance marks (``bearingsim table``, ``bearingsim compare A B C ...``, the end of
+``bearingsim sweep``).
+
+A table has one row per run (an archive, or a case of a sweep's or study's index ``sweep.h5``), label
+columns (the file, the swept keys or the scenario keys that differ) and number columns (summary
+numbers). ``I_dec_mean_Ns`` and ``I_acc_mean_Ns`` carry their standard error, the one estimator of
+:mod:`bearingsim.stats` (batch means over rotations), and a mark:
+
+    ``*`` when |x - x_ref| > 2 sqrt(SE² + SE_ref²), x_ref the first row with a number
+
+(two standard errors of the difference of two independent means, about 95 % for normal errors); no mark
+where the difference is within that, and none where a standard error is missing (fewer than 2
+rotations: NaN) so the difference cannot be judged. Impulses are shown in mN s; every other column in
+the unit its key names.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+
+#: a difference is marked when it exceeds this many standard errors of the difference
+SIGNIFICANCE_SE = 2.0
+RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2), x_ref the first row with a number (SE: batch means over "
+        "rotations, docs/statistics.md); no mark: within that, or no SE to judge by")
+#: number columns shown by default, those present
+DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "load_zone_half_angle_deg")
+#: summary keys with a standard error (the key of the error)
+SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns"}
+#: display scale and unit of units that read better scaled
+SCALED = {"N s": (1e3, "mN s")}
+
+
+@dataclass
+class Table:
+    """Rows of runs: ``labels[name]`` (text per row), ``numbers[key]`` (float per row, SI),
+    ``units[key]``; ``notes`` are lines printed above the table."""
+
+    label_names: list[str]
+    labels: dict[str, list[str]]
+    numbers: dict[str, np.ndarray]
+    units: dict[str, str]
+    notes: list[str] = field(default_factory=list)
+
+    def __len__(self) -> int:
+        return len(next(iter(self.labels.values()))) if self.labels else 0
+
+
+def significant(x: float, se: float, x0: float, se0: float) -> bool | None:
+    """True/False: whether ``x - x0`` exceeds :data:`SIGNIFICANCE_SE` standard errors of the difference;
+    None when it cannot be judged (a number or a standard error missing)."""
+    vals = (x, se, x0, se0)
+    if any(v is None or not math.isfinite(v) for v in vals):
+        return None
+    return abs(x - x0) > SIGNIFICANCE_SE * math.hypot(se, se0)
+
+
+def _text(v) -> str:
+    if isinstance(v, (float, np.floating)):
+        return f"{float(v):g}"
+    return str(v)
+
+
+def table_of_index(path) -> Table:
+    """The table of a sweep's or study's index (``DIR/sweep.h5`` or the file): one row per case,
+    labelled by its swept keys (and its status where it is not done or cached)."""
+    from bearingsim.sweeps.index import read_index, unit_of
+
+    cols, meta = read_index(path)
+    n = len(cols["case"])
+    axes = [k for k in meta["axes"] if k in cols]
+    status = [str(s) for s in cols["status"]]
+    names = list(axes)
+    labels = {k: [_text(v) for v in cols[k]] for k in axes}
+    if any(s not in ("done", "cached") for s in status):
+        names.append("status")
+        labels["status"] = status
+    if not names:
+        names, labels = ["case"], {"case": [str(c) for c in cols["case"]]}
+    numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", "wall_s", *axes)
+               and k not in ("status", "error", "archive") and np.asarray(cols[k]).dtype.kind == "f"}
+    notes = [f"{path}: {n} cases" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
+    return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes)
+
+
+def table_of_archives(paths) -> Table:
+    """The table of run archives, one row each: labelled by the file and the scenario keys that
+    differ between them (at most 4 as columns; the others listed in ``notes``); the standard errors
+    computed from each archive's per-rotation impulses (:func:`bearingsim.stats.result_standard_errors`)."""
+    from bearingsim.compare import _flatten
+    from bearingsim.simulation import COMPARED, load
+    from bearingsim.stats import result_standard_errors
+
+    results = [load(p, only=COMPARED) for p in paths]
+    flat = [_flatten(r.scenario.raw) for r in results]
+    differ = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    shown = [k for k in differ if k != "name"][:4]
+    names = ["archive", *shown]
+    labels = {"archive": [Path(p).name for p in paths]}
+    for k in shown:
+        labels[k] = [_text(f.get(k, "(unset)")) for f in flat]
+    keys = list(dict.fromkeys(k for r in results for k, v in r.summary.items() if _is_number(v)))
+    numbers, units = {}, {}
+    for k in keys:
+        numbers[k] = np.array([float(r.summary.get(k, math.nan)) for r in results])
+        units[k] = next((r.summary_units.get(k) for r in results if k in r.summary_units), "1")
+    errors = [result_standard_errors(r) for r in results]
+    for k in SEM_OF.values():
+        numbers[k] = np.array([e[k] for e in errors])
+        units[k] = "N s"
+    notes = []
+    if len(differ) > len(shown) + ("name" in differ):
+        rest = [k for k in differ if k not in shown and k != "name"]
+        notes.append("scenario keys that also differ: " + ", ".join(rest))
+    if not differ:
+        notes.append("scenarios: identical")
+    return Table(names, labels, numbers, units, notes)
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+
+
+def table_of(paths) -> Table:
+    """``bearingsim table`` of ``paths``: one folder or index file (a sweep's or study's ``sweep.h5``),
+    or run archives (one-line UserError otherwise)."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import INDEX_FORMAT
+
+    paths = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
+    if len(paths) == 1 and paths[0].is_dir():
+        index = paths[0] / "sweep.h5"
+        if not index.is_file():
+            raise UserError(f"{paths[0]}: holds no sweep.h5 (not a sweep or study folder); give the folder of a "
+                            f"sweep, cross-check or validate run, or archives")
+        return table_of_index(index)
+    indexes = [p for p in paths if archive.is_table_file(p, INDEX_FORMAT)]
+    if indexes and len(paths) == 1:
+        return table_of_index(paths[0])
+    if indexes:
+        raise UserError(f"{indexes[0]}: a sweep index among archives; give one folder or index, or archives only")
+    for p in paths:
+        if p.is_dir():
+            raise UserError(f"{p}: a folder among files; give one folder, or archives")
+    return table_of_archives(paths)
+
+
+def _bare(key: str) -> str:
+    """A key without its unit suffix (``I_dec_mean_Ns`` -> ``I_dec_mean``)."""
+    from bearingsim.sweeps.index import UNITS
+
+    for suffix, _ in UNITS:
+        if key.endswith(suffix):
+            return key[: -len(suffix)]
+    return key
+
+
+def _column(table: Table, key: str) -> tuple[str, list[str]]:
+    """Header and cells of number column ``key`` (with its standard error and marks when it has one,
+    against the first row that has a number)."""
+    unit = table.units.get(key, "1")
+    scale, shown = SCALED.get(unit, (1.0, unit))
+    head = _bare(key) + ("" if shown == "1" else f" [{shown}]")
+    x = table.numbers[key]
+    finite = np.flatnonzero(np.isfinite(x))
+    ref = int(finite[0]) if finite.size else None
+    se = table.numbers.get(SEM_OF.get(key, ""), None)
+    cells = []
+    for i, v in enumerate(x):
+        if not math.isfinite(v):
+            cells.append("-")
+            continue
+        text = f"{v * scale:.4g}"
+        if se is not None:
+            e = se[i]
+            text += " ± " + (f"{e * scale:.2g}" if math.isfinite(e) else "n/a")
+            mark = None if ref is None or i == ref else significant(v, e, x[ref], se[ref])
+            text += " *" if mark else "  "
+        cells.append(text)
+    return head, cells
+
+
+def format_table(table: Table, columns=None, max_rows: int | None = None) -> str:
+    """The table as aligned text: label columns left-aligned, number columns right-aligned, the rule
+    of the marks below it when a column has standard errors. ``columns``: summary keys to show
+    (default: :data:`DEFAULT_COLUMNS` present); ``max_rows``: at most this many rows (then a line
+    saying how many are left out)."""
+    if columns:
+        missing = [k for k in columns if k not in table.numbers]
+        if missing:
+            raise UserError(f"--columns: {', '.join(missing)}: not a number of these runs (they have: "
+                            f"{', '.join(k for k in table.numbers if not k.endswith('_sem_Ns'))})")
+    keys = list(columns) if columns else [k for k in DEFAULT_COLUMNS if k in table.numbers]
+    n = len(table)
+    heads = [*table.label_names]
+    cols = [table.labels[k] for k in table.label_names]
+    for key in keys:
+        head, cells = _column(table, key)
+        heads.append(head)
+        cols.append(cells)
+    shown = n if max_rows is None else min(n, max_rows)
+    widths = [max([len(h)] + [len(c) for c in col[:shown]]) for h, col in zip(heads, cols)]
+    nlab = len(table.label_names)
+
+    def line(cells):
+        return "  ".join(c.ljust(w) if j < nlab else c.rjust(w) for j, (c, w) in enumerate(zip(cells, widths))).rstrip()
+
+    out = [*table.notes, line(heads)]
+    out += [line([col[i] for col in cols]) for i in range(shown)]
+    if shown < n:
+        out.append(f"... {n - shown} more rows ('bearingsim table' prints them all)")
+    if any(k in SEM_OF for k in keys):
+        out.append(RULE)
+    return "\n".join(out)

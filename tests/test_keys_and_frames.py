@@ -1,0 +1,179 @@
+"""Issue 28, items 9 and 10: results as DataFrames and Datasets (with units), the sweep index as a
+DataFrame; the resolved scenario before a run (``show SCENARIO.toml``, ``run --dry-run``), every key
+with unit, bounds, default and source (``bearingsim keys``), "did you mean" on an unknown key."""
+from __future__ import annotations
+
+import json
+import sys
+import tomllib
+
+import numpy as np
+import pytest
+
+import bearingsim
+from bearingsim.scenario import load_scenario
+
+from .conftest import SCENARIOS
+from .test_cli import assert_user_error, bearingsim as cli
+
+PAPER = SCENARIOS / "paper_3000rpm.toml"
+
+
+def _flat(d, prefix=""):
+    out = {}
+    for k, v in d.items():
+        if isinstance(v, dict):
+            out.update(_flat(v, f"{prefix}{k}."))
+        else:
+            out[f"{prefix}{k}"] = v
+    return out
+
+
+# --- did you mean -----------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("setting, hint", [
+    ("operating.inner_ring_sped_rpm=3000", "did you mean operating.inner_ring_speed_rpm?"),
+    ("numerics.rotation=3", "did you mean numerics.rotations?"),
+    ("bearing.inner_ring_speed_rpm=3000", "did you mean operating.inner_ring_speed_rpm?"),  # wrong section
+    ("operatin.radial_load_N=900", "did you mean operating?"),
+])
+def test_unknown_key_in_set_gets_the_closest_key(tmp_path, setting, hint):
+    res = cli("run", PAPER, "--set", setting, "-o", tmp_path / "r.h5")
+    assert_user_error(res, setting.split("=")[0].split(".")[0], "unknown key", hint)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_unknown_key_in_a_file_gets_the_closest_key_and_nonsense_gets_none(tmp_path):
+    from bearingsim.errors import UserError
+
+    f = tmp_path / "s.toml"
+    f.write_text(PAPER.read_text() + "\n[wear]\nwear_coefficent = 1e-4\n")
+    with pytest.raises(UserError, match=r"wear\.wear_coefficent: unknown key \(did you mean wear\.wear_coefficient\?\)"):
+        load_scenario(f)
+    with pytest.raises(UserError) as exc:
+        load_scenario(PAPER, ["bearing.no_such_key=1"])
+    assert str(exc.value).endswith("bearing.no_such_key: unknown key")
+
+
+# --- keys ---------------------------------------------------------------------------------------------
+
+def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_source():
+    from bearingsim.keys import list_keys
+
+    keys = {k.key: k for k in list_keys()}
+    resolved = _flat(tomllib.loads(load_scenario(SCENARIOS / "multibody_3000rpm.toml").to_toml()))
+    assert set(resolved) <= set(keys), set(resolved) - set(keys)
+    rc = keys["bearing.roller_count"]
+    assert (rc.kind, rc.default) == ("int >= 1", "16") and rc.source.startswith("preset NU214-Suzuki2023: paper")
+    d = keys["bearing.roller_diameter_mm"]
+    assert d.unit == "mm" and d.kind == "float > 0" and "reconstructed" in d.source and "13 g" in d.why
+    assert keys["contact.restitution"].kind == "float >= 0, <= 1"
+    assert keys["multibody.raceway_contact"].kind == '"hertz" | "rigid"'
+    assert keys["numerics.rotations"].default == "5" and keys["numerics.rotations"].source == "package default"
+    assert keys["multibody.scene"].unused_by == ("reduced",)
+
+
+def test_keys_command(tmp_path):
+    res = cli("keys", "numerics.")
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    assert lines[0].split()[:2] == ["key", "unit"] and len(lines) == 5  # header + the 4 numerics keys
+    assert any(ln.startswith("numerics.output_rate_hz") and " Hz " in ln and "20000.0" in ln for ln in lines)
+    why = cli("keys", "pocket_clearance", "--why")
+    assert why.returncode == 0 and "Table 4" in why.stdout  # the reasoning behind the preset's value
+    assert_user_error(cli("keys", "no_such_thing"), "no_such_thing")
+    assert_user_error(cli("keys", "--preset", "nope"), "--preset", "nope")
+
+
+# --- the resolved scenario before a run ------------------------------------------------------------------
+
+def test_show_of_a_scenario_file_is_the_resolved_scenario(tmp_path):
+    res = cli("show", PAPER, "--set", "bearing.roller_count=14")
+    assert res.returncode == 0, res.stderr
+    shown = tomllib.loads(res.stdout)
+    assert shown["bearing"]["roller_count"] == 14 and shown["bearing"]["cage_guidance"] == "rollers"
+    assert "# differs from the preset: 14 rollers" in res.stdout
+    again = tmp_path / "again.toml"
+    again.write_text(res.stdout)
+    assert load_scenario(again).to_toml() == load_scenario(PAPER, ["bearing.roller_count=14"]).to_toml()
+    assert_user_error(cli("show", PAPER, "--set", "bearing.roler_count=14"), "did you mean bearing.roller_count?")
+
+
+def test_run_dry_run_runs_and_writes_nothing(tmp_path):
+    res = cli("run", PAPER, "--dry-run", "--set", "operating.inner_ring_speed_rpm=500", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert tomllib.loads(res.stdout)["operating"]["inner_ring_speed_rpm"] == 500.0
+    assert "would write outputs/paper_3000rpm.h5" in res.stdout and "nothing was run" in res.stdout
+    assert list(tmp_path.iterdir()) == []
+
+
+# --- DataFrames and Datasets --------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def multibody_result():
+    """Rigid raceways (the fast scene), 1 warm-up + 2 rotations at 3000 rpm."""
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml",
+                       ["numerics.rotations=2", 'multibody.raceway_contact="rigid"'])
+    return bearingsim.run(sc)
+
+
+def test_per_rotation_and_impacts_frames_hold_the_arrays_with_units(multibody_result):
+    r = multibody_result
+    per = r.to_dataframe("per_rotation")
+    dec = r.per_rotation["I_dec"]
+    assert per.shape[0] == dec.size and per.index.names == ["rotation", "pocket"]
+    assert per.loc[(1, 5), "I_dec"] == dec[1, 5] and per.attrs["units"]["I_dec"] == "N s"
+    assert per["I_dec"].mean() == pytest.approx(r.summary["I_dec_mean_Ns"], rel=1e-12)
+    imp = r.to_dataframe("impacts")
+    assert len(imp) == len(r.impacts["time_s"]) > 0 and imp.attrs["units"]["approach_speed_m_s"] == "m/s"
+    assert set(imp["face"]) <= {"rear", "front"}
+    named = r.to_dataframe("per_rotation", units_in_names=True)
+    assert "I_dec [N s]" in named.columns
+
+
+def test_observables_frame_and_dataset(multibody_result):
+    r = multibody_result
+    obs = r.to_dataframe("observables")
+    speed = r.series["cage_angular_speed"]
+    assert obs.index.name == "time_s" and np.array_equal(obs["cage_angular_speed"].to_numpy(), speed.value)
+    assert obs.attrs["units"]["cage_centre_x"] == "m" and np.array_equal(obs["cage_centre_y"], r.series["cage_centre"].value[:, 1])
+    ds = r.to_xarray()
+    assert ds["I_dec"].dims == ("rotation", "pocket") and ds["I_dec"].attrs["units"] == "N s"
+    assert ds["impact_theta_deg"].attrs["units"] == "deg" and ds["time"].attrs["units"] == "s"
+    assert ds.attrs["I_dec_mean_Ns"] == r.summary["I_dec_mean_Ns"] and ds.attrs["units_I_dec_mean_Ns"] == "N s"
+    assert load_scenario_text(ds.attrs["scenario_toml"]) == r.scenario.to_toml()
+    assert r.to_dataframe("summary").loc[r.scenario.name, "cage_slip"] == r.summary["cage_slip"]
+    with pytest.raises(ValueError, match="per_rotation, impacts, observables, summary"):
+        r.to_dataframe("everything")
+
+
+def load_scenario_text(text):
+    from bearingsim.sweeps.spec import scenario_from_toml
+
+    return scenario_from_toml(text).to_toml()
+
+
+def test_sweep_index_as_a_dataframe(tmp_path):
+    from bearingsim.sweeps import index_dataframe
+    from bearingsim.sweeps.index import write_index
+
+    rows = [{"case": f"c{i}", "values": {"operating.inner_ring_speed_rpm": s}, "status": "done", "error": "",
+             "archive": f"cases/c{i}.h5", "wall_s": 0.1, "summary": {"I_dec_mean_Ns": 0.005 * (i + 1), "I_dec_sem_Ns": 0.0}}
+            for i, s in enumerate((1000.0, 3000.0))]
+    write_index(tmp_path, rows, ["operating.inner_ring_speed_rpm"],
+                {"mode": "product", "grid": json.dumps(["operating.inner_ring_speed_rpm"]), "grid_rows": 2, "scenario": "x"})
+    df = index_dataframe(tmp_path)
+    assert list(df.index) == ["c0", "c1"] and df.loc["c1", "I_dec_mean_Ns"] == 0.01
+    assert df.loc["c0", "operating.inner_ring_speed_rpm"] == 1000.0 and df.loc["c0", "status"] == "done"
+    assert df.attrs["units"]["operating.inner_ring_speed_rpm"] == "rpm" and df.attrs["axes"] == ["operating.inner_ring_speed_rpm"]
+
+
+def test_without_pandas_a_one_line_hint_names_the_extra(monkeypatch, multibody_result):
+    from bearingsim.frames import MissingExtra
+
+    monkeypatch.setitem(sys.modules, "pandas", None)  # import pandas now raises ImportError
+    monkeypatch.setitem(sys.modules, "xarray", None)
+    with pytest.raises(MissingExtra, match=r"needs pandas.*bearingsim\[frames\]"):
+        multibody_result.to_dataframe()
+    with pytest.raises(MissingExtra, match=r"needs xarray.*bearingsim\[frames\]"):
+        multibody_result.to_xarray()

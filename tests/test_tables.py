@@ -1,0 +1,188 @@
+"""Issue 28, items 5 (one standard error), 7 (progress), 8 (tables, compare of N archives):
+``bearingsim table``, ``bearingsim compare A B C ...``, the table at the end of a sweep, one standard-error
+estimator for sweep, cross-check and table, and the progress bar only on a terminal."""
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+import threading
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+import bearingsim
+from bearingsim import tables
+from bearingsim.stats import batch_sem, impulse_standard_errors
+
+from .conftest import SCENARIOS, started
+from .test_cli import assert_user_error, bearingsim as cli
+
+PAPER = SCENARIOS / "paper_3000rpm.toml"
+
+
+@pytest.fixture(scope="module")
+def reduced_runs(tmp_path_factory):
+    """Three reduced-model archives: a.h5 and b.h5 of the same scenario, c.h5 at restitution 0.6."""
+    d = tmp_path_factory.mktemp("tables")
+    sc = bearingsim.load_scenario(PAPER)
+    bearingsim.run(sc).save(d / "a.h5")
+    bearingsim.run(sc).save(d / "b.h5")
+    bearingsim.run(bearingsim.load_scenario(PAPER, set={"contact.restitution": 0.6})).save(d / "c.h5")
+    return d
+
+
+# --- one standard error -------------------------------------------------------------------------
+
+def _correlated_series(n=20, seed=3):
+    """Per-rotation impulses of 4 pockets with a slow drift across rotations (correlated rotations)."""
+    rng = np.random.default_rng(seed)
+    drift = np.repeat(rng.normal(0.0, 1e-3, n // 4), 4)  # blocks of 4 rotations share an offset
+    return 0.01 + drift[:, None] + rng.normal(0.0, 2e-4, (n, 4))
+
+
+def test_sweep_crosscheck_and_table_give_the_same_standard_error():
+    """Was: the sweep's index divided the per-rotation scatter by sqrt(rotations) (rotations taken as
+    independent) while the cross-check used batch means, so the same archive had two standard errors.
+    Now the worker (sweep), the cross-check's rung numbers and the table call one estimator; on
+    correlated rotations it is the batch-means error, which differs from the naive one."""
+    from bearingsim.studies.crosscheck import rung_numbers
+    from bearingsim.sweeps.worker import standard_errors
+
+    dec, acc = _correlated_series(), _correlated_series(seed=4)
+    result = SimpleNamespace(per_rotation={"I_dec": dec, "I_acc": acc}, scenario=SimpleNamespace(model="multibody"),
+                             summary={"I_dec_mean_Ns": dec.mean(), "I_acc_mean_Ns": acc.mean(),
+                                      "first_impact_speed_m_s": 0.1, "cage_slip": 0.0})
+    sweep = standard_errors(dec, acc, "multibody")
+    cross = rung_numbers(result, reduced=False)
+    from bearingsim.stats import result_standard_errors
+
+    table = result_standard_errors(result)
+    for k in ("I_dec_sem_Ns", "I_acc_sem_Ns"):
+        assert sweep[k] == cross[k] == table[k]
+    naive = dec.mean(axis=1).std(ddof=1) / math.sqrt(len(dec))
+    assert sweep["I_dec_sem_Ns"] == batch_sem(dec.mean(axis=1)) and sweep["I_dec_sem_Ns"] > 1.5 * naive
+
+
+def test_batch_means_error_of_independent_rotations_is_the_plain_one_on_average():
+    """On independent rotations batch means estimate the same error as sd/sqrt(n): over 2000 series of
+    20 rotations the mean ratio is within 5 % of the exact expectation of the 4-degree-of-freedom
+    estimator against the 19-degree one (c4(5)/c4(20) = 0.940/0.987 = 0.952; 5 % is ~5 standard
+    errors of the mean ratio)."""
+    rng = np.random.default_rng(0)
+    ratios = []
+    for _ in range(2000):
+        x = rng.normal(size=20)
+        ratios.append(batch_sem(x) / (x.std(ddof=1) / math.sqrt(20)))
+    assert np.mean(ratios) == pytest.approx(0.9400 / 0.9869, rel=0.05)
+
+
+def test_reduced_model_error_is_zero_and_one_rotation_has_none():
+    one = np.ones((1, 4))
+    assert impulse_standard_errors(one, one, "reduced") == {"I_dec_sem_Ns": 0.0, "I_acc_sem_Ns": 0.0}
+    assert math.isnan(impulse_standard_errors(one, one, "multibody")["I_dec_sem_Ns"])
+
+
+# --- significance marks ---------------------------------------------------------------------------
+
+def test_marks_only_where_the_difference_exceeds_two_standard_errors():
+    t = tables.Table(["run"], {"run": ["ref", "within", "beyond", "no-se"]},
+                     {"I_dec_mean_Ns": np.array([10e-3, 10.5e-3, 11e-3, 20e-3]),
+                      "I_dec_sem_Ns": np.array([0.2e-3, 0.2e-3, 0.2e-3, math.nan])}, {"I_dec_mean_Ns": "N s"})
+    # 2 sqrt(0.2^2 + 0.2^2) = 0.566 mN s: 0.5 is within, 1.0 beyond; no SE: not judged
+    lines = tables.format_table(t).splitlines()
+    rows = {ln.split()[0]: ln for ln in lines[1:5]}
+    assert rows["beyond"].endswith("*") and not rows["within"].endswith("*") and not rows["no-se"].endswith("*")
+    assert not rows["ref"].endswith("*") and "± n/a" in rows["no-se"]
+    assert "I_dec_mean [mN s]" in lines[0] and "11 ± 0.2" in rows["beyond"]
+    assert lines[-1] == tables.RULE
+
+
+# --- the commands -------------------------------------------------------------------------------------
+
+def test_compare_of_three_archives(reduced_runs):
+    d = reduced_runs
+    res = cli("compare", d / "a.h5", d / "b.h5", d / "c.h5")
+    assert res.returncode == 1, res.stderr
+    out = res.stdout
+    assert "contact.restitution: 0.8, 0.8, 0.6" in out and "results: differ from a.h5: c.h5" in out
+    rows = {ln.split()[0]: ln for ln in out.splitlines() if ln.endswith(("*", "  ")) or ".h5 " in ln}
+    assert "*" in rows["c.h5"] and "*" not in rows["b.h5"]  # the reduced model: SE 0, any change is real
+    assert cli("compare", d / "a.h5", d / "b.h5", d / "a.h5").returncode == 0
+    two = cli("compare", d / "a.h5", d / "c.h5")  # two archives: the bit-for-bit comparison as before
+    assert two.returncode == 1 and "contact.restitution: 0.8 -> 0.6" in two.stdout and "differs: per_rotation/I_dec" in two.stdout
+
+
+def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
+    d = reduced_runs
+    res = cli("table", d / "a.h5", d / "c.h5", "--columns", "I_dec_mean_Ns,first_impact_speed_m_s")
+    assert res.returncode == 0, res.stderr
+    head = res.stdout.splitlines()[0]
+    assert head.split()[:2] == ["archive", "contact.restitution"] and "[mN s]" in head and "[m/s]" in head
+    a = bearingsim.load(d / "a.h5")
+    assert f"{a.summary['I_dec_mean_Ns'] * 1e3:.4g} ± 0" in res.stdout
+    assert_user_error(cli("table", d / "a.h5", "--columns", "I_dec_mean"), "--columns", "I_dec_mean")
+    assert_user_error(cli("table", tmp_path), str(tmp_path), "sweep.h5")
+    assert_user_error(cli("table", d / "nope.h5"), "nope.h5")
+
+
+def test_sweep_prints_its_table_and_table_of_the_folder_is_the_same(tmp_path):
+    out = tmp_path / "sw"
+    res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1", "--no-plots")
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    (i,) = [k for k, ln in enumerate(lines) if ln.startswith("operating.inner_ring_speed_rpm")]
+    assert "I_dec_mean [mN s]" in lines[i] and lines[i + 1].startswith("1000 ") and lines[i + 2].startswith("3000 ")
+    table = cli("table", out)
+    assert table.returncode == 0 and lines[i:i + 4] == table.stdout.splitlines()[1:5]
+    quiet = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1",
+                "--no-plots", "-q")
+    assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+
+
+# --- progress only on a terminal ------------------------------------------------------------------
+
+def _validate_on_a_terminal(tmp_path, *extra):
+    """``bearingsim validate --rig-rotations 0`` (36 reduced cases) with stderr on a pseudo-terminal:
+    (exit code, what the terminal got, stdout)."""
+    import pty
+
+    master, slave = pty.openpty()
+    got = []
+
+    def read():
+        while True:
+            try:
+                chunk = os.read(master, 4096)
+            except OSError:
+                return
+            if not chunk:
+                return
+            got.append(chunk)
+
+    cmd = [sys.executable, "-m", "bearingsim", "validate", "--rig-rotations", "0", "-j", "1",
+           "-o", str(tmp_path / "v"), *extra]
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    with started(cmd, stdout=subprocess.PIPE, stderr=slave, text=True) as proc:
+        os.close(slave)
+        out, _ = proc.communicate(timeout=600)
+    reader.join(timeout=10)
+    os.close(master)
+    return proc.returncode, b"".join(got).decode("utf-8", "replace"), out
+
+
+def test_validate_shows_progress_on_a_terminal_and_not_with_q(tmp_path):
+    rc, term, out = _validate_on_a_terminal(tmp_path)
+    assert rc == 0 and "fig9" in term and "36/36" in term and "case" in term, term
+    assert "wrote" in out
+    rc, term, out = _validate_on_a_terminal(tmp_path, "-q")
+    assert rc == 0 and term == "" and out == "", (term, out)
+
+
+def test_no_progress_text_when_stderr_is_not_a_terminal(tmp_path):
+    res = cli("validate", "--rig-rotations", "0", "-j", "1", "-o", tmp_path / "v")
+    assert res.returncode == 0, res.stderr
+    assert "\r" not in res.stderr and "case/s" not in res.stderr and "%|" not in res.stderr, res.stderr

@@ -34,7 +34,8 @@ class KeyInfo:
     """One scenario key: ``key`` (dotted), ``unit``, ``kind`` (type and bounds as text), ``default`` (the
     value a scenario gets when it does not set the key, as TOML text, or ``"(required)"``), ``source``
     (where that value comes from), ``why`` (the preset's reference or reasoning, may be empty),
-    ``unused_by`` (models that read nothing of the key)."""
+    ``unused_by`` (models that read nothing of the key), ``plausible`` (the preset's plausible range of
+    an uncertain value, ``"lo..hi"``, or empty: :mod:`bearingsim.ranges`)."""
 
     key: str
     unit: str
@@ -43,6 +44,7 @@ class KeyInfo:
     source: str
     why: str
     unused_by: tuple[str, ...]
+    plausible: str = ""
 
 
 def _kind(field) -> str:
@@ -113,6 +115,7 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
     if extra:
         kind = kind.replace("float", f"float {extra}", 1)
     why = ""
+    plausible = ""
     if section and name in preset_values.get(section, {}):
         default = _toml_value(preset_values[section][name])
         src = sources.get(section, {}).get(name, {}) if isinstance(sources.get(section), dict) else {}
@@ -120,6 +123,8 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
         short = where if len(where) <= WHERE_CHARS else where[:WHERE_CHARS - 1].rstrip() + "..."
         source = f"preset {preset}: {src.get('kind', 'no source entry')}" + (f" ({short})" if short else "")
         why = src.get("reason", "") or (where if short != where else "")
+        if isinstance(src.get("range"), list) and len(src["range"]) == 2:
+            plausible = f"{src['range'][0]:g}..{src['range'][1]:g}"
     elif section and name in defaults.get(section, {}):
         default = _toml_value(defaults[section][name])
         source = "package default" + (f": {DEFAULT_SOURCES[key]}" if key in DEFAULT_SOURCES else "")
@@ -135,7 +140,9 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
         default, source = "(none)", "a file in bearingsim/params"
     models = tuple(m for m, prefixes in unused.items()
                    if any(key == p or (p.endswith(".") and key.startswith(p)) for p in prefixes))
-    return KeyInfo(key, unit_of(key) if section else "1", kind, default, source, why, models)
+    if key == "ranges":
+        default, source = "the preset's", "plausible ranges of uncertain keys: [ranges.<section>.<key>] range, reason"
+    return KeyInfo(key, unit_of(key) if section else "1", kind, default, source, why, models, plausible)
 
 
 def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
@@ -144,7 +151,8 @@ def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = Fal
     rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
     head = ("key", "unit", "type and bounds", "default", "source")
     cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,
-              k.source + (f"; not used by the {', '.join(k.unused_by)} model" if k.unused_by else ""))
+              k.source + (f"; plausible {k.plausible}" if k.plausible else "")
+              + (f"; not used by the {', '.join(k.unused_by)} model" if k.unused_by else ""))
              for k in rows]
     widths = [max([len(h)] + [len(c[j]) for c in cells]) for j, h in enumerate(head[:-1])]
     lines = ["  ".join(h.ljust(w) for h, w in zip(head[:-1], widths)) + "  " + head[-1]]

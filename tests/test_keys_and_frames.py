@@ -62,7 +62,9 @@ def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_s
 
     keys = {k.key: k for k in list_keys()}
     resolved = _flat(tomllib.loads(load_scenario(SCENARIOS / "multibody_3000rpm.toml").to_toml()))
+    resolved = {"ranges" if k.startswith("ranges.") else k for k in resolved}  # one entry: the ranges table
     assert set(resolved) <= set(keys), set(resolved) - set(keys)
+    assert keys["bearing.pocket_clearance_mm"].plausible == "0.16..0.24"  # the preset's range, shown
     rc = keys["bearing.roller_count"]
     assert (rc.kind, rc.default) == ("int >= 1", "16") and rc.source.startswith("preset NU214-Suzuki2023: paper")
     d = keys["bearing.roller_diameter_mm"]

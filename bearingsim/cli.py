@@ -85,6 +85,32 @@ def _describe_index(path) -> tuple[str, str | None] | None:
                  "speeds [rpm]: " + ", ".join(f"{v:g}" for v in sorted(set(cols["rpm"].tolist())))]
         return archive.describe_table(path, "bearingsim cross-check table (one row per rung and speed)", cols,
                                       columns, lines), meta.get("scenario")
+    return _describe_study_table(path)
+
+
+def _describe_study_table(path) -> tuple[str, str | None] | None:
+    """The sensitivity, uncertainty and life tables (``sensitivity.h5``, ``uncertainty.h5``, ``life.h5``):
+    what each is, its columns, and the scenario it was made from."""
+    import json
+
+    from bearingsim import archive
+    from bearingsim.studies import life, sensitivity, uncertainty
+
+    kinds = ((sensitivity.INDEX_FORMAT, "bearingsim sensitivity table (one row per key and quantity)"),
+             (uncertainty.INDEX_FORMAT, "bearingsim uncertainty table (Sobol indices, one row per key and quantity)"),
+             (life.LIFE_FORMAT, "bearingsim life history (one row per stage)"))
+    for fmt, what in kinds:
+        if archive.is_table_file(path, fmt):
+            cols, meta = archive.read_table_file(path, fmt)
+            columns = json.loads(meta["columns"]) if "columns" in meta else list(cols)
+            name = meta.get("scenario_name")
+            if name is None and meta.get("scenario"):
+                import tomllib
+
+                name = tomllib.loads(meta["scenario"]).get("name")
+            lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
+            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages") if k in meta]
+            return archive.describe_table(path, what, cols, columns, lines), meta.get("scenario")
     return None
 
 

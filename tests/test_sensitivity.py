@@ -139,3 +139,29 @@ def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "ranges.contact.restitution" in err and "1.2" in err and "less than or equal to 1" in err
+
+
+def test_inspect_and_show_read_the_study_tables(tmp_path, capsys):
+    """`inspect` names what a sensitivity.h5 or uncertainty.h5 is and lists its columns; `show` gives the
+    scenario it was made from as runnable TOML (as for sweep.h5 and crosscheck.h5)."""
+    from bearingsim.studies.uncertainty import run_uncertainty
+
+    sc = load_scenario(REDUCED)
+    sens.run_sensitivity(sc, tmp_path / "s", KEYS[:1], 0.1)
+    run_uncertainty(sc, tmp_path / "u", samples=4, seed=0, keys=KEYS)
+    for path, what in ((tmp_path / "s" / "sensitivity.h5", "sensitivity table"),
+                       (tmp_path / "u" / "uncertainty.h5", "uncertainty table")):
+        assert main(["inspect", str(path)]) == 0
+        text = capsys.readouterr().out
+        assert what in text and "paper_6000rpm" in text and "columns:" in text
+        assert main(["show", str(path)]) == 0
+        shown = capsys.readouterr().out
+        assert load_scenario_text(shown) == sc
+
+
+def load_scenario_text(text):
+    import tomllib
+
+    from bearingsim.scenario import resolve
+
+    return resolve(tomllib.loads(text), "shown")

@@ -14,6 +14,8 @@ from bearingsim.multibody.scene import pocket_angles
 from bearingsim.reduced.core import FACE_FRONT, FACE_REAR
 from bearingsim.scenario import load_scenario
 
+from .conftest import SCENARIOS
+
 N = 4
 IDS = np.array([10, 11, 12, 13, 20], dtype=np.uint64)
 RP = 0.04875  # pocket centres' radius [m]
@@ -90,7 +92,7 @@ def test_contacts_past_the_faces_ends_count_in_the_end_bins():
 def fast_run(tmp_path_factory):
     from bearingsim.simulation import load, run_scenario
 
-    sc = load_scenario("scenarios/wear_test_6000rpm.toml", ["numerics.rotations=2", "multibody.raceway_contact=rigid"])
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["numerics.rotations=2", "multibody.raceway_contact=rigid"])
     path = tmp_path_factory.mktemp("wear") / "w.h5"
     run_scenario(sc, path, figures=False, notes=False)
     return load(path), path
@@ -175,7 +177,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
     again reuses every stage's archive and gives the same history bit for bit."""
     from bearingsim.studies.life import parse_limit, run_life
 
-    sc = load_scenario("scenarios/wear_test_6000rpm.toml", ["multibody.raceway_contact=rigid"])
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
     lim = parse_limit("clearance=0.203mm")
     cols = run_life(sc, tmp_path, lim, stages=3, rotations=1)
     assert np.all(np.diff(cols["pocket_clearance_mm"]) > 0) and np.all(np.diff(cols["hours_end"]) > 0)
@@ -189,14 +191,19 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
             np.testing.assert_array_equal(again[k], cols[k])
     with pytest.raises(UserError, match="another scenario or limit"):
         run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1)
+    from bearingsim.cli import main
+
+    assert main(["inspect", str(tmp_path / "life.h5")]) == 0  # bearingsim's own table file: described
+    text = capsys.readouterr().out
+    assert "life history" in text and "wear_test_6000rpm" in text and "limit: clearance=0.203mm" in text
 
 
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     from bearingsim.cli import main
 
-    code = main(["life", "scenarios/wear_test_6000rpm.toml", "--limit", "depth=1furlong", "-o", str(tmp_path)])
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "depth=1furlong", "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and "--limit" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
-    code = main(["life", "scenarios/paper_6000rpm.toml", "--limit", "depth=0.1mm", "-o", str(tmp_path)])
+    code = main(["life", str(SCENARIOS / "paper_6000rpm.toml"), "--limit", "depth=0.1mm", "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and "multibody" in err and len(err.strip().splitlines()) == 1

@@ -790,6 +790,11 @@ def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
 
 
 # --- docs/reliability.md -------------------------------------------------------------------------------
+#: the heading of the hand-written part of docs/reliability.md (classes tested by other functions), which
+#: :func:`write_doc` keeps below the generated table
+KEPT_SECTION = "## Classes tested outside this table"
+
+
 def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
     """Run every case (and the two signals) and write the table of input, expected and observed."""
     import tempfile
@@ -859,7 +864,9 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
               "`bearingsim/plausibility.py` (the Palmgren displacement bound, "
               "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
               "refused above)."]
-    path.write_text("\n".join(lines) + "\n")
+    kept = path.read_text() if path.is_file() else ""
+    tail = kept[kept.index(KEPT_SECTION):] if KEPT_SECTION in kept else ""  # written by hand: kept as it is
+    path.write_text("\n".join(lines) + "\n" + ("\n" + tail if tail else ""))
     print(f"wrote {path}")
 
 

@@ -44,7 +44,7 @@ def _cmd_run(args) -> int:
     if not args.quiet:
         from bearingsim.scenario import given_keys, unused_note
 
-        note = unused_note(scenario.model, given_keys(args.scenario, args.set))
+        note = unused_note(scenario.model, given_keys(args.scenario, args.set), scenario.reduced.method)
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     progress = not args.quiet and sys.stderr.isatty()

@@ -11,3 +11,13 @@ class SimulationUnstable(Exception):
     """A run diverged (non-finite state, penetration or energy growth). Never written as a result."""
 
     exit_code = 3
+
+
+class PlausibilityWarning(UserWarning):
+    """A run that is plausible but not clean (:func:`bearingsim.plausibility.check`): its result and
+    archive stand, and the message says what to know about them."""
+
+
+class SlowLoopWarning(UserWarning):
+    """The multibody model's compiled step loop cannot run with the installed pymunk: the plain loop
+    runs instead (the same numbers, several times slower). Issued once per process."""

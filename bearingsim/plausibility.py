@@ -38,6 +38,10 @@ NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converg
 # rotations of more than this fraction of the mean cage speed is a trend (a cage still accelerating
 # or decelerating): the run's means describe a transient, which a note says.
 MAX_CAGE_SPEED_DRIFT = 0.2
+# A mean cage speed above this multiple of the epicyclic speed (Eq. 11; a roller-guided cage slips
+# behind it, never ahead by much) is a cage driven by something other than rolling: the advice for too
+# few samples then names the traction and drag keys, not the output rate.
+OVERSPEED_FACTOR = 1.5
 
 
 def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
@@ -93,24 +97,23 @@ def check(result) -> list[str]:
             advice = ("the no-load pass has no rear-face impact; reduced.load_zone_half_angle_deg "
                       f"= {summary.get('load_zone_half_angle_deg', float('nan')):.4g} deg leaves too short a pass")
         else:
-            advice = _advice(p)
+            advice = _advice(result)
         raise SimulationUnstable(f"non-finite result ({', '.join(sorted(bad))}); {advice}")
     for name in ("I_dec", "I_acc"):
         arr = np.asarray(result.per_rotation.get(name, np.zeros(0)))
         if arr.size and not np.all(np.isfinite(arr)):
-            raise SimulationUnstable(f"non-finite {name} per rotation; {_advice(p)}")
+            raise SimulationUnstable(f"non-finite {name} per rotation; {_advice(result)}")
     if p.model == "multibody":
         disp = abs(float(summary.get("inner_ring_displacement_m", 0.0)))
         limit = max_ring_displacement_m(p)
         if disp > limit:
             raise SimulationUnstable(
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
-                f"for this load and clearance; {_advice(p)}")
+                f"for this load and clearance; {_advice(result)}")
         orbit = result.get("cage_orbit")
         samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
         if samples < MIN_ORBIT_SAMPLES:
-            raise SimulationUnstable(
-                f"{samples} time-series samples recorded; raise numerics.output_rate_hz or numerics.rotations")
+            raise SimulationUnstable(f"{samples} time-series samples recorded; {_few_samples_advice(result)}")
         drift = cage_speed_drift(result)
         if drift is not None:
             notes.append(drift)
@@ -142,10 +145,76 @@ def cage_speed_drift(result) -> str | None:
             f"multibody.traction_mu_max and lubrication.drag_coefficient)")
 
 
-def _advice(p) -> str:
-    if p.model == "multibody" and p.multibody.inner_ring != "quasi_static":
+def _advice(result) -> str:
+    """What to change after a run that is not a result: the key that most likely caused it, judged
+    from what the run did (a step the user gave that is longer than the automatic one, the inner ring
+    the run actually had, the cage guidance), not from the scenario's words ("auto")."""
+    p = result.parameters
+    step = _given_step_advice(result)
+    if step:
+        return step
+    if p.model == "multibody" and str(result.provenance.get("inner_ring", "")).startswith("dynamic"):
         return ("check multibody.inner_ring_mass_kg and operating.radial_load_N, or set "
                 "multibody.inner_ring=quasi_static, or a smaller numerics.dt_s")
     if p.model == "multibody":
-        return "check operating.radial_load_N and operating.inner_ring_speed_rpm, or set a smaller numerics.dt_s"
+        land = (", bearing.cage_land_clearance_mm and contact.land_friction (the land-guided cage)"
+                if p.bearing.cage_guidance != "rollers" and p.multibody.scene == "full" else "")
+        return (f"check operating.radial_load_N and operating.inner_ring_speed_rpm{land}, or set a smaller "
+                "numerics.dt_s")
     return "check bearing.roller_mass_kg, lubrication.drag_coefficient and reduced.load_zone_half_angle_deg"
+
+
+def automatic_dt(p) -> float | None:
+    """The step [s] the model would choose for the SI parameters ``p`` without ``numerics.dt_s``
+    (None: the reduced model's event method, which has no step)."""
+    import dataclasses
+
+    q = dataclasses.replace(p, numerics=dataclasses.replace(p.numerics, dt=None))
+    if p.model == "multibody":
+        from bearingsim.multibody.core import choose_dt
+
+        return float(choose_dt(q)[0])
+    if p.reduced.method == "euler":
+        from bearingsim.reduced.core import PassInputs
+        from bearingsim.reduced.euler import default_dt
+
+        return float(default_dt(PassInputs.from_parameters(q)))
+    return None
+
+
+def _given_step_advice(result) -> str | None:
+    """Advice naming ``numerics.dt_s`` when the run used a step the user gave that is longer than the
+    automatic step (None otherwise: then the step is not the first suspect)."""
+    how = str(result.provenance.get("dt_choice", ""))
+    dt = result.provenance.get("dt_s")
+    if not how.startswith(("numerics.dt_s", "simulate(dt=")) or dt is None or not math.isfinite(float(dt)):
+        return None
+    try:
+        auto = automatic_dt(result.parameters)
+    except Exception:  # noqa: BLE001 - advice only: a step the model cannot choose is no comparison
+        return None
+    if auto is None or not float(dt) > auto:
+        return None
+    return (f"the given step numerics.dt_s = {float(dt):.3g} s is {float(dt) / auto:.3g} times the automatic "
+            f"{auto:.3g} s: remove numerics.dt_s or set a smaller one")
+
+
+def _few_samples_advice(result) -> str:
+    """Why a multibody run recorded too few cage-orbit samples, and the key to change: a step longer
+    than the sampling interval (one sample per step at most), a cage that turned its recorded rotations
+    much faster than its epicyclic speed (traction or drag, not the output rate), or the output rate
+    and the run length themselves."""
+    p = result.parameters
+    rate = p.numerics.output_rate
+    dt = float(result.provenance.get("dt_s", float("nan")))
+    if math.isfinite(dt) and dt * rate > 1.0:
+        step = _given_step_advice(result)
+        return step or (f"the step {dt:.3g} s is longer than the sampling interval 1/numerics.output_rate_hz = "
+                        f"{1.0 / rate:.3g} s; set a smaller numerics.dt_s")
+    speed = abs(float(result.summary.get("cage_speed_mean_rad_s", float("nan"))))
+    nominal = p.operating.omega_c
+    if math.isfinite(speed) and speed > OVERSPEED_FACTOR * nominal:
+        return (f"the cage turned at {speed:.4g} rad/s, {speed / nominal:.3g} times its epicyclic speed "
+                f"{nominal:.4g} rad/s (Eq. 11), so its recorded rotations took little time: check "
+                "multibody.traction_mu_max, multibody.traction_slip_ref and lubrication.drag_coefficient")
+    return "raise numerics.output_rate_hz or numerics.rotations"

@@ -1,15 +1,33 @@
-"""Matplotlib set up for files, not screens (the Agg backend: no display needed), and the house style
-of report figures: units as engineers read them (µm, mN s, µm³/h), legends outside the data."""
+"""Figures for files, not screens, and the house style of report figures: units as engineers read
+them (µm, mN s, µm³/h), legends outside the data.
+
+Each figure is a :class:`matplotlib.figure.Figure` with its own Agg canvas (no display needed), made
+without pyplot: the library never switches the user's matplotlib backend nor adds figures to pyplot's
+list (a notebook or a GUI application that imports bearingsim keeps its backend; a figure returned by
+``Result.figures()`` is shown there as any figure is).
+"""
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+__all__ = ["figure", "subplots", "save_figure", "legend_outside"]
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
 
-__all__ = ["plt", "save_figure", "legend_outside"]
+def figure(**kw):
+    """A new :class:`matplotlib.figure.Figure` (``kw`` as for it) drawn by its own Agg canvas."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(**kw)
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, constrained_layout: bool = False, **kw):
+    """``(figure, axes)`` as :func:`matplotlib.pyplot.subplots` returns them, without pyplot
+    (``kw``: ``sharex``, ``sharey``, ``squeeze``, ... of :meth:`matplotlib.figure.Figure.subplots`)."""
+    fig = figure(figsize=figsize, layout="constrained" if constrained_layout else None)
+    return fig, fig.subplots(nrows, ncols, **kw)
 
 
 def legend_outside(ax, **kw) -> None:
@@ -18,28 +36,26 @@ def legend_outside(ax, **kw) -> None:
 
 
 def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
-    """Lay out, write and close one report figure; return its path.
+    """Lay out and write one report figure; return its path. (The figure is in no pyplot list: there
+    is nothing to close; its memory goes with its last reference.)
 
     Written atomically (:func:`bearingsim.outputs.atomic_file`); an existing ``path`` that is not a PNG
     file (a symbolic link, a directory, a user's file) is refused with a one-line error and kept
     (:func:`bearingsim.outputs.check_replaceable`). ``tight``: ``tight_layout`` and a bounding box
     that keeps a legend placed outside the axes.
     """
-    from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
-
     import warnings
 
+    from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
+
     path = Path(path)
-    try:
-        check_replaceable(path, PNG_SIGNATURE, "figure")
-        with warnings.catch_warnings():
-            # a scenario name in a script the font lacks (CJK with DejaVu Sans) is drawn as boxes; matplotlib
-            # would also warn once per glyph and layout pass, dozens of lines for one name
-            warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from (current )?font", category=UserWarning)
-            if tight:
-                fig.tight_layout()
-            with atomic_file(path) as fh:
-                fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
-    finally:
-        plt.close(fig)
+    check_replaceable(path, PNG_SIGNATURE, "figure")
+    with warnings.catch_warnings():
+        # a scenario name in a script the font lacks (CJK with DejaVu Sans) is drawn as boxes; matplotlib
+        # would also warn once per glyph and layout pass, dozens of lines for one name
+        warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from (current )?font", category=UserWarning)
+        if tight:
+            fig.tight_layout()
+        with atomic_file(path) as fh:
+            fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
     return path

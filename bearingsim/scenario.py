@@ -126,6 +126,18 @@ MAX_WEAR_COEFFICIENT = 0.1
 # beyond it the rings no longer hold the rollers (the load zone shrinks to one roller) and the models'
 # contact laws and steps are not made for it.
 MAX_RADIAL_CLEARANCE_TO_ROLLER = 0.05
+# Fewest rollers: an inner ring under a radial load, and a cage, are held in the plane by at least
+# three rollers (two leave a free direction); no rolling bearing has fewer, and both models describe
+# a whole bearing's load zone and cage (the reduced model's load-zone rule and cage speed included).
+MIN_ROLLER_COUNT = 3
+# Narrowest cage bar between two adjacent pockets, as a fraction of the roller diameter. Both models
+# take the cage as rigid; the bar carries the roller impacts. The narrowest gap between two circular
+# pockets of diameter D + s whose centres lie 2 r_p sin(pi/Z) apart on the pitch circle is that chord
+# minus D + s. The NU214 cage's bars are 5.9 mm there (45 % of its 13 mm rollers), those of the
+# 30-roller case of scenarios/hard 2.0 mm (25 %); a bar below a tenth of the roller it separates
+# (1.3 mm for 13 mm rollers) is a foil, not a rigid cage bar, and no cage is made that thin (a
+# judgement: bearing catalogues give no minimum).
+MIN_CAGE_BAR_TO_ROLLER = 0.1
 
 
 class _Section(BaseModel):
@@ -626,17 +638,18 @@ _TITLE_SKIP_MODEL = {
     "multibody": ("reduced.",),
 }
 # keys a model reads nothing of (set in a scenario of that model they change nothing): the reduced model
-# has no multibody scene, no cage rim and no lands. (The multibody model reads reduced.* in its
-# reduced-equivalent scene, so nothing is listed for it.)
+# has no multibody scene, no cage rim and no lands, and solves one pass per rotation (no warm-up, no time
+# series). (The multibody model reads reduced.* in its reduced-equivalent scene, so nothing is listed for it.)
 UNUSED_BY_MODEL = {
     "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
-                "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction"),
+                "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction",
+                "numerics.warmup_rotations", "numerics.output_rate_hz"),
 }
+# keys the reduced model's method reads nothing of: the event method is event-driven (no time step)
+UNUSED_BY_METHOD = {"event": ("numerics.dt_s",)}
 
 
-def unused_keys(model: str, keys) -> list[str]:
-    """The keys among ``keys`` (dotted) that ``model`` does not use, in order, each once."""
-    prefixes = UNUSED_BY_MODEL.get(model, ())
+def _matching(keys, prefixes) -> list[str]:
     out = []
     for k in keys:
         if k not in out and any(k == p or (p.endswith(".") and k.startswith(p)) for p in prefixes):
@@ -644,12 +657,27 @@ def unused_keys(model: str, keys) -> list[str]:
     return out
 
 
-def unused_note(model: str, keys) -> str | None:
-    """One line saying which of ``keys`` have no effect in ``model`` (None if all are used)."""
-    unused = unused_keys(model, keys)
-    if not unused:
-        return None
-    return f"{', '.join(unused)}: not used by the {model} model (no effect on the run)"
+def unused_keys(model: str, keys, method: str | None = None) -> list[str]:
+    """The keys among ``keys`` (dotted) that ``model`` does not use (with the reduced model's
+    ``method``, if given), in order, each once."""
+    out = _matching(keys, UNUSED_BY_MODEL.get(model, ()))
+    if model == "reduced":
+        out += [k for k in _matching(keys, UNUSED_BY_METHOD.get(method, ())) if k not in out]
+    return out
+
+
+def unused_note(model: str, keys, method: str | None = None) -> str | None:
+    """One line saying which of ``keys`` have no effect in ``model`` (and the reduced model's
+    ``method``, if given); None if all are used."""
+    by_model = _matching(keys, UNUSED_BY_MODEL.get(model, ()))
+    by_method = [k for k in unused_keys(model, keys, method) if k not in by_model]
+    parts = []
+    if by_model:
+        parts.append(f"{', '.join(by_model)}: not used by the {model} model (no effect on the run)")
+    if by_method:
+        parts.append(f"{', '.join(by_method)}: not used by reduced.method = {method!r} (event-driven, no time step; "
+                     f"no effect on the run)")
+    return "; ".join(parts) or None
 
 
 def given_keys(path, overrides=()) -> list[str]:
@@ -784,13 +812,14 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
 
 
 def check_run_request(scenario: "Scenario") -> None:
-    """Checks for a ``bearingsim run`` from the command line, beyond what the schema allows.
+    """Checks for a run asked for results (``bearingsim.run``, and so ``bearingsim run``, ``rerun``,
+    every case of a ``sweep`` and of a study), beyond what the schema allows.
 
     ``numerics.warmup_rotations = 0`` with the multibody model: every pocket's first window then
     starts from the assembled state, and the means over rotations are biased (issue 14 measured the
-    mean I_dec of the reduced-equivalent scene 21 % low). The Python API still accepts it, because a
-    stability scan (``benchmarks.stability`` of a source checkout) and the robustness tests want exactly one
-    rotation from the start state; a user asking the CLI for results is refused.
+    mean I_dec of the reduced-equivalent scene 21 % low). A stability scan (``benchmarks.stability`` of a
+    source checkout) and the kernel tests, which want exactly one rotation from the start state, call
+    the model's own ``simulate(parameters)``, below this check.
     """
     if scenario.model == "multibody" and scenario.numerics.warmup_rotations < 1:
         raise UserError(f"{scenario.source}: numerics.warmup_rotations: 0 with the multibody model averages "
@@ -875,26 +904,17 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
             f"{source}: bearing.roller_diameter_mm: {b.roller_diameter_mm} mm must be smaller than "
             f"the pitch diameter {b.pitch_diameter_mm} mm"
         )
-    pocket = b.roller_diameter_mm + b.pocket_clearance_mm
-    if b.roller_count >= 2:
-        chord = b.pitch_diameter_mm * math.sin(math.pi / b.roller_count)
-        if pocket >= chord:
-            most = max(int(math.pi / math.asin(min(1.0, pocket / b.pitch_diameter_mm))), 0)
-            raise UserError(
-                f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm (bearing.roller_diameter_mm "
-                f"+ bearing.pocket_clearance_mm) do not fit "
-                f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart; "
-                f"at most {most} fit)"
-            )
+    if b.roller_count < MIN_ROLLER_COUNT:
+        raise UserError(
+            f"{source}: bearing.roller_count: {b.roller_count} is too few; a bearing needs at least "
+            f"{MIN_ROLLER_COUNT} rollers to hold its inner ring and its cage (both models describe a whole bearing)"
+        )
     if b.pocket_clearance_mm >= b.roller_diameter_mm:
         raise UserError(
             f"{source}: bearing.pocket_clearance_mm: {b.pocket_clearance_mm} mm is not smaller than the "
             f"roller diameter {b.roller_diameter_mm} mm"
         )
-    if m.model == "multibody" and b.roller_count < 3:
-        raise UserError(
-            f"{source}: bearing.roller_count: the multibody model needs at least 3 rollers to hold the cage"
-        )
+    _check_cage_bars(b, source)
     flat = m.multibody.flat_pockets
     bad = [i for i in flat if not 0 <= i < b.roller_count]
     if bad:
@@ -902,6 +922,7 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
                         f"(pockets 0..{b.roller_count - 1}, bearing.roller_count = {b.roller_count})")
     if len(set(flat)) != len(flat):
         raise UserError(f"{source}: multibody.flat_pockets: a pocket is listed twice ({flat})")
+    _check_cage_wall(m, source)
     land = b.cage_guidance != "rollers"
     if land:
         _check_land(m, source)
@@ -918,6 +939,53 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")
 
 
+def _most_pockets(width_mm: float, pitch_mm: float) -> int:
+    """Most pockets whose centres are at least ``width_mm`` apart (chord) on a ``pitch_mm`` circle."""
+    return max(int(math.pi / math.asin(min(1.0, width_mm / pitch_mm))), 0)
+
+
+def _check_cage_bars(b: "BearingSection", source: str) -> None:
+    """The pockets fit on the pitch circle with a cage bar between each two of at least
+    :data:`MIN_CAGE_BAR_TO_ROLLER` of the roller diameter (adjacent pocket centres are the chord
+    2 r_p sin(pi/Z) apart; the bar is that chord minus the pocket width D + s)."""
+    pocket = b.roller_diameter_mm + b.pocket_clearance_mm
+    chord = b.pitch_diameter_mm * math.sin(math.pi / b.roller_count)
+    keys = "bearing.roller_diameter_mm + bearing.pocket_clearance_mm"
+    if pocket >= chord:
+        raise UserError(
+            f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) do not fit "
+            f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart; "
+            f"at most {_most_pockets(pocket, b.pitch_diameter_mm)} fit)")
+    least = MIN_CAGE_BAR_TO_ROLLER * b.roller_diameter_mm
+    if chord - pocket < least:
+        raise UserError(
+            f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) on a "
+            f"{b.pitch_diameter_mm} mm pitch circle leave cage bars of {chord - pocket:.3g} mm between them, less "
+            f"than {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter ({least:.3g} mm): not a rigid cage; at most "
+            f"{_most_pockets(pocket + least, b.pitch_diameter_mm)} rollers")
+
+
+def _check_cage_wall(m: ScenarioModel, source: str) -> None:
+    """The cage's given diameters: its bore smaller than its outside diameter (every model: the cage
+    inertia check reads them); where the cage wall is used (the multibody model, a land-guided cage)
+    the wall straddles the pitch circle and clears both raceways (diameters D_pw - D and D_pw + D)."""
+    b = m.bearing
+    bore, rim = b.cage_inner_diameter_mm, b.cage_outer_diameter_mm
+    if bore is not None and rim is not None and not bore < rim:
+        raise UserError(f"{source}: bearing.cage_inner_diameter_mm: the cage bore {bore:g} mm must be smaller than "
+                        f"its outside diameter bearing.cage_outer_diameter_mm = {rim:g} mm")
+    if m.model != "multibody" and b.cage_guidance == "rollers":
+        return  # the reduced model has no cage wall (UNUSED_BY_MODEL)
+    pitch, d = b.pitch_diameter_mm, b.roller_diameter_mm
+    wall = "(the cage wall holds the pockets around the pitch circle, between the raceways)"
+    if bore is not None and not pitch - d < bore < pitch:
+        raise UserError(f"{source}: bearing.cage_inner_diameter_mm: the cage bore {bore:g} mm must lie between the inner raceway "
+                        f"diameter {pitch - d:g} mm and the pitch diameter {pitch:g} mm {wall}")
+    if rim is not None and not pitch < rim < pitch + d:
+        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage's outside diameter {rim:g} mm must lie between the pitch diameter "
+                        f"{pitch:g} mm and the outer raceway diameter {pitch + d:g} mm {wall}")
+
+
 def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
     """The arc pocket faces fit the cage wall: "auto" needs the cage's diameters and a wall that holds
     the pocket centre; a given half angle may not reach past the wall (bearingsim.laws.pocket_face_extent)."""
@@ -931,10 +999,6 @@ def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
                             f"(multibody.pocket_face_half_angle_deg = 'auto'): give the cage's diameters or a "
                             f"half angle")
         return
-    if not wall[0] < b.pitch_diameter_mm < wall[1]:
-        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage ({wall[0]:g}..{wall[1]:g} mm, "
-                        f"bearing.cage_inner_diameter_mm..cage_outer_diameter_mm) must straddle the pitch "
-                        f"diameter {b.pitch_diameter_mm:g} mm")
     lo, hi = laws.pocket_face_extent(0.5e-3 * b.pitch_diameter_mm, 0.5e-3 * (b.roller_diameter_mm + b.pocket_clearance_mm),
                                      0.5e-3 * wall[0], 0.5e-3 * wall[1])
     a = mb.pocket_face_half_angle_deg
@@ -955,10 +1019,6 @@ def _check_land(m: ScenarioModel, source: str) -> None:
             raise UserError(f"{source}: bearing.{key}: missing; bearing.cage_guidance = {b.cage_guidance!r} needs it "
                             f"(set it in the scenario or name a [bearing] preset that has it)")
     od, idia, c = b.cage_outer_diameter_mm, b.cage_inner_diameter_mm, b.cage_land_clearance_mm
-    if not idia < b.pitch_diameter_mm < od:
-        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage ({idia:g}..{od:g} mm, "
-                        f"bearing.cage_inner_diameter_mm..cage_outer_diameter_mm) must straddle the pitch "
-                        f"diameter {b.pitch_diameter_mm:g} mm")
     if b.cage_guidance == "outer_land" and od + c >= b.pitch_diameter_mm + b.roller_diameter_mm:
         raise UserError(f"{source}: bearing.cage_land_clearance_mm: the outer land bore, cage OD + c_L = "
                         f"{od + c:g} mm, must be smaller than the outer raceway diameter "

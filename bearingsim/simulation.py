@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.parameters import Parameters
-from bearingsim.scenario import Scenario
+from bearingsim.scenario import Scenario, check_run_request
 
 
 #: the models, by the name a scenario and an archive give
@@ -65,7 +65,8 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice; it becomes the scenario's
         ``numerics.dt_s`` (validated as that key, and stored with the result, so its archive reruns it).
 
-    The checks are those of ``bearingsim run``: the step is validated as a scenario key, and a finished
+    The checks are those of ``bearingsim run``: the step is validated as a scenario key, the run request
+    too (:func:`bearingsim.scenario.check_run_request`: a multibody run needs a warm-up rotation), and a finished
     run that is not plausible (:func:`bearingsim.plausibility.check`) raises
     :class:`bearingsim.errors.SimulationUnstable`; the one-line notes of a plausible run that is not
     clean are in ``result.notes`` (the command line prints them).
@@ -80,6 +81,7 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     t0 = time.perf_counter()
     if dt is not None:
         scenario = scenario.replace(**{"numerics.dt_s": dt})
+    check_run_request(scenario)  # what `bearingsim run` refuses beyond the schema, refused on every path
     params = Parameters.from_scenario(scenario)
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario

@@ -191,9 +191,9 @@ def _markdown(rows: list[dict]) -> str:
 
 
 def _plot(rows: list[dict], path: Path) -> None:
-    from bearingsim.plotting import plt
+    from bearingsim.plotting import subplots
 
-    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    fig, ax = subplots(figsize=(7.5, 5.0))
     groups = {}
     for r in rows:
         groups.setdefault((r["model"], r["method"], r["scene"], r["rpm"]), []).append(r)

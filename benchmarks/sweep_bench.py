@@ -38,7 +38,7 @@ def _warm() -> bool:
     from bearingsim.scenario import load_scenario
     from bearingsim.simulation import run_scenario
 
-    sc = load_scenario(_scenario_path(), ["numerics.rotations=1", "numerics.warmup_rotations=0"])
+    sc = load_scenario(_scenario_path(), ["numerics.rotations=1", "numerics.warmup_rotations=1"])
     with tempfile.TemporaryDirectory() as tmp:
         run_scenario(sc, Path(tmp) / "warm.h5", figures=False)
     return True

@@ -79,12 +79,12 @@ def test_plot_replaces_its_own_figures(tmp_path):
 def test_a_figure_is_written_whole_or_not_at_all(tmp_path):
     """A figure whose drawing fails half-way (here after 100 bytes, as a full disk or a signal would)
     leaves the previous file as it was and no temporary file."""
-    from bearingsim.plotting import plt, save_figure
+    from bearingsim.plotting import figure, save_figure
 
     path = tmp_path / "f.png"
-    save_figure(plt.figure(), path)
+    save_figure(figure(), path)
     old = path.read_bytes()
-    fig = plt.figure()
+    fig = figure()
 
     def failing_savefig(target, **kw):
         if hasattr(target, "write"):

@@ -549,14 +549,24 @@ def test_version_guard_falls_back_to_the_plain_loop(monkeypatch):
     against does not, and then the plain loop runs (and "compiled" is refused, not run)."""
     import pymunk
 
+    from bearingsim.errors import SlowLoopWarning
+
     monkeypatch.delenv(chipmunk.PLAIN_ENV, raising=False)
     assert chipmunk.guard() is None
     monkeypatch.setattr(pymunk, "version", "8.0.0")
+    monkeypatch.setattr(chipmunk, "_announced", False)
     why = chipmunk.guard()
     assert why is not None and "8.0.0" in why
     space = pymunk.Space()
-    loop, reason = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
+    # announced once, loudly, with what it costs (issue 29, item 4); the second fallback is silent
+    with pytest.warns(SlowLoopWarning, match=r"cannot run \(pymunk 8\.0\.0 .*times slower"):
+        loop, reason = chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)
     assert loop.name == "plain" and reason == why
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16)[0].name == "plain"
     with pytest.raises(RuntimeError, match="cannot run"):
         chipmunk.open_step_loop(space, 1, chipmunk.lp.BODY_SET_FORCE, np.zeros(3), 16, step_loop="compiled")
 
@@ -672,3 +682,17 @@ def test_race_rotation_leaves_other_rollers_alone(case):
         vr = -2.0 * vt**2 * h / RC
     st, n_extra = _orbit(x, 0.0, vr, vt, h, q_in=q_in, hold=hold)
     assert list(st[0, [0, 1, 3, 4]]) == [x, 0.0, vr, vt] and n_extra == 0.0
+
+
+
+def test_pymunk_pin_matches_the_version_guard():
+    """pyproject.toml pins pymunk to the major versions whose internals the compiled loop checks
+    (``chipmunk.SUPPORTED_PYMUNK``): an install cannot bring a pymunk the guard would refuse."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    meta = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
+    spec = next(d for d in meta["project"]["dependencies"] if d.startswith("pymunk"))
+    lo, hi = re.fullmatch(r"pymunk>=(\d+)\.\d+(?:\.\d+)?,<(\d+)", spec.replace(" ", "")).groups()
+    assert tuple(range(int(lo), int(hi))) == chipmunk.SUPPORTED_PYMUNK, spec

@@ -106,6 +106,21 @@ def _setup_archive_and_figure_symlink(tmp):
     _setup_figure_symlink(tmp)
 
 
+def _multibody_archive_without_warmup(path: Path) -> None:
+    """An archive of a multibody run (a short rigid-raceway one) whose stored scenario has
+    ``numerics.warmup_rotations = 0``: what ``bearingsim.run`` wrote before it refused that."""
+    import h5py
+
+    res = bearingsim("run", MB, "-o", path, "--no-plots", "-q", "--set", "multibody.raceway_contact=rigid",
+                     "--set", "numerics.rotations=1")
+    assert res.returncode == 0, res.stderr
+    with h5py.File(path, "r+") as f:
+        text = f["scenario"][()].decode()
+        assert "warmup_rotations = 1" in text, text
+        del f["scenario"]
+        f.create_dataset("scenario", data=text.replace("warmup_rotations = 1", "warmup_rotations = 0"))
+
+
 def _setup_text(name, text="my notes\n"):
     return lambda tmp: (tmp / name).write_text(text)
 
@@ -350,6 +365,35 @@ CASES: list[Case] = [
     Case("euler-pocket-clearance-1e-9-automatic-step", "--set",
          run(*S("reduced.method=euler", "bearing.pocket_clearance_mm=1e-9")), 2,
          ("bearing.pocket_clearance_mm", "automatic", "more than 1e+08")),
+    # impossible geometry (issue 30, Low): the class (too few rollers, cage bars thinner than a tenth of the
+    # roller, inverted or misplaced cage diameters), refused with the key before anything runs
+    Case("geometry-1-roller-reduced", "geometry", run(*S("bearing.roller_count=1")), 2,
+         ("bearing.roller_count", "at least 3")),
+    Case("geometry-2-rollers-multibody", "geometry", run(*S("bearing.roller_count=2"), scenario=MB), 2,
+         ("bearing.roller_count", "at least 3")),
+    Case("geometry-23-pockets-0.08-mm-bars", "geometry", run(*S("bearing.roller_count=23")), 2,
+         ("bearing.roller_count", "cage bars of 0.0762 mm", "at most 21 rollers")),
+    Case("geometry-22-pockets-multibody", "geometry", run(*S("bearing.roller_count=22"), scenario=MB), 2,
+         ("bearing.roller_count", "cage bars", "at most 21 rollers")),
+    Case("geometry-cage-bore-above-rim", "geometry", run(*S("bearing.cage_inner_diameter_mm=105")), 2,
+         ("bearing.cage_inner_diameter_mm", "smaller than its outside diameter")),
+    Case("geometry-cage-rim-through-outer-raceway", "geometry",
+         run(*S("bearing.cage_outer_diameter_mm=120"), scenario=MB), 2, ("bearing.cage_outer_diameter_mm", "outer raceway")),
+    Case("geometry-cage-bore-through-inner-raceway", "geometry",
+         run(*S("bearing.cage_inner_diameter_mm=80"), scenario=MB), 2, ("bearing.cage_inner_diameter_mm", "inner raceway")),
+    # a multibody run without a warm-up rotation is refused on every path (issue 30, Low): sweep and rerun too
+    Case("sweep-multibody-warmup-0", "sweep", ["sweep", MB, "--set", "numerics.warmup_rotations=0", "--param",
+                                               "operating.inner_ring_speed_rpm=3000,6000", "-o", "{tmp}/sw"], 2,
+         ("numerics.warmup_rotations", "warm-up")),
+    Case("rerun-multibody-warmup-0", "archive tools", ["rerun", "{tmp}/a.h5"], 2,
+         ("numerics.warmup_rotations", "warm-up"), setup=lambda t: _multibody_archive_without_warmup(t / "a.h5")),
+    # exit-3 advice names the key that caused it (issue 30, Low): a given step 4.5e5 times the automatic one
+    # (was: "check multibody.inner_ring_mass_kg", for a quasi-static ring)
+    Case("advice-rigid-dt-10", "--set", run(*S("multibody.raceway_contact=rigid", "numerics.dt_s=10", *MB1), scenario=MB),
+         3, ("the given step numerics.dt_s = 10 s", "times the automatic")),
+    # the event method has no time step: a given one is noted as unused (issue 30, Low)
+    Case("note-event-method-dt", "works", run(*S("numerics.dt_s=1e-6")), 0,
+         ("numerics.dt_s: not used by reduced.method = 'event'", "wrote"), allow_new=("out.h5",)),
     # runs that work
     Case("works-reduced", "works", run(), 0, ("wrote",), allow_new=("out.h5",)),
     Case("note-ring-newton-failures", "works", run(*S("numerics.rotations=2"), scenario=SCENARIOS / "multibody_6000rpm.toml"),
@@ -521,6 +565,71 @@ def test_plausibility_refuses_too_few_orbit_samples():
         pl.check(r)
 
 
+def test_the_api_refuses_a_multibody_run_without_warm_up():
+    """Issue 30, Low: ``bearingsim.run`` refuses what ``bearingsim run`` refuses (the check is in the API,
+    so ``run``, ``rerun``, sweep cases and studies share it); the model's own ``simulate`` (stability
+    scan, kernel tests) is below it."""
+    import bearingsim as bs
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match="numerics.warmup_rotations"):
+        bs.run(_mb_scenario("numerics.warmup_rotations=0"))
+
+
+def test_unused_keys_of_the_reduced_methods():
+    """Issue 30, Low: the event method has no time step, so a given ``numerics.dt_s`` is noted as unused
+    (the euler method uses it); the reduced model never uses the warm-up or the output rate."""
+    from bearingsim.scenario import unused_keys, unused_note
+
+    keys = ["numerics.dt_s", "numerics.warmup_rotations", "numerics.rotations"]
+    assert unused_keys("reduced", keys, "event") == ["numerics.warmup_rotations", "numerics.dt_s"]
+    assert unused_keys("reduced", keys, "euler") == ["numerics.warmup_rotations"]
+    assert unused_keys("multibody", keys, "event") == []
+    assert unused_note("reduced", ["numerics.dt_s"], "euler") is None
+    assert "reduced.method = 'event'" in unused_note("reduced", ["numerics.dt_s"], "event")
+
+
+def test_plausibility_advice_follows_what_the_run_did():
+    """Issue 30, Low: the exit-3 advice names the key that caused it, judged from what ran. A ring the
+    scenario leaves at "auto" that ran quasi-static gets no ring-mass advice (it got it: the scenario
+    said "auto", not "quasi_static"); a ring that ran dynamic does; a land-guided cage gets its land keys."""
+    from bearingsim import plausibility as pl
+    from bearingsim.errors import SimulationUnstable
+
+    quasi = {"inner_ring": "quasi-static (massless); auto: 5 roller(s) loaded", "dt_choice": "auto: ..."}
+    with pytest.raises(SimulationUnstable) as err:
+        pl.check(_FakeResult(_mb_scenario(), quasi, inner_ring_displacement_m=1e-3))
+    assert "inner_ring_mass_kg" not in str(err.value) and "operating.radial_load_N" in str(err.value)
+    dynamic = {**quasi, "inner_ring": "dynamic, mass W / g_n = 98.9 kg"}
+    with pytest.raises(SimulationUnstable, match="multibody.inner_ring_mass_kg"):
+        pl.check(_FakeResult(_mb_scenario(), dynamic, inner_ring_displacement_m=1e-3))
+    with pytest.raises(SimulationUnstable, match="bearing.cage_land_clearance_mm and contact.land_friction"):
+        pl.check(_FakeResult(_mb_scenario("bearing.cage_guidance=outer_land"), quasi, inner_ring_displacement_m=1e-3))
+
+
+def test_too_few_samples_advice_names_the_cause():
+    """Issue 30, Low: "raise numerics.output_rate_hz" was the advice for every run with too few cage-orbit
+    samples. A step longer than the sampling interval (one sample per step at most) names numerics.dt_s;
+    a cage turning at 5 times its epicyclic speed (its recorded rotations took a fifth of their time)
+    names the traction and drag keys; only otherwise the output rate."""
+    import numpy as np
+
+    from bearingsim import plausibility as pl
+    from bearingsim.errors import SimulationUnstable
+
+    sc = _mb_scenario()
+    omega_c = si(sc).operating.omega_c
+    cases = [({"dt_s": 1e-3, "dt_choice": "numerics.dt_s"}, {}, "numerics.dt_s = 0.001 s"),
+             ({"dt_s": 4e-6, "dt_choice": "auto"}, {"cage_speed_mean_rad_s": 5 * omega_c}, "multibody.traction_mu_max"),
+             ({"dt_s": 4e-6, "dt_choice": "auto"}, {"cage_speed_mean_rad_s": omega_c}, "numerics.output_rate_hz")]
+    for prov, summary, words in cases:
+        r = _FakeResult(sc, prov, **summary)
+        r.orbit = np.full((10, 3), np.nan)
+        with pytest.raises(SimulationUnstable) as err:
+            pl.check(r)
+        assert words in str(err.value), (prov, summary, str(err.value))
+
+
 # --- signals ----------------------------------------------------------------------------------------
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
 def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
@@ -681,6 +790,11 @@ def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
 
 
 # --- docs/reliability.md -------------------------------------------------------------------------------
+#: the heading of the hand-written part of docs/reliability.md (classes tested by other functions), which
+#: :func:`write_doc` keeps below the generated table
+KEPT_SECTION = "## Classes tested outside this table"
+
+
 def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
     """Run every case (and the two signals) and write the table of input, expected and observed."""
     import tempfile
@@ -750,7 +864,9 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
               "`bearingsim/plausibility.py` (the Palmgren displacement bound, "
               "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
               "refused above)."]
-    path.write_text("\n".join(lines) + "\n")
+    kept = path.read_text() if path.is_file() else ""
+    tail = kept[kept.index(KEPT_SECTION):] if KEPT_SECTION in kept else ""  # written by hand: kept as it is
+    path.write_text("\n".join(lines) + "\n" + ("\n" + tail if tail else ""))
     print(f"wrote {path}")
 
 

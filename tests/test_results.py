@@ -61,12 +61,43 @@ def test_a_title_in_a_script_the_font_lacks_gives_no_warnings(tmp_path):
     boxes) without them. A private-use character stands for a glyph no font has."""
     import warnings
 
-    from bearingsim.plotting import plt, save_figure
+    from bearingsim.plotting import subplots, save_figure
 
-    fig, ax = plt.subplots()
+    fig, ax = subplots()
     ax.set_title("name \ue000\ue001")
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
         save_figure(fig, tmp_path / "f.png")
     assert [str(w.message) for w in seen if "Glyph" in str(w.message)] == []
     assert (tmp_path / "f.png").read_bytes().startswith(b"\x89PNG")
+
+
+_BACKEND_SCRIPT = """
+import sys
+import matplotlib
+matplotlib.use("svg")  # a backend the user chose (a notebook's inline one, a GUI's)
+import bearingsim
+r = bearingsim.run(bearingsim.load_scenario(PAPER))
+names = sorted(r.figures())
+written = r.save_figures(STEM)
+print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules, len(names) == len(written) > 0)
+"""
+
+
+def test_figures_leave_the_users_matplotlib_backend_alone(tmp_path):
+    """Issue 29, item 4: importing bearingsim's plotting switched matplotlib to Agg for the whole process
+    (``matplotlib.use("Agg")``) and drew through pyplot. Figures are now Figure objects with their own
+    Agg canvas: the user's backend stays, pyplot is not even imported, and the PNGs are written."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = str(Path(__file__).resolve().parents[1])
+    env = {**os.environ, "PYTHONPATH": root + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    script = _BACKEND_SCRIPT.replace("PAPER", repr(str(SCENARIOS / "paper_3000rpm.toml"))).replace(
+        "STEM", repr(str(tmp_path / "r")))
+    res = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300, env=env)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split() == ["svg", "False", "True"], res.stdout
+    assert all(p.read_bytes().startswith(b"\x89PNG") for p in tmp_path.glob("r_*.png"))

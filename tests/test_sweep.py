@@ -427,3 +427,15 @@ def test_figure_kind_follows_the_grid(tmp_path):
     cols, meta = read_index(tmp_path / "sweep.h5")
     assert list(cols["operating.direction"]) == ["forward", "reverse"] * 2
     assert math.isnan(cols["I_dec_mean_Ns"][1]) and cols["I_dec_mean_Ns"][2] == pytest.approx(0.007)
+
+
+def test_scheduler_without_dask_names_the_extra(tmp_path, monkeypatch, capsys):
+    """Issue 29, item 4: dask is the optional extra ``cluster``; a command that needs it when it is
+    missing says so in one line naming the extra (exit 2), not a traceback or another package name."""
+    from bearingsim import cli
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # `import distributed` raises ImportError
+    code = cli.main(["sweep", str(BASE), "--param", f"{SPEED}=1000,2000", "--scheduler", "tcp://127.0.0.1:9",
+                     "-o", str(tmp_path / "sw"), "--no-plots"])
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert code == 2 and len(err) == 1 and "pip install 'bearingsim[cluster]'" in err[0], (code, err)

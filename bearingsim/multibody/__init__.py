@@ -398,11 +398,11 @@ class MultibodyResult(Result):
 
     def plot_forces(self):
         """Fig. 5 analog: mean circumferential pocket force against θ, pocket 0 and the mean over pockets."""
-        from bearingsim.plotting import legend_outside, plt
+        from bearingsim.plotting import legend_outside, subplots
 
         th = self.get("theta_deg")
         fa, fd = self.get("force_vs_theta_acc"), self.get("force_vs_theta_dec")
-        fig, ax = plt.subplots(figsize=(9, 4))
+        fig, ax = subplots(figsize=(9, 4))
         ax.plot(th, fa[:, 0], lw=0.8, color="C0", label="$F_{acc}$ (front face), pocket 0")
         ax.plot(th, -fd[:, 0], lw=0.8, color="C3", label="$-F_{dec}$ (rear face), pocket 0")
         ax.plot(th, fa.mean(axis=1), lw=1.5, color="C0", ls="--", label="$F_{acc}$, mean over pockets")
@@ -421,11 +421,11 @@ class MultibodyResult(Result):
 
     def plot_impulses(self):
         """Fig. 7 analog: I_acc and I_dec per pocket, mean ± std over rotations."""
-        from bearingsim.plotting import legend_outside, plt
+        from bearingsim.plotting import legend_outside, subplots
 
         ia, idc = self.per_rotation["I_acc"], self.per_rotation["I_dec"]
         x = np.arange(ia.shape[1])
-        fig, ax = plt.subplots(figsize=(9, 4))
+        fig, ax = subplots(figsize=(9, 4))
         ax.errorbar(x - 0.12, ia.mean(0) * 1e3, yerr=ia.std(0) * 1e3, fmt="o", label="$I_{acc}$ (front face)")
         ax.errorbar(x + 0.12, idc.mean(0) * 1e3, yerr=idc.std(0) * 1e3, fmt="s", label="$I_{dec}$ (rear face)")
         ax.set_xlabel("pocket")
@@ -438,10 +438,10 @@ class MultibodyResult(Result):
 
     def plot_orbit(self):
         """Cage-centre orbit (last recorded samples), with the bearing axis and the reach of the faces."""
-        from bearingsim.plotting import legend_outside, plt
+        from bearingsim.plotting import legend_outside, subplots
 
         o = self.get("cage_orbit")
-        fig, ax = plt.subplots(figsize=(6.5, 5))
+        fig, ax = subplots(figsize=(6.5, 5))
         ax.plot(o[:, 1] * 1e6, o[:, 2] * 1e6, lw=0.6, label="cage centre")
         ax.plot([0.0], [0.0], "k+", ms=12, label="bearing axis")
         p = self.parameters
@@ -469,12 +469,12 @@ class MultibodyResult(Result):
 
     def plot_wear(self):
         """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
-        from bearingsim.plotting import legend_outside, plt
+        from bearingsim.plotting import legend_outside, subplots
 
         op = self.parameters.operating
         per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e18  # cage rotations per hour, m^3 -> µm^3
         x = np.arange(self.per_rotation["I_dec"].shape[1])
-        fig, ax = plt.subplots(figsize=(9, 4))
+        fig, ax = subplots(figsize=(9, 4))
         bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16)"),
                 (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16)"),
                 (self.get("wear/sliding_work_front"), "front face, sliding work"),

@@ -62,14 +62,36 @@ try:
 except ImportError:  # pragma: no cover - a pymunk without its cffi module
     ffi = lib = None
 
-#: pymunk major versions the compiled loop is known to work with (checked: 7.3.1)
+#: pymunk major versions the compiled loop is known to work with (checked: 7.3.1); pyproject.toml pins
+#: pymunk to the same major version (tests/test_multibody_kernels.py checks that they agree)
 SUPPORTED_PYMUNK = (7,)
 PLAIN_ENV = "BEARINGSIM_PLAIN_PYMUNK"
+#: how much slower the plain loop is, measured: the step loop of scenarios/multibody_3000rpm.toml
+#: (1 warm-up + 2 rotations, 34364 steps, kernels compiled beforehand) took 2.46 s plain against
+#: 0.53 s compiled (multibody.core.run(p, step_loop=...), one machine shared with other jobs)
+PLAIN_SLOWDOWN = 4.6
+_announced = False  # the fallback to the plain loop is announced once per process
 _FUNCTIONS = ("cpSpaceStep", "cpSpaceEachBody", "cpSpaceEachCachedArbiter", "pmSpaceBodyGetIteratorFuncBatched",
               "pmSpaceBodySetIteratorFuncBatched", "pmSpaceArbiterIteratorFuncBatched", "pmFloatArrayNew",
               "pmFloatArrayFree", "pmIntArrayNew", "pmIntArrayFree", "cpConstraintGetImpulse",
               "cpShapeSetElasticity", "cpSegmentShapeSetEndpoints")
 CLOCK_MONOTONIC = 1  # Linux and macOS
+
+
+def _announce_plain(why: str) -> None:
+    """Warn, once per process, that the compiled loop was refused and what that costs."""
+    global _announced
+    if _announced:
+        return
+    _announced = True
+    import warnings
+
+    from bearingsim.errors import SlowLoopWarning
+
+    warnings.warn(f"bearingsim: the multibody model's compiled step loop cannot run ({why}); the plain loop "
+                  f"runs instead: the same numbers, about {PLAIN_SLOWDOWN:g} times slower (install pymunk "
+                  f"{' or '.join(f'{v}.x' for v in SUPPORTED_PYMUNK)} for the compiled loop)",
+                  SlowLoopWarning, stacklevel=3)
 
 
 def guard() -> str | None:
@@ -307,8 +329,10 @@ def open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop=None, join
             step_loop, reason = "plain", f"{PLAIN_ENV}={os.environ[PLAIN_ENV]}"
         elif why_not is not None:
             step_loop, reason = "plain", why_not
+            _announce_plain(why_not)
         elif arc_shapes is not None and endpoints_layout() is not None:
             step_loop, reason = "plain", endpoints_layout()
+            _announce_plain(reason)
         else:
             step_loop, reason = "compiled", f"pymunk {pymunk.version}"
     elif step_loop == "compiled":

@@ -178,9 +178,9 @@ class ReducedResult(Result):
     # --- figures -----------------------------------------------------------------------------
     def plot_pass(self):
         """Fig. 8 analog: l_r, dl_r/dt and cumulative I_dec against θ over the no-load pass."""
-        from bearingsim.plotting import plt
+        from bearingsim.plotting import subplots
 
-        fig, ax = plt.subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
+        fig, ax = subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
         if "results/trace/theta_deg" not in self.data:
             ax[0].text(0.5, 0.5, "no trace recorded", transform=ax[0].transAxes, ha="center")
             return fig

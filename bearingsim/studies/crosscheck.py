@@ -287,12 +287,12 @@ def read_table(path) -> tuple[list[dict], dict]:
 def plot_crosscheck(index_path, outdir) -> list[Path]:
     """Draw ``crosscheck.png`` from the index alone: I_dec and I_acc against the rung, one line per
     speed, error bars ± 1 standard error (batch means)."""
-    from bearingsim.plotting import legend_outside, plt, save_figure
+    from bearingsim.plotting import legend_outside, subplots, save_figure
 
     rows, meta = read_table(index_path)
     speeds = sorted({r["rpm"] for r in rows})
     labels = {r["rung"]: f"{r['rung']} {r['scene']}" for r in rows}
-    fig, axes = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    fig, axes = subplots(2, 1, figsize=(9, 6.5), sharex=True)
     for k, rpm in enumerate(speeds):
         rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
         x = np.array([r["rung"] for r in rs]) + (k - 0.5 * (len(speeds) - 1)) * 0.06

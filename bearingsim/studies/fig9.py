@@ -102,7 +102,7 @@ def fig9_table(speeds=FIG9_SPEEDS_RPM, drags=FIG9_DRAG, *, outdir=None, jobs: in
 
 def save_fig9(outdir: str | Path, table: dict[str, np.ndarray]) -> list[Path]:
     """Write ``fig9_idec_vs_speed.csv`` and ``.png`` to ``outdir``; return their paths."""
-    from bearingsim.plotting import plt, save_figure
+    from bearingsim.plotting import subplots, save_figure
 
     outdir = Path(outdir)
     cols = list(table)
@@ -110,7 +110,7 @@ def save_fig9(outdir: str | Path, table: dict[str, np.ndarray]) -> list[Path]:
                          [[f"{table['speed_rpm'][i]:g}"] + [f"{table[c][i]:.6e}" for c in cols[1:]]
                           for i in range(len(table["speed_rpm"]))])
 
-    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    fig, ax = subplots(figsize=(6.5, 4.5))
     n = table["speed_rpm"]
     for c, mk in zip([c for c in cols[1:] if "previous" not in c], "os^"):
         ax.plot(n, table[c] * 1e3, marker=mk, label=f"present model, c = {c[len('I_dec_c'):-len('_Ns')]}")

@@ -101,7 +101,7 @@ CSV_COLUMNS = ("rpm", "rotations", "pocket0_I_dec_mean_Ns", "pocket0_I_dec_std_N
 
 def save_rig(outdir, rows: list[dict]) -> list[Path]:
     """Write ``rig_idec_vs_speed.{csv,png}`` and ``rig_pocket0_forces.png`` (Fig. 5 analog) to ``outdir``."""
-    from bearingsim.plotting import legend_outside, plt, save_figure
+    from bearingsim.plotting import legend_outside, subplots, save_figure
 
     outdir = Path(outdir)
     cells = []
@@ -111,7 +111,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     csv_path = write_csv(outdir / "rig_idec_vs_speed.csv", CSV_COLUMNS, cells)
 
     n = np.array([r["rpm"] for r in rows])
-    fig, ax = plt.subplots(figsize=(8.5, 4.5))
+    fig, ax = subplots(figsize=(8.5, 4.5))
     ax.plot(n, [r["reduced_I_dec_Ns"] * 1e3 for r in rows], "k-", marker="o",
             label="reduced model (paper's model, φ = 23.5°)")
     ax.fill_between(n, [r["reduced_I_dec_Ns"] * 0.75e3 for r in rows], [r["reduced_I_dec_Ns"] * 1.25e3 for r in rows],
@@ -131,7 +131,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     legend_outside(ax)
     png = save_figure(fig, outdir / "rig_idec_vs_speed.png")
 
-    fig, axes = plt.subplots(len(rows), 1, figsize=(8.5, 1.8 * len(rows) + 0.8), sharex=True, squeeze=False)
+    fig, axes = subplots(len(rows), 1, figsize=(8.5, 1.8 * len(rows) + 0.8), sharex=True, squeeze=False)
     for ax, r in zip(axes[:, 0], rows):
         ax.plot(r["theta_deg"], r["F_acc_pocket0"], lw=0.8, color="C0", label="$F_{acc}$ (front face)")
         ax.plot(r["theta_deg"], -r["F_dec_pocket0"], lw=0.8, color="C3", label="$-F_{dec}$ (rear face)")

@@ -136,8 +136,9 @@ class DaskEngine:
             return
         try:
             from distributed import Client
-        except ImportError:  # pragma: no cover
-            raise UserError("--scheduler: dask.distributed is not installed (pip install 'dask[distributed]')") from None
+        except ImportError:
+            raise UserError("--scheduler: dask.distributed is not installed; it is the optional extra 'cluster': "
+                            "pip install 'bearingsim[cluster]'") from None
         target = self.cluster if self.cluster is not None else self.address
         try:
             self.client = Client(target, timeout=f"{self.timeout_s}s", set_as_default=False)

@@ -87,8 +87,6 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
     notes : list, optional
         Receives one line for each figure that could not be drawn, and why.
     """
-    from bearingsim.plotting import plt
-
     notes = notes if notes is not None else []
     index_path = Path(index_path)
     outdir = Path(outdir) if outdir is not None else index_path.parent
@@ -103,26 +101,26 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
     written: list[Path] = []
     grid = [k for k in meta["grid"] if k in cols]
     if n and grid:
-        path = _grid_figure(plt, cols, meta, grid, range(n), outdir, title, notes)
+        path = _grid_figure(cols, meta, grid, range(n), outdir, title, notes)
         if path is not None:
             written.append(path)
     if n < total:  # extra cases (or cases alone): not on a grid
         if total > MAX_CASES:
             notes.append(f"no per-case figure: {total} cases are more than the {MAX_CASES} one chart labels")
         else:
-            written.append(_cases_chart(plt, cols, meta, outdir / "sweep_cases.png", title))
+            written.append(_cases_chart(cols, meta, outdir / "sweep_cases.png", title))
     return written
 
 
-def _grid_figure(plt, cols, meta, grid, rows, outdir, title, notes) -> Path | None:
+def _grid_figure(cols, meta, grid, rows, outdir, title, notes) -> Path | None:
     rows = list(rows)
     numeric = [k for k in grid if _numeric(cols[k]) and np.isfinite(cols[k][rows]).any()]
     if meta.get("mode") == "zip":  # zipped axes move together: one abscissa
-        return _lines(plt, cols, (numeric or grid)[:1], rows, outdir / "sweep_I.png", title, notes)
+        return _lines(cols, (numeric or grid)[:1], rows, outdir / "sweep_I.png", title, notes)
     if len(grid) == 2 and len(numeric) != 1:  # both numeric or both text: a map of the pairs
-        return _heat_map(plt, cols, grid, rows, outdir / "sweep_map.png", title)
+        return _heat_map(cols, grid, rows, outdir / "sweep_map.png", title)
     axes = numeric[:1] + [k for k in grid if k not in numeric[:1]]  # numeric abscissa when there is one
-    return _lines(plt, cols, axes, rows, outdir / "sweep_I.png", title, notes)
+    return _lines(cols, axes, rows, outdir / "sweep_I.png", title, notes)
 
 
 def _positions(cols, key, rows):
@@ -135,7 +133,7 @@ def _positions(cols, key, rows):
     return x, list(range(len(cats))), cats
 
 
-def _lines(plt, cols, axes, rows, path: Path, title: str, notes) -> Path | None:
+def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
     x_key, others = axes[0], axes[1:]
     x_all, ticks, tick_labels = _positions(cols, x_key, rows)
     groups: dict[tuple, list[int]] = {}
@@ -146,7 +144,9 @@ def _lines(plt, cols, axes, rows, path: Path, title: str, notes) -> Path | None:
         notes.append(f"no line figure: {len(groups)} combinations of "
                      + ", ".join(name_of(k) for k in others) + f" are more than the {MAX_LINES} lines one figure shows")
         return None
-    fig, panels = plt.subplots(1, 2, figsize=(10, 4.2), sharex=True, constrained_layout=True)
+    from bearingsim.plotting import subplots
+
+    fig, panels = subplots(1, 2, figsize=(10, 4.2), sharex=True, constrained_layout=True)
     for gi, (other, idx) in enumerate(groups.items()):
         idx = sorted(idx, key=lambda i: x_all[i])
         x = x_all[idx]
@@ -180,15 +180,17 @@ def _show(v) -> str:
     return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)
 
 
-def _heat_map(plt, cols, axes, rows, path: Path, title: str) -> Path:
+def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
     """One cell per sampled pair, centred on its tick (sampled values only: no extrapolated edges),
     equal cells, each with its value written; I_dec and I_acc in two panels with their own scales."""
     xk, yk = axes
     xs, ys = _sampled(cols[xk], rows), _sampled(cols[yk], rows)
     xpos = {_show(v): j for j, v in enumerate(xs)}
     ypos = {_show(v): j for j, v in enumerate(ys)}
-    fig, panels = plt.subplots(1, 2, figsize=(max(9.0, 1.2 * len(xs) * 2 + 3), max(4.2, 0.45 * len(ys) + 2.5)),
-                               constrained_layout=True)
+    from bearingsim.plotting import subplots
+
+    fig, panels = subplots(1, 2, figsize=(max(9.0, 1.2 * len(xs) * 2 + 3), max(4.2, 0.45 * len(ys) + 2.5)),
+                           constrained_layout=True)
     n_gap = 0
     for ax, (name, sym) in zip(panels, QUANTITIES):
         grid = np.full((len(ys), len(xs)), np.nan)
@@ -218,7 +220,7 @@ def _heat_map(plt, cols, axes, rows, path: Path, title: str) -> Path:
     return save_figure(fig, path, tight=False)
 
 
-def _cases_chart(plt, cols, meta, path: Path, title: str) -> Path:
+def _cases_chart(cols, meta, path: Path, title: str) -> Path:
     """Every case of the index as one bar, labelled by its swept values; I_dec and I_acc in two panels."""
     keys = [k for k in meta["axes"] if k in cols]
     total = len(cols["case"])
@@ -230,7 +232,9 @@ def _cases_chart(plt, cols, meta, path: Path, title: str) -> Path:
             parts.append("(failed)" if status == "failed" else "(not run)")
         labels.append(", ".join(parts) or "(base scenario)")
     pos = np.arange(total)
-    fig, panels = plt.subplots(1, 2, figsize=(11, 1.5 + 0.32 * total), sharey=True, constrained_layout=True)
+    from bearingsim.plotting import subplots
+
+    fig, panels = subplots(1, 2, figsize=(11, 1.5 + 0.32 * total), sharey=True, constrained_layout=True)
     for k, (ax, (name, sym)) in enumerate(zip(panels, QUANTITIES)):
         if f"{name}_mean_Ns" in cols:
             y = np.asarray(cols[f"{name}_mean_Ns"]) * 1e3

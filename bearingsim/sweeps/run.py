@@ -386,7 +386,9 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
         from bearingsim.scenario import given_keys, load_scenario, unused_note
 
         keys = given_keys(spec.scenario, spec.sets) + spec.keys
-        note = None if "model" in spec.keys else unused_note(load_scenario(spec.scenario, spec.sets).model, keys)
+        base = load_scenario(spec.scenario, spec.sets)
+        method = None if "reduced.method" in spec.keys else base.reduced.method  # swept: some cases use the step
+        note = None if "model" in spec.keys else unused_note(base.model, keys, method)
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)

@@ -35,7 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from bearingsim.errors import UserError
-from bearingsim.scenario import load_scenario, parse_override, read_toml_file
+from bearingsim.scenario import check_run_request, load_scenario, parse_override, read_toml_file
 
 SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
 # Most cases in one sweep: ten times the 100 x 100 map of scenarios/sweeps/. Each case is resolved and
@@ -319,6 +319,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
     for i, values in enumerate(points):
         try:
             sc = base.replace(**values)
+            check_run_request(sc)  # refused here as `bearingsim run` refuses it, before any case runs
         except UserError as exc:
             raise UserError(f"{exc} (sweep case {_label(values)})") from None
         text = sc.to_toml()

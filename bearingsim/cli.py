@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import logging
 import os
 import signal
 import sys
@@ -692,6 +693,35 @@ def _stdout_lost(exc: OSError, written) -> None:
               f"{written} is complete", file=sys.stderr)
 
 
+class _NoteHandler(logging.Handler):
+    """The library's notes (``logging`` records of the ``bearingsim`` loggers) on the command line's
+    stderr, one line each as the library words them; the stream is looked up at each note (a test's
+    captured stderr, a reconfigured one)."""
+
+    def emit(self, record):
+        try:
+            print(self.format(record), file=sys.stderr)
+        except Exception:  # noqa: BLE001 - a note must never end a command
+            self.handleError(record)
+
+
+@contextlib.contextmanager
+def _notes_on_stderr():
+    """While a command runs, the ``bearingsim`` loggers' notes go to stderr (and not on to the root
+    logger); afterwards the loggers are as they were (main() called from a program leaves no handler)."""
+    log = logging.getLogger("bearingsim")
+    handler, before = _NoteHandler(), (log.level, log.propagate)
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    log.propagate = False
+    try:
+        yield
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(before[0])
+        log.propagate = before[1]
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
@@ -713,7 +743,7 @@ def main(argv: list[str] | None = None) -> int:
             errors[name] = stream.errors
             stream.reconfigure(errors="backslashreplace")
     try:
-        with _interrupts_redelivered(), outputs.command_line_owns_stderr():
+        with _interrupts_redelivered(), outputs.command_line_owns_stderr(), _notes_on_stderr():
             code = args.func(args)
             try:
                 sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush

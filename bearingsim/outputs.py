@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import logging
 import os
 import re
 import stat
@@ -236,7 +237,8 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
     Parameters
     ----------
     folder : output folder
-    report : callable taking one line (default: print to stderr)
+    report : callable taking one line (default: a note of the ``bearingsim.outputs`` logger, which the
+        command line prints on stderr)
 
     Returns
     -------
@@ -244,7 +246,7 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
         The files removed.
     """
     folder = Path(folder)
-    report = report or (lambda line: print(line, file=sys.stderr))
+    report = report or logging.getLogger(__name__).info
     removed = []
     if not folder.is_dir():
         return removed

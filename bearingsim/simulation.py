@@ -11,13 +11,15 @@ for their time series and return a result; they never see the scenario file or t
 """
 from __future__ import annotations
 
-import sys
+import logging
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.parameters import Parameters
 from bearingsim.scenario import Scenario, check_run_request
+
+log = logging.getLogger(__name__)  # notes of a plausible run that is not clean (the command line prints them)
 
 
 #: the models, by the name a scenario and an archive give
@@ -183,7 +185,7 @@ def run_scenario(
             result = run(scenario, progress=progress, sink=spool)  # checked: exit 3 before anything is written
             if notes:
                 for note in result.notes:
-                    print(note, file=sys.stderr)
+                    log.info(note)
             archive.write(result, out, spool)
         written = True
         pngs = []

@@ -86,3 +86,19 @@ def test_sweep_case_prints_no_note(tmp_path, monkeypatch, capsys):
 def test_newton_note_says_what_it_means():
     text = plausibility.NEWTON_NOTE.format(fails=5, steps=22922, share=5 / 22922)
     assert "did not converge" in text and "ring_newton_failures" in text and "docs/" in text
+
+
+def test_the_library_prints_nothing_its_notes_are_log_records(tmp_path, monkeypatch, capsys, caplog):
+    """A note of a plausible but not clean run reaches a Python caller as ``result.notes`` and a record
+    of the ``bearingsim`` loggers, never as text on its stderr; only the command line prints it."""
+    import logging
+
+    from bearingsim.simulation import run_scenario
+
+    monkeypatch.setattr(plausibility, "check", lambda result: [NOTE])
+    sc = load_scenario(BASE)
+    with caplog.at_level(logging.INFO, logger="bearingsim"):
+        out = run_scenario(sc, tmp_path / "a.h5", figures=False)
+    assert out.result.notes == [NOTE]
+    assert capsys.readouterr().err == ""
+    assert [r.getMessage() for r in caplog.records if r.name.startswith("bearingsim")] == [NOTE]

@@ -5,12 +5,14 @@ no file system shared with the client: with ``return_bytes`` the archive comes b
 """
 from __future__ import annotations
 
-import sys
+import logging
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+
+log = logging.getLogger(__name__)
 
 
 def one_line_error(exc: BaseException) -> str:
@@ -54,7 +56,7 @@ def _run_in_memory(scenario, notes: bool = True):
     result = simulation.run(scenario)  # plausibility checked there
     for note in result.notes:
         if notes:
-            print(note, file=sys.stderr)
+            log.info(note)
     return result, archive.to_bytes(result)
 
 

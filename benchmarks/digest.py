@@ -1,0 +1,60 @@
+"""Digest of every number each scenario gives, to check a refactor bit for bit against the code before it.
+
+    python -m benchmarks.digest [--model reduced|multibody] [--rotations N] [SCENARIO ...] > after.txt
+
+prints one line per run: the scenario, the overrides, a SHA-256 of the summary (repr of each value),
+every per-rotation array and the impact table, and I_dec. The reduced model runs each scenario with
+the event method and with the euler method at dt = 2 µs; the multibody model runs N recorded rotations
+(default 3). Run it on the code before and after a change and ``diff`` the two outputs. Default
+scenarios: ``scenarios/*.toml`` and ``scenarios/hard/*.toml`` of the checkout.
+"""
+from __future__ import annotations
+
+import argparse
+import glob
+import hashlib
+import json
+
+import numpy as np
+
+import bearingsim
+
+
+def digest(result) -> str:
+    h = hashlib.sha256()
+    h.update(json.dumps({k: repr(v) for k, v in sorted(result.summary.items())}).encode())
+    for table in (result.per_rotation, result.impacts):
+        for key in sorted(table):
+            h.update(key.encode())
+            h.update(np.ascontiguousarray(np.asarray(table[key])).tobytes())
+    return h.hexdigest()[:16]
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenarios", nargs="*")
+    ap.add_argument("--model", choices=("reduced", "multibody"), default="reduced")
+    ap.add_argument("--rotations", type=int, default=3)
+    a = ap.parse_args(argv)
+    files = a.scenarios or sorted(glob.glob("scenarios/*.toml") + glob.glob("scenarios/hard/*.toml"))
+    for f in files:
+        try:
+            model = bearingsim.load_scenario(f).model
+        except bearingsim.UserError as exc:
+            print(f, "refused:", exc)
+            continue
+        if model != a.model:
+            continue
+        runs = ([{}, {"reduced.method": "euler", "numerics.dt_s": 2e-6}] if model == "reduced"
+                else [{"numerics.rotations": a.rotations}])
+        for overrides in runs:
+            try:
+                r = bearingsim.run(bearingsim.load_scenario(f, set=overrides))
+            except (bearingsim.UserError, bearingsim.SimulationUnstable) as exc:
+                print(f, overrides, type(exc).__name__, str(exc)[:100])
+                continue
+            print(f, overrides, digest(r), r.summary.get("I_dec_mean_Ns"), flush=True)
+
+
+if __name__ == "__main__":
+    main()

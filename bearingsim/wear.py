@@ -137,9 +137,9 @@ def shape_of(psi_deg, depth) -> dict[str, float]:
 def plot_wear_profile(rep: WearReport, title: str = ""):
     """Fig. 13 analog: worn depth against psi on the front and the rear face, the mean over pockets and
     the band from the least to the most worn pocket at each psi."""
-    from bearingsim.plotting import legend_outside, plt
+    from bearingsim.plotting import legend_outside, subplots
 
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4), sharey=True)
+    fig, axes = subplots(1, 2, figsize=(10, 4), sharey=True)
     for ax, f, c in ((axes[0], "front", "C0"), (axes[1], "rear", "C3")):
         d = (rep.depth_front if f == "front" else rep.depth_rear) * 1e6
         ax.fill_between(rep.psi_deg, d.min(axis=1), d.max(axis=1), step="mid", color=c, alpha=0.25,
@@ -157,10 +157,10 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
 
 def plot_wear_volume(rep: WearReport, title: str = ""):
     """Fig. 14 analog: worn volume of the front and the rear face of every pocket, with the spread."""
-    from bearingsim.plotting import legend_outside, plt
+    from bearingsim.plotting import legend_outside, subplots
 
     x = np.arange(len(rep.volume_front))
-    fig, ax = plt.subplots(figsize=(9, 4))
+    fig, ax = subplots(figsize=(9, 4))
     ax.bar(x - 0.2, rep.volume_front * 1e9, 0.4, color="C0", label=f"front face (CV {rep.cov('front'):.2f})")
     ax.bar(x + 0.2, rep.volume_rear * 1e9, 0.4, color="C3", label=f"rear face (CV {rep.cov('rear'):.2f})")
     ax.set_xticks(x)

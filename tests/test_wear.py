@@ -207,3 +207,20 @@ def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     code = main(["life", str(SCENARIOS / "paper_6000rpm.toml"), "--limit", "depth=0.1mm", "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and "multibody" in err and len(err.strip().splitlines()) == 1
+
+
+def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, capsys):
+    """`bearingsim wear ARCHIVE` draws the Fig. 13 and Fig. 14 analogs from the archive alone (a run
+    written and read back), `bearingsim life` its history figure from life.h5's columns."""
+    from bearingsim.cli import main
+
+    archive = tmp_path / "w.h5"
+    scenario = str(SCENARIOS / "wear_test_6000rpm.toml")
+    assert main(["run", scenario, "-o", str(archive), "--no-plots", "-q", "--set", "numerics.rotations=2",
+                 "--set", "multibody.raceway_contact=rigid"]) == 0
+    assert main(["wear", str(archive), "--rotations", "1e5", "-o", str(tmp_path / "figs")]) == 0
+    for name in ("w_wear_profile.png", "w_wear_volume.png"):
+        assert (tmp_path / "figs" / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert main(["life", scenario, "--limit", "clearance=0.203mm", "--stages", "2", "--rotations", "1", "-q",
+                 "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "life")]) == 0
+    assert (tmp_path / "life" / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

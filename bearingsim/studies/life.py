@@ -207,11 +207,11 @@ def read_life(path) -> tuple[dict, dict]:
 
 def plot_life(cols: dict, attrs: dict):
     """Worn depth, pocket clearance and wear rate against running time, stage by stage."""
-    from bearingsim.plotting import plt
+    from bearingsim.plotting import subplots
 
     h_end = cols["hours_end"]
     h_start = np.concatenate([[0.0], h_end[:-1]])
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8))
+    fig, axes = subplots(1, 3, figsize=(12, 3.8))
     axes[0].plot(np.concatenate([[0.0], h_end]), np.concatenate([[0.0], cols["max_depth_um"]]), "o-")
     axes[0].set_ylabel("deepest worn point [µm]")
     axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["pocket_clearance_mm"][0]],

@@ -304,10 +304,10 @@ def read_table(path) -> tuple[list[dict], dict]:
 def plot_tornado(rows, title: str = ""):
     """A tornado chart: one panel per headline number, one bar per key, ± 1 SE; keys ordered by the
     change of ln I_dec across their plausible range (``over_range``), the largest on top."""
-    from bearingsim.plotting import plt
+    from bearingsim.plotting import subplots
 
     quantities = [q for q in QUANTITIES if any(r["quantity"] == q[0] for r in rows)]
-    fig, axes = plt.subplots(1, len(quantities), figsize=(3.6 * len(quantities) + 1.5, 0.35 * len(
+    fig, axes = subplots(1, len(quantities), figsize=(3.6 * len(quantities) + 1.5, 0.35 * len(
         {r["key"] for r in rows}) + 1.8), squeeze=False)
     order = sorted({r["key"] for r in rows if r["quantity"] == "I_dec"},
                    key=lambda k: -abs(np.nan_to_num(next(r["over_range"] for r in rows

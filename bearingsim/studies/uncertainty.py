@@ -236,11 +236,11 @@ def write_tables(outdir, indices, spreads, study) -> list[Path]:
 def plot_indices(indices, spreads, title: str = ""):
     """One panel per output: S1 and ST of every key with their confidence intervals, and the output's
     median and 5-95 % interval in the panel's title."""
-    from bearingsim.plotting import plt
+    from bearingsim.plotting import subplots
 
     qs = list(dict.fromkeys(r["quantity"] for r in indices))
     keys = list(dict.fromkeys(r["key"] for r in indices))
-    fig, axes = plt.subplots(1, len(qs), figsize=(3.8 * len(qs) + 1.5, 0.35 * len(keys) + 2.0), squeeze=False)
+    fig, axes = subplots(1, len(qs), figsize=(3.8 * len(qs) + 1.5, 0.35 * len(keys) + 2.0), squeeze=False)
     y = np.arange(len(keys))[::-1]
     for ax, q in zip(axes[0], qs):
         rows = {r["key"]: r for r in indices if r["quantity"] == q}

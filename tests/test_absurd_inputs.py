@@ -29,6 +29,7 @@ def test_impossible_bearing_values_are_refused(scenario, setting, key):
     assert "\n" not in str(info.value)
 
 
+@pytest.mark.slow
 def test_the_refusal_is_one_line_from_the_cli(tmp_path):
     res = cli("run", PAPER, "--set", "wear.wear_coefficient=1e308", "-o", tmp_path / "o.h5")
     assert_user_error(res, "wear.wear_coefficient", "Archard")
@@ -43,6 +44,7 @@ def test_values_within_the_bounds_are_accepted(setting):
     bearingsim.load_scenario(MULTIBODY, overrides=[setting])
 
 
+@pytest.mark.slow
 def test_a_decelerating_cage_is_noted_as_not_steady():
     """Almost no traction and a strong oil drag: the cage slows through the whole run (95 -> 60 rad/s in
     one recorded rotation); was reported as one steady slip with no note."""

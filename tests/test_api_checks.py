@@ -42,6 +42,7 @@ def test_run_with_dt_stores_it_in_the_scenario():
     assert same.summary == r.summary
 
 
+@pytest.mark.slow
 def test_an_implausible_run_is_refused_by_the_api_as_by_the_cli(tmp_path):
     """Rigid raceways at dt = 10 s: was I_dec = 0 from the API while the CLI exits 3."""
     sc = bearingsim.load_scenario(MULTIBODY, overrides=RIGID)

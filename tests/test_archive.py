@@ -99,6 +99,7 @@ def test_foreign_truncated_and_incomplete_files_are_refused(tmp_path, base_reduc
         open_archive(tmp_path / "missing.h5")
 
 
+@pytest.mark.slow
 def test_read_gives_back_the_written_result(tmp_path, base_reduced):
     """write(result) then read(path): same class, scenario, summary, arrays, units and time series."""
     import bearingsim
@@ -264,6 +265,7 @@ except ArchiveWriteError as exc:
 """
 
 
+@pytest.mark.slow
 def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
     """Issue 30, item 9: writes failing past 4 KiB during ``Result.save`` (in a child process: the
     limit is per process) raise one ArchiveWriteError naming the path (not h5py's raw RuntimeError

@@ -59,6 +59,7 @@ def multibody_archive(tmp_path_factory):
     return d / "m.h5"
 
 
+@pytest.mark.slow
 def test_plot_draws_every_figure_again_from_the_archive_alone(tmp_path, multibody_archive):
     lone = tmp_path / "copy.h5"
     shutil.copy(multibody_archive, lone)  # no PNG, no scenario file beside it
@@ -78,6 +79,7 @@ def _edit_json_attr(group, key, change):
     group.attrs["attrs_json"] = json.dumps(values)
 
 
+@pytest.mark.slow
 def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive):
     res = cli("rerun", reduced_archive)
     assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
@@ -91,11 +93,13 @@ def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive
     assert "I_dec_mean_Ns" in res.stdout and "differs" in res.stdout and "numpy: archive 0.0.1" in res.stdout
 
 
+@pytest.mark.slow
 def test_rerun_of_a_multibody_archive_is_bit_identical(multibody_archive):
     res = cli("rerun", multibody_archive)
     assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
 
 
+@pytest.mark.slow
 def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
     assert cli("compare", reduced_archive, reduced_archive).returncode == 0
     other = tmp_path / "o.h5"
@@ -108,6 +112,7 @@ def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
     assert_user_error(cli("compare", reduced_archive, bad), "bad.h5")
 
 
+@pytest.mark.slow
 def test_show_gives_a_runnable_scenario_with_the_same_results(tmp_path, reduced_archive):
     res = cli("show", reduced_archive)
     assert res.returncode == 0

@@ -32,6 +32,7 @@ def assert_user_error(res, *words):
         ("bearing.roller_count=0", "bearing.roller_count"),
     ],
 )
+@pytest.mark.slow
 def test_bad_override_exits_2_naming_key_and_writes_nothing(tmp_path, setting, key):
     out = tmp_path / "r.h5"
     res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", out, "--set", setting)
@@ -39,6 +40,7 @@ def test_bad_override_exits_2_naming_key_and_writes_nothing(tmp_path, setting, k
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_wrong_type_in_file_names_key(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text((SCENARIOS / "paper_3000rpm.toml").read_text().replace("rotations = 1", 'rotations = "one"'))
@@ -47,11 +49,13 @@ def test_wrong_type_in_file_names_key(tmp_path):
     assert not (tmp_path / "x.h5").exists()
 
 
+@pytest.mark.slow
 def test_missing_scenario_file(tmp_path):
     res = bearingsim("run", tmp_path / "nope.toml")
     assert_user_error(res, "nope.toml", "not found")
 
 
+@pytest.mark.slow
 def test_unwritable_output_names_the_file(tmp_path):
     blocker = tmp_path / "blocker"
     blocker.write_text("")
@@ -59,12 +63,14 @@ def test_unwritable_output_names_the_file(tmp_path):
     assert_user_error(res, "blocker")
 
 
+@pytest.mark.slow
 def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"
     f.write_bytes(b"\x00" * 100)
     assert_user_error(bearingsim("inspect", f), "x.h5")
 
 
+@pytest.mark.slow
 def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
     """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every
     dataset, the resolved scenario) and the Fig. 8 analog PNG; `inspect` reads it back; the same scenario
@@ -102,6 +108,7 @@ def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
         assert np.array_equal(f["results/per_rotation/I_dec"][()], first)
 
 
+@pytest.mark.slow
 def test_inspect_into_a_pipe_closed_early_stops_quietly(tmp_path):
     """``bearingsim inspect x.h5 | head -1``: once the reader has gone, the command stops with exit 0
     and nothing on stderr (no "Broken pipe" error, no traceback)."""
@@ -139,6 +146,7 @@ def test_inspect_into_a_pipe_closed_early_stops_quietly(tmp_path):
     assert (proc.returncode, err.decode()) == (0, "")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["show", "inspect"])
 def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_reduced, command):
     """Issue 30, Low: under a C locale (stdout ASCII, strict) a scenario named "café" made ``show`` and
@@ -164,6 +172,7 @@ def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_r
         assert "scenario caf\\xe9" in out.decode("ascii")
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
 def test_stdout_on_a_full_device_after_the_archive_is_not_exit_2(tmp_path):
     """Issue 30, Low: ``bearingsim run ... > /dev/full`` wrote its archive, then exited 2 ("bad input,

@@ -98,12 +98,14 @@ def test_the_untouched_archive_loads(archive):
     assert r.per_rotation["I_dec"].shape == (1, 1) and "I_dec_mean_Ns" in r.summary
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(CASES))
 def test_show_prints_one_line_and_exits_2(archive, tmp_path, name):
     path = _crafted(archive, tmp_path, name)
     assert_user_error(cli("show", path), path.name, *CASES[name][1])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["plot", "compare", "rerun"])
 @pytest.mark.parametrize("name", ["summary-value-a-string", "model-contradicts-data", "observables-a-dataset"])
 def test_plot_compare_rerun_print_one_line_and_exit_2(archive, tmp_path, command, name):

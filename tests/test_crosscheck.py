@@ -55,6 +55,7 @@ def _rung(out, rung):
     return bearingsim.load(_archive(out, rung))
 
 
+@pytest.mark.slow
 def test_command_succeeds_and_reports(ladder):
     """Exit 0; the table and one sentence for the speed naming the largest change and each change's
     significance."""
@@ -123,6 +124,7 @@ def test_rung4_cage_centre_held_and_momentum_balanced(ladder):
     assert r.summary["cage_slip"] != 0.0  # its speed is its own
 
 
+@pytest.mark.slow
 def test_rung5_is_bearingsim_run_of_the_scenario(ladder):
     """The full rung is ``bearingsim run`` of the scenario at that speed and rotation count, bit for bit
     (every summary number and per-rotation array); its cage momentum balances too."""
@@ -181,6 +183,7 @@ def test_refusals(argv, words, capsys, tmp_path):
     assert not (tmp_path / "cc" / "cases").exists()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_path, signum, code):
     """Issue 30, item 4: ``crosscheck -j 2`` took 7-15 s to stop after SIGINT/SIGTERM and wrote rung

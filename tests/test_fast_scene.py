@@ -35,6 +35,7 @@ def pair_6000():
 
 
 # ------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_rigid_agrees_with_the_hertz_scene_at_6000rpm(pair_6000):
     """Issue 16's agreement criterion over 12 rotations: mean I_dec and I_acc per pocket and rotation within
     max(3 %, 2 standard errors of the difference) of the Hertz full scene; load-zone half angle within 1 deg;
@@ -119,6 +120,7 @@ def test_rigid_is_refused_where_rollers_would_leave_the_outer_race():
     assert rigid_radius(p) * omega_floor**2 == pytest.approx(RIGID_MIN_CENTRIFUGAL_RATIO * op.gravity, rel=1e-9)
 
 
+@pytest.mark.slow
 def test_rigid_refusal_through_the_command_line(tmp_path):
     """A user error: one line naming the key, exit 2, no archive."""
     out = tmp_path / "x.h5"
@@ -168,6 +170,7 @@ def test_reduced_equivalent_scene_gives_the_same_impulse_with_either_raceway():
     assert r.summary["I_dec_mean_Ns"] == pytest.approx(h.summary["I_dec_mean_Ns"], rel=0.01)
 
 
+@pytest.mark.slow
 def test_a_sweep_runs_the_rigid_scene(tmp_path):
     """The recommended fast path for design maps: a sweep over the rigid scene (each case's archive
     stores the key, so the index row of a case says which raceways it ran). One warm-up rotation: a
@@ -269,6 +272,7 @@ def test_start_phase_is_the_cage_settling_onto_its_rollers():
     assert rigid_start(p0, 2e-5) == (0.0, 2e-5)
 
 
+@pytest.mark.slow
 def test_rigid_at_500rpm_keeps_its_step_and_agrees_with_the_hertz_scene():
     """At 500 rpm the cage's fall at the start (0.11 m/s at the automatic 30 us, 1.2 % of s) restarted
     the whole run with a shorter step; with the start phase the run keeps the automatic step. The
@@ -318,6 +322,7 @@ def test_a_restart_says_how_the_first_run_chose_its_step():
     assert "start_phase_s" not in res.provenance
 
 
+@pytest.mark.slow
 def test_hard_case_with_too_long_a_given_step_stops_naming_the_step(tmp_path):
     """A given step of 1 ms (scenarios/hard/multibody_dt_too_large.toml) is not refused up front by rigid
     raceways (no raceway stability limit) but the first impact overlaps the face far beyond 1 % of s: the

@@ -29,6 +29,7 @@ def _one_line_refusal(res, *words):
         assert w in lines[0], lines[0]
 
 
+@pytest.mark.slow
 def test_run_leaves_a_linked_figure_and_its_target_alone(tmp_path):
     """The issue's case: ``o_pass.png`` a link to ``../victim.txt``; the run is refused before it
     starts, the link and its target are unchanged, no archive is written."""
@@ -42,6 +43,7 @@ def test_run_leaves_a_linked_figure_and_its_target_alone(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == ["o_pass.png"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("kind", ["symlink", "text", "fifo"])
 def test_plot_refuses_a_figure_path_it_did_not_write(tmp_path, kind):
     """``plot`` checks every figure path before drawing: a link, a user's file or a FIFO is kept."""
@@ -66,6 +68,7 @@ def test_plot_refuses_a_figure_path_it_did_not_write(tmp_path, kind):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["a.h5", "a_pass.png"]
 
 
+@pytest.mark.slow
 def test_plot_replaces_its_own_figures(tmp_path):
     res = cli("run", PAPER, "-o", tmp_path / "a.h5", "-q")
     assert res.returncode == 0, res.stderr
@@ -101,6 +104,7 @@ def test_a_figure_is_written_whole_or_not_at_all(tmp_path):
 
 
 # --- lock files (item 5) -------------------------------------------------------------------------
+@pytest.mark.slow
 def test_run_lock_file_is_never_followed(tmp_path):
     """A planted ``.o.h5.lock`` link is refused (was: followed, creating its target outside the folder)."""
     out = tmp_path / "out"
@@ -113,6 +117,7 @@ def test_run_lock_file_is_never_followed(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == [".o.h5.lock"]
 
 
+@pytest.mark.slow
 def test_run_lock_file_that_is_a_users_file_is_kept(tmp_path):
     """A non-empty ``.o.h5.lock`` is not bearingsim's (its lock files are empty): refused and kept
     (was: taken as the lock and deleted when the run ended)."""
@@ -128,6 +133,7 @@ def _sweep(out):
     return cli("sweep", PAPER, "--param", "contact.restitution=0.5,0.6", "-o", out, "-j", "1")
 
 
+@pytest.mark.slow
 def test_sweep_lock_link_does_not_truncate_its_target(tmp_path):
     out = tmp_path / "sw"
     out.mkdir()
@@ -141,6 +147,7 @@ def test_sweep_lock_link_does_not_truncate_its_target(tmp_path):
 
 @pytest.mark.parametrize("name, kind", [("sweep.csv", "text"), ("sweep.h5", "text"), ("sweep_I.png", "symlink"),
                                         ("sweep_map.png", "text"), ("cases", "symlink")])
+@pytest.mark.slow
 def test_sweep_refuses_a_folder_holding_a_users_file(tmp_path, name, kind):
     """Before any case runs: a user's file or a link at a path the sweep writes is refused and kept."""
     out = tmp_path / "sw"
@@ -163,6 +170,7 @@ def test_sweep_refuses_a_folder_holding_a_users_file(tmp_path, name, kind):
     assert sorted(p.name for p in out.iterdir()) == sorted({name, ".sweep.lock"})
 
 
+@pytest.mark.slow
 def test_sweep_rewrites_its_own_files(tmp_path):
     """Its own index and figure are replaced by the next sweep into the folder (resume)."""
     out = tmp_path / "sw"
@@ -172,6 +180,7 @@ def test_sweep_rewrites_its_own_files(tmp_path):
     assert {"sweep.csv", "sweep.h5", "sweep_I.png", "cases", ".sweep.lock"} == {p.name for p in out.iterdir()}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["crosscheck.csv", "crosscheck.h5", "crosscheck.png"])
 def test_crosscheck_refuses_a_folder_holding_a_users_file(tmp_path, name):
     """Before any rung runs (the refusal takes no simulation time)."""
@@ -185,6 +194,7 @@ def test_crosscheck_refuses_a_folder_holding_a_users_file(tmp_path, name):
     assert sorted(p.name for p in out.iterdir()) == [name]
 
 
+@pytest.mark.slow
 def test_validate_figure_is_never_written_through_a_link(tmp_path):
     """``validate`` (reduced Fig. 9 only) writes its figure through ``save_figure`` too."""
     out = tmp_path / "v"

@@ -74,6 +74,7 @@ def _frame(p, sc, i, face):
     return (e_t if face == 0 else -e_t), e_r
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sign", [1, -1])
 @pytest.mark.parametrize("psi_deg", [0.0, 10.0, -20.0, 25.0, -32.0])
 @pytest.mark.parametrize("face", [0, 1])
@@ -146,6 +147,7 @@ def test_face_extent_is_the_cage_wall_s():
     assert laws.pocket_face_extent(0.05, 0.006, 0.03, 0.07) == (-math.pi / 2, math.pi / 2)  # a wall beyond the pocket
 
 
+@pytest.mark.slow
 def test_a_face_wider_than_the_wall_is_refused(tmp_path):
     """A half angle past the cage wall's outer end (26.2 deg) is a user error naming the key, one line,
     nothing written; 'auto' without the cage's diameters names the missing one."""
@@ -155,6 +157,7 @@ def test_a_face_wider_than_the_wall_is_refused(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("segments", [0, 3, 9])
 def test_land_contact_does_not_depend_on_the_faces(segments):
     """An outer-land-guided cage rides on its land whatever the faces are drawn with: exact faces and
@@ -167,6 +170,7 @@ def test_land_contact_does_not_depend_on_the_faces(segments):
     assert raw["land"]["win"][:, 0].min() > 0.1
 
 
+@pytest.mark.slow
 def test_exact_faces_reach_the_fine_polyline_s_limit():
     """The circumscribed polyline converges to the exact arc as its segments shrink: over the same two
     rotations at 3000 rpm the exact faces' I_dec is nearer a 15-segment polyline's than the 3-segment

@@ -42,6 +42,7 @@ def test_hard_cases_cover_the_issue():
         assert f"multibody_{needed}" in names, needed
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("path", HARD, ids=[p.stem for p in HARD])
 def test_hard_case(path, tmp_path):
     sc = load_scenario(path, REDUCED_LENGTH)
@@ -92,6 +93,7 @@ def _check_multibody(result, sc):
         assert result.summary["cage_orbit_max_m"] <= half * (1.0 + LAND_OVERLAP_FRACTION)
 
 
+@pytest.mark.slow
 def test_dt_too_large_exits_2_from_the_cli(tmp_path):
     """The refusal reaches the user as one line with the largest allowed dt, exit code 2, no archive."""
     res = bearingsim("run", SCENARIOS / "hard" / "reduced_euler_dt_too_large.toml", "-o", tmp_path / "x.h5")
@@ -116,6 +118,7 @@ def test_zero_restitution_and_tight_pocket_end_at_rest_with_the_drag_impulse():
         assert math.isfinite(r.summary["first_impact_speed_m_s"])
 
 
+@pytest.mark.slow
 def test_run_that_goes_unstable_midway_is_stopped_and_not_written(tmp_path):
     """A dt between the Hertz limit 2/omega_n and the refusal threshold (2x) is accepted at the start but
     the raceway contacts blow up (explicit normal force beyond its stability limit). The run must stop
@@ -134,6 +137,7 @@ def test_run_that_goes_unstable_midway_is_stopped_and_not_written(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_cage_that_escapes_its_pockets_is_stopped_and_not_written(tmp_path):
     """Only the rollers guide the cage in this model. With pocket faces of +-10 deg the cage centre
     wanders past the radial reach of the face arcs (R sin A = 1.15 mm) and, unchecked, flew 90 mm off
@@ -147,6 +151,7 @@ def test_cage_that_escapes_its_pockets_is_stopped_and_not_written(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_automatic_dt_restart_is_recorded():
     """The 0.02 mm pocket at 20000 rpm needs a shorter step than the automatic estimate (an approach
     overlaps the 20 um clearance's face by 0.67 um at the automatic step, more than three times the

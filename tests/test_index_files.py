@@ -39,6 +39,7 @@ def _crosscheck_index(folder):
     return write_table(folder, rows, sc)[1], sc
 
 
+@pytest.mark.slow
 def test_inspect_and_show_describe_a_sweep_index(tmp_path):
     h5 = _sweep_index(tmp_path)
     res = bearingsim("inspect", h5)
@@ -50,6 +51,7 @@ def test_inspect_and_show_describe_a_sweep_index(tmp_path):
     assert all(line.startswith("# ") for line in res.stdout.splitlines()) and "3 cases" in res.stdout
 
 
+@pytest.mark.slow
 def test_inspect_and_show_describe_a_crosscheck_table(tmp_path):
     h5, sc = _crosscheck_index(tmp_path)
     res = bearingsim("inspect", h5)
@@ -84,12 +86,14 @@ def test_sweep_help_documents_the_range():
     assert "START:STOP:NUM" in res.stdout
 
 
+@pytest.mark.slow
 def test_param_inline_table_is_not_split_at_its_commas(tmp_path):
     res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "contact={restitution = 0.5, friction = 0.1}",
                      "-o", tmp_path, "-j", "1")
     assert_user_error(res, "contact={'restitution': 0.5, 'friction': 0.1}")  # the table whole, not '{restitution = 0.5'
 
 
+@pytest.mark.slow
 def test_keys_the_reduced_model_does_not_use_are_noted(tmp_path):
     base = SCENARIOS / "paper_3000rpm.toml"
     res = bearingsim("run", base, "--set", "bearing.cage_guidance=outer_land", "--set", "numerics.rotations=1",

@@ -6,6 +6,8 @@ import subprocess
 import sys
 import textwrap
 
+import pytest
+
 DEP = """
 from numba import njit
 
@@ -38,6 +40,7 @@ def _run(tmp_path, v):
     return int(out.stdout.strip())
 
 
+@pytest.mark.slow
 def test_guard_recompiles_after_an_edit_of_the_dependency(tmp_path):
     """Without the drop_stale_caches line the second run returns 1 with numba 0.68 (the cached caller keeps
     the old kernel; seen when this test was written): the guard is what makes it 2."""

@@ -75,6 +75,7 @@ def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_s
     assert keys["multibody.scene"].unused_by == ("reduced",)
 
 
+@pytest.mark.slow
 def test_keys_command(tmp_path):
     res = cli("keys", "numerics.")
     assert res.returncode == 0, res.stderr
@@ -89,6 +90,7 @@ def test_keys_command(tmp_path):
 
 # --- the resolved scenario before a run ------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_show_of_a_scenario_file_is_the_resolved_scenario(tmp_path):
     res = cli("show", PAPER, "--set", "bearing.roller_count=14")
     assert res.returncode == 0, res.stderr
@@ -101,6 +103,7 @@ def test_show_of_a_scenario_file_is_the_resolved_scenario(tmp_path):
     assert_user_error(cli("show", PAPER, "--set", "bearing.roler_count=14"), "did you mean bearing.roller_count?")
 
 
+@pytest.mark.slow
 def test_run_dry_run_runs_and_writes_nothing(tmp_path):
     res = cli("run", PAPER, "--dry-run", "--set", "operating.inner_ring_speed_rpm=500", cwd=tmp_path)
     assert res.returncode == 0, res.stderr

@@ -60,6 +60,7 @@ def test_outer_land_holds_the_cage_within_half_the_clearance(name, request):
     assert np.all(res.per_rotation["land_normal"] > 0.0)
 
 
+@pytest.mark.slow
 def test_inner_land_holds_the_cage_about_the_inner_ring(inner_3000):
     """On an inner land the cage is guided by the inner ring, whose centre moves with the load
     (~44 um down): the cage centre stays within c_L/2 (+ 1 % overlap bound) of the ring centre, so
@@ -150,6 +151,7 @@ def test_zero_or_negative_land_clearance_refused(value):
         _scenario("outer_land", extra=[f"bearing.cage_land_clearance_mm={value}"])
 
 
+@pytest.mark.slow
 def test_zero_land_clearance_is_one_line_from_the_cli(tmp_path):
     res = bearingsim("run", BASE, "--set", "bearing.cage_guidance=outer_land", "--set",
                      "bearing.cage_land_clearance_mm=0", "-o", tmp_path / "x.h5")

@@ -80,6 +80,7 @@ def test_rebound_ratio_equals_restitution():
     assert v_after / v0 == pytest.approx(e, rel=5e-3)
 
 
+@pytest.mark.slow
 def test_no_penetration(full_3000):
     """A roller never passes through a cage face: pymunk's contact solver keeps the overlap at the
     collision slop plus what one step's approach can add. Bound from the issue: 1 % of s."""
@@ -94,6 +95,7 @@ def test_cage_angular_momentum_balance(full_3000):
     assert abs(full_3000.summary["torque_balance_residual"]) < 0.01
 
 
+@pytest.mark.slow
 def test_frictionless_acc_dec_balance(full_3000_frictionless):
     """With frictionless pockets the only torques on the cage are the circumferential pocket forces;
     at steady cage speed their long-run mean cancels: I_acc / I_dec -> 1 (docs/physics.md).
@@ -124,6 +126,7 @@ def test_force_location(full_3000):
     assert phi < onset < phi + 60, onset
 
 
+@pytest.mark.slow
 def test_forward_reverse_same_I_dec(full_3000, full_3000_reverse):
     """Mirror symmetry (paper Fig. 7): reversing the rotation mirrors the scene, so the mean I_dec is
     the same; 5 % covers the statistical scatter of 320 pocket-rotations (std/mean ~ 0.3, correlated)."""
@@ -179,6 +182,7 @@ def test_inner_race_contact_extent_matches_discrete_quasi_statics(full_3000):
     assert full_3000.summary["load_zone_contact_half_angle_deg"] == pytest.approx(edge, abs=1.5), edge
 
 
+@pytest.mark.slow
 def test_dynamic_inner_ring_agrees_with_quasi_static_where_both_apply(full_3000):
     """With 16 rollers at 970 N the load is always shared by >= 2 rollers, so a dynamic inner ring (the
     rotor's mass W/g) must carry the same mean load on the same mean displacement as the quasi-static
@@ -212,6 +216,7 @@ def test_inner_ring_auto_choice():
     assert mass == pytest.approx(970.0 / STANDARD_GRAVITY) and "dynamic" in how
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rpm", [1000, 3000, 6000])
 def test_reduced_equivalent_matches_event_model(rpm):
     """The reduced-equivalent scene makes the reduced model's assumptions (docs/physics.md), so its mean
@@ -225,6 +230,7 @@ def test_reduced_equivalent_matches_event_model(rpm):
     assert r.per_rotation["I_dec"].mean() == pytest.approx(ref, rel=0.02)
 
 
+@pytest.mark.slow
 def test_I_dec_converges_with_dt():
     """Time-step convergence: over three halvings of dt the change of I_dec shrinks (deterministic
     reduced-equivalent scene at 3000 rpm, dt from 0.5x to 1/16x of the explicit Hertz limit). The
@@ -249,6 +255,7 @@ def test_dt_far_too_large_is_user_error():
         simulate(sc)
 
 
+@pytest.mark.slow
 def test_cli_main_job(tmp_path):
     """The README's main job writes an archive with the public names and units."""
     out = tmp_path / "mb.h5"

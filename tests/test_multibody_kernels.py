@@ -117,6 +117,7 @@ def _orbiting_roller(omega, r0):
     return state
 
 
+@pytest.mark.slow
 def test_roller_on_outer_race_carries_its_centrifugal_load():
     """A roller orbiting at omega on radius r0 presses on the outer race with its centrifugal load
     ``m r0 omega^2``: with the race placed so that the roller overlaps it by the Palmgren approach of that load,
@@ -270,6 +271,7 @@ FRONT_CONTACT = ((1.0, 0.0), (ROLLER_RADIUS, -0.04875), (ROLLER_RADIUS, -0.04875
 REAR_CONTACT = ((-1.0, 0.0), (-ROLLER_RADIUS, -0.04875), (-ROLLER_RADIUS, -0.04875))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("roller_is_a", [True, False])
 def test_front_face_impulse_is_I_acc(roller_is_a):
     """A roller moving ahead (+e_t) into the front face pushes the cage forward: the cage receives
@@ -381,6 +383,7 @@ def _same_bytes_without(probe, says, sc, monkeypatch):
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
 @pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", []), ("multibody_reduced_equivalent_3000rpm", []),
                                              ("multibody_3000rpm", ["multibody.raceway_contact=rigid"])])
+@pytest.mark.slow
 def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extra):
     """The plain loop (``Space.step`` and ``pymunk.batch``) calls the same kernels on the same inputs as
     the compiled one, so every accumulator, the impact table and the final state are identical bytes

@@ -479,6 +479,7 @@ def _unshare_works() -> bool:
         ["unshare", "-rm", "true"], capture_output=True).returncode == 0
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", _params())
 def test_case(case, tmp_path):
     if str(case.setup).startswith("tmpfs") and not _unshare_works():
@@ -631,6 +632,7 @@ def test_too_few_samples_advice_names_the_cause():
 
 
 # --- signals ----------------------------------------------------------------------------------------
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
 def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     obs = signal_case(tmp_path, sig)
@@ -638,6 +640,7 @@ def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     assert not obs.problems, obs.problems
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
 def test_signal_stops_the_euler_pass_within_a_second_leaving_nothing(tmp_path, sig, code):
     """The euler method's compiled loop returns to Python every ``CHUNK_STEPS`` steps, and returns no
@@ -667,6 +670,7 @@ except cli.Terminated:
 """
 
 
+@pytest.mark.slow
 def test_sigterm_inside_the_compiled_euler_loop_raises_cleanly():
     """A SIGTERM landing in the euler method's compiled loop: its handler's exception comes out of
     ``solve_euler`` within a chunk of steps. Before issue 30 the kernel returned arrays, numba ran the
@@ -739,6 +743,7 @@ def _long_run(tmp_path, kind="multibody"):
         yield proc
 
 
+@pytest.mark.slow
 def test_two_runs_to_one_archive_second_is_refused(tmp_path):
     """A real second run while the first is writing: refused (exit 2, one line); the first, then
     stopped by SIGTERM, leaves nothing; the lock is then free for a third run."""
@@ -755,6 +760,7 @@ def test_two_runs_to_one_archive_second_is_refused(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]
 
 
+@pytest.mark.slow
 def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     """SIGKILL cannot be handled: the run leaves ``.m.h5.tmp-PID`` (and its lock file, whose lock died
     with the process); the next run into that folder removes the temporary, says so, and writes
@@ -877,6 +883,7 @@ if __name__ == "__main__":
         print(__doc__)
 
 
+@pytest.mark.slow
 def test_rerun_output_takes_the_run_lock_and_cleans_dead_temporaries(tmp_path):
     """Issue 30, item 8: ``rerun -o`` writes through the path of ``run``: a temporary archive of a dead
     run in the target folder is removed (with a note), and a target whose lock another run holds is
@@ -933,6 +940,7 @@ def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary
 
 
+@pytest.mark.slow
 def test_a_refused_run_leaves_no_folder_it_created(tmp_path):
     """Issue 30, Low: a run refused after it took its output lock (here a step too long for the euler
     method, found when the run starts) left the folders it had created for ``-o new/deeper/out.h5``.

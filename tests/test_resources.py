@@ -23,6 +23,7 @@ HANG_TIMEOUT_S = 120  # ends a hang; a refusal takes the time of an import
     (["compare", "{fifo}", "{fifo}"], "archive"),
     (["rerun", "{fifo}"], "archive"),
 ], ids=lambda v: v[0] if isinstance(v, list) else None)
+@pytest.mark.slow
 def test_a_fifo_is_refused_not_waited_on(tmp_path, args, what):
     """Was: ``bearingsim run FIFO`` hung forever (opening a FIFO blocks until a writer comes). Now every
     input path is checked to be a regular file before it is opened: exit 2, one line. (The timeout only
@@ -41,6 +42,7 @@ def test_a_fifo_is_refused_not_waited_on(tmp_path, args, what):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.toml"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("call", ["load_scenario", "load"])
 def test_the_api_refuses_a_fifo_too(tmp_path, call):
     """``bearingsim.load_scenario`` and ``bearingsim.load`` of a FIFO: a UserError (run in a child, so
@@ -63,6 +65,7 @@ def _sweep_file(tmp_path, axes: str):
     return path
 
 
+@pytest.mark.slow
 def test_a_sweep_range_of_a_trillion_values_is_refused_at_once(tmp_path):
     """Was: ``num = 1000000000000`` accepted (then numpy's linspace ran out of memory, with advice
     about numerics.rotations)."""

@@ -4,6 +4,7 @@ import pickle
 from concurrent.futures import ProcessPoolExecutor
 
 import numpy as np
+import pytest
 
 import bearingsim
 from bearingsim.compare import compare_results
@@ -37,6 +38,7 @@ def test_result_pickles_and_round_trips_equal(tmp_path):
     assert repr(back.provenance) == repr(loaded.provenance)  # dt_s may be nan (not equal to itself)
 
 
+@pytest.mark.slow
 def test_run_maps_over_a_process_pool():
     """``ProcessPoolExecutor().map(bearingsim.run, scenarios)`` on the public API (spawned workers: the
     scenarios go out and the results come back through pickle alone)."""
@@ -84,6 +86,7 @@ print(matplotlib.get_backend(), "matplotlib.pyplot" in sys.modules, len(names) =
 """
 
 
+@pytest.mark.slow
 def test_figures_leave_the_users_matplotlib_backend_alone(tmp_path):
     """Issue 29, item 4: importing bearingsim's plotting switched matplotlib to Agg for the whole process
     (``matplotlib.use("Agg")``) and drew through pyplot. Figures are now Figure objects with their own

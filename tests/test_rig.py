@@ -13,6 +13,7 @@ def test_rig_scenario_files_are_the_rig_scene(rpm):
     assert load_scenario(SCENARIOS / f"rig_{rpm}rpm.toml").raw == rig_scenario(float(rpm)).raw
 
 
+@pytest.mark.slow
 def test_flat_rig_pocket_against_the_reduced_model_at_1000_rpm():
     """Goal of issue 12 (paper Fig. 9: the reduced model agreed with the measured pocket): pocket 0's mean
     I_dec per rotation within +-25 % of the reduced model's. Measured on the exact pocket faces

@@ -16,6 +16,7 @@ SPEED = "operating.inner_ring_speed_rpm"
 
 
 # --- defect 2: --set must not silently replace another scenario's archive --------------------------------
+@pytest.mark.slow
 def test_run_refuses_to_replace_an_archive_of_another_scenario(tmp_path):
     out = tmp_path / "a.h5"
     assert bearingsim("run", BASE, "-o", out, "--no-plots", "-q").returncode == 0
@@ -30,6 +31,7 @@ def test_run_refuses_to_replace_an_archive_of_another_scenario(tmp_path):
     assert load_scenario(BASE, [f"{SPEED}=500"]) == __import__("bearingsim").load(out).scenario
 
 
+@pytest.mark.slow
 def test_sweep_folder_of_another_sweep_is_refused_resume_and_force_work(tmp_path):
     first = ("sweep", BASE, "--param", f"{SPEED}=1000,2000", "-o", tmp_path, "-j", "1", "--no-plots")
     assert bearingsim(*first).returncode == 0

@@ -54,6 +54,7 @@ ISHIGAMI_S1 = np.array([0.3139, 0.4424, 0.0])
 ISHIGAMI_ST = np.array([0.5576, 0.4424, 0.2437])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_sobol_indices_of_the_ishigami_function(seed):
     """N = 4096 base samples through design() and sobol_indices(), the functions the uncertainty study

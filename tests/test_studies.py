@@ -26,6 +26,7 @@ def _archives(out):
     return {p.name: (p.stat().st_ino, p.stat().st_mtime_ns) for p in (out / "cases").glob("*.h5")}
 
 
+@pytest.mark.slow
 def test_a_failing_rung_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
     """Rung 3 given an impossible time step (1 ms, far above the bearing's stable step) fails at run
     time: the other four rungs' numbers are in the table, rung 3 has empty numbers, its status and
@@ -86,6 +87,7 @@ class _InterruptedAfterFirstCase(LocalEngine):
             os.kill(os.getpid(), signal.SIGINT)
 
 
+@pytest.mark.slow
 def test_an_interrupted_crosscheck_resumes_from_the_finished_rungs(tmp_path):
     """SIGINT after the first rung: the cross-check stops (no table), the finished rung's archive and
     the case index stay. The same cross-check again takes that archive as it is (cached, the file
@@ -151,6 +153,7 @@ def test_fig9_study_gives_the_table_of_before(tmp_path):
         assert {r["status"] for r in csv.DictReader(fh)} == {"cached"}
 
 
+@pytest.mark.slow
 def test_rig_study_gives_the_row_of_a_direct_run(tmp_path):
     """The rig study's row at 4000 rpm (2 rotations), through the engine (case archives written by worker
     processes, read back), is bit for bit the row made from a direct run of the same two scenarios in this
@@ -173,6 +176,7 @@ def test_rig_study_gives_the_row_of_a_direct_run(tmp_path):
     assert (tmp_path / "rig_idec_vs_speed.csv").is_file() and (tmp_path / "rig_pocket0_forces.png").is_file()
 
 
+@pytest.mark.slow
 def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
     """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come
     back as archives and give the very table the local pool gives."""

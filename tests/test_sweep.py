@@ -34,6 +34,7 @@ def _rows(folder):
         return list(csv.DictReader(fh))
 
 
+@pytest.mark.slow
 def test_sweep_table_matches_single_runs(tmp_path):
     res = bearingsim("sweep", BASE, "--param", f"{SPEED}=500,6000", "--param", "lubrication.drag_coefficient=0.01,0.03",
                      "-o", tmp_path, "-j", "2")
@@ -56,6 +57,7 @@ def test_sweep_table_matches_single_runs(tmp_path):
     np.testing.assert_array_equal(cols[SPEED], [500.0, 500.0, 6000.0, 6000.0])
 
 
+@pytest.mark.slow
 def test_sweep_with_a_bad_point_runs_nothing(tmp_path):
     res = bearingsim("sweep", BASE, "--param", "contact.restitution=0.5,1.5", "-o", tmp_path)
     assert_user_error(res, "contact.restitution")
@@ -67,12 +69,14 @@ def test_sweep_with_a_bad_point_runs_nothing(tmp_path):
     (["--param", f"{SPEED}=500,1000", "--set", f"{SPEED}=2000"], SPEED),
     (["--param", "bearing.no_such_key=1,2"], "bearing.no_such_key"),
 ])
+@pytest.mark.slow
 def test_key_twice_or_unknown_is_refused_before_running(tmp_path, args, key):
     res = bearingsim("sweep", BASE, *args, "-o", tmp_path / "out")
     assert_user_error(res, key)
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_sweep_file_zip_and_extra_cases(tmp_path):
     f = tmp_path / "s.toml"
     f.write_text(f"""scenario = "{BASE}"
@@ -107,6 +111,7 @@ lubrication.drag_coefficient = [0.01, 0.02, 0.03]
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_shipped_sweep_files_resolve():
     files = sorted((SCENARIOS / "sweeps").glob("*.toml"))
     assert len(files) >= 3
@@ -228,6 +233,7 @@ def test_sweep_wall_time_covers_its_cases(tmp_path, monkeypatch):
     assert out.wall_s >= sum(r["wall_s"] for r in out.rows) > 0.0
 
 
+@pytest.mark.slow
 def test_failed_case_is_recorded_and_the_others_go_on(tmp_path):
     # the euler method refuses a too-large time step only when the case runs
     res = bearingsim("sweep", BASE, "--set", "reduced.method=euler", "--param", "numerics.dt_s=1e-6,0.01,2e-6",
@@ -274,6 +280,7 @@ def _descendants(pid):
         return []
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code):
     import psutil
@@ -338,6 +345,7 @@ def test_a_signal_inside_a_weakref_callback_is_kept_without_a_traceback(monkeypa
     assert sys.unraisablehook is hook and ref_a() is None and ref_b() is None
 
 
+@pytest.mark.slow
 def test_local_cluster_runs_the_same_cases(tmp_path):
     pytest.importorskip("distributed")
     from distributed import LocalCluster
@@ -366,6 +374,7 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
             assert bool(f["bearingsim"].attrs["complete"])
 
 
+@pytest.mark.slow
 def test_unreachable_scheduler_is_a_user_error():
     pytest.importorskip("distributed")
     from bearingsim.errors import UserError
@@ -377,6 +386,7 @@ def test_unreachable_scheduler_is_a_user_error():
             DaskEngine("tcp://127.0.0.1:9", timeout_s=1).start()
 
 
+@pytest.mark.slow
 def test_figures_from_the_index(tmp_path):
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 3000])], sets=["numerics.rotations=2"])
     out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=True, progress=False)

@@ -64,6 +64,7 @@ def test_a_text_key_is_a_categorical_axis(tmp_path, figures):
     assert [a["xticks"] for a in panels] == [["rollers", "outer_land", "inner_land"]] * 2
 
 
+@pytest.mark.slow
 def test_extra_cases_get_a_per_case_chart(tmp_path, figures):
     points = [{SPEED: 1000.0}, {SPEED: 2000.0}, {SPEED: 3000.0, "contact.restitution": 0.6}]
     h5 = _index(tmp_path, points, [SPEED, "contact.restitution"], grid=[SPEED], grid_rows=2)
@@ -105,6 +106,7 @@ def test_title_names_the_swept_keys_not_the_base_scenario(tmp_path, figures):
     assert "inner ring speed × pocket clearance" in title and "4 cases" in title and "paper_3000rpm" not in title
 
 
+@pytest.mark.slow
 def test_plot_says_why_and_fails_when_it_draws_nothing(tmp_path):
     h5 = _index(tmp_path, [{SPEED: s} for s in (1000.0, 2000.0)], [SPEED], results=False)
     assert plot_sweep_index(h5, tmp_path / "f", notes=(notes := [])) == [] and len(notes) == 1

@@ -102,6 +102,7 @@ def test_marks_only_where_the_difference_exceeds_two_standard_errors():
 
 # --- the commands -------------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_compare_of_three_archives(reduced_runs):
     d = reduced_runs
     res = cli("compare", d / "a.h5", d / "b.h5", d / "c.h5")
@@ -115,6 +116,7 @@ def test_compare_of_three_archives(reduced_runs):
     assert two.returncode == 1 and "contact.restitution: 0.8 -> 0.6" in two.stdout and "differs: per_rotation/I_dec" in two.stdout
 
 
+@pytest.mark.slow
 def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
     d = reduced_runs
     res = cli("table", d / "a.h5", d / "c.h5", "--columns", "I_dec_mean_Ns,first_impact_speed_m_s")
@@ -128,6 +130,7 @@ def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
     assert_user_error(cli("table", d / "nope.h5"), "nope.h5")
 
 
+@pytest.mark.slow
 def test_sweep_prints_its_table_and_table_of_the_folder_is_the_same(tmp_path):
     out = tmp_path / "sw"
     res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1", "--no-plots")
@@ -174,6 +177,7 @@ def _validate_on_a_terminal(tmp_path, *extra):
     return proc.returncode, b"".join(got).decode("utf-8", "replace"), out
 
 
+@pytest.mark.slow
 def test_validate_shows_progress_on_a_terminal_and_not_with_q(tmp_path):
     rc, term, out = _validate_on_a_terminal(tmp_path)
     assert rc == 0 and "fig9" in term and "36/36" in term and "case" in term, term
@@ -182,6 +186,7 @@ def test_validate_shows_progress_on_a_terminal_and_not_with_q(tmp_path):
     assert rc == 0 and term == "" and out == "", (term, out)
 
 
+@pytest.mark.slow
 def test_no_progress_text_when_stderr_is_not_a_terminal(tmp_path):
     res = cli("validate", "--rig-rotations", "0", "-j", "1", "-o", tmp_path / "v")
     assert res.returncode == 0, res.stderr

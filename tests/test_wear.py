@@ -224,3 +224,18 @@ def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, c
     assert main(["life", scenario, "--limit", "clearance=0.203mm", "--stages", "2", "--rotations", "1", "-q",
                  "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "life")]) == 0
     assert (tmp_path / "life" / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+@pytest.mark.parametrize("name", ["life.h5", "life.png"])
+def test_life_keeps_a_users_file_in_its_folder(tmp_path, capsys, name):
+    """A life.h5 or life.png bearingsim did not write is refused in one line (exit 2), kept as it was,
+    and nothing is run or created."""
+    from bearingsim.cli import main
+
+    (tmp_path / name).write_text("my notes")
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm",
+                 "--stages", "2", "--rotations", "1", "-o", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert code == 2 and name in err and "not replaced" in err and len(err.strip().splitlines()) == 1
+    assert (tmp_path / name).read_text() == "my notes"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]

@@ -136,8 +136,9 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
         raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                         f"(bearing.pocket_clearance_mm); give a larger one")
     folder = Path(folder)
-    (folder / "stages").mkdir(parents=True, exist_ok=True)
+    _check_outputs(folder)
     _check_folder(folder, scenario, limit, force)
+    (folder / "stages").mkdir(parents=True, exist_ok=True)
     rows = []
     with FolderLock(folder):
         st = _State(s0)
@@ -184,6 +185,16 @@ def _row(j, sc, res, rate, n_stage, st, reused) -> dict:
         "clearance_end_mm": st.clearance() * 1e3, "I_dec_mean_mNs": res.summary["I_dec_mean_Ns"] * 1e3,
         "reused": int(reused),
     }
+
+
+def _check_outputs(folder: Path) -> None:
+    """A ``life.h5`` or ``life.png`` in ``folder`` that bearingsim did not write (a user's file, a link, a
+    folder) is refused in one line and kept, before anything is created or run."""
+    from bearingsim import archive
+    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
+
+    check_replaceable(folder / "life.h5", lambda p: archive.is_table_file(p, LIFE_FORMAT), "life history")
+    check_replaceable(folder / "life.png", PNG_SIGNATURE, "figure")
 
 
 def _check_folder(folder: Path, scenario, limit: Limit, force: bool) -> None:

@@ -108,6 +108,27 @@ def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch
         by[(KEYS[1], "I_dec")]["sensitivity"]
 
 
+def test_uncertainty_reads_the_summaries_the_archives_hold(tmp_path):
+    """The study's finish step takes each case's summary from the sweep's record (no archive loaded in
+    full): its outputs equal, bit for bit, the numbers of every archive loaded in full, both after the
+    runs (records from the runs) and on a resume (records read back from the archives)."""
+    from bearingsim.studies.engine import load_result, run_studies
+    from bearingsim.studies.uncertainty import Uncertainty
+
+    sc = load_scenario(REDUCED)
+    for expect in ("done", "cached"):
+        study = Uncertainty(sc, 2, seed=5, keys=KEYS)
+        out = run_studies([study], tmp_path)
+        assert out.count(expect) == len(study.cases) == 8
+        records = {r["case"]: r for r in out.sweep.rows}
+        f = study.outputs_of(tmp_path, records)
+        for (block, j), c in study.grid.items():
+            row = 0 if block == "A" else 1 if block == "B" else 2 + block
+            full = load_result(tmp_path, records[c.hash]).summary
+            assert f["I_dec"][row, j] == full["I_dec_mean_Ns"] and f["I_acc"][row, j] == full["I_acc_mean_Ns"]
+        assert np.all(np.isfinite(f["I_dec"])) and np.ptp(f["I_dec"]) > 0  # the design varies the answer
+
+
 def test_ranges_are_stored_in_the_archive_and_shown(tmp_path, capsys):
     out = tmp_path / "x.h5"
     assert main(["run", str(REDUCED), "-o", str(out), "--no-plots", "-q"]) == 0

@@ -81,6 +81,18 @@ def test_two_seeds_agree_within_their_intervals_and_a_seed_repeats():
         assert np.all(diff <= 2 * np.hypot(r[0][f"{name}_se"], r[1][f"{name}_se"]))
 
 
+def test_a_rarely_nonzero_output_has_finite_intervals():
+    """An output that is zero at all but one point of A and B (the reduced model's I_acc at 6000 rpm):
+    resamples without that point do not vary; they give no share (left out), not +-inf, so the
+    intervals are finite numbers and no warning is raised (pytest turns warnings into errors)."""
+    fa, fb, fab = np.zeros(16), np.zeros(16), np.zeros((2, 16))
+    fb[3], fab[0, 5] = 1.0, 1.0
+    r = sobol_indices(fa, fb, fab, 0)
+    for name in ("S1_low", "S1_high", "ST_low", "ST_high"):
+        assert np.all(np.isfinite(r[name])), name
+    assert np.all(r["ST_low"] <= r["ST"]) and np.all(r["ST"] <= r["ST_high"])
+
+
 def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
     """The + run of the drag coefficient given the explicit Euler method at a 5 ms step fails
     (unstable): its key's rows have NaN numbers, status failed and the error; the other key's rows are

@@ -67,6 +67,8 @@ def _indices(fa, fb, fab):
     c = np.mean(np.concatenate([fa, fb]))
     fa, fb, fab = fa - c, fb - c, fab - c
     v = np.var(np.concatenate([fa, fb]), ddof=1)
+    if not v > 0.0:  # a bootstrap resample where A and B do not vary: no shares (NaN, not +-inf)
+        return np.full(len(fab), np.nan), np.full(len(fab), np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):  # a resample where nothing varies: NaN
         s1 = np.mean(fb[None, :] * (fab - fa[None, :]), axis=1) / v
         st = 0.5 * np.mean((fa[None, :] - fab) ** 2, axis=1) / v

@@ -82,6 +82,18 @@ def test_two_seeds_agree_within_their_intervals_and_a_seed_repeats():
         assert np.all(diff <= 2 * np.hypot(r[0][f"{name}_se"], r[1][f"{name}_se"]))
 
 
+def test_a_rarely_nonzero_output_has_finite_intervals():
+    """An output that is zero at all but one point of A and B (the reduced model's I_acc at 6000 rpm):
+    resamples without that point do not vary; they give no share (left out), not +-inf, so the
+    intervals are finite numbers and no warning is raised (pytest turns warnings into errors)."""
+    fa, fb, fab = np.zeros(16), np.zeros(16), np.zeros((2, 16))
+    fb[3], fab[0, 5] = 1.0, 1.0
+    r = sobol_indices(fa, fb, fab, 0)
+    for name in ("S1_low", "S1_high", "ST_low", "ST_high"):
+        assert np.all(np.isfinite(r[name])), name
+    assert np.all(r["ST_low"] <= r["ST"]) and np.all(r["ST"] <= r["ST_high"])
+
+
 def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
     """The + run of the drag coefficient given the explicit Euler method at a 5 ms step fails
     (unstable): its key's rows have NaN numbers, status failed and the error; the other key's rows are
@@ -107,6 +119,27 @@ def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch
     assert again.outcome.count("cached") == 3 and again.outcome.count("done") == 1
     assert {(r["key"], r["quantity"]): r["sensitivity"] for r in again.table}[(KEYS[1], "I_dec")] == \
         by[(KEYS[1], "I_dec")]["sensitivity"]
+
+
+def test_uncertainty_reads_the_summaries_the_archives_hold(tmp_path):
+    """The study's finish step takes each case's summary from the sweep's record (no archive loaded in
+    full): its outputs equal, bit for bit, the numbers of every archive loaded in full, both after the
+    runs (records from the runs) and on a resume (records read back from the archives)."""
+    from bearingsim.studies.engine import load_result, run_studies
+    from bearingsim.studies.uncertainty import Uncertainty
+
+    sc = load_scenario(REDUCED)
+    for expect in ("done", "cached"):
+        study = Uncertainty(sc, 2, seed=5, keys=KEYS)
+        out = run_studies([study], tmp_path)
+        assert out.count(expect) == len(study.cases) == 8
+        records = {r["case"]: r for r in out.sweep.rows}
+        f = study.outputs_of(tmp_path, records)
+        for (block, j), c in study.grid.items():
+            row = 0 if block == "A" else 1 if block == "B" else 2 + block
+            full = load_result(tmp_path, records[c.hash]).summary
+            assert f["I_dec"][row, j] == full["I_dec_mean_Ns"] and f["I_acc"][row, j] == full["I_acc_mean_Ns"]
+        assert np.all(np.isfinite(f["I_dec"])) and np.ptp(f["I_dec"]) > 0  # the design varies the answer
 
 
 def test_ranges_are_stored_in_the_archive_and_shown(tmp_path, capsys):

@@ -188,3 +188,20 @@ def load_result(outdir: Path, record: dict):
     if record["status"] not in FINISHED:
         return None
     return bearingsim.load(Path(outdir) / record["archive"])
+
+
+def summary_of(outdir: Path, record: dict) -> dict[str, float] | None:
+    """The summary numbers of a finished case without loading its archive, or None for a failed or
+    pending case: the sweep's record holds them (from the run itself, or read by
+    :func:`bearingsim.archive.peek` for a case found in its archive); a record without them is read
+    the same cheap way (the summary's attributes, not the time series)."""
+    from bearingsim import archive
+
+    if record["status"] not in FINISHED:
+        return None
+    if record.get("summary"):
+        return record["summary"]
+    got = archive.peek(Path(outdir) / record["archive"])
+    if got is None:
+        raise UserError(f"{Path(outdir) / record['archive']}: incomplete or damaged archive of a finished case")
+    return got["summary"]

@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.studies.engine import Study, case_of, load_result
+from bearingsim.studies.engine import Study, case_of, summary_of
 
 INDEX_FORMAT = "bearingsim uncertainty index 1"
 BOOTSTRAP = 1000
@@ -67,6 +67,8 @@ def _indices(fa, fb, fab):
     c = np.mean(np.concatenate([fa, fb]))
     fa, fb, fab = fa - c, fb - c, fab - c
     v = np.var(np.concatenate([fa, fb]), ddof=1)
+    if not v > 0.0:  # a bootstrap resample where A and B do not vary: no shares (NaN, not +-inf)
+        return np.full(len(fab), np.nan), np.full(len(fab), np.nan)
     with np.errstate(invalid="ignore", divide="ignore"):  # a resample where nothing varies: NaN
         s1 = np.mean(fb[None, :] * (fab - fa[None, :]), axis=1) / v
         st = 0.5 * np.mean((fa[None, :] - fab) ** 2, axis=1) / v
@@ -171,12 +173,12 @@ class Uncertainty(Study):
         quantities = [q for q in QUANTITIES if self.scenario.model == "multibody" or q[0] != "cage_slip"]
         out = {q: np.full((k + 2, n), np.nan) for q, _, _ in quantities}
         for (block, j), c in self.grid.items():
-            res = load_result(outdir, records[c.hash])
-            if res is None:
+            summary = summary_of(outdir, records[c.hash])  # the summary alone: no archive loaded in full
+            if summary is None:
                 continue
             row = 0 if block == "A" else 1 if block == "B" else 2 + block
             for q, name, _ in quantities:
-                out[q][row, j] = float(res.summary[name])
+                out[q][row, j] = float(summary[name])
         return out
 
     def finish(self, outdir, records) -> list[Path]:

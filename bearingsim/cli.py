@@ -60,8 +60,8 @@ def _cmd_run(args) -> int:
 
 
 def _describe_index(path) -> tuple[str, str | None] | None:
-    """(description, scenario TOML or None) of bearingsim's own index files (``sweep.h5``,
-    ``crosscheck.h5``); None for any other file."""
+    """(description, scenario TOML or None) of bearingsim's own index files (``sweep.h5``, ``map.h5``,
+    ``crosscheck.h5``, the study tables); None for any other file."""
     import json
 
     from bearingsim import archive
@@ -74,10 +74,14 @@ def _describe_index(path) -> tuple[str, str | None] | None:
         lines = [f"sweep mode {meta.get('mode', '?')}; base scenario {meta.get('scenario') or '(none)'}",
                  "swept keys: " + (", ".join(meta["axes"]) or "(none)"),
                  f"grid of {', '.join(meta['grid']) or '(no axes)'}: {n} cases; extra cases: {total - n}",
-                 "each case's archive: the 'archive' column (relative to this folder); "
-                 "'bearingsim show' of a case archive gives its scenario"]
+                 "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
+                 "without one); 'bearingsim show' of a case archive gives its scenario"]
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
                                       meta["columns"], lines), None
+    from bearingsim.sweeps.grid import MAP_FORMAT, describe_map, read_map
+
+    if archive.is_grid_file(path, MAP_FORMAT):
+        return describe_map(path), read_map(path).attrs.get("scenario")
     if archive.is_table_file(path, crosscheck.INDEX_FORMAT):
         cols, meta = archive.read_table_file(path, crosscheck.INDEX_FORMAT)
         columns = json.loads(meta["columns"])

@@ -164,6 +164,20 @@ def test_archives_all_writes_every_archive_with_the_same_numbers(tmp_path):
     assert keeps_archive("reduced", "all") and not keeps_archive("multibody", "none")
 
 
+def test_inspect_show_and_table_of_a_map_folder(tmp_path):
+    """``inspect map.h5`` says what it is (axes, variables, units), ``show map.h5`` prints the base
+    scenario it stores, and the index's ``model_version`` is bookkeeping, not a number of the table."""
+    run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])]), tmp_path, engine=LocalEngine(1), figures=False,
+              progress=False)
+    res = cli("inspect", tmp_path / "map.h5")
+    assert res.returncode == 0, res.stderr
+    assert "bearingsim sweep map" in res.stdout and f"{SPEED} [rpm]: 2 values, 1000, 2000" in res.stdout
+    assert any(line.split()[:1] == ["I_dec_mean_Ns"] and line.rstrip().endswith("N s") for line in res.stdout.splitlines())
+    res = cli("show", tmp_path / "map.h5")
+    assert res.returncode == 0 and res.stdout == load_scenario(BASE).to_toml()
+    assert_user_error(cli("table", tmp_path, "--columns", "model_version"), "model_version")
+
+
 def test_a_user_file_named_map_h5_is_not_replaced(tmp_path):
     (tmp_path / "map.h5").write_text("mine")
     res = cli("sweep", BASE, "--param", f"{SPEED}=1000,2000", "-o", tmp_path, "-j", "1", "--no-plots")

@@ -144,3 +144,33 @@ def read_map(path) -> SweepMap:
     units = {k: a["units"] for k, a in attrs.items() if "units" in a}
     long_names = {k: a["long_name"] for k, a in attrs.items() if "long_name" in a}
     return SweepMap(dims, coords, data, units, long_names, root)
+
+
+def describe_map(path) -> str:
+    """What a sweep's ``map.h5`` holds (``bearingsim inspect``): its axes with their values, the cases
+    by status, then every variable with its shape and unit."""
+    from bearingsim.outputs import printable
+
+    m = read_map(path)
+
+    def values(c):
+        if c.dtype.kind == "f" and len(c) > 4:
+            return f"{c[0]:g} .. {c[-1]:g}"
+        return ", ".join(f"{v:g}" if isinstance(v, float) else str(v) for v in c)
+
+    by: dict[str, int] = {}
+    for s in np.asarray(m.data.get("status", [])).ravel():
+        by[str(s)] = by.get(str(s), 0) + 1
+    lines = [f"{path}: bearingsim sweep map (one array per quantity over the axes; xarray reads it with "
+             f"engine=\"h5netcdf\")",
+             f"base scenario {m.attrs.get('base_scenario', '?')} (its TOML: 'bearingsim show {path}'); "
+             f"bearingsim {m.attrs.get('bearingsim_version', '?')}",
+             "cases: " + (", ".join(f"{k} {v}" for k, v in sorted(by.items())) or "(none)"), "axes:"]
+    for d in m.dims:
+        unit = f" [{m.units[d]}]" if d in m.units else ""
+        lines.append(f"  {d}{unit}: {len(m.coords[d])} values, {values(m.coords[d])}")
+    lines.append("variables:")
+    for k, v in m.data.items():
+        lines.append(f"  {k:32s} {str(v.shape):14s} {'text' if v.dtype.kind == 'O' else str(v.dtype):8s} "
+                     f"{m.units.get(k, '')}")
+    return printable("\n".join(lines))

@@ -356,6 +356,10 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
                             progress=False, archives="all")
             assert len(cluster.scheduler_info["workers"]) == 2
             assert {r["case"] for r in out.rows} == {c.hash for c in resolve_cases(spec)}
+            bare = run_sweep(spec, tmp_path / "dask_bare", engine=DaskEngine(cluster=cluster), figures=False,
+                             progress=False)  # reduced cases: numbers only, no archive sent back
+    assert [r["archive"] for r in bare.rows] == [""] * 3 and not (tmp_path / "dask_bare" / "cases").exists()
+    assert [r["summary"] for r in bare.rows] == [r["summary"] for r in out.rows]
     assert [r["status"] for r in out.rows] == ["done"] * 3
     assert [str(w.message) for w in seen if "bearingsim" in w.filename] == []
     for a, b in zip(local.rows, out.rows):

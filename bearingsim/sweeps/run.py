@@ -296,25 +296,12 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if archives not in ARCHIVE_POLICIES:
         engine.stop()
         raise UserError(f"--archives: expected one of {', '.join(ARCHIVE_POLICIES)} (got {archives!r})")
-    grid, map_attrs = grid_axes(spec), {}
-    if isinstance(spec, SweepSpec):
-        warm_up = getattr(engine, "warm_up", None)
-        try:
-            if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
-                warm_up(spec, archives)
-            cases = resolve_cases(spec)
-            map_attrs = _map_attrs(spec) if grid else {}
-        except BaseException:
-            engine.stop()
-            raise
-        keys = spec.keys
-        meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
-                "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
-    else:
-        cases = list(spec)
-        keys = list(dict.fromkeys(k for c in cases for k in c.values))
-        meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
-                "grid_rows": 0}
+    grid = grid_axes(spec)
+    try:
+        cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
+    except BaseException:
+        engine.stop()
+        raise
     engine.start()  # an unreachable scheduler stops the sweep before anything is written
     try:
         outdir = check_writable_dir(outdir)
@@ -411,6 +398,23 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
         outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
     return outcome
+
+
+def _resolve(spec, engine, archives: str, grid) -> tuple[list[Case], list[str], dict, dict]:
+    """The cases of ``spec`` (a :class:`SweepSpec`, resolved here while a local pool's workers load the
+    model, or a list of cases), the swept keys, the index's metadata and the map's attributes."""
+    if not isinstance(spec, SweepSpec):
+        cases = list(spec)
+        keys = list(dict.fromkeys(k for c in cases for k in c.values))
+        return cases, keys, {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
+                             "grid_rows": 0}, {}
+    warm_up = getattr(engine, "warm_up", None)
+    if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
+        warm_up(spec, archives)
+    cases = resolve_cases(spec)
+    meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
+            "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
+    return cases, spec.keys, meta, (_map_attrs(spec) if grid else {})
 
 
 def _map_attrs(spec: SweepSpec) -> dict:

@@ -812,6 +812,83 @@ def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, An
     return cols, attrs
 
 
+def write_grid_file(path, axes: list[tuple[str, np.ndarray, dict[str, str]]],
+                    variables: dict[str, tuple[np.ndarray, dict[str, str]]], attrs: dict[str, Any]) -> Path:
+    """Write labelled arrays over a grid as netCDF-4-style HDF5, atomically: a sweep's ``map.h5``.
+
+    Each axis ``(name, values, attrs)`` is a 1-D dataset ``/<name>`` made an HDF5 dimension scale
+    named ``name``; each variable ``/<name>`` has the shape of the axes in their order, with every
+    dimension attached to its axis' scale, so xarray (``engine="h5netcdf"``) and netCDF tools read
+    the axes as dimensions and coordinates. Text (axis values or variables) is stored as
+    variable-length UTF-8; ``attrs`` go to the root, each variable's ``attrs`` (``units``,
+    ``long_name``) to its dataset.
+    """
+    h5py = _lazy_h5py()
+    path = Path(path)
+    tmp = _tmp_name(path)
+
+    def create(f, name, arr):
+        arr = np.asarray(arr)
+        if arr.dtype.kind in "OUS":
+            return f.create_dataset(name, data=arr.astype(object), dtype=h5py.string_dtype())
+        return f.create_dataset(name, data=arr)
+
+    try:
+        with h5py.File(tmp, "w") as f:
+            for k, v in attrs.items():
+                f.attrs[k] = v
+            scales = []
+            for name, values, a in axes:
+                ds = create(f, name, values)
+                ds.make_scale(name)
+                ds.attrs.update(a)
+                scales.append(ds)
+            for name, (arr, a) in variables.items():
+                ds = create(f, name, arr)
+                ds.attrs.update(a)
+                for i, scale in enumerate(scales):
+                    ds.dims[i].attach_scale(scale)
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def read_grid_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, dict], dict[str, Any]]:
+    """Read a file written by :func:`write_grid_file` whose root attribute ``format`` is ``fmt``:
+    (every dataset as an array, text as ``str`` objects; each dataset's attributes; root attributes).
+    One-line UserError for anything else."""
+    h5py = _lazy_h5py()
+    p = Path(path)
+    _check_regular(p)
+    try:
+        f = h5py.File(p, "r")
+    except (OSError, FileNotFoundError) as exc:
+        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+    skip = ("CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST")  # the dimension-scale bookkeeping
+    with f:
+        if f.attrs.get("format") != fmt:
+            raise UserError(f"{p}: not a {fmt}")
+        root = {k: _plain(v) for k, v in f.attrs.items()}
+        data, attrs = {}, {}
+        for name, ds in f.items():
+            data[name] = ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]
+            attrs[name] = {k: _plain(v) for k, v in ds.attrs.items() if k not in skip}
+    return data, attrs, root
+
+
+def is_grid_file(path, fmt: str) -> bool:
+    """True when ``path`` is a grid file of format ``fmt`` (:func:`write_grid_file`)."""
+    h5py = _lazy_h5py()
+    try:
+        _check_regular(Path(path))
+        with h5py.File(Path(path), "r") as f:
+            return f.attrs.get("format") == fmt
+    except (UserError, OSError):
+        return False
+
+
 def table_units(path) -> dict[str, str]:
     """The ``unit`` of every column of a table file (:func:`write_table_file`) that has one."""
     h5py = _lazy_h5py()

@@ -61,8 +61,8 @@ def _cmd_run(args) -> int:
 
 
 def _describe_index(path) -> tuple[str, str | None] | None:
-    """(description, scenario TOML or None) of bearingsim's own index files (``sweep.h5``,
-    ``crosscheck.h5``); None for any other file."""
+    """(description, scenario TOML or None) of bearingsim's own index files (``sweep.h5``, ``map.h5``,
+    ``crosscheck.h5``, the study tables); None for any other file."""
     import json
 
     from bearingsim import archive
@@ -75,10 +75,14 @@ def _describe_index(path) -> tuple[str, str | None] | None:
         lines = [f"sweep mode {meta.get('mode', '?')}; base scenario {meta.get('scenario') or '(none)'}",
                  "swept keys: " + (", ".join(meta["axes"]) or "(none)"),
                  f"grid of {', '.join(meta['grid']) or '(no axes)'}: {n} cases; extra cases: {total - n}",
-                 "each case's archive: the 'archive' column (relative to this folder); "
-                 "'bearingsim show' of a case archive gives its scenario"]
+                 "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
+                 "without one); 'bearingsim show' of a case archive gives its scenario"]
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
                                       meta["columns"], lines), None
+    from bearingsim.sweeps.grid import MAP_FORMAT, describe_map, read_map
+
+    if archive.is_grid_file(path, MAP_FORMAT):
+        return describe_map(path), read_map(path).attrs.get("scenario")
     if archive.is_table_file(path, crosscheck.INDEX_FORMAT):
         cols, meta = archive.read_table_file(path, crosscheck.INDEX_FORMAT)
         columns = json.loads(meta["columns"])
@@ -434,7 +438,7 @@ def _cmd_sweep(args) -> int:
 
     return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
                          scheduler=args.scheduler, figures=not args.no_plots, force=args.force, quiet=args.quiet,
-                         progress=_progress(args))
+                         progress=_progress(args), archives=args.archives or "auto")
 
 
 def _cmd_crosscheck(args) -> int:
@@ -557,7 +561,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--rotations", type=int, default=None,
                    help="recorded rotations per run of --fast-scene (default 40) or --geometry (default 30)")
     b.add_argument("--map", action="store_true",
-                   help="wall time of the 100 x 100 reduced-model sweep map (2 workers), with and without archives")
+                   help="the 100 x 100 reduced-model sweep map (2 workers), map only and with --archives all: "
+                        "wall time, resume, files and sizes")
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 
@@ -570,7 +575,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "is the product)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key in every case (repeatable)")
-    s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, cases/, figures)")
+    s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, map, cases/, figures)")
+    s.add_argument("--archives", choices=("none", "all"), default=None,
+                   help="per-case archives in DIR/cases/: 'all' or 'none' (default: the multibody cases only; "
+                        "every case's numbers are in the index sweep.h5 and, for a product grid, map.h5)")
     s.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")

@@ -116,6 +116,23 @@ def result_xarray(result):
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
+def map_xarray(sweep_map):
+    """A sweep's map (:class:`bearingsim.sweeps.grid.SweepMap`) as an xarray Dataset: one variable per
+    quantity over the axes, the axes as dims and coordinates, ``units`` and ``long_name`` attributes."""
+    xr = need("xarray", "SweepMap.to_xarray")
+    m = sweep_map
+
+    def attrs(name):
+        a = {"long_name": m.long_names[name]} if name in m.long_names else {}
+        if name in m.units:
+            a["units"] = m.units[name]
+        return a
+
+    coords = {d: (d, m.coords[d], attrs(d)) for d in m.dims}
+    data_vars = {k: (tuple(m.dims), v, attrs(k)) for k, v in m.data.items()}
+    return xr.Dataset(data_vars, coords=coords, attrs=dict(m.attrs))
+
+
 def index_dataframe(path, units_in_names: bool = False):
     """The case index of a sweep or study (``DIR`` or ``DIR/sweep.h5``) as a DataFrame: one row per
     case, index ``case`` (content hash), the swept keys, ``status``, ``error``, ``archive``, ``wall_s``

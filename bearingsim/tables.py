@@ -69,7 +69,7 @@ def _text(v) -> str:
 def table_of_index(path) -> Table:
     """The table of a sweep's or study's index (``DIR/sweep.h5`` or the file): one row per case,
     labelled by its swept keys (and its status where it is not done or cached)."""
-    from bearingsim.sweeps.index import read_index, unit_of
+    from bearingsim.sweeps.index import FIXED, read_index, unit_of
 
     cols, meta = read_index(path)
     n = len(cols["case"])
@@ -82,8 +82,8 @@ def table_of_index(path) -> Table:
         labels["status"] = status
     if not names:
         names, labels = ["case"], {"case": [str(c) for c in cols["case"]]}
-    numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", "wall_s", *axes)
-               and k not in ("status", "error", "archive") and np.asarray(cols[k]).dtype.kind == "f"}
+    numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", *FIXED, *axes)
+               and np.asarray(cols[k]).dtype.kind == "f"}
     notes = [f"{path}: {n} cases" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes)
 

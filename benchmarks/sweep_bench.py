@@ -109,70 +109,100 @@ def run_sweep_bench(outdir: str | Path = "outputs/bench") -> list[dict]:
     return rows
 
 
-def map_cost(outdir: str | Path, archives: bool = True, jobs: int = 2, figures: bool = False,
-             quiet: bool = False) -> dict:
-    """Run the 100 x 100 map ``scenarios/sweeps/map_speed_clearance.toml`` into ``outdir`` (a fresh
-    folder: every case runs) and return what it cost: ``wall_s`` (from reading the sweep file to the
-    end, index and, with ``figures``, the heat map included), ``done``, ``cached``, ``case_ms`` (the
-    mean of the cases' own times in the workers) and ``cpu_sweep_s`` (CPU time of the sweep process
-    itself: resolving, dispatch, index).
+def _size(paths) -> tuple[int, int]:
+    """(number of files, bytes) of ``paths`` that exist."""
+    sizes = [p.stat().st_size for p in paths if p.is_file()]
+    return len(sizes), sum(sizes)
 
-    With ``archives=False`` the workers (forked, so they inherit the change) solve each case without
-    building or writing its archive: what the engine, the solver and the index cost without
-    ``archive.py``. ``python -m benchmarks.sweep_bench map [--no-archives] OUTDIR``.
+
+def map_cost(outdir: str | Path, archives: str = "all", jobs: int = 2, figures: bool = False,
+             quiet: bool = False, resume: bool = True) -> dict:
+    """Run the 100 x 100 map ``scenarios/sweeps/map_speed_clearance.toml`` into ``outdir`` (a fresh
+    folder: every case runs) with the archive policy ``archives`` (``all``: one archive per case;
+    ``auto``, the default of ``bearingsim sweep``: none for these reduced-model cases) and return what
+    it cost: ``wall_s`` (from reading the sweep file to the end, index, ``map.h5`` and, with
+    ``figures``, the heat map included), ``done``, ``case_ms`` (the mean of the cases' own times in the
+    workers), ``cpu_sweep_s`` (CPU time of the sweep process itself: resolving, dispatch, index, map),
+    ``map_write_s`` (writing ``map.h5`` once), the files and bytes of the case archives, the index
+    (``sweep.h5`` + ``sweep.csv``) and ``map.h5``, and with ``resume`` ``resume_s``: the same sweep run
+    again, every case cached (from its archive, or from its index row).
+    ``python -m benchmarks.sweep_bench map [--archives none|all] OUTDIR``.
     """
     import resource
 
-    import bearingsim.archive as archive
-    import bearingsim.sweeps.worker as worker
+    import bearingsim.sweeps.grid as grid
     from bearingsim.sweeps.engines import LocalEngine
     from bearingsim.sweeps.run import run_sweep
     from bearingsim.sweeps.spec import load_sweep_file
 
-    real = archive.to_bytes, worker._write_file
-    if not archives:  # a reduced case's archive is built by to_bytes and written by _write_file
-        archive.to_bytes = lambda result: b""
-        worker._write_file = lambda target, data: None
+    outdir = Path(outdir)
+    map_s = []
+    real = grid.write_map
+
+    def timed(*a, **kw):
+        t = time.perf_counter()
+        try:
+            return real(*a, **kw)
+        finally:
+            map_s.append(time.perf_counter() - t)
+
+    grid.write_map = timed
     try:
         cpu0 = resource.getrusage(resource.RUSAGE_SELF)
         t0 = time.perf_counter()
         spec = load_sweep_file(_scenario_path().parent / "sweeps" / "map_speed_clearance.toml")
-        out = run_sweep(spec, Path(outdir), engine=LocalEngine(jobs), figures=figures, progress=False)
+        out = run_sweep(spec, outdir, engine=LocalEngine(jobs), figures=figures, progress=False, archives=archives)
         wall = time.perf_counter() - t0
         cpu1 = resource.getrusage(resource.RUSAGE_SELF)
     finally:
-        archive.to_bytes, worker._write_file = real
+        grid.write_map = real
     walls = [r["wall_s"] for r in out.rows if r["status"] == "done"]
+    n_cases, case_bytes = _size((outdir / "cases").glob("*.h5"))
     row = {"archives": archives, "workers": jobs, "cases": len(out.rows), "done": out.count("done"),
            "cached": out.count("cached"), "wall_s": wall,
            "case_ms": 1e3 * sum(walls) / max(1, len(walls)),
-           "cpu_sweep_s": (cpu1.ru_utime + cpu1.ru_stime) - (cpu0.ru_utime + cpu0.ru_stime)}
+           "cpu_sweep_s": (cpu1.ru_utime + cpu1.ru_stime) - (cpu0.ru_utime + cpu0.ru_stime),
+           "map_write_s": map_s[-1] if map_s else float("nan"),
+           "archive_files": n_cases, "archive_bytes": case_bytes,
+           "index_bytes": _size([outdir / "sweep.h5", outdir / "sweep.csv"])[1],
+           "map_bytes": _size([outdir / "map.h5"])[1], "resume_s": float("nan")}
+    if resume:
+        t0 = time.perf_counter()
+        again = run_sweep(load_sweep_file(_scenario_path().parent / "sweeps" / "map_speed_clearance.toml"), outdir,
+                          engine=LocalEngine(jobs), figures=False, progress=False, archives=archives)
+        row["resume_s"] = time.perf_counter() - t0
+        if again.count("cached") != len(again.rows):
+            raise RuntimeError(f"bench --map: resume ran {again.count('done')} cases again")
     if not quiet:
-        print(f"100 x 100 map, {'with' if archives else 'without'} archives, {jobs} workers: "
-              f"{row['done']} done, {row['cached']} cached in {wall:.1f} s")
+        print(f"100 x 100 map, archives={archives}, {jobs} workers: {row['done']} done in {wall:.1f} s, "
+              f"resumed in {row['resume_s']:.1f} s")
     return row
 
 
 def run_map_bench(outdir: str | Path = "outputs/bench", jobs: int = 2) -> list[dict]:
-    """``bearingsim bench --map``: the 100 x 100 reduced-model map with its archives, index and heat map
-    (what ``bearingsim sweep scenarios/sweeps/map_speed_clearance.toml -j 2`` does), then again
-    without archives; print the table, write ``map_cost.csv`` in ``outdir``; return the rows."""
+    """``bearingsim bench --map``: the 100 x 100 reduced-model map as ``bearingsim sweep
+    scenarios/sweeps/map_speed_clearance.toml -j 2`` runs it (index, ``map.h5``, heat map; no case
+    archives), then with ``--archives all`` (one archive per case), each resumed once; print the
+    table, write ``map_cost.csv`` in ``outdir``; return the rows."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     load_before = os.getloadavg()[0]
     rows = []
     with tempfile.TemporaryDirectory(prefix="bearingsim-bench-map-") as tmp:
-        rows.append(map_cost(Path(tmp) / "with", archives=True, jobs=jobs, figures=True, quiet=True))
-        rows.append(map_cost(Path(tmp) / "without", archives=False, jobs=jobs, figures=False, quiet=True))
+        rows.append(map_cost(Path(tmp) / "map", archives="auto", jobs=jobs, figures=True, quiet=True))
+        rows.append(map_cost(Path(tmp) / "all", archives="all", jobs=jobs, figures=True, quiet=True))
     path = write_csv(outdir / "map_cost.csv", list(rows[0]), [list(r.values()) for r in rows])
     print(f"100 x 100 map of the reduced model (scenarios/sweeps/map_speed_clearance.toml), {jobs} workers; "
           f"{os.cpu_count()} cores; 1-min load average {load_before:.2f} before, {os.getloadavg()[0]:.2f} after "
           f"(other users' work on the cores slows every row)")
-    print(f"{'run':34s} {'cases':>6s} {'wall [s]':>9s} {'case in worker [ms]':>19s} {'sweep process CPU [s]':>21s}")
-    names = {True: "archives, index, heat map", False: "no archives (solve, index)"}
+    print(f"{'run':28s} {'wall [s]':>8s} {'case [ms]':>9s} {'sweep CPU [s]':>13s} {'map.h5 write [s]':>16s} "
+          f"{'resume [s]':>10s} {'archives':>18s} {'index':>8s} {'map.h5':>8s}")
+    names = {"auto": "map only (default)", "all": "--archives all"}
     for r in rows:
-        print(f"{names[r['archives']]:34s} {r['done']:6d} {r['wall_s']:9.1f} {r['case_ms']:19.2f} "
-              f"{r['cpu_sweep_s']:21.1f}")
+        arch = f"{r['archive_files']} / {r['archive_bytes'] / 1e6:.0f} MB" if r["archive_files"] else "none"
+        print(f"{names[r['archives']]:28s} {r['wall_s']:8.1f} {r['case_ms']:9.2f} {r['cpu_sweep_s']:13.1f} "
+              f"{r['map_write_s']:16.3f} {r['resume_s']:10.1f} {arch:>18s} {r['index_bytes'] / 1e6:6.1f}MB "
+              f"{r['map_bytes'] / 1e6:6.1f}MB")
     print(f"wrote {path}")
     return rows
 
@@ -181,6 +211,6 @@ if __name__ == "__main__":  # pragma: no cover
     import sys
 
     if sys.argv[1:2] == ["map"]:
-        map_cost(sys.argv[-1], archives="--no-archives" not in sys.argv)
+        map_cost(sys.argv[-1], archives="none" if "none" in sys.argv[2:-1] else "all")
     else:
         run_sweep_bench()

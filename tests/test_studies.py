@@ -81,8 +81,8 @@ class _InterruptedAfterFirstCase(LocalEngine):
     """A local engine that receives SIGINT right after the first finished case is handed over: an
     interruption at a known point, whatever the machine's speed."""
 
-    def run(self, batches, cases_dir):
-        for records in super().run(batches, cases_dir):
+    def run(self, batches, cases_dir, *args):
+        for records in super().run(batches, cases_dir, *args):
             yield records
             os.kill(os.getpid(), signal.SIGINT)
 

@@ -37,7 +37,7 @@ def _rows(folder):
 @pytest.mark.slow
 def test_sweep_table_matches_single_runs(tmp_path):
     res = bearingsim("sweep", BASE, "--param", f"{SPEED}=500,6000", "--param", "lubrication.drag_coefficient=0.01,0.03",
-                     "-o", tmp_path, "-j", "2")
+                     "-o", tmp_path, "-j", "2", "--archives", "all")
     assert res.returncode == 0, res.stderr
     rows = _rows(tmp_path)
     assert len(rows) == 4
@@ -151,7 +151,7 @@ def test_standard_error_is_over_rotations_of_pocket_means():
 
 def test_resume_runs_only_what_is_missing(tmp_path):
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000, 4000])])
-    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in first.rows] == ["done"] * 4
     cases = tmp_path / "cases"
     kept = cases / f"{first.rows[0]['case']}.h5"
@@ -163,7 +163,7 @@ def test_resume_runs_only_what_is_missing(tmp_path):
         f["bearingsim"].attrs["complete"] = False
     (cases / f".{first.rows[1]['case']}.h5.tmp-99999").write_bytes(data)  # a dead worker's temporary file
 
-    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in again.rows] == ["cached", "done", "done", "done"]
     assert kept.stat().st_mtime_ns == mtime
     assert not list(cases.glob(".*"))
@@ -195,7 +195,7 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     from bearingsim.model_versions import MODEL_VERSIONS
 
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000])])
-    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     cases = tmp_path / "cases"
     archives = [cases / f"{r['case']}.h5" for r in first.rows]
     assert [peek(a)["model_version"] for a in archives] == [MODEL_VERSIONS["reduced"]] * 3
@@ -203,7 +203,7 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     _set_provenance(archives[2], model_version=None)  # written before models had a version
     kept = archives[0].stat().st_mtime_ns
 
-    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in again.rows] == ["cached", "stale", "stale"]
     assert again.count("stale") == 2
     assert archives[0].stat().st_mtime_ns == kept
@@ -213,7 +213,7 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     assert [r["status"] for r in _rows(tmp_path)] == ["cached", "stale", "stale"]
     index, _ = read_index(tmp_path / "sweep.h5")
     assert [str(s) for s in index["status"]] == ["cached", "stale", "stale"]
-    third = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    third = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in third.rows] == ["cached"] * 3
 
 
@@ -288,7 +288,7 @@ def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code)
     # euler at dt = 2 ns: about 1 s per case, so cases are running and queued when the signal comes
     dts = ",".join(f"{2 + i / 100:.2f}e-9" for i in range(8))
     cmd = [sys.executable, "-m", "bearingsim", "sweep", BASE, "--set", "reduced.method=euler",
-           "--param", f"numerics.dt_s={dts}", "-o", tmp_path, "-j", "2", "--no-plots"]
+           "--param", f"numerics.dt_s={dts}", "-o", tmp_path, "-j", "2", "--no-plots", "--archives", "all"]
     with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline:
@@ -353,7 +353,7 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
     from bearingsim.sweeps import DaskEngine
 
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [500, 2000, 6000])])
-    local = run_sweep(spec, tmp_path / "local", engine=LocalEngine(1), figures=False, progress=False)
+    local = run_sweep(spec, tmp_path / "local", engine=LocalEngine(1), figures=False, progress=False, archives="all")
     with warnings.catch_warnings(record=True) as seen:
         # dask's own start-up and shut-down notices (a port in use, comms closing) are recorded, not
         # raised; none may come from bearingsim itself
@@ -361,9 +361,13 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
         with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
                           host="127.0.0.1") as cluster:
             out = run_sweep(spec, tmp_path / "dask", engine=DaskEngine(cluster=cluster), figures=False,
-                            progress=False)
+                            progress=False, archives="all")
             assert len(cluster.scheduler_info["workers"]) == 2
             assert {r["case"] for r in out.rows} == {c.hash for c in resolve_cases(spec)}
+            bare = run_sweep(spec, tmp_path / "dask_bare", engine=DaskEngine(cluster=cluster), figures=False,
+                             progress=False)  # reduced cases: numbers only, no archive sent back
+    assert [r["archive"] for r in bare.rows] == [""] * 3 and not (tmp_path / "dask_bare" / "cases").exists()
+    assert [r["summary"] for r in bare.rows] == [r["summary"] for r in out.rows]
     assert [r["status"] for r in out.rows] == ["done"] * 3
     assert [str(w.message) for w in seen if "bearingsim" in w.filename] == []
     for a, b in zip(local.rows, out.rows):

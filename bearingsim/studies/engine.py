@@ -154,7 +154,8 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         raise
     with FolderLock(outdir) as lock:
         sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock,
-                          desc="+".join(s.name for s in studies), force=force)
+                          desc="+".join(s.name for s in studies), force=force,
+                          archives="all")  # a study's table and figures are made from its cases' archives
         out = StudiesOutcome(sweep)
         if sweep.interrupted is None:
             records = {r["case"]: r for r in sweep.rows}

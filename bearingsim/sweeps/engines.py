@@ -57,12 +57,12 @@ class LocalEngine:
             # fork: workers start in milliseconds and inherit the imported package
             self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
 
-    def warm_up(self, spec) -> None:
+    def warm_up(self, spec, archives: str = "all") -> None:
         """Start the pool and, if the sweep's base scenario is a reduced-model one, have the workers run
         it once without an archive (loading the compiled model takes ~0.3 s a process), while the
         sweep process resolves the cases. Does nothing else: errors are left to the sweep to report."""
         from bearingsim.scenario import load_scenario
-        from bearingsim.sweeps.worker import warm_up
+        from bearingsim.sweeps.worker import keeps_archive, warm_up
 
         try:
             base = load_scenario(spec.scenario, spec.sets)
@@ -73,10 +73,12 @@ class LocalEngine:
         self.start()
         text = base.to_toml()
         for _ in range(self.workers):
-            self._pool.apply_async(warm_up, (text,))
+            self._pool.apply_async(warm_up, (text, keeps_archive("reduced", archives)))
 
-    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str) -> Iterator[list[dict]]:
-        """Yield the records of each batch as it finishes (in completion order)."""
+    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str,
+            archives: str = "all") -> Iterator[list[dict]]:
+        """Yield the records of each batch as it finishes (in completion order); ``archives``: which
+        cases get an archive (:func:`bearingsim.sweeps.worker.keeps_archive`)."""
         import queue
 
         from bearingsim.sweeps.worker import one_line_error, run_batch
@@ -87,7 +89,7 @@ class LocalEngine:
             def lost(exc, b=b):  # the batch itself failed (a worker died): every case of it failed
                 done.put([{"hash": h, "status": "failed", "error": one_line_error(exc), "wall_s": float("nan"),
                            "summary": {}} for h, *_ in b])
-            self._pool.apply_async(run_batch, (b, cases_dir), callback=done.put, error_callback=lost)
+            self._pool.apply_async(run_batch, (b, cases_dir, archives), callback=done.put, error_callback=lost)
         for _ in batches:
             while True:
                 try:  # short waits: a signal handler runs between them
@@ -147,8 +149,10 @@ class DaskEngine:
                             f"{' '.join(str(exc).split())[:200]})") from None
         self.workers = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
 
-    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str) -> Iterator[list[dict]]:
-        """Yield the records of each batch as it finishes; archives are in ``record["archive"]`` (bytes)."""
+    def run(self, batches: list[list[tuple[str, str]]], cases_dir: str,
+            archives: str = "all") -> Iterator[list[dict]]:
+        """Yield the records of each batch as it finishes; archives are in ``record["archive"]`` (bytes);
+        ``archives``: which cases get one (:func:`bearingsim.sweeps.worker.keeps_archive`)."""
         from distributed import as_completed
 
         from bearingsim.sweeps.worker import run_batch
@@ -157,7 +161,7 @@ class DaskEngine:
         stamp = f"{os.getpid()}-{time.time_ns()}"
         # the text only: a worker elsewhere resolves it with its own bearingsim (no pickled models)
         batches = [[(h, text) for h, text, *_ in b] for b in batches]
-        self._futures = [self.client.submit(run_batch, b, None, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
+        self._futures = [self.client.submit(run_batch, b, None, archives, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
                          for i, b in enumerate(batches)]
         for fut in as_completed(self._futures, loop=self.client.loop):
             if self.should_stop():

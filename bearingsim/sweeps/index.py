@@ -5,8 +5,9 @@ One row per case, in the sweep's case order: ``case`` (content hash), the swept 
 of its model (:mod:`bearingsim.model_versions`), was already there; ``stale``: run now because the
 archive of the same scenario there was computed by another version of the model, or by a bearingsim
 that stored none; ``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
-``archive`` (path relative to the sweep folder), ``wall_s`` (seconds the case took; for a cached case
-the stored run's own wall time) and the summary numbers (SI, as in the archives' ``/results/summary``,
+``archive`` (path relative to the sweep folder; empty for a case run without one), ``wall_s`` (seconds
+the case took; for a cached case the stored run's own wall time), ``model_version`` (the version of the
+model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown) and the summary numbers (SI, as in the archives' ``/results/summary``,
 plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.stats.impulse_standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
@@ -30,7 +31,7 @@ from bearingsim.outputs import write_atomic_bytes
 
 INDEX_FORMAT = "bearingsim sweep index 1"
 CSV_SIGNATURE = b"case,"  # the first bytes of every sweep.csv bearingsim writes (its header)
-FIXED = ("status", "error", "archive", "wall_s")
+FIXED = ("status", "error", "archive", "wall_s", "model_version")
 # summary numbers shown first when present; any others follow in name order
 PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
              "first_impact_speed_m_s", "first_impact_energy_J", "cage_slip", "load_zone_half_angle_deg")
@@ -100,6 +101,7 @@ class IndexWriter:
             cols[col] = np.empty(n, dtype=object)
         cols["wall_s"] = np.full(n, math.nan)
         units["wall_s"] = "s"
+        cols["model_version"] = np.full(n, math.nan)
         for k in summ:
             cols[k] = np.full(n, math.nan)
             units[k] = unit_of(k)
@@ -118,11 +120,13 @@ class IndexWriter:
             buf.seek(0)
             buf.truncate()
             w.writerow([r["case"], *[r["values"].get(k, "") for k in keys], r["status"], r.get("error", ""),
-                        r.get("archive", ""), _fmt(r.get("wall_s")), *[_fmt(s.get(k)) for k in summ]])
+                        r.get("archive", ""), _fmt(r.get("wall_s")), _version_text(r.get("model_version")),
+                        *[_fmt(s.get(k)) for k in summ]])
             self._lines[i] = buf.getvalue()
             for col in ("status", "error", "archive"):
                 cols[col][i] = r.get(col, "")
             cols["wall_s"][i] = _float(r.get("wall_s"))
+            cols["model_version"][i] = _float(r.get("model_version"))
             for k in summ:
                 cols[k][i] = _float(s.get(k))
         self._dirty = set()
@@ -137,6 +141,15 @@ class IndexWriter:
         attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **self.meta}
         archive.write_table_file(h5_path, {c: cols[c] for c in columns}, self._units, attrs)
         return csv_path, h5_path
+
+    @property
+    def columns(self) -> dict[str, np.ndarray]:
+        """The index's columns as last written (one array per column, in column order)."""
+        return {c: self._cols[c] for c in ["case", *self.keys, *FIXED, *(self._summ or [])]}
+
+
+def _version_text(v) -> str:
+    return str(int(v)) if _is_number(v) and math.isfinite(v) else ""
 
 
 def _float(v) -> float:
@@ -217,4 +230,48 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
     summary.update(standard_errors(got["I_dec"], got["I_acc"], got["model"]))
     wall = got["wall_time_s"]
-    return {"status": "cached", "error": "", "wall_s": wall, "summary": summary}
+    return {"status": "cached", "error": "", "wall_s": wall, "summary": summary,
+            "model_version": got["model_version"]}
+
+
+#: statuses of an index row whose numbers a resumed sweep may take (when its model version matches)
+HAS_NUMBERS = ("done", "cached", "stale")
+
+
+def read_rows(path: Path) -> dict[str, dict]:
+    """The rows of an existing ``sweep.h5`` by case hash, each ``status``, ``model_version`` (None if
+    the index has none), ``wall_s`` and ``summary`` (every summary column, NaN included); ``{}`` when
+    ``path`` is missing or not a sweep index."""
+    from bearingsim.errors import UserError
+
+    try:
+        cols, meta = read_index(path)
+    except (UserError, OSError, KeyError, ValueError):  # none, or not an index: no row is trusted
+        return {}
+    summ = [c for c in meta["columns"] if c != "case" and c not in meta["axes"] and c not in FIXED]
+    n = len(cols["case"])
+    versions = cols.get("model_version", np.full(n, math.nan))
+    out = {}
+    for i in range(n):
+        v = float(versions[i])
+        out[str(cols["case"][i])] = {
+            "status": str(cols["status"][i]), "model_version": int(v) if math.isfinite(v) else None,
+            "wall_s": float(cols["wall_s"][i]), "summary": {k: float(cols[k][i]) for k in summ}}
+    return out
+
+
+def trusted_row(row: dict | None, model: str) -> dict | None:
+    """The record of a case taken from its row of the previous index (:func:`read_rows`), for a case
+    run without an archive: ``cached`` with the row's numbers when the row holds numbers (``done``,
+    ``cached`` or ``stale``) computed by the current version of ``model``
+    (:data:`bearingsim.model_versions.MODEL_VERSIONS`); ``{"status": "stale"}`` when they came from
+    another version or an index that recorded none; None (run it) for no row, or a failed or pending
+    one. The row is the case's because the index names it by the content hash of its scenario."""
+    from bearingsim.model_versions import MODEL_VERSIONS
+
+    if row is None or row["status"] not in HAS_NUMBERS:
+        return None
+    if row["model_version"] is None or row["model_version"] != MODEL_VERSIONS.get(model):
+        return {"status": "stale"}
+    return {"status": "cached", "error": "", "wall_s": row["wall_s"], "summary": dict(row["summary"]),
+            "model_version": row["model_version"]}

@@ -1,7 +1,10 @@
 """Running a sweep: resume, batches, failures, interruption, index, progress.
 
-The sweep folder ``DIR`` holds ``cases/<hash>.h5`` (one archive per case), ``sweep.csv`` and
-``sweep.h5`` (the index, :mod:`bearingsim.sweeps.index`) and, with figures, the sweep's PNGs.
+The sweep folder ``DIR`` holds ``sweep.csv`` and ``sweep.h5`` (the index,
+:mod:`bearingsim.sweeps.index`), for a product grid ``map.h5`` (the same numbers as arrays over the
+axes, :mod:`bearingsim.sweeps.grid`), ``cases/<hash>.h5`` (one archive per case that keeps one: by
+default the multibody cases, :func:`bearingsim.sweeps.worker.keeps_archive`) and, with figures, the
+sweep's PNGs.
 A lock file ``DIR/.sweep.lock`` (:class:`bearingsim.outputs.FolderLock`) keeps two sweeps or studies
 from writing the same folder at once.
 """
@@ -52,6 +55,7 @@ class SweepOutcome:
     csv: Path
     h5: Path
     rows: list[dict]
+    map: Path | None = None  # map.h5, for a product grid
     interrupted: int | None = None  # the signal number, if interrupted
     wall_s: float = 0.0
     figures: list[Path] = field(default_factory=list)
@@ -142,11 +146,13 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
     nothing in the folder is replaced (:func:`bearingsim.outputs.check_replaceable`)."""
     from bearingsim import archive
     from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
+    from bearingsim.sweeps.grid import MAP_FORMAT, MAP_NAME
     from bearingsim.sweeps.index import CSV_SIGNATURE, INDEX_FORMAT
     from bearingsim.sweeps.plot import FIGURE_NAMES
 
     check_replaceable(outdir / "sweep.csv", CSV_SIGNATURE, "sweep index")
     check_replaceable(outdir / "sweep.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sweep index")
+    check_replaceable(outdir / MAP_NAME, lambda p: archive.is_grid_file(p, MAP_FORMAT), "sweep map")
     for name in FIGURE_NAMES if figures else ():
         check_replaceable(outdir / name, PNG_SIGNATURE, "figure")
     cases = outdir / "cases"
@@ -210,10 +216,42 @@ def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
                 nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 
+def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str) -> tuple[list[Case], set]:
+    """Fill ``rows`` with what is already there; return (the cases to run, the hashes of stale ones).
+
+    A case is taken (``cached``) from its archive ``cases/<hash>.h5`` when that stores exactly its
+    scenario computed by the current model version (:func:`~bearingsim.sweeps.index.read_cached`);
+    a case that keeps no archive under ``archives`` is also taken from its row of the previous index
+    (:func:`~bearingsim.sweeps.index.trusted_row`: same content hash, same model version). A stale
+    archive or row, or none, means the case runs again; a stale archive is removed first."""
+    from bearingsim.sweeps.index import read_rows, trusted_row
+    from bearingsim.sweeps.worker import keeps_archive
+
+    cases_dir = outdir / "cases"
+    old = read_rows(outdir / "sweep.h5") if any(not keeps_archive(c.model, archives) for c in cases) else {}
+    todo, stale = [], set()
+    for c, row in zip(cases, rows):
+        rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
+        where = f"cases/{c.hash}.h5"
+        if rec is None or rec["status"] == "stale":
+            # the sweep's own file, incomplete, damaged or stale: it is run again and replaced
+            (cases_dir / f"{c.hash}.h5").unlink(missing_ok=True)
+            if not keeps_archive(c.model, archives):
+                rec = trusted_row(old.get(c.hash), c.model) or rec
+                where = ""
+        if rec is None or rec["status"] == "stale":
+            todo.append(c)
+            if rec is not None:
+                stale.add(c.hash)
+        else:
+            row.update(rec, archive=where)
+    return todo, stale
+
+
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
               progress: bool | None = None, log=None, lock: FolderLock | None = None,
-              desc: str = "sweep", force: bool = False) -> SweepOutcome:
-    """Run every case of ``spec`` that has no valid archive yet, and index them all.
+              desc: str = "sweep", force: bool = False, archives: str = "auto") -> SweepOutcome:
+    """Run every case of ``spec`` that has no valid result yet, and index them all.
 
     Parameters
     ----------
@@ -237,6 +275,10 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         The progress bar's label (a study's name).
     force : bool
         Replace another sweep or study in ``outdir`` (default: refused, :func:`check_same_sweep`).
+    archives : str
+        Which cases get an archive in ``outdir/cases/``: ``auto`` (the multibody cases; a reduced
+        case's numbers are in the index and, for a product grid, ``map.h5``), ``all`` or ``none``
+        (:func:`bearingsim.sweeps.worker.keeps_archive`).
 
     Returns
     -------
@@ -246,26 +288,20 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     """
     from bearingsim.archive import check_writable_dir
     from bearingsim.sweeps.engines import LocalEngine
+    from bearingsim.sweeps.grid import MAP_NAME, grid_axes, write_map
+    from bearingsim.sweeps.worker import ARCHIVE_POLICIES, keeps_archive
 
     t0 = time.perf_counter()
     engine = engine or LocalEngine(1)
-    if isinstance(spec, SweepSpec):
-        warm_up = getattr(engine, "warm_up", None)
-        try:
-            if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
-                warm_up(spec)
-            cases = resolve_cases(spec)
-        except BaseException:
-            engine.stop()
-            raise
-        keys = spec.keys
-        meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
-                "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
-    else:
-        cases = list(spec)
-        keys = list(dict.fromkeys(k for c in cases for k in c.values))
-        meta = {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
-                "grid_rows": 0}
+    if archives not in ARCHIVE_POLICIES:
+        engine.stop()
+        raise UserError(f"--archives: expected one of {', '.join(ARCHIVE_POLICIES)} (got {archives!r})")
+    grid = grid_axes(spec)
+    try:
+        cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
+    except BaseException:
+        engine.stop()
+        raise
     engine.start()  # an unreachable scheduler stops the sweep before anything is written
     try:
         outdir = check_writable_dir(outdir)
@@ -279,8 +315,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             check_sweep_outputs(outdir, figures)
             from bearingsim.sweeps.plot import FIGURE_NAMES
 
-            check_same_sweep(outdir, cases, force, FIGURE_NAMES)
-            cases_dir.mkdir(exist_ok=True)
+            check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
+            if any(keeps_archive(c.model, archives) for c in cases):
+                cases_dir.mkdir(exist_ok=True)
         except BaseException:
             if own:
                 lock.release()
@@ -291,9 +328,10 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if progress is None:
         progress = sys.stderr.isatty()
     rows = [{"case": c.hash, "values": c.values, "status": "pending", "error": "", "archive": "",
-             "wall_s": math.nan, "summary": {}} for c in cases]
+             "wall_s": math.nan, "model_version": None, "summary": {}} for c in cases]
     by_hash = {c.hash: i for i, c in enumerate(cases)}
-    outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows)
+    outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
+                           map=outdir / MAP_NAME if grid else None)
     index = IndexWriter(outdir, rows, keys, meta)
 
     with (lock if own else contextlib.nullcontext()), _Signals() as signals:
@@ -301,18 +339,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         bar = None
         try:
             _clean_temporaries(cases_dir)
-            todo = []
-            stale = set()  # hashes of cases whose archive came from another version of the model
-            for c, row in zip(cases, rows):
-                rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
-                if rec is None or rec["status"] == "stale":
-                    # the sweep's own file, incomplete, damaged or stale: it is run again and replaced
-                    (cases_dir / f"{c.hash}.h5").unlink(missing_ok=True)
-                    todo.append(c)
-                    if rec is not None:
-                        stale.add(c.hash)
-                else:
-                    row.update(rec, archive=f"cases/{c.hash}.h5")
+            # stale: hashes of cases whose archive or row came from another version of the model
+            todo, stale = _resume(cases, rows, outdir, archives)
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
             bar = _progress(len(cases), progress, counts["cached"], desc)
@@ -324,7 +352,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             index_s = 0.0  # how long the last rewrite took
             if todo:
                 batches = make_batches(todo, engine.workers)
-                for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None):
+                for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None, archives):
                     for rec in records:
                         i = by_hash[rec["hash"]]
                         row = rows[i]
@@ -332,9 +360,10 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                         if rec["status"] == "done" and data is not None:
                             write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
                         status = "stale" if rec["status"] == "done" and rec["hash"] in stale else rec["status"]
+                        kept = rec["status"] == "done" and keeps_archive(cases[i].model, archives)
                         row.update(status=status, error=rec["error"], wall_s=rec["wall_s"],
-                                   summary=rec["summary"],
-                                   archive=f"cases/{rec['hash']}.h5" if rec["status"] == "done" else "")
+                                   summary=rec["summary"], model_version=rec.get("model_version"),
+                                   archive=f"cases/{rec['hash']}.h5" if kept else "")
                         index.changed(i)
                         counts[status] += 1
                         if rec["status"] == "failed":
@@ -361,6 +390,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     bar.close()
                 _clean_temporaries(cases_dir)
                 index.write()
+                if grid:
+                    write_map(outcome.map, grid, index.columns, map_attrs)
     outcome.wall_s = time.perf_counter() - t0
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
@@ -369,11 +400,39 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     return outcome
 
 
+def _resolve(spec, engine, archives: str, grid) -> tuple[list[Case], list[str], dict, dict]:
+    """The cases of ``spec`` (a :class:`SweepSpec`, resolved here while a local pool's workers load the
+    model, or a list of cases), the swept keys, the index's metadata and the map's attributes."""
+    if not isinstance(spec, SweepSpec):
+        cases = list(spec)
+        keys = list(dict.fromkeys(k for c in cases for k in c.values))
+        return cases, keys, {"scenario": "", "mode": "cases", "origin": "run_sweep(cases)", "grid": json.dumps([]),
+                             "grid_rows": 0}, {}
+    warm_up = getattr(engine, "warm_up", None)
+    if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
+        warm_up(spec, archives)
+    cases = resolve_cases(spec)
+    meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
+            "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
+    return cases, spec.keys, meta, (_map_attrs(spec) if grid else {})
+
+
+def _map_attrs(spec: SweepSpec) -> dict:
+    """Root attributes of a sweep's ``map.h5``: bearingsim's version and the base scenario."""
+    from bearingsim._version import __version__
+    from bearingsim.scenario import load_scenario
+
+    base = load_scenario(spec.scenario, spec.sets)
+    return {"bearingsim_version": __version__, "scenario": base.to_toml(), "base_scenario": str(spec.scenario),
+            "sweep": spec.origin}
+
+
 def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: int | None = None,
                   scheduler: str | None = None, figures: bool = True, quiet: bool = False,
-                  force: bool = False, progress: bool | None = None) -> int:
+                  force: bool = False, progress: bool | None = None, archives: str = "auto") -> int:
     """``bearingsim sweep``: run, print what was written and the table of the cases (unless ``quiet``)
-    and return the exit code. ``progress``: the bar on stderr (default: when stderr is a terminal).
+    and return the exit code. ``progress``: the bar on stderr (default: when stderr is a terminal);
+    ``archives``: which cases keep an archive (:func:`run_sweep`).
 
     0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
     SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
@@ -395,7 +454,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")
     engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
-    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force,
+    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force, archives=archives,
                     progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))
     n = len(out.rows)
     counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
@@ -409,6 +468,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     if not quiet:
         print(f"wrote {out.csv}")
         print(f"wrote {out.h5}")
+        if out.map is not None:
+            print(f"wrote {out.map}")
         for p in out.figures:
             print(f"wrote {p}")
         for line in out.figure_notes:

@@ -39,8 +39,9 @@ from bearingsim.scenario import check_run_request, load_scenario, parse_override
 
 SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
 # Most cases in one sweep: ten times the 100 x 100 map of scenarios/sweeps/. Each case is resolved and
-# held as a row before the first runs, and writes an archive (~90 kB for the reduced model: 100000 cases
-# are ~9 GB on disk and ~1 GB of resolved scenarios in memory); more is a run to split into sweeps.
+# held as a row before the first runs (100000 cases: ~1 GB of resolved scenarios in memory) and, with
+# --archives all, writes an archive (~93 kB for the reduced model: ~9 GB on disk); more is a run to
+# split into sweeps.
 MAX_SWEEP_CASES = 100_000
 
 

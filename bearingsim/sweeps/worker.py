@@ -1,4 +1,4 @@
-"""What runs inside a worker: a batch of cases, each into its archive, failures caught one by one.
+"""What runs inside a worker: a batch of cases, each into its archive (or none), failures caught one by one.
 
 Imported by local pool processes and by dask workers (which need ``bearingsim`` installed; they need
 no file system shared with the client: with ``return_bytes`` the archive comes back as bytes).
@@ -47,27 +47,39 @@ def _per_rotation(res):
     return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
 
 
-def _run_in_memory(scenario, notes: bool = True):
-    """Run a case that streams no time series (the reduced model) and build its archive in memory:
-    what :func:`bearingsim.simulation.run_scenario` does (plausibility check and its notes included),
-    with the file written in one piece by the caller. Returns (result, archive bytes)."""
-    from bearingsim import archive, simulation
+ARCHIVE_POLICIES = ("auto", "all", "none")
+
+
+def keeps_archive(model: str, archives: str) -> bool:
+    """Whether a case of ``model`` gets its archive under the sweep's policy ``archives``: ``all``
+    every case, ``none`` no case, ``auto`` the multibody cases only (a reduced-model case's numbers
+    are in the sweep's index and map; its archive costs three times its solution)."""
+    return archives == "all" or (archives == "auto" and model != "reduced")
+
+
+def _run_in_memory(scenario, notes: bool = True, archive: bool = True):
+    """Run a case in memory and, with ``archive``, build its archive in memory: what
+    :func:`bearingsim.simulation.run_scenario` does (plausibility check and its notes included),
+    with the file written in one piece by the caller. Returns (result, archive bytes or None)."""
+    from bearingsim import archive as archive_module, simulation
 
     result = simulation.run(scenario)  # plausibility checked there
     for note in result.notes:
         if notes:
             log.info(note)
-    return result, archive.to_bytes(result)
+    return result, (archive_module.to_bytes(result) if archive else None)
 
 
-def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) -> dict:
+def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, archives: str = "all") -> dict:
     """Run one case into the archive ``target`` (written atomically), or with ``target`` None return
-    the archive's bytes under ``"archive"``. ``model``: the validated scenario model the client wrote
-    ``toml_text`` from (a forked local worker: the same code validated it), else the text is resolved
-    again here.
+    the archive's bytes under ``"archive"``; a case that keeps no archive under the policy
+    ``archives`` (:func:`keeps_archive`) runs in memory and returns its numbers only. ``model``: the
+    validated scenario model the client wrote ``toml_text`` from (a forked local worker: the same code
+    validated it), else the text is resolved again here.
 
-    Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s`` and the
-    summary numbers with the standard errors of :func:`standard_errors`.
+    Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s``,
+    ``model_version`` (of the model that computed it) and the summary numbers with the standard
+    errors of :func:`standard_errors`.
     """
     from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml
@@ -79,7 +91,10 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
             scenario = Scenario(model, "<sweep case>", toml=toml_text)
         else:
             scenario = scenario_from_toml(toml_text)
-        if scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
+        keep = keeps_archive(scenario.model, archives)
+        if not keep:  # numbers only: the same run as with an archive, without building it
+            res, data = _run_in_memory(scenario, notes=False, archive=False)
+        elif scenario.model == "reduced":  # one pass, no time series: the archive is built in memory
             res, data = _run_in_memory(scenario, notes=False)  # per-case notes: not on the sweep's terminal
             if target is not None:
                 _write_file(target, data)
@@ -94,7 +109,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None) ->
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res), scenario.model))
         rec = {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
-               "summary": summary}
+               "summary": summary, "model_version": res.provenance.get("model_version")}
         if data is not None:
             rec["archive"] = data
         return rec
@@ -121,18 +136,19 @@ def _write_file(target: Path, data: bytes) -> None:
         raise UserError(f"{target}: cannot write archive ({exc.strerror or exc}); nothing was written") from None
 
 
-def warm_up(toml_text: str) -> None:
-    """Run a reduced-model scenario once and build its archive in memory, discarding both: the first
-    case of a process loads the compiled model (~0.3 s). Errors are ignored (the cases report theirs)."""
+def warm_up(toml_text: str, archive: bool = True) -> None:
+    """Run a reduced-model scenario once and, with ``archive``, build its archive in memory, discarding
+    both: the first case of a process loads the compiled model (~0.3 s). Errors are ignored (the cases
+    report theirs)."""
     from bearingsim.sweeps.spec import scenario_from_toml
 
     try:
-        _run_in_memory(scenario_from_toml(toml_text), notes=False)
+        _run_in_memory(scenario_from_toml(toml_text), notes=False, archive=archive)
     except Exception:  # noqa: BLE001
         pass
 
 
-def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> list[dict]:
+def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archives: str = "all") -> list[dict]:
     """Run ``items`` (``(hash, resolved TOML)`` pairs) one after the other.
 
     Parameters
@@ -145,6 +161,8 @@ def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None) -> lis
         return each archive's bytes under ``"archive"`` (dask workers on other machines): a
         reduced-model archive is built in memory, a multibody run streams into a private temporary
         folder.
+    archives : str
+        Which cases get an archive (:func:`keeps_archive`): ``all``, ``none`` or ``auto``.
     """
-    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None, *model)
-            for h, text, *model in items]
+    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
+                     model[0] if model else None, archives) for h, text, *model in items]

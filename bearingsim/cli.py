@@ -554,7 +554,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
     b.add_argument("--fast-scene", action="store_true",
-                   help="rigid raceways against the Hertz full scene at 500, 1000, 3000 and 6000 rpm (issue 16)")
+                   help="rigid raceways against the Hertz full scene at 500, 1000, 3000 and 6000 rpm")
     b.add_argument("--geometry", action="store_true",
                    help="pocket-face geometry: exact faces against polylines of 3 to 63 segments at 2000 and 3000 rpm "
                         "(1 warm-up + 30 rotations each, or --rotations)")
@@ -567,7 +567,7 @@ def build_parser() -> argparse.ArgumentParser:
     b.set_defaults(func=_cmd_bench)
 
     s = sub.add_parser("sweep", help="what-if sweep: resumable, failures recorded, local pool or dask cluster")
-    s.add_argument("scenario", help="scenario TOML (with --param) or sweep file (README: Sweeps)")
+    s.add_argument("scenario", help="scenario TOML (with --param) or sweep file (docs/sweeps.md)")
     s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...|KEY=START:STOP:NUM",
                    help="key and the values to sweep, as a list (values as TOML; commas inside [ ], { } or "
                         "quotes do not split) or as a range START:STOP:NUM of NUM evenly spaced numbers, both "
@@ -588,7 +588,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
     s.set_defaults(func=_cmd_sweep)
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
-                                           "(README: Cross-check; run again to resume)")
+                                           "(docs/crosscheck.md; run again to resume)")
     cc.add_argument("scenario", help="multibody scenario TOML, full scene")
     cc.add_argument("--speeds", default="1000,3000,6000", help="inner-ring speeds in rpm (default 1000,3000,6000)")
     cc.add_argument("--rotations", type=int, default=10, help="recorded cage rotations of every rung (default 10)")

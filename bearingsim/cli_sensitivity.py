@@ -1,4 +1,4 @@
-"""``bearingsim sensitivity`` and ``bearingsim uncertainty`` (issue 25): their parsers and commands,
+"""``bearingsim sensitivity`` and ``bearingsim uncertainty``: their parsers and commands,
 kept beside :mod:`bearingsim.cli`, which adds them with :func:`add_parsers`."""
 from __future__ import annotations
 

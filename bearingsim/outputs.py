@@ -1,6 +1,6 @@
 """Output-path policy: where a run may write, and who may write there at once.
 
-Rules (issue 14), each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any work:
+Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any work:
 
 * a default output name (``outputs/<name>.h5``) never leaves the output folder;
 * an archive path ends in ``.h5`` / ``.hdf5`` (so ``-o my.toml`` or ``-o notes.txt`` is refused);

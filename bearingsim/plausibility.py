@@ -1,4 +1,4 @@
-"""Plausibility of a finished run, checked before anything is written (issue 14).
+"""Plausibility of a finished run, checked before anything is written.
 
 A run that finishes with non-finite numbers, an inner ring displaced further than the contact law
 allows for its load, or too few time-series samples is not a result: :func:`check` raises

@@ -1,4 +1,4 @@
-"""Plausible ranges of uncertain scenario keys (issue 25).
+"""Plausible ranges of uncertain scenario keys.
 
 A preset gives a range beside a value's source::
 

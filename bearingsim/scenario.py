@@ -78,7 +78,7 @@ DEFAULTS: dict[str, dict[str, Any]] = {
 
 PRESET_DIR = "params"
 
-# --- limits on what a scenario may ask for (issue 14). Each says why. ------------------------------
+# --- limits on what a scenario may ask for. Each says why. ------------------------------
 # Scenario files are about 1 kB and presets about 5 kB; reading is bounded so that `run /dev/zero` or a
 # wrong multi-GB file stops at once instead of filling memory.
 MAX_SCENARIO_BYTES = 1 << 20
@@ -93,7 +93,7 @@ MAX_NAME_BYTES = 200
 # terminal or a file listing show the characters in another order than they are (U+202E "RLO")
 _BIDI_CONTROLS = frozenset("\u061c\u200e\u200f\u202a\u202b\u202c\u202d\u202e\u2066\u2067\u2068\u2069")
 # Per-rotation arrays, the impact table and the run time grow with the number of rotations: the
-# multibody model takes ~0.2 s per cage rotation (README), so 1e5 rotations is ~6 h; the reduced
+# multibody model takes ~0.2 s per cage rotation (docs/bench.md), so 1e5 rotations is ~6 h; the reduced
 # model's impact table is ~1e2 rows per rotation, so 1e5 rotations is ~1e7 rows (~0.6 GB in memory).
 MAX_ROTATIONS = 100_000
 # dm*n: the fastest rolling bearings in service (jet-lubricated aircraft-engine mainshaft bearings)
@@ -816,7 +816,7 @@ def check_run_request(scenario: "Scenario") -> None:
     every case of a ``sweep`` and of a study), beyond what the schema allows.
 
     ``numerics.warmup_rotations = 0`` with the multibody model: every pocket's first window then
-    starts from the assembled state, and the means over rotations are biased (issue 14 measured the
+    starts from the assembled state, and the means over rotations are biased (measured: the
     mean I_dec of the reduced-equivalent scene 21 % low). A stability scan (``benchmarks.stability`` of a
     source checkout) and the kernel tests, which want exactly one rotation from the start state, call
     the model's own ``simulate(parameters)``, below this check.

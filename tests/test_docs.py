@@ -37,3 +37,13 @@ def test_readme_is_a_users_page():
     assert "![" in text                                   # a picture
     assert not re.search(r"\bissue \d+", text, re.I)       # no development log
     assert len(text.splitlines()) < 150
+
+
+def test_help_texts_and_scenarios_carry_no_development_references():
+    """Users read the help texts, module docstrings and scenario files: no issue numbers, no pointers
+    into a README section that is not there."""
+    files = [*(ROOT / "bearingsim").rglob("*.py"), *(ROOT / "scenarios").rglob("*.toml")]
+    pattern = re.compile(r"\bissue \d+|\(issue\b|README: ", re.I)
+    offenders = [f"{p.relative_to(ROOT)}:{i + 1}" for p in files
+                 for i, line in enumerate(p.read_text().splitlines()) if pattern.search(line)]
+    assert not offenders, offenders

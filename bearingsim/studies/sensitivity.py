@@ -1,5 +1,5 @@
 """Which unknowns matter: the normalised sensitivity of the headline numbers to every ranged key
-(``bearingsim sensitivity``, issue 25).
+(``bearingsim sensitivity``).
 
 For each key, two runs: the key at x (1 - step) and at x (1 + step), each held within the key's
 plausible range (:func:`perturbed_values`), everything else as the scenario says (the same start, the

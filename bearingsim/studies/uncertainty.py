@@ -1,4 +1,4 @@
-"""How wide is the answer: every ranged key sampled over its range (``bearingsim uncertainty``, issue 25).
+"""How wide is the answer: every ranged key sampled over its range (``bearingsim uncertainty``).
 
 Design (Saltelli 2010): a scrambled Sobol' sequence (``scipy.stats.qmc.Sobol``, seeded) of N points in
 2k dimensions (k ranged keys) gives two independent quasi-random matrices A and B (N x k, uniform over

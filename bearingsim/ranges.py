@@ -83,11 +83,19 @@ def _bound_error(section, key: str, value: float) -> str | None:
     return msg
 
 
+#: ranges found valid: (section, key, low, high). Validity depends on the schema only (the key's type and
+#: bounds), not on the scenario's values, so the thousands of cases of a sweep check each range once.
+_VALID: set[tuple[str, str, float, float]] = set()
+
+
 def check_ranges(model, source: str) -> None:
     """Refuse a wrong ``ranges`` table of a validated scenario model in one line naming the key."""
     for section, keys in (model.ranges or {}).items():
         sec = getattr(model, section, None) if section in type(model).model_fields else None
         for key, entry in keys.items():
+            seen = (section, key, float(entry.range[0]), float(entry.range[1]))
+            if seen in _VALID:
+                continue
             where = f"{source}: ranges.{section}.{key}"
             if sec is None or not hasattr(type(sec), "model_fields") or _field_kind(sec, key) is None:
                 raise UserError(f"{where}: no key {section}.{key} in the scenario to give a range to")
@@ -101,6 +109,7 @@ def check_ranges(model, source: str) -> None:
                 if msg is not None:
                     raise UserError(f"{where}: range = [{lo:g}, {hi:g}] leaves the key's bounds: "
                                     f"{section}.{key} = {end:g} {msg}")
+            _VALID.add(seen)
 
 
 def ranged_keys(scenario) -> dict[str, tuple[float, float, str]]:

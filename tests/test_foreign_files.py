@@ -177,7 +177,7 @@ def test_sweep_rewrites_its_own_files(tmp_path):
     for _ in range(2):
         res = _sweep(out)
         assert res.returncode == 0, res.stderr
-    assert {"sweep.csv", "sweep.h5", "sweep_I.png", "cases", ".sweep.lock"} == {p.name for p in out.iterdir()}
+    assert {"sweep.csv", "sweep.h5", "sweep_I.png", "map.h5", ".sweep.lock"} == {p.name for p in out.iterdir()}
 
 
 @pytest.mark.slow

@@ -33,7 +33,8 @@ def test_run_refuses_to_replace_an_archive_of_another_scenario(tmp_path):
 
 @pytest.mark.slow
 def test_sweep_folder_of_another_sweep_is_refused_resume_and_force_work(tmp_path):
-    first = ("sweep", BASE, "--param", f"{SPEED}=1000,2000", "-o", tmp_path, "-j", "1", "--no-plots")
+    first = ("sweep", BASE, "--param", f"{SPEED}=1000,2000", "-o", tmp_path, "-j", "1", "--no-plots",
+             "--archives", "all")  # the case archives are what this test follows
     assert bearingsim(*first).returncode == 0
     cases = sorted(p.name for p in (tmp_path / "cases").glob("*.h5"))
     res = bearingsim("sweep", BASE, "--param", f"{SPEED}=3000,4000", "-o", tmp_path, "-j", "1", "--no-plots")
@@ -42,7 +43,7 @@ def test_sweep_folder_of_another_sweep_is_refused_resume_and_force_work(tmp_path
     res = bearingsim(*first)  # the same sweep again: resumed (all cached)
     assert res.returncode == 0 and "2 cached" in res.stdout, res.stderr
     res = bearingsim("sweep", BASE, "--param", f"{SPEED}=3000,4000", "-o", tmp_path, "-j", "1", "--no-plots",
-                     "--force")
+                     "--force", "--archives", "all")
     assert res.returncode == 0, res.stderr
     now = sorted(p.name for p in (tmp_path / "cases").glob("*.h5"))
     assert len(now) == 2 and not set(now) & set(cases)  # the first sweep's archives are gone, not mixed in

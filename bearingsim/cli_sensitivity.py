@@ -29,8 +29,9 @@ def _cmd_sensitivity(args) -> int:
     study = Sensitivity(scenario, _keys(args.keys), step)  # bad keys refused before any run
     engine = make_engine(args.jobs, args.scheduler)
     t0 = time.perf_counter()
-    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force)
-    if outcome.interrupted is None:
+    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force,
+                          progress=False if args.quiet else None)
+    if outcome.interrupted is None and not args.quiet:
         print(f"sensitivity of {args.scenario}: {len(study.keys)} keys x 2 runs at x (1 ± {step:.0%}) within each "
               f"key's range, {time.perf_counter() - t0:.1f} s")
         print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
@@ -54,8 +55,9 @@ def _cmd_uncertainty(args) -> int:
     study = Uncertainty(scenario, args.samples, args.seed, _keys(args.keys))
     engine = make_engine(args.jobs, args.scheduler)
     t0 = time.perf_counter()
-    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force)
-    if outcome.interrupted is None:
+    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force,
+                          progress=False if args.quiet else None)
+    if outcome.interrupted is None and not args.quiet:
         print(f"uncertainty of {args.scenario}: {len(study.keys)} keys, N = {args.samples} ({len(study.cases)} runs), "
               f"seed {args.seed}, {time.perf_counter() - t0:.1f} s")
         for s in study.spreads:
@@ -78,6 +80,7 @@ def _common(p, default_out):
     p.add_argument("-o", "--output", default=default_out, help="output folder")
     p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table (failures still said)")
     p.add_argument("--force", action="store_true",
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
 

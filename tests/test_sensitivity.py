@@ -199,3 +199,16 @@ def load_scenario_text(text):
     from bearingsim.scenario import resolve
 
     return resolve(tomllib.loads(text), "shown")
+
+
+def test_every_study_command_takes_quiet(tmp_path, capsys):
+    """-q means the same on every command that runs many cases: nothing printed when all goes well."""
+    from bearingsim.cli import build_parser
+
+    parser = build_parser()
+    for cmd in (["sweep", "x.toml"], ["crosscheck", "x.toml"], ["validate"], ["sensitivity", "x.toml"],
+                ["uncertainty", "x.toml", "--samples", "4"], ["life", "x.toml", "--limit", "depth=0.1mm"]):
+        assert parser.parse_args([*cmd, "-q"]).quiet is True, cmd
+    assert main(["sensitivity", str(REDUCED), "--keys", KEYS[0], "-o", str(tmp_path), "-j", "1", "-q"]) == 0
+    assert capsys.readouterr().out == ""
+    assert (tmp_path / "sensitivity.csv").is_file()

@@ -794,16 +794,22 @@ def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str]
     return path
 
 
+def _open_table(p: Path):
+    """``p`` opened read-only with h5py (a one-line UserError for a path that is not a regular file or
+    not HDF5): the start of both table readers."""
+    h5py = _lazy_h5py()
+    _check_regular(p)
+    try:
+        return h5py.File(p, "r")
+    except (OSError, FileNotFoundError) as exc:
+        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+
+
 def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """Read a table written by :func:`write_table_file` whose root attribute ``format`` is ``fmt``:
     (columns, root attributes). One-line UserError for anything else."""
-    h5py = _lazy_h5py()
     p = Path(path)
-    _check_regular(p)
-    try:
-        f = h5py.File(p, "r")
-    except (OSError, FileNotFoundError) as exc:
-        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+    f = _open_table(p)
     with f:
         if f.attrs.get("format") != fmt or "index" not in f:
             raise UserError(f"{p}: not a {fmt}")
@@ -859,13 +865,8 @@ def read_grid_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, dic
     """Read a file written by :func:`write_grid_file` whose root attribute ``format`` is ``fmt``:
     (every dataset as an array, text as ``str`` objects; each dataset's attributes; root attributes).
     One-line UserError for anything else."""
-    h5py = _lazy_h5py()
     p = Path(path)
-    _check_regular(p)
-    try:
-        f = h5py.File(p, "r")
-    except (OSError, FileNotFoundError) as exc:
-        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+    f = _open_table(p)
     skip = ("CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST")  # the dimension-scale bookkeeping
     with f:
         if f.attrs.get("format") != fmt:

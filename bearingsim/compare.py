@@ -9,16 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-
-def _flatten(d: dict, prefix: str = "") -> dict:
-    out = {}
-    for k, v in d.items():
-        key = f"{prefix}{k}"
-        if isinstance(v, dict):
-            out.update(_flatten(v, key + "."))
-        else:
-            out[key] = v
-    return out
+from bearingsim.scenario import flatten as _flatten  # the one flattener, under this module's old name
 
 
 def _same(a, b) -> bool:

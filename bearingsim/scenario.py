@@ -683,7 +683,7 @@ def unused_note(model: str, keys, method: str | None = None) -> str | None:
 def given_keys(path, overrides=()) -> list[str]:
     """Every dotted key a scenario file and its ``KEY=VALUE`` overrides set (not its preset's or the
     defaults': those are the model's own)."""
-    return list(_flat(read_toml_file(path))) + [parse_override(o)[0] for o in overrides]
+    return list(flatten(read_toml_file(path))) + [parse_override(o)[0] for o in overrides]
 
 
 # compact wording of the differences most often made (others: ``key = value`` by the key's last part)
@@ -700,11 +700,12 @@ _TITLE_LABELS = {
 }
 
 
-def _flat(d: dict, prefix: str = "") -> dict:
+def flatten(d: dict, prefix: str = "") -> dict:
+    """A nested table as ``{"section.key": value}`` (dotted keys, as ``--set`` names them)."""
     out = {}
     for k, v in d.items():
         if isinstance(v, dict):
-            out.update(_flat(v, f"{prefix}{k}."))
+            out.update(flatten(v, f"{prefix}{k}."))
         else:
             out[f"{prefix}{k}"] = v
     return out
@@ -741,7 +742,7 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
         ref = _drop_none(ScenarioModel.model_validate(ref).model_dump())
     except ValidationError:  # no preset: compare with what the defaults set
         pass
-    have, base = _flat(raw), _flat(ref)
+    have, base = flatten(raw), flatten(ref)
     skip = _TITLE_SKIP + _TITLE_SKIP_MODEL.get(raw.get("model"), ())
     out = []
     for key, v in have.items():

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import bearingsim
-from bearingsim.scenario import load_scenario
+from bearingsim.scenario import flatten, load_scenario
 
 from .conftest import SCENARIOS
 from .test_cli import assert_user_error, bearingsim as cli
@@ -19,14 +19,7 @@ from .test_cli import assert_user_error, bearingsim as cli
 PAPER = SCENARIOS / "paper_3000rpm.toml"
 
 
-def _flat(d, prefix=""):
-    out = {}
-    for k, v in d.items():
-        if isinstance(v, dict):
-            out.update(_flat(v, f"{prefix}{k}."))
-        else:
-            out[f"{prefix}{k}"] = v
-    return out
+_flat = flatten  # dotted keys of a nested table
 
 
 # --- did you mean -----------------------------------------------------------------------------------

@@ -31,8 +31,6 @@ ordinary archives) and ``sweep.csv``/``sweep.h5`` (the engine's index of the cas
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from pathlib import Path
@@ -231,34 +229,19 @@ def run_crosscheck(scenario, outdir, speeds=DEFAULT_SPEEDS_RPM, rotations: int |
     return study.rows, outcome
 
 
-def _fmt(v) -> str:
-    if isinstance(v, str):
-        return v
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    return "" if math.isnan(v) else repr(float(v))
-
-
 def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
     """Write ``crosscheck.csv`` (exactly :data:`COLUMNS`; a failed rung's numbers empty) and
     ``crosscheck.h5`` (the same columns and ``archive``, ``wall_s``, ``status``, ``error``, as an index
     table; :func:`bearingsim.archive.write_table_file`) atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
+    from bearingsim.studies.engine import table_columns, table_csv
 
     outdir = Path(outdir)
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS)
-    for r in rows:
-        w.writerow([_fmt(r[c]) for c in COLUMNS])
     csv_path = outdir / "crosscheck.csv"
-    write_atomic_bytes(csv_path, buf.getvalue().encode("utf-8"))
+    write_atomic_bytes(csv_path, table_csv(rows, COLUMNS))
     columns = (*COLUMNS, "archive", "wall_s", "status", "error")
-    cols = {}
-    for c in columns:
-        vals = [r[c] for r in rows]
-        cols[c] = np.array(vals, dtype=object) if isinstance(vals[0], str) else np.array(vals, dtype=float)
+    cols = table_columns(rows, columns)
     units = {**UNITS, "wall_s": "s"}
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
              "scenario_name": scenario.name}

@@ -22,6 +22,39 @@ from bearingsim.errors import UserError
 from bearingsim.stats import batch_sem  # noqa: F401 - the studies' estimator, re-exported
 from bearingsim.sweeps.spec import Case, case_hash
 
+
+def table_csv(rows: list[dict], columns) -> bytes:
+    """A study's table as CSV text (UTF-8): the header, then each row's ``columns``: text as it is, an
+    integer as an integer, a float by ``repr`` (every digit), NaN as an empty field."""
+    import csv
+    import io
+    import math
+
+    import numpy as np
+
+    def cell(v) -> str:
+        if isinstance(v, str):
+            return v
+        if isinstance(v, (int, np.integer)):
+            return str(int(v))
+        return "" if math.isnan(v) else repr(float(v))
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(columns)
+    for r in rows:
+        w.writerow([cell(r[c]) for c in columns])
+    return buf.getvalue().encode("utf-8")
+
+
+def table_columns(rows: list[dict], columns) -> dict:
+    """A study's rows as the columns of an index table (:func:`bearingsim.archive.write_table_file`):
+    a text column as objects, any other as float64 (the first row says which)."""
+    import numpy as np
+
+    return {c: (np.array([r[c] for r in rows], dtype=object) if isinstance(rows[0][c], str)
+                else np.array([r[c] for r in rows], dtype=float)) for c in columns}
+
 #: statuses of a case whose archive holds its numbers
 FINISHED = ("done", "cached", "stale")
 

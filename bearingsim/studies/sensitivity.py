@@ -26,8 +26,6 @@ index, with each run's archive, status and error), ``sensitivity.png`` (tornado 
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 from pathlib import Path
@@ -261,29 +259,18 @@ class Sensitivity(Study):
         return [*paths, *plot_sensitivity(outdir / "sensitivity.h5", outdir)]
 
 
-def _fmt(v) -> str:
-    if isinstance(v, str):
-        return v
-    return "" if math.isnan(v) else repr(float(v))
-
-
 def write_table(outdir, rows, scenario, step) -> tuple[Path, Path]:
     """``sensitivity.csv`` (exactly :data:`COLUMNS`, a failed pair's numbers empty) and
     ``sensitivity.h5`` (those columns and each pair's archives, status and error) atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
+    from bearingsim.studies.engine import table_columns, table_csv
 
     outdir = Path(outdir)
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS)
-    for r in rows:
-        w.writerow([_fmt(r[c]) for c in COLUMNS])
     csv_path = outdir / "sensitivity.csv"
-    write_atomic_bytes(csv_path, buf.getvalue().encode("utf-8"))
+    write_atomic_bytes(csv_path, table_csv(rows, COLUMNS))
     columns = (*COLUMNS, "archive_minus", "archive_plus", "status", "error")
-    cols = {c: (np.array([r[c] for r in rows], dtype=object) if isinstance(rows[0][c], str)
-                else np.array([r[c] for r in rows], dtype=float)) for c in columns}
+    cols = table_columns(rows, columns)
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
              "scenario_name": scenario.name, "step": float(step)}
     h5_path = archive.write_table_file(outdir / "sensitivity.h5", cols, UNITS, attrs)

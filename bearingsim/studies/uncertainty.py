@@ -20,8 +20,6 @@ them (the Ishigami test goes through the same two functions).
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
 import warnings
@@ -205,28 +203,18 @@ def analyse(f: dict[str, np.ndarray], keys, seed: int) -> tuple[list[dict], list
     return indices, spreads
 
 
-def _csv(rows, columns) -> bytes:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(columns)
-    for r in rows:
-        w.writerow([r[c] if isinstance(r[c], str) else ("" if math.isnan(r[c]) else repr(float(r[c])))
-                    for c in columns])
-    return buf.getvalue().encode("utf-8")
-
-
 def write_tables(outdir, indices, spreads, study) -> list[Path]:
     """``uncertainty.csv``, ``uncertainty_spread.csv`` and ``uncertainty.h5`` (the index table plus the
     spreads and the design in its attributes), atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
+    from bearingsim.studies.engine import table_columns, table_csv
 
     outdir = Path(outdir)
     p1, p2 = outdir / "uncertainty.csv", outdir / "uncertainty_spread.csv"
-    write_atomic_bytes(p1, _csv(indices, COLUMNS))
-    write_atomic_bytes(p2, _csv(spreads, SPREAD_COLUMNS))
-    cols = {c: (np.array([r[c] for r in indices], dtype=object) if isinstance(indices[0][c], str)
-                else np.array([r[c] for r in indices], dtype=float)) for c in COLUMNS}
+    write_atomic_bytes(p1, table_csv(indices, COLUMNS))
+    write_atomic_bytes(p2, table_csv(spreads, SPREAD_COLUMNS))
+    cols = table_columns(indices, COLUMNS)
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(COLUMNS), "scenario": study.scenario.to_toml(),
              "scenario_name": study.scenario.name, "samples": study.samples, "seed": study.seed,
              "keys": json.dumps(study.keys), "bounds": json.dumps(study.bounds.tolist()),

@@ -433,14 +433,6 @@ def _cmd_bench(args) -> int:
     return 0
 
 
-def _cmd_sweep(args) -> int:
-    from bearingsim.sweeps import run_sweep_cli
-
-    return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
-                         scheduler=args.scheduler, figures=not args.no_plots, force=args.force, quiet=args.quiet,
-                         progress=_progress(args), archives=args.archives or "auto")
-
-
 def _cmd_crosscheck(args) -> int:
     import time
 
@@ -478,6 +470,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--version", action="version", version=f"bearingsim {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
+    _add_run_commands(sub)
+    _add_study_commands(sub)
+    from bearingsim import cli_sweep
+
+    cli_sweep.add_commands(sub)  # sweep (bearingsim/cli_sweep.py)
+    from bearingsim import cli_wear
+
+    cli_wear.add_commands(sub)  # wear, life (bearingsim/cli_wear.py)
+    from bearingsim.cli_sensitivity import add_parsers as _add_sensitivity_parsers
+
+    _add_sensitivity_parsers(sub)
+    return p
+
+
+def _add_run_commands(sub) -> None:
+    """One run and its archive: run, inspect, show, plot, rerun, compare, table, keys."""
     r = sub.add_parser("run", help="run a scenario file and write an HDF5 archive and figures")
     r.add_argument("scenario", help="scenario TOML file")
     r.add_argument("-o", "--output", help="archive path (default outputs/<name>.h5)")
@@ -535,6 +543,9 @@ def build_parser() -> argparse.ArgumentParser:
     ks.add_argument("--why", action="store_true", help="each preset value's reasoning or reference below it")
     ks.set_defaults(func=_cmd_keys)
 
+
+def _add_study_commands(sub) -> None:
+    """Many-case studies that are not sweeps: validate, bench, crosscheck."""
     v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
                                         "(pocket 0 flat) against it (tables and PNGs; run again to resume)")
     v.add_argument("-o", "--output", default="outputs/validate", help="output folder")
@@ -566,27 +577,6 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
     b.set_defaults(func=_cmd_bench)
 
-    s = sub.add_parser("sweep", help="what-if sweep: resumable, failures recorded, local pool or dask cluster")
-    s.add_argument("scenario", help="scenario TOML (with --param) or sweep file (docs/sweeps.md)")
-    s.add_argument("--param", action="append", default=[], metavar="KEY=V1,V2,...|KEY=START:STOP:NUM",
-                   help="key and the values to sweep, as a list (values as TOML; commas inside [ ], { } or "
-                        "quotes do not split) or as a range START:STOP:NUM of NUM evenly spaced numbers, both "
-                        "ends included, e.g. operating.inner_ring_speed_rpm=500:6000:12 (repeatable: the grid "
-                        "is the product)")
-    s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
-                   help="override a scenario key in every case (repeatable)")
-    s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, map, cases/, figures)")
-    s.add_argument("--archives", choices=("none", "all"), default=None,
-                   help="per-case archives in DIR/cases/: 'all' or 'none' (default: the multibody cases only; "
-                        "every case's numbers are in the index sweep.h5 and, for a product grid, map.h5)")
-    s.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
-    s.add_argument("--scheduler", metavar="ADDRESS",
-                   help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
-    s.add_argument("--no-plots", action="store_true", help="index only, no figures")
-    s.add_argument("--force", action="store_true",
-                   help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
-    s.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
-    s.set_defaults(func=_cmd_sweep)
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
                                            "(docs/crosscheck.md; run again to resume)")
     cc.add_argument("scenario", help="multibody scenario TOML, full scene")
@@ -602,13 +592,6 @@ def build_parser() -> argparse.ArgumentParser:
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     cc.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
     cc.set_defaults(func=_cmd_crosscheck)
-    from bearingsim import cli_wear
-
-    cli_wear.add_commands(sub)  # wear, life (bearingsim/cli_wear.py)
-    from bearingsim.cli_sensitivity import add_parsers as _add_sensitivity_parsers
-
-    _add_sensitivity_parsers(sub)
-    return p
 
 
 class Terminated(KeyboardInterrupt):

@@ -161,22 +161,7 @@ class Parameters:
     @classmethod
     def from_scenario(cls, scenario) -> "Parameters":
         """Build the SI parameters of a resolved :class:`bearingsim.scenario.Scenario`."""
-        b = scenario.bearing
-        bearing = Bearing(
-            roller_count=b.roller_count,
-            roller_radius=b.roller_diameter_mm * 0.5e-3,
-            roller_length=b.roller_length_mm * 1e-3,
-            roller_mass=b.roller_mass_kg,
-            pitch_radius=b.pitch_diameter_mm * 0.5e-3,
-            pocket_clearance=b.pocket_clearance_mm * 1e-3,
-            radial_clearance=b.radial_clearance_mm * 1e-3,
-            cage_mass=b.cage_mass_kg,
-            cage_inertia=b.cage_inertia_kgm2,
-            cage_guidance=b.cage_guidance,
-            cage_land_clearance=None if b.cage_land_clearance_mm is None else b.cage_land_clearance_mm * 1e-3,
-            cage_outer_radius=None if b.cage_outer_diameter_mm is None else b.cage_outer_diameter_mm * 0.5e-3,
-            cage_inner_radius=None if b.cage_inner_diameter_mm is None else b.cage_inner_diameter_mm * 0.5e-3,
-        )
+        bearing = _bearing(scenario.bearing)
         o = scenario.operating
         omega_i = laws.inner_ring_angular_speed(o.inner_ring_speed_rpm)
         omega_c = laws.cage_angular_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
@@ -217,15 +202,7 @@ class Parameters:
             load_zone_rule="quasi-static" if given is None else "given",
             resting_contact=bool(r.resting_contact),
         )
-        if mb.pocket_face_half_angle_deg != "auto":
-            half = math.radians(float(mb.pocket_face_half_angle_deg))
-            face_extent = (-half, half)
-        elif bearing.cage_inner_radius is not None and bearing.cage_outer_radius is not None:
-            face_extent = laws.pocket_face_extent(bearing.pitch_radius,
-                                                  bearing.roller_radius + 0.5 * bearing.pocket_clearance,
-                                                  bearing.cage_inner_radius, bearing.cage_outer_radius)
-        else:  # a reduced-model scenario whose preset has no cage ring: the faces are not used
-            face_extent = (math.nan, math.nan)
+        face_extent = _face_extent(mb.pocket_face_half_angle_deg, bearing)
         multibody = MultibodyOptions(
             scene=mb.scene,
             inner_ring=mb.inner_ring,
@@ -241,3 +218,35 @@ class Parameters:
                     hardness=float(scenario.wear.hardness_Pa))
         return cls(name=scenario.name, model=scenario.model, bearing=bearing, operating=operating,
                    contact=contact, numerics=numerics, reduced=reduced, multibody=multibody, wear=wear)
+
+
+def _bearing(b) -> Bearing:
+    """The SI :class:`Bearing` of a scenario's ``[bearing]`` section."""
+    return Bearing(
+        roller_count=b.roller_count,
+        roller_radius=b.roller_diameter_mm * 0.5e-3,
+        roller_length=b.roller_length_mm * 1e-3,
+        roller_mass=b.roller_mass_kg,
+        pitch_radius=b.pitch_diameter_mm * 0.5e-3,
+        pocket_clearance=b.pocket_clearance_mm * 1e-3,
+        radial_clearance=b.radial_clearance_mm * 1e-3,
+        cage_mass=b.cage_mass_kg,
+        cage_inertia=b.cage_inertia_kgm2,
+        cage_guidance=b.cage_guidance,
+        cage_land_clearance=None if b.cage_land_clearance_mm is None else b.cage_land_clearance_mm * 1e-3,
+        cage_outer_radius=None if b.cage_outer_diameter_mm is None else b.cage_outer_diameter_mm * 0.5e-3,
+        cage_inner_radius=None if b.cage_inner_diameter_mm is None else b.cage_inner_diameter_mm * 0.5e-3,
+    )
+
+
+def _face_extent(half_angle_deg, bearing: Bearing) -> tuple[float, float]:
+    """The arc faces' extent (psi_in, psi_out) [rad]: ``multibody.pocket_face_half_angle_deg`` when given,
+    else what the cage wall allows (:func:`bearingsim.laws.pocket_face_extent`); NaN for a reduced-model
+    scenario whose preset has no cage ring (the faces are not used)."""
+    if half_angle_deg != "auto":
+        half = math.radians(float(half_angle_deg))
+        return (-half, half)
+    if bearing.cage_inner_radius is not None and bearing.cage_outer_radius is not None:
+        return laws.pocket_face_extent(bearing.pitch_radius, bearing.roller_radius + 0.5 * bearing.pocket_clearance,
+                                       bearing.cage_inner_radius, bearing.cage_outer_radius)
+    return (math.nan, math.nan)

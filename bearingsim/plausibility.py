@@ -133,9 +133,9 @@ def cage_speed_drift(result) -> str | None:
     """A note when the cage speed of a fresh multibody run drifted over its recorded rotations by more
     than :data:`MAX_CAGE_SPEED_DRIFT` of its mean (not statistically steady), else None."""
     raw = getattr(result, "raw", None)
-    if not raw or raw.get("cage_w_start") is None:  # read back from an archive, or never recorded
+    if raw is None or raw.cage_w_start is None:  # read back from an archive, or never recorded
         return None
-    ws, we = float(raw["cage_w_start"]), float(raw["cage_w_end"])
+    ws, we = float(raw.cage_w_start), float(raw.cage_w_end)
     mean = abs(float(result.summary.get("cage_speed_mean_rad_s", float("nan"))))
     if not (math.isfinite(ws) and math.isfinite(we) and mean > 0) or abs(we - ws) <= MAX_CAGE_SPEED_DRIFT * mean:
         return None

@@ -77,9 +77,7 @@ class Result:
     def parameters(self):
         """The SI :class:`bearingsim.parameters.Parameters` of :attr:`scenario`."""
         if self._parameters is None:
-            from bearingsim.parameters import Parameters
-
-            self._parameters = Parameters.from_scenario(self.scenario)
+            self._parameters = self.scenario.parameters
         return self._parameters
 
     @property

@@ -294,8 +294,9 @@ class Scenario:
         self.model_ = model
         self.source = source
         self._toml = toml
+        self._parameters = None
 
-    _OWN = frozenset({"model_", "source", "_toml"})
+    _OWN = frozenset({"model_", "source", "_toml", "_parameters"})
 
     def __setattr__(self, item, value):
         """Only the constructor sets attributes: a scenario is validated once and frozen (``sc.name =
@@ -326,6 +327,16 @@ class Scenario:
     @property
     def raw(self) -> dict[str, Any]:
         return _drop_none(self.model_.model_dump())
+
+    @property
+    def parameters(self):
+        """The SI :class:`bearingsim.parameters.Parameters` the models take, built once (the scenario is
+        frozen, so they cannot change)."""
+        if self._parameters is None:
+            from bearingsim.parameters import Parameters
+
+            self._parameters = Parameters.from_scenario(self)
+        return self._parameters
 
     def to_toml(self) -> str:
         """The resolved scenario as TOML text (what an archive stores), formatted once: the model is
@@ -804,12 +815,13 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
                 msg += f" (got {err['input']!r})"
         raise UserError(f"{source}: {key}: {msg}") from None
     _check_geometry(model, source)
-    _check_limits(model, source)
+    scenario = Scenario(model, source)
+    _check_limits(model, source, scenario)
     if model.ranges:
         from bearingsim.ranges import check_ranges
 
         check_ranges(model, source)
-    return Scenario(model, source)
+    return scenario
 
 
 def check_run_request(scenario: "Scenario") -> None:
@@ -827,9 +839,9 @@ def check_run_request(scenario: "Scenario") -> None:
                         "windows that start from the assembled state (biased means); use at least 1 warm-up rotation")
 
 
-def _check_limits(m: ScenarioModel, source: str) -> None:
+def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
     """Sizes, run length and physically absurd values, each refused with the limit and its reason
-    (the constants above)."""
+    (the constants above); ``scenario``: ``m`` as a scenario, whose SI parameters the last checks use."""
     b, o, n = m.bearing, m.operating, m.numerics
     total = n.rotations + n.warmup_rotations
     if total > MAX_ROTATIONS:
@@ -860,9 +872,8 @@ def _check_limits(m: ScenarioModel, source: str) -> None:
         raise UserError(f"{source}: wear.hardness_Pa: {m.wear.hardness_Pa:g} Pa is outside the hardness of "
                         f"solids ({lo:g}..{hi:g} Pa)")
     from bearingsim import laws
-    from bearingsim.parameters import Parameters
 
-    view = Parameters.from_scenario(Scenario(m, source))
+    view = scenario.parameters
     g_r, op = view.bearing, view.operating
     n_free = g_r.roller_mass * (g_r.pitch_radius * op.omega_c**2 + op.gravity)  # Eq. (3), least N
     if n_free > 0:

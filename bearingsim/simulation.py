@@ -16,7 +16,6 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bearingsim.parameters import Parameters
 from bearingsim.scenario import Scenario, check_run_request
 
 log = logging.getLogger(__name__)  # notes of a plausible run that is not clean (the command line prints them)
@@ -84,7 +83,7 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     if dt is not None:
         scenario = scenario.replace(**{"numerics.dt_s": dt})
     check_run_request(scenario)  # what `bearingsim run` refuses beyond the schema, refused on every path
-    params = Parameters.from_scenario(scenario)
+    params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
     result.provenance["wall_time_s"] = time.perf_counter() - t0

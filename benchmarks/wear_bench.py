@@ -29,7 +29,7 @@ def _solver_s(sc, profile: bool) -> float:
         raw = multibody.simulate(Parameters.from_scenario(sc)).raw  # (with its restarts at a shorter step)
     finally:
         core.rk.RecorderConfig = real
-    return raw["loop_s"]  # the step loop of the last (kept) run
+    return raw.loop_s  # the step loop of the last (kept) run
 
 
 def cost(repeats: int = 3) -> None:

@@ -73,10 +73,10 @@ def test_rollers_never_pass_the_outer_race(pair_6000):
     r = pair_6000["rigid"]
     p, raw = r.parameters, r.raw
     h = r.provenance["dt_s"]
-    chord = raw["rigid_radius"] * (1.5 * p.operating.omega_c * h) ** 2 / 2.0
+    chord = raw.setup.rigid_radius * (1.5 * p.operating.omega_c * h) ** 2 / 2.0
     assert r.summary["roller_beyond_race_max_m"] > 0.0
-    assert raw["beyond_before"] <= chord, (raw["beyond_before"], chord)
-    assert raw["beyond_max"] <= max(raw["beyond_before"], 0.0) + h * max(raw["beyond_vr"], 0.0) + chord, raw
+    assert raw.beyond_before <= chord, (raw.beyond_before, chord)
+    assert raw.beyond_max <= max(raw.beyond_before, 0.0) + h * max(raw.beyond_vr, 0.0) + chord, raw
 
 
 def test_loaded_rollers_sit_on_their_constraint(pair_6000):
@@ -88,8 +88,8 @@ def test_loaded_rollers_sit_on_their_constraint(pair_6000):
     r = pair_6000["rigid"]
     p = r.parameters
     n = p.bearing.roller_count
-    st = r.raw["final_state"]
-    r_c = r.raw["rigid_radius"]
+    st = r.raw.final_state
+    r_c = r.raw.setup.rigid_radius
     radius = np.hypot(st[:n, 0], st[:n, 1])
     angle_from_load = np.degrees(np.arctan2(st[:n, 0], -st[:n, 1]))  # 0 at the bottom (load-zone centre)
     loaded = np.abs(angle_from_load) < r.summary["load_zone_half_angle_deg"] - 1.0  # a 46 deg window: >= 2 rollers

@@ -12,7 +12,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pymunk
 import pytest
 
 from bearingsim import laws
@@ -166,8 +165,8 @@ def test_land_contact_does_not_depend_on_the_faces(segments):
     sc = load_scenario(MB, ["bearing.cage_guidance=outer_land", f"multibody.pocket_face_segments={segments}",
                             "numerics.rotations=1", "numerics.warmup_rotations=1"])
     raw = run(si(sc))
-    assert raw["land"] is not None
-    assert raw["land"]["win"][:, 0].min() > 0.1
+    assert raw.land is not None
+    assert raw.land["win"][:, 0].min() > 0.1
 
 
 @pytest.mark.slow
@@ -179,6 +178,6 @@ def test_exact_faces_reach_the_fine_polyline_s_limit():
     res = {}
     for n_seg in (0, 3, 15):
         sc = load_scenario(MB, [f"multibody.pocket_face_segments={n_seg}", "numerics.rotations=2"])
-        res[n_seg] = float(run(si(sc))["win"]["I_dec"].sum())
+        res[n_seg] = float(run(si(sc)).win["I_dec"].sum())
     assert abs(res[0] - res[15]) < abs(res[3] - res[15])
     assert res[0] == pytest.approx(res[15], rel=0.10)

@@ -362,7 +362,7 @@ COMPARED = ("steps", "t_end", "t_record", "win", "first_imp", "f_bin", "t_bin", 
 def _assert_same_bytes(a, b):
     """Every compared result of two runs is the same bytes."""
     for key in COMPARED:
-        x, y = np.asarray(a[key]), np.asarray(b[key])
+        x, y = np.asarray(getattr(a, key)), np.asarray(getattr(b, key))
         assert x.dtype == y.dtype and x.shape == y.shape and x.tobytes() == y.tobytes(), key
 
 
@@ -372,10 +372,10 @@ def _same_bytes_without(probe, says, sc, monkeypatch):
     are the same bytes. Returns the first run's results."""
     assert getattr(chipmunk, probe)() is None
     taken = run(si(sc), step_loop="compiled")
-    assert says not in taken["step_loop_reason"]
+    assert says not in taken.step_loop_reason
     monkeypatch.setattr(chipmunk, probe, lambda: "a layout the probe did not find")
     without = run(si(sc), step_loop="compiled")
-    assert f"{says} (a layout the probe did not find)" in without["step_loop_reason"]
+    assert f"{says} (a layout the probe did not find)" in without.step_loop_reason
     _assert_same_bytes(taken, without)
     return taken
 
@@ -393,8 +393,8 @@ def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extr
     sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
     compiled = run(si(sc), step_loop="compiled")
     plain = run(si(sc), step_loop="plain")
-    assert (compiled["step_loop"], plain["step_loop"]) == ("compiled", "plain")
-    assert len(compiled["impacts"]) > 0
+    assert (compiled.step_loop, plain.step_loop) == ("compiled", "plain")
+    assert len(compiled.impacts) > 0
     _assert_same_bytes(compiled, plain)
 
 
@@ -423,7 +423,7 @@ def test_narrowed_face_masks_change_no_number(scenario, extra, monkeypatch):
     checks the same from the other side."""
     sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
     narrowed = _same_bytes_without("mask_layout", "face masks not narrowed", sc, monkeypatch)
-    assert len(narrowed["impacts"]) > 0
+    assert len(narrowed.impacts) > 0
 
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
@@ -438,7 +438,7 @@ def test_joints_solved_outside_pymunk_change_no_number(extra, monkeypatch):
     sc = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0",
                                                                "multibody.raceway_contact=rigid", *extra])
     own = _same_bytes_without("joint_layout", "every joint left to pymunk", sc, monkeypatch)
-    assert len(own["impacts"]) > 0 and own["t_start"] > 0.0
+    assert len(own.impacts) > 0 and own.setup.t_start > 0.0
 
 
 def test_joint_solve_is_chipmunk_s_slide_joint_bit_for_bit():

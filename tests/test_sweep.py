@@ -18,7 +18,8 @@ from bearingsim.simulation import run as simulate
 from bearingsim.scenario import load_scenario
 from bearingsim.sweeps import LocalEngine, SweepSpec, case_hash, read_index, resolve_cases, run_sweep
 from bearingsim.sweeps.plot import axis_label, plot_sweep_index
-from bearingsim.sweeps.run import make_batches, run_sweep_cli
+from bearingsim.cli_sweep import run_sweep_cli
+from bearingsim.sweeps.run import make_batches
 from bearingsim.sweeps.spec import Case, load_sweep_file, scenario_from_toml
 from bearingsim.sweeps.worker import standard_errors
 

@@ -134,7 +134,7 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
             dt = new_dt
             sink.discard_timeseries()
     if retries:  # the last run was given its dt: describe how the first one was chosen, then the restarts
-        raw["dt_choice"] = "; ".join([first_how or choose_dt(p)[1], *retries])
+        raw = raw._replace(setup=raw.setup._replace(dt_how="; ".join([first_how or choose_dt(p)[1], *retries])))
     res = MultibodyResult.from_raw(p, raw)
     res.series = sink.collect()
     return res
@@ -184,6 +184,181 @@ def _load_zone_half_angle(q_bin, tq_bin):
     return 0.5 * width
 
 
+def _summary(p, raw, per) -> tuple[dict, dict]:
+    """The headline numbers of a run and their units."""
+    geo, op = p.bearing, p.operating
+    # every scene but the reduced-equivalent one has an inner ring: its load zone emerges
+    with_ring = not paper_assumptions(raw.setup.scene)
+    # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
+    # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
+    # (wider with discrete rollers: the laterally free ring shifts towards the exiting roller)
+    ring_centre_mean = raw.ring_centre_mean
+    if with_ring:
+        phi_deg = math.degrees(laws.load_zone_from_displacement(-ring_centre_mean[1], geo.radial_clearance))
+        phi_contact_deg = _load_zone_half_angle(raw.q_bin, raw.tq_bin)
+    else:
+        phi_deg = phi_contact_deg = math.degrees(raw.setup.phi)
+    t_rec = raw.t_record
+    cage_speed_mean = 2.0 * math.pi * p.numerics.rotations / t_rec if t_rec > 0 else float("nan")
+    g = raw.glob
+    ws, we = raw.cage_w_start, raw.cage_w_end
+    momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
+    drive = abs(per["I_acc"].sum()) * geo.pitch_radius
+    if drive == 0.0:  # nothing drives the cage (a kinematic cage turned by its prescription): scale by
+        drive = abs(per["I_dec"].sum()) * geo.pitch_radius  # the braking; -1 = all from the prescription
+    land = raw.land
+    tau = g["tau_normal"] + g["tau_friction"]
+    if land is not None:  # the land friction torque on a land-guided cage
+        tau = tau + land["tau"]
+    torque_residual = ((tau - momentum_change) / drive if drive > 0 else float("nan"))
+    fi = raw.first_imp[np.isfinite(raw.first_imp)]
+    v1 = float(fi.mean()) if fi.size else float("nan")
+    summary = {
+        "I_dec_mean_Ns": float(per["I_dec"].mean()),
+        "I_dec_std_Ns": float(per["I_dec"].std()),
+        "I_acc_mean_Ns": float(per["I_acc"].mean()),
+        "I_acc_std_Ns": float(per["I_acc"].std()),
+        "first_impact_speed_m_s": v1,
+        "first_impact_energy_J": 0.5 * geo.roller_mass * v1 * v1,
+        "cage_speed_mean_rad_s": float(cage_speed_mean),
+        "cage_slip": float(1.0 - cage_speed_mean / op.omega_c),
+        "load_zone_half_angle_deg": float(phi_deg),
+        "load_zone_contact_half_angle_deg": float(phi_contact_deg),
+        "torque_balance_residual": float(torque_residual),
+        "max_penetration_m": float(max(g["maxpen_front"], g["maxpen_rear"])),
+        "max_penetration_all_m": float(g["maxpen_all"]),
+        "cage_orbit_max_m": float(raw.orbit_max),
+        "dt_s": float(raw.setup.dt),
+        "steps": int(raw.steps),
+    }
+    if with_ring:  # the reduced-equivalent scene has no inner ring
+        summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
+    units = dict(SUMMARY_UNITS)
+    if raw.lift_max is not None:  # rigid raceways (docs/fast_scene.md)
+        summary["roller_lift_max_m"] = float(raw.lift_max)
+        summary["roller_beyond_race_max_m"] = float(raw.beyond_max)
+        units.update(RIGID_SUMMARY_UNITS)
+    if land is not None:
+        summary.update({
+            "land_normal_impulse_mean_Ns": float(land["win"][:, 0].mean()),
+            "land_friction_impulse_mean_Ns": float(land["win"][:, 1].mean()),
+            "land_torque_impulse_Nms": float(land["tau"]),
+            "land_overlap_max_m": float(land["overlap_max"]),
+            "land_stiffness_N_m": float(land["stiffness"]),
+        })
+        units.update(LAND_SUMMARY_UNITS)
+    return summary, units
+
+
+_PER_ROTATION_DESC = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
+
+
+def _per_rotation_arrays(per, first_imp, land) -> dict:
+    """``/results/per_rotation``: the impulses, sliding work and first impact speed [rotation, pocket],
+    and a land-guided cage's land impulses [rotation]."""
+    desc = _PER_ROTATION_DESC
+    pr = "results/per_rotation"
+    data = {
+        f"{pr}/I_acc": NamedArray(per["I_acc"], "N s", "front-face impulse, circumferential component, " + desc),
+        f"{pr}/I_dec": NamedArray(per["I_dec"], "N s", "rear-face impulse, circumferential component (braking), " + desc),
+        f"{pr}/Jn_front": NamedArray(per["Jn_front"], "N s", "front-face normal impulse, " + desc),
+        f"{pr}/Jn_rear": NamedArray(per["Jn_rear"], "N s", "rear-face normal impulse, " + desc),
+        f"{pr}/Jf_front": NamedArray(per["Jf_front"], "N s", "front-face friction impulse, " + desc),
+        f"{pr}/Jf_rear": NamedArray(per["Jf_rear"], "N s", "rear-face friction impulse, " + desc),
+        f"{pr}/slide_work_front": NamedArray(per["slide_work_front"], "J", "sum J_n |v_slide| on the front face, " + desc),
+        f"{pr}/slide_work_rear": NamedArray(per["slide_work_rear"], "J", "sum J_n |v_slide| on the rear face, " + desc),
+        f"{pr}/first_impact_speed": NamedArray(first_imp, "m/s", "approach speed of the first rear-face impact "
+                                               "in the no-load zone (NaN: none), " + desc),
+    }
+    if land is not None:
+        land_desc = ("per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start), "
+                     "land-guided cage")
+        data[f"{pr}/land_normal"] = NamedArray(land["win"][:, 0].copy(), "N s",
+                                               "normal impulse of the cage rim on its guiding land, " + land_desc)
+        data[f"{pr}/land_friction"] = NamedArray(land["win"][:, 1].copy(), "N s",
+                                                 "friction impulse magnitude on the land, " + land_desc)
+        data[f"{pr}/land_torque"] = NamedArray(land["win"][:, 2].copy(), "N m s",
+                                               "angular impulse of the land friction on the cage about its "
+                                               "centre (counter-clockwise positive), " + land_desc)
+    return data
+
+
+def _theta_arrays(raw) -> dict:
+    """Pocket forces per theta bin and pocket, and (with an inner ring) the raceway loads per theta bin."""
+    nb = THETA_BINS
+    theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
+    tb = raw.t_bin  # (n, nb)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        force_acc = np.where(tb > 0, raw.f_bin["front"] / tb, 0.0).T  # (nb, n)
+        force_dec = np.where(tb > 0, raw.f_bin["rear"] / tb, 0.0).T
+        tq = raw.tq_bin
+        load_inner = np.where(tq > 0, raw.q_bin["inner"] / np.maximum(tq, 1e-300), 0.0)
+        load_outer = np.where(tq > 0, raw.q_bin["outer"] / np.maximum(tq, 1e-300), 0.0)
+    data = {
+        "results/theta_deg": NamedArray(theta_deg, "deg", "bin centres of theta (load-zone centre = 0)"),
+        "results/force_vs_theta": NamedArray(force_acc - force_dec, "N",
+                                             "mean circumferential roller-cage force on the cage (F_acc - F_dec) per "
+                                             "theta bin (rows, /results/theta_deg) and pocket (columns), recorded rotations"),
+        "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
+        "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
+    }
+    if not paper_assumptions(raw.setup.scene):
+        data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
+        data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
+    return data
+
+
+def _impact_arrays(imp) -> dict:
+    """The impact table's columns."""
+    return {
+        "results/impacts/time_s": NamedArray(imp["time"], "s"),
+        "results/impacts/theta_deg": NamedArray(imp["theta_deg"], "deg"),
+        "results/impacts/approach_speed_m_s": NamedArray(imp["approach_speed"], "m/s"),
+        "results/impacts/impulse_Ns": NamedArray(imp["impulse"], "N s"),
+        "results/impacts/pocket": NamedArray(imp["pocket"].astype(np.int64)),
+        # face codes and strings of the reduced model (reduced/core.py)
+        "results/impacts/face": NamedArray(np.where(imp["face"] == rk.FACE_FRONT, "front", "rear")),
+        "results/impacts/rotation": NamedArray(imp["rotation"].astype(np.int64)),
+    }
+
+
+_WEAR_DESC = {
+    "paper_index_front": "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket",
+    "paper_index_rear": "Archard wear per cage rotation, rear face, k I_dec r_r omega_r / H, per pocket",
+    "sliding_work_front": "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket",
+    "sliding_work_rear": "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket",
+}
+
+
+def _wear_arrays(p, per) -> dict:
+    """Archard wear per cage rotation and pocket face [m^3]: the paper's index and the sliding work."""
+    geo, op, w_ = p.bearing, p.operating, p.wear
+    wear = {
+        "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
+                                                      geo.roller_radius, op.omega_r, w_.hardness),
+        "paper_index_rear": laws.archard_wear_volume(w_.wear_coefficient, per["I_dec"].mean(axis=0),
+                                                     geo.roller_radius, op.omega_r, w_.hardness),
+        "sliding_work_front": w_.wear_coefficient * per["slide_work_front"].mean(axis=0) / w_.hardness,
+        "sliding_work_rear": w_.wear_coefficient * per["slide_work_rear"].mean(axis=0) / w_.hardness,
+    }
+    return {f"results/wear/{k}": NamedArray(v, "m^3", _WEAR_DESC[k]) for k, v in wear.items()}
+
+
+def _provenance(raw) -> dict:
+    """How the numbers were computed: the step and how it was chosen, the solver and its timings."""
+    su = raw.setup
+    provenance = {
+        "model_version": MODEL_VERSION, "dt_s": float(su.dt), "dt_choice": su.dt_how,
+        "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw.steps),
+        "ring_newton_failures": int(raw.newton_failures), "inner_ring": su.ring_how,
+        "solver_wall_s": float(raw.wall_s), "pymunk_step_s": float(raw.pymunk_step_s),
+        "step_loop": raw.step_loop, "step_loop_reason": raw.step_loop_reason,
+    }
+    if su.t_start > 0.0:  # rigid raceways: the cage's settling at a step of its own
+        provenance.update(start_phase_s=float(su.t_start), start_phase_dt_s=float(su.dt_start))
+    return provenance
+
+
 class MultibodyResult(Result):
     """Result of :func:`simulate` (or read back from an archive). Arrays are [rotation, pocket] unless
     stated; ``raw`` holds the step loop's own accumulators on a fresh result (None when read back)."""
@@ -227,164 +402,25 @@ class MultibodyResult(Result):
 
     @classmethod
     def from_raw(cls, p, raw) -> "MultibodyResult":
-        """Lay out the step loop's accumulators as a result."""
-        geo, op = p.bearing, p.operating
-        scene = raw["scene"]
-        rotations = p.numerics.rotations
-        w = raw["win"]
+        """Lay out the step loop's :class:`~bearingsim.multibody.core.MultibodyRaw` as a result."""
+        w = raw.win
         per = {name: w[field].copy() for name, field in (
             ("I_acc", "I_acc"), ("I_dec", "I_dec"), ("Jn_front", "Jn_front"), ("Jn_rear", "Jn_rear"),
             ("Jf_front", "Jf_front"), ("Jf_rear", "Jf_rear"), ("slide_work_front", "work_front"),
             ("slide_work_rear", "work_rear"))}
-        first_imp = raw["first_imp"]
-        nb = THETA_BINS
-        theta_deg = (np.arange(nb) + 0.5) * 360.0 / nb
-        tb = raw["t_bin"]  # (n, nb)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            force_acc = np.where(tb > 0, raw["f_bin"]["front"] / tb, 0.0).T  # (nb, n)
-            force_dec = np.where(tb > 0, raw["f_bin"]["rear"] / tb, 0.0).T
-            tq = raw["tq_bin"]
-            load_inner = np.where(tq > 0, raw["q_bin"]["inner"] / np.maximum(tq, 1e-300), 0.0)
-            load_outer = np.where(tq > 0, raw["q_bin"]["outer"] / np.maximum(tq, 1e-300), 0.0)
-        # every scene but the reduced-equivalent one has an inner ring: its load zone emerges
-        with_ring = not paper_assumptions(scene)
-        # two measures of the load zone (docs/archive.md): the classical half angle from the mean ring
-        # displacement (what the paper's 23.5 deg is) and the extent of the measured inner-race contact
-        # (wider with discrete rollers: the laterally free ring shifts towards the exiting roller)
-        ring_centre_mean = raw["ring_centre_mean"]
-        if with_ring:
-            phi_deg = math.degrees(laws.load_zone_from_displacement(-ring_centre_mean[1], geo.radial_clearance))
-            phi_contact_deg = _load_zone_half_angle(raw["q_bin"], raw["tq_bin"])
-        else:
-            phi_deg = phi_contact_deg = math.degrees(raw["phi"])
-        t_rec = raw["t_record"]
-        cage_speed_mean = 2.0 * math.pi * rotations / t_rec if t_rec > 0 else float("nan")
-        g = raw["glob"]
-        ws, we = raw["cage_w_start"], raw["cage_w_end"]
-        momentum_change = geo.cage_inertia * (we - ws) if ws is not None else float("nan")
-        drive = abs(per["I_acc"].sum()) * geo.pitch_radius
-        if drive == 0.0:  # nothing drives the cage (a kinematic cage turned by its prescription): scale by
-            drive = abs(per["I_dec"].sum()) * geo.pitch_radius  # the braking; -1 = all from the prescription
-        land = raw.get("land")
-        tau = g["tau_normal"] + g["tau_friction"]
-        if land is not None:  # the land friction torque on a land-guided cage
-            tau = tau + land["tau"]
-        torque_residual = ((tau - momentum_change) / drive if drive > 0 else float("nan"))
-        w_ = p.wear
-        wear = {
-            "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
-                                                          geo.roller_radius, op.omega_r, w_.hardness),
-            "paper_index_rear": laws.archard_wear_volume(w_.wear_coefficient, per["I_dec"].mean(axis=0),
-                                                         geo.roller_radius, op.omega_r, w_.hardness),
-            "sliding_work_front": w_.wear_coefficient * per["slide_work_front"].mean(axis=0) / w_.hardness,
-            "sliding_work_rear": w_.wear_coefficient * per["slide_work_rear"].mean(axis=0) / w_.hardness,
-        }
-        fi = first_imp[np.isfinite(first_imp)]
-        v1 = float(fi.mean()) if fi.size else float("nan")
-        summary = {
-            "I_dec_mean_Ns": float(per["I_dec"].mean()),
-            "I_dec_std_Ns": float(per["I_dec"].std()),
-            "I_acc_mean_Ns": float(per["I_acc"].mean()),
-            "I_acc_std_Ns": float(per["I_acc"].std()),
-            "first_impact_speed_m_s": v1,
-            "first_impact_energy_J": 0.5 * geo.roller_mass * v1 * v1,
-            "cage_speed_mean_rad_s": float(cage_speed_mean),
-            "cage_slip": float(1.0 - cage_speed_mean / op.omega_c),
-            "load_zone_half_angle_deg": float(phi_deg),
-            "load_zone_contact_half_angle_deg": float(phi_contact_deg),
-            "torque_balance_residual": float(torque_residual),
-            "max_penetration_m": float(max(g["maxpen_front"], g["maxpen_rear"])),
-            "max_penetration_all_m": float(g["maxpen_all"]),
-            "cage_orbit_max_m": float(raw["orbit_max"]),
-            "dt_s": float(raw["dt"]),
-            "steps": int(raw["steps"]),
-        }
-        if with_ring:  # the reduced-equivalent scene has no inner ring
-            summary["inner_ring_displacement_m"] = float(-ring_centre_mean[1])
-        units = dict(SUMMARY_UNITS)
-        if raw.get("lift_max") is not None:  # rigid raceways (docs/fast_scene.md)
-            summary["roller_lift_max_m"] = float(raw["lift_max"])
-            summary["roller_beyond_race_max_m"] = float(raw["beyond_max"])
-            units.update(RIGID_SUMMARY_UNITS)
-        if land is not None:
-            summary.update({
-                "land_normal_impulse_mean_Ns": float(land["win"][:, 0].mean()),
-                "land_friction_impulse_mean_Ns": float(land["win"][:, 1].mean()),
-                "land_torque_impulse_Nms": float(land["tau"]),
-                "land_overlap_max_m": float(land["overlap_max"]),
-                "land_stiffness_N_m": float(land["stiffness"]),
-            })
-            units.update(LAND_SUMMARY_UNITS)
-        desc = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
-        pr = "results/per_rotation"
-        data = {
-            f"{pr}/I_acc": NamedArray(per["I_acc"], "N s", "front-face impulse, circumferential component, " + desc),
-            f"{pr}/I_dec": NamedArray(per["I_dec"], "N s", "rear-face impulse, circumferential component (braking), " + desc),
-            f"{pr}/Jn_front": NamedArray(per["Jn_front"], "N s", "front-face normal impulse, " + desc),
-            f"{pr}/Jn_rear": NamedArray(per["Jn_rear"], "N s", "rear-face normal impulse, " + desc),
-            f"{pr}/Jf_front": NamedArray(per["Jf_front"], "N s", "front-face friction impulse, " + desc),
-            f"{pr}/Jf_rear": NamedArray(per["Jf_rear"], "N s", "rear-face friction impulse, " + desc),
-            f"{pr}/slide_work_front": NamedArray(per["slide_work_front"], "J", "sum J_n |v_slide| on the front face, " + desc),
-            f"{pr}/slide_work_rear": NamedArray(per["slide_work_rear"], "J", "sum J_n |v_slide| on the rear face, " + desc),
-            f"{pr}/first_impact_speed": NamedArray(first_imp, "m/s", "approach speed of the first rear-face impact "
-                                                   "in the no-load zone (NaN: none), " + desc),
-            "results/theta_deg": NamedArray(theta_deg, "deg", "bin centres of theta (load-zone centre = 0)"),
-            "results/force_vs_theta": NamedArray(force_acc - force_dec, "N",
-                                                 "mean circumferential roller-cage force on the cage (F_acc - F_dec) per "
-                                                 "theta bin (rows, /results/theta_deg) and pocket (columns), recorded rotations"),
-            "results/force_vs_theta_acc": NamedArray(force_acc, "N", "mean F_acc (front face) [theta bin, pocket]"),
-            "results/force_vs_theta_dec": NamedArray(force_dec, "N", "mean F_dec (rear face) [theta bin, pocket]"),
-        }
-        if land is not None:
-            land_desc = ("per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start), "
-                         "land-guided cage")
-            data[f"{pr}/land_normal"] = NamedArray(land["win"][:, 0].copy(), "N s",
-                                                   "normal impulse of the cage rim on its guiding land, " + land_desc)
-            data[f"{pr}/land_friction"] = NamedArray(land["win"][:, 1].copy(), "N s",
-                                                     "friction impulse magnitude on the land, " + land_desc)
-            data[f"{pr}/land_torque"] = NamedArray(land["win"][:, 2].copy(), "N m s",
-                                                   "angular impulse of the land friction on the cage about its "
-                                                   "centre (counter-clockwise positive), " + land_desc)
-        if with_ring:
-            data["results/raceway_load_inner"] = NamedArray(load_inner, "N", "mean inner-race roller load per theta bin (all rollers)")
-            data["results/raceway_load_outer"] = NamedArray(load_outer, "N", "mean outer-race roller load per theta bin (all rollers)")
-        imp = raw["impacts"]
-        data.update({
-            "results/impacts/time_s": NamedArray(imp["time"], "s"),
-            "results/impacts/theta_deg": NamedArray(imp["theta_deg"], "deg"),
-            "results/impacts/approach_speed_m_s": NamedArray(imp["approach_speed"], "m/s"),
-            "results/impacts/impulse_Ns": NamedArray(imp["impulse"], "N s"),
-            "results/impacts/pocket": NamedArray(imp["pocket"].astype(np.int64)),
-            # face codes and strings of the reduced model (reduced/core.py)
-            "results/impacts/face": NamedArray(np.where(imp["face"] == rk.FACE_FRONT, "front", "rear")),
-            "results/impacts/rotation": NamedArray(imp["rotation"].astype(np.int64)),
-        })
-        wear_desc = {
-            "paper_index_front": "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket",
-            "paper_index_rear": "Archard wear per cage rotation, rear face, k I_dec r_r omega_r / H, per pocket",
-            "sliding_work_front": "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket",
-            "sliding_work_rear": "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket",
-        }
-        for k, v in wear.items():
-            data[f"results/wear/{k}"] = NamedArray(v, "m^3", wear_desc[k])
-        data.update(_profile_arrays(raw["prof"], p.multibody.pocket_face_extent))
-        orbit = raw["orbit"]
+        summary, units = _summary(p, raw, per)
+        data = {**_per_rotation_arrays(per, raw.first_imp, raw.land), **_theta_arrays(raw),
+                **_impact_arrays(raw.impacts), **_wear_arrays(p, per),
+                **_profile_arrays(raw.prof, p.multibody.pocket_face_extent)}
+        orbit = raw.orbit
         data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
                                                 "last recorded samples of the cage centre: columns time, x, y")
-        groups = {"results/summary": AttrGroup({**summary, "scene": scene, "pockets": geo.roller_count}, units)}
-        provenance = {
-            "model_version": MODEL_VERSION, "dt_s": float(raw["dt"]), "dt_choice": raw["dt_choice"],
-            "solver": "pymunk 7 (roller-cage) + numba raceway kernel", "steps": int(raw["steps"]),
-            "ring_newton_failures": int(raw["newton_failures"]), "inner_ring": raw["inner_ring"],
-            "solver_wall_s": float(raw["wall_s"]), "pymunk_step_s": float(raw["pymunk_step_s"]),
-            "step_loop": raw["step_loop"], "step_loop_reason": raw["step_loop_reason"],
-        }
-        if raw.get("t_start", 0.0) > 0.0:  # rigid raceways: the cage's settling at a step of its own
-            provenance.update(start_phase_s=float(raw["t_start"]), start_phase_dt_s=float(raw["dt_start"]))
+        groups = {"results/summary": AttrGroup({**summary, "scene": raw.setup.scene,
+                                                "pockets": p.bearing.roller_count}, units)}
         tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
                                      "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "
                                      "pocket centre; rotation = row of /results/per_rotation the impact counts in"}
-        res = cls(None, data, groups, provenance=provenance, tables=tables, raw=raw)
+        res = cls(None, data, groups, provenance=_provenance(raw), tables=tables, raw=raw)
         res._parameters = p
         return res
 

@@ -32,8 +32,8 @@ symbols and struct layout it relies on are there. Otherwise, or when asked for w
 ``run(..., step_loop="plain")`` or the environment variable ``BEARINGSIM_PLAIN_PYMUNK=1``, it gives
 :class:`bearingsim.multibody.loop.PlainLoop`, a Python loop over ``Space.step`` and the public
 ``pymunk.batch`` functions that calls the same kernels in the same order on the same inputs: the same
-numbers bit for bit, slower. A run records which loop ran (``raw["step_loop"]``) and why
-(``raw["step_loop_reason"]``).
+numbers bit for bit, slower. A run records which loop ran (``raw.step_loop``) and why
+(``raw.step_loop_reason``).
 """
 from __future__ import annotations
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 import sys
 import time
+from typing import NamedTuple
 
 import numpy as np
 
@@ -370,42 +371,51 @@ def face_radial_reach(p) -> float:
     return (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(min(-lo, hi))
 
 
-def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
-        step_loop=None):
-    """Run the parameters ``p``; return a dict of raw accumulators (see :class:`MultibodyResult`).
+class MultibodySetup(NamedTuple):
+    """What one run fixes before its first step, computed once from the parameters by :func:`make_setup`
+    (SI). The step loop's named inputs (``prm``, ``cfg``, ``land``, ``limits``, ``hold_rule``) are built
+    here, so :func:`run` only places the scene and drives the loop."""
 
-    Time series go to ``sink`` (``timeseries(...)`` appenders; see :class:`bearingsim.results.MemorySink`).
+    p: object  #: the run's :class:`bearingsim.parameters.Parameters`
+    scene: str  #: ``multibody.scene``
+    reduced_eq: bool  #: the paper's assumptions in the plane (:func:`paper_assumptions`)
+    kinematic: bool  #: the cage turns at the epicyclic speed (:data:`KINEMATIC_CAGE_SCENES`)
+    rigid: bool  #: rigid raceways (:func:`rigid`)
+    dt: float  #: the time step [s]
+    dt_how: str  #: how it was chosen (the archive's ``dt_choice``)
+    dt_explicit_limit: float  #: the explicit stability limit 2/omega_n [s] (inf: none)
+    t_start: float  #: rigid raceways, automatic step: the start phase's length [s] (0: none)
+    dt_start: float  #: the start phase's step [s] (``dt`` without one)
+    radial_play: float  #: the diametral clearance the rollers' path has (0 in the reduced-equivalent scene) [m]
+    rigid_radius: float  #: rigid raceways: the largest roller-centre radius [m]
+    roller_start_radius: float  #: the rollers' centres at t = 0 [m]
+    centrifugal_load: float  #: a roller's centrifugal load (+1 mN) [N]
+    ring_how: str  #: the inner ring's model, as described in the provenance
+    prm: fk.RacewayParams
+    cfg: rk.RecorderConfig
+    land: fk.LandParams
+    limits: lp.LoopLimits
+    hold_rule: lp.HoldRule
+    phi: float  #: the reduced-equivalent scene's load-zone half angle [rad] (0 elsewhere)
+    face_reach: float  #: :func:`face_radial_reach` [m]
 
-    ``step_loop``: "compiled", "plain" or None (see :mod:`bearingsim.multibody.chipmunk`); which one ran is
-    ``raw["step_loop"]``.
-    """
-    t_wall0 = time.perf_counter()
-    geo = p.bearing
-    op = p.operating
+
+def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetup:
+    """The :class:`MultibodySetup` of the parameters ``p`` (``dt`` overrides the step's choice; UserError
+    for what the scene cannot run)."""
+    geo, op = p.bearing, p.operating
     scene_kind = p.multibody.scene
     # two separate choices of the scene (docs/crosscheck.md): the paper's assumptions (no inner ring,
     # no traction, fixed spin, rollers held at the front of their pockets in the load zone, roller path
     # on the pitch circle) and a kinematic cage turning at the epicyclic speed
     reduced_eq = paper_assumptions(scene_kind)
-    kinematic = scene_kind in KINEMATIC_CAGE_SCENES
     n = geo.roller_count
     if n < 3:
         raise UserError(f"bearing.roller_count = {n}: the multibody model needs at least 3 rollers")
     is_rigid = rigid(p)
     if is_rigid:
         check_rigid(p)
-    h, dt_how, dt_lim = choose_dt(p, dt)
-    # rigid raceways, automatic step: the cage's settling at the start at a step of its own
-    t_start, h_start = rigid_start(p, h) if is_rigid and dt is None and p.numerics.dt is None else (0.0, h)
-    if h_start < h:
-        dt_how += f"; the first {t_start:.3g} s (the cage settling onto its rollers) at {h_start:.3e} s"
-    else:
-        t_start = 0.0
-    sign = op.sign
-    e = p.contact.restitution
-    mu_c = p.contact.cage_friction
-    warm = p.numerics.warmup_rotations
-    nrot = p.numerics.rotations
+    h, dt_how, dt_lim, t_start, h_start = _steps(p, dt, is_rigid)
     s = geo.pocket_clearance
     rr = geo.roller_radius
     rp = geo.pitch_radius
@@ -413,113 +423,23 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     # the reduced-equivalent scene keeps the paper's roller path on the pitch circle (no clearance)
     pd = 0.0 if reduced_eq else geo.radial_clearance
     ro_race = geo.outer_race_radius + 0.25 * pd
-    ri_race = geo.inner_race_radius - 0.25 * pd
     # rigid raceways: roller centres on the outer race, at most r_c from the axis (a unilateral joint);
     # the inner-race contact carries both contacts' compliance in series, Q = K 2^(-10/9) delta^(10/9)
     r_c = rigid_radius(p)
     K_race = K * 2.0 ** (-10.0 / 9.0) if is_rigid else K
-
-    n_seg = p.multibody.pocket_face_segments
-    sc = build_scene(geo, op, e, mu_c, extent=p.multibody.pocket_face_extent,
-                     n_seg=n_seg, kinematic_cage=kinematic, spin_free=not reduced_eq,
-                     flat_pockets=p.multibody.flat_pockets, centred_cage=scene_kind == "centred_cage",
-                     rigid_radius=r_c if is_rigid else None)
-    space = sc.space
-    nb = n + 1
     # rollers start on the outer race (centrifugal), moving with the cage
     n_centrifugal = geo.roller_mass * rp * op.omega_c**2 + 1e-3
     r0 = r_c if is_rigid else ro_race - rr - (n_centrifugal / K) ** 0.9
-    omega_cage = sign * op.omega_c
-    for i, b in enumerate(sc.rollers):
-        a = sc.pocket_body_angle[i]
-        b.position = (r0 * math.cos(a), r0 * math.sin(a))
-        b.velocity = (-omega_cage * r0 * math.sin(a), omega_cage * r0 * math.cos(a))
-
     ring_mass, ring_how = inner_ring_model(p)
-    prm = fk.RacewayParams(
-        roller_radius=float(rr), roller_mass=float(geo.roller_mass), roller_inertia=float(geo.roller_inertia),
-        outer_race_radius=float(ro_race), inner_race_radius=float(ri_race),
-        outer_race_geom_radius=float(geo.outer_race_radius), inner_race_geom_radius=float(geo.inner_race_radius),
-        palmgren_stiffness=float(K_race), damping_time=0.0 if is_rigid else CONTACT_DAMPING_S,
-        damping_fade=DAMPING_FADE_M,
-        traction_mu_max=float(p.contact.traction_mu_max),
-        traction_slip_ref=float(p.contact.traction_slip_ref), min_entrainment=MIN_ENTRAINMENT_M_S,
-        drag_coefficient=float(p.contact.drag_coefficient), drag_direction_eps=DRAG_DIRECTION_EPS_M_S,
-        omega_ring=float(sign * op.omega_i), radial_load=float(op.radial_load), gravity=float(op.gravity),
-        inner_ring=not reduced_eq, traction=not reduced_eq, spin_free=not reduced_eq,
-        newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass), rigid=is_rigid, rigid_radius=float(r_c))
-    cfg = rk.RecorderConfig(sign=float(sign), roller_count=int(n), warmup_rotations=float(warm), rotations=nrot,
-                            theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S,
+    prm = _raceway_params(p, reduced_eq, is_rigid, pd, r_c, K_race, ring_mass)
+    nrot = p.numerics.rotations
+    cfg = rk.RecorderConfig(sign=float(op.sign), roller_count=int(n), warmup_rotations=float(p.numerics.warmup_rotations),
+                            rotations=nrot, theta_bins=THETA_BINS, impact_speed_threshold=IMPACT_SPEED_THRESHOLD_M_S,
                             pocket_centre_radius=float(geo.pitch_radius),
                             psi_lo=float(p.multibody.pocket_face_extent[0]),
                             psi_hi=float(p.multibody.pocket_face_extent[1]))
-    acc = rk.accumulators(nrot, n, THETA_BINS, IMPACT_CAPACITY)
-    # pocket angles from the load-zone centre at t = 0, in [0, 2 pi)
-    theta0 = np.mod(-2.0 * math.pi * np.arange(n) / n, 2.0 * math.pi)
-    # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
-    _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not reduced_eq else (0, 0)
-    # (the same start for rigid raceways: the continuous distribution's displacement is that of two
-    # contacts in series already)
-    ids = sc.body_ids
-    order = np.argsort(ids)
-
     # reduced-equivalent: held rollers sit at the front of their pockets on the outer race
     phi = p.reduced.load_zone_half_angle if reduced_eq else 0.0
-    if reduced_eq or is_rigid:  # held rollers (reduced-equivalent), rollers on the race (rigid): states set too
-        set_fields = lp.BODY_SET_ALL
-        set_arr = np.zeros(nb * 7)
-    else:
-        set_fields = lp.BODY_SET_FORCE
-        set_arr = np.zeros(nb * 3)
-    ORBIT_KEEP = 4096
-    wk = lp.StepWork(
-        ring_c=np.array([0.0, -max(0.5 * pd, delta_qs)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
-        hold=np.zeros(n, dtype=np.bool_),
-        # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
-        out_f=np.zeros(nb * 3) if (reduced_eq or is_rigid) else set_arr, set_arr=set_arr,
-        diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
-        orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((nrot, 3)),
-        n_out=np.full(n, n_centrifugal),  # rigid: the first step's outer-race loads, before a joint has acted
-        n_held=np.zeros(n),
-        e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_),
-        n_extra=np.zeros(n),
-        arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
-        arc_todo=np.zeros((n, 2), dtype=np.bool_))
-    # room for every roller against every face segment of every pocket: pymunk never grows the arrays
-    arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
-    masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
-    arc = arc_faces(sc, rr, sign) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
-    io, loop_why = chipmunk.open_step_loop(space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
-                                           [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks,
-                                           sc.arc_shapes)
-
-    total_rot = warm + nrot
-    travel_end = 2.0 * math.pi * total_rot
-    omega_nom = op.omega_c
-    steps_est = int(math.ceil(travel_end / omega_nom / h + t_start / h_start))
-    def sample_every(step):  # steps between samples (and health checks) at numerics.output_rate
-        return max(1, int(round(1.0 / (p.numerics.output_rate * step))))
-
-    out_every = sample_every(h)
-    series = None
-    if sink is not None:
-        series = [
-            (sink.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
-             ("cage_speed",)),
-            (sink.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), ("cage_slip",)),
-            (sink.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
-             ("cage_x", "cage_y")),
-        ]
-        if not reduced_eq:
-            series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
-                           ("ring_x", "ring_y")))
-    bar = None
-    if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=total_rot, unit="rot", desc="cage rotations", file=sys.stderr)
-    bar_done = 0
-    io.read_states()
     # the rollers hold the cage only while its centre stays within the radial reach of the face arcs
     face_reach = face_radial_reach(p)
     # a land-guided cage is held by its land (the full scene's free cage only)
@@ -528,28 +448,232 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     if land.active:  # the inner land moves with the inner ring, at most P_d/2 plus its raceway approach
         orbit_limit = land.half_clearance * (1.0 + LAND_ORBIT_MARGIN) + (
             0.5 * pd + raceway_approach_limit(p) if land.inner else 0.0)
+    total_rot = p.numerics.warmup_rotations + nrot
+    travel_end = 2.0 * math.pi * total_rot
+    steps_est = int(math.ceil(travel_end / op.omega_c / h + t_start / h_start))
     lim = lp.LoopLimits(
-        travel_end=travel_end, travel_record=2.0 * math.pi * warm,
+        travel_end=travel_end, travel_record=2.0 * math.pi * p.numerics.warmup_rotations,
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
-        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=float(orbit_limit),
-        raceway_approach=raceway_approach_limit(p), out_every=out_every,
+        omega=3.0 * op.omega_i + 10.0, omega_nominal=float(op.omega_c), orbit=float(orbit_limit),
+        raceway_approach=raceway_approach_limit(p), out_every=_sample_every(p, h),
         max_steps=int(3 * steps_est + 1000))
+    hold = lp.HoldRule(active=reduced_eq, phi=float(phi), radius=r_c if is_rigid else rp - (n_centrifugal / K) ** 0.9,
+                       front_offset=0.5 * s, omega_cage=float(op.sign * op.omega_c))
+    return MultibodySetup(
+        p=p, scene=scene_kind, reduced_eq=reduced_eq, kinematic=scene_kind in KINEMATIC_CAGE_SCENES, rigid=is_rigid,
+        dt=h, dt_how=dt_how, dt_explicit_limit=dt_lim, t_start=t_start, dt_start=h_start, radial_play=pd,
+        rigid_radius=r_c, roller_start_radius=r0, centrifugal_load=n_centrifugal, ring_how=ring_how, prm=prm,
+        cfg=cfg, land=land, limits=lim, hold_rule=hold, phi=phi, face_reach=face_reach)
+
+
+def _steps(p, dt, is_rigid):
+    """(step [s], how it was chosen, explicit limit [s], start phase [s], its step [s]): :func:`choose_dt`,
+    and with rigid raceways and the automatic step the cage's settling at a step of its own
+    (:func:`rigid_start`; a start phase of 0 s when that step is not shorter)."""
+    h, dt_how, dt_lim = choose_dt(p, dt)
+    t_start, h_start = rigid_start(p, h) if is_rigid and dt is None and p.numerics.dt is None else (0.0, h)
+    if h_start < h:
+        dt_how += f"; the first {t_start:.3g} s (the cage settling onto its rollers) at {h_start:.3e} s"
+    else:
+        t_start = 0.0
+    return h, dt_how, dt_lim, t_start, h_start
+
+
+def _raceway_params(p, reduced_eq, is_rigid, pd, r_c, K_race, ring_mass) -> fk.RacewayParams:
+    """The raceway kernel's :class:`~bearingsim.multibody.forces.RacewayParams`: the races widened by a
+    quarter of the diametral play ``pd`` each [m], the contact stiffness ``K_race``, the rigid scene's
+    radius ``r_c`` [m] and the inner ring's mass (0: quasi-static)."""
+    geo, op = p.bearing, p.operating
+    rr = geo.roller_radius
+    ro_race = geo.outer_race_radius + 0.25 * pd
+    ri_race = geo.inner_race_radius - 0.25 * pd
+    return fk.RacewayParams(
+        roller_radius=float(rr), roller_mass=float(geo.roller_mass), roller_inertia=float(geo.roller_inertia),
+        outer_race_radius=float(ro_race), inner_race_radius=float(ri_race),
+        outer_race_geom_radius=float(geo.outer_race_radius), inner_race_geom_radius=float(geo.inner_race_radius),
+        palmgren_stiffness=float(K_race), damping_time=0.0 if is_rigid else CONTACT_DAMPING_S,
+        damping_fade=DAMPING_FADE_M,
+        traction_mu_max=float(p.contact.traction_mu_max),
+        traction_slip_ref=float(p.contact.traction_slip_ref), min_entrainment=MIN_ENTRAINMENT_M_S,
+        drag_coefficient=float(p.contact.drag_coefficient), drag_direction_eps=DRAG_DIRECTION_EPS_M_S,
+        omega_ring=float(op.sign * op.omega_i), radial_load=float(op.radial_load), gravity=float(op.gravity),
+        inner_ring=not reduced_eq, traction=not reduced_eq, spin_free=not reduced_eq,
+        newton_max_step=NEWTON_MAX_STEP_M, ring_mass=float(ring_mass), rigid=is_rigid, rigid_radius=float(r_c))
+
+
+def _sample_every(p, step) -> int:
+    """Steps between output samples (and health checks) at ``numerics.output_rate`` for a step ``step`` [s]."""
+    return max(1, int(round(1.0 / (p.numerics.output_rate * step))))
+
+
+ORBIT_KEEP = 4096  # the last cage-centre samples kept for the orbit figure
+
+
+class _Placed(NamedTuple):
+    """The pymunk scene of a run, placed at t = 0, with the step loop open on it."""
+
+    sc: object  #: :class:`bearingsim.multibody.scene.Scene`
+    io: object  #: the step loop (:func:`bearingsim.multibody.chipmunk.open_step_loop`)
+    why: str | None  #: why the plain loop runs, if it does
+    inp: lp.StepInputs
+    wk: lp.StepWork
+
+
+def _place(su: MultibodySetup, step_loop) -> _Placed:
+    """Build the scene, put the rollers on the outer race moving with the cage, and open the step loop."""
+    p = su.p
+    geo, op = p.bearing, p.operating
+    n = geo.roller_count
+    n_seg = p.multibody.pocket_face_segments
+    sc = build_scene(geo, op, p.contact.restitution, p.contact.cage_friction, extent=p.multibody.pocket_face_extent,
+                     n_seg=n_seg, kinematic_cage=su.kinematic, spin_free=not su.reduced_eq,
+                     flat_pockets=p.multibody.flat_pockets, centred_cage=su.scene == "centred_cage",
+                     rigid_radius=su.rigid_radius if su.rigid else None)
+    nb = n + 1
+    r0 = su.roller_start_radius
+    omega_cage = op.sign * op.omega_c
+    for i, b in enumerate(sc.rollers):
+        a = sc.pocket_body_angle[i]
+        b.position = (r0 * math.cos(a), r0 * math.sin(a))
+        b.velocity = (-omega_cage * r0 * math.sin(a), omega_cage * r0 * math.cos(a))
+    # pocket angles from the load-zone centre at t = 0, in [0, 2 pi)
+    theta0 = np.mod(-2.0 * math.pi * np.arange(n) / n, 2.0 * math.pi)
+    # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
+    # (the same start for rigid raceways: the continuous distribution's displacement is that of two
+    # contacts in series already)
+    pd = su.radial_play
+    _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not su.reduced_eq else (0, 0)
+    ids = sc.body_ids
+    order = np.argsort(ids)
+    if su.reduced_eq or su.rigid:  # held rollers (reduced-equivalent), rollers on the race (rigid): states set too
+        set_fields = lp.BODY_SET_ALL
+        set_arr = np.zeros(nb * 7)
+    else:
+        set_fields = lp.BODY_SET_FORCE
+        set_arr = np.zeros(nb * 3)
+    e = float(p.contact.restitution)
+    wk = lp.StepWork(
+        ring_c=np.array([0.0, -max(0.5 * pd, delta_qs)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
+        hold=np.zeros(n, dtype=np.bool_),
+        # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
+        out_f=np.zeros(nb * 3) if (su.reduced_eq or su.rigid) else set_arr, set_arr=set_arr,
+        diag=np.zeros(n, dtype=fk.DIAG), smp=np.zeros(2048, dtype=lp.SAMPLE),
+        orbit=np.full((ORBIT_KEEP, 3), np.nan), land_out=np.zeros(4), land_win=np.zeros((p.numerics.rotations, 3)),
+        n_out=np.full(n, su.centrifugal_load),  # rigid: the first step's outer-race loads, before a joint has acted
+        n_held=np.zeros(n),
+        e_set=np.full(n, e), e_want=np.full(n, e), touched=np.zeros(n, dtype=np.bool_),
+        n_extra=np.zeros(n),
+        arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
+        arc_todo=np.zeros((n, 2), dtype=np.bool_))
+    # room for every roller against every face segment of every pocket: pymunk never grows the arrays
+    arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
+    rr = geo.roller_radius
+    masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
+    arc = arc_faces(sc, rr, op.sign) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
+    io, why = chipmunk.open_step_loop(sc.space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
+                                      [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks,
+                                      sc.arc_shapes)
     inp = lp.StepInputs(
-        h=float(h), prm=prm, cfg=cfg, lim=lim,
-        hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi),
-                              radius=r_c if is_rigid else rp - (n_centrifugal / K) ** 0.9,
-                              front_offset=0.5 * s, omega_cage=float(omega_cage)),
-        land=land,
+        h=float(su.dt), prm=su.prm, cfg=su.cfg, lim=su.limits, hold_rule=su.hold_rule, land=su.land,
         pocket_a=np.ascontiguousarray(sc.pocket_body_angle, dtype=np.float64), theta0=theta0,
         ids_sorted=ids[order].astype(np.uint64), ids_index=order.astype(np.int64),
-        onset_restitution=is_rigid, restitution=float(e), arc=arc)
-    inp_main = inp
-    if t_start > 0.0:  # the start phase: its own step (and samples at the same rate)
-        inp = inp._replace(h=float(h_start), lim=lim._replace(
-            t_phase_end=float(t_start), out_every=sample_every(h_start)))
+        onset_restitution=su.rigid, restitution=e, arc=arc)
+    return _Placed(sc, io, why, inp, wk)
+
+
+def _series(sink, reduced_eq: bool):
+    """The time series a run streams to ``sink``: (appender, sample fields) pairs (None: no sink)."""
+    if sink is None:
+        return None
+    series = [
+        (sink.timeseries("cage_angular_speed", (), "rad/s", "cage angular speed in the direction of rotation"),
+         ("cage_speed",)),
+        (sink.timeseries("cage_slip", (), "1", "1 - cage speed / epicyclic speed (Eq. 11)"), ("cage_slip",)),
+        (sink.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
+         ("cage_x", "cage_y")),
+    ]
+    if not reduced_eq:
+        series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
+                       ("ring_x", "ring_y")))
+    return series
+
+
+class MultibodyRaw(NamedTuple):
+    """What one run of the step loop gives (:func:`run`): its set-up, its accumulators and its end state,
+    SI. :meth:`bearingsim.multibody.MultibodyResult.from_raw` lays it out as a result."""
+
+    setup: MultibodySetup
+    steps: int  #: steps taken
+    wall_s: float  #: the run's wall time [s]
+    loop_s: float  #: the step loop's wall time [s]
+    pymunk_step_s: float  #: time inside pymunk's step (NaN: not timed)
+    step_loop: str  #: "compiled" or "plain"
+    step_loop_reason: str | None  #: why the plain loop ran, if it did
+    t_end: float  #: simulated time [s]
+    t_record: float  #: recorded time [s] (0: the recording never started)
+    win: np.ndarray  #: per-rotation window accumulators (:func:`bearingsim.multibody.recorder.accumulators`)
+    first_imp: np.ndarray  #: first rear-face impact speed in the no-load zone [rotation, pocket] (NaN: none)
+    f_bin: np.ndarray  #: pocket force per theta bin, summed over steps
+    t_bin: np.ndarray  #: steps per pocket and theta bin
+    q_bin: np.ndarray  #: raceway loads per theta bin, summed over steps
+    tq_bin: np.ndarray  #: steps per theta bin
+    glob: np.void  #: whole-run accumulators (overlaps, torques)
+    impacts: np.ndarray  #: the impact table, sorted by (time, pocket, face)
+    prof: np.ndarray  #: the wear profile over the faces
+    impacts_dropped: bool  #: the impact table filled up
+    cage_w_start: float | None  #: cage speed when recording started [rad/s] (None: never)
+    cage_w_end: float  #: cage speed at the end [rad/s]
+    newton_failures: int  #: steps whose inner-ring force balance did not converge
+    orbit_max: float  #: largest distance of the cage centre from the axis [m]
+    final_state: np.ndarray  #: the bodies' states at the end
+    orbit: np.ndarray  #: the last :data:`ORBIT_KEEP` cage-centre samples (t, x, y), oldest first
+    ring_centre_mean: np.ndarray  #: mean inner-ring centre over the recorded steps [m] (NaN: no ring)
+    lift_max: float | None  #: rigid raceways: largest lift of a roller off the outer race [m]
+    beyond_max: float | None  #: rigid raceways: largest move of a roller beyond the race [m]
+    beyond_vr: float | None  #: rigid raceways: the radial speed with it [m/s]
+    beyond_before: float | None  #: rigid raceways: the move beyond the race before the joint acted [m]
+    land: dict | None  #: land-guided cage: per-rotation impulses, torque, overlap, stiffness, half clearance
+
+
+def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
+        step_loop=None) -> MultibodyRaw:
+    """Run the parameters ``p``; return the step loop's :class:`MultibodyRaw`.
+
+    Time series go to ``sink`` (``timeseries(...)`` appenders; see :class:`bearingsim.results.MemorySink`).
+
+    ``step_loop``: "compiled", "plain" or None (see :mod:`bearingsim.multibody.chipmunk`); which one ran is
+    ``raw.step_loop``.
+    """
+    t_wall0 = time.perf_counter()
+    su = make_setup(p, dt, penetration_limit)
+    pl = _place(su, step_loop)
+    acc = rk.accumulators(p.numerics.rotations, p.bearing.roller_count, THETA_BINS, IMPACT_CAPACITY)
     ls = np.zeros(1, dtype=lp.LOOP_STATE)
-    st = ls[0]
     t_loop0 = time.perf_counter()
+    _drive(su, pl, acc, ls, _series(sink, su.reduced_eq), progress)
+    loop_s = time.perf_counter() - t_loop0
+    return _raw(su, pl, acc, ls[0], loop_s, t_wall0)
+
+
+def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, progress) -> None:
+    """Advance the step loop to the end of the run, streaming samples to ``series`` and moving the
+    progress bar; raise for a run that cannot go on (:func:`_stop`)."""
+    n = su.p.bearing.roller_count
+    sign = su.p.operating.sign
+    total_rot = su.p.numerics.warmup_rotations + su.p.numerics.rotations
+    io, wk, inp_main = pl.io, pl.wk, pl.inp
+    inp = inp_main
+    if su.t_start > 0.0:  # the start phase: its own step (and samples at the same rate)
+        inp = inp._replace(h=float(su.dt_start), lim=su.limits._replace(
+            t_phase_end=float(su.t_start), out_every=_sample_every(su.p, su.dt_start)))
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=total_rot, unit="rot", desc="cage rotations", file=sys.stderr)
+    bar_done = 0
+    io.read_states()
+    st = ls[0]
     while True:
         code = io.advance(inp, wk, acc, ls)
         k = int(st["n_samples"])
@@ -559,8 +683,6 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
                 ts.append(smp["step"].copy(), smp["t"].copy(),
                           smp[cols[0]].copy() if len(cols) == 1 else np.stack([smp[c] for c in cols], axis=1))
         st["n_samples"] = 0
-        t = float(st["t"])
-        step = int(st["step"])
         state = io.states[int(st["cur"])]
         if bar is not None:
             done = min(total_rot, int(sign * state[n, 2] / (2.0 * math.pi)))
@@ -571,7 +693,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
             continue
         if code == lp.CODE_PHASE_END:
             # the overlap is checked every out_every steps: the phase's last ones are checked here
-            if acc.glob[0]["maxpen_all"] <= lim.penetration:
+            if acc.glob[0]["maxpen_all"] <= su.limits.penetration:
                 inp = inp_main
                 continue
             code = lp.CODE_PENETRATION  # stopped with the start phase's step
@@ -579,40 +701,55 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
             break
         if bar is not None:
             bar.close()
-        if code == lp.CODE_NONFINITE:
-            raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
-                                     f"try a smaller numerics.dt_s than {h:.3g} s")
-        if code == lp.CODE_PENETRATION:
-            g = acc.glob[0]
-            raise PenetrationExceeded(g["maxpen_all"], lim.penetration, inp.h, g["maxpen_time"],
-                                          g["maxpen_approach"], dt_how)
-        if code == lp.CODE_BLOWUP:
-            raise SimulationUnstable(
-                f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if is_rigid else 0.0):.3g} m (limit {lim.raceway_approach:.3g} m, 3x the "
-                f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
-                f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); try a smaller "
-                f"numerics.dt_s than {h:.3g} s")
-        if code == lp.CODE_STALLED:
-            raise SimulationUnstable(
-                f"cage did not complete {total_rot} rotations in {step} steps "
-                f"(cage speed {state[n, 5]:.3g} rad/s): the cage stalled")
-        if code == lp.CODE_CAGE_LOST and land.active:
-            raise SimulationUnstable(
-                f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
-                f"t = {t:.6g} s, more than {LAND_ORBIT_MARGIN:.0%} of half the land clearance "
-                f"(bearing.cage_land_clearance_mm) beyond its {geo.cage_guidance.replace('_', ' ')}: the land "
-                f"contact did not hold it; try a smaller numerics.dt_s than {h:.3g} s")
-        if code == lp.CODE_CAGE_LOST:
-            raise SimulationUnstable(
-                f"the cage centre moved {math.hypot(state[n, 0], state[n, 1]) * 1e3:.4g} mm off the bearing axis at "
-                f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({face_reach * 1e3:.4g} mm): the rollers no "
-                f"longer hold it; widen the faces (multibody.pocket_face_half_angle_deg, at most what the cage wall "
-                f"allows) or guide the cage on a ring land (bearing.cage_guidance)")
-        raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
+        _stop(code, su, inp, wk, acc, state, float(st["t"]), int(st["step"]))
     if bar is not None:
         bar.update(total_rot - bar_done)
         bar.close()
-    loop_s = time.perf_counter() - t_loop0
+
+
+def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
+    """Raise the error of a step loop that stopped with ``code`` before the end of the run."""
+    n = su.p.bearing.roller_count
+    h = inp.h
+    lim = su.limits
+    if code == lp.CODE_NONFINITE:
+        raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
+                                 f"try a smaller numerics.dt_s than {h:.3g} s")
+    if code == lp.CODE_PENETRATION:
+        g = acc.glob[0]
+        raise PenetrationExceeded(g["maxpen_all"], lim.penetration, h, g["maxpen_time"], g["maxpen_approach"],
+                                  su.dt_how)
+    if code == lp.CODE_BLOWUP:
+        raise SimulationUnstable(
+            f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if su.rigid else 0.0):.3g} m "
+            f"(limit {lim.raceway_approach:.3g} m, 3x the "
+            f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
+            f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); try a smaller "
+            f"numerics.dt_s than {h:.3g} s")
+    if code == lp.CODE_STALLED:
+        total_rot = su.p.numerics.warmup_rotations + su.p.numerics.rotations
+        raise SimulationUnstable(
+            f"cage did not complete {total_rot} rotations in {step} steps "
+            f"(cage speed {state[n, 5]:.3g} rad/s): the cage stalled")
+    off = math.hypot(state[n, 0], state[n, 1]) * 1e3
+    if code == lp.CODE_CAGE_LOST and su.land.active:
+        raise SimulationUnstable(
+            f"the cage centre moved {off:.4g} mm off the bearing axis at "
+            f"t = {t:.6g} s, more than {LAND_ORBIT_MARGIN:.0%} of half the land clearance "
+            f"(bearing.cage_land_clearance_mm) beyond its {su.p.bearing.cage_guidance.replace('_', ' ')}: the land "
+            f"contact did not hold it; try a smaller numerics.dt_s than {h:.3g} s")
+    if code == lp.CODE_CAGE_LOST:
+        raise SimulationUnstable(
+            f"the cage centre moved {off:.4g} mm off the bearing axis at "
+            f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({su.face_reach * 1e3:.4g} mm): the rollers no "
+            f"longer hold it; widen the faces (multibody.pocket_face_half_angle_deg, at most what the cage wall "
+            f"allows) or guide the cage on a ring land (bearing.cage_guidance)")
+    raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
+
+
+def _raw(su: MultibodySetup, pl: _Placed, acc, st, loop_s: float, t_wall0: float) -> MultibodyRaw:
+    """The :class:`MultibodyRaw` of a finished run."""
+    n = su.p.bearing.roller_count
     n_imp = int(st["n_imp"])
     # impacts in one step come in pymunk's arbiter order, which follows shape addresses: sort them by
     # (time, pocket, face) so that the table is the same in every run (front before rear, as before the
@@ -620,30 +757,28 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     imp = acc.impacts[:n_imp]
     imp = imp[np.lexsort((imp["face"] != rk.FACE_FRONT, imp["pocket"], imp["time"]))]
     wall = time.perf_counter() - t_wall0
+    io, wk = pl.io, pl.wk
     prev = io.states[int(st["cur"])]
     rec_started = st["recording"] == 1
-    t_rec = t - st["t_rec0"] if rec_started else 0.0
+    t = float(st["t"])
     ring_n = st["ring_n"]
     n_orbit = int(st["n_orbit"])
-    pymunk_s = st["pymunk_ns"] * 1e-9 if io.timed else float("nan")
-    return dict(
-        parameters=p, scene=scene_kind, inner_ring=ring_how, dt=h, dt_choice=dt_how, dt_explicit_limit=dt_lim, steps=step,
-        t_start=t_start, dt_start=h_start if t_start > 0.0 else h,  # rigid: the start phase (0: none)
-        wall_s=wall, loop_s=loop_s, pymunk_step_s=pymunk_s, step_loop=io.name, step_loop_reason=loop_why, t_end=t,
-        t_record=t_rec, win=acc.win, first_imp=acc.first_imp, f_bin=acc.f_bin, t_bin=acc.t_bin, q_bin=acc.q_bin,
-        tq_bin=acc.tq_bin, glob=acc.glob.copy()[0], impacts=imp, prof=acc.prof,
-        impacts_dropped=n_imp >= IMPACT_CAPACITY, cage_w_start=st["cage_w_start"] if rec_started else None,
-        cage_w_end=prev[n, 5],
-        cage_inertia=geo.cage_inertia, newton_failures=int(st["newton_failures"]), orbit_max=st["orbit_max"],
-        phi=phi,
-        final_state=prev.copy(), orbit=np.roll(wk.orbit, -(n_orbit % ORBIT_KEEP), axis=0),
-        ring_centre_mean=(np.array([st["ring_sum_x"], st["ring_sum_y"]]) / ring_n if ring_n and not reduced_eq
+    land = su.land
+    rigid_ = su.rigid
+    return MultibodyRaw(
+        setup=su, steps=int(st["step"]), wall_s=wall, loop_s=loop_s,
+        pymunk_step_s=st["pymunk_ns"] * 1e-9 if io.timed else float("nan"), step_loop=io.name,
+        step_loop_reason=pl.why, t_end=t, t_record=t - st["t_rec0"] if rec_started else 0.0, win=acc.win,
+        first_imp=acc.first_imp, f_bin=acc.f_bin, t_bin=acc.t_bin, q_bin=acc.q_bin, tq_bin=acc.tq_bin,
+        glob=acc.glob.copy()[0], impacts=imp, prof=acc.prof, impacts_dropped=n_imp >= IMPACT_CAPACITY,
+        cage_w_start=st["cage_w_start"] if rec_started else None, cage_w_end=prev[n, 5],
+        newton_failures=int(st["newton_failures"]), orbit_max=st["orbit_max"], final_state=prev.copy(),
+        orbit=np.roll(wk.orbit, -(n_orbit % ORBIT_KEEP), axis=0),
+        ring_centre_mean=(np.array([st["ring_sum_x"], st["ring_sum_y"]]) / ring_n if ring_n and not su.reduced_eq
                           else np.full(2, np.nan)),
-        radial_clearance=geo.radial_clearance, raceway_contact=p.multibody.raceway_contact,
-        lift_max=float(st["lift_max"]) if is_rigid else None,
-        beyond_max=float(st["beyond_max"]) if is_rigid else None, beyond_vr=float(st["beyond_vr"]) if is_rigid else None,
-        beyond_before=float(st["beyond_before"]) if is_rigid else None,
-        rigid_radius=float(r_c),
+        lift_max=float(st["lift_max"]) if rigid_ else None,
+        beyond_max=float(st["beyond_max"]) if rigid_ else None, beyond_vr=float(st["beyond_vr"]) if rigid_ else None,
+        beyond_before=float(st["beyond_before"]) if rigid_ else None,
         land=(dict(win=wk.land_win.copy(), tau=float(st["land_tau"]), overlap_max=float(st["land_overlap_max"]),
                    stiffness=land.stiffness, half_clearance=land.half_clearance) if land.active else None),
     )

@@ -151,10 +151,35 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
         step; a roller pulled inward leaves it.
     """
     n = geometry.roller_count
-    rr = geometry.roller_radius
-    rp = geometry.pitch_radius
-    R = rr + 0.5 * geometry.pocket_clearance
+    R = geometry.roller_radius + 0.5 * geometry.pocket_clearance
     sign = op.sign
+    space = _space(op, R, n, n_seg, spatial_hash)
+    a = pocket_angles(n, sign)
+    omega_cage = sign * op.omega_c
+    exact = n_seg == 0
+    n_seg = max(n_seg, 1)  # an exact face is one segment
+    bits_each = own_bits(n_seg)
+    all_faces = sum(segment_bit(f, k, n_seg) for f in (0, 1) for k in range(n_seg)) if bits_each else CAGE_CATEGORY
+    rollers = _add_rollers(space, geometry, op, a, restitution, cage_friction, spin_free,
+                           pymunk.ShapeFilter(categories=ROLLER_CATEGORY, mask=all_faces))
+    if kinematic_cage:
+        cage = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+    else:
+        cage = pymunk.Body(geometry.cage_mass, geometry.cage_inertia)
+    cage.position = (0.0, 0.0)
+    cage.angle = 0.0
+    cage.angular_velocity = float(omega_cage)
+    faces = _add_faces(space, cage, geometry.pitch_radius, R, a, sign, extent, n_seg, exact, bits_each,
+                       set(int(i) for i in flat_pockets))
+    joints = _add_joints(space, cage, rollers, centred_cage and not kinematic_cage, rigid_radius)
+    ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
+    verts, seg_ends, seg_bits, centres, arc_shapes = faces
+    return Scene(space, rollers, cage, a, R, verts, ids, joints, seg_ends, seg_bits if bits_each else None, centres,
+                 arc_shapes if exact else None, tuple(float(x) for x in extent))
+
+
+def _space(op, R: float, n: int, n_seg: int, spatial_hash: bool):
+    """An empty pymunk space set for this scale (gravity along -y)."""
     space = pymunk.Space()
     space.gravity = (0.0, -op.gravity)
     space.collision_slop = 1e-8  # m: the default 0.1 is 10 cm at this scale
@@ -168,37 +193,38 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
     space.iterations = 10
     if spatial_hash:
         space.use_spatial_hash(2.0 * R, 4 * n * (n_seg + 1))
-    a = pocket_angles(n, sign)
-    omega_cage = sign * op.omega_c
-    spin = sign * (op.omega_c - op.omega_r)  # absolute roller spin in pure rolling, Eq. (11)-(12)
+    return space
+
+
+def _add_rollers(space, geometry, op, a, restitution, cage_friction, spin_free, roller_filter) -> list:
+    """The rollers at their pocket centres (angles ``a``), moving with the cage and spinning as in pure
+    rolling, added to ``space``."""
+    rp = geometry.pitch_radius
+    omega_cage = op.sign * op.omega_c
+    spin = op.sign * (op.omega_c - op.omega_r)  # absolute roller spin in pure rolling, Eq. (11)-(12)
     rollers = []
-    exact = n_seg == 0
-    n_seg = max(n_seg, 1)  # an exact face is one segment
-    bits_each = own_bits(n_seg)
-    all_faces = sum(segment_bit(f, k, n_seg) for f in (0, 1) for k in range(n_seg)) if bits_each else CAGE_CATEGORY
-    roller_filter = pymunk.ShapeFilter(categories=ROLLER_CATEGORY, mask=all_faces)
-    for i in range(n):
+    for i in range(geometry.roller_count):
         moment = geometry.roller_inertia if spin_free else float("inf")
         b = pymunk.Body(geometry.roller_mass, moment)
         c = np.array([rp * math.cos(a[i]), rp * math.sin(a[i])])
         b.position = (float(c[0]), float(c[1]))
         b.velocity = (float(-omega_cage * c[1]), float(omega_cage * c[0]))
         b.angular_velocity = float(spin)
-        shape = pymunk.Circle(b, rr)
+        shape = pymunk.Circle(b, geometry.roller_radius)
         shape.elasticity = restitution
         shape.friction = cage_friction
         shape.filter = roller_filter
         space.add(b, shape)
         rollers.append(b)
-    if kinematic_cage:
-        cage = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
-    else:
-        cage = pymunk.Body(geometry.cage_mass, geometry.cage_inertia)
-    cage.position = (0.0, 0.0)
-    cage.angle = 0.0
-    cage.angular_velocity = float(omega_cage)
+    return rollers
+
+
+def _add_faces(space, cage, rp, R, a, sign, extent, n_seg, exact, bits_each, flat):
+    """Every pocket's front and rear face as segments of ``cage`` (flat, exact tangent or polyline), added
+    to ``space`` with the cage. Returns (vertices, segment ends, segment bits, pocket centres, exact faces'
+    segments)."""
+    n = len(a)
     verts = []
-    flat = set(int(i) for i in flat_pockets)
     shapes = []
     seg_ends = np.zeros((n, 2 * n_seg, 4))
     seg_bits = np.zeros((n, 2 * n_seg), dtype=np.uint32)
@@ -230,7 +256,12 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
                 seg_bits[i, f * n_seg + k] = bit
                 shapes.append(seg)
     space.add(cage, *shapes)
-    if centred_cage and not kinematic_cage:
+    return verts, seg_ends, seg_bits, centres, arc_shapes
+
+
+def _add_joints(space, cage, rollers, centred: bool, rigid_radius) -> list:
+    """The centred cage's pivot and the rigid raceways' slide joints (returned), added to ``space``."""
+    if centred:
         # a static anchor of its own, not added to the space: the space's own static_body would be
         # added to its bodies, and the batched body read expects rollers and cage only
         anchor = pymunk.Body(body_type=pymunk.Body.STATIC)
@@ -247,6 +278,4 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
             j.error_bias = 0.0  # a roller outside the circle is put back within one step
             joints.append(j)
         space.add(*joints)
-    ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
-    return Scene(space, rollers, cage, a, R, verts, ids, joints, seg_ends, seg_bits if bits_each else None, centres,
-                 arc_shapes if exact else None, tuple(float(x) for x in extent))
+    return joints

@@ -10,8 +10,8 @@ from bearingsim.sweeps.engines import DaskEngine, LocalEngine
 from bearingsim.sweeps.grid import SweepMap, read_map
 from bearingsim.sweeps.index import index_dataframe, read_index
 from bearingsim.sweeps.plot import plot_sweep_index
-from bearingsim.sweeps.run import SweepOutcome, run_sweep, run_sweep_cli
+from bearingsim.sweeps.run import SweepOutcome, run_sweep
 from bearingsim.sweeps.spec import Case, SweepSpec, case_hash, load_sweep_file, resolve_cases, spec_from_args
 
 __all__ = ["Case", "DaskEngine", "LocalEngine", "SweepMap", "SweepOutcome", "SweepSpec", "case_hash", "index_dataframe", "load_sweep_file",
-           "plot_sweep_index", "read_index", "read_map", "resolve_cases", "run_sweep", "run_sweep_cli", "spec_from_args"]
+           "plot_sweep_index", "read_index", "read_map", "resolve_cases", "run_sweep", "spec_from_args"]

@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import contextlib
 import json
+import logging
 import math
-import os
 import signal
 import sys
 import threading
@@ -35,8 +35,8 @@ INDEX_EVERY_S = 1.0
 # (a 10 000-row index takes ~50-80 ms to write; every second that was ~2 s of a 30 s map, on a core the
 # workers need)
 INDEX_TIME_SHARE = 0.02
-#: rows of the table printed at the end of a sweep ('bearingsim table DIR' prints them all)
-TABLE_ROWS = 40
+
+_log = logging.getLogger(__name__)  # a failed case, when no progress bar shows it
 
 
 class SweepInterrupted(Exception):
@@ -267,7 +267,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     progress : bool, optional
         Show a progress bar on stderr; default: when stderr is a terminal.
     log : callable, optional
-        Receives one line per failed case (default: stderr).
+        Receives one line per failed case (default: the progress bar, or a warning of the
+        ``bearingsim.sweeps.run`` logger).
     lock : FolderLock, optional
         The folder's lock, already held by the caller (a study holds it until its table is written);
         default: taken here and released when the sweep ends.
@@ -286,10 +287,9 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the sweep (the index is
         written and finished archives kept either way).
     """
-    from bearingsim.archive import check_writable_dir
     from bearingsim.sweeps.engines import LocalEngine
     from bearingsim.sweeps.grid import MAP_NAME, grid_axes, write_map
-    from bearingsim.sweeps.worker import ARCHIVE_POLICIES, keeps_archive
+    from bearingsim.sweeps.worker import ARCHIVE_POLICIES
 
     t0 = time.perf_counter()
     engine = engine or LocalEngine(1)
@@ -304,24 +304,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         raise
     engine.start()  # an unreachable scheduler stops the sweep before anything is written
     try:
-        outdir = check_writable_dir(outdir)
-        cases_dir = outdir / "cases"
-        own = lock is None
-        if own:
-            lock = FolderLock(outdir).acquire()
-        elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
-            raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
-        try:
-            check_sweep_outputs(outdir, figures)
-            from bearingsim.sweeps.plot import FIGURE_NAMES
-
-            check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
-            if any(keeps_archive(c.model, archives) for c in cases):
-                cases_dir.mkdir(exist_ok=True)
-        except BaseException:
-            if own:
-                lock.release()
-            raise
+        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives)
     except BaseException:
         engine.stop()
         raise
@@ -329,59 +312,42 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         progress = sys.stderr.isatty()
     rows = [{"case": c.hash, "values": c.values, "status": "pending", "error": "", "archive": "",
              "wall_s": math.nan, "model_version": None, "summary": {}} for c in cases]
-    by_hash = {c.hash: i for i, c in enumerate(cases)}
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
                            map=outdir / MAP_NAME if grid else None)
     index = IndexWriter(outdir, rows, keys, meta)
+    with lock if own else contextlib.nullcontext():
+        outcome.interrupted = _run_cases(engine, cases, rows, index, outdir / "cases", archives, progress, desc, log,
+                                         lambda: write_map(outcome.map, grid, index.columns, map_attrs) if grid else None)
+    outcome.wall_s = time.perf_counter() - t0
+    if figures and outcome.interrupted is None:
+        from bearingsim.sweeps.plot import plot_sweep_index
 
-    with (lock if own else contextlib.nullcontext()), _Signals() as signals:
+        outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
+    return outcome
+
+
+def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map) -> int | None:
+    """Resume, run what is left on ``engine`` and keep the index (and, through ``write_map``, the map)
+    written however the run ends; the signal number if SIGINT/SIGTERM stopped it, else None."""
+    with _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
         bar = None
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
-            todo, stale = _resume(cases, rows, outdir, archives)
+            todo, stale = _resume(cases, rows, cases_dir.parent, archives)
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
             bar = _progress(len(cases), progress, counts["cached"], desc)
             if bar is not None:
                 bar.set_postfix(counts, refresh=True)
-            say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None
-                          else (lambda line: print(line, file=sys.stderr)))
-            last_index = time.monotonic()
-            index_s = 0.0  # how long the last rewrite took
+            say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None else _log.warning)
             if todo:
-                batches = make_batches(todo, engine.workers)
-                for records in engine.run(batches, str(cases_dir) if engine.shared_fs else None, archives):
-                    for rec in records:
-                        i = by_hash[rec["hash"]]
-                        row = rows[i]
-                        data = rec.pop("archive", None)
-                        if rec["status"] == "done" and data is not None:
-                            write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
-                        status = "stale" if rec["status"] == "done" and rec["hash"] in stale else rec["status"]
-                        kept = rec["status"] == "done" and keeps_archive(cases[i].model, archives)
-                        row.update(status=status, error=rec["error"], wall_s=rec["wall_s"],
-                                   summary=rec["summary"], model_version=rec.get("model_version"),
-                                   archive=f"cases/{rec['hash']}.h5" if kept else "")
-                        index.changed(i)
-                        counts[status] += 1
-                        if rec["status"] == "failed":
-                            say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
-                    if bar is not None:
-                        bar.set_postfix(counts, refresh=False)
-                        bar.update(len(records))
-                    if time.monotonic() - last_index >= max(INDEX_EVERY_S, index_s / INDEX_TIME_SHARE):
-                        t_index = time.monotonic()
-                        index.write()
-                        last_index = time.monotonic()
-                        index_s = last_index - t_index
-                    if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
-                        raise SweepInterrupted(signals.fired)
+                _collect(engine, todo, cases, rows, stale, counts, index, bar, say, signals, cases_dir, archives)
             if signals.fired is not None:
                 raise SweepInterrupted(signals.fired)
         except SweepInterrupted as exc:
-            outcome.interrupted = exc.signum
+            return exc.signum
         finally:
             try:
                 engine.stop()
@@ -390,14 +356,71 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                     bar.close()
                 _clean_temporaries(cases_dir)
                 index.write()
-                if grid:
-                    write_map(outcome.map, grid, index.columns, map_attrs)
-    outcome.wall_s = time.perf_counter() - t0
-    if figures and outcome.interrupted is None:
-        from bearingsim.sweeps.plot import plot_sweep_index
+                write_map()
+    return None
 
-        outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
-    return outcome
+
+def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str):
+    """Check the sweep folder and take its lock (unless the caller holds it): (folder, lock, whether the
+    lock is taken here). Refused: an unwritable folder, foreign files, another sweep or study."""
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.sweeps.grid import MAP_NAME
+    from bearingsim.sweeps.plot import FIGURE_NAMES
+    from bearingsim.sweeps.worker import keeps_archive
+
+    outdir = check_writable_dir(outdir)
+    own = lock is None
+    if own:
+        lock = FolderLock(outdir).acquire()
+    elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
+        raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
+    try:
+        check_sweep_outputs(outdir, figures)
+        check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
+        if any(keeps_archive(c.model, archives) for c in cases):
+            (outdir / "cases").mkdir(exist_ok=True)
+    except BaseException:
+        if own:
+            lock.release()
+        raise
+    return outdir, lock, own
+
+
+def _collect(engine, todo, cases, rows, stale, counts, index, bar, say, signals, cases_dir, archives) -> None:
+    """Run the cases ``todo`` on ``engine`` and take their records as they come: archives written, rows and
+    counts updated, failures said, the index rewritten now and then; stops on a signal."""
+    from bearingsim.sweeps.worker import keeps_archive
+
+    by_hash = {c.hash: i for i, c in enumerate(cases)}
+    last_index = time.monotonic()
+    index_s = 0.0  # how long the last rewrite took
+    for records in engine.run(make_batches(todo, engine.workers), str(cases_dir) if engine.shared_fs else None,
+                              archives):
+        for rec in records:
+            i = by_hash[rec["hash"]]
+            row = rows[i]
+            data = rec.pop("archive", None)
+            if rec["status"] == "done" and data is not None:
+                write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
+            status = "stale" if rec["status"] == "done" and rec["hash"] in stale else rec["status"]
+            kept = rec["status"] == "done" and keeps_archive(cases[i].model, archives)
+            row.update(status=status, error=rec["error"], wall_s=rec["wall_s"],
+                       summary=rec["summary"], model_version=rec.get("model_version"),
+                       archive=f"cases/{rec['hash']}.h5" if kept else "")
+            index.changed(i)
+            counts[status] += 1
+            if rec["status"] == "failed":
+                say(f"failed: case {row['case']} ({cases[i].label()}): {rec['error']}")
+        if bar is not None:
+            bar.set_postfix(counts, refresh=False)
+            bar.update(len(records))
+        if time.monotonic() - last_index >= max(INDEX_EVERY_S, index_s / INDEX_TIME_SHARE):
+            t_index = time.monotonic()
+            index.write()
+            last_index = time.monotonic()
+            index_s = last_index - t_index
+        if signals.fired is not None:  # its exception was swallowed (raised inside a callback)
+            raise SweepInterrupted(signals.fired)
 
 
 def _resolve(spec, engine, archives: str, grid) -> tuple[list[Case], list[str], dict, dict]:
@@ -425,64 +448,3 @@ def _map_attrs(spec: SweepSpec) -> dict:
     base = load_scenario(spec.scenario, spec.sets)
     return {"bearingsim_version": __version__, "scenario": base.to_toml(), "base_scenario": str(spec.scenario),
             "sweep": spec.origin}
-
-
-def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: int | None = None,
-                  scheduler: str | None = None, figures: bool = True, quiet: bool = False,
-                  force: bool = False, progress: bool | None = None, archives: str = "auto") -> int:
-    """``bearingsim sweep``: run, print what was written and the table of the cases (unless ``quiet``)
-    and return the exit code. ``progress``: the bar on stderr (default: when stderr is a terminal);
-    ``archives``: which cases keep an archive (:func:`run_sweep`).
-
-    0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
-    SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
-    """
-    from bearingsim.sweeps.engines import DaskEngine, LocalEngine
-    from bearingsim.sweeps.spec import spec_from_args
-
-    spec = spec_from_args(target, params, sets)
-    if not quiet:  # keys that change nothing in the base scenario's model (unless the model is swept too)
-        from bearingsim.scenario import given_keys, load_scenario, unused_note
-
-        keys = given_keys(spec.scenario, spec.sets) + spec.keys
-        base = load_scenario(spec.scenario, spec.sets)
-        method = None if "reduced.method" in spec.keys else base.reduced.method  # swept: some cases use the step
-        note = None if "model" in spec.keys else unused_note(base.model, keys, method)
-        if note:
-            print(f"bearingsim: note: {note}", file=sys.stderr)
-    jobs = jobs if jobs is not None else (os.cpu_count() or 1)
-    if jobs < 1:
-        raise UserError(f"--jobs: must be at least 1 (got {jobs})")
-    engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
-    out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force, archives=archives,
-                    progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))
-    n = len(out.rows)
-    counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
-    if out.count("stale"):
-        counts += f", {out.count('stale')} stale (computed by another model version: run again)"
-    if out.interrupted is not None:
-        print(f"bearingsim: sweep interrupted ({signal.Signals(out.interrupted).name}): {counts}, "
-              f"{out.count('pending')} not run, of {n}; index {out.h5}; run the same command again to resume",
-              file=sys.stderr)
-        return 128 + out.interrupted
-    if not quiet:
-        print(f"wrote {out.csv}")
-        print(f"wrote {out.h5}")
-        if out.map is not None:
-            print(f"wrote {out.map}")
-        for p in out.figures:
-            print(f"wrote {p}")
-        for line in out.figure_notes:
-            print(f"bearingsim: note: {line}", file=sys.stderr)
-        from bearingsim import tables
-
-        print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
-        print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
-    if out.failed:
-        names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"
-                          for r in out.failed[:10])
-        more = f" and {len(out.failed) - 10} more" if len(out.failed) > 10 else ""
-        print(f"bearingsim: {len(out.failed)} of {n} cases failed: {names}{more} (errors in {out.csv})",
-              file=sys.stderr)
-        return 1
-    return 0

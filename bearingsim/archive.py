@@ -669,7 +669,7 @@ def _damaged(path, what: str) -> UserError:
 
 def _model_attr(f, path) -> str:
     """``/bearingsim@model``: the name of a known model, else a one-line UserError."""
-    from bearingsim.simulation import MODELS
+    from bearingsim.model_versions import MODELS
 
     model = _plain(f["bearingsim"].attrs.get("model"))
     if model is None:

@@ -14,16 +14,10 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
+from bearingsim.cli_common import progress_wanted as _progress
+from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
+from bearingsim.cli_common import report_study as _report_study
 from bearingsim.errors import SimulationUnstable, UserError
-
-
-def _refuse_archive_as_scenario(path) -> None:
-    """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
-    from bearingsim.archive import is_archive
-
-    if is_archive(path):  # missing or unreadable files: the scenario reader reports them
-        raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
-                        f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
 
 
 def _print_summary(summary) -> None:
@@ -331,29 +325,6 @@ def _cmd_keys(args) -> int:
         raise UserError(f"keys {args.pattern!r}: no scenario key contains it ('bearingsim keys' lists them all)")
     print(text)
     return 0
-
-
-def _report_study(outcome, command: str) -> int:
-    """The end of a study command: exit 0, 1 if a case failed (named on stderr), 128 + signal if
-    interrupted (finished cases kept: the same command resumes)."""
-    n = len(outcome.sweep.rows)
-    if outcome.interrupted is not None:
-        print(f"bearingsim: {command} interrupted ({signal.Signals(outcome.interrupted).name}): {outcome.counts()}, "
-              f"{outcome.count('pending')} not run, of {n} cases; run the same command again to resume",
-              file=sys.stderr)
-        return 128 + outcome.interrupted
-    if outcome.failed:
-        names = "; ".join(f"{', '.join(f'{k}={v}' for k, v in r['values'].items())}: {r['error']}"
-                          for r in outcome.failed[:10])
-        print(f"bearingsim: {len(outcome.failed)} of {n} cases of the {command} failed ({names}); the other "
-              f"cases' numbers are kept (errors in {outcome.sweep.csv})", file=sys.stderr)
-        return 1
-    return 0
-
-
-def _progress(args) -> bool:
-    """A progress bar on stderr: only on a terminal, and not with -q."""
-    return not getattr(args, "quiet", False) and sys.stderr.isatty()
 
 
 def _cmd_validate(args) -> int:

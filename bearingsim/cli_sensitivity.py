@@ -18,7 +18,8 @@ def _keys(text):
 
 
 def _cmd_sensitivity(args) -> int:
-    from bearingsim.cli import _refuse_archive_as_scenario, _report_study
+    from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
+    from bearingsim.cli_common import report_study as _report_study
     from bearingsim.scenario import load_scenario
     from bearingsim.studies import make_engine, run_studies
     from bearingsim.studies.sensitivity import Sensitivity, parse_step
@@ -45,7 +46,8 @@ def _cmd_sensitivity(args) -> int:
 
 
 def _cmd_uncertainty(args) -> int:
-    from bearingsim.cli import _refuse_archive_as_scenario, _report_study
+    from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
+    from bearingsim.cli_common import report_study as _report_study
     from bearingsim.scenario import load_scenario
     from bearingsim.studies import make_engine, run_studies
     from bearingsim.studies.uncertainty import Uncertainty

@@ -101,7 +101,7 @@ def add_commands(sub) -> None:
 
 
 def _cmd_sweep(args) -> int:
-    from bearingsim.cli import _progress
+    from bearingsim.cli_common import progress_wanted as _progress
 
     return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
                          scheduler=args.scheduler, figures=not args.no_plots, force=args.force, quiet=args.quiet,

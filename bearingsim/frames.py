@@ -133,23 +133,16 @@ def map_xarray(sweep_map):
     return xr.Dataset(data_vars, coords=coords, attrs=dict(m.attrs))
 
 
-def index_dataframe(path, units_in_names: bool = False):
-    """The case index of a sweep or study (``DIR`` or ``DIR/sweep.h5``) as a DataFrame: one row per
-    case, index ``case`` (content hash), the swept keys, ``status``, ``error``, ``archive``, ``wall_s``
-    and the summary numbers (SI); ``attrs``: ``units``, ``axes`` (the swept keys) and ``folder``."""
-    from pathlib import Path
-
-    from bearingsim.sweeps.index import read_index, unit_of
-
+def index_frame(cols: dict, axes, folder: str, unit_of, units_in_names: bool = False):
+    """A case index's columns ``cols`` (:func:`bearingsim.sweeps.index.read_index`) as a DataFrame: one row
+    per case, index ``case`` (content hash), the swept keys, ``status``, ``error``, ``archive``, ``wall_s``
+    and the summary numbers (SI); ``attrs``: ``units`` (from ``unit_of(column)``), ``axes`` (the swept
+    keys) and ``folder``."""
     pd = need("pandas", "index_dataframe")
-    p = Path(path)
-    if p.is_dir():
-        p = p / "sweep.h5"
-    cols, meta = read_index(p)
     frame = pd.DataFrame({k: (v.astype(str) if v.dtype == object else v) for k, v in cols.items() if k != "case"},
                          index=pd.Index(cols["case"].astype(str), name="case"))
     units = {k: unit_of(k) for k in frame.columns if k not in ("status", "error", "archive")
              and frame[k].dtype.kind == "f"}
     frame = _named(frame, units, units_in_names)
-    frame.attrs.update(axes=list(meta["axes"]), folder=str(p.parent))
+    frame.attrs.update(axes=list(axes), folder=folder)
     return frame

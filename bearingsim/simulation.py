@@ -16,13 +16,10 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from bearingsim.model_versions import MODELS  # noqa: F401 - the models by name, re-exported here
 from bearingsim.scenario import Scenario, check_run_request
 
 log = logging.getLogger(__name__)  # notes of a plausible run that is not clean (the command line prints them)
-
-
-#: the models, by the name a scenario and an archive give
-MODELS = ("reduced", "multibody")
 
 
 def model_module(name: str):

@@ -217,11 +217,11 @@ def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: boo
 
 def load_result(outdir: Path, record: dict):
     """The result stored in a finished case's archive, or None for a failed or pending case."""
-    import bearingsim
+    from bearingsim.simulation import load
 
     if record["status"] not in FINISHED:
         return None
-    return bearingsim.load(Path(outdir) / record["archive"])
+    return load(Path(outdir) / record["archive"])
 
 
 def summary_of(outdir: Path, record: dict) -> dict[str, float] | None:

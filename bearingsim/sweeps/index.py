@@ -178,10 +178,14 @@ def read_index(path: str | Path) -> tuple[dict[str, np.ndarray], dict]:
 
 def index_dataframe(path, units_in_names: bool = False):
     """The index of a sweep or study folder (``DIR`` or ``DIR/sweep.h5``) as a pandas DataFrame, one
-    row per case (needs the extra ``bearingsim[frames]``; :func:`bearingsim.frames.index_dataframe`)."""
-    from bearingsim.frames import index_dataframe as frame
+    row per case (needs the extra ``bearingsim[frames]``; :func:`bearingsim.frames.index_frame`)."""
+    from bearingsim.frames import index_frame
 
-    return frame(path, units_in_names)
+    p = Path(path)
+    if p.is_dir():
+        p = p / "sweep.h5"
+    cols, meta = read_index(p)
+    return index_frame(cols, meta["axes"], str(p.parent), unit_of, units_in_names)
 
 
 # unit suffixes of scenario and summary keys -> unit text for labels
@@ -219,7 +223,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     another) gives ``{"status": "stale"}`` without its numbers: the case runs again too.
     """
     from bearingsim.model_versions import MODEL_VERSIONS
-    from bearingsim.sweeps.worker import standard_errors
+    from bearingsim.stats import impulse_standard_errors as standard_errors
 
     got = archive.peek(archive_path)
     if got is None or got["scenario"] != toml_text:

@@ -1,0 +1,41 @@
+"""What the subcommands share: refusing an archive given as a scenario, a study's exit code, whether
+a progress bar is drawn. Imported by :mod:`bearingsim.cli` and the command modules beside it
+(``cli_sweep``, ``cli_sensitivity``, ``cli_wear``), none of which import each other."""
+from __future__ import annotations
+
+import signal
+import sys
+
+from bearingsim.errors import UserError
+
+
+def refuse_archive_as_scenario(path) -> None:
+    """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
+    from bearingsim.archive import is_archive
+
+    if is_archive(path):  # missing or unreadable files: the scenario reader reports them
+        raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
+                        f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
+
+
+def report_study(outcome, command: str) -> int:
+    """The end of a study command: exit 0, 1 if a case failed (named on stderr), 128 + signal if
+    interrupted (finished cases kept: the same command resumes)."""
+    n = len(outcome.sweep.rows)
+    if outcome.interrupted is not None:
+        print(f"bearingsim: {command} interrupted ({signal.Signals(outcome.interrupted).name}): {outcome.counts()}, "
+              f"{outcome.count('pending')} not run, of {n} cases; run the same command again to resume",
+              file=sys.stderr)
+        return 128 + outcome.interrupted
+    if outcome.failed:
+        names = "; ".join(f"{', '.join(f'{k}={v}' for k, v in r['values'].items())}: {r['error']}"
+                          for r in outcome.failed[:10])
+        print(f"bearingsim: {len(outcome.failed)} of {n} cases of the {command} failed ({names}); the other "
+              f"cases' numbers are kept (errors in {outcome.sweep.csv})", file=sys.stderr)
+        return 1
+    return 0
+
+
+def progress_wanted(args) -> bool:
+    """A progress bar on stderr: only on a terminal, and not with -q."""
+    return not getattr(args, "quiet", False) and sys.stderr.isatty()

@@ -90,6 +90,7 @@ def report(path, out, *, animation: str | None = "gif") -> Path:
     title, sections = _sections(kind, file, animation)
     html = render(title, str(path), kind, sections)
     try:
+        out.parent.mkdir(parents=True, exist_ok=True)
         with atomic_file(out) as fh:
             fh.write(html.encode("utf-8"))
     except OSError as exc:
@@ -99,7 +100,8 @@ def report(path, out, *, animation: str | None = "gif") -> Path:
 
 def check_output(out, source=None) -> Path:
     """Refuse, in one line, an output that is not an ``.html`` path bearingsim may write: a folder, a
-    link, a file that is not a report bearingsim wrote, the input itself, a folder it cannot create."""
+    link, a file that is not a report bearingsim wrote, the input itself, below a file. Nothing is
+    created here: :func:`report` creates the missing folders when the page is ready."""
     from bearingsim.outputs import check_replaceable
 
     out = Path(out)
@@ -107,13 +109,10 @@ def check_output(out, source=None) -> Path:
         raise UserError(f"{out}: report path must end in .html (got {out.suffix or 'no suffix'!r})")
     if source is not None and out.exists() and Path(source).exists() and out.resolve() == Path(source).resolve():
         raise UserError(f"{out}: the report path is the input; choose another -o")
+    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise UserError(f"{out.parent}: cannot create the report's folder ({existing} is not a folder)")
     check_replaceable(out, SIGNATURE, "report")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise UserError(f"{out.parent}: cannot create the report's folder ({exc.strerror or exc})") from None
-    if not out.parent.is_dir():
-        raise UserError(f"{out.parent}: not a folder; cannot write the report there")
     return out
 
 

@@ -3,6 +3,7 @@
 The browser is the distribution's Chromium (/usr/bin/chromium, Debian's package `chromium`) driven by
 playwright; without it these tests FAIL, saying how to install it (the README's test command does).
 """
+import re
 import sys
 import types
 from pathlib import Path
@@ -70,6 +71,8 @@ def open_page(browser, path: Path, screenshot: Path | None = None) -> dict:
     if screenshot is not None:
         screenshot.parent.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(screenshot), full_page=True)
+        pdf = page.pdf(format="A4")  # what the browser's Print to PDF makes of the page (print styles)
+        seen["pdf_pages"] = len(re.findall(rb"/Type\s*/Page[^s]", pdf)) if pdf.startswith(b"%PDF") else 0
     context.close()
     seen["errors"] = errors
     return seen
@@ -112,6 +115,7 @@ def test_report_of_a_run_archive_renders_in_chromium(runs, browser, tmp_path, no
     assert_renders(seen, ["summary", "figures", "pockets", "checks", "scenario", "provenance"])
     assert len(seen["images"]) == len(bearingsim.load(runs / "m.h5").FIGURES) == 4  # forces, impulses, orbit, wear
     assert SCREENSHOT.stat().st_size > 0
+    assert seen["pdf_pages"] >= 4  # printable: contents, then 6 sections with 4 figures, over several A4 pages
     text = seen["text"]
     # the checks of bearingsim run, measured from this archive, every one passed
     assert "inner-ring displacement within the Palmgren bound" in text and "FAILED" not in text
@@ -134,8 +138,8 @@ def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path, no_
 
 
 def _fake_animation(gif: bytes, calls: list):
-    """A stand-in for bearingsim.animation (the other half of issue 27): ``has_motion`` and ``render``
-    with its signature, writing ``gif``."""
+    """A stand-in for bearingsim.animation (a separate module, absent on a checkout without it):
+    ``has_motion`` and ``render`` with its signature, writing ``gif``."""
     mod = types.ModuleType("bearingsim.animation")
     mod.has_motion = lambda path: True
 

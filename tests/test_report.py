@@ -92,14 +92,20 @@ def assert_renders(seen: dict, sections: list[str]) -> None:
 # --- inputs -------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    """A whole-bearing archive (6000 rpm, 1 warm-up + 1 rotation) and a reduced one whose scenario name
-    is markup (it must be shown as text)."""
+    """A folder with ``r.h5``: a reduced-model archive whose scenario name is markup (it must be shown
+    as text)."""
     d = tmp_path_factory.mktemp("report")
-    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 1})
-    bearingsim.run(sc).save(d / "m.h5")
     sc = bearingsim.load_scenario(PAPER, set={"name": "<img src=x onerror=alert(1)>"})
     bearingsim.run(sc).save(d / "r.h5")
     return d
+
+
+@pytest.fixture(scope="module")
+def whole(runs):
+    """``runs/m.h5``: a whole-bearing archive (6000 rpm, 1 warm-up + 1 rotation)."""
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 1})
+    bearingsim.run(sc).save(runs / "m.h5")
+    return runs / "m.h5"
 
 
 @pytest.fixture
@@ -109,11 +115,11 @@ def no_animation_module(monkeypatch):
 
 
 @pytest.mark.slow
-def test_report_of_a_run_archive_renders_in_chromium(runs, browser, tmp_path, no_animation_module):
-    out = bearingsim.report(runs / "m.h5", tmp_path / "m.html")
+def test_report_of_a_run_archive_renders_in_chromium(whole, browser, tmp_path, no_animation_module):
+    out = bearingsim.report(whole, tmp_path / "m.html")
     seen = open_page(browser, out, SCREENSHOT)
     assert_renders(seen, ["summary", "figures", "pockets", "checks", "scenario", "provenance"])
-    assert len(seen["images"]) == len(bearingsim.load(runs / "m.h5").FIGURES) == 4  # forces, impulses, orbit, wear
+    assert len(seen["images"]) == len(bearingsim.load(whole).FIGURES) == 4  # forces, impulses, orbit, wear
     assert SCREENSHOT.stat().st_size > 0
     assert seen["pdf_pages"] >= 4  # printable: contents, then 6 sections with 4 figures, over several A4 pages
     text = seen["text"]
@@ -164,13 +170,13 @@ def _gif(frames=3, size=(40, 30)) -> bytes:
 
 
 @pytest.mark.slow
-def test_the_animation_is_embedded_and_loads(runs, browser, tmp_path, monkeypatch):
+def test_the_animation_is_embedded_and_loads(whole, browser, tmp_path, monkeypatch):
     """The archive's animation, made by bearingsim.animation.render (here a stand-in writing a 3-frame
     40 x 30 GIF), is embedded in its own section and decodes in the browser at its size."""
     calls = []
     monkeypatch.setitem(sys.modules, "bearingsim.animation", _fake_animation(_gif(), calls))
-    out = bearingsim.report(runs / "m.h5", tmp_path / "a.html")
-    assert [c[0] for c in calls] == [runs / "m.h5"] and calls[0][1].suffix == ".gif"
+    out = bearingsim.report(whole, tmp_path / "a.html")
+    assert [c[0] for c in calls] == [whole] and calls[0][1].suffix == ".gif"
     seen = open_page(browser, out)
     assert_renders(seen, ["summary", "figures", "animation"])
     anim = [i for i in seen["images"] if i["id"] == "animation"]
@@ -178,6 +184,7 @@ def test_the_animation_is_embedded_and_loads(runs, browser, tmp_path, monkeypatc
     assert not list(tmp_path.glob(".*tmp*"))
 
 
+@pytest.mark.slow
 def test_without_the_animation_module_there_is_no_animation_section(runs, tmp_path, no_animation_module):
     from bearingsim.reports import _animation_section
 
@@ -199,6 +206,7 @@ def test_an_archive_without_motion_has_no_animation_section(runs, monkeypatch):
     assert section.blocks[0]["element"] == "video" and section.blocks[0]["src"].startswith("data:video/mp4;base64,")
 
 
+@pytest.mark.slow
 def test_the_same_archive_gives_the_same_bytes(runs, tmp_path, no_animation_module):
     a = bearingsim.report(runs / "r.h5", tmp_path / "a.html").read_bytes()
     b = bearingsim.report(runs / "r.h5", tmp_path / "b.html").read_bytes()
@@ -208,14 +216,18 @@ def test_the_same_archive_gives_the_same_bytes(runs, tmp_path, no_animation_modu
 # --- folders ------------------------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def folders(tmp_path_factory):
-    """A reduced-model sweep (2 speeds, archives kept) and sensitivity study (2 keys), run; a cross-check
-    and a life table written by their own writers from given rows (their runs take minutes)."""
+    """A reduced-model sweep (2 speeds, archives kept), sensitivity and uncertainty study (2 keys; N = 2:
+    8 runs), run; a cross-check and a life table written by their own writers from given rows (their
+    runs take minutes)."""
     d = tmp_path_factory.mktemp("folders")
     res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "--archives", "all",
               "-o", d / "sweep", "-j", "1", "-q")
     assert res.returncode == 0, res.stderr
     res = cli("sensitivity", PAPER, "--keys", "contact.restitution,lubrication.drag_coefficient", "-o", d / "sens",
               "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    res = cli("uncertainty", PAPER, "--keys", "contact.restitution,lubrication.drag_coefficient", "--samples", "2",
+              "-o", d / "unc", "-j", "1", "-q")
     assert res.returncode == 0, res.stderr
     _crosscheck_table(d / "cc")
     _life_table(d / "life")
@@ -253,6 +265,7 @@ def _life_table(folder: Path) -> None:
 @pytest.mark.parametrize("name, kind, words", [
     ("sweep", "sweep", ["inner_ring_speed_rpm", "2 cases: done 2", "I_dec_mean [mN s]"]),
     ("sens", "sensitivity", ["contact.restitution", "lubrication.drag_coefficient", "d ln y / d ln x"]),
+    ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
     ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),
     ("life", "life", ["clearance=0.23mm", "max_depth_um [um]"]),
 ])
@@ -269,6 +282,7 @@ def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name
         assert w in seen["text"], w
 
 
+@pytest.mark.slow
 def test_a_table_file_reports_its_folder(folders):
     from bearingsim.reports import kind_of
 
@@ -277,6 +291,7 @@ def test_a_table_file_reports_its_folder(folders):
 
 
 # --- refusals -----------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_not_a_bearingsim_path_is_one_line(tmp_path):
     (tmp_path / "notes.txt").write_text("hello")
     assert_user_error(cli("report", tmp_path, "-o", tmp_path / "r.html"), str(tmp_path), "not a bearingsim archive")
@@ -285,6 +300,7 @@ def test_not_a_bearingsim_path_is_one_line(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]  # nothing written
 
 
+@pytest.mark.slow
 def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
     src = runs / "r.h5"
     user = tmp_path / "mine.html"
@@ -298,6 +314,7 @@ def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.html", "mine.html"]
 
 
+@pytest.mark.slow
 def test_a_report_replaces_its_own_earlier_report(runs, tmp_path, no_animation_module):
     out = tmp_path / "r.html"
     bearingsim.report(runs / "r.h5", out)

@@ -336,3 +336,19 @@ def test_the_template_ships_with_the_package():
     assert files and all(any(fnmatch.fnmatch(f, pat) for pat in patterns) for f in files)
     assert "jinja2>=3.1" in meta["project"]["dependencies"]
     assert any(d.startswith("playwright") for d in meta["project"]["optional-dependencies"]["test"])
+
+
+def test_a_check_that_fails_is_shown_as_failed(runs):
+    """The checks table is measured, not a list of labels: an archive read back with a non-finite
+    impulse (a crafted file: bearingsim run writes none) shows that check FAILED and says the archive
+    does not pass, with the reason plausibility.check gives."""
+    from bearingsim.reports import _checks_blocks
+
+    result = bearingsim.load(runs / "r.h5")
+    rows = _checks_blocks(result)[0]["rows"]
+    assert [r["passed"] for r in rows] == [True, True]
+    result.per_rotation["I_dec"][...] = np.nan  # the arrays of the result, as a damaged archive would give
+    blocks = _checks_blocks(result)
+    assert [(r["name"], r["passed"]) for r in blocks[0]["rows"]] == [("summary numbers finite", True),
+                                                                      ("I_dec and I_acc per rotation finite", False)]
+    assert blocks[1]["text"].startswith("This archive does NOT pass the checks: non-finite I_dec per rotation")

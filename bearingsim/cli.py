@@ -436,6 +436,16 @@ def _cmd_crosscheck(args) -> int:
     return _report_study(outcome, "cross-check")
 
 
+def _cmd_report(args) -> int:
+    """``bearingsim report PATH -o report.html`` (:mod:`bearingsim.reports`)."""
+    from bearingsim.reports import report
+
+    out = report(args.path, args.output, animation=None if args.animation == "none" else args.animation)
+    if not args.quiet:
+        print(f"wrote {out}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="bearingsim", description="Roller/cage dynamics and cage-wear impulse.")
     p.add_argument("--version", action="version", version=f"bearingsim {__version__}")
@@ -563,6 +573,14 @@ def _add_study_commands(sub) -> None:
                    help="replace another sweep or study in the output folder (default: refused; the same command resumes)")
     cc.add_argument("-q", "--quiet", action="store_true", help="no progress bar, no table, nothing printed on success")
     cc.set_defaults(func=_cmd_crosscheck)
+    rp = sub.add_parser("report", help="one self-contained HTML page of a run archive, a sweep folder or a study "
+                                       "folder: figures, animation, tables, checks, scenario, provenance (docs/report.md)")
+    rp.add_argument("path", help="run archive, or sweep, cross-check, sensitivity, uncertainty or life folder")
+    rp.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default report.html)")
+    rp.add_argument("--animation", choices=("gif", "mp4", "none"), default="gif",
+                    help="embed an archive's animation as a GIF image (default), an MP4 video, or not at all")
+    rp.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
+    rp.set_defaults(func=_cmd_report)
 
 
 class Terminated(KeyboardInterrupt):

@@ -129,6 +129,39 @@ def check(result) -> list[str]:
     return notes
 
 
+def checks_made(result) -> list[tuple[str, str, bool]]:
+    """What :func:`check` verifies of ``result``, for a report: one ``(check, what was measured against
+    its limit, passed)`` per check, with the limits :func:`check` uses (a report shows them beside the
+    notes and the verdict of :func:`check` itself, which stays the one that refuses a run)."""
+    p = result.parameters
+    summary = dict(result.summary)
+    bad = _nonfinite(summary)
+    allowed = {"first_impact_speed_m_s", "first_impact_energy_J"} if p.model == "multibody" else set()
+    out = [("summary numbers finite", f"{len(summary)} numbers; not finite: {', '.join(sorted(bad)) or 'none'}"
+            + (" (no rear-face impact in the no-load zone: allowed)" if bad and set(bad) <= allowed else ""),
+            not bad or set(bad) <= allowed)]
+    arrays = [np.asarray(result.per_rotation.get(n, np.zeros(0))) for n in ("I_dec", "I_acc")]
+    finite = all(bool(np.all(np.isfinite(a))) for a in arrays)
+    out.append(("I_dec and I_acc per rotation finite", f"{sum(a.size for a in arrays)} values", finite))
+    if p.model != "multibody":
+        return out
+    if "inner_ring_displacement_m" in summary:
+        disp, limit = abs(float(summary["inner_ring_displacement_m"])), max_ring_displacement_m(p)
+        out.append(("inner-ring displacement within the Palmgren bound",
+                    f"{disp * 1e6:.4g} µm against {limit * 1e6:.4g} µm ({DISPLACEMENT_MARGIN:g} x (half the "
+                    "radial clearance + the approach of one roller carrying the load))", disp <= limit))
+    orbit = result.get("cage_orbit")
+    samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
+    out.append(("cage-orbit samples recorded", f"{samples} against at least {MIN_ORBIT_SAMPLES}",
+                samples >= MIN_ORBIT_SAMPLES))
+    fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
+    steps = int(summary.get("steps", 0) or 0)
+    if steps:
+        out.append(("inner ring's force balance converged", f"not in {fails} of {steps} steps ({fails / steps:.2%}) "
+                    f"against at most {MAX_NEWTON_FAILURE_FRACTION:.0%}", fails <= MAX_NEWTON_FAILURE_FRACTION * steps))
+    return out
+
+
 def cage_speed_drift(result) -> str | None:
     """A note when the cage speed of a fresh multibody run drifted over its recorded rotations by more
     than :data:`MAX_CAGE_SPEED_DRIFT` of its mean (not statistically steady), else None."""

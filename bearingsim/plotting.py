@@ -8,9 +8,10 @@ list (a notebook or a GUI application that imports bearingsim keeps its backend;
 """
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
-__all__ = ["figure", "subplots", "save_figure", "legend_outside"]
+__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside"]
 
 
 def figure(**kw):
@@ -44,18 +45,37 @@ def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
     (:func:`bearingsim.outputs.check_replaceable`). ``tight``: ``tight_layout`` and a bounding box
     that keeps a legend placed outside the axes.
     """
-    import warnings
-
     from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
 
     path = Path(path)
     check_replaceable(path, PNG_SIGNATURE, "figure")
-    with warnings.catch_warnings():
-        # a scenario name in a script the font lacks (CJK with DejaVu Sans) is drawn as boxes; matplotlib
-        # would also warn once per glyph and layout pass, dozens of lines for one name
-        warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from (current )?font", category=UserWarning)
+    with _missing_glyphs_quiet():
         if tight:
             fig.tight_layout()
         with atomic_file(path) as fh:
             fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
     return path
+
+
+def figure_png(fig, *, dpi: int = 120, tight: bool = True) -> bytes:
+    """The PNG bytes :func:`save_figure` would write for ``fig`` (a report embeds them)."""
+    import io
+
+    buf = io.BytesIO()
+    with _missing_glyphs_quiet():
+        if tight:
+            fig.tight_layout()
+        fig.savefig(buf, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
+    return buf.getvalue()
+
+
+@contextlib.contextmanager
+def _missing_glyphs_quiet():
+    """matplotlib's missing-glyph warnings ignored: a scenario name in a script the font lacks (CJK with
+    DejaVu Sans) is drawn as boxes, and matplotlib would also warn once per glyph and layout pass,
+    dozens of lines for one name."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=r"Glyph \d+ .*missing from (current )?font", category=UserWarning)
+        yield

@@ -160,7 +160,7 @@ def _bare(key: str) -> str:
     return key
 
 
-def _column(table: Table, key: str) -> tuple[str, list[str]]:
+def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
     """Header and cells of number column ``key`` (with its standard error and marks when it has one,
     against the first row that has a number)."""
     unit = table.units.get(key, "1")
@@ -200,7 +200,7 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
     heads = [*table.label_names]
     cols = [table.labels[k] for k in table.label_names]
     for key in keys:
-        head, cells = _column(table, key)
+        head, cells = column_cells(table, key)
         heads.append(head)
         cols.append(cells)
     shown = n if max_rows is None else min(n, max_rows)

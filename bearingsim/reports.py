@@ -1,0 +1,443 @@
+"""One self-contained HTML report of a run archive, a sweep folder or a study folder (cross-check,
+sensitivity, uncertainty, life): ``bearingsim report PATH -o report.html``, ``bearingsim.report(path, out)``.
+
+The page gathers what the other commands print and draw, read from the files alone: the figures
+(the same figure functions as ``bearingsim plot``, the sweeps' and the studies', embedded as PNG data
+URIs), the animation of an archive that holds the bodies' motion (:mod:`bearingsim.animation`, when
+installed), the tables (with the standard errors and marks of ``bearingsim table``), the plausibility
+checks, the scenario as TOML and the provenance, under a table of contents. Nothing is fetched when
+it is read: it works offline and prints to PDF from the browser (print styles: one section after
+another, no figure split across pages). The page is a Jinja2 template shipped with the package
+(``bearingsim/templates/report.html.j2``), every value autoescaped; ``docs/report.md``.
+
+The same inputs give the same bytes (no clock in the page: the run's own time is in its provenance).
+"""
+from __future__ import annotations
+
+import base64
+import math
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+
+#: the first bytes of every report bearingsim writes: what ``-o`` may replace
+SIGNATURE = b"<!DOCTYPE html>\n<!-- bearingsim report"
+SUFFIXES = (".html", ".htm")
+#: most rows of a table in the page (a 10 000-case sweep: 'bearingsim table' prints them all)
+MAX_ROWS = 200
+#: the formats of the embedded animation and how the page shows them
+ANIMATIONS = {"gif": ("image/gif", "img"), "mp4": ("video/mp4", "video")}
+KINDS = ("run", "sweep", "crosscheck", "sensitivity", "uncertainty", "life")
+
+
+@dataclass
+class Section:
+    """One section of the page: an anchor ``id``, a title and its blocks (dicts with a ``kind``: text,
+    list, table, figure, animation, checks, pre; see the template)."""
+
+    id: str
+    title: str
+    blocks: list[dict] = field(default_factory=list)
+
+
+# --- what PATH is -------------------------------------------------------------------------------
+def kind_of(path) -> tuple[str, Path]:
+    """``(kind, file)`` of ``path``: a run archive (``"run"``, the archive) or a folder (or its table
+    file) of a life study, cross-check, sensitivity or uncertainty study or sweep (the kind and its
+    table file); a one-line UserError for anything else."""
+    from bearingsim import archive
+
+    p = Path(path)
+    if not p.exists():
+        raise UserError(f"{p}: file or folder not found")
+    if p.is_file() and archive.is_archive(p):
+        return "run", p
+    folder = p if p.is_dir() else p.parent
+    for kind, name, fmt in _tables():
+        f = folder / name
+        if (p.is_dir() or p.name == name) and f.is_file() and archive.is_table_file(f, fmt):
+            return kind, f
+    raise UserError(f"{p}: not a bearingsim archive, nor a sweep, cross-check, sensitivity, uncertainty or life "
+                    f"folder (no sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
+
+
+def _tables():
+    """(kind, file name, format) of the folders' tables, a study's before the sweep index it also has."""
+    from bearingsim.studies import crosscheck, life, sensitivity, uncertainty
+    from bearingsim.sweeps.index import INDEX_FORMAT
+
+    return (("life", "life.h5", life.LIFE_FORMAT), ("crosscheck", "crosscheck.h5", crosscheck.INDEX_FORMAT),
+            ("sensitivity", "sensitivity.h5", sensitivity.INDEX_FORMAT),
+            ("uncertainty", "uncertainty.h5", uncertainty.INDEX_FORMAT), ("sweep", "sweep.h5", INDEX_FORMAT))
+
+
+# --- the report ---------------------------------------------------------------------------------
+def report(path, out, *, animation: str | None = "gif") -> Path:
+    """Write the report of ``path`` (a run archive, or a sweep or study folder) to ``out`` (``.html``),
+    atomically; return ``out``. ``animation``: the format of an archive's embedded animation, ``"gif"``
+    (an image: every browser, printed as its frame) or ``"mp4"`` (a video, smaller), None for none.
+    One-line UserError for a PATH that is none of these and for an output that cannot be written."""
+    from bearingsim.outputs import atomic_file
+
+    if animation is not None and animation not in ANIMATIONS:
+        raise UserError(f"animation {animation!r}: give one of {', '.join(ANIMATIONS)} or None")
+    out = check_output(out, path)
+    kind, file = kind_of(path)
+    title, sections = _sections(kind, file, animation)
+    html = render(title, str(path), kind, sections)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_file(out) as fh:
+            fh.write(html.encode("utf-8"))
+    except OSError as exc:
+        raise UserError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
+    return out
+
+
+def check_output(out, source=None) -> Path:
+    """Refuse, in one line, an output that is not an ``.html`` path bearingsim may write: a folder, a
+    link, a file that is not a report bearingsim wrote, the input itself, below a file. Nothing is
+    created here: :func:`report` creates the missing folders when the page is ready."""
+    from bearingsim.outputs import check_replaceable
+
+    out = Path(out)
+    if out.suffix.lower() not in SUFFIXES:
+        raise UserError(f"{out}: report path must end in .html (got {out.suffix or 'no suffix'!r})")
+    if source is not None and out.exists() and Path(source).exists() and out.resolve() == Path(source).resolve():
+        raise UserError(f"{out}: the report path is the input; choose another -o")
+    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise UserError(f"{out.parent}: cannot create the report's folder ({existing} is not a folder)")
+    check_replaceable(out, SIGNATURE, "report")
+    return out
+
+
+def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
+    """The page (text) of ``sections`` from the package's template, every value autoescaped."""
+    import jinja2
+
+    from bearingsim import __version__
+
+    env = jinja2.Environment(loader=jinja2.PackageLoader("bearingsim", "templates"), autoescape=True,
+                             undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
+                             keep_trailing_newline=True)
+    return env.get_template("report.html.j2").render(title=title, source=source, kind=kind, sections=sections,
+                                                     version=__version__)
+
+
+def _sections(kind: str, file: Path, animation) -> tuple[str, list[Section]]:
+    if kind == "run":
+        return _run_sections(file, animation)
+    builders = {"sweep": _sweep_sections, "crosscheck": _crosscheck_sections, "sensitivity": _sensitivity_sections,
+                "uncertainty": _uncertainty_sections, "life": _life_sections}
+    title, sections, toml = builders[kind](file)
+    sections += _folder_sections(file.parent, toml)
+    return title, sections
+
+
+# --- blocks -------------------------------------------------------------------------------------
+def _data_uri(data: bytes, mime: str) -> str:
+    return f"data:{mime};base64,{base64.b64encode(data).decode('ascii')}"
+
+
+def figure_block(fig, caption: str) -> dict:
+    """A matplotlib figure as an embedded PNG."""
+    from bearingsim.plotting import figure_png
+
+    return {"kind": "figure", "src": _data_uri(figure_png(fig), "image/png"), "caption": caption}
+
+
+def drawn_blocks(draw, captions: dict[str, str] | None = None) -> list[dict]:
+    """The PNGs a figure function writes into a folder (``draw(folder) -> [paths]``), drawn into a
+    temporary folder and embedded; ``captions`` by file name."""
+    captions = captions or {}
+    with tempfile.TemporaryDirectory(prefix="bearingsim-report-") as tmp:
+        paths = draw(Path(tmp))
+        return [{"kind": "figure", "src": _data_uri(Path(p).read_bytes(), "image/png"),
+                 "caption": captions.get(Path(p).name, Path(p).stem.replace("_", " "))} for p in paths]
+
+
+def _cell(v, scale: float = 1.0, digits: int = 4) -> str:
+    if isinstance(v, (str, np.str_)):
+        return str(v)
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return str(v)
+    return "-" if not math.isfinite(x) else f"{x * scale:.{digits}g}"
+
+
+def table_block(caption: str, head: list[str], rows: list[list[str]], numeric: list[bool] | None = None,
+                note: str = "") -> dict:
+    """A table: ``rows`` of text cells (at most :data:`MAX_ROWS`, then a note); ``numeric`` columns
+    right-aligned."""
+    numeric = numeric or [False] * len(head)
+    left = len(rows) - MAX_ROWS
+    if left > 0:
+        rows = rows[:MAX_ROWS]
+        note = (note + " " if note else "") + f"{left} more rows are not shown ('bearingsim table' prints them all)."
+    return {"kind": "table", "caption": caption, "head": head, "rows": rows, "numeric": numeric, "note": note}
+
+
+def _summary_table_block(table, caption: str) -> dict:
+    """A :class:`bearingsim.tables.Table` with the columns ``bearingsim table`` shows, standard errors
+    and significance marks included."""
+    from bearingsim import tables
+
+    keys = [k for k in tables.DEFAULT_COLUMNS if k in table.numbers]
+    heads, cols = list(table.label_names), [table.labels[k] for k in table.label_names]
+    for key in keys:
+        head, cells = tables.column_cells(table, key)
+        heads.append(head)
+        cols.append([c.strip() for c in cells])
+    rows = [list(r) for r in zip(*cols)] if cols else []
+    rule = tables.RULE if any(k in tables.SEM_OF for k in keys) else ""
+    return table_block(caption, heads, rows, [False] * len(table.label_names) + [True] * len(keys),
+                       " ".join([*table.notes, rule]).strip())
+
+
+# --- a run archive ------------------------------------------------------------------------------
+def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
+    from bearingsim.simulation import load
+
+    result = load(path)
+    sections = [Section("summary", "Summary", [{"kind": "text", "text": result.title()}, _run_summary(result)]),
+                Section("figures", "Figures", _run_figures(result))]
+    anim = _animation_section(path, animation)
+    if anim is not None:
+        sections.append(anim)
+    sections += [Section("pockets", "Per pocket", [_pocket_table(result)]),
+                 Section("checks", "Plausibility checks", _checks_blocks(result)),
+                 Section("scenario", "Scenario", _scenario_blocks(result.scenario.to_toml(), path)),
+                 Section("provenance", "Provenance", [_provenance_table(result.provenance)])]
+    return f"{result.scenario.name}: {result.description()}", sections
+
+
+def _run_summary(result) -> dict:
+    from bearingsim.stats import result_standard_errors
+
+    units = result.summary_units
+    errors = result_standard_errors(result)
+    rows = [[k, _cell(v, digits=6), units.get(k, "")] for k, v in result.summary.items()]
+    rows += [[k, _cell(v, digits=3), "N s"] for k, v in errors.items()]
+    return table_block("Summary numbers (SI; every number of /results/summary)", ["quantity", "value", "unit"],
+                       rows, [False, True, False],
+                       "The *_sem_Ns rows: standard errors of the means, batch means over rotations "
+                       "(docs/statistics.md).")
+
+
+def _run_figures(result) -> list[dict]:
+    blocks = []
+    for name in result.FIGURES:
+        method = getattr(result, f"plot_{name}")
+        doc = (method.__doc__ or name).strip().splitlines()[0]
+        blocks.append(figure_block(method(), doc))
+    return blocks
+
+
+def _pocket_table(result) -> dict:
+    i_dec, i_acc = (np.asarray(result.per_rotation[k], float) for k in ("I_dec", "I_acc"))
+    n = i_dec.shape[0]
+    with np.errstate(invalid="ignore"):
+        rows = [[str(j), _cell(np.nanmean(i_dec[:, j]), 1e3), _cell(np.nanstd(i_dec[:, j]), 1e3),
+                 _cell(np.nanmean(i_acc[:, j]), 1e3), _cell(np.nanstd(i_acc[:, j]), 1e3)]
+                for j in range(i_dec.shape[1])]
+    return table_block(f"Impulse per cage rotation of each pocket, mean and standard deviation over {n} recorded "
+                       "rotations [mN s]", ["pocket", "I_dec mean", "I_dec std", "I_acc mean", "I_acc std"], rows,
+                       [False, True, True, True, True])
+
+
+def _checks_blocks(result) -> list[dict]:
+    from bearingsim import plausibility
+    from bearingsim.errors import SimulationUnstable
+
+    rows = plausibility.checks_made(result)
+    blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok} for n, m, ok in rows]}]
+    try:
+        notes = plausibility.check(result)
+        verdict = ("Every check passed: 'bearingsim run' writes an archive only for a run that passes them "
+                   "(docs/reliability.md); checked again from this archive.")
+    except SimulationUnstable as exc:
+        notes, verdict = [], f"This archive does NOT pass the checks: {exc}"
+    blocks.append({"kind": "text", "text": verdict})
+    if notes:
+        blocks.append({"kind": "list", "items": [n.removeprefix("bearingsim: note: ") for n in notes]})
+    return blocks
+
+
+def _scenario_blocks(toml: str | None, where) -> list[dict]:
+    if not toml:
+        return [{"kind": "text", "text": f"{where} stores no scenario."}]
+    return [{"kind": "text", "text": f"The resolved scenario (every key), as stored in {where}; save it as a .toml "
+                                     "file to run it again."}, {"kind": "pre", "text": toml}]
+
+
+def _provenance_table(prov: dict, caption: str = "How the run was made") -> dict:
+    rows = [[k, str(v)] for k, v in prov.items() if not k.startswith("version_")]
+    rows += [[k, str(v)] for k, v in prov.items() if k.startswith("version_")]
+    return table_block(caption, ["item", "value"], rows)
+
+
+def _animation_section(archive, fmt: str | None = "gif") -> Section | None:
+    """The archive's animation (:func:`bearingsim.animation.render`) embedded, or None: no ``fmt``, no
+    :mod:`bearingsim.animation` in this installation, or an archive without the bodies' motion."""
+    if fmt is None:
+        return None
+    try:
+        from bearingsim import animation
+    except ImportError:
+        return None
+    if not animation.has_motion(archive):
+        return None
+    mime, element = ANIMATIONS[fmt]
+    with tempfile.TemporaryDirectory(prefix="bearingsim-report-") as tmp:
+        made = animation.render(archive, Path(tmp) / f"animation.{fmt}")
+        data = Path(made).read_bytes()
+    block = {"kind": "animation", "element": element, "mime": mime, "src": _data_uri(data, mime),
+             "caption": "The bearing in motion, from the archive's recorded poses (bearingsim animate; its frame "
+                        "states the clearance exaggeration, the time and the cage slip)."}
+    return Section("animation", "Animation", [block])
+
+
+# --- folders ------------------------------------------------------------------------------------
+def _sweep_sections(index: Path):
+    from bearingsim import tables
+    from bearingsim.sweeps.grid import MAP_NAME, MAP_FORMAT, read_map
+    from bearingsim.sweeps.index import read_index
+    from bearingsim.sweeps.plot import plot_sweep_index, sweep_title
+    from bearingsim import archive
+
+    cols, meta = read_index(index)
+    notes: list[str] = []
+    figures = drawn_blocks(lambda d: plot_sweep_index(index, d, notes=notes))
+    figures += [{"kind": "text", "text": n} for n in notes]
+    keys = ", ".join(meta["axes"]) or "(none)"
+    head = {"kind": "text", "text": f"Base scenario {meta.get('scenario') or '(cases only)'}; swept keys: {keys}; "
+                                    f"mode {meta.get('mode', '?')}."}
+    map_path = index.parent / MAP_NAME
+    toml = read_map(map_path).attrs.get("scenario") if archive.is_grid_file(map_path, MAP_FORMAT) else None
+    sections = [Section("table", "Cases", [head, _summary_table_block(tables.table_of_index(index),
+                                                                      "Summary numbers of every case")]),
+                Section("figures", "Figures", figures)]
+    return sweep_title(meta, len(cols["case"])), sections, toml
+
+
+def _crosscheck_sections(table: Path):
+    from bearingsim.studies import crosscheck as cc
+
+    rows, meta = cc.read_table(table)
+    head = ["rpm", "rung", "scene", "relaxed", "I_dec [mN s]", "I_acc [mN s]", "first impact speed [m/s]",
+            "cage slip", "change of I_dec [mN s]"]
+    cells = [[_cell(r["rpm"]), str(r["rung"]), r["scene"], r["relaxed"], _pm(r["I_dec_mean_Ns"], r["I_dec_sem_Ns"]),
+              _pm(r["I_acc_mean_Ns"], r["I_acc_sem_Ns"]), _cell(r["first_impact_speed_m_s"]), _cell(r["cage_slip"], digits=3),
+              _cell(r["change_from_previous"], 1e3)] for r in rows]
+    blocks = [table_block("Impulses per pocket and cage rotation, mean over all pockets ± batch-means standard "
+                          "error; each rung drops one assumption of the paper's model (docs/crosscheck.md)", head, cells,
+                          [True, True, False, False, True, True, True, True, True]),
+              {"kind": "list", "items": cc.verdicts(rows)}]
+    figures = drawn_blocks(lambda d: cc.plot_crosscheck(table, d))
+    sections = [Section("table", "Cross-check", blocks), Section("figures", "Figures", figures)]
+    return f"Cross-check of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
+
+
+def _pm(mean, sem) -> str:
+    """``mean ± sem`` of an impulse in mN s."""
+    return f"{_cell(mean, 1e3)} ± {_cell(sem, 1e3, 2) if math.isfinite(sem) else 'n/a'}"
+
+
+def _sensitivity_sections(table: Path):
+    from bearingsim.studies import sensitivity as sens
+
+    rows, meta = sens.read_table(table)
+    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range"]
+    cells = [[r["key"], r["quantity"], r["measure"], f"{_cell(r['sensitivity'], digits=3)} ± "
+              f"{_cell(r['sensitivity_se'], digits=2)}", _cell(r["over_range"], digits=3)] for r in rows]
+    blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {meta.get('step', 0):.0%})); log: d ln y / d ln x, "
+                          "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
+                          [False, False, False, True, True])]
+    figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))
+    sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
+    return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
+
+
+def _uncertainty_sections(table: Path):
+    from bearingsim.studies import uncertainty as unc
+
+    rows, spreads, meta = unc.read_table(table)
+    spread = table_block("Each output over the sampled ranges", ["quantity", "median", "5 %", "95 %", "mean", "std",
+                                                                  "runs used"],
+                         [[s["quantity"], *(_cell(s[c]) for c in ("median", "p05", "p95", "mean", "std")),
+                           _cell(s["runs_used"])] for s in spreads], [False] + [True] * 6)
+    ci = f"{unc.CONFIDENCE:.0%}"
+    index = table_block(f"Sobol indices with {ci} bootstrap intervals (docs/sensitivity.md)",
+                        ["quantity", "key", "S1", f"S1 {ci}", "ST", f"ST {ci}"],
+                        [[r["quantity"], r["key"], _cell(r["S1"], digits=3),
+                          f"{_cell(r['S1_low'], digits=3)} .. {_cell(r['S1_high'], digits=3)}", _cell(r["ST"], digits=3),
+                          f"{_cell(r['ST_low'], digits=3)} .. {_cell(r['ST_high'], digits=3)}"] for r in rows],
+                        [False, False, True, True, True, True])
+    figures = drawn_blocks(lambda d: unc.plot_uncertainty(table, d))
+    sections = [Section("table", "Uncertainty", [{"kind": "text", "text": f"{meta.get('samples')} base samples, "
+                                                  f"{meta.get('runs')} runs, seed {meta.get('seed')}."}, spread, index]),
+                Section("figures", "Figures", figures)]
+    return f"Uncertainty of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
+
+
+def _life_sections(table: Path):
+    from bearingsim import archive
+    from bearingsim.studies import life
+
+    cols, attrs = life.read_life(table)
+    units = archive.table_units(table)
+    names = list(cols)
+    head = [n + (f" [{units[n]}]" if units.get(n, "1") != "1" else "") for n in names]
+    rows = [[_cell(cols[n][i]) for n in names] for i in range(len(cols[names[0]]))]
+    blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; {attrs.get('mapping', '')}."},
+              table_block("The life history, one row per stage (docs/wear.md)", head, rows, [True] * len(names))]
+    figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "
+                                                         "running time, stage by stage")]
+    import tomllib
+
+    toml = attrs.get("scenario")
+    name = tomllib.loads(toml).get("name", "?") if toml else "?"
+    sections = [Section("table", "Life", blocks), Section("figures", "Figures", figures)]
+    return f"Life of {name} to {attrs.get('limit', '?')}", sections, toml
+
+
+def _folder_sections(folder: Path, toml) -> list[Section]:
+    """The cases (status counts, failures), the scenario and the provenance of a folder's first case
+    archive."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import INDEX_FORMAT, read_index
+
+    index = folder / "sweep.h5"
+    checks: list[dict] = []
+    first = None
+    if archive.is_table_file(index, INDEX_FORMAT):
+        cols, _ = read_index(index)
+        status = [str(s) for s in cols["status"]]
+        counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
+        checks.append({"kind": "text", "text": f"{len(status)} cases: {counts}. A case's archive is written only when "
+                                               "its run passes the plausibility checks (docs/reliability.md); a "
+                                               "failed case keeps its one-line error:"})
+        failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]
+        if failed:
+            checks.append(table_block("Failed cases", ["case", "error"], failed))
+        first = next((folder / a for a in cols["archive"] if a and (folder / a).is_file()), None)
+    else:  # a life study: its stages' archives
+        first = next(iter(sorted((folder / "stages").glob("stage_*.h5"))), None)
+        checks.append({"kind": "text", "text": "Every stage's archive passed the plausibility checks when it was "
+                                               "written (docs/reliability.md)."})
+    sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario",
+                                                                        _scenario_blocks(toml, folder))]
+    if first is not None:
+        from bearingsim.simulation import load
+
+        prov = load(first, only=("results/summary",)).provenance
+        sections.append(Section("provenance", "Provenance", [
+            _provenance_table(prov, f"How the first case was made ({first.relative_to(folder)}; every case ran with "
+                                    "the same code unless the index's model_version column says otherwise)")]))
+    return sections

@@ -1,0 +1,354 @@
+"""`bearingsim report PATH -o report.html`: one self-contained HTML page, opened in a real browser.
+
+The browser is the distribution's Chromium (/usr/bin/chromium, Debian's package `chromium`) driven by
+playwright; without it these tests FAIL, saying how to install it (the README's test command does).
+"""
+import re
+import sys
+import types
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import bearingsim
+
+from .conftest import ROOT, SCENARIOS
+from .test_cli import assert_user_error, bearingsim as cli
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync"]
+PAPER = SCENARIOS / "paper_3000rpm.toml"
+SCREENSHOT = ROOT / "outputs" / "report_screenshot.png"
+
+
+# --- the browser --------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def browser():
+    """A headless Chromium for the module, or the one line saying why there is none (each test that
+    needs it fails with that line: a missing browser is not a skipped test)."""
+    if not CHROMIUM.is_file():
+        yield (f"{CHROMIUM} not found: the report tests open the page in the distribution's Chromium; install it "
+               f"with 'apt-get install -y chromium' (Debian/Ubuntu; .ci/run does) and run the tests again")
+        return
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError:
+        yield "playwright is not installed: pip install -e '.[test]' (the test extra brings it)"
+        return
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+        try:
+            yield b
+        finally:
+            b.close()
+
+
+def open_page(browser, path: Path, screenshot: Path | None = None) -> dict:
+    """Open ``path`` offline (every request but the file itself refused) and return what it showed:
+    console errors and failed requests, each image's ``naturalWidth``, the animation element's state,
+    the section ids and the contents' link targets."""
+    if isinstance(browser, str):
+        pytest.fail(browser)
+    context = browser.new_context(offline=True, viewport={"width": 1200, "height": 900})
+    page = context.new_page()
+    errors = []
+    page.on("console", lambda m: errors.append(f"console {m.type}: {m.text}") if m.type == "error" else None)
+    page.on("pageerror", lambda e: errors.append(f"page error: {e}"))
+    page.on("requestfailed", lambda r: errors.append(f"request failed: {r.url[:80]}"))
+    page.goto(path.resolve().as_uri(), wait_until="load")
+    seen = page.evaluate("""() => ({
+        images: Array.from(document.images).map(i => ({id: i.id, complete: i.complete, width: i.naturalWidth,
+                                                        src: i.src.slice(0, 22)})),
+        video: (v => v ? {ready: v.readyState, width: v.videoWidth} : null)(document.querySelector('video#animation')),
+        ids: Array.from(document.querySelectorAll('section[id]')).map(s => s.id),
+        toc: Array.from(document.querySelectorAll('nav.toc a')).map(a => a.getAttribute('href')),
+        external: Array.from(document.querySelectorAll('[src],[href]')).map(e => e.getAttribute('src') || e.getAttribute('href'))
+                       .filter(u => !u.startsWith('data:') && !u.startsWith('#')),
+        text: document.body.innerText,
+    })""")
+    if screenshot is not None:
+        screenshot.parent.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(screenshot), full_page=True)
+        pdf = page.pdf(format="A4")  # what the browser's Print to PDF makes of the page (print styles)
+        seen["pdf_pages"] = len(re.findall(rb"/Type\s*/Page[^s]", pdf)) if pdf.startswith(b"%PDF") else 0
+    context.close()
+    seen["errors"] = errors
+    return seen
+
+
+def assert_renders(seen: dict, sections: list[str]) -> None:
+    """No console error, every image decoded, nothing outside the file, the contents linking every section."""
+    assert seen["errors"] == []
+    assert seen["images"], "no figure in the report"
+    assert [i for i in seen["images"] if not (i["complete"] and i["width"] > 0)] == []
+    assert all(i["src"].startswith("data:image/") for i in seen["images"])
+    assert seen["external"] == []
+    assert set(sections) <= set(seen["ids"])
+    assert seen["toc"] == [f"#{s}" for s in seen["ids"]]
+
+
+# --- inputs -------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """A folder with ``r.h5``: a reduced-model archive whose scenario name is markup (it must be shown
+    as text)."""
+    d = tmp_path_factory.mktemp("report")
+    sc = bearingsim.load_scenario(PAPER, set={"name": "<img src=x onerror=alert(1)>"})
+    bearingsim.run(sc).save(d / "r.h5")
+    return d
+
+
+@pytest.fixture(scope="module")
+def whole(runs):
+    """``runs/m.h5``: a whole-bearing archive (6000 rpm, 1 warm-up + 1 rotation)."""
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 1})
+    bearingsim.run(sc).save(runs / "m.h5")
+    return runs / "m.h5"
+
+
+@pytest.fixture
+def no_animation_module(monkeypatch):
+    """This branch's state: no bearingsim.animation (the import fails whatever is installed)."""
+    monkeypatch.setitem(sys.modules, "bearingsim.animation", None)
+
+
+@pytest.mark.slow
+def test_report_of_a_run_archive_renders_in_chromium(whole, browser, tmp_path, no_animation_module):
+    out = bearingsim.report(whole, tmp_path / "m.html")
+    seen = open_page(browser, out, SCREENSHOT)
+    assert_renders(seen, ["summary", "figures", "pockets", "checks", "scenario", "provenance"])
+    assert len(seen["images"]) == len(bearingsim.load(whole).FIGURES) == 4  # forces, impulses, orbit, wear
+    assert SCREENSHOT.stat().st_size > 0
+    assert seen["pdf_pages"] >= 4  # printable: contents, then 6 sections with 4 figures, over several A4 pages
+    text = seen["text"]
+    # the checks of bearingsim run, measured from this archive, every one passed
+    assert "inner-ring displacement within the Palmgren bound" in text and "FAILED" not in text
+    assert text.count("passed") >= 5
+    assert 'name = "multibody_6000rpm"' in text  # the scenario as TOML
+    assert "git_commit" in text and "version_numpy" in text  # the provenance
+
+
+@pytest.mark.slow
+def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path, no_animation_module):
+    """Every value is autoescaped: a name that is an HTML tag adds no element (an unescaped <img src=x>
+    would be an image that fails to load and a script that runs)."""
+    out = bearingsim.report(runs / "r.h5", tmp_path / "r.html")
+    html = out.read_text()
+    assert "<img src=x" not in html and "&lt;img src=x onerror=alert(1)&gt;" in html
+    seen = open_page(browser, out)
+    assert_renders(seen, ["summary", "figures"])
+    assert len(seen["images"]) == 1  # the reduced model's one figure (the pass), no injected image
+    assert "<img src=x onerror=alert(1)>" in seen["text"]
+
+
+def _fake_animation(gif: bytes, calls: list):
+    """A stand-in for bearingsim.animation (a separate module, absent on a checkout without it):
+    ``has_motion`` and ``render`` with its signature, writing ``gif``."""
+    mod = types.ModuleType("bearingsim.animation")
+    mod.has_motion = lambda path: True
+
+    def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None):
+        calls.append((Path(path), Path(out)))
+        Path(out).write_bytes(gif)
+        return Path(out)
+
+    mod.render = render
+    return mod
+
+
+def _gif(frames=3, size=(40, 30)) -> bytes:
+    import io
+
+    from PIL import Image
+
+    ims = [Image.new("RGB", size, (60 * k, 120, 200)) for k in range(frames)]
+    buf = io.BytesIO()
+    ims[0].save(buf, format="GIF", save_all=True, append_images=ims[1:], duration=100, loop=0)
+    return buf.getvalue()
+
+
+@pytest.mark.slow
+def test_the_animation_is_embedded_and_loads(whole, browser, tmp_path, monkeypatch):
+    """The archive's animation, made by bearingsim.animation.render (here a stand-in writing a 3-frame
+    40 x 30 GIF), is embedded in its own section and decodes in the browser at its size."""
+    calls = []
+    monkeypatch.setitem(sys.modules, "bearingsim.animation", _fake_animation(_gif(), calls))
+    out = bearingsim.report(whole, tmp_path / "a.html")
+    assert [c[0] for c in calls] == [whole] and calls[0][1].suffix == ".gif"
+    seen = open_page(browser, out)
+    assert_renders(seen, ["summary", "figures", "animation"])
+    anim = [i for i in seen["images"] if i["id"] == "animation"]
+    assert anim == [{"id": "animation", "complete": True, "width": 40, "src": "data:image/gif;base64,"}]
+    assert not list(tmp_path.glob(".*tmp*"))
+
+
+@pytest.mark.slow
+def test_without_the_animation_module_there_is_no_animation_section(runs, tmp_path, no_animation_module):
+    from bearingsim.reports import _animation_section
+
+    assert _animation_section(runs / "r.h5") is None
+    html = bearingsim.report(runs / "r.h5", tmp_path / "r.html").read_text()
+    assert 'id="animation"' not in html
+
+
+def test_an_archive_without_motion_has_no_animation_section(runs, monkeypatch):
+    from bearingsim.reports import _animation_section
+
+    calls = []
+    mod = _fake_animation(_gif(), calls)
+    mod.has_motion = lambda path: False
+    monkeypatch.setitem(sys.modules, "bearingsim.animation", mod)
+    assert _animation_section(runs / "r.h5") is None and calls == []
+    monkeypatch.setattr(mod, "has_motion", lambda path: True)
+    section = _animation_section(runs / "r.h5", "mp4")
+    assert section.blocks[0]["element"] == "video" and section.blocks[0]["src"].startswith("data:video/mp4;base64,")
+
+
+@pytest.mark.slow
+def test_the_same_archive_gives_the_same_bytes(runs, tmp_path, no_animation_module):
+    a = bearingsim.report(runs / "r.h5", tmp_path / "a.html").read_bytes()
+    b = bearingsim.report(runs / "r.h5", tmp_path / "b.html").read_bytes()
+    assert a == b
+
+
+# --- folders ------------------------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def folders(tmp_path_factory):
+    """A reduced-model sweep (2 speeds, archives kept), sensitivity and uncertainty study (2 keys; N = 2:
+    8 runs), run; a cross-check and a life table written by their own writers from given rows (their
+    runs take minutes)."""
+    d = tmp_path_factory.mktemp("folders")
+    res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "--archives", "all",
+              "-o", d / "sweep", "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    res = cli("sensitivity", PAPER, "--keys", "contact.restitution,lubrication.drag_coefficient", "-o", d / "sens",
+              "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    res = cli("uncertainty", PAPER, "--keys", "contact.restitution,lubrication.drag_coefficient", "--samples", "2",
+              "-o", d / "unc", "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    _crosscheck_table(d / "cc")
+    _life_table(d / "life")
+    return d
+
+
+def _crosscheck_table(folder: Path) -> None:
+    from bearingsim.studies import crosscheck as cc
+
+    folder.mkdir()
+    rows = [{"rpm": 3000.0, "rung": k, "scene": scene, "relaxed": what, "I_dec_mean_Ns": 5e-3 * k,
+             "I_dec_sem_Ns": 2e-4, "I_acc_mean_Ns": 3e-3, "I_acc_sem_Ns": 1e-4, "first_impact_speed_m_s": 0.1,
+             "cage_slip": 0.01, "archive": "", "wall_s": 1.0, "status": "done", "error": ""}
+            for k, scene, what in cc.RUNGS]
+    cc.write_table(folder, cc.add_changes(rows), bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
+
+
+def _life_table(folder: Path) -> None:
+    from bearingsim import archive
+    from bearingsim.studies import life
+
+    folder.mkdir()
+    n = 3
+    cols = {"stage": np.arange(n), "pocket_clearance_mm": [0.2, 0.21, 0.22], "stage_rotations": [1e6] * n,
+            "rotations_end": [1e6, 2e6, 3e6], "hours_end": [10.0, 20.0, 30.0], "max_depth_rate_um_per_h": [1.0] * n,
+            "max_volume_rate_mm3_per_h": [1e-3] * n, "max_depth_um": [10.0, 20.0, 30.0],
+            "max_volume_mm3": [0.01, 0.02, 0.03], "clearance_end_mm": [0.21, 0.22, 0.23],
+            "I_dec_mean_mNs": [14.0] * n, "reused": [0] * n}
+    archive.write_table_file(folder / "life.h5", {k: np.asarray(v) for k, v in cols.items()}, life.LIFE_UNITS, {
+        "format": life.LIFE_FORMAT, "limit": "clearance=0.23mm", "stages": n,
+        "scenario": bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml").to_toml(), "mapping": "test rows"})
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name, kind, words", [
+    ("sweep", "sweep", ["inner_ring_speed_rpm", "2 cases: done 2", "I_dec_mean [mN s]"]),
+    ("sens", "sensitivity", ["contact.restitution", "lubrication.drag_coefficient", "d ln y / d ln x"]),
+    ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
+    ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),
+    ("life", "life", ["clearance=0.23mm", "max_depth_um [um]"]),
+])
+def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name, kind, words):
+    from bearingsim.reports import kind_of
+
+    assert kind_of(folders / name)[0] == kind
+    res = cli("report", folders / name, "-o", tmp_path / f"{name}.html")
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == f"wrote {tmp_path / f'{name}.html'}"
+    seen = open_page(browser, tmp_path / f"{name}.html")
+    assert_renders(seen, ["table", "figures", "checks", "scenario"])
+    for w in words:
+        assert w in seen["text"], w
+
+
+@pytest.mark.slow
+def test_a_table_file_reports_its_folder(folders):
+    from bearingsim.reports import kind_of
+
+    assert kind_of(folders / "sens" / "sensitivity.h5") == ("sensitivity", folders / "sens" / "sensitivity.h5")
+    assert kind_of(folders / "sens" / "sweep.h5") == ("sweep", folders / "sens" / "sweep.h5")
+
+
+# --- refusals -----------------------------------------------------------------------------------
+@pytest.mark.slow
+def test_not_a_bearingsim_path_is_one_line(tmp_path):
+    (tmp_path / "notes.txt").write_text("hello")
+    assert_user_error(cli("report", tmp_path, "-o", tmp_path / "r.html"), str(tmp_path), "not a bearingsim archive")
+    assert_user_error(cli("report", tmp_path / "notes.txt", "-o", tmp_path / "r.html"), "notes.txt")
+    assert_user_error(cli("report", tmp_path / "missing.h5", "-o", tmp_path / "r.html"), "not found")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]  # nothing written
+
+
+@pytest.mark.slow
+def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
+    src = runs / "r.h5"
+    user = tmp_path / "mine.html"
+    user.write_text("<html>my own page</html>")
+    assert_user_error(cli("report", src, "-o", user), "mine.html", "not replaced")
+    assert user.read_text() == "<html>my own page</html>"
+    assert_user_error(cli("report", src, "-o", tmp_path / "r.pdf"), "must end in .html")
+    (tmp_path / "dir.html").mkdir()
+    assert_user_error(cli("report", src, "-o", tmp_path / "dir.html"), "dir.html", "directory")
+    assert_user_error(cli("report", src, "-o", user / "sub" / "r.html"), "cannot create the report's folder")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.html", "mine.html"]
+
+
+@pytest.mark.slow
+def test_a_report_replaces_its_own_earlier_report(runs, tmp_path, no_animation_module):
+    out = tmp_path / "r.html"
+    bearingsim.report(runs / "r.h5", out)
+    first = out.stat().st_mtime_ns
+    bearingsim.report(runs / "r.h5", out)
+    assert out.stat().st_mtime_ns >= first and out.read_bytes().startswith(b"<!DOCTYPE html>\n<!-- bearingsim report")
+    assert [p.name for p in tmp_path.iterdir()] == ["r.html"]  # no temporary file left
+
+
+def test_the_template_ships_with_the_package():
+    """pyproject's package-data names the templates: every file in bearingsim/templates matches it (a
+    wheel without the template would fail at the first report)."""
+    import fnmatch
+    import tomllib
+
+    meta = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    patterns = meta["tool"]["setuptools"]["package-data"]["bearingsim"]
+    files = [p.relative_to(ROOT / "bearingsim").as_posix() for p in (ROOT / "bearingsim" / "templates").iterdir()]
+    assert files and all(any(fnmatch.fnmatch(f, pat) for pat in patterns) for f in files)
+    assert "jinja2>=3.1" in meta["project"]["dependencies"]
+    assert any(d.startswith("playwright") for d in meta["project"]["optional-dependencies"]["test"])
+
+
+def test_a_check_that_fails_is_shown_as_failed(runs):
+    """The checks table is measured, not a list of labels: an archive read back with a non-finite
+    impulse (a crafted file: bearingsim run writes none) shows that check FAILED and says the archive
+    does not pass, with the reason plausibility.check gives."""
+    from bearingsim.reports import _checks_blocks
+
+    result = bearingsim.load(runs / "r.h5")
+    rows = _checks_blocks(result)[0]["rows"]
+    assert [r["passed"] for r in rows] == [True, True]
+    result.per_rotation["I_dec"][...] = np.nan  # the arrays of the result, as a damaged archive would give
+    blocks = _checks_blocks(result)
+    assert [(r["name"], r["passed"]) for r in blocks[0]["rows"]] == [("summary numbers finite", True),
+                                                                      ("I_dec and I_acc per rotation finite", False)]
+    assert blocks[1]["text"].startswith("This archive does NOT pass the checks: non-finite I_dec per rotation")

@@ -120,7 +120,7 @@ def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
     """The page (text) of ``sections`` from the package's template, every value autoescaped."""
     import jinja2
 
-    from bearingsim import __version__
+    from bearingsim._version import __version__
 
     env = jinja2.Environment(loader=jinja2.PackageLoader("bearingsim", "templates"), autoescape=True,
                              undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,

@@ -127,7 +127,8 @@ TANGENT_HALF_LENGTH = 0.05
 
 def build_scene(geometry, op, restitution: float, cage_friction: float, *, extent: tuple[float, float],
                 n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
-                flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None) -> Scene:
+                flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None,
+                worn=None) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
 
     Parameters
@@ -149,6 +150,9 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
         ``pymunk.SlideJoint`` from 0 to ``rigid_radius`` to a static anchor at the axis). pymunk solves it
         with the roller-cage contacts, so a cage pushing a roller outward meets the raceway in the same
         step; a roller pulled inward leaves it.
+    worn : (n, 2, bins) worn depth of each pocket's (front, rear) face [m], or None. Arc faces take it in
+        the step loop (:func:`bearingsim.multibody.loop.worn_contact`); a flat face is moved outwards by
+        its mean worn depth (a plane stays a plane: a uniform shift).
     """
     n = geometry.roller_count
     rr = geometry.roller_radius
@@ -212,7 +216,8 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
         verts.append([])
         for f, direction in enumerate((e_t, -e_t)):  # front, rear
             if i in flat:
-                pts = np.array([c + R * direction - R * e_r, c + R * direction + R * e_r])
+                off = R + (float(np.mean(worn[i, f])) if worn is not None else 0.0)
+                pts = np.array([c + off * direction - R * e_r, c + off * direction + R * e_r])
             elif exact:
                 pts = face_tangent(c, direction, e_r, R, extent)
             else:

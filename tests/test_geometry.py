@@ -268,3 +268,24 @@ def test_zero_worn_depth_is_the_unworn_run_bit_for_bit():
         assert repr(a.summary[k]) == repr(b.summary[k]), k
     for k in a.per_rotation:
         assert np.array_equal(a.per_rotation[k], b.per_rotation[k], equal_nan=True), k
+
+
+def test_a_worn_flat_face_is_shifted_by_its_mean_worn_depth():
+    """A flat face (the rig's pocket 0) stays a plane: worn, it moves outwards along e_t by the mean of its
+    worn-depth row (a uniform shift), to rounding of sums of numbers of order 0.05 m (1e-15 m)."""
+    p = si(load_scenario(MB))
+    n = p.bearing.roller_count
+    worn = np.zeros((n, 2, 32))
+    worn[0, 0] = np.linspace(0.0, 40e-6, 32)  # front face, mean 20 um
+    worn[0, 1, :4] = 8e-6  # rear face, mean 1 um
+    extent = (-math.radians(33.0), math.radians(26.0))
+    plain = build_scene(p.bearing, p.operating, 0.8, 0.1, extent=extent, n_seg=0, kinematic_cage=False,
+                        spin_free=True, flat_pockets=(0,))
+    sc = build_scene(p.bearing, p.operating, 0.8, 0.1, extent=extent, n_seg=0, kinematic_cage=False,
+                     spin_free=True, flat_pockets=(0,), worn=worn)
+    for f, mean in ((0, 20e-6), (1, 1e-6)):
+        u, _ = _frame(p, sc, 0, f)
+        moved = sc.face_vertices[0][f] - plain.face_vertices[0][f]
+        np.testing.assert_allclose(moved, np.outer([1.0, 1.0], mean * u), rtol=0, atol=1e-15)
+    for i in range(1, n):  # arc pockets: their segments are placed by the step loop
+        np.testing.assert_array_equal(sc.face_segments[i], plain.face_segments[i])

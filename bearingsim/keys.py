@@ -18,7 +18,7 @@ from bearingsim.sweeps.index import unit_of
 DEFAULT_SOURCES = {
     "multibody.traction_mu_max": "EHL traction of mineral oils (Johnson & Tevaarwerk 1977)",
     "multibody.traction_slip_ref": "EHL traction of mineral oils (Johnson & Tevaarwerk 1977)",
-    "wear.wear_coefficient": "Archard & Hirst 1956, 60/40 brass on tool steel",
+    "wear.wear_coefficient": "Rabinowicz 1981: unlike metals, boundary lubrication (log-middle)",
     "wear.hardness_Pa": "high-strength brass, ~HV 150",
     "contact.land_friction": "reconstructed: equal to the roller-cage friction (brass on steel)",
     "bearing.cage_guidance": "the paper's roller-guided cage",
@@ -47,6 +47,13 @@ class KeyInfo:
     plausible: str = ""
 
 
+def _type_name(arg) -> str:
+    """``int``, ``list of int``, ``list of list of float``."""
+    if typing.get_origin(arg) is list:
+        return "list of " + _type_name(typing.get_args(arg)[0])
+    return getattr(arg, "__name__", str(arg))
+
+
 def _kind(field) -> str:
     """Type and bounds of a pydantic field: ``int >= 1``, ``"full" | "rigid"``, ``float > 0 | "auto"``."""
     parts = []
@@ -56,7 +63,7 @@ def _kind(field) -> str:
         elif arg is type(None):
             continue  # optional: said by the default "(unset)"
         else:
-            parts.append(getattr(arg, "__name__", str(arg)).replace("list", "list of int"))
+            parts.append(_type_name(arg))
     bounds = [f"{op} {getattr(m, name):g}" for m in field.metadata for name, op in _OPS
               if getattr(m, name, None) is not None]
     if bounds:

@@ -134,10 +134,13 @@ class MultibodyOptions:
 
 @dataclass(frozen=True)
 class Wear:
-    """Archard wear of the cage: V = k W L / H."""
+    """Archard wear of the cage: V = k W L / H; and the depth the pocket faces have worn already."""
 
     wear_coefficient: float  # k [-]
     hardness: float  # H [Pa]
+    #: worn depth of each pocket's (front, rear) face per bin of psi, equal bins over the faces' extent
+    #: ``[pocket][face][bin]`` [m]; None: unworn faces (docs/wear.md, "Worn faces")
+    worn_depth: tuple[tuple[tuple[float, ...], ...], ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -215,7 +218,7 @@ class Parameters:
             raceway_contact=mb.raceway_contact,
         )
         wear = Wear(wear_coefficient=float(scenario.wear.wear_coefficient),
-                    hardness=float(scenario.wear.hardness_Pa))
+                    hardness=float(scenario.wear.hardness_Pa), worn_depth=_worn_depth(scenario.wear))
         return cls(name=scenario.name, model=scenario.model, bearing=bearing, operating=operating,
                    contact=contact, numerics=numerics, reduced=reduced, multibody=multibody, wear=wear)
 
@@ -250,3 +253,15 @@ def _face_extent(half_angle_deg, bearing: Bearing) -> tuple[float, float]:
         return laws.pocket_face_extent(bearing.pitch_radius, bearing.roller_radius + 0.5 * bearing.pocket_clearance,
                                        bearing.cage_inner_radius, bearing.cage_outer_radius)
     return (math.nan, math.nan)
+
+
+def _worn_depth(w) -> tuple | None:
+    """``[pocket][face (front, rear)][bin]`` worn depth [m] of a scenario's ``[wear]`` section (a face not
+    given is unworn); None when neither face is given or every depth is 0 (the unworn faces' code path)."""
+    rows = [v for v in (w.worn_depth_front_um, w.worn_depth_rear_um) if v is not None]
+    if not rows or not any(x > 0.0 for v in rows for row in v for x in row):
+        return None
+    zero = [[0.0] * len(row) for row in rows[0]]
+    front = w.worn_depth_front_um if w.worn_depth_front_um is not None else zero
+    rear = w.worn_depth_rear_um if w.worn_depth_rear_um is not None else zero
+    return tuple((tuple(x * 1e-6 for x in f), tuple(x * 1e-6 for x in r)) for f, r in zip(front, rear))

@@ -71,9 +71,13 @@ DEFAULTS: dict[str, dict[str, Any]] = {
         # from the quasi-static distribution: dt set by the roller-cage impacts; docs/fast_scene.md)
         "raceway_contact": "hertz",
     },
-    # Archard & Hirst (1956), Proc. R. Soc. A 236:397, Table 1: 60/40 brass on tool steel,
-    # k = 6e-4; high-strength brass hardness ~HV 150 -> 1.5e9 Pa.
-    "wear": {"wear_coefficient": 6.0e-4, "hardness_Pa": 1.5e9},
+    # Archard's k of brass on steel under boundary lubrication (a grease-lubricated cage pocket): 5e-6,
+    # the middle on a log scale of 3e-7..1e-4, Rabinowicz's adhesive wear coefficients of unlike metals
+    # between "average" and "poor" lubrication (Rabinowicz 1981, J. Lubr. Technol. 103:188; the range and
+    # what of it was read: the preset's [source.wear.wear_coefficient]). Dry, 60/40 brass on tool steel
+    # gives 6e-4 (Archard & Hirst 1956, Proc. R. Soc. A 236:397). High-strength brass hardness ~HV 150
+    # -> 1.5e9 Pa.
+    "wear": {"wear_coefficient": 5.0e-6, "hardness_Pa": 1.5e9},
 }
 
 PRESET_DIR = "params"
@@ -120,6 +124,10 @@ ISO76_C0_FACTOR = 44.0
 # steel, are ~1e-2 (Archard 1953, J. Appl. Phys. 24:981, Table 1: 7e-3); lubricated contacts are
 # 1e-6..1e-9. 0.1 leaves an order of magnitude above any measurement.
 MAX_WEAR_COEFFICIENT = 0.1
+# Bins of psi of a worn-depth profile (wear.worn_depth_*_um): the step loop interpolates it per contact;
+# the recorded wear profile has 32 (~1.8 deg each), and 1000 (~0.06 deg, 7 um of the reference pocket's
+# arc) is finer than any profilometer trace of a cage pocket.
+MAX_WORN_BINS = 1000
 # Radial (diametral, operating) clearance: the largest standard group of a cylindrical roller bearing,
 # ISO 5753-1 C5, is a few tenths of a per cent of the bore, 1..2 % of the roller diameter (0.1..0.2 mm
 # for the NU214's 13 mm rollers). 5 % of the roller diameter leaves room for a worn or special bearing;
@@ -239,6 +247,10 @@ class MultibodySection(_Section):
 class WearSection(_Section):
     wear_coefficient: float = Field(ge=0.0)
     hardness_Pa: float = Field(gt=0.0)
+    # the depth each pocket face has worn already (multibody model, exact arc faces): one row of equal
+    # bins of psi over the face's extent per pocket; unset: unworn (docs/wear.md, "Worn faces")
+    worn_depth_front_um: list[list[float]] | None = None
+    worn_depth_rear_um: list[list[float]] | None = None
 
 
 class RangeEntry(_Section):
@@ -940,6 +952,7 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
         _check_land(m, source)
     if m.model == "multibody":
         _check_pocket_faces(m, source)
+    _check_worn(m, source)
     if m.model == "multibody" and not land and (m.multibody.pocket_shape == "flat" or len(set(flat)) == b.roller_count):
         raise UserError(
             f"{source}: multibody.pocket_shape: with every pocket flat nothing guides the roller-guided cage "
@@ -949,6 +962,40 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
     if m.reduced.load_zone_half_angle_deg != "auto" and m.model == "reduced":
         if m.reduced.load_zone_half_angle_deg >= 180.0:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")
+
+
+def _check_worn(m: ScenarioModel, source: str) -> None:
+    """A worn-depth profile (``wear.worn_depth_front_um``, ``_rear_um``): the multibody model with exact arc
+    faces, one row per pocket, rows of equal length (the bins of psi), depths >= 0, and a cage bar that
+    is not worn through (the deepest front plus the deepest rear depth below the bar's width)."""
+    w = m.wear
+    given = [(k, v) for k, v in (("worn_depth_front_um", w.worn_depth_front_um),
+                                 ("worn_depth_rear_um", w.worn_depth_rear_um)) if v is not None]
+    if not given:
+        return
+    key = f"wear.{given[0][0]}"
+    if m.model != "multibody":
+        raise UserError(f"{source}: {key}: worn pocket faces need the whole bearing (model = \"multibody\"); the "
+                        f"reduced model has no shape of the pocket faces")
+    if m.multibody.pocket_face_segments != 0:
+        raise UserError(f"{source}: {key}: worn faces need the exact arc faces (multibody.pocket_face_segments = 0)")
+    b = m.bearing
+    bins = {len(row) for _, v in given for row in v}
+    for k, v in given:
+        if len(v) != b.roller_count:
+            raise UserError(f"{source}: wear.{k}: {len(v)} rows; give one per pocket ({b.roller_count}, "
+                            f"bearing.roller_count)")
+    if len(bins) != 1 or not 1 <= min(bins) <= MAX_WORN_BINS:
+        raise UserError(f"{source}: {key}: every row (both faces) must have the same number of bins of psi, "
+                        f"1 to {MAX_WORN_BINS} (got {sorted(bins)[:4]})")
+    for k, v in given:
+        if min(min(row) for row in v) < 0.0:
+            raise UserError(f"{source}: wear.{k}: a worn depth is negative; wear only removes material")
+    deepest = sum(max(max(row) for row in v) for _, v in given) * 1e-3
+    bar = b.pitch_diameter_mm * math.sin(math.pi / b.roller_count) - b.roller_diameter_mm - b.pocket_clearance_mm
+    if deepest >= bar:
+        raise UserError(f"{source}: {key}: the deepest front and rear worn depths ({deepest:.4g} mm together) "
+                        f"reach the cage bar's width ({bar:.4g} mm): the bar would be worn through")
 
 
 def _most_pockets(width_mm: float, pitch_mm: float) -> int:

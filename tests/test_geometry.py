@@ -34,10 +34,12 @@ def _scene(extent=(-math.radians(33.0), math.radians(26.0)), sign=1):
     return p, sc
 
 
-def _place(p, sc, i, d):
+def _place(p, sc, i, d, worn=None, ends_out=None):
     """Put roller ``i`` at pocket centre + d (cage at rest at angle 0: cage frame = world frame), place
     the exact faces as the step loop does (``h`` = 0: positions as they are) and return the pymunk
-    contact of the roller with each of its two faces, (front, rear), None where they do not touch."""
+    contact of the roller with each of its two faces, (front, rear), None where they do not touch.
+    ``worn``: (n, 2, bins) worn depth of the (front, rear) faces [m]; ``ends_out``: receives the placed
+    segments (n, 2, 4)."""
     n = p.bearing.roller_count
     state = np.zeros((n + 1, 6))
     for k, b in enumerate(sc.rollers):
@@ -45,8 +47,8 @@ def _place(p, sc, i, d):
         state[k, 0:2] = sc.pocket_centres[k]
     state[i, 0:2] = sc.pocket_centres[i] + np.asarray(d)
     sc.rollers[i].position = tuple(state[i, 0:2])
-    af = arc_faces(sc, p.bearing.roller_radius, p.operating.sign)._replace(near2=0.0)
-    ends = np.zeros((n, 2, 4))
+    af = arc_faces(sc, p.bearing.roller_radius, p.operating.sign, worn)._replace(near2=0.0)
+    ends = np.zeros((n, 2, 4)) if ends_out is None else ends_out
     todo = np.zeros((n, 2), dtype=np.bool_)
     lp.arc_faces(state, 0.0, af, ends, todo)
     roller = next(iter(sc.rollers[i].shapes))
@@ -181,3 +183,108 @@ def test_exact_faces_reach_the_fine_polyline_s_limit():
         res[n_seg] = float(run(si(sc)).win["I_dec"].sum())
     assert abs(res[0] - res[15]) < abs(res[3] - res[15])
     assert res[0] == pytest.approx(res[15], rel=0.10)
+
+
+# --- worn faces ---------------------------------------------------------------------------------------
+def _worn(n, face, i, row):
+    """(n, 2, bins) worn depth: ``row`` [m] on face ``face`` (0 front, 1 rear) of pocket ``i``, else 0."""
+    w = np.zeros((n, 2, len(row)))
+    w[i, face] = row
+    return w
+
+
+@pytest.mark.parametrize("face", [0, 1])
+@pytest.mark.parametrize("psi_deg", [0.0, 15.0, -25.0])
+def test_a_uniformly_worn_face_moves_the_contact_outwards_by_w(face, psi_deg):
+    """A face worn uniformly by w = 30 um is the pocket circle of radius R + w on that face: a roller at
+    angle psi pressed 1 um into it has pymunk's contact with normal d/|d| and depth |d| - (s/2 + w)
+    (the same rounding tolerances as the unworn face's test: 1e-12, 1e-15 m); at |d| = s/2 + w - 1 um,
+    where it would be 29 um into the unworn face, it touches nothing; the other face is not touched."""
+    p, sc = _scene()
+    n, i, w = p.bearing.roller_count, 3, 30e-6
+    half_s = 0.5 * p.bearing.pocket_clearance
+    u, e_r = _frame(p, sc, i, face)
+    psi = math.radians(psi_deg)
+    direction = math.cos(psi) * u + math.sin(psi) * e_r
+    worn = _worn(n, face, i, np.full(32, w))
+    got = _place(p, sc, i, (half_s + w + 1e-6) * direction, worn)
+    cps = got[face]
+    assert cps is not None and got[1 - face] is None and len(cps.points) == 1
+    assert np.allclose(np.array(cps.normal), direction, atol=1e-12, rtol=0.0)
+    assert -cps.points[0].distance == pytest.approx(1e-6, abs=1e-15)
+    assert _place(p, sc, i, (half_s + w - 1e-6) * direction, worn) == [None, None]
+
+
+def test_a_worn_profile_puts_the_contact_on_the_nearest_worn_line():
+    """A face with a worn profile w(psi) (a groove 40 um deep around psi = -10 deg, 5 um at the middle,
+    linear between bin centres): the roller touches the face's tangent line nearest to it, the support
+    line h(psi) = R + w(psi) minimising g(psi) = h(psi) - d . u(psi). Checked against a brute-force
+    minimum of g over 200001 angles of the extent (its grid error, rho dpsi^2 / 2 with rho <= 0.2 mm and
+    dpsi = 5e-6 rad, is below 1e-14 m; 1e-12 m allowed): the placed segment's distance from the roller's
+    centre is that minimum and its normal the direction of the minimising psi (1e-6 rad: the brute-force
+    grid's spacing), for roller directions on and off the groove."""
+    p, sc = _scene()
+    n, i, face = p.bearing.roller_count, 6, 1
+    lo, hi = sc.extent
+    R, half_s = sc.pocket_radius, 0.5 * p.bearing.pocket_clearance
+    centres = lo + (hi - lo) * (np.arange(32) + 0.5) / 32
+    row = 5e-6 + 35e-6 * np.exp(-((centres - math.radians(-10.0)) / math.radians(4.0)) ** 2)
+    worn = _worn(n, face, i, row)
+    u, e_r = _frame(p, sc, i, face)
+    grid = np.linspace(lo, hi, 200001)
+    h = R + np.interp(grid, centres, row)  # constant beyond the end bins' centres, as the step loop
+    for psi_deg, rho in ((0.0, half_s), (-10.0, half_s + 30e-6), (-4.0, half_s + 20e-6), (20.0, 0.6 * half_s)):
+        psi = math.radians(psi_deg)
+        d = rho * (math.cos(psi) * u + math.sin(psi) * e_r)
+        ends = np.zeros((n, 2, 4))
+        _place(p, sc, i, d, worn, ends)
+        a, b = ends[i, face, 0:2] - sc.pocket_centres[i], ends[i, face, 2:4] - sc.pocket_centres[i]
+        t = (b - a) / np.linalg.norm(b - a)
+        normal = np.array([t[1], -t[0]])
+        normal = normal if normal @ a > 0 else -normal  # outward, from the pocket centre
+        g = h - rho * np.cos(grid - psi)  # d . u(psi') = rho cos(psi' - psi)
+        k = int(np.argmin(g))
+        assert (a - d) @ normal == pytest.approx(g[k], abs=1e-12)
+        assert a @ normal == pytest.approx(h[k], abs=1e-12)
+        got_psi = math.atan2(normal @ e_r, normal @ u)
+        assert got_psi == pytest.approx(grid[k], abs=1e-6)
+
+
+def test_zero_worn_depth_is_the_unworn_run_bit_for_bit():
+    """A scenario that gives a worn depth of 0 on every face runs the unworn faces' code (no worn depth
+    in its parameters) and gives every summary number and per-rotation array of the run without it, bit
+    for bit (fast scene at 6000 rpm, 1 recorded rotation)."""
+    from bearingsim import run
+
+    base = load_scenario(SCENARIOS / "wear_test_6000rpm.toml", ["multibody.raceway_contact=rigid",
+                                                                "numerics.rotations=1"])
+    zero = [[0.0] * 32 for _ in range(base.bearing.roller_count)]
+    worn = base.replace(**{"wear.worn_depth_front_um": zero, "wear.worn_depth_rear_um": zero})
+    assert si(worn).wear.worn_depth is None
+    a, b = run(base), run(worn)
+    assert a.summary.keys() == b.summary.keys()
+    for k in a.summary:
+        assert repr(a.summary[k]) == repr(b.summary[k]), k
+    for k in a.per_rotation:
+        assert np.array_equal(a.per_rotation[k], b.per_rotation[k], equal_nan=True), k
+
+
+def test_a_worn_flat_face_is_shifted_by_its_mean_worn_depth():
+    """A flat face (the rig's pocket 0) stays a plane: worn, it moves outwards along e_t by the mean of its
+    worn-depth row (a uniform shift), to rounding of sums of numbers of order 0.05 m (1e-15 m)."""
+    p = si(load_scenario(MB))
+    n = p.bearing.roller_count
+    worn = np.zeros((n, 2, 32))
+    worn[0, 0] = np.linspace(0.0, 40e-6, 32)  # front face, mean 20 um
+    worn[0, 1, :4] = 8e-6  # rear face, mean 1 um
+    extent = (-math.radians(33.0), math.radians(26.0))
+    plain = build_scene(p.bearing, p.operating, 0.8, 0.1, extent=extent, n_seg=0, kinematic_cage=False,
+                        spin_free=True, flat_pockets=(0,))
+    sc = build_scene(p.bearing, p.operating, 0.8, 0.1, extent=extent, n_seg=0, kinematic_cage=False,
+                     spin_free=True, flat_pockets=(0,), worn=worn)
+    for f, mean in ((0, 20e-6), (1, 1e-6)):
+        u, _ = _frame(p, sc, 0, f)
+        moved = sc.face_vertices[0][f] - plain.face_vertices[0][f]
+        np.testing.assert_allclose(moved, np.outer([1.0, 1.0], mean * u), rtol=0, atol=1e-15)
+    for i in range(1, n):  # arc pockets: their segments are placed by the step loop
+        np.testing.assert_array_equal(sc.face_segments[i], plain.face_segments[i])

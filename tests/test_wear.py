@@ -172,8 +172,8 @@ def test_limit_parsing():
 
 
 def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
-    """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the clearance
-    grows stage by stage, the running time grows, the last stage ends at the limit; the same command
+    """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the effective
+    clearance grows stage by stage, each stage runs with the worn depth of the stages before it, the running time grows, the last stage ends at the limit; the same command
     again reuses every stage's archive and gives the same history bit for bit."""
     from bearingsim.studies.life import parse_limit, run_life
 
@@ -184,6 +184,19 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
     assert np.all(cols["stage_rotations"] > 0)
     assert cols["clearance_end_mm"][-1] == pytest.approx(0.203, rel=1e-9)
     assert np.all(cols["reused"] == 0)
+    # the worn shape is fed back: stage j runs with the depth accumulated by stages 0..j-1 on each face,
+    # per pocket and bin of psi (rounded to 1e-6 um in its scenario); stage 0 with none
+    from bearingsim.simulation import load
+
+    assert load(tmp_path / "stages" / "stage_00.h5").scenario.wear.worn_depth_front_um is None
+    for j in (1, 2):
+        w = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario.wear
+        for f in ("front", "rear"):
+            np.testing.assert_allclose(np.array(getattr(w, f"worn_depth_{f}_um")).T, cols[f"worn_depth_{f}_um"][j - 1],
+                                       rtol=0, atol=5e-7)
+    assert np.all(np.diff(cols["worn_depth_rear_um"], axis=0) >= 0) and cols["worn_depth_rear_um"][-1].max() > 0
+    assert cols["max_depth_um"][-1] == pytest.approx(max(cols["worn_depth_front_um"][-1].max(),
+                                                         cols["worn_depth_rear_um"][-1].max()), rel=1e-12)
     again = run_life(sc, tmp_path, lim, stages=3, rotations=1)
     assert np.all(again["reused"] == 1)
     for k in cols:
@@ -239,3 +252,23 @@ def test_life_keeps_a_users_file_in_its_folder(tmp_path, capsys, name):
     assert code == 2 and name in err and "not replaced" in err and len(err.strip().splitlines()) == 1
     assert (tmp_path / name).read_text() == "my notes"
     assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+
+
+# --- worn faces in the scenario -------------------------------------------------------------------------
+@pytest.mark.parametrize("over, words", [
+    ({"wear.worn_depth_front_um": [[1.0] * 32] * 15}, "15 rows"),
+    ({"wear.worn_depth_front_um": [[1.0] * 32] * 15 + [[1.0] * 31]}, "same number of bins"),
+    ({"wear.worn_depth_rear_um": [[-1.0] * 32] * 16}, "negative"),
+    ({"wear.worn_depth_front_um": [[3000.0] * 32] * 16, "wear.worn_depth_rear_um": [[3000.0] * 32] * 16},
+     "worn through"),
+    ({"wear.worn_depth_front_um": [[1.0] * 32] * 16, "multibody.pocket_face_segments": 4}, "exact arc faces"),
+    ({"wear.worn_depth_front_um": [[1.0] * 32] * 16, "model": "reduced"}, "multibody"),
+])
+def test_bad_worn_depth_is_refused_naming_the_key(over, words):
+    """A worn-depth profile that does not fit the bearing is refused in one line naming the key: a row per
+    pocket (16), equal rows, no negative depth, a cage bar (5.9 mm) not worn through by its front and
+    rear faces together, exact arc faces, the multibody model."""
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"))
+    with pytest.raises(UserError, match=r"wear\.worn_depth_(front|rear)_um") as exc:
+        sc.replace(**over)
+    assert words in str(exc.value) and "\n" not in str(exc.value)

@@ -346,9 +346,9 @@ def face_geometry(sc, rr, margin):
                         clear * clear if clear > 0.0 else -1.0, reach * reach, arc)
 
 
-def arc_faces(sc, rr, sign) -> "lp.ArcFaces":
+def arc_faces(sc, rr, sign, worn=None) -> "lp.ArcFaces":
     """:class:`bearingsim.multibody.loop.ArcFaces` of a scene with exact arc faces (roller radius ``rr`` [m],
-    ``sign`` of the rotation)."""
+    ``sign`` of the rotation); ``worn``: :func:`worn_array` (None: unworn faces)."""
     n = len(sc.arc_shapes)
     a = np.asarray(sc.pocket_body_angle, dtype=np.float64)
     sign = 1.0 if sign > 0 else -1.0
@@ -358,17 +358,35 @@ def arc_faces(sc, rr, sign) -> "lp.ArcFaces":
     near = ARC_NEAR_FRACTION * play
     from bearingsim.multibody.scene import TANGENT_HALF_LENGTH
 
-    return lp.ArcFaces(True, np.array([pair[0] is not None for pair in sc.arc_shapes], dtype=np.bool_),
-                       np.ascontiguousarray(sc.pocket_centres, dtype=np.float64), np.ascontiguousarray(e_t),
-                       np.ascontiguousarray(e_r), float(sc.pocket_radius), float(sc.extent[0]), float(sc.extent[1]),
-                       float(TANGENT_HALF_LENGTH * sc.pocket_radius), float(near * near))
+    af = lp.ArcFaces(True, np.array([pair[0] is not None for pair in sc.arc_shapes], dtype=np.bool_),
+                     np.ascontiguousarray(sc.pocket_centres, dtype=np.float64), np.ascontiguousarray(e_t),
+                     np.ascontiguousarray(e_r), float(sc.pocket_radius), float(sc.extent[0]), float(sc.extent[1]),
+                     float(TANGENT_HALF_LENGTH * sc.pocket_radius), float(near * near))
+    if worn is None:
+        return af
+    lo, hi = sc.extent
+    bins = worn.shape[2]
+    knots = np.concatenate([[lo], lo + (hi - lo) * (np.arange(bins) + 0.5) / bins, [hi]])
+    h = sc.pocket_radius + np.concatenate([worn[:, :, :1], worn, worn[:, :, -1:]], axis=2)
+    return af._replace(worn_on=True, knot_psi=knots, knot_cos=np.cos(knots), knot_sin=np.sin(knots),
+                       knot_h=np.ascontiguousarray(h, dtype=np.float64))
+
+
+def worn_array(p) -> np.ndarray | None:
+    """(n, 2, bins) worn depth of each pocket's (front, rear) face per bin of psi [m] (``p.wear.worn_depth``);
+    None for unworn faces."""
+    if p.wear.worn_depth is None:
+        return None
+    return np.array(p.wear.worn_depth, dtype=np.float64)
 
 
 def face_radial_reach(p) -> float:
     """How far [m] the cage centre can move off the axis while the rollers still hold it: the radial reach
     of the arc faces from the pocket centre, ``R sin(min(-psi_in, psi_out))``."""
     lo, hi = p.multibody.pocket_face_extent
-    return (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance) * math.sin(min(-lo, hi))
+    worn = worn_array(p)
+    deepest = float(worn.max()) if worn is not None else 0.0  # worn faces reach further
+    return (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance + deepest) * math.sin(min(-lo, hi))
 
 
 class MultibodySetup(NamedTuple):
@@ -528,7 +546,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     sc = build_scene(geo, op, p.contact.restitution, p.contact.cage_friction, extent=p.multibody.pocket_face_extent,
                      n_seg=n_seg, kinematic_cage=su.kinematic, spin_free=not su.reduced_eq,
                      flat_pockets=p.multibody.flat_pockets, centred_cage=su.scene == "centred_cage",
-                     rigid_radius=su.rigid_radius if su.rigid else None)
+                     rigid_radius=su.rigid_radius if su.rigid else None, worn=worn_array(p))
     nb = n + 1
     r0 = su.roller_start_radius
     omega_cage = op.sign * op.omega_c
@@ -569,7 +587,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
     masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
-    arc = arc_faces(sc, rr, op.sign) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
+    arc = arc_faces(sc, rr, op.sign, worn_array(p)) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
     io, why = chipmunk.open_step_loop(sc.space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
                                       [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks,
                                       sc.arc_shapes)

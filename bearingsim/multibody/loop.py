@@ -133,11 +133,61 @@ class ArcFaces(NamedTuple):
     #: squared offset from the pocket centre below which a roller's faces are left where they are: a
     #: roller that far inside its pocket cannot reach either face in the step [m^2]
     near2: float
+    #: worn faces (:func:`worn_contact`): else every face is the circle of radius ``radius``
+    worn_on: bool = False
+    knot_psi: np.ndarray = np.zeros(0)  #: (K,) knots of the worn profile in psi: psi_lo, the bin centres, psi_hi [rad]
+    knot_cos: np.ndarray = np.zeros(0)  #: (K,) cos of each knot
+    knot_sin: np.ndarray = np.zeros(0)  #: (K,) sin of each knot
+    #: (n, 2, K) each pocket's (front, rear) face: distance of its tangent line from the pocket centre at
+    #: each knot, R + worn depth [m] (linear between knots)
+    knot_h: np.ndarray = np.zeros((0, 2, 0))
 
 
 #: inactive :class:`ArcFaces` (polyline or flat faces: every segment static)
 ARC_FACES_OFF = ArcFaces(False, np.zeros(0, dtype=np.bool_), np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 2)),
                          0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@njit(cache=True, inline="always")
+def worn_contact(x, y, rho, kpsi, kc, ks, kh):
+    """Where a roller touches a worn face: ``(cos psi, sin psi, h)`` of the face's tangent line nearest to it.
+
+    A worn face is the pocket circle pushed outwards by the worn depth ``w(psi)``: the lines at distance
+    ``h(psi) = R + w(psi)`` from the pocket centre, normal to the direction ``psi`` (``h`` linear in psi
+    between the knots ``kpsi``, values ``kh``). A roller centre at ``rho (x, y)`` from the pocket centre
+    (face frame, ``(x, y)`` a unit vector) is ``g(psi) = h(psi) - rho cos(psi - phi)`` from the line at psi
+    (``phi`` its direction); it touches the line of least ``g`` over the face's extent. On a knot interval
+    ``g`` is convex (``rho cos`` is concave within 90 deg), so its least value is at a knot or where
+    ``g' = a + rho sin(psi - phi)`` changes sign (``a``: the slope of ``h``). Unworn (``h = R``), this is
+    ``psi = phi`` clamped to the extent: the exact arc's contact."""
+    px = rho * x
+    py = rho * y
+    best = math.inf
+    bx = kc[0]
+    by = ks[0]
+    bh = kh[0]
+    for k in range(kpsi.shape[0]):
+        g = kh[k] - (px * kc[k] + py * ks[k])
+        if g < best:
+            best = g
+            bx = kc[k]
+            by = ks[k]
+            bh = kh[k]
+    for k in range(kpsi.shape[0] - 1):
+        a = (kh[k + 1] - kh[k]) / (kpsi[k + 1] - kpsi[k])
+        if a + px * ks[k] - py * kc[k] < 0.0 < a + px * ks[k + 1] - py * kc[k + 1]:
+            psi = math.atan2(y, x) - math.asin(min(1.0, max(-1.0, a / rho)))
+            if kpsi[k] < psi < kpsi[k + 1]:
+                c = math.cos(psi)
+                s = math.sin(psi)
+                h = kh[k] + a * (psi - kpsi[k])
+                g = h - (px * c + py * s)
+                if g < best:
+                    best = g
+                    bx = c
+                    by = s
+                    bh = h
+    return bx, by, bh
 
 
 class StepInputs(NamedTuple):
@@ -180,7 +230,10 @@ def arc_faces(state, h, af, ends, todo):
     ``ends``: (n, 2, 4) each pocket's (front, rear) segment ends (ax, ay, bx, by) in the cage frame, updated;
     ``todo``: (n, 2) bool, set where a segment moved (the loop hands those to chipmunk). A roller within
     ``near2`` of its pocket centre leaves its faces as they are: every point of a tangent segment is at
-    least R from the pocket centre, out of its reach."""
+    least R from the pocket centre, out of its reach.
+
+    Worn faces (``af.worn_on``): the segment lies on the worn face's tangent line nearest to the roller
+    (:func:`worn_contact`), ``R + w`` from the pocket centre instead of ``R``; the rest is as above."""
     n = todo.shape[0]
     cx = state[n, 0] + state[n, 3] * h
     cy = state[n, 1] + state[n, 4] * h
@@ -214,6 +267,9 @@ def arc_faces(state, h, af, ends, todo):
             uy = af.e_t[i, 1] if f == 0 else -af.e_t[i, 1]
             x = (dx * ux + dy * uy) * inv  # the roller's direction in this face's frame
             y = y0
+            Rf = R  # the face's tangent line's distance from the pocket centre
+            if af.worn_on:
+                x, y, Rf = worn_contact(x, y, d2 * inv, af.knot_psi, af.knot_cos, af.knot_sin, af.knot_h[i, f])
             s_lo = y * cl - x * sl  # sin(psi - psi_lo)
             s_hi = x * sh - y * ch  # sin(psi_hi - psi)
             if s_lo < 0.0 or s_hi < 0.0:  # past an end: the end nearer in angle
@@ -227,10 +283,10 @@ def arc_faces(state, h, af, ends, todo):
                 s_hi = x * sh - y * ch
             c_lo = x * cl + y * sl  # cos(psi - psi_lo)
             c_hi = x * ch + y * sh  # cos(psi_hi - psi)
-            l_lo = R * s_lo / c_lo if c_lo > 0.0 and R * s_lo < ell * c_lo else ell
-            l_hi = R * s_hi / c_hi if c_hi > 0.0 and R * s_hi < ell * c_hi else ell
-            qx = af.centre[i, 0] + R * (x * ux + y * erx)  # tangent point
-            qy = af.centre[i, 1] + R * (x * uy + y * ery)
+            l_lo = Rf * s_lo / c_lo if c_lo > 0.0 and Rf * s_lo < ell * c_lo else ell
+            l_hi = Rf * s_hi / c_hi if c_hi > 0.0 and Rf * s_hi < ell * c_hi else ell
+            qx = af.centre[i, 0] + Rf * (x * ux + y * erx)  # tangent point
+            qy = af.centre[i, 1] + Rf * (x * uy + y * ery)
             tx = -y * ux + x * erx  # tangent, toward larger psi
             ty = -y * uy + x * ery
             e = ends[i, f]

@@ -127,7 +127,8 @@ TANGENT_HALF_LENGTH = 0.05
 
 def build_scene(geometry, op, restitution: float, cage_friction: float, *, extent: tuple[float, float],
                 n_seg: int, kinematic_cage: bool, spin_free: bool, spatial_hash: bool = True,
-                flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None) -> Scene:
+                flat_pockets=(), centred_cage: bool = False, rigid_radius: float | None = None,
+                worn=None) -> Scene:
     """Build the space: ``roller_count`` rollers at their pocket centres and the cage.
 
     Parameters
@@ -149,6 +150,9 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
         ``pymunk.SlideJoint`` from 0 to ``rigid_radius`` to a static anchor at the axis). pymunk solves it
         with the roller-cage contacts, so a cage pushing a roller outward meets the raceway in the same
         step; a roller pulled inward leaves it.
+    worn : (n, 2, bins) worn depth of each pocket's (front, rear) face [m], or None. Arc faces take it in
+        the step loop (:func:`bearingsim.multibody.loop.worn_contact`); a flat face is moved outwards by
+        its mean worn depth (a plane stays a plane: a uniform shift).
     """
     n = geometry.roller_count
     R = geometry.roller_radius + 0.5 * geometry.pocket_clearance
@@ -170,7 +174,7 @@ def build_scene(geometry, op, restitution: float, cage_friction: float, *, exten
     cage.angle = 0.0
     cage.angular_velocity = float(omega_cage)
     faces = _add_faces(space, cage, geometry.pitch_radius, R, a, sign, extent, n_seg, exact, bits_each,
-                       set(int(i) for i in flat_pockets))
+                       set(int(i) for i in flat_pockets), worn)
     joints = _add_joints(space, cage, rollers, centred_cage and not kinematic_cage, rigid_radius)
     ids = np.array([b.id for b in rollers] + [cage.id], dtype=np.uint64)
     verts, seg_ends, seg_bits, centres, arc_shapes = faces
@@ -219,9 +223,9 @@ def _add_rollers(space, geometry, op, a, restitution, cage_friction, spin_free, 
     return rollers
 
 
-def _add_faces(space, cage, rp, R, a, sign, extent, n_seg, exact, bits_each, flat):
+def _add_faces(space, cage, rp, R, a, sign, extent, n_seg, exact, bits_each, flat, worn):
     """Every pocket's front and rear face as segments of ``cage`` (flat, exact tangent or polyline), added
-    to ``space`` with the cage. Returns (vertices, segment ends, segment bits, pocket centres, exact faces'
+    to ``space`` with the cage (``worn``: see :func:`build_scene`). Returns (vertices, segment ends, segment bits, pocket centres, exact faces'
     segments)."""
     n = len(a)
     verts = []
@@ -238,7 +242,8 @@ def _add_faces(space, cage, rp, R, a, sign, extent, n_seg, exact, bits_each, fla
         verts.append([])
         for f, direction in enumerate((e_t, -e_t)):  # front, rear
             if i in flat:
-                pts = np.array([c + R * direction - R * e_r, c + R * direction + R * e_r])
+                off = R + (float(np.mean(worn[i, f])) if worn is not None else 0.0)
+                pts = np.array([c + off * direction - R * e_r, c + off * direction + R * e_r])
             elif exact:
                 pts = face_tangent(c, direction, e_r, R, extent)
             else:

@@ -7,12 +7,13 @@ bring the limited quantity from ``j / stages`` to ``(j + 1) / stages`` of the li
 last stage ends at the limit). The rates can change from stage to stage: the wear acts back through the
 clearance.
 
-How the worn shape maps onto the model's geometry (a first model, stated): the whole bearing's pockets
-stay arcs, and every pocket's clearance ``s`` grows by the worn depth of the **worst pocket** (largest
-worn volume), front plus rear, each face's depth taken as its **mean over the face** (worn volume /
-face area, so the model's pocket removes as much brass as wore). The shape of the wear (deeper at the
-faces' ends) is reported but not fed back. Limits: ``depth`` (the deepest point of any face),
-``clearance`` (the grown pocket clearance ``s``), ``volume`` (the largest worn volume of one face).
+How the worn shape maps onto the model's geometry: the worn depth is added to each face where it wore.
+The depth accumulated by the stages before stage ``j``, per pocket, face and bin of psi, is stage ``j``'s
+``[wear] worn_depth_front_um`` / ``worn_depth_rear_um``: each arc face is the pocket circle pushed
+outwards by it (:func:`bearingsim.multibody.loop.worn_contact`), a flat face by its mean (a uniform
+shift); ``bearing.pocket_clearance_mm`` stays as given. Limits: ``depth`` (the deepest point of any
+face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
+**mean** worn depth: worn volume / face area), ``volume`` (the largest worn volume of one face).
 
 Stages run in sequence in one folder under :class:`bearingsim.outputs.FolderLock`: ``stages/stage_NN.h5``
 (each a normal archive) and ``life.h5`` (the history, written atomically at the end). A stage archive
@@ -62,9 +63,9 @@ def parse_limit(text: str) -> Limit:
 class _State:
     """The wear accumulated up to a stage: depth profiles and volumes of every face, running time."""
 
-    def __init__(self, s0: float):
+    def __init__(self, s0: float, start=None):
         self.s0 = s0
-        self.depth = None  # (2, bins, pockets) front, rear [m]
+        self.depth = start  # (2, bins, pockets) front, rear [m]; the scenario's own worn depth or None
         self.volume = None  # (2, pockets) [m^3]
         self.shaft = 0.0
         self.hours = 0.0
@@ -92,12 +93,33 @@ def _stage_length(q_now, q_rate, target) -> float:
     return float(np.min((target - q_now[grow]) / q_rate[grow]))
 
 
-def stage_scenario(scenario, clearance: float, index: int, rotations: int | None):
-    """The scenario of stage ``index``: ``scenario`` at pocket clearance ``clearance`` [m]."""
-    over = {"bearing.pocket_clearance_mm": float(round(clearance * 1e3, 9)), "name": f"{scenario.name}_stage{index:02d}"}
+def stage_scenario(scenario, depth, index: int, rotations: int | None):
+    """The scenario of stage ``index``: ``scenario`` with the worn depth ``depth`` ((2, bins, pockets) front,
+    rear [m]; None: as it is) as its ``[wear] worn_depth_front_um`` and ``worn_depth_rear_um`` (rounded to
+    1e-6 um)."""
+    over = {"name": f"{scenario.name}_stage{index:02d}"}
+    if depth is not None:
+        for f, face in enumerate(("front", "rear")):
+            over[f"wear.worn_depth_{face}_um"] = [[float(round(x * 1e6, 6)) for x in col] for col in depth[f].T]
     if rotations is not None:
         over["numerics.rotations"] = int(rotations)
     return scenario.replace(**over)
+
+
+def _start_depth(scenario) -> np.ndarray | None:
+    """The scenario's own worn depth as the start of the accumulated wear ((2, bins, pockets) [m]), or None;
+    refused unless its bins are the wear profile's."""
+    from bearingsim.multibody.recorder import FACE_BINS
+    from bearingsim.parameters import Parameters
+
+    worn = Parameters.from_scenario(scenario).wear.worn_depth
+    if worn is None:
+        return None
+    arr = np.array(worn, dtype=np.float64)  # (pockets, 2, bins)
+    if arr.shape[2] != FACE_BINS:
+        raise UserError(f"{scenario.source}: wear.worn_depth_front_um: a life study adds the wear profile's "
+                        f"{FACE_BINS} bins of psi to it; give {FACE_BINS} bins per pocket (got {arr.shape[2]})")
+    return arr.transpose(1, 2, 0).copy()
 
 
 def _run_stage(sc, path: Path, progress):
@@ -110,8 +132,10 @@ def _run_stage(sc, path: Path, progress):
     if got is not None and got["scenario"] == sc.to_toml():
         return load(path), True
     if progress:
-        progress(f"stage {path.stem}: running {sc.numerics.rotations} rotations at pocket clearance "
-                 f"{sc.bearing.pocket_clearance_mm:.4g} mm")
+        worn = [max(max(row) for row in v) for v in (sc.wear.worn_depth_front_um, sc.wear.worn_depth_rear_um)
+                if v is not None]
+        progress(f"stage {path.stem}: running {sc.numerics.rotations} rotations, deepest worn point "
+                 f"{max(worn, default=0.0):.4g} um")
     run_scenario(sc, path, figures=False, exclusive=False, notes=False, force=True)
     return load(path), False
 
@@ -135,22 +159,25 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
     if limit.kind == "clearance" and limit.value <= s0:
         raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                         f"(bearing.pocket_clearance_mm); give a larger one")
+    start = _start_depth(scenario)
     folder = Path(folder)
     _check_outputs(folder)
     _check_folder(folder, scenario, limit, force)
     (folder / "stages").mkdir(parents=True, exist_ok=True)
     rows = []
     with FolderLock(folder):
-        st = _State(s0)
+        st = _State(s0, start)
         for j in range(stages):
-            sc = stage_scenario(scenario, st.clearance(), j, rotations)
+            sc = stage_scenario(scenario, st.depth if j else None, j, rotations)
             res, reused = _run_stage(sc, folder / "stages" / f"stage_{j:02d}.h5", progress)
             rate = wear_report(res, rotations=1.0)
             d_rate = np.stack([rate.depth_front, rate.depth_rear])
             v_rate = np.stack([rate.volume_front, rate.volume_rear])
-            if st.depth is None:
-                st.depth, st.volume = np.zeros_like(d_rate), np.zeros_like(v_rate)
+            if st.volume is None:
                 st.area = rate.bin_area * len(rate.psi_deg)
+                st.depth = np.zeros_like(d_rate) if st.depth is None else st.depth
+                st.volume = st.depth.sum(axis=1) * rate.bin_area
+            clearance = st.clearance()
             start = st.s0 if limit.kind == "clearance" else 0.0
             goal = start + (limit.value - start) * (j + 1) / stages
             q_now = st.quantity(limit.kind, st.depth, st.volume)
@@ -160,30 +187,34 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
             st.volume = st.volume + v_rate * n_stage
             st.shaft += n_stage
             st.hours += n_stage * rate.hours
-            rows.append(_row(j, sc, res, rate, n_stage, st, reused))
+            rows.append(_row(j, clearance, res, rate, n_stage, st, reused))
         cols = {k: np.array([r[k] for r in rows]) for k in rows[0]}
         archive.write_table_file(folder / "life.h5", cols, LIFE_UNITS, {
             "format": LIFE_FORMAT, "limit": limit.text, "stages": stages, "scenario": scenario.to_toml(),
-            "mapping": "every pocket's clearance grows by the worst pocket's mean worn depth, front + rear"})
+            "mapping": "the worn depth added to each face where it wore (per pocket, face and bin of psi); "
+                       "flat faces shifted by their mean"})
     return cols
 
 
 LIFE_UNITS = {"stage": "1", "pocket_clearance_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
               "hours_end": "h", "max_depth_rate_um_per_h": "um/h", "max_volume_rate_mm3_per_h": "mm^3/h",
               "max_depth_um": "um", "max_volume_mm3": "mm^3", "clearance_end_mm": "mm", "I_dec_mean_mNs": "mN s",
-              "reused": "1"}
+              "reused": "1", "psi_deg": "deg", "worn_depth_front_um": "um", "worn_depth_rear_um": "um"}
 
 
-def _row(j, sc, res, rate, n_stage, st, reused) -> dict:
+def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
+    """One stage's history row; ``clearance``: the effective pocket clearance it ran at [m]. The worn
+    depth at the stage's end is ``worn_depth_*_um`` [bin, pocket], at the bins ``psi_deg``."""
     per_hour = 1.0 / rate.hours  # rate report is for one rotation
     return {
-        "stage": j, "pocket_clearance_mm": sc.bearing.pocket_clearance_mm, "stage_rotations": n_stage,
+        "stage": j, "pocket_clearance_mm": clearance * 1e3, "stage_rotations": n_stage,
         "rotations_end": st.shaft, "hours_end": st.hours,
         "max_depth_rate_um_per_h": rate.max_depth * per_hour * 1e6,
         "max_volume_rate_mm3_per_h": float(max(rate.volume_front.max(), rate.volume_rear.max())) * per_hour * 1e9,
         "max_depth_um": float(st.depth.max()) * 1e6, "max_volume_mm3": float(st.volume.max()) * 1e9,
         "clearance_end_mm": st.clearance() * 1e3, "I_dec_mean_mNs": res.summary["I_dec_mean_Ns"] * 1e3,
-        "reused": int(reused),
+        "reused": int(reused), "psi_deg": rate.psi_deg,
+        "worn_depth_front_um": st.depth[0] * 1e6, "worn_depth_rear_um": st.depth[1] * 1e6,
     }
 
 
@@ -217,23 +248,49 @@ def read_life(path) -> tuple[dict, dict]:
 
 
 def plot_life(cols: dict, attrs: dict):
-    """Worn depth, pocket clearance and wear rate against running time, stage by stage."""
+    """Worn depth, effective pocket clearance and wear rate against running time, stage by stage, and the
+    worn faces: the depth profile over psi (mean over pockets) at the end of each stage."""
     from bearingsim.plotting import subplots
 
     h_end = cols["hours_end"]
     h_start = np.concatenate([[0.0], h_end[:-1]])
-    fig, axes = subplots(1, 3, figsize=(12, 3.8))
+    fig, axes = subplots(1, 4, figsize=(16, 3.8))
     axes[0].plot(np.concatenate([[0.0], h_end]), np.concatenate([[0.0], cols["max_depth_um"]]), "o-")
     axes[0].set_ylabel("deepest worn point [µm]")
     axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["pocket_clearance_mm"][0]],
                                                                    cols["clearance_end_mm"]]), "o-", color="C2")
-    axes[1].set_ylabel("pocket clearance s [mm]")
+    axes[1].set_ylabel("effective pocket clearance [mm]\n(worst pocket: s + mean worn depth)")
     axes[2].hlines(cols["max_depth_rate_um_per_h"], h_start, h_end, color="C3")
     axes[2].set_ylabel("deepest point's wear rate [µm/h]")
     axes[2].set_ylim(bottom=0.0)
-    for ax in axes:
+    for ax in axes[:3]:
         ax.set_xlabel("running time [h]")
+    _plot_worn_faces(axes[3], cols)
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} inner-ring "
                  f"rotations, {len(h_end)} stages", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _plot_worn_faces(ax, cols: dict) -> None:
+    """The worn depth over psi at each stage's end, mean over pockets: front face solid, rear dashed, the
+    later stages darker (histories written before life.h5 held the profiles: a note instead)."""
+    if "worn_depth_front_um" not in cols:
+        ax.text(0.5, 0.5, "no worn-depth profiles in this life.h5", ha="center", va="center", transform=ax.transAxes)
+        return
+    import matplotlib
+
+    cmap = matplotlib.colormaps["viridis_r"]
+    n = len(cols["stage"])
+    for j in range(n):
+        c = cmap(0.15 + 0.85 * (j + 1) / n)
+        psi = cols["psi_deg"][j]
+        ax.step(psi, cols["worn_depth_front_um"][j].mean(axis=1), where="mid", color=c, lw=1.2,
+                label="front" if j == n - 1 else None)
+        ax.step(psi, cols["worn_depth_rear_um"][j].mean(axis=1), where="mid", color=c, lw=1.2, ls="--",
+                label="rear" if j == n - 1 else None)
+    ax.set_xlabel("ψ on the face: bore end ← 0 → rim end [deg]")
+    ax.set_ylabel("worn depth, mean over pockets [µm]")
+    ax.set_title("worn faces at each stage's end (darker: later)", fontsize=8)
+    ax.set_ylim(bottom=0.0)
+    ax.legend(fontsize=7)

@@ -71,12 +71,13 @@ def parse_step(text) -> float:
 
 
 def default_keys(scenario) -> list[str]:
-    """Every ranged key the scenario's model reads: the land keys only with a land-guided cage, the
+    """Every ranged key the scenario's model reads for its headline numbers (not the wear keys, which only
+    scale the wear outputs): the land keys only with a land-guided cage, the
     reduced model without the cage's mass, inertia, diameters, frictions and the multibody keys, and
     without the radial clearance when its load zone is given."""
     from bearingsim.ranges import ranged_keys
 
-    skip = list(_UNUSED.get(scenario.model, ()))
+    skip = list(_UNUSED.get(scenario.model, ())) + ["wear."]  # Archard's k and H scale the wear outputs only
     if scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
         skip += _LAND_KEYS
     if scenario.model == "reduced" and scenario.reduced.load_zone_half_angle_deg != "auto":

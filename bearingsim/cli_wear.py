@@ -42,7 +42,7 @@ def _cmd_life(args) -> int:
     folder = check_writable_dir(args.output or Path("outputs") / f"{scenario.name}_life")
     say = None if args.quiet else (lambda line: print(line, file=sys.stderr))
     cols = life.run_life(scenario, folder, limit, stages=args.stages, rotations=args.rotations, force=args.force,
-                         progress=say)
+                         mapping=args.mapping, progress=say)
     cols_, attrs = life.read_life(folder / "life.h5")
     png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
     print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
@@ -78,5 +78,9 @@ def add_commands(sub) -> None:
     li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
     li.add_argument("--force", action="store_true", help="replace a life study of another scenario or limit")
+    li.add_argument("--mapping", choices=("uniform", "shape"), default="uniform",
+                    help="how a stage's wear acts back: 'uniform' (default), every pocket's clearance grows by the "
+                         "worst pocket's mean worn depth; 'shape', the worn depth added to each face where it wore "
+                         "(docs/wear.md: its runs stop on the roller-cage overlap limit before 0.1 mm)")
     li.add_argument("-q", "--quiet", action="store_true", help="no line per stage run")
     li.set_defaults(func=_cmd_life)

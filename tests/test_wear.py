@@ -171,39 +171,50 @@ def test_limit_parsing():
     assert parse_limit("volume=2mm3").value == pytest.approx(2e-9)
 
 
-def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys):
+@pytest.mark.parametrize("mapping", ["uniform", "shape"])
+def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, mapping):
     """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the effective
-    clearance grows stage by stage, each stage runs with the worn depth of the stages before it, the running time grows, the last stage ends at the limit; the same command
-    again reuses every stage's archive and gives the same history bit for bit."""
+    clearance grows stage by stage, the running time grows, the last stage ends at the limit; each stage
+    runs with the wear of the stages before it (uniform: at the grown pocket clearance; shape: with the
+    worn depth on each face); the same command again reuses every stage's archive and gives the same
+    history bit for bit."""
+    from bearingsim.simulation import load
     from bearingsim.studies.life import parse_limit, run_life
 
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
     lim = parse_limit("clearance=0.203mm")
-    cols = run_life(sc, tmp_path, lim, stages=3, rotations=1)
+    cols = run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=mapping)
     assert np.all(np.diff(cols["pocket_clearance_mm"]) > 0) and np.all(np.diff(cols["hours_end"]) > 0)
     assert np.all(cols["stage_rotations"] > 0)
     assert cols["clearance_end_mm"][-1] == pytest.approx(0.203, rel=1e-9)
     assert np.all(cols["reused"] == 0)
-    # the worn shape is fed back: stage j runs with the depth accumulated by stages 0..j-1 on each face,
-    # per pocket and bin of psi (rounded to 1e-6 um in its scenario); stage 0 with none
-    from bearingsim.simulation import load
-
     assert load(tmp_path / "stages" / "stage_00.h5").scenario.wear.worn_depth_front_um is None
-    for j in (1, 2):
-        w = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario.wear
-        for f in ("front", "rear"):
-            np.testing.assert_allclose(np.array(getattr(w, f"worn_depth_{f}_um")).T, cols[f"worn_depth_{f}_um"][j - 1],
-                                       rtol=0, atol=5e-7)
+    if mapping == "uniform":  # stage j runs at the clearance stages 0..j-1 left (rounded to 1e-9 mm)
+        for j in (1, 2):
+            stage = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario
+            assert stage.wear.worn_depth_front_um is None
+            assert stage.bearing.pocket_clearance_mm == pytest.approx(cols["clearance_end_mm"][j - 1], abs=1e-9)
+    else:  # stage j runs with the depth accumulated by stages 0..j-1 on each face, per pocket and bin of
+        # psi (rounded to 1e-6 um in its scenario), at the given pocket clearance
+        for j in (1, 2):
+            stage = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario
+            assert stage.bearing.pocket_clearance_mm == sc.bearing.pocket_clearance_mm
+            for f in ("front", "rear"):
+                np.testing.assert_allclose(np.array(getattr(stage.wear, f"worn_depth_{f}_um")).T,
+                                           cols[f"worn_depth_{f}_um"][j - 1], rtol=0, atol=5e-7)
     assert np.all(np.diff(cols["worn_depth_rear_um"], axis=0) >= 0) and cols["worn_depth_rear_um"][-1].max() > 0
     assert cols["max_depth_um"][-1] == pytest.approx(max(cols["worn_depth_front_um"][-1].max(),
                                                          cols["worn_depth_rear_um"][-1].max()), rel=1e-12)
-    again = run_life(sc, tmp_path, lim, stages=3, rotations=1)
+    again = run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=mapping)
     assert np.all(again["reused"] == 1)
     for k in cols:
         if k != "reused":
             np.testing.assert_array_equal(again[k], cols[k])
-    with pytest.raises(UserError, match="another scenario or limit"):
-        run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1)
+    with pytest.raises(UserError, match="another scenario, limit or mapping"):
+        run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1, mapping=mapping)
+    other = "shape" if mapping == "uniform" else "uniform"
+    with pytest.raises(UserError, match="another scenario, limit or mapping"):
+        run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=other)
     from bearingsim.cli import main
 
     assert main(["inspect", str(tmp_path / "life.h5")]) == 0  # bearingsim's own table file: described

@@ -30,7 +30,7 @@ def browser():
     needs it fails with that line: a missing browser is not a skipped test)."""
     if not CHROMIUM.is_file():
         yield (f"{CHROMIUM} not found: the report tests open the page in the distribution's Chromium; install it "
-               f"with 'apt-get install -y chromium' (Debian/Ubuntu; .ci/run does) and run the tests again")
+               f"with 'bash .ci/browser' (Debian's chromium package, as the README's test command does) and run the tests again")
         return
     try:
         from playwright.sync_api import sync_playwright

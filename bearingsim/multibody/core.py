@@ -484,7 +484,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         e_set=np.full(n, float(e)), e_want=np.full(n, float(e)), touched=np.zeros(n, dtype=np.bool_),
         n_extra=np.zeros(n),
         arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
-        arc_todo=np.zeros((n, 2), dtype=np.bool_))
+        arc_todo=np.zeros((n, 2), dtype=np.bool_), mot=rk.motion_block(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
@@ -513,6 +513,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         if not reduced_eq:
             series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
                            ("ring_x", "ring_y")))
+    motion = rk.MotionSeries(sink, n, not reduced_eq) if sink is not None and p.numerics.motion_rotations > 0 else None
     bar = None
     if progress:
         from tqdm import tqdm
@@ -533,7 +534,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(omega_nom), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=out_every,
-        max_steps=int(3 * steps_est + 1000))
+        max_steps=int(3 * steps_est + 1000), **rk.motion_limits(p))
     inp = lp.StepInputs(
         h=float(h), prm=prm, cfg=cfg, lim=lim,
         hold_rule=lp.HoldRule(active=reduced_eq, phi=float(phi),
@@ -559,6 +560,9 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
                 ts.append(smp["step"].copy(), smp["t"].copy(),
                           smp[cols[0]].copy() if len(cols) == 1 else np.stack([smp[c] for c in cols], axis=1))
         st["n_samples"] = 0
+        if motion is not None:
+            motion.flush(wk.mot, int(st["n_motion"]))
+        st["n_motion"] = 0
         t = float(st["t"])
         step = int(st["step"])
         state = io.states[int(st["cur"])]

@@ -43,6 +43,7 @@ WIDTH_PX, HEIGHT_PX, DPI = 1024, 768, 100
 VIEW_RECT = (0.0, 0.0, HEIGHT_PX / WIDTH_PX, 1.0)  # figure fraction: the left 768 x 768 px
 #: colours; the cage's is not used by any other part, so a test can find the cage in a frame
 CAGE_COLOUR = "#c9a227"
+TRAIL_COLOUR = "#d95f02"
 RING_COLOUR = "#b4bcc6"
 ROLLER_COLOUR = "#5f6b78"
 FORCE_COLOURS = ("#d0d0d0", "#4292c6", "#08306b")  # face force colour scale: no force light grey, then blues
@@ -195,6 +196,16 @@ class _Motion:
         return np.where(before, j - 1, j)
 
 
+def view_half_width(p, k: float) -> float:
+    """Half the width [mm] of the square view of the bearing (:data:`VIEW_RECT`, centred on the bearing
+    axis, x to the right, y up) at exaggeration ``k``: the drawn outer ring and a margin."""
+    from bearingsim.multibody.core import paper_assumptions
+
+    g = p.bearing
+    pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
+    return (g.pitch_radius + 0.25 * k * pd + 1.5 * g.roller_radius) * 1e3 + 2.0
+
+
 def _force_cmap():
     from matplotlib.colors import LinearSegmentedColormap
 
@@ -262,7 +273,7 @@ class _Drawing:
         self.face_r = np.where(flat[:, None], np.tan(psi)[None, :], np.sin(psi)[None, :])
         r_outer = self.rp + 0.25 * k * pd + self.rr  # drawn raceways: a roller touching one touches it here
         r_inner = self.rp - 0.25 * k * pd - self.rr
-        span = r_outer + 0.55 * self.rr + 2.0
+        span = view_half_width(p, k)
         self.fig = fig = figure(figsize=(WIDTH_PX / DPI, HEIGHT_PX / DPI), dpi=DPI)
         fig.patch.set_facecolor("white")
         ax = self.ax = fig.add_axes(VIEW_RECT)
@@ -354,7 +365,7 @@ class _Drawing:
         tax.tick_params(labelsize=7)
         tax.plot([0.0], [0.0], "k+", ms=8)
         tax.set_title("cage centre [µm],\nlast cage rotation", fontsize=8)
-        (self.trail,) = tax.plot([], [], lw=0.8, color=CAGE_COLOUR)
+        (self.trail,) = tax.plot([], [], lw=0.8, color=TRAIL_COLOUR)
         (self.trail_now,) = tax.plot([], [], "o", ms=4, color="black")
 
     def draw(self, f: int) -> np.ndarray:

@@ -505,10 +505,12 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         now = st1
         prev = st0
     t = s.t
-    s.n_imp = rk.record_step(arb_f, arb_i, n_arb, inp.ids_sorted, inp.ids_index, prev, now, t, inp.h, inp.cfg,
-                             inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp, wk.touched)
+    # the pose before the step's impulses are added: a pose's face forces are those of the steps whose cage
+    # travel (after the step) lies between the previous pose's and its own, as the recorder counts rotations
     motion_full = lim.motion_step > 0.0 and rk.record_motion(now, t, s.step, sign, lim, wk.ring_c, acc.j_int,
                                                              wk.mot, s)
+    s.n_imp = rk.record_step(arb_f, arb_i, n_arb, inp.ids_sorted, inp.ids_index, prev, now, t, inp.h, inp.cfg,
+                             inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp, wk.touched)
     if s.step % lim.out_every == 0:
         ok = True
         for i in range(nb):

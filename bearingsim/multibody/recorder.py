@@ -415,8 +415,10 @@ def record_motion(now, t, step, sign, lim, ring_c, j_int, mot, s):
     Poses are due at cage travel ``lo + j dphi`` (``lim.motion_lo``, ``motion_step``), j = 0 .. up to
     ``motion_hi``, each taken after the first step that reaches it (a step longer than ``dphi`` skips
     the poses it passed: the next one due is the first after it). ``j_int`` (circumferential face
-    impulses since it was last zeroed) is divided by the time since then and zeroed at each pose, and at
-    ``lo - dphi``, so the first pose's forces cover one interval too. ``s``: the loop state record
+    impulses since it was last zeroed; called before the step's impulses are added to it) is divided by
+    the time since then and zeroed at each pose, and at ``lo - dphi``, so the first pose's forces cover
+    one interval too: a pose's forces are the mean over the steps whose cage travel after the step lies
+    from the previous pose's up to its own, the steps the recorder counts in a rotation by the same rule. ``s``: the loop state record
     (``motion_next``: travel of the next pose [rad], ``t_motion``: time of the last one [s], ``n_motion``:
     rows of ``mot`` used); ``now``: (n + 1, 6) body states (rollers, cage)."""
     n = j_int.shape[0]

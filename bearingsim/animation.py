@@ -440,7 +440,7 @@ def _write_mp4(out: Path, frames, fps: float, total: int, progress) -> None:
     with atomic_file(out):  # ffmpeg writes the temporary file by its name; renamed when complete
         writer = imageio_ffmpeg.write_frames(
             str(temporary_name(out)), (WIDTH_PX, HEIGHT_PX), fps=fps, codec="libx264", quality=7,
-            macro_block_size=16, output_params=["-f", "mp4"], ffmpeg_log_level="error")
+            macro_block_size=16, output_params=["-preset", "veryfast", "-f", "mp4"], ffmpeg_log_level="error")
         writer.send(None)
         try:
             for i, frame in enumerate(frames):
@@ -459,7 +459,8 @@ def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
 
     images = []
     for i, frame in enumerate(frames):
-        images.append(Image.fromarray(frame).quantize(colors=128, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE))
+        images.append(Image.fromarray(frame).quantize(colors=128, method=Image.Quantize.FASTOCTREE,
+                                                      dither=Image.Dither.NONE))
         if progress is not None:
             progress(i + 1, total)
     with atomic_file(out) as fh:

@@ -608,6 +608,17 @@ def model_of(path) -> str:
         f.close()
 
 
+def has_observable(path, name: str) -> bool:
+    """True when the archive at ``path`` holds the time series ``/observables/<name>`` (metadata only;
+    one-line UserError for a file that is not an archive)."""
+    f = open_archive(path)
+    try:
+        obs = f.get("observables")
+        return isinstance(obs, _lazy_h5py().Group) and name in obs
+    finally:
+        f.close()
+
+
 def _wanted(name: str, only) -> bool:
     return only is None or any(name == p or name.startswith(p + "/") for p in only)
 

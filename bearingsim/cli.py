@@ -459,6 +459,9 @@ def build_parser() -> argparse.ArgumentParser:
     from bearingsim import cli_wear
 
     cli_wear.add_commands(sub)  # wear, life (bearingsim/cli_wear.py)
+    from bearingsim import cli_animate
+
+    cli_animate.add_commands(sub)  # animate (bearingsim/cli_animate.py)
     from bearingsim.cli_sensitivity import add_parsers as _add_sensitivity_parsers
 
     _add_sensitivity_parsers(sub)

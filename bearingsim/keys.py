@@ -22,6 +22,9 @@ DEFAULT_SOURCES = {
     "wear.hardness_Pa": "high-strength brass, ~HV 150",
     "contact.land_friction": "reconstructed: equal to the roller-cage friction (brass on steel)",
     "bearing.cage_guidance": "the paper's roller-guided cage",
+    "output.motion_rotations": "what an animation shows by default (2 cage rotations; docs/animation.md)",
+    "output.motion_start_rotation": "the end of the run, when the cage has settled",
+    "output.motion_samples_per_rotation": "2 poses per frame of a 30 fps video at 4 s per cage rotation",
 }
 #: longest preset reference shown in the table (the whole of it with --why)
 WHERE_CHARS = 60
@@ -95,6 +98,7 @@ def _bounds_note(section: str, name: str) -> str:
         ("reduced", "load_zone_half_angle_deg"): "in [0, 180)",
         ("multibody", "inner_ring_mass_kg"): "> 0",
         ("multibody", "pocket_face_half_angle_deg"): "in (0, 90)",
+        ("output", "motion_start_rotation"): ">= 0, + motion_rotations <= numerics.rotations",
     }.get((section, name), "")
 
 

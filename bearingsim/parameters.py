@@ -104,6 +104,11 @@ class Numerics:
     rotations: int  # recorded cage rotations
     warmup_rotations: int  # cage rotations run before recording
     output_rate: float  # time-series samples per second [Hz]
+    #: motion of every body (multibody model, ``[output] motion_*``): the window's start and length in
+    #: recorded cage rotations (length 0: no motion) and the poses per cage rotation
+    motion_start: float = 0.0
+    motion_rotations: float = 0.0
+    motion_samples_per_rotation: int = 0
 
 
 @dataclass(frozen=True)
@@ -141,6 +146,15 @@ class Wear:
     #: worn depth of each pocket's (front, rear) face per bin of psi, equal bins over the faces' extent
     #: ``[pocket][face][bin]`` [m]; None: unworn faces (docs/wear.md, "Worn faces")
     worn_depth: tuple[tuple[tuple[float, ...], ...], ...] | None = None
+
+
+def _motion_window(out, rotations: int) -> dict:
+    """The motion window of ``[output]`` in recorded rotations: "last" ends it with the run, and a
+    window longer than the run is the whole run."""
+    length = min(float(out.motion_rotations), float(rotations))
+    start = rotations - length if out.motion_start_rotation == "last" else float(out.motion_start_rotation)
+    return dict(motion_start=start, motion_rotations=length,
+                motion_samples_per_rotation=int(out.motion_samples_per_rotation))
 
 
 @dataclass(frozen=True)
@@ -195,6 +209,7 @@ class Parameters:
             rotations=int(nu.rotations),
             warmup_rotations=int(nu.warmup_rotations),
             output_rate=float(nu.output_rate_hz),
+            **_motion_window(scenario.output, int(nu.rotations)),
         )
         r = scenario.reduced
         given = None if r.load_zone_half_angle_deg == "auto" else float(r.load_zone_half_angle_deg)

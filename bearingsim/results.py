@@ -133,6 +133,15 @@ class Result:
 
         return result_xarray(self)
 
+    def animate(self, out, **kw) -> Path:
+        """Write an animation of this run's stored motion (``.mp4`` or ``.gif``) to ``out``; return the path.
+        ``kw``: ``rotations=(a, b)``, ``exaggerate``, ``fps``, ``progress`` of
+        :func:`bearingsim.animation.render` (docs/animation.md). A multibody run stores the motion of
+        the window its ``[output] motion_*`` keys set."""
+        from bearingsim.animation import render_result
+
+        return render_result(self, out, **kw)
+
     def save(self, path) -> Path:
         """Write this result as an archive at ``path`` (atomically); return the path."""
         from bearingsim import archive

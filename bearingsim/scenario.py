@@ -78,6 +78,11 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     # gives 6e-4 (Archard & Hirst 1956, Proc. R. Soc. A 236:397). High-strength brass hardness ~HV 150
     # -> 1.5e9 Pa.
     "wear": {"wear_coefficient": 5.0e-6, "hardness_Pa": 1.5e9},
+    # motion of every body for animations (multibody model; docs/archive.md, docs/animation.md): the last
+    # 2 recorded cage rotations (an animation shows 2 rotations by default), 240 poses per cage rotation
+    # (one pose per frame of a 30 fps video at 4 s per rotation, with 2x to spare: 1.5 deg of cage
+    # travel between poses, ~22 poses per roller pass of the 16-roller NU214); 0 rotations: no motion
+    "output": {"motion_rotations": 2.0, "motion_start_rotation": "last", "motion_samples_per_rotation": 240},
 }
 
 PRESET_DIR = "params"
@@ -108,6 +113,10 @@ MAX_DM_N_MM_RPM = 4.0e6
 # Implied roller density m / (pi/4 d^2 l): between light engineering polymers (~0.9e3 kg/m^3,
 # polyethylene) and tungsten carbide (~15.6e3 kg/m^3), with a margin; bearing steel is 7.8e3.
 ROLLER_DENSITY_RANGE_KG_M3 = (500.0, 20_000.0)
+# Motion samples (poses of every body, [output] motion_*): at most 1e5 per run, ~70 MB before
+# compression for the 16-roller NU214 (85 numbers of 8 bytes per sample): an hour of video at 30 fps,
+# far more than anyone animates, and bounded so a typo (1e9 samples per rotation) cannot fill a disk.
+MAX_MOTION_SAMPLES = 100_000
 # Vickers hardness of cage materials: from soft polymers (PTFE ~ 3e7 Pa) to hard ceramics (~2e10 Pa);
 # 1e7..1.2e11 Pa (diamond ~1e11 Pa) bounds every solid (Archard's H in Eq. 16).
 HARDNESS_RANGE_PA = (1.0e7, 1.2e11)
@@ -253,6 +262,21 @@ class WearSection(_Section):
     worn_depth_rear_um: list[list[float]] | None = None
 
 
+class OutputSection(_Section):
+    """What a run stores beyond its results: the bodies' motion for animations (multibody model)."""
+
+    motion_rotations: float = Field(ge=0.0)  # cage rotations of motion stored; 0: none
+    motion_start_rotation: float | Literal["last"]  # recorded rotation the window starts at; "last": ends with the run
+    motion_samples_per_rotation: int = Field(ge=8, le=MAX_MOTION_SAMPLES)
+
+    @field_validator("motion_start_rotation")
+    @classmethod
+    def _start(cls, v):
+        if v != "last" and not v >= 0.0:
+            raise ValueError("must be 'last' (the window ends with the run) or a recorded rotation >= 0")
+        return v
+
+
 class RangeEntry(_Section):
     """A plausible range of one numeric key (``[ranges.<section>.<key>]``): ``range = [low, high]`` in the
     key's unit and the ``reason`` for it (:mod:`bearingsim.ranges`)."""
@@ -284,6 +308,7 @@ class ScenarioModel(_Section):
     numerics: NumericsSection
     multibody: MultibodySection
     wear: WearSection
+    output: OutputSection
     # plausible ranges of uncertain keys, by section and key (bearingsim.ranges; the preset's are merged in)
     ranges: dict[str, dict[str, RangeEntry]] | None = None
 
@@ -654,7 +679,7 @@ def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
 # keys a figure title shows already (speed, direction, load) or that set only how long and how often
 # a run records, and keys a model does not use: not named as differences from the preset
 _TITLE_SKIP = ("schema_version", "name", "model", "bearing.preset", "operating.inner_ring_speed_rpm",
-               "operating.direction", "operating.radial_load_N", "numerics.", "multibody.scene")
+               "operating.direction", "operating.radial_load_N", "numerics.", "multibody.scene", "output.")
 _TITLE_SKIP_MODEL = {
     "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
                 "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction"),
@@ -666,7 +691,7 @@ _TITLE_SKIP_MODEL = {
 UNUSED_BY_MODEL = {
     "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
                 "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction",
-                "numerics.warmup_rotations", "numerics.output_rate_hz"),
+                "numerics.warmup_rotations", "numerics.output_rate_hz", "output."),
 }
 # keys the reduced model's method reads nothing of: the event method is event-driven (no time step)
 UNUSED_BY_METHOD = {"event": ("numerics.dt_s",)}
@@ -829,6 +854,7 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
     _check_geometry(model, source)
     scenario = Scenario(model, source)
     _check_limits(model, source, scenario)
+    _check_motion(model, source)
     if model.ranges:
         from bearingsim.ranges import check_ranges
 
@@ -907,6 +933,21 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
             raise UserError(f"{source}: numerics.output_rate_hz: {n.output_rate_hz:g} Hz gives {per_rotation:.3g} "
                             f"samples per cage rotation; at least {need} (2 per roller pass) are needed, use "
                             f">= {need / period:.3g} Hz")
+
+
+def _check_motion(m: ScenarioModel, source: str) -> None:
+    """The motion window lies in the recorded rotations (a given start) and holds at most
+    :data:`MAX_MOTION_SAMPLES` poses. With start "last" a window longer than the run is the whole run."""
+    out, rotations = m.output, m.numerics.rotations
+    if out.motion_start_rotation != "last" and out.motion_start_rotation + out.motion_rotations > rotations:
+        raise UserError(f"{source}: output.motion_start_rotation: the window {out.motion_start_rotation:g} .. "
+                        f"{out.motion_start_rotation + out.motion_rotations:g} ends after the "
+                        f"{rotations} recorded rotations (numerics.rotations); start it earlier or set 'last'")
+    length = min(out.motion_rotations, rotations)
+    if length * out.motion_samples_per_rotation > MAX_MOTION_SAMPLES:
+        raise UserError(f"{source}: output.motion_rotations: {length:g} rotations x {out.motion_samples_per_rotation} "
+                        f"samples per rotation is more than {MAX_MOTION_SAMPLES} motion samples; store a shorter "
+                        f"window or fewer output.motion_samples_per_rotation")
 
 
 def _check_cage_inertia(b: "BearingSection", source: str) -> None:

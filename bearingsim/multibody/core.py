@@ -474,7 +474,7 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(op.omega_c), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=_sample_every(p, h),
-        max_steps=int(3 * steps_est + 1000))
+        max_steps=int(3 * steps_est + 1000), **rk.motion_limits(p))
     hold = lp.HoldRule(active=reduced_eq, phi=float(phi), radius=r_c if is_rigid else rp - (n_centrifugal / K) ** 0.9,
                        front_offset=0.5 * s, omega_cage=float(op.sign * op.omega_c))
     return MultibodySetup(
@@ -582,7 +582,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
         e_set=np.full(n, e), e_want=np.full(n, e), touched=np.zeros(n, dtype=np.bool_),
         n_extra=np.zeros(n),
         arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
-        arc_todo=np.zeros((n, 2), dtype=np.bool_))
+        arc_todo=np.zeros((n, 2), dtype=np.bool_), mot=rk.motion_block(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
@@ -668,14 +668,17 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     acc = rk.accumulators(p.numerics.rotations, p.bearing.roller_count, THETA_BINS, IMPACT_CAPACITY)
     ls = np.zeros(1, dtype=lp.LOOP_STATE)
     t_loop0 = time.perf_counter()
-    _drive(su, pl, acc, ls, _series(sink, su.reduced_eq), progress)
+    motion = (rk.MotionSeries(sink, p.bearing.roller_count, not su.reduced_eq)
+              if sink is not None and p.numerics.motion_rotations > 0 else None)
+    _drive(su, pl, acc, ls, _series(sink, su.reduced_eq), motion, progress)
     loop_s = time.perf_counter() - t_loop0
     return _raw(su, pl, acc, ls[0], loop_s, t_wall0)
 
 
-def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, progress) -> None:
-    """Advance the step loop to the end of the run, streaming samples to ``series`` and moving the
-    progress bar; raise for a run that cannot go on (:func:`_stop`)."""
+def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -> None:
+    """Advance the step loop to the end of the run, streaming samples to ``series`` and the bodies' poses
+    to ``motion`` (:class:`bearingsim.multibody.recorder.MotionSeries`, or None) and moving the progress
+    bar; raise for a run that cannot go on (:func:`_stop`)."""
     n = su.p.bearing.roller_count
     sign = su.p.operating.sign
     total_rot = su.p.numerics.warmup_rotations + su.p.numerics.rotations
@@ -701,6 +704,9 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, progress) -> None:
                 ts.append(smp["step"].copy(), smp["t"].copy(),
                           smp[cols[0]].copy() if len(cols) == 1 else np.stack([smp[c] for c in cols], axis=1))
         st["n_samples"] = 0
+        if motion is not None:
+            motion.flush(wk.mot, int(st["n_motion"]))
+        st["n_motion"] = 0
         state = io.states[int(st["cur"])]
         if bar is not None:
             done = min(total_rot, int(sign * state[n, 2] / (2.0 * math.pi)))

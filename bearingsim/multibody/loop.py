@@ -79,6 +79,9 @@ LOOP_STATE = np.dtype([
     ("beyond_max", np.float64),  # rigid raceways: largest distance of a roller centre outside its circle after a step [m]
     ("beyond_before", np.float64),  # rigid raceways: that roller's distance outside it before that step [m]
     ("beyond_vr", np.float64),  # rigid raceways: that roller's radial speed before that step [m/s]
+    ("n_motion", np.int64),  # rows of the motion block not yet handed to Python
+    ("motion_next", np.float64),  # cage travel of the next motion pose (recorder.record_motion) [rad]
+    ("t_motion", np.float64),  # time of the last motion pose [s]
 ], align=True)
 
 #: Time-series samples, one row every ``out_every`` steps (array shape (block,)).
@@ -105,6 +108,9 @@ class LoopLimits(NamedTuple):
     out_every: int  #: steps between samples and checks
     max_steps: int  #: steps after which the cage counts as stalled
     t_phase_end: float = math.inf  #: time at which the start phase (its own step) ends [s]
+    motion_lo: float = 0.0  #: cage travel of the first motion pose [rad] (:func:`~bearingsim.multibody.recorder.motion_limits`)
+    motion_hi: float = 0.0  #: cage travel of the last one [rad]
+    motion_step: float = 0.0  #: cage travel between two motion poses [rad]; 0: no motion stored
 
 
 class HoldRule(NamedTuple):
@@ -348,6 +354,8 @@ class StepWork(NamedTuple):
     n_extra: np.ndarray  #: (n,) rigid raceways: the outer race's force of :func:`~bearingsim.multibody.forces.race_orbit` in the step [N]
     arc_ends: np.ndarray  #: (n, 2, 4) exact faces: each pocket's (front, rear) segment as placed (ax, ay, bx, by), cage frame [m]
     arc_todo: np.ndarray  #: (n, 2) bool, exact faces: the segments :func:`arc_faces` moved for the coming step
+    #: (rows, columns) motion poses (:func:`bearingsim.multibody.recorder.record_motion`)
+    mot: np.ndarray = np.zeros((1, 1))
 
 
 @njit(cache=True)
@@ -553,6 +561,10 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         now = st1
         prev = st0
     t = s.t
+    # the pose before the step's impulses are added: a pose's face forces are those of the steps whose cage
+    # travel (after the step) lies between the previous pose's and its own, as the recorder counts rotations
+    motion_full = lim.motion_step > 0.0 and rk.record_motion(now, t, s.step, sign, lim, wk.ring_c, acc.j_int,
+                                                             wk.mot, s)
     s.n_imp = rk.record_step(arb_f, arb_i, n_arb, inp.ids_sorted, inp.ids_index, prev, now, t, inp.h, inp.cfg,
                              inp.pocket_a, inp.theta0, wk.diag, acc, s.n_imp, wk.touched)
     if s.step % lim.out_every == 0:
@@ -606,6 +618,8 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
         s.n_samples = k + 1
         if k + 1 == wk.smp.shape[0]:
             return CODE_BLOCK_FULL
+    if motion_full:
+        return CODE_BLOCK_FULL
     return CODE_CONTINUE
 
 

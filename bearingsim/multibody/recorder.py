@@ -376,4 +376,114 @@ def record_step(arb_f, arb_i, n_arb, ids_sorted, ids_index, prev, now, t, h, cfg
     return n_imp
 
 
+# --- motion of every body (``[output] motion_*``, docs/archive.md) -------------------------------------
+#: rows of the motion block handed to Python at once
+MOTION_BLOCK = 1024
+
+
+def motion_columns(n: int) -> dict[str, slice]:
+    """Columns of a row of the motion block (:func:`record_motion`) for ``n`` rollers: time [s], step,
+    every body's (x [m], y [m], angle [rad]) (rollers 0..n-1, then the cage), the inner-ring centre
+    (x, y) [m], and per pocket the mean circumferential force on its rear and front face since the
+    previous row [N] (``j_int`` over the interval)."""
+    nb = n + 1
+    return {"time": slice(0, 1), "step": slice(1, 2), "bodies": slice(2, 2 + 3 * nb),
+            "ring": slice(2 + 3 * nb, 4 + 3 * nb), "force": slice(4 + 3 * nb, 4 + 3 * nb + 2 * n)}
+
+
+def motion_block(n: int) -> np.ndarray:
+    """An empty motion block of :data:`MOTION_BLOCK` rows for ``n`` rollers."""
+    return np.zeros((MOTION_BLOCK, motion_columns(n)["force"].stop))
+
+
+def motion_limits(p) -> dict:
+    """The motion window as the step loop sees it (:class:`bearingsim.multibody.loop.LoopLimits`):
+    cage travel [rad] of its first and last pose and between two poses (0: no motion)."""
+    nu = p.numerics
+    if nu.motion_rotations <= 0.0:
+        return dict(motion_lo=0.0, motion_hi=0.0, motion_step=0.0)
+    lo = TWO_PI * (nu.warmup_rotations + nu.motion_start)
+    return dict(motion_lo=lo, motion_hi=lo + TWO_PI * nu.motion_rotations,
+                motion_step=TWO_PI / nu.motion_samples_per_rotation)
+
+
+@njit(cache=True, inline="always")
+def record_motion(now, t, step, sign, lim, ring_c, j_int, mot, s):
+    """Store a pose of every body when the cage has turned to the next pose of the motion window; return
+    True when the block ``mot`` is full (Python then flushes it).
+
+    Poses are due at cage travel ``lo + j dphi`` (``lim.motion_lo``, ``motion_step``), j = 0 .. up to
+    ``motion_hi``, each taken after the first step that reaches it (a step longer than ``dphi`` skips
+    the poses it passed: the next one due is the first after it). ``j_int`` (circumferential face
+    impulses since it was last zeroed; called before the step's impulses are added to it) is divided by
+    the time since then and zeroed at each pose, and at ``lo - dphi``, so the first pose's forces cover
+    one interval too: a pose's forces are the mean over the steps whose cage travel after the step lies
+    from the previous pose's up to its own, the steps the recorder counts in a rotation by the same rule. ``s``: the loop state record
+    (``motion_next``: travel of the next pose [rad], ``t_motion``: time of the last one [s], ``n_motion``:
+    rows of ``mot`` used); ``now``: (n + 1, 6) body states (rollers, cage)."""
+    n = j_int.shape[0]
+    travel = sign * now[n, 2]
+    if travel < s.motion_next or s.motion_next > lim.motion_hi + 0.5 * lim.motion_step:
+        return False
+    if travel >= lim.motion_lo - 0.5 * lim.motion_step:  # a pose of the window (else: the zeroing before it)
+        row = mot[s.n_motion]
+        dt = t - s.t_motion
+        inv = 1.0 / dt if dt > 0.0 else 0.0
+        row[0] = t
+        row[1] = step
+        for i in range(n + 1):
+            row[2 + 3 * i] = now[i, 0]
+            row[3 + 3 * i] = now[i, 1]
+            row[4 + 3 * i] = now[i, 2]
+        c = 2 + 3 * (n + 1)
+        row[c] = ring_c[0]
+        row[c + 1] = ring_c[1]
+        for i in range(n):
+            row[c + 2 + 2 * i] = j_int[i].rear * inv
+            row[c + 3 + 2 * i] = j_int[i].front * inv
+        s.n_motion += 1
+    for i in range(n):
+        j_int[i].rear = 0.0
+        j_int[i].front = 0.0
+    s.t_motion = t
+    j = math.floor((travel - lim.motion_lo) / lim.motion_step) + 1.0
+    s.motion_next = lim.motion_lo + j * lim.motion_step
+    return s.n_motion == mot.shape[0]
+
+
+class MotionSeries:
+    """The motion's time series in a run's sink (names ``motion_*``, docs/archive.md), filled from the
+    step loop's motion blocks by :meth:`flush`."""
+
+    def __init__(self, sink, n: int, with_ring: bool):
+        self.n = n
+        self.cols = motion_columns(n)
+        ts = sink.timeseries
+        self.rollers_xy = ts("motion_roller_position", (n, 2), "m", "roller centres (x, y), rollers = pockets")
+        self.rollers_a = ts("motion_roller_angle", (n,), "rad", "roller angles (counter-clockwise, unwrapped)")
+        self.cage_xy = ts("motion_cage_position", (2,), "m", "cage centre (x, y); y up, radial load along -y")
+        self.cage_a = ts("motion_cage_angle", (), "rad", "cage angle (counter-clockwise, unwrapped; 0 at t = 0)")
+        self.ring = ts("motion_inner_ring_centre", (2,), "m", "inner-ring centre (x, y)") if with_ring else None
+        self.force = ts("motion_pocket_force", (n, 2), "N",
+                        "mean circumferential roller force on each pocket's rear (column 0, braking the roller) "
+                        "and front face (column 1, driving the cage) since the previous sample")
+
+    def flush(self, block: np.ndarray, k: int) -> None:
+        """Append the first ``k`` rows of ``block`` (:func:`motion_columns`)."""
+        if not k:
+            return
+        rows = block[:k]
+        c, n = self.cols, self.n
+        step = rows[:, 1].astype(np.int64)
+        t = rows[:, 0].copy()
+        bodies = rows[:, c["bodies"]].reshape(k, n + 1, 3)
+        self.rollers_xy.append(step, t, bodies[:, :n, :2].copy())
+        self.rollers_a.append(step, t, bodies[:, :n, 2].copy())
+        self.cage_xy.append(step, t, bodies[:, n, :2].copy())
+        self.cage_a.append(step, t, bodies[:, n, 2].copy())
+        if self.ring is not None:
+            self.ring.append(step, t, rows[:, c["ring"]].copy())
+        self.force.append(step, t, rows[:, c["force"]].reshape(k, n, 2).copy())
+
+
 drop_stale_caches(__name__, (_reduced_core,))  # record_step compiles in the face codes of reduced/core.py

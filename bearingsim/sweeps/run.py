@@ -203,7 +203,7 @@ def _clean_temporaries(cases_dir: Path) -> None:
         p.unlink(missing_ok=True)
 
 
-def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
+def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep", unit: str = "case"):
     if not enabled:
         return None
     from tqdm import tqdm
@@ -212,7 +212,7 @@ def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep"):
 
     tqdm.monitor_interval = 0  # no monitor thread
     size = shutil.get_terminal_size((100, 24))  # a terminal that reports no size (a bare pty) gets 100 x 24
-    return tqdm(total=total, desc=desc, unit="case", file=sys.stderr, ncols=min(max(size.columns, 60), 160),
+    return tqdm(total=total, desc=desc, unit=unit, file=sys.stderr, ncols=min(max(size.columns, 60), 160),
                 nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 

@@ -1,0 +1,468 @@
+"""See the bearing move: an animation (MP4 or GIF) of a multibody run's stored motion (docs/animation.md).
+
+A multibody run stores every body's pose over a window of cage rotations (``[output] motion_*``, the
+``/observables/motion_*`` time series of docs/archive.md). :func:`render` draws one frame per
+``1 / fps`` s of video, the video showing each cage rotation in :data:`SECONDS_PER_ROTATION` s, from the
+archive alone:
+
+* the bearing in the plane, the clearances drawn ``K`` times their size (the radial clearance of the
+  raceways, each roller's offset in its pocket and the pocket's clearance, the cage's and the inner ring's
+  offsets from the axis; the parts themselves at their size), ``K`` stated on the frame;
+* each roller with a mark that turns with it (its spin);
+* each pocket face coloured by the mean circumferential force on it since the previous pose;
+* impacts (``/results/impacts``) flashing on their face for three frames, larger for a larger impulse;
+* the cage centre's trail over the last cage rotation in an inset, time, cage rotation, pocket 0's
+  angle theta from the load-zone centre and the cage slip as text.
+
+Frames are drawn by matplotlib's Agg canvas (the user's backend is never touched), MP4 written by the
+ffmpeg binary that ``imageio-ffmpeg`` packages (H.264), GIF by Pillow; the file appears complete or not at
+all (:func:`bearingsim.outputs.atomic_file`).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from bearingsim.errors import UserError
+
+__all__ = ["has_motion", "render", "render_result", "SECONDS_PER_ROTATION"]
+
+#: seconds of video per cage rotation: at 30 fps a frame every 3 deg of cage travel, slow enough to follow
+#: a roller across its pocket (at 6000 rpm a rotation takes 23 ms: the video is ~170 times slower)
+SECONDS_PER_ROTATION = 4.0
+#: frames an impact flashes for, and its opacity in each
+FLASH_ALPHA = (1.0, 0.55, 0.25)
+#: the automatic exaggeration makes the drawn pocket play (K s / 2) about this fraction of the roller radius
+AUTO_PLAY_FRACTION = 0.3
+MAX_EXAGGERATION = 1000.0
+MAX_FPS = 120.0
+#: the frame: pixels (multiples of 16, as H.264's macro blocks) and the bearing's square view in it
+WIDTH_PX, HEIGHT_PX, DPI = 1024, 768, 100
+VIEW_RECT = (0.0, 0.0, HEIGHT_PX / WIDTH_PX, 1.0)  # figure fraction: the left 768 x 768 px
+#: colours; the cage's is not used by any other part, so a test can find the cage in a frame
+CAGE_COLOUR = "#c9a227"
+TRAIL_COLOUR = "#d95f02"
+RING_COLOUR = "#b4bcc6"
+ROLLER_COLOUR = "#5f6b78"
+FORCE_COLOURS = ("#d0d0d0", "#4292c6", "#08306b")  # face force colour scale: no force light grey, then blues
+FLASH_COLOUR = "#e4002b"
+MOTION = "motion_roller_position"  # the series whose presence means an archive holds motion
+#: the archive paths an animation reads (besides the scenario and the summary)
+ANIMATION_DATA = ("observables", "results/impacts")
+
+
+def has_motion(path) -> bool:
+    """True when the archive at ``path`` holds the bodies' motion (a one-line UserError for a bad file)."""
+    from bearingsim import archive
+
+    return archive.has_observable(path, MOTION)
+
+
+def _no_motion(result, where) -> UserError:
+    if result.model != "multibody":
+        return UserError(f"{where}: an archive of the {result.model} model holds no motion (only multibody runs "
+                         f"store it); run a multibody scenario")
+    return UserError(f"{where}: holds no motion; run it again with output.motion_rotations > 0 (e.g. 'bearingsim "
+                     f"run SCENARIO --set output.motion_rotations=2')")
+
+
+def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None) -> Path:
+    """Animate the motion stored in the archive at ``path`` into ``out`` (``.mp4`` or ``.gif``); return
+    ``out``.
+
+    ``rotations``: ``(a, b)``, the recorded cage rotations to show (default: the whole stored window);
+    ``exaggerate``: the factor K the clearances are drawn at (None: automatic, about 0.3 roller radii of
+    drawn pocket play); ``fps``: frames per second of video; ``progress``: ``progress(done, total)``
+    called after each frame. One-line :class:`UserError` for an archive without motion, a window outside
+    the stored one, or an output that is not ``.mp4``/``.gif`` or not replaceable.
+    """
+    from bearingsim.simulation import load
+
+    out = _check_output(out)
+    result = load(path, only=ANIMATION_DATA)
+    return render_result(result, out, rotations=rotations, exaggerate=exaggerate, fps=fps, progress=progress,
+                         where=str(path))
+
+
+def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progress=None, where="result") -> Path:
+    """:func:`render` of a result in memory (``Result.animate``) or read back."""
+    out = _check_output(out)
+    if MOTION not in result.series:
+        raise _no_motion(result, where)
+    fps = _check_number(fps, "fps", 1.0, MAX_FPS)
+    motion = _Motion(result)
+    a, b = motion.window(rotations, where)
+    n_frames = max(1, int(round((b - a) * SECONDS_PER_ROTATION * fps)))
+    frame_rot = a + (b - a) * np.arange(n_frames) / n_frames
+    rows = motion.rows_at(frame_rot)
+    k = _exaggeration(result.parameters, exaggerate)
+    drawing = _Drawing(result, motion, k, rows)
+    frames = (drawing.draw(f) for f in range(n_frames))
+    if out.suffix.lower() == ".gif":
+        _write_gif(out, frames, fps, n_frames, progress)
+    else:
+        _write_mp4(out, frames, fps, n_frames, progress)
+    return out
+
+
+# --- inputs --------------------------------------------------------------------------------------------
+def _check_output(out) -> Path:
+    from bearingsim import outputs
+
+    out = Path(out)
+    suffix = out.suffix.lower()
+    if suffix not in (".mp4", ".gif"):
+        raise UserError(f"{out}: animation path must end in .mp4 or .gif (got {out.suffix or 'no suffix'!r})")
+    if not out.parent.is_dir():
+        raise UserError(f"{out}: folder {out.parent} does not exist")
+    if suffix == ".gif":
+        outputs.check_replaceable(out, b"GIF8", "GIF animation")
+    else:
+        outputs.check_replaceable(out, _is_mp4, "MP4 animation")
+    return out
+
+
+def _is_mp4(path) -> bool:
+    with open(path, "rb") as fh:
+        return fh.read(8)[4:8] == b"ftyp"
+
+
+def _check_number(value, name, lo, hi) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise UserError(f"{name}: expected a number, got {value!r}") from None
+    if not (lo <= v <= hi):
+        raise UserError(f"{name}: {value!r} is outside {lo:g} .. {hi:g}")
+    return v
+
+
+def _exaggeration(p, given) -> float:
+    """The factor K the clearances are drawn at: ``given``, or the 1-2-5 number at or below the one that
+    makes the drawn pocket play K s / 2 :data:`AUTO_PLAY_FRACTION` of the roller radius (10 for the NU214)."""
+    if given is not None:
+        return _check_number(given, "exaggerate", 1.0, MAX_EXAGGERATION)
+    g = p.bearing
+    want = AUTO_PLAY_FRACTION * g.roller_radius / (0.5 * g.pocket_clearance)
+    if want <= 1.0:
+        return 1.0
+    decade = 10.0 ** math.floor(math.log10(want))
+    return max(m * decade for m in (1.0, 2.0, 5.0) if m * decade <= want)
+
+
+class _Motion:
+    """The stored motion of a result, with each pose's place in the recorded cage rotations."""
+
+    def __init__(self, result):
+        s = result.series
+        p = result.parameters
+        self.sign = p.operating.sign
+        self.time = s["motion_cage_angle"].time
+        self.cage_angle = s["motion_cage_angle"].value
+        self.cage_xy = s["motion_cage_position"].value
+        self.rollers_xy = s["motion_roller_position"].value
+        self.rollers_angle = s["motion_roller_angle"].value
+        self.force = s["motion_pocket_force"].value  # (M, n, [rear, front])
+        ring = s.get("motion_inner_ring_centre")
+        self.ring_xy = None if ring is None else ring.value
+        # recorded cage rotations: the cage's travel from t = 0, less the warm-up
+        self.rotation = self.sign * self.cage_angle / (2.0 * math.pi) - p.numerics.warmup_rotations
+        slip = s.get("cage_slip")
+        self.slip = (None if slip is None or not len(slip.time)
+                     else np.interp(self.time, slip.time, slip.value))
+
+    def window(self, rotations, where) -> tuple[float, float]:
+        lo, hi = float(self.rotation[0]), float(self.rotation[-1])
+        if rotations is None:
+            return lo, hi
+        try:
+            a, b = (float(v) for v in rotations)
+        except (TypeError, ValueError):
+            raise UserError(f"rotations: expected two numbers a, b (recorded cage rotations), got {rotations!r}") from None
+        tol = 0.5 * float(np.median(np.diff(self.rotation))) if len(self.rotation) > 1 else 0.0
+        if not (math.isfinite(a) and math.isfinite(b) and a < b):
+            raise UserError(f"rotations {a:g}:{b:g}: expected a < b")
+        if a < lo - tol or b > hi + tol:
+            raise UserError(f"rotations {a:g}:{b:g}: outside the stored motion of {where} (recorded rotations "
+                            f"{lo:.3f} .. {hi:.3f}; output.motion_* set what a run stores)")
+        return a, b
+
+    def rows_at(self, rot) -> np.ndarray:
+        """Index of the pose nearest to each of the recorded rotations ``rot``."""
+        j = np.clip(np.searchsorted(self.rotation, rot), 1, len(self.rotation) - 1)
+        before = rot - self.rotation[j - 1] < self.rotation[j] - rot
+        return np.where(before, j - 1, j)
+
+
+def view_half_width(p, k: float) -> float:
+    """Half the width [mm] of the square view of the bearing (:data:`VIEW_RECT`, centred on the bearing
+    axis, x to the right, y up) at exaggeration ``k``: the drawn outer ring and a margin."""
+    from bearingsim.multibody.core import paper_assumptions
+
+    g = p.bearing
+    pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
+    return (g.pitch_radius + 0.25 * k * pd + 1.5 * g.roller_radius) * 1e3 + 2.0
+
+
+def _force_cmap():
+    from matplotlib.colors import LinearSegmentedColormap
+
+    return LinearSegmentedColormap.from_list("bearingsim_face_force", FORCE_COLOURS)
+
+
+# --- frames --------------------------------------------------------------------------------------------
+def _annulus(r_in: float, r_out: float, points: int = 360):
+    """A matplotlib Path of the ring between ``r_in`` and ``r_out`` about the origin."""
+    from matplotlib.path import Path as MplPath
+
+    a = np.linspace(0.0, 2.0 * math.pi, points, endpoint=False)
+    ring = [np.column_stack([r * np.cos(a), r * np.sin(a)]) for r in (r_out, r_in)]
+    ring[1] = ring[1][::-1]  # the hole turns the other way (non-zero winding)
+    verts, codes = [], []
+    for v in ring:
+        verts += [*v, v[0]]
+        codes += [MplPath.MOVETO] + [MplPath.LINETO] * (len(v) - 1) + [MplPath.CLOSEPOLY]
+    return MplPath(np.array(verts), codes)
+
+
+def _face_forces(motion, rows) -> np.ndarray:
+    """(frames, n, [rear, front]) mean face force over each frame's interval [N]: the poses' forces are
+    means since the pose before, so their impulses are summed between two frames' poses."""
+    t = motion.time
+    dt = np.diff(t, prepend=t[0] - (t[1] - t[0] if len(t) > 1 else 0.0))
+    cum = np.cumsum(motion.force * dt[:, None, None], axis=0)
+    out = motion.force[rows].copy()
+    span = t[rows[1:]] - t[rows[:-1]]
+    ok = span > 0.0
+    out[1:][ok] = (cum[rows[1:]] - cum[rows[:-1]])[ok] / span[ok, None, None]
+    return out
+
+
+class _Drawing:
+    """The figure of an animation, made once; :meth:`draw` moves its parts to a frame's pose and returns
+    the frame's RGB pixels. Lengths in mm; clearances drawn ``k`` times their size (module docstring)."""
+
+    def __init__(self, result, motion, k: float, rows: np.ndarray):
+        from matplotlib.collections import EllipseCollection, LineCollection
+        from matplotlib.colors import Normalize
+        from matplotlib.patches import PathPatch
+
+        from bearingsim import laws
+        from bearingsim.multibody.core import paper_assumptions
+        from bearingsim.multibody.scene import pocket_angles
+        from bearingsim.plotting import figure
+
+        p = result.parameters
+        g = p.bearing
+        self.m, self.k, self.n, self.sign = motion, k, g.roller_count, p.operating.sign
+        self.rp, self.rr = g.pitch_radius * 1e3, g.roller_radius * 1e3
+        pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance * 1e3
+        self.pocket_a = pocket_angles(self.n, self.sign)
+        self.R = self.rr + 0.5 * k * g.pocket_clearance * 1e3  # drawn pocket radius
+        c_in = (g.cage_inner_radius or g.pitch_radius - 0.5 * g.roller_radius) * 1e3
+        c_out = (g.cage_outer_radius or g.pitch_radius + 0.5 * g.roller_radius) * 1e3
+        lo, hi = p.multibody.pocket_face_extent
+        if p.multibody.pocket_face_rule == "cage wall" or not (math.isfinite(lo) and math.isfinite(hi)):
+            lo, hi = laws.pocket_face_extent(self.rp, self.R, c_in, c_out)  # the drawn pocket in the drawn wall
+        psi = np.linspace(lo, hi, 9)
+        flat = np.isin(np.arange(self.n), list(p.multibody.flat_pockets))
+        # each face's points as (along u, along e_r) in units of R: arcs, or planes for flat pockets
+        self.face_u = np.where(flat[:, None], 1.0, np.cos(psi)[None, :])
+        self.face_r = np.where(flat[:, None], np.tan(psi)[None, :], np.sin(psi)[None, :])
+        r_outer = self.rp + 0.25 * k * pd + self.rr  # drawn raceways: a roller touching one touches it here
+        r_inner = self.rp - 0.25 * k * pd - self.rr
+        span = view_half_width(p, k)
+        self.fig = fig = figure(figsize=(WIDTH_PX / DPI, HEIGHT_PX / DPI), dpi=DPI)
+        fig.patch.set_facecolor("white")
+        ax = self.ax = fig.add_axes(VIEW_RECT)
+        ax.set_xlim(-span, span)
+        ax.set_ylim(-span, span)
+        ax.set_aspect("equal")
+        ax.axis("off")
+        self.span = span
+        self.cage = ax.add_patch(PathPatch(_annulus(c_in, c_out), facecolor=CAGE_COLOUR, edgecolor="none", zorder=1))
+        self.pockets = ax.add_collection(EllipseCollection(
+            2 * self.R, 2 * self.R, 0.0, units="xy", offsets=np.zeros((self.n, 2)), offset_transform=ax.transData,
+            facecolor="white", edgecolor="none", zorder=2))
+        self.outer = ax.add_patch(PathPatch(_annulus(r_outer, r_outer + 0.5 * self.rr), facecolor=RING_COLOUR,
+                                            edgecolor="0.45", lw=0.6, zorder=3))
+        self.ring = None
+        if motion.ring_xy is not None:
+            self.ring = ax.add_patch(PathPatch(_annulus(r_inner - 0.6 * self.rr, r_inner), facecolor=RING_COLOUR,
+                                               edgecolor="0.45", lw=0.6, zorder=3))
+        self.rollers = ax.add_collection(EllipseCollection(
+            2 * self.rr, 2 * self.rr, 0.0, units="xy", offsets=np.zeros((self.n, 2)), offset_transform=ax.transData,
+            facecolor=ROLLER_COLOUR, edgecolor="0.2", linewidth=0.6, zorder=4))
+        self.spin = ax.add_collection(LineCollection([], colors="white", linewidths=1.6, zorder=5))
+        self.rows = rows
+        self.forces = _face_forces(motion, rows)
+        top = float(np.percentile(self.forces, 99.5)) if self.forces.size else 0.0
+        self.norm = Normalize(0.0, top if top > 0.0 else 1.0)
+        self._flash_schedule(result)
+        self.cmap = _force_cmap()
+        self.faces = ax.add_collection(LineCollection([], cmap=self.cmap, norm=self.norm, linewidths=3.0,
+                                                      capstyle="round", zorder=6))
+        self.flash = ax.scatter(np.zeros(0), np.zeros(0), marker="*", s=[], zorder=7, linewidths=0)
+        self.label0 = ax.text(0, 0, "0", ha="center", va="center", fontsize=9, color="black", zorder=8)
+        self._static(result, p, k, pd, span)
+        # blitting: what moves is drawn, in this order, over the rest drawn once (text costs ~0.1 s a frame)
+        self.moving = [a for a in (self.cage, self.pockets, self.outer, self.ring, self.rollers, self.spin,
+                                   self.faces, self.flash, self.label0, self.state, self.trail, self.trail_now)
+                       if a is not None]
+        for a in self.moving:
+            a.set_animated(True)
+        fig.canvas.draw()
+        self.background = fig.canvas.copy_from_bbox(fig.bbox)
+
+    def _flash_schedule(self, result) -> None:
+        """Which frame each impact of the shown window first flashes in (the first frame at or after it)."""
+        imp = result.impacts
+        t_frames = self.m.time[self.rows]
+        first_dt = t_frames[1] - t_frames[0] if len(t_frames) > 1 else 0.0
+        if "time_s" not in imp or not len(t_frames):
+            self.imp_frame = np.zeros(0, dtype=np.int64)
+            return
+        t = np.asarray(imp["time_s"], dtype=float)
+        keep = (t > t_frames[0] - first_dt) & (t <= t_frames[-1])
+        self.imp_frame = np.searchsorted(t_frames, t[keep], side="left")
+        self.imp_pocket = np.asarray(imp["pocket"])[keep].astype(np.int64)
+        self.imp_front = np.asarray(imp["face"])[keep] == "front"
+        j = np.asarray(imp["impulse_Ns"], dtype=float)[keep]
+        self.imp_size = 60.0 + 340.0 * np.sqrt(j / j.max()) if len(j) and j.max() > 0 else np.full(len(j), 60.0)
+
+    def _static(self, result, p, k, pd, span) -> None:
+        """What does not move: the load zone, the texts, the force scale, the trail's inset."""
+        from matplotlib.cm import ScalarMappable
+
+        ax, fig = self.ax, self.fig
+        phi = result.summary.get("load_zone_half_angle_deg", float("nan"))
+        if math.isfinite(phi) and phi > 0.0:
+            for a in (-90.0 - phi, -90.0 + phi):
+                r = np.array([0.35, 0.8]) * (self.rp - self.rr)
+                ax.plot(r * math.cos(math.radians(a)), r * math.sin(math.radians(a)), color="0.6", lw=0.8, ls="--")
+            ax.text(0.0, -0.5 * (self.rp - self.rr), f"load zone\n±{phi:.1f}°", ha="center", va="center",
+                    fontsize=8, color="0.4")
+        x0 = VIEW_RECT[2] + 0.01
+        head = result.title().splitlines()[0]
+        fig.text(x0, 0.975, head.replace(": ", ":\n", 1), fontsize=8.5, va="top", wrap=True)
+        g = p.bearing
+        fig.text(x0, 0.885, f"clearances drawn ×{k:g}\n(pocket s = {g.pocket_clearance * 1e3:.3g} mm, "
+                            f"radial {pd:.3g} mm;\nparts at their size)", fontsize=8, va="top", color="0.15")
+        self.state = fig.text(x0, 0.77, "", fontsize=9, va="top", family="monospace")
+        fig.text(x0, 0.545, "pocket faces: mean circumferential\nforce on the face [N]", fontsize=8, va="top")
+        cax = fig.add_axes((x0 + 0.005, 0.47, 0.22, 0.022))
+        fig.colorbar(ScalarMappable(self.norm, self.cmap), cax=cax, orientation="horizontal")
+        cax.tick_params(labelsize=7)
+        fig.text(x0, 0.43, "★ impact (size ∝ impulse)", fontsize=8, va="top", color=FLASH_COLOUR)
+        c_um = self.m.cage_xy * 1e6
+        lim = max(1.0, 1.15 * float(np.max(np.abs(c_um)))) if c_um.size else 1.0
+        tax = self.trail_ax = fig.add_axes((x0 + 0.035, 0.05, 0.2, 0.3))
+        tax.set_xlim(-lim, lim)
+        tax.set_ylim(-lim, lim)
+        tax.set_aspect("equal")
+        tax.tick_params(labelsize=7)
+        tax.plot([0.0], [0.0], "k+", ms=8)
+        tax.set_title("cage centre [µm],\nlast cage rotation", fontsize=8)
+        (self.trail,) = tax.plot([], [], lw=0.8, color=TRAIL_COLOUR)
+        (self.trail_now,) = tax.plot([], [], "o", ms=4, color="black")
+
+    def draw(self, f: int) -> np.ndarray:
+        """The RGB pixels (HEIGHT_PX, WIDTH_PX, 3) of frame ``f``."""
+        m, k, j = self.m, self.k, int(self.rows[f])
+        cage = m.cage_xy[j] * 1e3
+        alpha = m.cage_angle[j] + self.pocket_a
+        e_r = np.column_stack([np.cos(alpha), np.sin(alpha)])
+        e_t = self.sign * np.column_stack([-e_r[:, 1], e_r[:, 0]])
+        centred = self.rp * e_r  # pocket centres of a cage on the axis
+        pockets = k * cage + centred
+        rollers = centred + k * (m.rollers_xy[j] * 1e3 - cage - centred)
+        self.pockets.set_offsets(pockets)
+        self.rollers.set_offsets(rollers)
+        self.cage.set_transform(self._shift(k * cage))
+        if self.ring is not None:
+            self.ring.set_transform(self._shift(k * m.ring_xy[j] * 1e3))
+        a = m.rollers_angle[j]
+        mark = rollers + self.rr * np.column_stack([np.cos(a), np.sin(a)])
+        self.spin.set_segments(np.stack([rollers, mark], axis=1))
+        # faces: [pocket, rear/front, point, xy]; u = -e_t on the rear face, +e_t on the front
+        u = np.stack([-e_t, e_t], axis=1)
+        pts = (pockets[:, None, None, :] + self.R * (self.face_u[:, None, :, None] * u[:, :, None, :]
+                                                     + self.face_r[:, None, :, None] * e_r[:, None, None, :]))
+        self.faces.set_segments(pts.reshape(2 * self.n, -1, 2))
+        self.faces.set_array(self.forces[f].reshape(-1))
+        self._flashes(f, pockets, u)
+        self.label0.set_position(pockets[0] - (self.R + 0.35 * self.rr) * e_r[0])
+        self._text(f, j)
+        canvas = self.fig.canvas
+        canvas.restore_region(self.background)
+        for a in self.moving:
+            self.fig.draw_artist(a)
+        return np.asarray(canvas.buffer_rgba())[:, :, :3].copy()
+
+    def _shift(self, xy):
+        from matplotlib.transforms import Affine2D
+
+        return Affine2D().translate(float(xy[0]), float(xy[1])) + self.ax.transData
+
+    def _flashes(self, f, pockets, u) -> None:
+        age = f - self.imp_frame
+        on = (age >= 0) & (age < len(FLASH_ALPHA))
+        i = self.imp_pocket[on] if on.any() else np.zeros(0, dtype=np.int64)
+        face = self.imp_front[on].astype(np.int64) if on.any() else np.zeros(0, dtype=np.int64)
+        self.flash.set_offsets(pockets[i] + self.R * u[i, face] if len(i) else np.zeros((0, 2)))
+        colours = np.zeros((len(i), 4))
+        colours[:, :3] = (0.894, 0.0, 0.169)
+        colours[:, 3] = np.asarray(FLASH_ALPHA)[age[on]] if len(i) else []
+        self.flash.set_facecolors(colours)
+        self.flash.set_sizes(self.imp_size[on] if len(i) else [])
+
+    def _text(self, f, j) -> None:
+        m = self.m
+        theta = math.degrees((self.sign * (m.cage_angle[j] + self.pocket_a[0] + 0.5 * math.pi)) % (2.0 * math.pi))
+        slip = f"{100.0 * m.slip[j]:7.3f} %" if m.slip is not None else "      -"
+        self.state.set_text(f"t          {m.time[j]:9.6f} s\ncage turn  {m.rotation[j]:9.3f}\n"
+                            f"θ pocket 0 {theta:7.1f}°\ncage slip  {slip}\nframe      {f + 1:5d}")
+        lo = int(np.searchsorted(m.rotation, m.rotation[j] - 1.0))
+        c = m.cage_xy[lo:j + 1] * 1e6
+        self.trail.set_data(c[:, 0], c[:, 1])
+        self.trail_now.set_data([c[-1, 0]], [c[-1, 1]])
+
+
+# --- writers -------------------------------------------------------------------------------------------
+def _write_mp4(out: Path, frames, fps: float, total: int, progress) -> None:
+    """H.264 MP4 through the ffmpeg binary of ``imageio-ffmpeg``, into a temporary file renamed at the end."""
+    import imageio_ffmpeg
+
+    from bearingsim.outputs import atomic_file, temporary_name
+
+    with atomic_file(out):  # ffmpeg writes the temporary file by its name; renamed when complete
+        writer = imageio_ffmpeg.write_frames(
+            str(temporary_name(out)), (WIDTH_PX, HEIGHT_PX), fps=fps, codec="libx264", quality=7,
+            macro_block_size=16, output_params=["-preset", "veryfast", "-f", "mp4"], ffmpeg_log_level="error")
+        writer.send(None)
+        try:
+            for i, frame in enumerate(frames):
+                writer.send(frame)
+                if progress is not None:
+                    progress(i + 1, total)
+        finally:
+            writer.close()
+
+
+def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
+    """GIF through Pillow (each frame on an adaptive palette), written atomically."""
+    from PIL import Image
+
+    from bearingsim.outputs import atomic_file
+
+    images = []
+    for i, frame in enumerate(frames):
+        images.append(Image.fromarray(frame).quantize(colors=128, method=Image.Quantize.FASTOCTREE,
+                                                      dither=Image.Dither.NONE))
+        if progress is not None:
+            progress(i + 1, total)
+    with atomic_file(out) as fh:
+        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps,
+                       loop=0, optimize=False, disposal=1)

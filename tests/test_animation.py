@@ -1,0 +1,221 @@
+"""Motion in the archive and ``bearingsim animate`` (issue 27, docs/animation.md). Each test says why its check
+must hold.
+
+One short run of the fast scene (rigid raceways, 6000 rpm, 1 warm-up + 1 recorded rotation, the motion of the
+whole recorded rotation at 60 poses per rotation) is shared, with its twin that stores no motion.
+"""
+import math
+import subprocess
+
+import numpy as np
+import pytest
+
+import bearingsim
+from bearingsim import animation
+from bearingsim.cli import main
+from bearingsim.errors import UserError
+from bearingsim.multibody.scene import pocket_angles
+from tests.conftest import SCENARIOS
+
+pytestmark = pytest.mark.slow
+
+SPR = 60  # poses per cage rotation of the shared run
+
+
+def _scenario(motion_rotations):
+    return bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+        "multibody.raceway_contact": "rigid", "numerics.rotations": 1, "numerics.warmup_rotations": 1,
+        "output.motion_rotations": motion_rotations, "output.motion_samples_per_rotation": SPR})
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    """(result in memory, its archive, the archive of the same run without motion)."""
+    folder = tmp_path_factory.mktemp("anim")
+    res = bearingsim.run(_scenario(1.0))
+    plain = bearingsim.run(_scenario(0.0))
+    return res, res.save(folder / "motion.h5"), plain.save(folder / "plain.h5"), plain
+
+
+def _gif_frames(path):
+    from PIL import Image, ImageSequence
+
+    with Image.open(path) as im:
+        return [np.asarray(f.convert("RGB")) for f in ImageSequence.Iterator(im)]
+
+
+def test_motion_changes_no_number_and_is_where_the_run_says(runs):
+    """Recording poses only reads the bodies' states (and zeroes an accumulator nothing else reads): the
+    per-rotation arrays and the summary must be bit-identical with and without motion. The poses must be
+    one per 1/SPR cage rotation over the window (1 rotation: SPR + 1 poses, the first at the start of the
+    recorded period, each at the first step past its due travel), and every roller i must sit in pocket i: its centre within s/2 of the pocket centre along
+    the circumference (where both faces are, at psi = 0), plus the 1 % of s the model allows a roller to
+    overlap a face (PENETRATION_LIMIT). (Radially a pocket holds a roller only as far as its arc faces
+    reach: ~0.2 mm here, and the cage rides ~0.2 mm off the axis.)"""
+    res, _, _, plain = runs
+    for k, v in plain.per_rotation.items():
+        assert np.array_equal(v, res.per_rotation[k], equal_nan=True), k
+    assert res.summary == plain.summary
+    assert not any(k.startswith("motion_") for k in plain.series)
+    s = res.series
+    angle = s["motion_cage_angle"].value
+    assert len(angle) == SPR + 1
+    p = res.parameters
+    travel = p.operating.sign * angle / (2.0 * math.pi) - p.numerics.warmup_rotations
+    # pose j is taken after the first step that reaches j / SPR: at most one step's travel later (the cage
+    # turns ~omega_c dt per step; twice that bounds its speed's excursions)
+    late = travel - np.arange(len(travel)) / SPR
+    assert np.all(late >= 0.0)
+    assert late.max() < 2.0 * p.operating.omega_c * res.summary["dt_s"] / (2.0 * math.pi)
+    g = p.bearing
+    a = angle[:, None] + pocket_angles(g.roller_count, p.operating.sign)[None, :]
+    centres = s["motion_cage_position"].value[:, None, :] + g.pitch_radius * np.stack([np.cos(a), np.sin(a)], -1)
+    e_t = p.operating.sign * np.stack([-np.sin(a), np.cos(a)], -1)
+    along = np.abs(((s["motion_roller_position"].value - centres) * e_t).sum(-1))
+    assert along.max() <= 0.5 * g.pocket_clearance * 1.01
+    assert along.max() > 0.4 * g.pocket_clearance  # the rollers do cross their pockets
+    # the face forces are the circumferential impulses of the steps between two poses over their time: summed
+    # over the window (poses 1..SPR) they are the front and rear impulses of the steps whose cage travel lies
+    # in the recorded rotation. Pocket 0's rotation is exactly that window (it starts at theta = 0), so they
+    # are its I_acc and I_dec, to rounding (the other pockets' rotations start at other cage angles)
+    force = s["motion_pocket_force"].value
+    dt = np.diff(s["motion_cage_angle"].time)
+    impulse = (force[1:, 0, :] * dt[:, None]).sum(0)
+    assert impulse[1] == pytest.approx(res.per_rotation["I_acc"][0, 0], rel=1e-9)
+    assert impulse[0] == pytest.approx(res.per_rotation["I_dec"][0, 0], rel=1e-9)
+    assert impulse.min() > 0.0
+
+
+def test_gif_has_the_frames_of_its_window_and_fps(runs, tmp_path):
+    """Frames: one per 1/fps s of video, each cage rotation shown in SECONDS_PER_ROTATION s: rotations
+    0.25..0.5 at 12 fps are round(0.25 x 4 x 12) = 12 frames. Also ``Result.animate`` of the result in
+    memory (the same drawing)."""
+    res = runs[0]
+    out = res.animate(tmp_path / "a.gif", rotations=(0.25, 0.5), fps=12)
+    assert len(_gif_frames(out)) == round(0.25 * animation.SECONDS_PER_ROTATION * 12)
+
+
+def test_mp4_through_the_command_line(runs, tmp_path, capsys):
+    """``bearingsim animate ... --rotations a:b --fps F``: decoded back to raw RGB by the same packaged
+    ffmpeg, the MP4 has round((b - a) x 4 x F) frames of the frame's size, and the command says what it
+    wrote."""
+    import imageio_ffmpeg
+
+    out = tmp_path / "a.mp4"
+    assert main(["animate", str(runs[1]), "-o", str(out), "--rotations", "0.5:0.75", "--fps", "20"]) == 0
+    assert capsys.readouterr().out.strip() == f"wrote {out}"
+    raw = subprocess.run([imageio_ffmpeg.get_ffmpeg_exe(), "-v", "error", "-i", str(out), "-f", "rawvideo",
+                          "-pix_fmt", "rgb24", "-"], capture_output=True, check=True, timeout=120).stdout
+    frames = np.frombuffer(raw, np.uint8).reshape(-1, animation.HEIGHT_PX, animation.WIDTH_PX, 3)
+    assert len(frames) * animation.HEIGHT_PX * animation.WIDTH_PX * 3 == len(raw)
+    assert len(frames) == round(0.25 * animation.SECONDS_PER_ROTATION * 20)
+    assert frames[-1].std() > 10.0  # a drawing, not a blank frame
+    assert not [p for p in tmp_path.iterdir() if p.name != "a.mp4"]  # no temporary file left
+
+
+def _cage_centre_px(frame, guess):
+    """Centre (col, row) [px] of the circle through the outer edges of the cage's bars in ``frame``: the
+    outermost pixel of CAGE_COLOUR in each degree around ``guess``, a least-squares circle through them,
+    fitted again without the points more than 2 px, then 1 px, off it (a bar whose edge an impact star or a face's
+    end covers). The outer edge, unlike the bars' centroid, is not moved by what is drawn over the bars
+    (rollers, face arcs, stars): it lies beyond the faces' ends."""
+    rgb = np.array([int(animation.CAGE_COLOUR[i:i + 2], 16) for i in (1, 3, 5)])
+    view = frame[:, :animation.HEIGHT_PX]  # the bearing's square
+    rows, cols = np.nonzero(np.abs(view.astype(int) - rgb).max(axis=-1) <= 12)
+    x, y = cols + 0.5 - guess[0], rows + 0.5 - guess[1]
+    r = np.hypot(x, y)
+    b = ((np.arctan2(y, x) + math.pi) / (2 * math.pi) * 360).astype(int) % 360
+    best = np.full(360, -1.0)
+    np.maximum.at(best, b, r)
+    edge = (r == best[b]) & (r > 0.8 * r.max())
+    px, py = x[edge], y[edge]
+    for off in (2.0, 1.0, None):
+        a = np.column_stack([2 * px, 2 * py, np.ones_like(px)])
+        (cx, cy, c), *_ = np.linalg.lstsq(a, px**2 + py**2, rcond=None)
+        if off is None:
+            break
+        keep = np.abs(np.hypot(px - cx, py - cy) - math.sqrt(c + cx**2 + cy**2)) < off
+        px, py = px[keep], py[keep]
+    return np.array([cx + guess[0], cy + guess[1]]), len(px)
+
+
+def test_the_cage_is_drawn_where_the_archive_says(runs, tmp_path):
+    """The cage is drawn in CAGE_COLOUR, which nothing else uses, as the ring between its inner and outer
+    diameters less the pockets, centred on K times the archive's cage centre (the clearances drawn K
+    times): the circle through its bars' outer edges must be centred there, to 2 px (anti-aliased edges on
+    the GIF's palette and the 1-degree bins: measured up to 1.3 px; the cage moves 0.1 px per pose). The cage is
+    ~200 um off the axis at 6000 rpm: K = 20 draws it ~24 px off, so a cage drawn on the axis (or not
+    exaggerated) fails."""
+    res, path = runs[0], runs[1]
+    k, a, b, fps = 20.0, 0.4, 0.6, 10
+    frames = _gif_frames(animation.render(path, tmp_path / "c.gif", rotations=(a, b), exaggerate=k, fps=fps))
+    p = res.parameters
+    s = res.series
+    travel = p.operating.sign * s["motion_cage_angle"].value / (2 * math.pi) - p.numerics.warmup_rotations
+    half = animation.view_half_width(p, k)
+    side = animation.HEIGHT_PX  # the view is the left HEIGHT_PX x HEIGHT_PX square
+    errors, shifts = [], []
+    for f, frame in enumerate(frames):
+        pose = int(np.argmin(np.abs(travel - (a + (b - a) * f / len(frames)))))
+        c = k * s["motion_cage_position"].value[pose] * 1e3  # drawn cage centre [mm]
+        want = np.array([(c[0] + half) / (2 * half) * side, (half - c[1]) / (2 * half) * side])  # (col, row) px
+        got, points = _cage_centre_px(frame, (side / 2, side / 2))
+        assert points > 30  # degrees of bar edge: about half of what the 16 bars show (~3.5 deg each)
+        errors.append(np.hypot(*(got - want)))
+        shifts.append(np.hypot(*(want - side / 2)))
+    assert len(frames) == round((b - a) * animation.SECONDS_PER_ROTATION * fps)
+    assert min(shifts) > 10.0
+    assert max(errors) < 2.0, (errors, shifts)
+
+
+def test_an_archive_without_motion_is_refused_in_one_line(runs, tmp_path, capsys):
+    """No motion: exit 2, one line naming the archive and the key to set, no traceback, no file left."""
+    out = tmp_path / "x.mp4"
+    assert not animation.has_motion(runs[2]) and animation.has_motion(runs[1])
+    assert main(["animate", str(runs[2]), "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "output.motion_rotations" in err and str(runs[2]) in err
+    assert "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("window, words", [("0.5-0.7", "expected a:b"), ("0.7:0.5", "a < b"),
+                                           ("nan:1", "a < b"), ("3:4", "outside the stored motion")])
+def test_bad_rotations_are_refused_in_one_line(runs, tmp_path, capsys, window, words):
+    """A window that is not a:b, not increasing, or outside the stored poses (recorded rotations 0..1 here):
+    exit 2, one line naming --rotations or the window, nothing written."""
+    out = tmp_path / "x.gif"
+    assert main(["animate", str(runs[1]), "-o", str(out), "--rotations", window]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and words in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_output_and_options_are_refused(runs, tmp_path):
+    """Only .mp4 and .gif; a user's file of another kind at the output path is kept; K and fps in range."""
+    with pytest.raises(UserError, match=r"\.mp4 or \.gif"):
+        animation.render(runs[1], tmp_path / "a.avi")
+    mine = tmp_path / "mine.gif"
+    mine.write_text("not a gif")
+    with pytest.raises(UserError, match="not replaced"):
+        animation.render(runs[1], mine)
+    assert mine.read_text() == "not a gif"
+    with pytest.raises(UserError, match="exaggerate"):
+        animation.render(runs[1], tmp_path / "b.gif", exaggerate=0.5)
+    with pytest.raises(UserError, match="fps"):
+        animation.render(runs[1], tmp_path / "b.gif", fps=0)
+
+
+def test_motion_window_keys_are_checked():
+    """A given start must leave the window inside the recorded rotations (naming the key); "last" with a
+    window longer than the run stores the whole run; the pose count is bounded."""
+    with pytest.raises(UserError, match="output.motion_start_rotation"):
+        bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+            "output.motion_start_rotation": 39.5, "output.motion_rotations": 1})
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+        "numerics.rotations": 1, "output.motion_rotations": 5})
+    nu = bearingsim.parameters.Parameters.from_scenario(sc).numerics
+    assert (nu.motion_start, nu.motion_rotations) == (0.0, 1.0)
+    with pytest.raises(UserError, match="output.motion_rotations"):
+        bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+            "output.motion_rotations": 40, "output.motion_samples_per_rotation": 10000})

@@ -68,7 +68,7 @@ def _no_motion(result, where) -> UserError:
                      f"run SCENARIO --set output.motion_rotations=2')")
 
 
-def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None) -> Path:
+def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None, last=None) -> Path:
     """Animate the motion stored in the archive at ``path`` into ``out`` (``.mp4`` or ``.gif``); return
     ``out``.
 
@@ -82,18 +82,22 @@ def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None)
 
     out = _check_output(out)
     result = load(path, only=ANIMATION_DATA)
-    return render_result(result, out, rotations=rotations, exaggerate=exaggerate, fps=fps, progress=progress,
+    return render_result(result, out, rotations=rotations, exaggerate=exaggerate, fps=fps, progress=progress, last=last,
                          where=str(path))
 
 
-def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progress=None, where="result") -> Path:
-    """:func:`render` of a result in memory (``Result.animate``) or read back."""
+def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progress=None, where="result",
+                  last=None) -> Path:
+    """:func:`render` of a result in memory (``Result.animate``) or read back; ``last``: only the last so many
+    cage rotations of the window (a short clip, as the report embeds)."""
     out = _check_output(out)
     if MOTION not in result.series:
         raise _no_motion(result, where)
     fps = _check_number(fps, "fps", 1.0, MAX_FPS)
     motion = _Motion(result)
     a, b = motion.window(rotations, where)
+    if last is not None:
+        a = max(a, b - float(last))
     n_frames = max(1, int(round((b - a) * SECONDS_PER_ROTATION * fps)))
     frame_rot = a + (b - a) * np.arange(n_frames) / n_frames
     rows = motion.rows_at(frame_rot)

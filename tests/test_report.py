@@ -4,8 +4,6 @@ The browser is the distribution's Chromium (/usr/bin/chromium, Debian's package 
 playwright; without it these tests FAIL, saying how to install it (the README's test command does).
 """
 import re
-import sys
-import types
 from pathlib import Path
 
 import numpy as np
@@ -108,30 +106,54 @@ def whole(runs):
     return runs / "m.h5"
 
 
-@pytest.fixture
-def no_animation_module(monkeypatch):
-    """This branch's state: no bearingsim.animation (the import fails whatever is installed)."""
-    monkeypatch.setitem(sys.modules, "bearingsim.animation", None)
-
-
 @pytest.mark.slow
-def test_report_of_a_run_archive_renders_in_chromium(whole, browser, tmp_path, no_animation_module):
+def test_report_of_a_run_archive_renders_in_chromium(whole, browser, tmp_path):
     out = bearingsim.report(whole, tmp_path / "m.html")
     seen = open_page(browser, out, SCREENSHOT)
-    assert_renders(seen, ["summary", "figures", "pockets", "checks", "scenario", "provenance"])
-    assert len(seen["images"]) == len(bearingsim.load(whole).FIGURES) == 4  # forces, impulses, orbit, wear
+    assert_renders(seen, ["summary", "figures", "animation", "pockets", "checks", "scenario", "provenance"])
+    figures = [i for i in seen["images"] if i["id"] != "animation"]
+    assert len(figures) == len(bearingsim.load(whole).FIGURES) == 4  # forces, impulses, orbit, wear
+    # the animation (bearingsim.animation.render of the archive's motion) decodes in the browser at the
+    # frame size animation.py draws
+    from bearingsim.animation import WIDTH_PX
+
+    anim = [i for i in seen["images"] if i["id"] == "animation"]
+    assert anim == [{"id": "animation", "complete": True, "width": WIDTH_PX, "src": "data:image/gif;base64,"}]
     assert SCREENSHOT.stat().st_size > 0
-    assert seen["pdf_pages"] >= 4  # printable: contents, then 6 sections with 4 figures, over several A4 pages
+    assert seen["pdf_pages"] >= 4  # printable: contents, then 7 sections with 4 figures, over several A4 pages
     text = seen["text"]
     # the checks of bearingsim run, measured from this archive, every one passed
     assert "inner-ring displacement within the Palmgren bound" in text and "FAILED" not in text
     assert text.count("passed") >= 5
     assert 'name = "multibody_6000rpm"' in text  # the scenario as TOML
     assert "git_commit" in text and "version_numpy" in text  # the provenance
+    assert not list(tmp_path.glob(".*tmp*"))
 
 
 @pytest.mark.slow
-def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path, no_animation_module):
+def test_the_embedded_clip_is_the_last_half_rotation(whole, tmp_path):
+    """The report embeds the last REPORT_CLIP_ROTATIONS cage rotations of the stored motion at
+    REPORT_CLIP_FPS: decoded back from the page, the GIF has (rotations x 4 s x fps) frames; as MP4 it is a
+    <video> element with the same frames."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    from bearingsim import animation, reports
+
+    html = bearingsim.report(whole, tmp_path / "a.html").read_text()
+    data = re.search(r'id="animation"[^>]*src="data:image/gif;base64,([^"]+)"', html)
+    data = data or re.search(r'src="data:image/gif;base64,([^"]+)"[^>]*id="animation"', html)
+    im = Image.open(io.BytesIO(base64.b64decode(data.group(1))))
+    want = round(reports.REPORT_CLIP_ROTATIONS * animation.SECONDS_PER_ROTATION * reports.REPORT_CLIP_FPS)
+    assert im.n_frames == want == 30
+    section = reports._animation_section(whole, "mp4")
+    assert section.blocks[0]["element"] == "video" and section.blocks[0]["src"].startswith("data:video/mp4;base64,")
+
+
+@pytest.mark.slow
+def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path):
     """Every value is autoescaped: a name that is an HTML tag adds no element (an unescaped <img src=x>
     would be an image that fails to load and a script that runs)."""
     out = bearingsim.report(runs / "r.h5", tmp_path / "r.html")
@@ -143,71 +165,15 @@ def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path, no_
     assert "<img src=x onerror=alert(1)>" in seen["text"]
 
 
-def _fake_animation(gif: bytes, calls: list):
-    """A stand-in for bearingsim.animation (a separate module, absent on a checkout without it):
-    ``has_motion`` and ``render`` with its signature, writing ``gif``."""
-    mod = types.ModuleType("bearingsim.animation")
-    mod.has_motion = lambda path: True
-
-    def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None):
-        calls.append((Path(path), Path(out)))
-        Path(out).write_bytes(gif)
-        return Path(out)
-
-    mod.render = render
-    return mod
-
-
-def _gif(frames=3, size=(40, 30)) -> bytes:
-    import io
-
-    from PIL import Image
-
-    ims = [Image.new("RGB", size, (60 * k, 120, 200)) for k in range(frames)]
-    buf = io.BytesIO()
-    ims[0].save(buf, format="GIF", save_all=True, append_images=ims[1:], duration=100, loop=0)
-    return buf.getvalue()
-
-
-@pytest.mark.slow
-def test_the_animation_is_embedded_and_loads(whole, browser, tmp_path, monkeypatch):
-    """The archive's animation, made by bearingsim.animation.render (here a stand-in writing a 3-frame
-    40 x 30 GIF), is embedded in its own section and decodes in the browser at its size."""
-    calls = []
-    monkeypatch.setitem(sys.modules, "bearingsim.animation", _fake_animation(_gif(), calls))
-    out = bearingsim.report(whole, tmp_path / "a.html")
-    assert [c[0] for c in calls] == [whole] and calls[0][1].suffix == ".gif"
-    seen = open_page(browser, out)
-    assert_renders(seen, ["summary", "figures", "animation"])
-    anim = [i for i in seen["images"] if i["id"] == "animation"]
-    assert anim == [{"id": "animation", "complete": True, "width": 40, "src": "data:image/gif;base64,"}]
-    assert not list(tmp_path.glob(".*tmp*"))
-
-
-@pytest.mark.slow
-def test_without_the_animation_module_there_is_no_animation_section(runs, tmp_path, no_animation_module):
+def test_an_archive_without_motion_has_no_animation_section(runs):
+    """A reduced-model archive holds no motion: no animation section, nothing rendered."""
     from bearingsim.reports import _animation_section
 
     assert _animation_section(runs / "r.h5") is None
-    html = bearingsim.report(runs / "r.h5", tmp_path / "r.html").read_text()
-    assert 'id="animation"' not in html
-
-
-def test_an_archive_without_motion_has_no_animation_section(runs, monkeypatch):
-    from bearingsim.reports import _animation_section
-
-    calls = []
-    mod = _fake_animation(_gif(), calls)
-    mod.has_motion = lambda path: False
-    monkeypatch.setitem(sys.modules, "bearingsim.animation", mod)
-    assert _animation_section(runs / "r.h5") is None and calls == []
-    monkeypatch.setattr(mod, "has_motion", lambda path: True)
-    section = _animation_section(runs / "r.h5", "mp4")
-    assert section.blocks[0]["element"] == "video" and section.blocks[0]["src"].startswith("data:video/mp4;base64,")
 
 
 @pytest.mark.slow
-def test_the_same_archive_gives_the_same_bytes(runs, tmp_path, no_animation_module):
+def test_the_same_archive_gives_the_same_bytes(runs, tmp_path):
     a = bearingsim.report(runs / "r.h5", tmp_path / "a.html").read_bytes()
     b = bearingsim.report(runs / "r.h5", tmp_path / "b.html").read_bytes()
     assert a == b
@@ -315,7 +281,7 @@ def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
 
 
 @pytest.mark.slow
-def test_a_report_replaces_its_own_earlier_report(runs, tmp_path, no_animation_module):
+def test_a_report_replaces_its_own_earlier_report(runs, tmp_path):
     out = tmp_path / "r.html"
     bearingsim.report(runs / "r.h5", out)
     first = out.stat().st_mtime_ns

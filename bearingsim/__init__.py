@@ -68,5 +68,13 @@ def report(path, out="report.html", *, animation: str | None = "gif"):
     return _report(path, out, animation=animation)
 
 
+def animate(path, out, **kw):
+    """Animate the motion stored in a multibody archive into ``out`` (.mp4 or .gif) and return its path
+    (:func:`bearingsim.simulation.animate`, docs/animation.md)."""
+    from bearingsim.simulation import animate as _animate
+
+    return _animate(path, out, **kw)
+
+
 __all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load", "sensitivity",
-           "uncertainty", "report"]
+           "uncertainty", "report", "animate"]

@@ -27,7 +27,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 
-__all__ = ["has_motion", "render", "render_result", "SECONDS_PER_ROTATION"]
+__all__ = ["has_motion", "render_result", "SECONDS_PER_ROTATION"]
 
 #: seconds of video per cage rotation: at 30 fps a frame every 3 deg of cage travel, slow enough to follow
 #: a roller across its pocket (at 6000 rpm a rotation takes 23 ms: the video is ~170 times slower)
@@ -68,29 +68,11 @@ def _no_motion(result, where) -> UserError:
                      f"run SCENARIO --set output.motion_rotations=2')")
 
 
-def render(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None, last=None) -> Path:
-    """Animate the motion stored in the archive at ``path`` into ``out`` (``.mp4`` or ``.gif``); return
-    ``out``.
-
-    ``rotations``: ``(a, b)``, the recorded cage rotations to show (default: the whole stored window);
-    ``exaggerate``: the factor K the clearances are drawn at (None: automatic, about 0.3 roller radii of
-    drawn pocket play); ``fps``: frames per second of video; ``progress``: ``progress(done, total)``
-    called after each frame. One-line :class:`UserError` for an archive without motion, a window outside
-    the stored one, or an output that is not ``.mp4``/``.gif`` or not replaceable.
-    """
-    from bearingsim.simulation import load
-
-    out = _check_output(out)
-    result = load(path, only=ANIMATION_DATA)
-    return render_result(result, out, rotations=rotations, exaggerate=exaggerate, fps=fps, progress=progress, last=last,
-                         where=str(path))
-
-
 def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progress=None, where="result",
                   last=None) -> Path:
     """:func:`render` of a result in memory (``Result.animate``) or read back; ``last``: only the last so many
     cage rotations of the window (a short clip, as the report embeds)."""
-    out = _check_output(out)
+    out = check_output(out)
     if MOTION not in result.series:
         raise _no_motion(result, where)
     fps = _check_number(fps, "fps", 1.0, MAX_FPS)
@@ -112,7 +94,9 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
 
 
 # --- inputs --------------------------------------------------------------------------------------------
-def _check_output(out) -> Path:
+def check_output(out) -> Path:
+    """``out`` as a Path, refused in one line unless it ends in .mp4 or .gif, its folder exists and it is
+    not a file bearingsim did not write."""
     from bearingsim import outputs
 
     out = Path(out)
@@ -203,7 +187,7 @@ class _Motion:
 def view_half_width(p, k: float) -> float:
     """Half the width [mm] of the square view of the bearing (:data:`VIEW_RECT`, centred on the bearing
     axis, x to the right, y up) at exaggeration ``k``: the drawn outer ring and a margin."""
-    from bearingsim.multibody.core import paper_assumptions
+    from bearingsim.parameters import paper_assumptions
 
     g = p.bearing
     pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
@@ -254,8 +238,7 @@ class _Drawing:
         from matplotlib.patches import PathPatch
 
         from bearingsim import laws
-        from bearingsim.multibody.core import paper_assumptions
-        from bearingsim.multibody.scene import pocket_angles
+        from bearingsim.parameters import paper_assumptions, pocket_angles
         from bearingsim.plotting import figure
 
         p = result.parameters

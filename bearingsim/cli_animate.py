@@ -23,7 +23,7 @@ def parse_rotations(text: str) -> tuple[float, float]:
 
 
 def _cmd_animate(args) -> int:
-    from bearingsim.animation import render
+    from bearingsim.simulation import animate as render
     from bearingsim.sweeps.run import _progress as progress_bar  # the bar of sweep, crosscheck and validate
 
     rotations = parse_rotations(args.rotations) if args.rotations is not None else None

@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from bearingsim import laws
 
 
@@ -280,3 +282,21 @@ def _worn_depth(w) -> tuple | None:
     front = w.worn_depth_front_um if w.worn_depth_front_um is not None else zero
     rear = w.worn_depth_rear_um if w.worn_depth_rear_um is not None else zero
     return tuple((tuple(x * 1e-6 for x in f), tuple(x * 1e-6 for x in r)) for f, r in zip(front, rear))
+
+
+def paper_assumptions(scene: str) -> bool:
+    """True for the scene that makes the reduced model's assumptions in the plane (no inner ring, no
+    traction, roller spin fixed, rollers held at the front of their pockets through the load zone):
+    ``reduced_equivalent``. Every other scene has the inner ring, traction and free spin."""
+    return scene == "reduced_equivalent"
+
+
+def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
+    """Cage-frame angles [rad] of the pocket centres at cage angle 0.
+
+    Pocket 0 sits at the bottom (load-zone centre); pocket ``i`` trails pocket 0 by ``i`` pitches,
+    so its angle from the load-zone centre, measured in the direction of cage rotation, starts at
+    ``-2 pi i / n``.
+    """
+    i = np.arange(roller_count)
+    return -0.5 * math.pi - sign * 2.0 * math.pi * i / roller_count

@@ -290,10 +290,11 @@ REPORT_CLIP_FPS = 15
 
 
 def _animation_section(archive, fmt: str | None = "gif") -> Section | None:
-    """The archive's animation (:func:`bearingsim.animation.render`: the last
+    """The archive's animation (:func:`bearingsim.simulation.animate`: the last
     :data:`REPORT_CLIP_ROTATIONS` cage rotations of its stored motion at :data:`REPORT_CLIP_FPS` frames per
     second) embedded, or None: no ``fmt``, or an archive without the bodies' motion."""
     from bearingsim import animation
+    from bearingsim.simulation import animate
 
     if fmt is None:
         return None
@@ -301,7 +302,7 @@ def _animation_section(archive, fmt: str | None = "gif") -> Section | None:
         return None
     mime, element = ANIMATIONS[fmt]
     with tempfile.TemporaryDirectory(prefix="bearingsim-report-") as tmp:
-        made = animation.render(archive, Path(tmp) / f"animation.{fmt}", last=REPORT_CLIP_ROTATIONS,
+        made = animate(archive, Path(tmp) / f"animation.{fmt}", last=REPORT_CLIP_ROTATIONS,
                                 fps=REPORT_CLIP_FPS)
         data = Path(made).read_bytes()
     block = {"kind": "animation", "element": element, "mime": mime, "src": _data_uri(data, mime),

@@ -136,7 +136,7 @@ class Result:
     def animate(self, out, **kw) -> Path:
         """Write an animation of this run's stored motion (``.mp4`` or ``.gif``) to ``out``; return the path.
         ``kw``: ``rotations=(a, b)``, ``exaggerate``, ``fps``, ``progress`` of
-        :func:`bearingsim.animation.render` (docs/animation.md). A multibody run stores the motion of
+        :func:`bearingsim.simulation.animate` (docs/animation.md). A multibody run stores the motion of
         the window its ``[output] motion_*`` keys set."""
         from bearingsim.animation import render_result
 

@@ -46,6 +46,24 @@ def load(path, only=None):
     return archive.read(path, model_module(archive.model_of(path)).RESULT, only=only)
 
 
+def animate(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None, last=None) -> Path:
+    """Animate the motion stored in the archive at ``path`` into ``out`` (``.mp4`` or ``.gif``); return
+    ``out`` (:func:`bearingsim.animation.render_result` of the archive read back; docs/animation.md).
+
+    ``rotations``: ``(a, b)``, the recorded cage rotations to show (default: the whole stored window);
+    ``last``: only the last so many cage rotations of it; ``exaggerate``: the factor K the clearances are
+    drawn at (None: automatic, about 0.3 roller radii of drawn pocket play); ``fps``: frames per second of
+    video; ``progress``: ``progress(done, total)`` called after each frame. One-line :class:`UserError` for
+    an archive without motion, a window outside the stored one, or an output that is not ``.mp4``/``.gif``
+    or not replaceable.
+    """
+    from bearingsim import animation
+
+    animation.check_output(out)
+    return animation.render_result(load(path, only=animation.ANIMATION_DATA), out, rotations=rotations,
+                                   exaggerate=exaggerate, fps=fps, progress=progress, last=last, where=str(path))
+
+
 #: what each archive command reads besides the scenario, the summary and the provenance
 #: (``show`` prints the scenario; ``compare`` and ``rerun`` compare summaries and per-rotation arrays)
 SCENARIO_ONLY: tuple[str, ...] = ()

@@ -24,11 +24,11 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
 def still(archive: Path, out: Path) -> None:
     from PIL import Image
 
-    from bearingsim import animation, load
+    from bearingsim import animate, load
 
     res = load(archive)
     with tempfile.TemporaryDirectory() as tmp:
-        gif = animation.render(archive, Path(tmp) / "a.gif", fps=30, rotations=_first_tenth(res))
+        gif = animate(archive, Path(tmp) / "a.gif", fps=30, rotations=_first_tenth(res))
         im = Image.open(gif)
         im.seek(im.n_frames - 1)
         im.convert("RGB").save(out, optimize=True)

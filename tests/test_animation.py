@@ -148,7 +148,7 @@ def test_the_cage_is_drawn_where_the_archive_says(runs, tmp_path):
     exaggerated) fails."""
     res, path = runs[0], runs[1]
     k, a, b, fps = 20.0, 0.4, 0.6, 10
-    frames = _gif_frames(animation.render(path, tmp_path / "c.gif", rotations=(a, b), exaggerate=k, fps=fps))
+    frames = _gif_frames(bearingsim.animate(path, tmp_path / "c.gif", rotations=(a, b), exaggerate=k, fps=fps))
     p = res.parameters
     s = res.series
     travel = p.operating.sign * s["motion_cage_angle"].value / (2 * math.pi) - p.numerics.warmup_rotations
@@ -194,16 +194,16 @@ def test_bad_rotations_are_refused_in_one_line(runs, tmp_path, capsys, window, w
 def test_bad_output_and_options_are_refused(runs, tmp_path):
     """Only .mp4 and .gif; a user's file of another kind at the output path is kept; K and fps in range."""
     with pytest.raises(UserError, match=r"\.mp4 or \.gif"):
-        animation.render(runs[1], tmp_path / "a.avi")
+        bearingsim.animate(runs[1], tmp_path / "a.avi")
     mine = tmp_path / "mine.gif"
     mine.write_text("not a gif")
     with pytest.raises(UserError, match="not replaced"):
-        animation.render(runs[1], mine)
+        bearingsim.animate(runs[1], mine)
     assert mine.read_text() == "not a gif"
     with pytest.raises(UserError, match="exaggerate"):
-        animation.render(runs[1], tmp_path / "b.gif", exaggerate=0.5)
+        bearingsim.animate(runs[1], tmp_path / "b.gif", exaggerate=0.5)
     with pytest.raises(UserError, match="fps"):
-        animation.render(runs[1], tmp_path / "b.gif", fps=0)
+        bearingsim.animate(runs[1], tmp_path / "b.gif", fps=0)
 
 
 def test_motion_window_keys_are_checked():

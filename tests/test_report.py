@@ -113,7 +113,7 @@ def test_report_of_a_run_archive_renders_in_chromium(whole, browser, tmp_path):
     assert_renders(seen, ["summary", "figures", "animation", "pockets", "checks", "scenario", "provenance"])
     figures = [i for i in seen["images"] if i["id"] != "animation"]
     assert len(figures) == len(bearingsim.load(whole).FIGURES) == 4  # forces, impulses, orbit, wear
-    # the animation (bearingsim.animation.render of the archive's motion) decodes in the browser at the
+    # the animation (bearingsim.animate of the archive's motion) decodes in the browser at the
     # frame size animation.py draws
     from bearingsim.animation import WIDTH_PX
 

@@ -31,6 +31,7 @@ from bearingsim.multibody import chipmunk
 from bearingsim.multibody import loop as lp
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
+from bearingsim.parameters import paper_assumptions  # noqa: F401 - re-exported: the scene of the paper's assumptions
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
 # exact arc faces: a roller further than this fraction of the play R - r from its pocket centre has its faces
@@ -108,13 +109,6 @@ def land_params(p, active: bool) -> fk.LandParams:
 
 # scenes whose cage is a pymunk KINEMATIC body turning at the epicyclic speed about the bearing axis
 KINEMATIC_CAGE_SCENES = ("reduced_equivalent", "kinematic_cage")
-
-
-def paper_assumptions(scene: str) -> bool:
-    """True for the scene that makes the reduced model's assumptions in the plane (no inner ring, no
-    traction, roller spin fixed, rollers held at the front of their pockets through the load zone):
-    ``reduced_equivalent``. Every other scene has the inner ring, traction and free spin."""
-    return scene == "reduced_equivalent"
 
 
 class PenetrationExceeded(Exception):

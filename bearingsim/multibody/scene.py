@@ -48,6 +48,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import pymunk
 
+from bearingsim.parameters import pocket_angles  # noqa: F401 - re-exported: the pocket centres' angles
+
 ROLLER_CATEGORY = 0b01
 CAGE_CATEGORY = 0b10  # every face segment when there are too many for a bit each (then no narrowed masks)
 
@@ -82,17 +84,6 @@ def segment_bit(face: int, k: int, n_seg: int) -> int:
 def own_bits(n_seg: int) -> bool:
     """Whether each face segment can have a category bit of its own (chipmunk's masks are 32 bits)."""
     return 1 + 2 * n_seg <= 32
-
-
-def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
-    """Cage-frame angles [rad] of the pocket centres at cage angle 0.
-
-    Pocket 0 sits at the bottom (load-zone centre); pocket ``i`` trails pocket 0 by ``i`` pitches,
-    so its angle from the load-zone centre, measured in the direction of cage rotation, starts at
-    ``-2 pi i / n``.
-    """
-    i = np.arange(roller_count)
-    return -0.5 * math.pi - sign * 2.0 * math.pi * i / roller_count
 
 
 def face_polyline(centre, e_t, e_r, radius, extent, n_seg):

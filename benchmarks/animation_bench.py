@@ -1,4 +1,4 @@
-"""Animation speed (issue 27's goal: 2 cage rotations at 6000 rpm at 30 fps in under 30 s).
+"""Animation speed (the goal: 2 cage rotations at 6000 rpm at 30 fps in under 30 s).
 
 ``python -m benchmarks.animation_bench [ARCHIVE]`` (from the checkout's root): animates the default window
 (the last 2 recorded rotations) of ``ARCHIVE`` (default ``outputs/multibody_6000rpm.h5``, the archive

@@ -95,7 +95,7 @@ def _closed_form_cost(inp, evaluations: int) -> dict:
 
 
 def reduced_goal(rows: list[dict]) -> list[str]:
-    """Issue 2's goal: event reaches <= 1e-6 for <= 1/100 of the time euler needs to reach 1e-4."""
+    """The goal: event reaches <= 1e-6 for <= 1/100 of the time euler needs to reach 1e-4."""
     lines = []
     for rpm in REDUCED_SPEEDS:
         ev = [r for r in rows if r["model"] == "reduced" and r["method"] == "event" and r["rpm"] == rpm][0]

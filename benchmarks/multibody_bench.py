@@ -36,7 +36,7 @@ from bearingsim.multibody.core import PenetrationExceeded, choose_dt
 from bearingsim.parameters import Parameters
 from bearingsim.scenario import resolve
 
-GOAL_S_PER_ROTATION = 0.2  # issue 3: full scene at 6000 rpm
+GOAL_S_PER_ROTATION = 0.2  # the goal: full scene at 6000 rpm
 GOAL_ERROR = 0.01
 
 
@@ -110,7 +110,7 @@ def bench_cases(quick: bool) -> list[dict]:
                 continue
             rows.append(_row("full", rpm, dt, runs, total_rot, ref_idec, f"full scene at dt = {dt_ref:g} s"))
         rows.append(_row("full", rpm, dt_ref, [ref], total_rot, ref_idec, "itself"))
-        # rigid raceways (issue 16) at their automatic step, against the same Hertz reference
+        # rigid raceways at their automatic step, against the same Hertz reference
         rig = Parameters.from_scenario(reference_scenario(rpm, nrot, 1, raceway_contact="rigid"))
         runs = [simulate(rig) for _ in range(repeats)]
         rows.append(_row("full_rigid_raceways", rpm, runs[0].provenance["dt_s"], runs, total_rot, ref_idec,
@@ -194,7 +194,7 @@ def goal_lines(rows: list[dict]) -> list[str]:
         met = best["wall_s"] <= GOAL_S_PER_ROTATION
         ratio = (best["wall_s"] - best["pymunk_step_s"]) / best["pymunk_step_s"]
         lines.append(f"goal (<= {GOAL_S_PER_ROTATION} s per rotation within 1 % of converged): best {best['wall_s']:.3f} s "
-                     f"at dt = {best['dt_s']:.1e} s -> {'met' if met else 'not met'}; goal (rest of the step, i.e. the issue's 'Python side', <= pymunk "
+                     f"at dt = {best['dt_s']:.1e} s -> {'met' if met else 'not met'}; goal (rest of the step, i.e. the 'Python side', <= pymunk "
                      f"step): {ratio:.2f} -> {'met' if ratio <= 1.0 else 'not met'}")
     return lines
 

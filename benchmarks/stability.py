@@ -6,7 +6,7 @@ radial load, the largest dt at which one cage rotation (after none of warm-up, f
 * **runs**: finishes without a blow-up (non-finite state, raceway approach > 50 um, cage faster than
   3 omega_i, or a roller more than s/2 into a cage face: the checks of :func:`core.run`);
 * **is accurate**: in addition, no roller overlaps a cage face by more than 1 % of the pocket
-  clearance (the bound of issue 4; what the automatic dt restarts on).
+  clearance (the bound the automatic dt restarts on).
 
 It prints a markdown table beside the explicit Hertz limit 2/omega_n of the stiffest raceway contact
 and the automatic dt, for ``docs/stability.md``. Bisection on a log scale to 5 % between 1 us and

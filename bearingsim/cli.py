@@ -14,9 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import progress_wanted as _progress
-from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
-from bearingsim.cli_common import report_study as _report_study
+from bearingsim.cli_common import progress_wanted, refuse_archive_as_scenario, report_study
 from bearingsim.errors import SimulationUnstable, UserError
 
 
@@ -31,7 +29,7 @@ def _cmd_run(args) -> int:
     from bearingsim.scenario import check_run_request, load_scenario
     from bearingsim.simulation import run_scenario
 
-    _refuse_archive_as_scenario(args.scenario)
+    refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
     if args.dry_run:
@@ -337,10 +335,10 @@ def _cmd_validate(args) -> int:
 
         studies.append(Rig(rotations=args.rig_rotations))
     engine = make_engine(args.jobs, args.scheduler)
-    outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force, progress=_progress(args))
+    outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force, progress=progress_wanted(args))
     if not args.quiet:
         _print_validate(args, studies, outcome)
-    return _report_study(outcome, "validate")
+    return report_study(outcome, "validate")
 
 
 def _print_validate(args, studies, outcome) -> None:
@@ -411,7 +409,7 @@ def _cmd_crosscheck(args) -> int:
     from bearingsim.studies import crosscheck as cc
     from bearingsim.studies import make_engine
 
-    _refuse_archive_as_scenario(args.scenario)
+    refuse_archive_as_scenario(args.scenario)
     speeds = cc.parse_speeds(args.speeds)
     if args.rotations < 1:
         raise UserError(f"--rotations {args.rotations}: give at least 1 recorded rotation")
@@ -420,7 +418,7 @@ def _cmd_crosscheck(args) -> int:
     cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
     rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine,
-                                      force=args.force, progress=_progress(args))
+                                      force=args.force, progress=progress_wanted(args))
     wall = time.perf_counter() - t0
     if outcome.interrupted is None and not args.quiet:
         where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
@@ -433,7 +431,7 @@ def _cmd_crosscheck(args) -> int:
         for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
-    return _report_study(outcome, "cross-check")
+    return report_study(outcome, "cross-check")
 
 
 def _cmd_report(args) -> int:

@@ -17,24 +17,36 @@ def _keys(text):
     return keys
 
 
-def _cmd_sensitivity(args) -> int:
-    from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
-    from bearingsim.cli_common import report_study as _report_study
+def _scenario(args):
+    """The scenario a study command is given (an archive refused with a hint)."""
+    from bearingsim.cli_common import refuse_archive_as_scenario
     from bearingsim.scenario import load_scenario
-    from bearingsim.studies import make_engine, run_studies
-    from bearingsim.studies.sensitivity import Sensitivity, parse_step
 
-    _refuse_archive_as_scenario(args.scenario)
-    step = parse_step(args.step)
-    scenario = load_scenario(args.scenario, args.set)
-    study = Sensitivity(scenario, _keys(args.keys), step)  # bad keys refused before any run
+    refuse_archive_as_scenario(args.scenario)
+    return load_scenario(args.scenario, args.set)
+
+
+def _run(study, args):
+    """Run ``study`` into ``-o`` on the engine of ``-j``/``--scheduler``: (its outcome, wall time [s])."""
+    from bearingsim.studies import make_engine, run_studies
+
     engine = make_engine(args.jobs, args.scheduler)
     t0 = time.perf_counter()
     outcome = run_studies([study], Path(args.output), engine=engine, force=args.force,
                           progress=False if args.quiet else None)
+    return outcome, time.perf_counter() - t0
+
+
+def _cmd_sensitivity(args) -> int:
+    from bearingsim.cli_common import report_study
+    from bearingsim.studies.sensitivity import Sensitivity, parse_step
+
+    step = parse_step(args.step)
+    study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
+    outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
         print(f"sensitivity of {args.scenario}: {len(study.keys)} keys x 2 runs at x (1 ± {step:.0%}) within each "
-              f"key's range, {time.perf_counter() - t0:.1f} s")
+              f"key's range, {wall:.1f} s")
         print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
         for r in study.rows:
             print(f"{r['key']:34s} {r['quantity']:18s} {r['sensitivity']:+9.3f} {r['sensitivity_se']:8.3f} "
@@ -42,26 +54,18 @@ def _cmd_sensitivity(args) -> int:
         for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
-    return _report_study(outcome, "sensitivity")
+    return report_study(outcome, "sensitivity")
 
 
 def _cmd_uncertainty(args) -> int:
-    from bearingsim.cli_common import refuse_archive_as_scenario as _refuse_archive_as_scenario
-    from bearingsim.cli_common import report_study as _report_study
-    from bearingsim.scenario import load_scenario
-    from bearingsim.studies import make_engine, run_studies
+    from bearingsim.cli_common import report_study
     from bearingsim.studies.uncertainty import Uncertainty
 
-    _refuse_archive_as_scenario(args.scenario)
-    scenario = load_scenario(args.scenario, args.set)
-    study = Uncertainty(scenario, args.samples, args.seed, _keys(args.keys))
-    engine = make_engine(args.jobs, args.scheduler)
-    t0 = time.perf_counter()
-    outcome = run_studies([study], Path(args.output), engine=engine, force=args.force,
-                          progress=False if args.quiet else None)
+    study = Uncertainty(_scenario(args), args.samples, args.seed, _keys(args.keys))
+    outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
         print(f"uncertainty of {args.scenario}: {len(study.keys)} keys, N = {args.samples} ({len(study.cases)} runs), "
-              f"seed {args.seed}, {time.perf_counter() - t0:.1f} s")
+              f"seed {args.seed}, {wall:.1f} s")
         for s in study.spreads:
             print(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
                   f"({int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0} runs)")
@@ -72,7 +76,7 @@ def _cmd_uncertainty(args) -> int:
         for name in ("uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
-    return _report_study(outcome, "uncertainty")
+    return report_study(outcome, "uncertainty")
 
 
 def _common(p, default_out):

@@ -101,8 +101,8 @@ def add_commands(sub) -> None:
 
 
 def _cmd_sweep(args) -> int:
-    from bearingsim.cli_common import progress_wanted as _progress
+    from bearingsim.cli_common import progress_wanted
 
     return run_sweep_cli(args.scenario, args.param, args.set, Path(args.output), jobs=args.jobs,
                          scheduler=args.scheduler, figures=not args.no_plots, force=args.force, quiet=args.quiet,
-                         progress=_progress(args), archives=args.archives or "auto")
+                         progress=progress_wanted(args), archives=args.archives or "auto")

@@ -59,7 +59,6 @@ def animate(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None
     """
     from bearingsim import animation
 
-    animation.check_output(out)
     return animation.render_result(load(path, only=animation.ANIMATION_DATA), out, rotations=rotations,
                                    exaggerate=exaggerate, fps=fps, progress=progress, last=last, where=str(path))
 

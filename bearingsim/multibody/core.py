@@ -348,7 +348,6 @@ def face_geometry(sc, rr, margin):
 def arc_faces(sc, rr, sign, worn=None) -> "lp.ArcFaces":
     """:class:`bearingsim.multibody.loop.ArcFaces` of a scene with exact arc faces (roller radius ``rr`` [m],
     ``sign`` of the rotation); ``worn``: :func:`worn_array` (None: unworn faces)."""
-    n = len(sc.arc_shapes)
     a = np.asarray(sc.pocket_body_angle, dtype=np.float64)
     sign = 1.0 if sign > 0 else -1.0
     e_r = np.stack([np.cos(a), np.sin(a)], axis=1)
@@ -415,6 +414,7 @@ class MultibodySetup(NamedTuple):
     hold_rule: lp.HoldRule
     phi: float  #: the reduced-equivalent scene's load-zone half angle [rad] (0 elsewhere)
     face_reach: float  #: :func:`face_radial_reach` [m]
+    worn: np.ndarray | None  #: :func:`worn_array`: each face's worn depth per bin of psi [m] (None: unworn)
 
 
 def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetup:
@@ -480,7 +480,7 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         p=p, scene=scene_kind, reduced_eq=reduced_eq, kinematic=scene_kind in KINEMATIC_CAGE_SCENES, rigid=is_rigid,
         dt=h, dt_how=dt_how, dt_explicit_limit=dt_lim, t_start=t_start, dt_start=h_start, radial_play=pd,
         rigid_radius=r_c, roller_start_radius=r0, centrifugal_load=n_centrifugal, ring_how=ring_how, prm=prm,
-        cfg=cfg, land=land, limits=lim, hold_rule=hold, phi=phi, face_reach=face_reach)
+        cfg=cfg, land=land, limits=lim, hold_rule=hold, phi=phi, face_reach=face_reach, worn=worn_array(p))
 
 
 def _steps(p, dt, is_rigid):
@@ -545,7 +545,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     sc = build_scene(geo, op, p.contact.restitution, p.contact.cage_friction, extent=p.multibody.pocket_face_extent,
                      n_seg=n_seg, kinematic_cage=su.kinematic, spin_free=not su.reduced_eq,
                      flat_pockets=p.multibody.flat_pockets, centred_cage=su.scene == "centred_cage",
-                     rigid_radius=su.rigid_radius if su.rigid else None, worn=worn_array(p))
+                     rigid_radius=su.rigid_radius if su.rigid else None, worn=su.worn)
     nb = n + 1
     r0 = su.roller_start_radius
     omega_cage = op.sign * op.omega_c
@@ -586,7 +586,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
     masks = face_geometry(sc, rr, lp.MASK_MARGIN_M)
-    arc = arc_faces(sc, rr, op.sign, worn_array(p)) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
+    arc = arc_faces(sc, rr, op.sign, su.worn) if sc.arc_shapes is not None else lp.ARC_FACES_OFF
     io, why = chipmunk.open_step_loop(sc.space, nb, set_fields, set_arr, arb_cap, step_loop, sc.joints,
                                       [next(iter(b.shapes)) for b in sc.rollers], [*sc.rollers, sc.cage], masks,
                                       sc.arc_shapes)

@@ -129,9 +129,7 @@ def _start_depth(scenario) -> np.ndarray | None:
     """The scenario's own worn depth as the start of the accumulated wear ((2, bins, pockets) [m]), or None;
     refused unless its bins are the wear profile's."""
     from bearingsim.multibody.recorder import FACE_BINS
-    from bearingsim.parameters import Parameters
-
-    worn = Parameters.from_scenario(scenario).wear.worn_depth
+    worn = scenario.parameters.wear.worn_depth
     if worn is None:
         return None
     arr = np.array(worn, dtype=np.float64)  # (pockets, 2, bins)

@@ -49,11 +49,9 @@ def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
 
     path = Path(path)
     check_replaceable(path, PNG_SIGNATURE, "figure")
-    with _missing_glyphs_quiet():
-        if tight:
-            fig.tight_layout()
-        with atomic_file(path) as fh:
-            fig.savefig(fh, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
+    data = figure_png(fig, dpi=dpi, tight=tight)  # drawn whole before anything is written
+    with atomic_file(path) as fh:
+        fh.write(data)
     return path
 
 

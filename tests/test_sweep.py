@@ -454,3 +454,29 @@ def test_scheduler_without_dask_names_the_extra(tmp_path, monkeypatch, capsys):
                      "-o", str(tmp_path / "sw"), "--no-plots"])
     err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
     assert code == 2 and len(err) == 1 and "pip install 'bearingsim[cluster]'" in err[0], (code, err)
+
+
+@pytest.mark.slow
+def test_stop_ends_a_pool_whose_result_queue_lock_is_held(monkeypatch):
+    """A worker ended while it held the pool's result-queue lock leaves that lock taken, and
+    ``Pool.terminate`` then waits forever (seen: a refused sweep whose warm-up tasks were finishing).
+    Here the lock is taken as such a worker would leave it: ``stop()`` still returns, after
+    ``STOP_WAIT_S``, with every worker process ended and reaped."""
+    import threading
+
+    import psutil
+
+    from bearingsim.sweeps import engines
+
+    monkeypatch.setattr(engines, "STOP_WAIT_S", 1.0)
+    before = {p.pid for p in psutil.Process().children(recursive=True)}
+    engine = LocalEngine(2)
+    engine.start()
+    workers = list(engine._pool._pool)
+    assert engine._pool._outqueue._wlock.acquire(timeout=5)  # held for good, as by a killed worker
+    stopper = threading.Thread(target=engine.stop, daemon=True)
+    stopper.start()
+    stopper.join(30.0)  # before the fallback: Pool.terminate never returned
+    assert not stopper.is_alive()
+    assert all(p.exitcode is not None for p in workers)
+    assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()

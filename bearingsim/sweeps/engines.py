@@ -14,6 +14,10 @@ from collections.abc import Iterator
 
 from bearingsim.errors import UserError
 
+#: how long LocalEngine.stop waits for the pool to end itself before it ends the workers directly [s]
+#: (the pool ends in well under a second when its result queue's lock is free)
+STOP_WAIT_S = 10.0
+
 
 def _pool_worker_init() -> None:
     # Ctrl-C reaches the whole process group: only the sweep process acts on it and then ends the
@@ -102,11 +106,34 @@ class LocalEngine:
             yield records
 
     def stop(self) -> None:
-        """End every worker process now (queued batches are dropped) and wait for them to exit."""
-        if self._pool is not None:
-            self._pool.terminate()
-            self._pool.join()
-            self._pool = None
+        """End every worker process now (queued batches are dropped) and wait for them to exit.
+
+        ``Pool.terminate`` can wait forever: a worker ended while it held the result queue's lock (sending
+        a finished task's result, e.g. a warm-up's) leaves the lock taken, and the pool's task handler then
+        waits for it before it exits, and terminate for the task handler. So the pool is ended in a
+        thread of its own; if that has not finished within :data:`STOP_WAIT_S`, the workers are ended
+        (SIGKILL) and reaped here, and the stuck thread is left behind (a daemon: it holds nothing the
+        process needs)."""
+        import threading
+
+        pool, self._pool = self._pool, None
+        if pool is None:
+            return
+        workers = list(pool._pool)  # the worker processes (multiprocessing.pool.Pool keeps them here)
+        ended = threading.Event()
+
+        def end():
+            pool.terminate()
+            pool.join()
+            ended.set()
+
+        threading.Thread(target=end, name="bearingsim-pool-stop", daemon=True).start()
+        if ended.wait(STOP_WAIT_S):
+            return
+        for p in workers:
+            if p.is_alive():
+                p.kill()
+            p.join(STOP_WAIT_S)
 
 
 class DaskEngine:

@@ -23,7 +23,6 @@ rigid scene's whole call (restarts included).
 """
 from __future__ import annotations
 
-import csv
 import hashlib
 import math
 import os
@@ -31,6 +30,7 @@ import time
 from pathlib import Path
 
 from benchmarks.multibody_bench import reference_scenario
+from bearingsim.outputs import write_atomic_bytes, write_csv
 from bearingsim.parameters import Parameters
 
 SPEEDS = (500, 1000, 3000, 6000)
@@ -110,16 +110,9 @@ def run_fast_scene_bench(outdir: Path, speeds=SPEEDS, rotations: int = ROTATIONS
                 f"{row['wall_s_per_rotation']:.4f} s per rotation, load average {row['load_1min']:.2f}")
         rows += [pair["hertz"], pair["rigid"]]
         comps.append(compare(pair["hertz"], pair["rigid"]))
-    with open(outdir / "fast_scene.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
-    with open(outdir / "fast_scene_comparison.csv", "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(comps[0]))
-        w.writeheader()
-        w.writerows(comps)
-    text = markdown(rows, comps)
-    (outdir / "fast_scene.md").write_text(text)
+    for name, table in (("fast_scene.csv", rows), ("fast_scene_comparison.csv", comps)):
+        write_csv(outdir / name, list(table[0]), [list(r.values()) for r in table])
+    write_atomic_bytes(outdir / "fast_scene.md", markdown(rows, comps).encode("utf-8"))
     return rows, comps
 
 

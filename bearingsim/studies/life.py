@@ -140,13 +140,16 @@ def _start_depth(scenario) -> np.ndarray | None:
 
 
 def _run_stage(sc, path: Path, progress):
-    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` (resume),
+    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` and was
+    computed by the present version of the model (resume, as a sweep's: :mod:`bearingsim.model_versions`),
     else a new run."""
     from bearingsim import archive
+    from bearingsim.model_versions import MODEL_VERSIONS
     from bearingsim.simulation import load, run_scenario
 
     got = archive.peek(path) if path.exists() else None
-    if got is not None and got["scenario"] == sc.to_toml():
+    if (got is not None and got["scenario"] == sc.to_toml()
+            and got["model_version"] == MODEL_VERSIONS.get(got["model"])):
         return load(path), True
     if progress:
         worn = [max(max(row) for row in v) for v in (sc.wear.worn_depth_front_um, sc.wear.worn_depth_rear_um)

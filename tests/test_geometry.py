@@ -341,7 +341,8 @@ def test_a_worn_face_s_contact_is_the_nearest_point_of_its_material(face):
         for shift, touches in ((1e-6, True), (-1e-6, False)):
             d = (a + shift) * direction
             dist, point = nearest(d)
-            got = _place(p, sc, i, d[0] * u + d[1] * e_r, worn)  # (at 100 deg, 0.44 mm off, it meets the other face too)
+            # (at 100 deg, 0.44 mm off its pocket centre, the roller meets the other face too)
+            got = _place(p, sc, i, d[0] * u + d[1] * e_r, worn)
             assert (got[face] is not None) == touches, (phi_deg, shift, dist - r)
             if touches:
                 cp = got[face].points[0]
@@ -353,7 +354,8 @@ def test_a_worn_face_s_contact_is_the_nearest_point_of_its_material(face):
                 assert np.linalg.norm(q) == pytest.approx(radius(theta)[0], abs=1e-10), phi_deg
                 normal = np.array(got[face].normal)
                 want = (q - d) / np.linalg.norm(q - d)
-                assert normal @ u == pytest.approx(want[0], abs=1e-9) and normal @ e_r == pytest.approx(want[1], abs=1e-9)
+                assert normal @ u == pytest.approx(want[0], abs=1e-9)
+                assert normal @ e_r == pytest.approx(want[1], abs=1e-9)
 
 
 @pytest.mark.slow

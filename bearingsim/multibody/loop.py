@@ -148,7 +148,8 @@ class ArcFaces(NamedTuple):
     #: each knot, R + worn depth [m] (linear between knots)
     knot_h: np.ndarray = np.zeros((0, 2, 0))
     #: (n, 2, 2, 2) each worn face's edges, (inner, outer) end: where the worn face meets the rays of its
-    #: extent, (x, y) in the face's frame (x along its middle, y outward) [m] (:func:`bearingsim.multibody.core.worn_edges`)
+    #: extent, (x, y) in the face's frame (x along its middle, y outward) [m]
+    #: (:func:`bearingsim.multibody.core.worn_edges`)
     edge: np.ndarray = np.zeros((0, 2, 2, 2))
 
 

@@ -81,6 +81,6 @@ def add_commands(sub) -> None:
     li.add_argument("--mapping", choices=("uniform", "shape"), default="uniform",
                     help="how a stage's wear acts back: 'uniform' (default), every pocket's clearance grows by the "
                          "worst pocket's mean worn depth; 'shape', the worn depth added to each face where it wore "
-                         "(docs/wear.md: its runs stop on the roller-cage overlap limit before 0.1 mm)")
+                         "(docs/wear.md)")
     li.add_argument("-q", "--quiet", action="store_true", help="no line per stage run")
     li.set_defaults(func=_cmd_life)

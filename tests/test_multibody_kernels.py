@@ -382,14 +382,15 @@ def _same_bytes_without(probe, says, sc, monkeypatch):
 
 @pytest.mark.skipif(chipmunk.guard() is not None, reason="the compiled loop cannot run with this pymunk")
 @pytest.mark.parametrize("scenario, extra", [("multibody_3000rpm", []), ("multibody_reduced_equivalent_3000rpm", []),
-                                             ("multibody_3000rpm", ["multibody.raceway_contact=rigid"])])
+                                             ("multibody_3000rpm", ["multibody.raceway_contact=rigid"]),
+                                             ("../tests/data/worn_stage05_rigid", [])])
 @pytest.mark.slow
 def test_plain_pymunk_loop_gives_the_compiled_numbers_bit_for_bit(scenario, extra):
     """The plain loop (``Space.step`` and ``pymunk.batch``) calls the same kernels on the same inputs as
     the compiled one, so every accumulator, the impact table and the final state are identical bytes
     (one rotation, no warm-up: ~11 500 steps, a few hundred impacts). With rigid raceways the plain loop
     reads the joints' impulses through ``Constraint.impulse``, the compiled one through
-    ``cpConstraintGetImpulse``: the same numbers."""
+    ``cpConstraintGetImpulse``: the same numbers. Worn faces (a life study's stage, tests/data) too."""
     sc = load_scenario(SCENARIOS / f"{scenario}.toml", ["numerics.rotations=1", "numerics.warmup_rotations=0", *extra])
     compiled = run(si(sc), step_loop="compiled")
     plain = run(si(sc), step_loop="plain")

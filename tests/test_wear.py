@@ -222,6 +222,21 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     assert "life history" in text and "wear_test_6000rpm" in text and "limit: clearance=0.203mm" in text
 
 
+@pytest.mark.slow
+def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, monkeypatch):
+    """A stage archive that stores the stage's scenario but was computed by another version of the model
+    (bearingsim.model_versions: its numbers moved since) is run again, not reused, as a sweep's case is."""
+    from bearingsim import model_versions
+    from bearingsim.studies.life import parse_limit, run_life
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
+    lim = parse_limit("clearance=0.201mm")
+    assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [0]
+    assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [1]
+    monkeypatch.setitem(model_versions.MODEL_VERSIONS, "multibody", model_versions.MODEL_VERSIONS["multibody"] + 1)
+    assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [0]
+
+
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     from bearingsim.cli import main
 

@@ -367,7 +367,46 @@ def arc_faces(sc, rr, sign, worn=None) -> "lp.ArcFaces":
     knots = np.concatenate([[lo], lo + (hi - lo) * (np.arange(bins) + 0.5) / bins, [hi]])
     h = sc.pocket_radius + np.concatenate([worn[:, :, :1], worn, worn[:, :, -1:]], axis=2)
     return af._replace(worn_on=True, knot_psi=knots, knot_cos=np.cos(knots), knot_sin=np.sin(knots),
-                       knot_h=np.ascontiguousarray(h, dtype=np.float64))
+                       knot_h=np.ascontiguousarray(h, dtype=np.float64), edge=worn_edges(knots, h, lo, hi))
+
+
+def worn_edges(knots, h, lo, hi) -> np.ndarray:
+    """(..., 2, 2) where each worn face meets the rays of its extent, (inner ``lo``, outer ``hi``) end,
+    (x, y) in the face's frame [m]: the face's edges (:func:`bearingsim.multibody.loop.worn_contact`).
+
+    ``knots`` (K,) [rad] and ``h`` (..., K) [m]: the face's lines ``p . u(psi) <= h(psi)``, ``h`` linear
+    between the knots. Along the ray at angle ``e`` the nearest line is at
+    ``r(e) = min over psi of h(psi) / cos(e - psi)``; on a knot interval the derivative's numerator
+    ``a cos(e - psi) - h(psi) sin(e - psi)`` (``a`` the slope of ``h``) grows with psi (its derivative is
+    ``h cos(e - psi) > 0``), so the least value is at a knot or at that numerator's single zero, found by
+    bisection. Unworn (``h = R``) the edges are the arc's ends, ``R (cos e, sin e)``."""
+    h = np.asarray(h, dtype=np.float64)
+    out = np.zeros(h.shape[:-1] + (2, 2))
+    p0, p1 = knots[:-1], knots[1:]
+    h0, h1 = h[..., :-1], h[..., 1:]
+    slope = (h1 - h0) / (p1 - p0)
+    for j, e in enumerate((lo, hi)):
+        def ratio(psi, hv):
+            c = np.cos(e - psi)
+            return np.where(c > 0.0, hv / np.where(c > 0.0, c, 1.0), np.inf)
+
+        def numer(psi):
+            return slope * np.cos(e - psi) - (h0 + slope * (psi - p0)) * np.sin(e - psi)
+
+        best = ratio(knots, h).min(axis=-1)
+        a, b = np.broadcast_to(p0, h0.shape).copy(), np.broadcast_to(p1, h0.shape).copy()
+        root = (numer(a) < 0.0) & (numer(b) > 0.0) & (np.cos(e - a) > 0.0) & (np.cos(e - b) > 0.0)
+        for _ in range(100):
+            m = 0.5 * (a + b)
+            neg = numer(m) < 0.0
+            a = np.where(neg, m, a)
+            b = np.where(neg, b, m)
+        m = 0.5 * (a + b)
+        inner = np.where(root, ratio(m, h0 + slope * (m - p0)), np.inf)
+        r = np.minimum(best, inner.min(axis=-1))
+        out[..., j, 0] = r * math.cos(e)
+        out[..., j, 1] = r * math.sin(e)
+    return np.ascontiguousarray(out)
 
 
 def worn_array(p) -> np.ndarray | None:

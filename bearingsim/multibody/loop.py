@@ -147,6 +147,10 @@ class ArcFaces(NamedTuple):
     #: (n, 2, K) each pocket's (front, rear) face: distance of its tangent line from the pocket centre at
     #: each knot, R + worn depth [m] (linear between knots)
     knot_h: np.ndarray = np.zeros((0, 2, 0))
+    #: (n, 2, 2, 2) each worn face's edges, (inner, outer) end: where the worn face meets the rays of its
+    #: extent, (x, y) in the face's frame (x along its middle, y outward) [m]
+    #: (:func:`bearingsim.multibody.core.worn_edges`)
+    edge: np.ndarray = np.zeros((0, 2, 2, 2))
 
 
 #: inactive :class:`ArcFaces` (polyline or flat faces: every segment static)
@@ -155,45 +159,91 @@ ARC_FACES_OFF = ArcFaces(False, np.zeros(0, dtype=np.bool_), np.zeros((0, 2)), n
 
 
 @njit(cache=True, inline="always")
-def worn_contact(x, y, rho, kpsi, kc, ks, kh):
-    """Where a roller touches a worn face: ``(cos psi, sin psi, h)`` of the face's tangent line nearest to it.
+def worn_contact(px, py, kpsi, kc, ks, kh, cl, sl, ch, sh, edge, ell):
+    """Where a roller touches a worn face: the segment to place, ``(ax, ay, bx, by)`` in the face's
+    frame (``x`` along its middle, ``y`` outward, from the pocket centre) [m].
 
-    A worn face is the pocket circle pushed outwards by the worn depth ``w(psi)``: the lines at distance
-    ``h(psi) = R + w(psi)`` from the pocket centre, normal to the direction ``psi`` (``h`` linear in psi
-    between the knots ``kpsi``, values ``kh``). A roller centre at ``rho (x, y)`` from the pocket centre
-    (face frame, ``(x, y)`` a unit vector) is ``g(psi) = h(psi) - rho cos(psi - phi)`` from the line at psi
-    (``phi`` its direction); it touches the line of least ``g`` over the face's extent. On a knot interval
-    ``g`` is convex (``rho cos`` is concave within 90 deg), so its least value is at a knot or where
-    ``g' = a + rho sin(psi - phi)`` changes sign (``a``: the slope of ``h``). Unworn (``h = R``), this is
-    ``psi = phi`` clamped to the extent: the exact arc's contact."""
-    px = rho * x
-    py = rho * y
+    A worn face is the pocket circle pushed outwards by the worn depth ``w(psi)``: the pocket is the set
+    ``K`` of points ``p`` with ``p . u(psi) <= h(psi) = R + w(psi)`` for every ``psi`` of the extent
+    (the lines at ``h(psi)`` from the pocket centre, normal to the direction ``psi``; ``h`` linear in psi
+    between the knots ``kpsi``, values ``kh``), and the face's material is what lies outside ``K``
+    within the extent's sector ``S`` (between the rays ``psi_lo``, ``psi_hi``: ``(cl, sl)``, ``(ch, sh)``).
+    The roller (centre ``(px, py)``) touches the point of that material nearest to its centre. That point
+    is either the foot of the perpendicular from the centre on one of the lines, where the foot lies in
+    ``S`` (every such foot is a point of the material: the line bounds ``K``), or one of the face's two
+    edges ``edge[0]``, ``edge[1]``, where its boundary meets the rays. On the lines, the distance
+    ``g(psi) = h(psi) - (px, py) . u(psi)`` is least at a knot or where ``g' = a + rho sin(psi - phi)``
+    changes sign (``a``: the slope of ``h``; ``rho``, ``phi``: the centre's distance and direction); a
+    least ``g`` over the psi whose foot lies in ``S`` that is not one of those lies where the foot is on
+    a ray, no nearer than that ray's edge. So the nearest point is the nearest of the feet (in ``S``) of
+    the knots and of those stationary points, and the two edges.
+
+    A foot: the segment lies on its line, over ``ell`` either side of the foot and never past the rays.
+    An edge: the segment ends at it, at right angles to the line from the roller's centre (chipmunk's
+    closest point is then the edge itself: a point contact, normal from the edge to the centre), and
+    runs ``ell`` into the face. Unworn (``h = R``) this is the exact arc's contact: the foot at the
+    roller's direction within the extent, the arc's end past it."""
+    rho = math.sqrt(px * px + py * py)
     best = math.inf
-    bx = kc[0]
-    by = ks[0]
-    bh = kh[0]
+    bc = 0.0
+    bs = 0.0
+    bh = 0.0
     for k in range(kpsi.shape[0]):
         g = kh[k] - (px * kc[k] + py * ks[k])
         if g < best:
-            best = g
-            bx = kc[k]
-            by = ks[k]
-            bh = kh[k]
-    for k in range(kpsi.shape[0] - 1):
-        a = (kh[k + 1] - kh[k]) / (kpsi[k + 1] - kpsi[k])
-        if a + px * ks[k] - py * kc[k] < 0.0 < a + px * ks[k + 1] - py * kc[k + 1]:
-            psi = math.atan2(y, x) - math.asin(min(1.0, max(-1.0, a / rho)))
-            if kpsi[k] < psi < kpsi[k + 1]:
-                c = math.cos(psi)
-                s = math.sin(psi)
-                h = kh[k] + a * (psi - kpsi[k])
-                g = h - (px * c + py * s)
-                if g < best:
-                    best = g
-                    bx = c
-                    by = s
-                    bh = h
-    return bx, by, bh
+            fx = px + g * kc[k]
+            fy = py + g * ks[k]
+            if fy * cl - fx * sl >= 0.0 and fx * sh - fy * ch >= 0.0:  # the foot lies in the sector
+                best = g
+                bc = kc[k]
+                bs = ks[k]
+                bh = kh[k]
+    if rho > 0.0:
+        phi = math.atan2(py, px)
+        for k in range(kpsi.shape[0] - 1):
+            a = (kh[k + 1] - kh[k]) / (kpsi[k + 1] - kpsi[k])
+            if a + px * ks[k] - py * kc[k] < 0.0 < a + px * ks[k + 1] - py * kc[k + 1]:
+                psi = phi - math.asin(min(1.0, max(-1.0, a / rho)))
+                if kpsi[k] < psi < kpsi[k + 1]:
+                    c = math.cos(psi)
+                    s = math.sin(psi)
+                    h = kh[k] + a * (psi - kpsi[k])
+                    g = h - (px * c + py * s)
+                    if g < best:
+                        fx = px + g * c
+                        fy = py + g * s
+                        if fy * cl - fx * sl >= 0.0 and fx * sh - fy * ch >= 0.0:
+                            best = g
+                            bc = c
+                            bs = s
+                            bh = h
+    nearest_edge = -1
+    for e in range(2):
+        dist = math.sqrt((edge[e, 0] - px) ** 2 + (edge[e, 1] - py) ** 2)
+        if dist < best:
+            best = dist
+            nearest_edge = e
+    if nearest_edge < 0:
+        tx = -bs  # along the line, toward larger psi
+        ty = bc
+        s_f = px * tx + py * ty  # the foot, from the line's point nearest the pocket centre
+        s_lo = bh * (sl * bc - cl * bs) / (cl * bc + sl * bs)  # the rays of the extent: h tan(psi_lo - psi)
+        s_hi = bh * (sh * bc - ch * bs) / (ch * bc + sh * bs)
+        s_a = max(s_lo, s_f - ell)
+        s_b = min(s_hi, s_f + ell)
+        return bh * bc + s_a * tx, bh * bs + s_a * ty, bh * bc + s_b * tx, bh * bs + s_b * ty
+    ex = edge[nearest_edge, 0]
+    ey = edge[nearest_edge, 1]
+    tx = (py - ey) / best  # at right angles to the line from the centre to the edge ...
+    ty = (ex - px) / best
+    if nearest_edge == 0:  # ... into the face: toward larger psi from the inner end, smaller from the outer
+        inward = -tx * sl + ty * cl > 0.0
+    else:
+        inward = tx * sh - ty * ch > 0.0
+    if not inward:
+        tx = -tx
+        ty = -ty
+    return ex, ey, ex + ell * tx, ey + ell * ty
 
 
 class StepInputs(NamedTuple):
@@ -238,8 +288,9 @@ def arc_faces(state, h, af, ends, todo):
     ``near2`` of its pocket centre leaves its faces as they are: every point of a tangent segment is at
     least R from the pocket centre, out of its reach.
 
-    Worn faces (``af.worn_on``): the segment lies on the worn face's tangent line nearest to the roller
-    (:func:`worn_contact`), ``R + w`` from the pocket centre instead of ``R``; the rest is as above."""
+    Worn faces (``af.worn_on``): the segment is :func:`worn_contact`'s, at the point of the worn face's
+    material nearest to the roller's centre (a foot on one of its lines, ``R + w`` from the pocket centre,
+    or one of its edges)."""
     n = todo.shape[0]
     cx = state[n, 0] + state[n, 3] * h
     cy = state[n, 1] + state[n, 4] * h
@@ -271,11 +322,24 @@ def arc_faces(state, h, af, ends, todo):
         for f in range(2):
             ux = af.e_t[i, 0] if f == 0 else -af.e_t[i, 0]
             uy = af.e_t[i, 1] if f == 0 else -af.e_t[i, 1]
+            if af.worn_on:  # the worn face's segment in the face's frame (worn_contact), then in the cage frame
+                wax, way, wbx, wby = worn_contact(dx * ux + dy * uy, dx * erx + dy * ery, af.knot_psi, af.knot_cos,
+                                                  af.knot_sin, af.knot_h[i, f], cl, sl, ch, sh, af.edge[i, f], ell)
+                ax_ = af.centre[i, 0] + wax * ux + way * erx
+                ay_ = af.centre[i, 1] + wax * uy + way * ery
+                bx_ = af.centre[i, 0] + wbx * ux + wby * erx
+                by_ = af.centre[i, 1] + wbx * uy + wby * ery
+                e = ends[i, f]
+                if e[0] != ax_ or e[1] != ay_ or e[2] != bx_ or e[3] != by_:
+                    e[0] = ax_
+                    e[1] = ay_
+                    e[2] = bx_
+                    e[3] = by_
+                    todo[i, f] = True
+                continue
             x = (dx * ux + dy * uy) * inv  # the roller's direction in this face's frame
             y = y0
             Rf = R  # the face's tangent line's distance from the pocket centre
-            if af.worn_on:
-                x, y, Rf = worn_contact(x, y, d2 * inv, af.knot_psi, af.knot_cos, af.knot_sin, af.knot_h[i, f])
             s_lo = y * cl - x * sl  # sin(psi - psi_lo)
             s_hi = x * sh - y * ch  # sin(psi_hi - psi)
             if s_lo < 0.0 or s_hi < 0.0:  # past an end: the end nearer in angle

@@ -16,8 +16,8 @@ How the wear maps onto the next stage's geometry (``mapping``, :data:`MAPPINGS`)
   before stage ``j``, per pocket, face and bin of psi, is stage ``j``'s ``[wear] worn_depth_front_um`` /
   ``worn_depth_rear_um``: each arc face is the pocket circle pushed outwards by it
   (:func:`bearingsim.multibody.loop.worn_contact`), a flat face by its mean (a uniform shift);
-  ``bearing.pocket_clearance_mm`` stays as given. Its runs on the wear-test scene stop on the roller-cage
-  overlap limit at 60-80 um of worn depth (docs/wear.md): an open problem.
+  ``bearing.pocket_clearance_mm`` stays as given. Its runs on the wear-test scene reach the depth and
+  clearance limits as the uniform mapping's do (docs/wear.md).
 
 Limits: ``depth`` (the deepest point of any
 face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
@@ -25,7 +25,8 @@ face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` 
 
 Stages run in sequence in one folder under :class:`bearingsim.outputs.FolderLock`: ``stages/stage_NN.h5``
 (each a normal archive) and ``life.h5`` (the history, written atomically at the end). A stage archive
-that stores exactly its stage's scenario is reused: an interrupted study resumes where it stopped.
+that stores exactly its stage's scenario and was computed by the present model version is reused: an
+interrupted study resumes where it stopped.
 """
 from __future__ import annotations
 
@@ -140,13 +141,16 @@ def _start_depth(scenario) -> np.ndarray | None:
 
 
 def _run_stage(sc, path: Path, progress):
-    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` (resume),
+    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` and was
+    computed by the present version of the model (resume, as a sweep's: :mod:`bearingsim.model_versions`),
     else a new run."""
     from bearingsim import archive
+    from bearingsim.model_versions import MODEL_VERSIONS
     from bearingsim.simulation import load, run_scenario
 
     got = archive.peek(path) if path.exists() else None
-    if got is not None and got["scenario"] == sc.to_toml():
+    if (got is not None and got["scenario"] == sc.to_toml()
+            and got["model_version"] == MODEL_VERSIONS.get(got["model"])):
         return load(path), True
     if progress:
         worn = [max(max(row) for row in v) for v in (sc.wear.worn_depth_front_um, sc.wear.worn_depth_rear_um)

@@ -25,9 +25,10 @@ This module imports nothing, so a sweep's resume check does not load the models.
 """
 
 # multibody 2: exact arc pocket faces over the cage wall; 3: the rigid scene's automatic step at 80 % of the
-# overlap bound; 4: a worn face's contact at the nearest point of its material (its edges)
+# overlap bound; 4: a worn face's contact at the nearest point of its material (its edges); 5: the automatic
+# step's impact speed across the play worn faces leave (core.worn_play)
 #: version of each model's numbers (bumped when a change moves numbers; see the module docstring)
-MODEL_VERSIONS = {"reduced": 1, "multibody": 4}
+MODEL_VERSIONS = {"reduced": 1, "multibody": 5}
 
 #: the models, by the name a scenario's ``model`` key and an archive's ``/bearingsim@model`` give
 MODELS = tuple(MODEL_VERSIONS)

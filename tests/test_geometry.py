@@ -361,7 +361,8 @@ def test_a_worn_face_s_contact_is_the_nearest_point_of_its_material(face):
 @pytest.mark.slow
 def test_a_run_on_worn_faces_stays_within_the_overlap_bound():
     """The rigid-raceway wear-test scene with the worn faces of a life study's stage 5
-    (tests/data/worn_stage05_rigid.toml: 1 warm-up + 3 rotations at the automatic step, 1.4e-5 s): no roller
+    (tests/data/worn_stage05_rigid.toml: 1 warm-up + 3 rotations at the automatic step, 1.32e-5 s over the
+    worn play): no roller
     overlaps a face by more than 1 % of s (run raises PenetrationExceeded beyond). With the worn faces'
     edges not taken as contacts, a roller resting past the outer end of pocket 3's front face sank unseen
     into the face's material for 17 steps and was found 2.68 um deep at t = 0.068 s, moving at 0.012 m/s;
@@ -371,6 +372,91 @@ def test_a_run_on_worn_faces_stays_within_the_overlap_bound():
     g = raw.glob
     assert g["maxpen_all"] <= 0.01 * p.bearing.pocket_clearance
     assert g["maxpen_approach"] > 0.1
+
+
+def _worn_scenario(base, front, rear):
+    """``base`` with ``front`` / ``rear`` ((n, 32) [m]) as its worn depth."""
+    um = lambda w: [[float(x * 1e6) for x in row] for row in w]  # noqa: E731
+    return base.replace(**{"wear.worn_depth_front_um": um(front), "wear.worn_depth_rear_um": um(rear)})
+
+
+def test_the_automatic_step_takes_the_play_worn_faces_leave():
+    """Pocket 3's front face worn uniformly by 40 um, its rear by 25 um: they are the circle of radius R + w
+    (test above), so a roller crosses s + 65 um there, and the automatic step's impact speed is that of a
+    free flight across it, v = sqrt(2 a L) (docs/fast_scene.md, *Time step*; docs/wear.md, *Worn faces*):
+    with the bound still 1 % of s, the rigid scene's step, and the Hertz scene's impact resolution, are the
+    unworn ones times sqrt(s / L) (1e-12: rounding), and the rigid start phase's fall is across L too. The
+    Hertz scene's step stays its stability limit (the impact resolution is longer). ``dt_choice`` says so."""
+    from bearingsim.multibody.core import choose_dt, impact_dt, rigid_start, worn_play
+
+    base = load_scenario(SCENARIOS / "wear_test_6000rpm.toml", ["multibody.raceway_contact=rigid"])
+    n = base.bearing.roller_count
+    front, rear = np.zeros((n, 32)), np.zeros((n, 32))
+    front[3], rear[3] = 40e-6, 25e-6
+    p0, p = si(base), si(_worn_scenario(base, front, rear))
+    s = p.bearing.pocket_clearance
+    play, pocket = worn_play(p)
+    assert worn_play(p0) == (s, None)
+    assert pocket == 3 and play == pytest.approx(s + 65e-6, abs=1e-15)
+    dt, how, _ = choose_dt(p)
+    assert dt == pytest.approx(choose_dt(p0)[0] * math.sqrt(s / play), rel=1e-12)
+    assert "worn play 0.265 mm" in how and "pocket 3" in how and "worn play" not in choose_dt(p0)[1]
+    g = p.operating.gravity
+    t_start, dt_start = rigid_start(p, 1.0)
+    assert dt_start == pytest.approx(0.005 * s / math.sqrt(2.0 * g * play), rel=1e-12)
+    e = p.contact.restitution
+    assert t_start == pytest.approx(min(math.sqrt(2.0 * play / g) * (1 + e) / (1 - e),
+                                        2 * math.pi / p.operating.omega_c), rel=1e-12)
+    hz0 = si(base.replace(**{"multibody.raceway_contact": "hertz"}))
+    hz = si(_worn_scenario(base.replace(**{"multibody.raceway_contact": "hertz"}), front, rear))
+    assert impact_dt(hz) == pytest.approx(impact_dt(hz0) * math.sqrt(s / play), rel=1e-12)
+    assert choose_dt(hz)[0] == choose_dt(hz0)[0] < impact_dt(hz)
+
+
+def test_the_worn_play_is_the_depth_the_contact_meets():
+    """The worn play on the measured stage-5 profile (tests/data/worn_stage05_rigid.toml, every pocket's
+    own): s plus the largest, over pockets and directions theta of the extent, of the front and rear
+    faces' polar radius less R in the same direction, against a brute force independent of the model: the
+    polar radius of the pocket ``min over psi of h(psi) / cos(theta - psi)`` over 4001 angles psi and the
+    knots, in 545 directions theta (the knots, the edges and 16 per bin: finer than the knots at which
+    ``worn_play`` evaluates it). Tolerance 1e-10 m: the psi grid's error, R dpsi^2 / 8 = 6e-11 m. The end
+    bins, up to 50 um deep, are bridged by their neighbours' lines: the play is s + 24.2 um, not s plus the
+    deepest bins' front + rear depth (79 um)."""
+    from bearingsim.multibody.core import worn_play
+
+    p = si(load_scenario(SCENARIOS.parent / "tests" / "data" / "worn_stage05_rigid.toml"))
+    worn = np.array(p.wear.worn_depth)  # (n, 2, 32) [m]
+    s, lo, hi = p.bearing.pocket_clearance, *p.multibody.pocket_face_extent
+    R = p.bearing.roller_radius + 0.5 * s
+    centres = lo + (hi - lo) * (np.arange(32) + 0.5) / 32
+    psi = np.union1d(np.linspace(lo, hi, 4001), np.concatenate([[lo, hi], centres]))
+    theta = np.union1d(np.linspace(lo, hi, 32 * 16 + 1), np.concatenate([[lo, hi], centres]))
+    c = np.cos(theta[None, :] - psi[:, None])
+    c = np.where(c > 0.0, c, np.nan)
+    extra = np.zeros((worn.shape[0], len(theta)))
+    for i in range(worn.shape[0]):
+        for f in range(2):
+            h = R + np.interp(psi, centres, worn[i, f])
+            extra[i] += np.nanmin(h[:, None] / c, axis=0) - R
+    play, pocket = worn_play(p)
+    assert play == pytest.approx(s + extra.max(), abs=1e-10)
+    assert pocket == int(np.argmax(extra.max(axis=1)))
+    assert extra.max() < 0.5 * (worn[:, 0] + worn[:, 1]).max()  # the deepest bins are bridged
+
+
+@pytest.mark.slow
+def test_a_run_across_a_grown_play_keeps_its_automatic_step():
+    """Stage 8 of the rigid-raceway clearance life with the shape fed back
+    (tests/data/worn_stage08_rigid_clearance.toml; the play a roller crosses 0.371 mm): at the automatic
+    step taken over the worn play (1.03e-5 s) its roller-cage overlaps stay within the bound, 1 % of s
+    (run raises PenetrationExceeded beyond). At the step taken over s alone (1.4e-5 s) a roller met a face
+    at 0.17 m/s, 2.3 um deep, at t = 0.047 s, and the run restarted from its start."""
+    from bearingsim.multibody.core import choose_dt
+
+    p = si(load_scenario(SCENARIOS.parent / "tests" / "data" / "worn_stage08_rigid_clearance.toml"))
+    raw = run(p)
+    assert raw.setup.dt == choose_dt(p)[0]
+    assert raw.glob["maxpen_all"] <= 0.01 * p.bearing.pocket_clearance
 
 
 def test_zero_worn_depth_is_the_unworn_run_bit_for_bit():

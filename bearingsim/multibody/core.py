@@ -219,19 +219,56 @@ def stability_limit(p) -> float:
     return 2.0 / omega_n
 
 
+def worn_play(p) -> tuple[float, int | None]:
+    """(the play [m] a roller crosses in its pocket, the pocket whose play it is (None: unworn)).
+
+    Unworn: the pocket clearance s (``bearing.pocket_clearance_mm``), exactly. With worn faces
+    (``[wear] worn_depth_*``): s plus the largest, over pockets and directions psi of the extent, of the
+    front and the rear face's worn depth **as the contact meets the face** in the same direction psi (the
+    worn boundary's polar radius less R, :func:`worn_radius`, at the bin centres and the two edges): a
+    groove narrower than the roller and a deep end bin are bridged by the lines beside them, so the
+    roller never crosses their depth (docs/wear.md, *Worn faces*). A roller crossing its pocket at a radial
+    offset meets both faces at about the same psi. A flat face moves out by its mean worn depth (a
+    uniform shift): its pocket's play is s plus its front and rear means."""
+    s = p.bearing.pocket_clearance
+    worn = worn_array(p)
+    if worn is None:
+        return s, None
+    rr = p.bearing.roller_radius
+    R = rr + 0.5 * s
+    knots, h = worn_lines(p.multibody.pocket_face_extent, R, worn)
+    r = worn_radius(knots, h, knots)  # (n, 2, K): the knots are the bin centres and the edges
+    extra = (r[:, 0] - R + r[:, 1] - R).max(axis=1)
+    for i in p.multibody.flat_pockets:
+        extra[i] = float(np.mean(worn[i, 0])) + float(np.mean(worn[i, 1]))
+    i = int(np.argmax(extra))
+    return s + max(float(extra[i]), 0.0), i
+
+
 def impact_dt(p) -> float:
     """Impact resolution [s]: a rear impact may overlap the face by at most 0.5 % of s in one step.
 
-    Approach speed estimate: free flight across the clearance under the no-load-zone deceleration
-    (F_o at the centrifugal load, plus g), ``v = sqrt(2 a s)``, as in the reduced model.
-    """
+    Approach speed estimate: free flight across the play under the no-load-zone deceleration
+    (F_o at the centrifugal load, plus g), ``v = sqrt(2 a L)``, as in the reduced model; L the play a
+    roller crosses (:func:`worn_play`: s, or with worn faces s plus the deepest front and rear worn depth
+    a roller meets in its pocket). The bound stays 0.5 % of s: the overlap limit is a fraction of s."""
     g = p.bearing
     op = p.operating
     n_c = g.roller_mass * g.pitch_radius * op.omega_c**2
     f_o = laws.oil_film_drag(p.contact.drag_coefficient, n_c, op.rolling_velocity)
     a = float(f_o) / g.roller_mass + op.gravity + 1e-3
-    v = math.sqrt(2.0 * a * g.pocket_clearance)
+    v = math.sqrt(2.0 * a * worn_play(p)[0])
     return IMPACT_OVERLAP_FRACTION * g.pocket_clearance / v
+
+
+def _play_text(p) -> str:
+    """How :func:`worn_play` chose the play, for ``dt_choice`` ("" unworn)."""
+    play, i = worn_play(p)
+    if i is None:
+        return ""
+    s = p.bearing.pocket_clearance
+    return (f"; v_impact across the worn play {play * 1e3:.4g} mm = s + {(play - s) * 1e6:.4g} um (pocket {i}'s "
+            f"deepest front + rear worn depth in one direction, as the contact meets the faces)")
 
 
 def land_stability_limit(p) -> float:
@@ -256,7 +293,8 @@ def choose_dt(p, dt=None):
         dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
         how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
                f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
-               f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s")
+               f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
+               + _play_text(p))
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of this bearing "
@@ -282,7 +320,7 @@ def _choose_dt_rigid(p, dt):
                f"{dti:.3e} s (s = {s * 1e3:.3g} mm)"
                + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
                   if math.isfinite(lim) else "")
-               + f" and {RIGID_DT_CAP_S:.0e} s")
+               + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p))
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of the cage on its land "
@@ -294,23 +332,25 @@ def rigid_start(p, dt):
     """Rigid raceways with the automatic step: the start phase, (its duration [s], its step [s]).
 
     The cage starts centred and settles onto its rollers (or its land) under gravity: a fall across
-    the pocket clearance s, ``v_fall = sqrt(2 g s)``, bouncing with the roller-cage restitution e for
-    ``t_fall (1 + e) / (1 - e)`` (a bouncing ball; 58 ms on the reference bearing), at most one cage
-    rotation. Those first contacts come faster than the steady impacts the automatic step is set for
-    (measured on the reference bearing with the start phase off: 0.11 m/s at 500 rpm and 0.10 m/s at
-    3000 rpm within the first 10 ms, against the automatic step's estimates of 0.07 and 0.09 m/s), and
-    at the 1 % bound they would restart the whole run with a shorter step. The start phase runs at the step
-    that keeps ``v_fall`` within 0.5 % of s (the Hertz scene's margin), if that is shorter.
+    the play L (the pocket clearance s, or with worn faces :func:`worn_play`), ``v_fall = sqrt(2 g L)``,
+    bouncing with the roller-cage restitution e for ``t_fall (1 + e) / (1 - e)`` (a bouncing ball; 58 ms
+    on the reference bearing), at most one cage rotation. Those first contacts come faster than the
+    steady impacts the automatic step is set for (measured on the reference bearing with the start phase
+    off: 0.11 m/s at 500 rpm and 0.10 m/s at 3000 rpm within the first 10 ms, against the automatic
+    step's estimates of 0.07 and 0.09 m/s), and at the 1 % bound they would restart the whole run with a
+    shorter step. The start phase runs at the step that keeps ``v_fall`` within 0.5 % of s (the Hertz
+    scene's margin), if that is shorter.
     Returns (0, dt) when there is no fall (no gravity)."""
     g, op = p.bearing, p.operating
     s = g.pocket_clearance
     e = p.contact.restitution
     if op.gravity <= 0.0:
         return 0.0, dt
-    t_fall = math.sqrt(2.0 * s / op.gravity)
+    play = worn_play(p)[0]
+    t_fall = math.sqrt(2.0 * play / op.gravity)
     t_settle = t_fall * (1.0 + e) / (1.0 - e) if e < 1.0 else math.inf
     t_start = min(t_settle, 2.0 * math.pi / op.omega_c)
-    dt_start = RIGID_START_OVERLAP_FRACTION * s / math.sqrt(2.0 * op.gravity * s)
+    dt_start = RIGID_START_OVERLAP_FRACTION * s / math.sqrt(2.0 * op.gravity * play)
     return t_start, min(dt, dt_start)
 
 
@@ -363,49 +403,75 @@ def arc_faces(sc, rr, sign, worn=None) -> "lp.ArcFaces":
     if worn is None:
         return af
     lo, hi = sc.extent
-    bins = worn.shape[2]
-    knots = np.concatenate([[lo], lo + (hi - lo) * (np.arange(bins) + 0.5) / bins, [hi]])
-    h = sc.pocket_radius + np.concatenate([worn[:, :, :1], worn, worn[:, :, -1:]], axis=2)
+    knots, h = worn_lines(sc.extent, sc.pocket_radius, worn)
     return af._replace(worn_on=True, knot_psi=knots, knot_cos=np.cos(knots), knot_sin=np.sin(knots),
                        knot_h=np.ascontiguousarray(h, dtype=np.float64), edge=worn_edges(knots, h, lo, hi))
 
 
-def worn_edges(knots, h, lo, hi) -> np.ndarray:
-    """(..., 2, 2) where each worn face meets the rays of its extent, (inner ``lo``, outer ``hi``) end,
-    (x, y) in the face's frame [m]: the face's edges (:func:`bearingsim.multibody.loop.worn_contact`).
+def worn_lines(extent, pocket_radius, worn):
+    """(knots (bins + 2,) [rad], h (n, 2, bins + 2) [m]) of worn arc faces: the lines ``p . u(psi) <= h(psi)``
+    bounding each pocket's (front, rear) face, ``h = R + w`` at the bin centres of psi, constant in the half
+    bins at the extent's ends (``worn``: :func:`worn_array`)."""
+    lo, hi = extent
+    bins = worn.shape[2]
+    knots = np.concatenate([[lo], lo + (hi - lo) * (np.arange(bins) + 0.5) / bins, [hi]])
+    h = pocket_radius + np.concatenate([worn[:, :, :1], worn, worn[:, :, -1:]], axis=2)
+    return knots, h
+
+
+def worn_radius(knots, h, e) -> np.ndarray:
+    """Polar radius [m] of each worn face's boundary from its pocket centre in the directions ``e`` (E,)
+    [rad] within the extent: shape ``h.shape[:-1] + (E,)``.
 
     ``knots`` (K,) [rad] and ``h`` (..., K) [m]: the face's lines ``p . u(psi) <= h(psi)``, ``h`` linear
-    between the knots. Along the ray at angle ``e`` the nearest line is at
+    between the knots (:func:`worn_lines`). Along the ray at angle ``e`` the nearest line is at
     ``r(e) = min over psi of h(psi) / cos(e - psi)``; on a knot interval the derivative's numerator
     ``a cos(e - psi) - h(psi) sin(e - psi)`` (``a`` the slope of ``h``) grows with psi (its derivative is
     ``h cos(e - psi) > 0``), so the least value is at a knot or at that numerator's single zero, found by
-    bisection. Unworn (``h = R``) the edges are the arc's ends, ``R (cos e, sin e)``."""
+    bisection. Unworn (``h = R``) it is ``R``."""
     h = np.asarray(h, dtype=np.float64)
-    out = np.zeros(h.shape[:-1] + (2, 2))
+    e = np.asarray(e, dtype=np.float64)
     p0, p1 = knots[:-1], knots[1:]
-    h0, h1 = h[..., :-1], h[..., 1:]
-    slope = (h1 - h0) / (p1 - p0)
-    for j, e in enumerate((lo, hi)):
-        def ratio(psi, hv):
-            c = np.cos(e - psi)
-            return np.where(c > 0.0, hv / np.where(c > 0.0, c, 1.0), np.inf)
+    h0 = h[..., None, :-1]  # (..., 1, K - 1): one row per direction
+    slope = (h[..., None, 1:] - h0) / (p1 - p0)
+    ee = e[:, None]
 
-        def numer(psi):
-            return slope * np.cos(e - psi) - (h0 + slope * (psi - p0)) * np.sin(e - psi)
+    def ratio(psi, hv, ang):
+        c = np.cos(ang - psi)
+        return np.where(c > 0.0, hv / np.where(c > 0.0, c, 1.0), np.inf)
 
-        best = ratio(knots, h).min(axis=-1)
-        a, b = np.broadcast_to(p0, h0.shape).copy(), np.broadcast_to(p1, h0.shape).copy()
-        root = (numer(a) < 0.0) & (numer(b) > 0.0) & (np.cos(e - a) > 0.0) & (np.cos(e - b) > 0.0)
-        for _ in range(100):
-            m = 0.5 * (a + b)
-            neg = numer(m) < 0.0
-            a = np.where(neg, m, a)
-            b = np.where(neg, b, m)
+    def numer(psi, sl, hl, pl, ang):
+        return sl * np.cos(ang - psi) - (hl + sl * (psi - pl)) * np.sin(ang - psi)
+
+    shape = np.broadcast_shapes(h0.shape, ee.shape)
+    best = ratio(knots, h[..., None, :], ee).min(axis=-1)
+    sl, hl = np.broadcast_to(slope, shape), np.broadcast_to(h0, shape)
+    pl, pr, ang = np.broadcast_to(p0, shape), np.broadcast_to(p1, shape), np.broadcast_to(ee, shape)
+    root = ((numer(pl, sl, hl, pl, ang) < 0.0) & (numer(pr, sl, hl, pl, ang) > 0.0)
+            & (np.cos(ang - pl) > 0.0) & (np.cos(ang - pr) > 0.0))
+    # bisection on the intervals with a zero only
+    sl, hl, p_, ang = sl[root], hl[root], pl[root], ang[root]
+    a, b = p_.copy(), pr[root].copy()
+    for _ in range(100):
         m = 0.5 * (a + b)
-        inner = np.where(root, ratio(m, h0 + slope * (m - p0)), np.inf)
-        r = np.minimum(best, inner.min(axis=-1))
-        out[..., j, 0] = r * math.cos(e)
-        out[..., j, 1] = r * math.sin(e)
+        neg = numer(m, sl, hl, p_, ang) < 0.0
+        a = np.where(neg, m, a)
+        b = np.where(neg, b, m)
+    m = 0.5 * (a + b)
+    inner = np.full(shape, np.inf)
+    inner[root] = ratio(m, hl + sl * (m - p_), ang)
+    return np.minimum(best, inner.min(axis=-1))
+
+
+def worn_edges(knots, h, lo, hi) -> np.ndarray:
+    """(..., 2, 2) where each worn face meets the rays of its extent, (inner ``lo``, outer ``hi``) end,
+    (x, y) in the face's frame [m]: the face's edges (:func:`bearingsim.multibody.loop.worn_contact`), at
+    the polar radius :func:`worn_radius`. Unworn (``h = R``) the edges are the arc's ends, ``R (cos e, sin e)``."""
+    r = worn_radius(knots, h, np.array([lo, hi]))
+    out = np.zeros(r.shape + (2,))
+    for j, e in enumerate((lo, hi)):
+        out[..., j, 0] = r[..., j] * math.cos(e)
+        out[..., j, 1] = r[..., j] * math.sin(e)
     return np.ascontiguousarray(out)
 
 

@@ -78,9 +78,9 @@ def add_commands(sub) -> None:
     li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
     li.add_argument("--force", action="store_true", help="replace a life study of another scenario or limit")
-    li.add_argument("--mapping", choices=("uniform", "shape"), default="uniform",
-                    help="how a stage's wear acts back: 'uniform' (default), every pocket's clearance grows by the "
-                         "worst pocket's mean worn depth; 'shape', the worn depth added to each face where it wore "
-                         "(docs/wear.md)")
+    li.add_argument("--mapping", choices=("shape", "uniform"), default="shape",
+                    help="how a stage's wear acts back: 'shape' (default), the worn depth added to each face where "
+                         "it wore; 'uniform', every pocket's clearance grows by the worst pocket's mean worn depth "
+                         "(the pockets stay arcs; docs/wear.md)")
     li.add_argument("-q", "--quiet", action="store_true", help="no line per stage run")
     li.set_defaults(func=_cmd_life)

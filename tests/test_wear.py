@@ -213,7 +213,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     with pytest.raises(UserError, match="another scenario, limit or mapping"):
         run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1, mapping=mapping)
     other = "shape" if mapping == "uniform" else "uniform"
-    with pytest.raises(UserError, match="another scenario, limit or mapping"):
+    with pytest.raises(UserError, match=f"another scenario, limit or mapping .*give --mapping {mapping} to resume"):
         run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=other)
     from bearingsim.cli import main
 
@@ -250,7 +250,9 @@ def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
 
 def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, capsys):
     """`bearingsim wear ARCHIVE` draws the Fig. 13 and Fig. 14 analogs from the archive alone (a run
-    written and read back), `bearingsim life` its history figure from life.h5's columns."""
+    written and read back), `bearingsim life` its history figure from life.h5's columns; without
+    ``--mapping`` the life study feeds the worn shape back (the default, docs/wear.md), its second stage
+    running with the first stage's worn depth on the faces."""
     from bearingsim.cli import main
 
     archive = tmp_path / "w.h5"
@@ -263,6 +265,13 @@ def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, c
     assert main(["life", scenario, "--limit", "clearance=0.203mm", "--stages", "2", "--rotations", "1", "-q",
                  "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "life")]) == 0
     assert (tmp_path / "life" / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    from bearingsim.simulation import load
+    from bearingsim.studies.life import read_life
+
+    assert read_life(tmp_path / "life" / "life.h5")[1]["mapping"] == "shape"
+    stage = load(tmp_path / "life" / "stages" / "stage_01.h5").scenario
+    assert stage.wear.worn_depth_rear_um is not None
+    assert stage.bearing.pocket_clearance_mm == load_scenario(scenario).bearing.pocket_clearance_mm
 
 
 @pytest.mark.parametrize("name", ["life.h5", "life.png"])

@@ -1,23 +1,22 @@
 """Cage life with the clearance it wears: simulate, wear the pockets, simulate again (docs/wear.md).
 
-A life study is a sequence of ``stages``. Stage ``j`` runs the scenario at the pocket clearance the wear
-of the stages before it left, reads the wear rate of every face from its wear profile
+A life study is a sequence of ``stages``. Stage ``j`` runs the scenario in the pockets the wear of the
+stages before it left, reads the wear rate of every face from its wear profile
 (:func:`bearingsim.wear.wear_report` per inner-ring rotation), and runs it on for as many rotations as
 bring the limited quantity from ``j / stages`` to ``(j + 1) / stages`` of the limit at that rate (so the
 last stage ends at the limit). The rates can change from stage to stage: the wear acts back through the
-clearance.
+worn pockets.
 
 How the wear maps onto the next stage's geometry (``mapping``, :data:`MAPPINGS`):
 
-* ``uniform`` (the default): the pockets stay arcs and every pocket's clearance ``s`` grows by the worn
-  depth of the worst pocket, front plus rear, each face's depth its mean over the face (worn volume /
-  face area, so the model's pocket removes as much brass as wore);
-* ``shape``: the worn depth is added to each face where it wore. The depth accumulated by the stages
-  before stage ``j``, per pocket, face and bin of psi, is stage ``j``'s ``[wear] worn_depth_front_um`` /
-  ``worn_depth_rear_um``: each arc face is the pocket circle pushed outwards by it
+* ``shape`` (the default): the worn depth is added to each face where it wore. The depth accumulated by
+  the stages before stage ``j``, per pocket, face and bin of psi, is stage ``j``'s ``[wear]
+  worn_depth_front_um`` / ``worn_depth_rear_um``: each arc face is the pocket circle pushed outwards by it
   (:func:`bearingsim.multibody.loop.worn_contact`), a flat face by its mean (a uniform shift);
-  ``bearing.pocket_clearance_mm`` stays as given. Its runs on the wear-test scene reach the depth and
-  clearance limits as the uniform mapping's do (docs/wear.md).
+  ``bearing.pocket_clearance_mm`` stays as given. The pocket the next stage runs in is the worn one;
+* ``uniform``: the pockets stay arcs and every pocket's clearance ``s`` grows by the worn depth of the
+  worst pocket, front plus rear, each face's depth its mean over the face (worn volume / face area, so the
+  model's pocket removes as much brass as wore): the clearance growth alone, without where the wear is.
 
 Limits: ``depth`` (the deepest point of any
 face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
@@ -54,10 +53,10 @@ class Limit:
 
 #: how the wear of a stage acts back on the next (docs/wear.md, *Life*)
 MAPPINGS = {
-    "uniform": "every pocket's clearance grows by the worst pocket's mean worn depth, front + rear (the "
-               "pockets stay arcs)",
     "shape": "the worn depth added to each face where it wore (per pocket, face and bin of psi); flat faces "
              "shifted by their mean",
+    "uniform": "every pocket's clearance grows by the worst pocket's mean worn depth, front + rear (the "
+               "pockets stay arcs)",
 }
 
 
@@ -162,7 +161,7 @@ def _run_stage(sc, path: Path, progress):
 
 
 def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int | None = None,
-             force: bool = False, progress=None, mapping: str = "uniform") -> dict:
+             force: bool = False, progress=None, mapping: str = "shape") -> dict:
     """Run a life study (module docstring) into ``folder``; return the history's columns (also written
     as ``folder/life.h5``). ``progress``: a callable given one line per stage run (the CLI prints them).
     ``mapping``: how the wear acts back on the next stage, :data:`MAPPINGS`."""
@@ -260,10 +259,13 @@ def _check_folder(folder: Path, scenario, limit: Limit, force: bool, mapping: st
     if not path.exists() or force:
         return
     _, attrs = archive.read_table_file(path, LIFE_FORMAT)
-    if (attrs.get("scenario") != scenario.to_toml() or attrs.get("limit") != limit.text
-            or attrs.get("mapping", "uniform") != mapping):
+    held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
+    if attrs.get("scenario") != scenario.to_toml() or attrs.get("limit") != limit.text:
         raise UserError(f"{path}: holds a life study of another scenario, limit or mapping; give another folder "
                         f"or --force")
+    if held != mapping:
+        raise UserError(f"{path}: holds a life study of another scenario, limit or mapping (--mapping {held}; "
+                        f"this one: {mapping}); give --mapping {held} to resume it, another folder, or --force")
 
 
 def read_life(path) -> tuple[dict, dict]:

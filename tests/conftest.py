@@ -66,7 +66,8 @@ def started(cmd, **kw):
 # --- pytest-xdist: how many workers, and the tests that run alone ------------------------------------
 #: most workers ``-n auto`` starts: each worker loads numba's compiled kernels (and compiles them on a
 #: fresh checkout), many tests start process pools or command-line runs of their own, and the longest
-#: test file takes about two minutes, so more workers add memory and start-up rather than speed
+#: test file (tests/test_reliability.py) takes 2-3 minutes on one worker, so more workers add memory and
+#: start-up rather than speed
 MAX_WORKERS = 4
 
 

@@ -1,5 +1,13 @@
-"""Shared test helpers. Paths are absolute so tests run from any folder."""
+"""Shared test helpers. Paths are absolute so tests run from any folder.
+
+The suite runs on pytest-xdist (``-n auto --dist loadfile`` in pyproject.toml): each test file on one
+worker, so a module's fixtures are computed once. Tests marked ``alone`` bound a wall time (a signal
+answered within so many seconds): under xdist they run while no other test runs, as they did in one
+process.
+"""
 import contextlib
+import fcntl
+import os
 import subprocess
 from pathlib import Path
 
@@ -53,3 +61,54 @@ def started(cmd, **kw):
             if stream is not None:
                 stream.close()
         proc.wait()
+
+
+# --- pytest-xdist: how many workers, and the tests that run alone ------------------------------------
+#: most workers ``-n auto`` starts: each worker loads numba's compiled kernels (and compiles them on a
+#: fresh checkout), many tests start process pools or command-line runs of their own, and the longest
+#: test file (tests/test_reliability.py) takes 2-3 minutes on one worker, so more workers add memory and
+#: start-up rather than speed
+MAX_WORKERS = 4
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_auto_num_workers(config):
+    """``-n auto``: the CPUs this process may run on (its affinity, which a container or ``taskset``
+    limits, unlike the machine's core count), at most :data:`MAX_WORKERS`; on one CPU no workers (the
+    tests run in this process). ``PYTEST_XDIST_AUTO_NUM_WORKERS`` still decides when set."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None  # xdist's own hook reads it
+    n = min(len(os.sched_getaffinity(0)), MAX_WORKERS)
+    return n if n > 1 else 0
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """Under xdist, each test (set-up, call, tear-down) holds a shared lock that an ``alone`` test takes
+    exclusively: it starts once the other workers' running tests have ended, and none starts until it
+    has ended. The lock files are in the run's base temporary folder, which xdist shares with every
+    worker of this run only."""
+    if "PYTEST_XDIST_WORKER" not in os.environ:  # one process: every test runs alone
+        return (yield)
+    folder = Path(item.config.option.basetemp).parent  # the controller's basetemp; each worker's is inside
+    with _turn(folder, alone=item.get_closest_marker("alone") is not None):
+        return (yield)
+
+
+@contextlib.contextmanager
+def _turn(folder: Path, alone: bool):
+    """A readers-writer lock of two ``flock`` files: ``gate`` keeps new tests out while an ``alone`` test
+    waits (so it cannot be starved), ``room`` is held shared by running tests and exclusively by it."""
+    gate = os.open(folder / "alone.gate", os.O_RDWR | os.O_CREAT, 0o600)
+    room = os.open(folder / "alone.room", os.O_RDWR | os.O_CREAT, 0o600)
+    try:
+        fcntl.flock(gate, fcntl.LOCK_EX)
+        if alone:
+            fcntl.flock(room, fcntl.LOCK_EX)  # the gate stays closed until this test has ended
+        else:
+            fcntl.flock(room, fcntl.LOCK_SH)
+            fcntl.flock(gate, fcntl.LOCK_UN)
+        yield
+    finally:
+        os.close(room)  # closing a file releases its locks
+        os.close(gate)

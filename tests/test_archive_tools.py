@@ -46,7 +46,8 @@ def test_set_with_a_bad_key_is_a_user_error():
 @pytest.fixture(scope="module")
 def reduced_archive(tmp_path_factory):
     d = tmp_path_factory.mktemp("arch")
-    res = cli("run", SCENARIOS / "paper_1000rpm.toml", "-o", d / "a.h5", "-q")
+    # the tests read the archive, never its figures: --no-plots (the figures are plot's and run's own tests)
+    res = cli("run", SCENARIOS / "paper_1000rpm.toml", "-o", d / "a.h5", "-q", "--no-plots")
     assert res.returncode == 0, res.stderr
     return d / "a.h5"
 
@@ -54,7 +55,8 @@ def reduced_archive(tmp_path_factory):
 @pytest.fixture(scope="module")
 def multibody_archive(tmp_path_factory):
     d = tmp_path_factory.mktemp("mb")
-    res = cli("run", SCENARIOS / "multibody_6000rpm.toml", "--set", "numerics.rotations=1", "-o", d / "m.h5", "-q")
+    res = cli("run", SCENARIOS / "multibody_6000rpm.toml", "--set", "numerics.rotations=1", "-o", d / "m.h5", "-q",
+              "--no-plots")  # plot draws them again from a copy of the archive alone
     assert res.returncode == 0, res.stderr
     return d / "m.h5"
 
@@ -103,7 +105,8 @@ def test_rerun_of_a_multibody_archive_is_bit_identical(multibody_archive):
 def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
     assert cli("compare", reduced_archive, reduced_archive).returncode == 0
     other = tmp_path / "o.h5"
-    assert cli("run", SCENARIOS / "paper_1000rpm.toml", "--set", "contact.restitution=0.7", "-o", other, "-q").returncode == 0
+    assert cli("run", SCENARIOS / "paper_1000rpm.toml", "--set", "contact.restitution=0.7", "-o", other, "-q",
+               "--no-plots").returncode == 0
     res = cli("compare", reduced_archive, other)
     assert res.returncode == 1
     assert "contact.restitution: 0.8 -> 0.7" in res.stdout and "I_dec_mean_Ns" in res.stdout
@@ -118,7 +121,7 @@ def test_show_gives_a_runnable_scenario_with_the_same_results(tmp_path, reduced_
     assert res.returncode == 0
     toml = tmp_path / "again.toml"
     toml.write_text(res.stdout)
-    assert cli("run", toml, "-o", tmp_path / "again.h5", "-q").returncode == 0
+    assert cli("run", toml, "-o", tmp_path / "again.h5", "-q", "--no-plots").returncode == 0
     assert cli("compare", reduced_archive, tmp_path / "again.h5").returncode == 0
 
 

@@ -183,6 +183,7 @@ def test_refusals(argv, words, capsys, tmp_path):
     assert not (tmp_path / "cc" / "cases").exists()
 
 
+@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_path, signum, code):

@@ -632,6 +632,7 @@ def test_too_few_samples_advice_names_the_cause():
 
 
 # --- signals ----------------------------------------------------------------------------------------
+@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
 def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
@@ -640,6 +641,7 @@ def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     assert not obs.problems, obs.problems
 
 
+@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 @pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
 def test_signal_stops_the_euler_pass_within_a_second_leaving_nothing(tmp_path, sig, code):
@@ -670,6 +672,7 @@ except cli.Terminated:
 """
 
 
+@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 def test_sigterm_inside_the_compiled_euler_loop_raises_cleanly():
     """A SIGTERM landing in the euler method's compiled loop: its handler's exception comes out of

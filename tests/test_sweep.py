@@ -218,6 +218,7 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     assert [r["status"] for r in third.rows] == ["cached"] * 3
 
 
+@pytest.mark.alone  # bounds a wall time
 def test_sweep_wall_time_covers_its_cases(tmp_path, monkeypatch):
     """``SweepOutcome.wall_s`` is the sweep's wall time from call to return (80 %: the call's own
     set-up and return are outside it), and on one worker at least the sum of the cases' own times (a
@@ -281,6 +282,7 @@ def _descendants(pid):
         return []
 
 
+@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code):

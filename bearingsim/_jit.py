@@ -5,6 +5,10 @@ that calls a kernel from another file carries that kernel's code inside its cach
 edit of the other file it would keep running the old kernel. :func:`drop_stale_caches`, called at the
 end of such a module, keeps a digest of the sources it depends on beside the cache and empties the
 module's caches when the digest changes.
+
+A module that compiles functions written in another file (``njit(cache=True)(other.f)``, as
+:mod:`bearingsim.compiled_laws` does) passes them as ``dispatchers``: their ``__module__`` is the other
+file's, and the decorator's options live in this one, which numba's check of the other file misses.
 """
 from __future__ import annotations
 
@@ -15,12 +19,15 @@ from pathlib import Path
 from numba.core.dispatcher import Dispatcher
 
 
-def drop_stale_caches(module_name: str, dependencies) -> None:
-    """Empty the numba caches of every compiled function of ``module_name`` if any module in
-    ``dependencies`` changed since the caches were written (a read-only install is left alone)."""
-    module = sys.modules[module_name]
-    dispatchers = [v for v in vars(module).values()
-                   if isinstance(v, Dispatcher) and getattr(v, "__module__", None) == module_name]
+def drop_stale_caches(module_name: str, dependencies, dispatchers=None) -> None:
+    """Empty the numba caches of every compiled function of ``module_name`` (or of ``dispatchers``, when
+    given) if any module in ``dependencies`` changed since the caches were written (a read-only install is
+    left alone)."""
+    if dispatchers is None:
+        module = sys.modules[module_name]
+        dispatchers = [v for v in vars(module).values()
+                       if isinstance(v, Dispatcher) and getattr(v, "__module__", None) == module_name]
+    dispatchers = list(dispatchers)
     if not dispatchers:
         return
     digest = hashlib.sha256(b"".join(Path(m.__file__).read_bytes() for m in dependencies)).hexdigest()

@@ -2,7 +2,7 @@
 
 * kinematics of the bearing, Eqs. (10)-(12) and (4) of the seed paper;
 * the outer-race normal load, Eq. (3), and the oil-film (EHL rolling) resistance, Eq. (2), with a
-  compiled scalar form for the kernels (:func:`oil_film_drag_scalar`);
+  scalar form for the kernels (:func:`oil_film_drag_scalar`);
 * the Palmgren line contact ``Q = K delta^(10/9)`` (:func:`palmgren_stiffness`,
   :func:`palmgren_load`);
 * the load-zone rule: the half angle ``psi_l = arccos(P_d / (2 delta_r))`` of a ring displaced by
@@ -13,13 +13,16 @@
 * gravity (:data:`STANDARD_GRAVITY`).
 
 Equation numbers refer to Suzuki et al., Machines 11(6):594, 2023 (the seed paper).
+
+Plain Python and numpy only: scenario loading and validation import this module, and it does not load
+numba. The scalar laws the compiled kernels call (:func:`oil_film_drag_scalar`, :func:`palmgren_load`)
+are compiled from these same functions by :mod:`bearingsim.compiled_laws`.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
-from numba import njit
 
 STANDARD_GRAVITY = 9.80665  # m/s^2
 
@@ -64,9 +67,8 @@ def oil_film_drag(drag_coefficient, normal_load, rolling_velocity):
     return drag_coefficient * n**DRAG_LOAD_EXPONENT * np.abs(rolling_velocity) ** DRAG_SPEED_EXPONENT
 
 
-@njit(cache=True)
 def oil_film_drag_scalar(drag_coefficient, normal_load, rolling_velocity):
-    """Eq. (2) for one contact, compiled: F_o = c N^0.246 V^0.648 [N] for N > 0, else 0.
+    """Eq. (2) for one contact (compiled for the kernels: :mod:`bearingsim.compiled_laws`): F_o = c N^0.246 V^0.648 [N] for N > 0, else 0.
 
     Parameters
     ----------
@@ -82,9 +84,9 @@ def oil_film_drag_scalar(drag_coefficient, normal_load, rolling_velocity):
     return drag_coefficient * normal_load**DRAG_LOAD_EXPONENT * rolling_velocity**DRAG_SPEED_EXPONENT
 
 
-@njit(cache=True)
 def palmgren_load(stiffness, approach):
-    """Palmgren line contact: Q = K delta^(10/9) [N] for an approach delta [m] > 0, else 0."""
+    """Palmgren line contact: Q = K delta^(10/9) [N] for an approach delta [m] > 0, else 0 (compiled for
+    the kernels: :mod:`bearingsim.compiled_laws`)."""
     if approach <= 0.0:
         return 0.0
     return stiffness * approach ** (10.0 / 9.0)

@@ -7,25 +7,41 @@ import pytest
 from bearingsim import laws
 
 
-def test_palmgren_constant_in_si():
+#: the scalar laws as Python functions (laws.py) and as the kernels call them, compiled (compiled_laws.py)
+SCALAR_FORMS = pytest.mark.parametrize("form", ["python", "compiled"])
+
+
+def _scalar(form):
+    if form == "python":
+        return laws
+    from bearingsim import compiled_laws
+
+    return compiled_laws
+
+
+@SCALAR_FORMS
+def test_palmgren_constant_in_si(form):
     """Palmgren (Harris & Kotzalas Eq. 6.49): K = 8.06e4 l^(8/9) N/mm^(10/9), l in mm. For l = 13 mm a
     contact carrying 1000 N is compressed by delta = (1000 / K_mm)^(9/10) mm; the SI constant must give
     the same force for the same approach in m (to rounding)."""
+    f = _scalar(form)
     k_mm = 8.06e4 * 13.0 ** (8.0 / 9.0)
     delta_mm = (1000.0 / k_mm) ** 0.9
-    assert laws.palmgren_load(laws.palmgren_stiffness(13e-3), delta_mm * 1e-3) == pytest.approx(1000.0, rel=1e-12)
-    assert laws.palmgren_load(1e9, 0.0) == 0.0 and laws.palmgren_load(1e9, -1e-6) == 0.0
+    assert f.palmgren_load(laws.palmgren_stiffness(13e-3), delta_mm * 1e-3) == pytest.approx(1000.0, rel=1e-12)
+    assert f.palmgren_load(1e9, 0.0) == 0.0 and f.palmgren_load(1e9, -1e-6) == 0.0
 
 
-def test_oil_film_drag_eq2_scalar_and_array_forms_agree():
-    """Eq. (2), F_o = c N^0.246 V^0.648: the compiled scalar form equals the vectorised one, is zero
-    without contact (N <= 0), and scales with the paper's exponents."""
+@SCALAR_FORMS
+def test_oil_film_drag_eq2_scalar_and_array_forms_agree(form):
+    """Eq. (2), F_o = c N^0.246 V^0.648: the scalar form (Python and compiled) equals the vectorised one,
+    is zero without contact (N <= 0), and scales with the paper's exponents."""
+    f = _scalar(form)
     for n, v in [(3.5, 1.2), (120.0, 18.0), (0.0, 5.0), (-2.0, 5.0)]:
-        assert laws.oil_film_drag_scalar(0.02, n, v) == pytest.approx(float(laws.oil_film_drag(0.02, n, v)), rel=1e-14)
-    assert laws.oil_film_drag_scalar(0.02, 0.0, 5.0) == 0.0
-    base = laws.oil_film_drag_scalar(0.02, 10.0, 2.0)
-    assert laws.oil_film_drag_scalar(0.02, 20.0, 2.0) / base == pytest.approx(2.0**0.246, rel=1e-14)
-    assert laws.oil_film_drag_scalar(0.02, 10.0, 4.0) / base == pytest.approx(2.0**0.648, rel=1e-14)
+        assert f.oil_film_drag_scalar(0.02, n, v) == pytest.approx(float(laws.oil_film_drag(0.02, n, v)), rel=1e-14)
+    assert f.oil_film_drag_scalar(0.02, 0.0, 5.0) == 0.0
+    base = f.oil_film_drag_scalar(0.02, 10.0, 2.0)
+    assert f.oil_film_drag_scalar(0.02, 20.0, 2.0) / base == pytest.approx(2.0**0.246, rel=1e-14)
+    assert f.oil_film_drag_scalar(0.02, 10.0, 4.0) / base == pytest.approx(2.0**0.648, rel=1e-14)
 
 
 def test_epicyclic_kinematics_pure_rolling():

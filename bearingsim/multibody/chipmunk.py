@@ -50,7 +50,7 @@ import pymunk.batch as pb
 from numba import carray, njit, types
 from numba.extending import intrinsic
 
-from bearingsim import laws
+from bearingsim import compiled_laws, laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import loop as lp
@@ -773,4 +773,4 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             return lp.CODE_BLOCK_FULL
 
 
-drop_stale_caches(__name__, (fk, rk, lp, _reduced_core, laws))  # advance() compiles in the step kernels
+drop_stale_caches(__name__, (fk, rk, lp, _reduced_core, laws, compiled_laws))  # advance() compiles in the step kernels

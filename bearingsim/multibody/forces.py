@@ -48,7 +48,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from bearingsim import laws
+from bearingsim import compiled_laws, laws
 
 
 class RacewayParams(NamedTuple):
@@ -98,7 +98,7 @@ def _normal_force(delta, delta_rate, K, c_r, d_fade):
     """Normal force [N], its derivative in delta [N/m] and in delta_rate [N s/m] of one contact."""
     if delta <= 0.0:
         return 0.0, 0.0, 0.0
-    q_el = laws.palmgren_load(K, delta)  # Q = K delta^(10/9), delta > 0 here
+    q_el = compiled_laws.palmgren_load(K, delta)  # Q = K delta^(10/9), delta > 0 here
     k_lin = TEN_NINTHS * K * delta ** (1.0 / 9.0)
     fade = delta / d_fade if delta < d_fade else 1.0
     dfade = 1.0 / d_fade if delta < d_fade else 0.0
@@ -237,7 +237,7 @@ def _contact(
     u_ent = 0.5 * (abs(w - orbit) * rr + abs(omega_race - orbit) * r_race_geom)
     u_ref = max(u_ent, prm.min_entrainment)
     # oil-film rolling resistance, Eq. (2), on the roller centre against its motion relative to the race
-    fo = laws.oil_film_drag_scalar(prm.drag_coefficient, q, u_ent)  # Eq. (2) with this contact's N and V
+    fo = compiled_laws.oil_film_drag_scalar(prm.drag_coefficient, q, u_ent)  # Eq. (2) with this contact's N and V
     rel = vx * tx + vy * ty - w_race
     weps = prm.drag_direction_eps
     sq = math.sqrt(rel * rel + weps * weps)
@@ -682,4 +682,4 @@ def land_force(state, h, lp, ring_c, ring_c_prev, out_f, out):
 
 from bearingsim._jit import drop_stale_caches  # noqa: E402
 
-drop_stale_caches(__name__, (laws,))  # the contact kernels compile in the laws of laws.py
+drop_stale_caches(__name__, (laws, compiled_laws))  # the contact kernels compile in the laws of laws.py

@@ -35,7 +35,7 @@ import numpy as np
 import pymunk.batch as pb
 from numba import njit
 
-from bearingsim import laws
+from bearingsim import compiled_laws, laws
 from bearingsim._jit import drop_stale_caches
 from bearingsim.multibody import forces as fk
 from bearingsim.multibody import recorder as rk
@@ -760,4 +760,4 @@ class PlainLoop:
                 return CODE_BLOCK_FULL
 
 
-drop_stale_caches(__name__, (fk, rk, _reduced_core, laws))  # the step kernels compile in the force and recording kernels
+drop_stale_caches(__name__, (fk, rk, _reduced_core, laws, compiled_laws))  # the step kernels compile in the force and recording kernels

@@ -587,11 +587,33 @@ def _provenance(result) -> dict[str, Any]:
     return prov
 
 
+#: the HDF5 format signature: at the start of the superblock, at byte 0 or 512, 1024, 2048, ... of a file
+_HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _has_hdf5_signature(path) -> bool:
+    """False when no HDF5 superblock can start anywhere in the regular file ``path`` (the signature is at
+    none of the offsets where the HDF5 library looks for it: 0 and 512 * 2^k); then the file is not
+    HDF5, and telling so needs no h5py (a scenario file, the usual case, is decided here)."""
+    with open(path, "rb") as f:
+        size = f.seek(0, 2)
+        offset = 0
+        while offset + len(_HDF5_SIGNATURE) <= size:
+            f.seek(offset)
+            if f.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
+                return True
+            offset = 512 if offset == 0 else 2 * offset
+    return False
+
+
 def is_archive(path) -> bool:
     """True when ``path`` is an HDF5 file written by bearingsim (complete or not)."""
     try:
+        # a FIFO is never opened: it would block; h5py only for a file that may be HDF5
+        if not Path(path).is_file() or not _has_hdf5_signature(path):
+            return False
         h5py = _lazy_h5py()
-        if not Path(path).is_file() or not h5py.is_hdf5(path):  # a FIFO is never opened: it would block
+        if not h5py.is_hdf5(path):
             return False
         with h5py.File(path, "r") as f:
             return "bearingsim" in f and "format_version" in f["bearingsim"].attrs

@@ -11,9 +11,13 @@ from bearingsim.errors import UserError
 
 def refuse_archive_as_scenario(path) -> None:
     """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
+    from pathlib import Path
+
+    if not Path(path).is_file():  # missing files and the like: the scenario reader reports them (no archive)
+        return
     from bearingsim.archive import is_archive
 
-    if is_archive(path):  # missing or unreadable files: the scenario reader reports them
+    if is_archive(path):  # unreadable files: the scenario reader reports them
         raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
                         f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
 

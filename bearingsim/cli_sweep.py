@@ -8,7 +8,6 @@ import sys
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.sweeps.run import run_sweep
 
 #: rows of the table printed at the end of a sweep ('bearingsim table DIR' prints them all)
 TABLE_ROWS = 40
@@ -25,6 +24,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
     """
     from bearingsim.sweeps.engines import DaskEngine, LocalEngine
+    from bearingsim.sweeps.run import run_sweep
     from bearingsim.sweeps.spec import spec_from_args
 
     spec = spec_from_args(target, params, sets)

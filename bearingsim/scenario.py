@@ -22,7 +22,6 @@ from typing import Any, Literal
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
-from bearingsim import laws
 from bearingsim.errors import UserError
 
 SCHEMA_VERSION = 1
@@ -1089,6 +1088,8 @@ def _check_cage_wall(m: ScenarioModel, source: str) -> None:
 def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
     """The arc pocket faces fit the cage wall: "auto" needs the cage's diameters and a wall that holds
     the pocket centre; a given half angle may not reach past the wall (bearingsim.laws.pocket_face_extent)."""
+    from bearingsim import laws
+
     b = m.bearing
     mb = m.multibody
     wall = (b.cage_inner_diameter_mm, b.cage_outer_diameter_mm)

@@ -6,12 +6,34 @@ indexes them in ``sweep.csv``/``sweep.h5`` (:mod:`bearingsim.sweeps.index`) and,
 ``map.h5`` (one array per quantity over the axes: :mod:`bearingsim.sweeps.grid`, ``read_map``);
 ``plot_sweep_index`` draws the sweep's figures from the index.
 """
-from bearingsim.sweeps.engines import DaskEngine, LocalEngine
-from bearingsim.sweeps.grid import SweepMap, read_map
-from bearingsim.sweeps.index import index_dataframe, read_index
-from bearingsim.sweeps.plot import plot_sweep_index
-from bearingsim.sweeps.run import SweepOutcome, run_sweep
-from bearingsim.sweeps.spec import Case, SweepSpec, case_hash, load_sweep_file, resolve_cases, spec_from_args
+import importlib
+
+#: where each name of the package lives: imported on first use (PEP 562), so that importing one light
+#: submodule (``bearingsim.sweeps.index``, for ``bearingsim keys``) does not load the scenario reader,
+#: the runner and their dependencies
+_SOURCES = {
+    "DaskEngine": "engines", "LocalEngine": "engines",
+    "SweepMap": "grid", "read_map": "grid",
+    "index_dataframe": "index", "read_index": "index",
+    "plot_sweep_index": "plot",
+    "SweepOutcome": "run", "run_sweep": "run",
+    "Case": "spec", "SweepSpec": "spec", "case_hash": "spec", "load_sweep_file": "spec", "resolve_cases": "spec",
+    "spec_from_args": "spec",
+}
 
 __all__ = ["Case", "DaskEngine", "LocalEngine", "SweepMap", "SweepOutcome", "SweepSpec", "case_hash", "index_dataframe", "load_sweep_file",
            "plot_sweep_index", "read_index", "read_map", "resolve_cases", "run_sweep", "spec_from_args"]
+
+
+def __getattr__(name):
+    if name in _SOURCES:
+        value = getattr(importlib.import_module(f"{__name__}.{_SOURCES[name]}"), name)
+        globals()[name] = value
+        return value
+    if name in {"engines", "grid", "index", "plot", "run", "spec"}:  # the submodules the package imported eagerly
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))

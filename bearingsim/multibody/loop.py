@@ -265,6 +265,19 @@ class StepInputs(NamedTuple):
 
 
 @njit(cache=True, inline="always")
+def _move_segment(e, ax, ay, bx, by):
+    """Set the segment ends ``e`` (ax, ay, bx, by) to the given ones; True when they changed (the loop then
+    hands the segment to chipmunk)."""
+    if e[0] == ax and e[1] == ay and e[2] == bx and e[3] == by:
+        return False
+    e[0] = ax
+    e[1] = ay
+    e[2] = bx
+    e[3] = by
+    return True
+
+
+@njit(cache=True, inline="always")
 def arc_faces(state, h, af, ends, todo):
     """Place the exact arc faces for the coming step: each face's segment on the arc's tangent at the
     direction of its roller's centre from the pocket centre, clamped to the face's extent.
@@ -329,17 +342,10 @@ def arc_faces(state, h, af, ends, todo):
                 ay_ = af.centre[i, 1] + wax * uy + way * ery
                 bx_ = af.centre[i, 0] + wbx * ux + wby * erx
                 by_ = af.centre[i, 1] + wbx * uy + wby * ery
-                e = ends[i, f]
-                if e[0] != ax_ or e[1] != ay_ or e[2] != bx_ or e[3] != by_:
-                    e[0] = ax_
-                    e[1] = ay_
-                    e[2] = bx_
-                    e[3] = by_
-                    todo[i, f] = True
+                todo[i, f] = _move_segment(ends[i, f], ax_, ay_, bx_, by_)
                 continue
             x = (dx * ux + dy * uy) * inv  # the roller's direction in this face's frame
             y = y0
-            Rf = R  # the face's tangent line's distance from the pocket centre
             s_lo = y * cl - x * sl  # sin(psi - psi_lo)
             s_hi = x * sh - y * ch  # sin(psi_hi - psi)
             if s_lo < 0.0 or s_hi < 0.0:  # past an end: the end nearer in angle
@@ -353,23 +359,13 @@ def arc_faces(state, h, af, ends, todo):
                 s_hi = x * sh - y * ch
             c_lo = x * cl + y * sl  # cos(psi - psi_lo)
             c_hi = x * ch + y * sh  # cos(psi_hi - psi)
-            l_lo = Rf * s_lo / c_lo if c_lo > 0.0 and Rf * s_lo < ell * c_lo else ell
-            l_hi = Rf * s_hi / c_hi if c_hi > 0.0 and Rf * s_hi < ell * c_hi else ell
-            qx = af.centre[i, 0] + Rf * (x * ux + y * erx)  # tangent point
-            qy = af.centre[i, 1] + Rf * (x * uy + y * ery)
+            l_lo = R * s_lo / c_lo if c_lo > 0.0 and R * s_lo < ell * c_lo else ell
+            l_hi = R * s_hi / c_hi if c_hi > 0.0 and R * s_hi < ell * c_hi else ell
+            qx = af.centre[i, 0] + R * (x * ux + y * erx)  # tangent point
+            qy = af.centre[i, 1] + R * (x * uy + y * ery)
             tx = -y * ux + x * erx  # tangent, toward larger psi
             ty = -y * uy + x * ery
-            e = ends[i, f]
-            ax_ = qx - l_lo * tx
-            ay_ = qy - l_lo * ty
-            bx_ = qx + l_hi * tx
-            by_ = qy + l_hi * ty
-            if e[0] != ax_ or e[1] != ay_ or e[2] != bx_ or e[3] != by_:
-                e[0] = ax_
-                e[1] = ay_
-                e[2] = bx_
-                e[3] = by_
-                todo[i, f] = True
+            todo[i, f] = _move_segment(ends[i, f], qx - l_lo * tx, qy - l_lo * ty, qx + l_hi * tx, qy + l_hi * ty)
 
 
 #: the narrowed masks keep a face segment whose distance from the roller's circle after pymunk's position

@@ -5,14 +5,13 @@ from __future__ import annotations
 
 import signal
 import sys
+from pathlib import Path
 
 from bearingsim.errors import UserError
 
 
 def refuse_archive_as_scenario(path) -> None:
     """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
-    from pathlib import Path
-
     if not Path(path).is_file():  # missing files and the like: the scenario reader reports them (no archive)
         return
     from bearingsim.archive import is_archive

@@ -478,20 +478,21 @@ def test_joint_solve_is_chipmunk_s_slide_joint_bit_for_bit():
     assert taut >= 9 and slack >= 1
 
 
-def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-5):
+def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-5, n_seg=5):
     """face_masks for a 4-pocket scene with the roller of pocket 0 at ``q`` (cage frame, relative to its
-    pocket centre, after the step's position update), the cage at the origin turned by ``cage_angle``."""
+    pocket centre, after the step's position update), the cage at the origin turned by ``cage_angle``;
+    ``n_seg`` = 0: exact faces, placed by ``arc_faces`` for the step first, as the compiled loop does."""
     from types import SimpleNamespace
 
     from bearingsim.multibody import loop as lp
-    from bearingsim.multibody.core import face_geometry
+    from bearingsim.multibody.core import arc_faces, face_geometry
     from bearingsim.multibody.scene import build_scene
 
     geo = SimpleNamespace(roller_count=4, roller_radius=0.01, pitch_radius=0.05, pocket_clearance=0.001,
                           roller_mass=0.1, roller_inertia=1e-5, cage_mass=1.0, cage_inertia=1e-3)
     op = SimpleNamespace(sign=1, gravity=0.0, omega_c=0.0, omega_r=0.0)
-    sc = build_scene(geo, op, 0.5, 0.1, extent=(-math.radians(45.0), math.radians(45.0)), n_seg=5, kinematic_cage=False,
-                     spin_free=True)
+    sc = build_scene(geo, op, 0.5, 0.1, extent=(-math.radians(45.0), math.radians(45.0)), n_seg=n_seg,
+                     kinematic_cage=False, spin_free=True)
     fm = face_geometry(sc, 0.01, lp.MASK_MARGIN_M)
     a1 = cage_angle + cage_w * h  # where the position update turns the cage
     c, s = math.cos(a1), math.sin(a1)
@@ -508,8 +509,11 @@ def _one_pocket_masks(q, vb_roller=(0.0, 0.0), cage_angle=0.0, cage_w=0.0, h=1e-
     state[0, 0:2] = p_world - (state[0, 3:5] + vb[0, 0:2]) * h
     state[4, 2] = cage_angle
     state[4, 5] = cage_w
+    ends = sc.face_segments[:, :2, :].copy() if n_seg == 0 else np.zeros((4, 2, 4))
+    if n_seg == 0:
+        lp.arc_faces.py_func(state, h, arc_faces(sc, 0.01, 1), ends, np.zeros((4, 2), dtype=np.bool_))
     want = np.zeros(4, dtype=np.uint32)
-    lp.face_masks.py_func(state, vb, h, fm, want)
+    lp.face_masks.py_func(state, vb, h, fm, ends, want)
     return want, sc
 
 
@@ -536,6 +540,36 @@ def test_face_masks_keep_exactly_the_segments_within_reach():
     assert by_bias[0] == segment_bit(0, 2, 5)
     turned, _ = _one_pocket_masks(tuple((gap + 1e-6) * e_t0), cage_angle=0.7, cage_w=300.0)
     assert turned[0] == segment_bit(0, 2, 5)
+
+
+def test_face_masks_keep_only_the_exact_face_within_reach():
+    """Exact faces: each face's one segment is placed on the arc's tangent nearest the roller
+    (``arc_faces``), and the mask keeps a face only when that segment is within reach (R = 10.5 mm, faces
+    +-45 deg). Pressed 1 um into the front arc at 20 deg from its middle: the front face's bit alone;
+    1 um short of it: nothing; against the rear arc: the rear's alone; moved 1.5 x the play straight out
+    along the pocket's radius, beyond both faces' extent (the cage wall there is open): nothing, so a
+    rigid-raceway roller there leaves its joint to ``joint_solve``; further out it meets both faces' outer
+    edges (R at +-45 deg), where |d e_r - R u(45 deg)| = r: d = R sin45 - sqrt(r^2 - R^2 cos^2 45) = 0.727 mm,
+    checked at 0.98 and 1.02 d. The first and the last but one fail if the exact faces keep both bits
+    whenever the roller is off its pocket centre."""
+    from bearingsim.multibody.scene import segment_bit
+
+    gap = 0.0005  # s / 2
+    psi = math.radians(20.0)
+    u = np.array([math.cos(psi), math.sin(psi)])  # pocket 0 at the bottom: front +x, e_r -y
+    u[1] = -u[1]
+    into, _ = _one_pocket_masks(tuple((gap + 1e-6) * u), n_seg=0)
+    assert into[0] == segment_bit(0, 0, 1) and into[1:].tolist() == [0, 0, 0]
+    short, _ = _one_pocket_masks(tuple((gap - 1e-6) * u), n_seg=0)
+    assert short[0] == 0
+    rear, _ = _one_pocket_masks(tuple(-(gap + 1e-6) * u), n_seg=0)
+    assert rear[0] == segment_bit(1, 0, 1)
+    R, r, c45 = 0.0105, 0.01, math.cos(math.radians(45.0))
+    d_edge = R * c45 - math.sqrt(r * r - (R * c45) ** 2)
+    out, _ = _one_pocket_masks((0.0, -0.98 * d_edge), n_seg=0)
+    assert out[0] == 0
+    edges, _ = _one_pocket_masks((0.0, -1.02 * d_edge), n_seg=0)
+    assert edges[0] == segment_bit(0, 0, 1) | segment_bit(1, 0, 1)
 
 
 def test_plain_loop_is_chosen_by_the_environment(monkeypatch):

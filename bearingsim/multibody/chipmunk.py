@@ -605,15 +605,16 @@ _as_u32_ptr = _pointer_cast(types.uint32)
 
 
 @njit(cache=True, inline="always")
-def _narrow_masks(body_ptrs, shape_ptrs, state, h, fm, vb, now, want):
+def _narrow_masks(body_ptrs, shape_ptrs, state, h, fm, arc_ends, vb, now, want):
     """Read the bodies' bias velocities, compute the rollers' masks for the coming step
-    (:func:`bearingsim.multibody.loop.face_masks`) and write those that changed into their ``cpShape``."""
+    (:func:`bearingsim.multibody.loop.face_masks`; ``arc_ends``: the exact faces' segments as placed for
+    the step) and write those that changed into their ``cpShape``."""
     for k in range(body_ptrs.shape[0]):
         b = carray(_as_float_ptr(body_ptrs[k]), BODY_WBIAS + 1)
         vb[k, 0] = b[BODY_VBIAS]
         vb[k, 1] = b[BODY_VBIAS + 1]
         vb[k, 2] = b[BODY_WBIAS]
-    lp.face_masks(state, vb, h, fm, want)
+    lp.face_masks(state, vb, h, fm, arc_ends, want)
     for i in range(shape_ptrs.shape[0]):
         if want[i] != now[i]:
             carray(_as_u32_ptr(shape_ptrs[i]), SHAPE_MASK + 1)[SHAPE_MASK] = want[i]
@@ -701,7 +702,8 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     bytes as chipmunk's (``jn_acc``, ``free_now``: those joints' accumulated impulses and which they
     are; ``prev_h``: the last step size; ``iterations``: the space's; ``joint_max``: the joints' length).
     ``endpoints_fn``, ``arc_ptrs``: exact arc faces (``inp.arc.active``): each pocket's (front, rear) segment
-    (``cpShape *``) placed before each step where :func:`~bearingsim.multibody.loop.arc_faces` says.
+    (``cpShape *``) placed before each step where :func:`~bearingsim.multibody.loop.arc_faces` says (before the masks are
+    narrowed, which test the segments where they are placed).
     ``inp``, ``wk``, ``acc``, ``ls``: those of the step kernels.
     """
     sp = ptr.space
@@ -718,10 +720,17 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
         code = lp.before_step(prev, inp, wk, ls)
         if code != lp.CODE_CONTINUE:
             return code
+        if inp.arc.active:  # the exact faces first: the narrowed masks test the segments where they are placed
+            lp.arc_faces(prev, h, inp.arc, wk.arc_ends, wk.arc_todo)
+            for i in range(arc_ptrs.shape[0]):
+                for f in range(2):
+                    if wk.arc_todo[i, f]:
+                        e = wk.arc_ends[i, f]
+                        endpoints_fn(arc_ptrs[i, f], e[0], e[1], e[2], e[3])
         if body_ptrs.shape[0]:
             _write_bodies(body_ptrs, prev, wk.out_f, set_pv)
             if fm.active:
-                _narrow_masks(body_ptrs, shape_ptrs, prev, h, fm, vb, mask_now, mask_want)
+                _narrow_masks(body_ptrs, shape_ptrs, prev, h, fm, wk.arc_ends, vb, mask_now, mask_want)
             if free_on:
                 _hand_over_joints(joint_ptrs, mask_want, jn_acc, free_now, joint_max)
         else:
@@ -729,13 +738,6 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
                 lp.pack_all(prev, wk.out_f, wk.set_arr, prev.shape[0])
             hdr.set[0] = 0  # the setter reads the buffer from the start
             each_body_fn(sp, ptr.body_set, ptr.data_set)
-        if inp.arc.active:
-            lp.arc_faces(prev, h, inp.arc, wk.arc_ends, wk.arc_todo)
-            for i in range(arc_ptrs.shape[0]):
-                for f in range(2):
-                    if wk.arc_todo[i, f]:
-                        e = wk.arc_ends[i, f]
-                        endpoints_fn(arc_ptrs[i, f], e[0], e[1], e[2], e[3])
         if timed:
             t0 = _now_ns(clock_fn, ptr.timespec, ts)
             step_fn(sp, h)

@@ -388,7 +388,7 @@ class FaceMasks(NamedTuple):
     clear2: float
     reach2: float  #: (r + margin)^2 [m^2]: a segment closer to the roller centre may be touched
     #: (n,) bool, pocket with exact arc faces: its two segments move (:func:`arc_faces`), so a roller
-    #: beyond ``clear2`` keeps both in its mask
+    #: beyond ``clear2`` is tested against them where they are placed for the step (``arc_ends``)
     arc: np.ndarray = np.zeros(0, dtype=np.bool_)
 
 
@@ -500,7 +500,7 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
 
 
 @njit(cache=True, inline="always")
-def face_masks(state, vb, h, fm, want):
+def face_masks(state, vb, h, fm, arc_ends, want):
     """The collision mask of each roller for the coming step, into ``want`` (uint32): the category bits
     of the face segments of its pocket within ``MASK_MARGIN_M`` of its circle where chipmunk's position
     update will put roller and cage, ``p + (v + v_bias) h`` and ``a + (w + w_bias) h`` (the same
@@ -512,8 +512,9 @@ def face_masks(state, vb, h, fm, want):
     A roller centre closer than ``R - r`` to its pocket centre touches no face (every face point is at
     least ``R`` from it: the polyline circumscribes the arc, an exact face's tangent segment touches it
     at one point, a flat face is a plane at ``R``), so most
-    rollers need one distance; the others are tested against each segment of their pocket. A roller
-    stays in its own pocket (it would have to pass through a face)."""
+    rollers need one distance; the others are tested against each segment of their pocket, an exact
+    face's where :func:`arc_faces` has placed it for this step (``arc_ends``: (n, 2, 4), cage frame). A
+    roller stays in its own pocket (it would have to pass through a face)."""
     n = want.shape[0]
     cx = state[n, 0] + (state[n, 3] + vb[n, 0]) * h
     cy = state[n, 1] + (state[n, 4] + vb[n, 1]) * h
@@ -530,7 +531,16 @@ def face_masks(state, vb, h, fm, want):
         dy = qy - fm.centre[i, 1]
         m = np.uint32(0)
         if dx * dx + dy * dy >= fm.clear2 and fm.arc.shape[0] and fm.arc[i]:
-            m = fm.bits[i, 0] | fm.bits[i, 1]  # an exact face's segment is placed where the roller is
+            for f in range(2):  # an exact face: its segment as arc_faces placed it for this step
+                e = arc_ends[i, f]
+                ex = e[2] - e[0]
+                ey = e[3] - e[1]
+                e2 = ex * ex + ey * ey
+                t = min(max(((qx - e[0]) * ex + (qy - e[1]) * ey) / e2, 0.0), 1.0) if e2 > 0.0 else 0.0
+                ux = e[0] + t * ex - qx
+                uy = e[1] + t * ey - qy
+                if ux * ux + uy * uy < fm.reach2:
+                    m |= fm.bits[i, f]
         elif dx * dx + dy * dy >= fm.clear2:
             for j in range(seg.shape[1]):
                 bit = fm.bits[i, j]

@@ -38,6 +38,17 @@ NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converg
 # rotations of more than this fraction of the mean cage speed is a trend (a cage still accelerating
 # or decelerating): the run's means describe a transient, which a note says.
 MAX_CAGE_SPEED_DRIFT = 0.2
+# The start of a multibody run: the cage starts centred on the axis and settles onto its rollers (or its
+# land) during the warm-up rotations. One warm-up rotation leaves the next ones off the steady state at
+# some speeds (on the reference bearing the first recorded rotation is +10 % at 3000 rpm and the first
+# four swing by up to 2.6 % at 1000 rpm; docs/statistics.md). A first recorded rotation whose pocket-mean
+# I_dec lies further than START_TRANSIENT_SD standard deviations of the later rotations from their mean,
+# and by more than START_TRANSIENT_MIN_REL of it, gets a note (normal scatter passes 3 sd in 0.3 % of
+# runs); with fewer than START_TRANSIENT_MIN_ROTATIONS recorded rotations the later ones give no scatter
+# to judge by.
+START_TRANSIENT_SD = 3.0
+START_TRANSIENT_MIN_REL = 0.01
+START_TRANSIENT_MIN_ROTATIONS = 4
 # A mean cage speed above this multiple of the epicyclic speed (Eq. 11; a roller-guided cage slips
 # behind it, never ahead by much) is a cage driven by something other than rolling: the advice for too
 # few samples then names the traction and drag keys, not the output rate.
@@ -114,9 +125,9 @@ def check(result) -> list[str]:
         samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
         if samples < MIN_ORBIT_SAMPLES:
             raise SimulationUnstable(f"{samples} time-series samples recorded; {_few_samples_advice(result)}")
-        drift = cage_speed_drift(result)
-        if drift is not None:
-            notes.append(drift)
+        for note in (cage_speed_drift(result), start_transient(result)):
+            if note is not None:
+                notes.append(note)
         fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
         steps = int(summary.get("steps", 0) or 0)
         if fails and steps:
@@ -154,12 +165,54 @@ def checks_made(result) -> list[tuple[str, str, bool]]:
     samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
     out.append(("cage-orbit samples recorded", f"{samples} against at least {MIN_ORBIT_SAMPLES}",
                 samples >= MIN_ORBIT_SAMPLES))
+    off = _first_rotation_offset(result)
+    if off is not None:
+        rel, sds, n = off
+        out.append(("warm-up reached a steady state", f"first recorded rotation's I_dec {rel:+.1%} off the mean of "
+                    f"the {n} later ones, {sds:.1f} of their standard deviations, against at most "
+                    f"{START_TRANSIENT_SD:g} or {START_TRANSIENT_MIN_REL:.0%}",
+                    abs(rel) <= START_TRANSIENT_MIN_REL or sds <= START_TRANSIENT_SD))
     fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
     steps = int(summary.get("steps", 0) or 0)
     if steps:
         out.append(("inner ring's force balance converged", f"not in {fails} of {steps} steps ({fails / steps:.2%}) "
                     f"against at most {MAX_NEWTON_FAILURE_FRACTION:.0%}", fails <= MAX_NEWTON_FAILURE_FRACTION * steps))
     return out
+
+
+def _first_rotation_offset(result) -> tuple[float, float, int] | None:
+    """(offset of the first recorded rotation's pocket-mean I_dec from the mean of the later ones, relative
+    to that mean; the offset in standard deviations of the later ones; their count) of a multibody
+    result with at least :data:`START_TRANSIENT_MIN_ROTATIONS` recorded rotations, else None."""
+    if result.parameters.model != "multibody":
+        return None
+    arr = np.asarray(result.per_rotation.get("I_dec", np.zeros(0)), dtype=float)
+    if arr.ndim != 2 or arr.shape[0] < START_TRANSIENT_MIN_ROTATIONS or not np.all(np.isfinite(arr)):
+        return None
+    x = arr.mean(axis=1)
+    rest = x[1:]
+    mean = float(rest.mean())
+    sd = float(rest.std(ddof=1))
+    d = float(x[0]) - mean
+    if mean <= 0.0:
+        return None
+    return d / mean, (abs(d) / sd if sd > 0.0 else (math.inf if d else 0.0)), len(rest)
+
+
+def start_transient(result) -> str | None:
+    """A note when a multibody run's first recorded rotation is still off the steady state that the later
+    ones show (:data:`START_TRANSIENT_SD`, :data:`START_TRANSIENT_MIN_REL`), else None."""
+    off = _first_rotation_offset(result)
+    if off is None:
+        return None
+    rel, sds, n = off
+    if abs(rel) <= START_TRANSIENT_MIN_REL or sds <= START_TRANSIENT_SD:
+        return None
+    rotations = len(np.asarray(result.per_rotation["I_dec"]))
+    return (f"bearingsim: note: the first recorded rotation's I_dec is {rel:+.1%} off the mean of the {n} later "
+            f"ones ({sds:.1f} of their standard deviations): the warm-up did not reach a steady state, and the "
+            f"mean I_dec holds {rel / rotations:+.2%} of it; set more numerics.warmup_rotations (now "
+            f"{result.parameters.numerics.warmup_rotations}) or more numerics.rotations (docs/statistics.md)")
 
 
 def cage_speed_drift(result) -> str | None:

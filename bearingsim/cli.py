@@ -611,30 +611,56 @@ def _interrupts_redelivered():
     sets it pending (``_thread.interrupt_main``) ``REDELIVER_AFTER_S`` later, when the main thread has
     left the callback (the hook runs inside it, and a signal set pending at once would raise into the
     hook), and the handler raises it again there; a signal that lands in a callback again comes back
-    again. Every other unraisable exception goes to the previous hook."""
+    again. Every other unraisable exception goes to the previous hook. Yields the :class:`_Swallowed`
+    signal: a command that fails while a signal waits there (the callback that swallowed it could not
+    finish its work) ends as that signal (:func:`main` takes it, and it is not delivered again)."""
     import _thread
     import threading
     import time
 
     previous = sys.unraisablehook
+    swallowed = _Swallowed()
 
     def deliver(signum):
         time.sleep(REDELIVER_AFTER_S)
-        _thread.interrupt_main(signum)
+        with swallowed.lock:
+            if swallowed.signum != signum:  # taken meanwhile by the command's failure (see main)
+                return
+            swallowed.signum = None
+            _thread.interrupt_main(signum)
 
     def hook(unraisable):
         exc = unraisable.exc_value
         if isinstance(exc, KeyboardInterrupt):
             signum = signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
+            with swallowed.lock:
+                swallowed.signum = signum
             threading.Thread(target=deliver, args=(signum,), daemon=True).start()
         else:
             previous(unraisable)
 
     sys.unraisablehook = hook
     try:
-        yield
+        yield swallowed
     finally:
         sys.unraisablehook = previous
+
+
+class _Swallowed:
+    """A signal whose exception a callback swallowed, while it waits to be delivered again
+    (:func:`_interrupts_redelivered`): ``signum``, or None."""
+
+    def __init__(self):
+        import threading
+
+        self.lock = threading.Lock()
+        self.signum = None
+
+    def take(self):
+        """The waiting signal, or None; it will not be delivered again."""
+        with self.lock:
+            signum, self.signum = self.signum, None
+        return signum
 
 
 def _one_line(exc: BaseException) -> str:
@@ -724,8 +750,17 @@ def main(argv: list[str] | None = None) -> int:
             errors[name] = stream.errors
             stream.reconfigure(errors="backslashreplace")
     try:
-        with _interrupts_redelivered(), outputs.command_line_owns_stderr(), _notes_on_stderr():
-            code = args.func(args)
+        with _interrupts_redelivered() as swallowed, outputs.command_line_owns_stderr(), _notes_on_stderr():
+            try:
+                code = args.func(args)
+            except Exception as exc:
+                signum = swallowed.take()
+                if signum is None:
+                    raise
+                # the signal came first, and its exception was swallowed in a callback that then could not
+                # do its work (numba's compiler, called back from LLVM, left without the object it was
+                # handed: "no compiled object yet"); the command failed of that: the signal ends it
+                raise (Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()) from exc
             try:
                 sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
             except BrokenPipeError:

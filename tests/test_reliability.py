@@ -722,6 +722,43 @@ def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch
     assert sys.unraisablehook is hook and ref_a() is None and ref_b() is None
 
 
+def test_a_command_that_fails_after_a_swallowed_signal_ends_as_the_signal(monkeypatch, capsys):
+    """A SIGTERM whose handler ran inside a callback that C code called (LLVM calling numba back while it
+    compiles a kernel from a cold cache): its ``Terminated`` is swallowed there, the callback's work is
+    left undone, and the command fails of that a moment later (numba: "RuntimeError: no compiled object
+    yet", seen once in a fresh clone's suite as a traceback and exit 1). The command line reports the
+    signal instead: exit 143, its one line, and the signal is not delivered again afterwards. A failure
+    with no signal waiting stays what it is."""
+    import weakref
+
+    from bearingsim import cli
+
+    class Thing:
+        pass
+
+    def fails_after_a_swallowed_signal(args):
+        a = Thing()
+        ref = weakref.ref(a, lambda r: cli._raise_terminated(signal.SIGTERM, None))  # the swallowing callback
+        del a
+        assert ref() is None
+        raise RuntimeError("no compiled object yet")
+
+    monkeypatch.setattr(cli, "_cmd_keys", fails_after_a_swallowed_signal)
+    assert cli.main(["keys"]) == 143
+    err = capsys.readouterr().err
+    assert err == "bearingsim: terminated (SIGTERM), no archive written\n", err
+    deadline = time.monotonic() + 10 * cli.REDELIVER_AFTER_S  # a delivery again would raise Terminated here
+    while time.monotonic() < deadline:
+        pass
+
+    def fails(args):
+        raise RuntimeError("a defect")
+
+    monkeypatch.setattr(cli, "_cmd_keys", fails)
+    with pytest.raises(RuntimeError, match="a defect"):
+        cli.main(["keys"])
+
+
 #: a run long enough to be caught writing: 200 multibody rotations, or one euler pass of 1e8 steps (the
 #: most the euler method takes; ~6 s at ~60 ns a step) spent in one compiled loop
 LONG_RUNS = {

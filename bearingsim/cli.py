@@ -623,11 +623,10 @@ def _interrupts_redelivered():
 
     def deliver(signum):
         time.sleep(REDELIVER_AFTER_S)
-        with swallowed.lock:
-            if swallowed.signum != signum:  # taken meanwhile by the command's failure (see main)
-                return
-            swallowed.signum = None
-            _thread.interrupt_main(signum)
+        with swallowed.lock:  # unless taken meanwhile by the command's failure (see main)
+            if swallowed.signum == signum:
+                swallowed.signum = None
+                _thread.interrupt_main(signum)
 
     def hook(unraisable):
         exc = unraisable.exc_value

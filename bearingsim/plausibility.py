@@ -208,10 +208,9 @@ def start_transient(result) -> str | None:
     rel, sds, n = off
     if abs(rel) <= START_TRANSIENT_MIN_REL or sds <= START_TRANSIENT_SD:
         return None
-    rotations = len(np.asarray(result.per_rotation["I_dec"]))
     return (f"bearingsim: note: the first recorded rotation's I_dec is {rel:+.1%} off the mean of the {n} later "
             f"ones ({sds:.1f} of their standard deviations): the warm-up did not reach a steady state, and the "
-            f"mean I_dec holds {rel / rotations:+.2%} of it; set more numerics.warmup_rotations (now "
+            f"mean I_dec holds {rel / (n + 1):+.2%} of it; set more numerics.warmup_rotations (now "
             f"{result.parameters.numerics.warmup_rotations}) or more numerics.rotations (docs/statistics.md)")
 
 

@@ -245,25 +245,26 @@ def worn_play(p) -> tuple[float, int | None]:
     return s + max(float(extra[i]), 0.0), i
 
 
-def impact_dt(p) -> float:
+def impact_dt(p, play=None) -> float:
     """Impact resolution [s]: a rear impact may overlap the face by at most 0.5 % of s in one step.
 
     Approach speed estimate: free flight across the play under the no-load-zone deceleration
     (F_o at the centrifugal load, plus g), ``v = sqrt(2 a L)``, as in the reduced model; L the play a
     roller crosses (:func:`worn_play`: s, or with worn faces s plus the deepest front and rear worn depth
-    a roller meets in its pocket). The bound stays 0.5 % of s: the overlap limit is a fraction of s."""
+    a roller meets in its pocket; ``play``: its result when the caller has it). The bound stays 0.5 % of s:
+    the overlap limit is a fraction of s."""
     g = p.bearing
     op = p.operating
     n_c = g.roller_mass * g.pitch_radius * op.omega_c**2
     f_o = laws.oil_film_drag(p.contact.drag_coefficient, n_c, op.rolling_velocity)
     a = float(f_o) / g.roller_mass + op.gravity + 1e-3
-    v = math.sqrt(2.0 * a * worn_play(p)[0])
+    v = math.sqrt(2.0 * a * (play or worn_play(p))[0])
     return IMPACT_OVERLAP_FRACTION * g.pocket_clearance / v
 
 
-def _play_text(p) -> str:
-    """How :func:`worn_play` chose the play, for ``dt_choice`` ("" unworn)."""
-    play, i = worn_play(p)
+def _play_text(p, play) -> str:
+    """How :func:`worn_play` chose the play (``play``: its result), for ``dt_choice`` ("" unworn)."""
+    play, i = play
     if i is None:
         return ""
     s = p.bearing.pocket_clearance
@@ -277,10 +278,11 @@ def land_stability_limit(p) -> float:
     return 2.0 * math.sqrt(p.bearing.cage_mass / land.stiffness) if land.active else math.inf
 
 
-def choose_dt(p, dt=None):
-    """(dt [s], how it was chosen, explicit limit [s]). Raises UserError for a dt far above stable."""
+def choose_dt(p, dt=None, play=None):
+    """(dt [s], how it was chosen, explicit limit [s]). Raises UserError for a dt far above stable.
+    ``play``: :func:`worn_play` of ``p`` when the caller has it (else computed where needed)."""
     if rigid(p):
-        return _choose_dt_rigid(p, dt)
+        return _choose_dt_rigid(p, dt, play)
     lim = stability_limit(p)
     largest = DT_MAX_FACTOR * lim
     if dt is None and p.numerics.dt is not None:
@@ -289,12 +291,13 @@ def choose_dt(p, dt=None):
     elif dt is not None:
         how = "simulate(dt=...)"
     else:
-        dti = impact_dt(p)
+        play = play or worn_play(p)
+        dti = impact_dt(p, play)
         dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
         how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
                f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
                f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
-               + _play_text(p))
+               + _play_text(p, play))
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of this bearing "
@@ -303,7 +306,7 @@ def choose_dt(p, dt=None):
     return float(dt), how, lim
 
 
-def _choose_dt_rigid(p, dt):
+def _choose_dt_rigid(p, dt, play=None):
     """Rigid raceways: no raceway spring; the step resolves the roller-cage impacts (and the land's
     penalty contact of a land-guided cage). Returns (dt, how, explicit limit [s] (the land's or inf))."""
     lim = land_stability_limit(p)
@@ -314,13 +317,14 @@ def _choose_dt_rigid(p, dt):
         how = "simulate(dt=...)"
     else:
         s = p.bearing.pocket_clearance
-        dti = RIGID_IMPACT_OVERLAP_FRACTION / IMPACT_OVERLAP_FRACTION * impact_dt(p)
+        play = play or worn_play(p)
+        dti = RIGID_IMPACT_OVERLAP_FRACTION / IMPACT_OVERLAP_FRACTION * impact_dt(p, play)
         dt = min(dti, DT_FRACTION * lim, RIGID_DT_CAP_S)
         how = (f"auto (rigid raceways): min of impact resolution {RIGID_IMPACT_OVERLAP_FRACTION:g} s / v_impact = "
                f"{dti:.3e} s (s = {s * 1e3:.3g} mm)"
                + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
                   if math.isfinite(lim) else "")
-               + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p))
+               + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p, play))
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of the cage on its land "
@@ -328,7 +332,7 @@ def _choose_dt_rigid(p, dt):
     return float(dt), how, lim
 
 
-def rigid_start(p, dt):
+def rigid_start(p, dt, play=None):
     """Rigid raceways with the automatic step: the start phase, (its duration [s], its step [s]).
 
     The cage starts centred and settles onto its rollers (or its land) under gravity: a fall across
@@ -340,13 +344,13 @@ def rigid_start(p, dt):
     step's estimates of 0.07 and 0.09 m/s), and at the 1 % bound they would restart the whole run with a
     shorter step. The start phase runs at the step that keeps ``v_fall`` within 0.5 % of s (the Hertz
     scene's margin), if that is shorter.
-    Returns (0, dt) when there is no fall (no gravity)."""
+    Returns (0, dt) when there is no fall (no gravity). ``play``: :func:`worn_play` of ``p`` if the caller has it."""
     g, op = p.bearing, p.operating
     s = g.pocket_clearance
     e = p.contact.restitution
     if op.gravity <= 0.0:
         return 0.0, dt
-    play = worn_play(p)[0]
+    play = (play or worn_play(p))[0]
     t_fall = math.sqrt(2.0 * play / op.gravity)
     t_settle = t_fall * (1.0 + e) / (1.0 - e) if e < 1.0 else math.inf
     t_start = min(t_settle, 2.0 * math.pi / op.omega_c)
@@ -592,8 +596,10 @@ def _steps(p, dt, is_rigid):
     """(step [s], how it was chosen, explicit limit [s], start phase [s], its step [s]): :func:`choose_dt`,
     and with rigid raceways and the automatic step the cage's settling at a step of its own
     (:func:`rigid_start`; a start phase of 0 s when that step is not shorter)."""
-    h, dt_how, dt_lim = choose_dt(p, dt)
-    t_start, h_start = rigid_start(p, h) if is_rigid and dt is None and p.numerics.dt is None else (0.0, h)
+    auto = dt is None and p.numerics.dt is None
+    play = worn_play(p) if auto else None  # the worn play, once (its polar radii take a bisection)
+    h, dt_how, dt_lim = choose_dt(p, dt, play)
+    t_start, h_start = rigid_start(p, h, play) if is_rigid and auto else (0.0, h)
     if h_start < h:
         dt_how += f"; the first {t_start:.3g} s (the cage settling onto its rollers) at {h_start:.3e} s"
     else:

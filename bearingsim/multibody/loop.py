@@ -500,6 +500,16 @@ def onset_elasticity(arb_i, n_arb, inp, wk):
 
 
 @njit(cache=True, inline="always")
+def _segment_within(ax, ay, ex, ey, inv2, qx, qy, reach2):
+    """Whether the segment from ``(ax, ay)`` along ``(ex, ey)`` (``inv2`` = 1 / |e|^2, 0 for a point) comes
+    closer to ``(qx, qy)`` than ``sqrt(reach2)``."""
+    t = min(max(((qx - ax) * ex + (qy - ay) * ey) * inv2, 0.0), 1.0)
+    ux = ax + t * ex - qx
+    uy = ay + t * ey - qy
+    return ux * ux + uy * uy < reach2
+
+
+@njit(cache=True, inline="always")
 def face_masks(state, vb, h, fm, arc_ends, want):
     """The collision mask of each roller for the coming step, into ``want`` (uint32): the category bits
     of the face segments of its pocket within ``MASK_MARGIN_M`` of its circle where chipmunk's position
@@ -536,24 +546,13 @@ def face_masks(state, vb, h, fm, arc_ends, want):
                 ex = e[2] - e[0]
                 ey = e[3] - e[1]
                 e2 = ex * ex + ey * ey
-                t = min(max(((qx - e[0]) * ex + (qy - e[1]) * ey) / e2, 0.0), 1.0) if e2 > 0.0 else 0.0
-                ux = e[0] + t * ex - qx
-                uy = e[1] + t * ey - qy
-                if ux * ux + uy * uy < fm.reach2:
+                if _segment_within(e[0], e[1], ex, ey, 1.0 / e2 if e2 > 0.0 else 0.0, qx, qy, fm.reach2):
                     m |= fm.bits[i, f]
         elif dx * dx + dy * dy >= fm.clear2:
             for j in range(seg.shape[1]):
                 bit = fm.bits[i, j]
-                if bit == 0:
-                    continue
-                ax = seg[i, j, 0]
-                ay = seg[i, j, 1]
-                ex = seg[i, j, 2]
-                ey = seg[i, j, 3]
-                t = min(max(((qx - ax) * ex + (qy - ay) * ey) * seg[i, j, 4], 0.0), 1.0)
-                ux = ax + t * ex - qx
-                uy = ay + t * ey - qy
-                if ux * ux + uy * uy < fm.reach2:
+                if bit != 0 and _segment_within(seg[i, j, 0], seg[i, j, 1], seg[i, j, 2], seg[i, j, 3], seg[i, j, 4],
+                                                qx, qy, fm.reach2):
                     m |= bit
         want[i] = m
 

@@ -284,11 +284,12 @@ def _compare_many(paths) -> int:
     with standard errors and significance marks against the first (:mod:`bearingsim.tables`); exit 0
     when every archive's results are bit-identical to the first's, else 1."""
     from bearingsim import tables
-    from bearingsim.compare import _flatten, compare_results
+    from bearingsim.compare import compare_results
+    from bearingsim.scenario import flatten
     from bearingsim.simulation import COMPARED, load as read
 
     results = [read(p, only=COMPARED) for p in paths]
-    flat = [_flatten(r.scenario.raw) for r in results]
+    flat = [flatten(r.scenario.raw) for r in results]
     keys = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
     if keys:
         print("scenario keys that differ (archive 1, 2, ...):")

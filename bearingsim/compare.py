@@ -9,13 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from bearingsim.scenario import flatten as _flatten  # the one flattener, under this module's old name
-
-
-def _same(a, b) -> bool:
-    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
-        return True
-    return a == b and type(a) is type(b)
+from bearingsim.scenario import differing_keys, same_value
 
 
 @dataclass
@@ -47,16 +41,12 @@ class Comparison:
 def compare_results(a, b) -> Comparison:
     """Compare results ``a`` and ``b`` (:class:`bearingsim.results.Result`)."""
     c = Comparison()
-    fa, fb = _flatten(a.scenario.raw), _flatten(b.scenario.raw)
-    for k in sorted(set(fa) | set(fb)):
-        va, vb = fa.get(k, "(unset)"), fb.get(k, "(unset)")
-        if not _same(va, vb):
-            c.scenario_keys.append((k, va, vb))
+    c.scenario_keys = differing_keys(a.scenario.raw, b.scenario.raw)
     sa, sb = a.summary, b.summary
     for k in list(sa) + [k for k in sb if k not in sa]:
         va, vb = sa.get(k, float("nan")), sb.get(k, float("nan"))
         c.summary.append((k, va, vb))
-        if k not in sa or k not in sb or not _same(va, vb):
+        if k not in sa or k not in sb or not same_value(va, vb):
             c.summary_differs.append(k)
     pa, pb = a.per_rotation, b.per_rotation
     for k in list(pa) + [k for k in pb if k not in pa]:

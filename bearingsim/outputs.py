@@ -212,6 +212,26 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     return p
 
 
+def missing_folders(folder: Path) -> list[Path]:
+    """``folder`` and those of its parents that do not exist yet, deepest first."""
+    missing = []
+    for p in (folder, *folder.parents):
+        if p.exists() or p.is_symlink():
+            break
+        missing.append(p)
+    return missing
+
+
+def remove_empty(folders: list[Path]) -> None:
+    """Remove ``folders`` (deepest first) while they are empty: never a file, never a folder someone
+    has put something into meanwhile."""
+    for p in folders:
+        try:
+            os.rmdir(p)
+        except OSError:
+            return
+
+
 def figure_path(stem: str | Path, name: str) -> Path:
     """Where a run's figure ``name`` goes: ``<stem>_<name>.png``."""
     return Path(f"{stem}_{name}.png")

@@ -758,6 +758,21 @@ def flatten(d: dict, prefix: str = "") -> dict:
     return out
 
 
+def same_value(a, b) -> bool:
+    """Two scenario or summary values are the same: equal and of one type (1 is not 1.0), NaN equal to NaN."""
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return a == b and type(a) is type(b)
+
+
+def differing_keys(a: dict, b: dict) -> list[tuple[str, object, object]]:
+    """The dotted keys whose values differ between the scenario tables ``a`` and ``b``, sorted, each with
+    its value in ``a`` and in ``b`` (``"(unset)"`` where a table lacks the key)."""
+    fa, fb = flatten(a), flatten(b)
+    pairs = ((k, fa.get(k, "(unset)"), fb.get(k, "(unset)")) for k in sorted(set(fa) | set(fb)))
+    return [(k, va, vb) for k, va, vb in pairs if not same_value(va, vb)]
+
+
 def _title_value(key: str, v) -> str:
     label = _TITLE_LABELS.get(key)
     if label is not None:

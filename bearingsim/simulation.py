@@ -127,9 +127,8 @@ def check_same_scenario(out: Path, scenario: Scenario) -> None:
     import tomllib
 
     from bearingsim import archive
-    from bearingsim.compare import _flatten, _same
     from bearingsim.errors import UserError
-    from bearingsim.scenario import resolve
+    from bearingsim.scenario import differing_keys, resolve
 
     got = archive.peek(out) if out.is_file() else None
     if got is None:
@@ -142,9 +141,7 @@ def check_same_scenario(out: Path, scenario: Scenario) -> None:
         return
     keys = []
     if old is not None:
-        fa, fb = _flatten(old.raw), _flatten(scenario.raw)
-        keys = [f"{k} {fa.get(k, '(unset)')} -> {fb.get(k, '(unset)')}" for k in sorted(set(fa) | set(fb))
-                if not _same(fa.get(k, "(unset)"), fb.get(k, "(unset)"))]
+        keys = [f"{k} {va} -> {vb}" for k, va, vb in differing_keys(old.raw, scenario.raw)]
     what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
     raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: write this run elsewhere "
                     f"with -o, or add --force to replace it")
@@ -182,11 +179,11 @@ def run_scenario(
     out = Path(out) if out is not None else default_output(scenario)
     names = model_module(scenario.model).RESULT.FIGURES if figures else ()
     outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
-    made = _missing_folders(out.parent)  # created for this run: removed again if it writes no archive
+    made = outputs.missing_folders(out.parent)  # created for this run: removed again if it writes no archive
     try:
         lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included
     except BaseException:
-        _remove_empty(made)
+        outputs.remove_empty(made)
         raise
     written = False
     try:
@@ -204,7 +201,7 @@ def run_scenario(
         pngs = []
         if figures:
             try:
-                pngs = load(out).save_figures(out.with_suffix(""))
+                pngs = archive.read(out, type(result)).save_figures(out.with_suffix(""))
             except OSError as exc:
                 raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
                                 f"({exc.strerror or exc}); the archive {out} is complete") from None
@@ -215,27 +212,5 @@ def run_scenario(
         if lock is not None:
             lock.release()
         if not written:  # refused (exit 2/3), interrupted or failed: no folder of its own left behind
-            _remove_empty(made)
+            outputs.remove_empty(made)
     return RunOutput(archive=out, figures=list(pngs), result=result)
-
-
-def _missing_folders(folder: Path) -> list[Path]:
-    """``folder`` and those of its parents that do not exist yet, deepest first."""
-    missing = []
-    for p in (folder, *folder.parents):
-        if p.exists() or p.is_symlink():
-            break
-        missing.append(p)
-    return missing
-
-
-def _remove_empty(folders: list[Path]) -> None:
-    """Remove ``folders`` (deepest first) while they are empty: never a file, never a folder someone
-    has put something into meanwhile."""
-    import os
-
-    for p in folders:
-        try:
-            os.rmdir(p)
-        except OSError:
-            return

@@ -92,12 +92,12 @@ def table_of_archives(paths) -> Table:
     """The table of run archives, one row each: labelled by the file and the scenario keys that
     differ between them (at most 4 as columns; the others listed in ``notes``); the standard errors
     computed from each archive's per-rotation impulses (:func:`bearingsim.stats.result_standard_errors`)."""
-    from bearingsim.compare import _flatten
+    from bearingsim.scenario import flatten
     from bearingsim.simulation import COMPARED, load
     from bearingsim.stats import result_standard_errors
 
     results = [load(p, only=COMPARED) for p in paths]
-    flat = [_flatten(r.scenario.raw) for r in results]
+    flat = [flatten(r.scenario.raw) for r in results]
     differ = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
     shown = [k for k in differ if k != "name"][:4]
     names = ["archive", *shown]

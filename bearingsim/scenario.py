@@ -362,7 +362,9 @@ class Scenario:
 
     @property
     def raw(self) -> dict[str, Any]:
-        return _drop_none(self.model_.model_dump())
+        """The resolved scenario as nested plain tables, unset keys left out (a new dictionary per call:
+        the caller may change it)."""
+        return self.model_.model_dump(exclude_none=True)
 
     @property
     def parameters(self):
@@ -397,8 +399,9 @@ def _dumps(raw: dict[str, Any]) -> str:
 
     tomli_w writes the top-level values, then each table, separated by a blank line; a table's text
     depends only on its name and its content, so thousands of sweep cases that differ in one or two
-    keys share the text of their other tables. The key is the table's ``repr`` (which tells 1, 1.0 and
-    True apart), used only for plain data (str, int, float, bool, lists and tables of them).
+    keys share the text of their other tables. The key is the table's ``repr``, which tells 1, 1.0 and
+    True apart: ``raw`` is a scenario model's dump, whose tables hold only str, int, float, bool and
+    lists and tables of them, each of which its ``repr`` spells out whole.
     """
     top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
     if not all(_plain_data(v) for v in top.values()):  # e.g. an array of tables: as tomli_w does it
@@ -406,9 +409,6 @@ def _dumps(raw: dict[str, Any]) -> str:
     parts = [tomli_w.dumps(top)] if top else []
     for k, v in raw.items():
         if isinstance(v, dict):
-            if not _plain_data(v):
-                parts.append(tomli_w.dumps({k: v}))
-                continue
             key = (k, repr(v))
             text = _TOML_TABLES.get(key)
             if text is None:
@@ -430,12 +430,6 @@ def _plain_data(v, depth: int = 0) -> bool:
     if type(v) is dict:
         return all(type(k) is str and _plain_data(x, depth + 1) for k, x in v.items())
     return False
-
-
-def _drop_none(d):
-    if isinstance(d, dict):
-        return {k: _drop_none(v) for k, v in d.items() if v is not None}
-    return d
 
 
 def available_presets() -> list[str]:
@@ -801,7 +795,7 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
             pass
     ref = _merge(ref, {k: raw[k] for k in ("schema_version", "name", "model", "operating", "numerics") if k in raw})
     try:
-        ref = _drop_none(ScenarioModel.model_validate(ref).model_dump())
+        ref = ScenarioModel.model_validate(ref).model_dump(exclude_none=True)
     except ValidationError:  # no preset: compare with what the defaults set
         pass
     have, base = flatten(raw), flatten(ref)

@@ -210,10 +210,10 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     for k in cols:
         if k != "reused":
             np.testing.assert_array_equal(again[k], cols[k])
-    with pytest.raises(UserError, match="another scenario, limit or mapping"):
+    with pytest.raises(UserError, match="another scenario or limit; give another folder or --force"):
         run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1, mapping=mapping)
     other = "shape" if mapping == "uniform" else "uniform"
-    with pytest.raises(UserError, match=f"another scenario, limit or mapping .*give --mapping {mapping} to resume"):
+    with pytest.raises(UserError, match=f"another wear mapping .*this one: {other}.*give --mapping {mapping} to resume"):
         run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=other)
     from bearingsim.cli import main
 

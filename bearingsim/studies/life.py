@@ -261,10 +261,10 @@ def _check_folder(folder: Path, scenario, limit: Limit, force: bool, mapping: st
     _, attrs = archive.read_table_file(path, LIFE_FORMAT)
     held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
     if attrs.get("scenario") != scenario.to_toml() or attrs.get("limit") != limit.text:
-        raise UserError(f"{path}: holds a life study of another scenario, limit or mapping; give another folder "
+        raise UserError(f"{path}: holds a life study of another scenario or limit; give another folder "
                         f"or --force")
     if held != mapping:
-        raise UserError(f"{path}: holds a life study of another scenario, limit or mapping (--mapping {held}; "
+        raise UserError(f"{path}: holds a life study with another wear mapping (--mapping {held}; "
                         f"this one: {mapping}); give --mapping {held} to resume it, another folder, or --force")
 
 

@@ -449,10 +449,15 @@ def pack_all(state, out_f, set_arr, nb):
     (positions and velocities that the step's rules set: held rollers, rollers on a rigid race) and the
     forces."""
     a = set_arr.reshape(nb, 7)
-    a[:, 0:2] = state[:, 0:2]
-    a[:, 2:4] = state[:, 3:5]
     f = out_f.reshape(nb, 3)
-    a[:, 4:7] = f
+    for i in range(nb):  # element by element: a slice assignment compiles numba's shape-error formatting
+        a[i, 0] = state[i, 0]
+        a[i, 1] = state[i, 1]
+        a[i, 2] = state[i, 3]
+        a[i, 3] = state[i, 4]
+        a[i, 4] = f[i, 0]
+        a[i, 5] = f[i, 1]
+        a[i, 6] = f[i, 2]
 
 
 @njit(cache=True)

@@ -92,6 +92,23 @@ def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
     assert set(panels[1]["texts"]) == {"2", "–", "3", "3.5", "4", "4.5"}  # case i: 2 + i / 2
 
 
+def test_a_large_map_is_a_page_with_every_kth_value_labelled(tmp_path, figures):
+    """The 100 x 100 map of scenarios/sweeps/map_speed_clearance.toml: the figure stays within the bounds
+    of sweeps.plot (21 x 12 in, 2520 x 1440 px at 120 dpi; it grew with the axes to 29160 x 5700 px),
+    at most 20 labelled ticks per axis, every 5th value, and no values written in cells of 0.09 in."""
+    from PIL import Image
+
+    xs = [500.0 + 55.0 * i for i in range(100)]
+    ys = [round(0.05 + 0.005 * j, 4) for j in range(100)]
+    h5 = _index(tmp_path, [{SPEED: s, CLEAR: c} for s in xs for c in ys], [SPEED, CLEAR])
+    (png,) = plot_sweep_index(h5, tmp_path / "f")
+    with Image.open(png) as im:
+        assert im.size == (2520, 1440)
+    for a in figures["sweep_map.png"]["axes"]:
+        assert a["xticks"] == [f"{v:g}" for v in xs[::5]] and a["yticks"] == [f"{v:g}" for v in ys[::5]]
+        assert a["xlim"] == (-0.5, 99.5) and a["ylim"] == (-0.5, 99.5) and a["texts"] == []
+
+
 def test_i_dec_and_i_acc_in_separate_panels(tmp_path, figures):
     h5 = _index(tmp_path, [{SPEED: s} for s in (1000.0, 2000.0)], [SPEED])
     plot_sweep_index(h5, tmp_path / "f")

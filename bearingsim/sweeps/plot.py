@@ -32,6 +32,10 @@ FIGURE_NAMES = ("sweep_I.png", "sweep_map.png", "sweep_cases.png")
 
 MAX_LINES = 8
 MAX_CASES = 60  # most cases a per-case chart labels one by one
+MAP_TICKS = 20  # most labelled ticks on a heat map's axis (a longer axis labels every k-th value)
+MAP_TEXT_CELLS = 20  # most cells along either axis of a heat map that still get their value written
+MAP_PANEL_IN = (3.0, 9.0)  # width of a heat map's panel [in]: 1.2 in per cell within these bounds
+MAP_HEIGHT_IN = (4.2, 12.0)  # height of a heat map [in]: 0.45 in per cell and 2.5 in of titles within these
 QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
 Y_LABEL = "per pocket and cage rotation [mN s]"
 
@@ -189,8 +193,10 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
     ypos = {_show(v): j for j, v in enumerate(ys)}
     from bearingsim.plotting import subplots
 
-    fig, panels = subplots(1, 2, figsize=(max(9.0, 1.2 * len(xs) * 2 + 3), max(4.2, 0.45 * len(ys) + 2.5)),
-                           constrained_layout=True)
+    panel = min(MAP_PANEL_IN[1], max(MAP_PANEL_IN[0], 1.2 * len(xs)))  # bounded: a 100 x 100 map stays a page
+    height = min(MAP_HEIGHT_IN[1], max(MAP_HEIGHT_IN[0], 0.45 * len(ys) + 2.5))
+    fig, panels = subplots(1, 2, figsize=(max(9.0, 2 * panel + 3), height), constrained_layout=True)
+    text = len(xs) <= MAP_TEXT_CELLS and len(ys) <= MAP_TEXT_CELLS  # values written while they fit their cells
     n_gap = 0
     for ax, (name, sym) in zip(panels, QUANTITIES):
         grid = np.full((len(ys), len(xs)), np.nan)
@@ -205,12 +211,13 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
         fig.colorbar(mesh, ax=ax, label=f"{sym} {Y_LABEL}")
         finite = grid[np.isfinite(grid)]
         mid = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
-        if len(xs) * len(ys) <= 400:  # values written in the cells while they fit
+        if text:
             for (yi, xi), z in np.ndenumerate(grid):
                 ax.text(xi, yi, f"{z:.3g}" if math.isfinite(z) else "–", ha="center", va="center", fontsize=7,
                         color="black" if not math.isfinite(z) or z > mid else "white")
-        ax.set_xticks(range(len(xs)), [_show(v) for v in xs])
-        ax.set_yticks(range(len(ys)), [_show(v) for v in ys])
+        kx, ky = -(-len(xs) // MAP_TICKS), -(-len(ys) // MAP_TICKS)  # every k-th value labelled
+        ax.set_xticks(range(0, len(xs), kx), [_show(v) for v in xs[::kx]], rotation=90 if kx > 1 else 0)
+        ax.set_yticks(range(0, len(ys), ky), [_show(v) for v in ys[::ky]])
         ax.set_xlabel(axis_label(xk))
         ax.set_ylabel(axis_label(yk))
         ax.set_title(sym, fontsize=9)

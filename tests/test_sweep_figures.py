@@ -92,6 +92,7 @@ def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
     assert set(panels[1]["texts"]) == {"2", "–", "3", "3.5", "4", "4.5"}  # case i: 2 + i / 2
 
 
+@pytest.mark.slow
 def test_a_large_map_is_a_page_with_every_kth_value_labelled(tmp_path, figures):
     """The 100 x 100 map of scenarios/sweeps/map_speed_clearance.toml: the figure stays within the bounds
     of sweeps.plot (21 x 12 in, 2520 x 1440 px at 120 dpi; it grew with the axes to 29160 x 5700 px),

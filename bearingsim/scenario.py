@@ -400,12 +400,11 @@ def _dumps(raw: dict[str, Any]) -> str:
     tomli_w writes the top-level values, then each table, separated by a blank line; a table's text
     depends only on its name and its content, so thousands of sweep cases that differ in one or two
     keys share the text of their other tables. The key is the table's ``repr``, which tells 1, 1.0 and
-    True apart: ``raw`` is a scenario model's dump, whose tables hold only str, int, float, bool and
-    lists and tables of them, each of which its ``repr`` spells out whole.
+    True apart: ``raw`` is a scenario model's dump, whose top-level values are plain scalars and whose
+    tables hold only str, int, float, bool and lists and tables of them, each of which its ``repr``
+    spells out whole (no array of tables, which tomli_w would write after the tables).
     """
     top = {k: v for k, v in raw.items() if not isinstance(v, dict)}
-    if not all(_plain_data(v) for v in top.values()):  # e.g. an array of tables: as tomli_w does it
-        return tomli_w.dumps(raw)
     parts = [tomli_w.dumps(top)] if top else []
     for k, v in raw.items():
         if isinstance(v, dict):
@@ -417,19 +416,6 @@ def _dumps(raw: dict[str, Any]) -> str:
                 text = _TOML_TABLES[key] = tomli_w.dumps({k: v})
             parts.append(text)
     return "\n".join(parts)
-
-
-def _plain_data(v, depth: int = 0) -> bool:
-    """str, int, float or bool, or lists and tables of them (no table inside a list)."""
-    if isinstance(v, (str, int, float)):  # bool is an int
-        return type(v) in (str, int, float, bool)
-    if depth > MAX_NESTING_DEPTH:
-        return False
-    if type(v) is list:
-        return all(not isinstance(x, dict) and _plain_data(x, depth + 1) for x in v)
-    if type(v) is dict:
-        return all(type(k) is str and _plain_data(x, depth + 1) for k, x in v.items())
-    return False
 
 
 def available_presets() -> list[str]:

@@ -65,9 +65,8 @@ def started(cmd, **kw):
 
 # --- pytest-xdist: how many workers, and the tests that run alone ------------------------------------
 #: most workers ``-n auto`` starts: each worker loads numba's compiled kernels (and compiles them on a
-#: fresh checkout), many tests start process pools or command-line runs of their own, and the longest
-#: test file (tests/test_reliability.py) takes 2-3 minutes on one worker, so more workers add memory and
-#: start-up rather than speed
+#: fresh checkout) and has its own server of forked command lines (tests/forked_cli.py), and many tests
+#: start process pools of their own, so more workers add memory and start-up rather than speed
 MAX_WORKERS = 4
 
 

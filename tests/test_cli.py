@@ -5,12 +5,13 @@ import sys
 
 import pytest
 
+from . import forked_cli
 from .conftest import SCENARIOS
 
 
-def bearingsim(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "bearingsim", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, timeout=600)
+def bearingsim(*args, cwd=None, fresh_interpreter=False):
+    """``bearingsim ARGS`` run to its end (:func:`tests.forked_cli.run`)."""
+    return forked_cli.run(args, cwd=cwd, fresh_interpreter=fresh_interpreter)
 
 
 def assert_user_error(res, *words):

@@ -9,6 +9,10 @@ lock file ``.NAME.lock`` of ``bearingsim/outputs.py`` included).
 ``docs/reliability.md`` is generated from these cases, observed results included::
 
     PYTHONPATH=. python3 -m tests.test_reliability --write-doc
+
+The command lines run in processes forked from the tests' server (:mod:`tests.forked_cli`), those of
+the full-disk cases in a fresh interpreter in their own mount namespace; with
+``BEARINGSIM_TEST_FORK=0`` (every command line a fresh interpreter) the generated page is the same.
 """
 from __future__ import annotations
 
@@ -26,6 +30,7 @@ from typing import Callable
 
 import pytest
 
+from . import forked_cli
 from .conftest import started
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -42,8 +47,8 @@ def si(scenario):
 
 
 def bearingsim(*args, cwd=None, timeout=300):
-    return subprocess.run([sys.executable, "-m", "bearingsim", *map(str, args)], capture_output=True,
-                          text=True, cwd=cwd, timeout=timeout, env=ENV)
+    """``bearingsim ARGS`` run to its end (:func:`tests.forked_cli.run`)."""
+    return forked_cli.run(args, cwd=cwd, timeout=timeout)
 
 
 # --- files a case starts from --------------------------------------------------------------------
@@ -434,8 +439,11 @@ def execute(case: Case, tmp: Path) -> Observed:
         case.setup(tmp)
     before = _snapshot(tmp)
     argv = [a.replace("{tmp}", str(tmp)) for a in map(str, case.args)]
-    cmd = (prefix or [sys.executable]) + ["-m", "bearingsim", *argv]
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=300, env=ENV, cwd=tmp)
+    if prefix:  # the command in its own mount namespace: a fresh interpreter there
+        res = subprocess.run(prefix + ["-m", "bearingsim", *argv], capture_output=True, text=True, timeout=300,
+                             env=ENV, cwd=tmp)
+    else:
+        res = forked_cli.run(argv, cwd=tmp, timeout=300)
     if holder is not None:
         os.close(holder)
     obs = Observed(res.returncode, res.stderr, res.stdout)
@@ -906,7 +914,10 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
               "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "
               "into that folder), a SIGTERM whose handler runs inside a weakref callback (Python cannot raise "
               "its exception there; the command gets the signal again and stops, with no traceback; "
-              "`tests/test_sweep.py` checks the same for a sweep), and unit tests of "
+              "`tests/test_sweep.py` checks the same for a sweep), a command that fails right after such a "
+              "swallowed signal (numba compiling a kernel from a cold cache, its LLVM callback interrupted: \"no "
+              "compiled object yet\"; it ends as the signal, exit 143 and its one line, and the signal is not "
+              "delivered again), and unit tests of "
               "`bearingsim/plausibility.py` (the Palmgren displacement bound, "
               "non-finite summaries, too few orbit samples, `ring_newton_failures` noted up to 1 % of steps and "
               "refused above)."]

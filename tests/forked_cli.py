@@ -113,16 +113,18 @@ def _changed(before: dict, now: dict) -> bool:
 def run(args, cwd=None, timeout=600, fresh_interpreter=False) -> subprocess.CompletedProcess:
     """``bearingsim ARGS`` run to its end, as ``subprocess.run([python, -m, bearingsim, *ARGS],
     capture_output=True, text=True)`` returns it: in a fork of the server, or with
-    ``fresh_interpreter`` (or ``BEARINGSIM_TEST_FORK=0``) in a fresh interpreter. A test that changed
-    the environment since the server started (``monkeypatch.setenv``) gets a fresh interpreter too: a
-    fork would run in the server's."""
+    ``fresh_interpreter`` (or ``BEARINGSIM_TEST_FORK=0``) in a fresh interpreter. The server runs in
+    the environment of the test process: when that changed since the server started (a test's
+    ``monkeypatch.setenv``; a dask cluster sets ``PYTHONHASHSEED`` and the thread counts for good), a
+    new server starts in the new one."""
     global _server
-    if fresh_interpreter or not FORK:
-        return fresh(args, cwd, timeout)
-    if _server is None or _server.proc.poll() is not None:
-        _server = _Server()
-    if _changed(_server.env, environment()) or (cwd is not None and not Path(cwd).is_dir()):
+    if fresh_interpreter or not FORK or (cwd is not None and not Path(cwd).is_dir()):
         return fresh(args, cwd, timeout)  # (a missing folder: subprocess's own error)
+    if _server is not None and (_server.proc.poll() is not None or _changed(_server.env, environment())):
+        _server.close()
+        _server = None
+    if _server is None:
+        _server = _Server()
     return _server.run(args, cwd, timeout)
 
 

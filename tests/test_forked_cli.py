@@ -99,3 +99,16 @@ def test_a_forked_command_line_ends_as_a_fresh_interpreter_s(tmp_path):
     written = _files(folders["fork"])
     assert {"a.h5", "figs/b.h5", "sw/sweep.h5"} <= set(written) and any(n.endswith(".png") for n in written)
     assert written == _files(folders["fresh"])
+
+
+@pytest.mark.skipif(not forked_cli.FORK, reason="BEARINGSIM_TEST_FORK=0: every command line in a fresh interpreter")
+@pytest.mark.slow
+def test_a_changed_environment_gets_a_server_started_in_it(tmp_path, monkeypatch):
+    """A fresh interpreter inherits the test process's environment as it is at the call; so does a fork,
+    from a server started again once the environment changed."""
+    assert forked_cli.run(["--version"], cwd=tmp_path).returncode == 0
+    first = forked_cli._server.proc.pid
+    monkeypatch.setenv("BEARINGSIM_TEST_PROBE", "1")
+    res = forked_cli.run(["--version"], cwd=tmp_path)
+    assert (res.returncode, res.args[0]) == (0, forked_cli.FORKED)
+    assert forked_cli._server.proc.pid != first and forked_cli._server.env["BEARINGSIM_TEST_PROBE"] == "1"

@@ -285,16 +285,15 @@ def _compare_many(paths) -> int:
     when every archive's results are bit-identical to the first's, else 1."""
     from bearingsim import tables
     from bearingsim.compare import compare_results
-    from bearingsim.scenario import flatten
+    from bearingsim.scenario import differing_keys
     from bearingsim.simulation import COMPARED, load as read
 
     results = [read(p, only=COMPARED) for p in paths]
-    flat = [flatten(r.scenario.raw) for r in results]
-    keys = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    keys = differing_keys(*(r.scenario.raw for r in results))
     if keys:
         print("scenario keys that differ (archive 1, 2, ...):")
-        for k in keys:
-            print(f"  {k}: " + ", ".join(repr(f.get(k, "(unset)")) for f in flat))
+        for k, *values in keys:
+            print(f"  {k}: " + ", ".join(map(repr, values)))
     else:
         print("scenarios: identical")
     print(tables.format_table(tables.table_of_archives(paths)))

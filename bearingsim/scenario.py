@@ -745,12 +745,12 @@ def same_value(a, b) -> bool:
     return a == b and type(a) is type(b)
 
 
-def differing_keys(a: dict, b: dict) -> list[tuple[str, object, object]]:
-    """The dotted keys whose values differ between the scenario tables ``a`` and ``b``, sorted, each with
-    its value in ``a`` and in ``b`` (``"(unset)"`` where a table lacks the key)."""
-    fa, fb = flatten(a), flatten(b)
-    pairs = ((k, fa.get(k, "(unset)"), fb.get(k, "(unset)")) for k in sorted(set(fa) | set(fb)))
-    return [(k, va, vb) for k, va, vb in pairs if not same_value(va, vb)]
+def differing_keys(*tables: dict) -> list[tuple]:
+    """The dotted keys whose values differ (:func:`same_value`) between the scenario tables, sorted, each
+    as ``(key, value in the first table, in the second, ...)`` (``"(unset)"`` where a table lacks it)."""
+    flat = [flatten(t) for t in tables]
+    rows = ((k, *(f.get(k, "(unset)") for f in flat)) for k in sorted(set().union(*flat)))
+    return [row for row in rows if not all(same_value(row[1], v) for v in row[2:])]
 
 
 def _title_value(key: str, v) -> str:

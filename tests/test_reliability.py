@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
 PAPER = SCENARIOS / "paper_3000rpm.toml"
 MB = SCENARIOS / "multibody_3000rpm.toml"
-ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+ENV = forked_cli.environment()  # this checkout first on the path
 
 
 def si(scenario):

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import progress_wanted, refuse_archive_as_scenario, report_study
+from bearingsim.cli_common import progress_wanted, report_study
 from bearingsim.errors import SimulationUnstable, UserError
 
 
@@ -26,20 +26,17 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import check_run_request, load_scenario
+    from bearingsim.scenario import check_run_request, given_keys, load_scenario, unused_note
     from bearingsim.simulation import run_scenario
 
-    refuse_archive_as_scenario(args.scenario)
     scenario = load_scenario(args.scenario, args.set)
     check_run_request(scenario)
-    if args.dry_run:
-        return _dry_run(scenario, args)
-    if not args.quiet:
-        from bearingsim.scenario import given_keys, unused_note
-
+    if not args.quiet:  # the keys given that have no effect on the run, noted by the dry run too
         note = unused_note(scenario.model, given_keys(args.scenario, args.set), scenario.reduced.method)
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
+    if args.dry_run:
+        return _dry_run(scenario, args)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force)
@@ -157,12 +154,6 @@ def _dry_run(scenario, args) -> int:
 
     out = Path(args.output) if args.output else default_output(scenario)
     _write_toml(_resolved_text(scenario, out))
-    if not args.quiet:
-        from bearingsim.scenario import given_keys, unused_note
-
-        note = unused_note(scenario.model, given_keys(args.scenario, args.set))
-        if note:
-            print(f"bearingsim: note: {note}", file=sys.stderr)
     return 0
 
 
@@ -409,7 +400,6 @@ def _cmd_crosscheck(args) -> int:
     from bearingsim.studies import crosscheck as cc
     from bearingsim.studies import make_engine
 
-    refuse_archive_as_scenario(args.scenario)
     speeds = cc.parse_speeds(args.speeds)
     if args.rotations < 1:
         raise UserError(f"--rotations {args.rotations}: give at least 1 recorded rotation")

@@ -1,24 +1,10 @@
-"""What the subcommands share: refusing an archive given as a scenario, a study's exit code, whether
-a progress bar is drawn. Imported by :mod:`bearingsim.cli` and the command modules beside it
-(``cli_sweep``, ``cli_sensitivity``, ``cli_wear``), none of which import each other."""
+"""What the subcommands share: a study's exit code, whether a progress bar is drawn. Imported by
+:mod:`bearingsim.cli` and the command modules beside it (``cli_sweep``, ``cli_sensitivity``,
+``cli_wear``), none of which import each other."""
 from __future__ import annotations
 
 import signal
 import sys
-from pathlib import Path
-
-from bearingsim.errors import UserError
-
-
-def refuse_archive_as_scenario(path) -> None:
-    """``bearingsim run`` given an archive: a one-line hint instead of a TOML decoding error."""
-    if not Path(path).is_file():  # missing files and the like: the scenario reader reports them (no archive)
-        return
-    from bearingsim.archive import is_archive
-
-    if is_archive(path):  # unreadable files: the scenario reader reports them
-        raise UserError(f"{path}: is an HDF5 archive, not a scenario file; use 'bearingsim rerun {path}' to run it "
-                        f"again, or 'bearingsim show {path} > scenario.toml' to get its scenario")
 
 
 def report_study(outcome, command: str) -> int:

@@ -19,10 +19,8 @@ def _keys(text):
 
 def _scenario(args):
     """The scenario a study command is given (an archive refused with a hint)."""
-    from bearingsim.cli_common import refuse_archive_as_scenario
     from bearingsim.scenario import load_scenario
 
-    refuse_archive_as_scenario(args.scenario)
     return load_scenario(args.scenario, args.set)
 
 

@@ -571,10 +571,11 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
             if not stat.S_ISREG(mode):
                 raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not a scenario file")
             data = fh.read(MAX_SCENARIO_BYTES + 1)
+        if data.startswith(b"\x89HDF"):  # an HDF5 file, a bearingsim archive most likely
+            raise UserError(f"{p}: is an HDF5 file (a bearingsim archive?), not a scenario file; 'bearingsim rerun "
+                            f"{p}' runs an archive again, 'bearingsim show {p} > scenario.toml' gives its scenario")
         if len(data) > MAX_SCENARIO_BYTES:
             raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")
-        if data.startswith(b"\x89HDF"):
-            raise UserError(f"{p}: is an HDF5 file (an archive?), not a scenario TOML file")
         text = data.decode("utf-8")
     except FileNotFoundError:
         raise UserError(f"{p}: scenario file not found") from None

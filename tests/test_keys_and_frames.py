@@ -105,6 +105,37 @@ def test_run_dry_run_runs_and_writes_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
+def test_run_dry_run_gives_the_notes_the_run_gives(tmp_path):
+    """The dry run says what the run would do, its notes included: here the time step, which the
+    event-driven method does not use, and the cage guidance, which the reduced model does not use."""
+    sets = ["--set", 'reduced.method="event"', "--set", "numerics.dt_s=1e-6", "--set", "bearing.cage_guidance=outer_land",
+            "--set", "numerics.rotations=1"]
+    dry = cli("run", PAPER, "--dry-run", *sets, cwd=tmp_path)
+    real = cli("run", PAPER, *sets, "--no-plots", "-o", tmp_path / "a.h5")
+    assert dry.returncode == 0 and real.returncode == 0, (dry.stderr, real.stderr)
+
+    def notes(res):
+        return [line for line in res.stderr.splitlines() if "note" in line]
+
+    assert notes(dry) == notes(real)
+    assert len(notes(dry)) == 1 and "numerics.dt_s" in notes(dry)[0] and "bearing.cage_guidance" in notes(dry)[0]
+
+
+def test_an_archive_given_as_a_scenario_is_refused_with_the_commands_that_read_it(tmp_path):
+    """Through the Python API as on the command line, and whatever the archive's size (a scenario file
+    is refused above 1 MiB: an archive is told apart first)."""
+    import h5py
+
+    from bearingsim.errors import UserError
+
+    path = tmp_path / "big.h5"
+    with h5py.File(path, "w") as f:
+        f["x"] = np.zeros(300_000)  # 2.4 MB
+    with pytest.raises(UserError, match=r"big\.h5: is an HDF5 file .*'bearingsim rerun .*big\.h5' runs"):
+        load_scenario(path)
+
+
 # --- DataFrames and Datasets --------------------------------------------------------------------------
 
 @pytest.fixture(scope="module")

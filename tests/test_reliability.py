@@ -213,7 +213,7 @@ CASES: list[Case] = [
     Case("file-binary", "scenario file", run(scenario="{tmp}/s.toml"), 2, ("s.toml", "cannot read"),
          setup=lambda t: _scenario(t, b"\xff\xfe\x00garbage")),
     Case("file-hdf5-archive", "scenario file", run(scenario="{tmp}/a.h5", o="{tmp}/out.h5"), 2,
-         ("a.h5", "HDF5"), setup=_setup_archive()),
+         ("a.h5", "HDF5", "bearingsim rerun"), setup=_setup_archive()),
     Case("file-invalid-toml", "scenario file", run(scenario="{tmp}/s.toml"), 2, ("s.toml", "not valid TOML"),
          setup=lambda t: _scenario(t, "schema_version = = 1\n")),
     Case("file-empty", "scenario file", run(scenario="{tmp}/s.toml"), 2, ("schema_version", "missing"),

@@ -611,6 +611,9 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     """
     from collections.abc import Mapping
 
+    if not isinstance(path, (str, os.PathLike)):
+        raise UserError(f"path: expected the path of a scenario file, a str or a pathlib.Path "
+                        f"(got {type(path).__name__})")
     if values is not None and not isinstance(values, Mapping):
         raise UserError(f"set: expected a dict of dotted keys and values such as {{'numerics.rotations': 10}} "
                         f"(got {type(values).__name__})")
@@ -835,7 +838,8 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
     try:
         model = ScenarioModel.model_validate(merged)
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errors = exc.errors()  # an unknown key first: a misspelt section or key is why another one is missing
+        err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
         key = _loc(err)
         if err["type"] == "missing":
             msg = "missing (set it in the scenario or name a [bearing] preset)"

@@ -48,6 +48,20 @@ def test_unknown_key_in_a_file_gets_the_closest_key_and_nonsense_gets_none(tmp_p
     assert str(exc.value).endswith("bearing.no_such_key: unknown key")
 
 
+@pytest.mark.parametrize("section", ["bearing", "operating"])
+def test_a_misspelt_section_is_named_rather_than_the_keys_it_leaves_missing(tmp_path, section):
+    """A misspelt table leaves its keys unset: the misspelling is the error to name (one error is told,
+    the one that explains the others)."""
+    from bearingsim.errors import UserError
+
+    text = PAPER.read_text()
+    assert f"\n[{section}]\n" in text
+    f = tmp_path / "s.toml"
+    f.write_text(text.replace(f"\n[{section}]\n", f"\n[{section[:3] + section[4:]}]\n"))
+    with pytest.raises(UserError, match=rf"s\.toml: {section[:3] + section[4:]}: unknown key \(did you mean {section}\?\)"):
+        load_scenario(f)
+
+
 # --- keys ---------------------------------------------------------------------------------------------
 
 def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_source():

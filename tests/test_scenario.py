@@ -113,6 +113,8 @@ def test_missing_and_invalid_files(tmp_path):
     bad.write_text("schema_version = 1\nmodel = [\n")
     with pytest.raises(UserError, match="not valid TOML"):
         load_scenario(bad)
+    with pytest.raises(UserError, match=r"path: expected the path of a scenario file.*\(got int\)"):
+        load_scenario(5)  # the API's wrong type: a one-line UserError too (docs/usage.md)
 
 
 def test_every_shipped_scenario_validates():

@@ -226,13 +226,15 @@ def _cmd_rerun(args) -> int:
         new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
                            force=args.force).result
         args.written = Path(args.output)
-        print(f"wrote {args.output}")
     else:
         new = run(old.scenario, progress=progress)
     from bearingsim import __version__ as version
 
     new.provenance.update({f"version_{k}": v for k, v in package_versions().items()}, bearingsim_version=version)
     c = compare_results(old, new)
+    args.status = 0 if c.identical else 1  # the verdict, kept if the reader of stdout goes early (main)
+    if args.output:
+        print(f"wrote {args.output}")
     if c.identical:
         print(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
               f"{len(old.per_rotation)} per-rotation arrays)")
@@ -243,7 +245,7 @@ def _cmd_rerun(args) -> int:
         print(f"  differs: {name}")
     for k, va, vb in c.versions:
         print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
-    return 1
+    return args.status
 
 
 def _cmd_compare(args) -> int:
@@ -253,10 +255,11 @@ def _cmd_compare(args) -> int:
     if len(args.archives) < 2:
         raise UserError("compare: give at least two archives")
     if len(args.archives) > 2:
-        return _compare_many(args.archives)
+        return _compare_many(args.archives, args)
     args.a, args.b = args.archives
     a, b = read(args.a, only=COMPARED), read(args.b, only=COMPARED)
     c = compare_results(a, b)
+    args.status = 0 if c.identical else 1  # the verdict, kept if the reader of stdout goes early (main)
     if c.scenario_keys:
         print("scenario keys that differ (A -> B):")
         for k, va, vb in c.scenario_keys:
@@ -267,10 +270,10 @@ def _cmd_compare(args) -> int:
     for name in c.arrays_differ:
         print(f"  differs: {name}")
     print("results: identical" if c.identical else "results: differ")
-    return 0 if c.identical else 1
+    return args.status
 
 
-def _compare_many(paths) -> int:
+def _compare_many(paths, args) -> int:
     """``compare`` of three or more archives: the scenario keys that differ, then the summary table
     with standard errors and significance marks against the first (:mod:`bearingsim.tables`); exit 0
     when every archive's results are bit-identical to the first's, else 1."""
@@ -280,6 +283,8 @@ def _compare_many(paths) -> int:
     from bearingsim.simulation import COMPARED, load as read
 
     results = [read(p, only=COMPARED) for p in paths]
+    differ = [Path(p).name for p, r in zip(paths[1:], results[1:]) if not compare_results(results[0], r).identical]
+    args.status = 1 if differ else 0  # the verdict, kept if the reader of stdout goes early (main)
     keys = differing_keys(*(r.scenario.raw for r in results))
     if keys:
         print("scenario keys that differ (archive 1, 2, ...):")
@@ -288,9 +293,8 @@ def _compare_many(paths) -> int:
     else:
         print("scenarios: identical")
     print(tables.format_table(tables.table_of_archives(paths)))
-    differ = [Path(p).name for p, r in zip(paths[1:], results[1:]) if not compare_results(results[0], r).identical]
     print("results: identical" if not differ else f"results: differ from {Path(paths[0]).name}: {', '.join(differ)}")
-    return 1 if differ else 0
+    return args.status
 
 
 def _cmd_table(args) -> int:
@@ -723,7 +727,9 @@ def main(argv: list[str] | None = None) -> int:
 
     Exit codes: 0 success, 2 bad input or an unwritable output (one line on stderr), 3 an unstable or
     unphysical run (no archive), 130 SIGINT, 143 SIGTERM (no archive, no temporary file); 0 also when
-    the reader of the output goes away early (``bearingsim inspect x.h5 | head -1``), with nothing said.
+    the reader of the output goes away early (``bearingsim inspect x.h5 | head -1``), with nothing said,
+    except for ``compare`` and ``rerun``, whose exit code is their verdict (0 identical, 1 differ) and
+    stays so (``args.status``, set before they print).
     """
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -761,7 +767,7 @@ def main(argv: list[str] | None = None) -> int:
             return code
     except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: stop quietly
         _stdout_to_devnull()
-        return 0
+        return getattr(args, "status", 0)  # compare and rerun: their verdict, decided before they print
     except outputs.ArchiveWriteError as exc:  # HDF5 cannot be torn down cleanly: the line, then out at once
         print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
         _exit_quietly(exc.exit_code)
@@ -784,8 +790,11 @@ def main(argv: list[str] | None = None) -> int:
         if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
             _stdout_lost(exc, args.written)
             return 0
-        where = exc.filename or "bearingsim"
-        print(f"bearingsim: error: {_one_line(where)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
+        if exc.filename is None:  # standard output: the files bearingsim writes go through outputs, which names them
+            print(f"bearingsim: error: cannot write to standard output ({_one_line(exc.strerror or exc)})",
+                  file=sys.stderr)
+        else:
+            print(f"bearingsim: error: {_one_line(exc.filename)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
         return 2
     except MemoryError:
         print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "

@@ -148,6 +148,46 @@ def test_inspect_into_a_pipe_closed_early_stops_quietly(tmp_path):
 
 
 @pytest.mark.slow
+def test_compare_keeps_its_verdict_when_the_reader_of_its_output_has_gone(tmp_path, base_reduced):
+    """``compare a b | head -1``: exit 1 says "the results differ" even when the pipe breaks while the
+    comparison prints (as it did at random: exit 0, "identical"). The reader is gone before the command
+    starts, so the pipe breaks at its first write, every time."""
+    import bearingsim
+    from bearingsim.scenario import resolve
+
+    from .conftest import started
+
+    paths = []
+    for rpm in (1000.0, 2000.0, 2000.0):
+        sc = resolve({**base_reduced, "operating": {**base_reduced["operating"], "inner_ring_speed_rpm": rpm}})
+        paths.append(bearingsim.run(sc).save(tmp_path / f"a{len(paths)}.h5"))
+    for archives, verdict in ((paths[:2], 1), (paths[1:], 0), (paths, 1)):
+        r, w = os.pipe()
+        os.close(r)
+        with open(w, "wb") as writer, started([sys.executable, "-m", "bearingsim", "compare", *archives],
+                                              stdout=writer, stderr=subprocess.PIPE) as proc:
+            writer.close()
+            _, err = proc.communicate(timeout=120)
+        assert (proc.returncode, err.decode()) == (verdict, ""), archives
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="needs /dev/full")
+def test_stdout_on_a_full_device_is_named_in_the_error(tmp_path):
+    """``bearingsim show s.toml > /dev/full``: exit 2 with one line naming standard output (it said
+    "bearingsim: error: bearingsim: No space left on device")."""
+    from .conftest import ROOT, started
+
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    with open("/dev/full", "w") as full, started([sys.executable, "-m", "bearingsim", "show",
+                                                 SCENARIOS / "paper_3000rpm.toml"],
+                                                env=env, stdout=full, stderr=subprocess.PIPE, text=True) as proc:
+        _, err = proc.communicate(timeout=120)
+    assert proc.returncode == 2 and err.count("\n") == 1, err
+    assert err.startswith("bearingsim: error: cannot write to standard output (") and err.endswith(")\n"), err
+
+
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["show", "inspect"])
 def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_reduced, command):
     """Issue 30, Low: under a C locale (stdout ASCII, strict) a scenario named "café" made ``show`` and

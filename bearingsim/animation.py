@@ -86,16 +86,24 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
     k = _exaggeration(result.parameters, exaggerate)
     drawing = _Drawing(result, motion, k, rows)
     frames = (drawing.draw(f) for f in range(n_frames))
-    if out.suffix.lower() == ".gif":
-        _write_gif(out, frames, fps, n_frames, progress)
-    else:
-        _write_mp4(out, frames, fps, n_frames, progress)
+    from bearingsim import outputs
+
+    made = outputs.missing_folders(out.parent)  # created for this animation, removed again if it is not written
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        (_write_gif if out.suffix.lower() == ".gif" else _write_mp4)(out, frames, fps, n_frames, progress)
+    except OSError as exc:  # the folder or its temporary file: found before the first frame is drawn
+        raise UserError(f"{out}: cannot write the animation ({exc.strerror or exc})") from None
+    finally:
+        if not out.exists():
+            outputs.remove_empty(made)
     return out
 
 
 # --- inputs --------------------------------------------------------------------------------------------
 def check_output(out) -> Path:
-    """``out`` as a Path, refused in one line unless it ends in .mp4 or .gif, its folder exists and it is
+    """``out`` as a Path, refused in one line unless it ends in .mp4 or .gif, its folder is a folder or
+    can be made one (a missing folder is created when the animation is written, as a run's is) and it is
     not a file bearingsim did not write."""
     from bearingsim import outputs
 
@@ -103,8 +111,9 @@ def check_output(out) -> Path:
     suffix = out.suffix.lower()
     if suffix not in (".mp4", ".gif"):
         raise UserError(f"{out}: animation path must end in .mp4 or .gif (got {out.suffix or 'no suffix'!r})")
-    if not out.parent.is_dir():
-        raise UserError(f"{out}: folder {out.parent} does not exist")
+    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise UserError(f"{out.parent}: cannot create the animation's folder ({existing} is not a folder)")
     if suffix == ".gif":
         outputs.check_replaceable(out, b"GIF8", "GIF animation")
     else:
@@ -444,12 +453,12 @@ def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
 
     from bearingsim.outputs import atomic_file
 
-    images = []
-    for i, frame in enumerate(frames):
-        images.append(Image.fromarray(frame).quantize(colors=128, method=Image.Quantize.FASTOCTREE,
-                                                      dither=Image.Dither.NONE))
-        if progress is not None:
-            progress(i + 1, total)
-    with atomic_file(out) as fh:
+    with atomic_file(out) as fh:  # the temporary file first: an unwritable folder is told before any frame
+        images = []
+        for i, frame in enumerate(frames):
+            images.append(Image.fromarray(frame).quantize(colors=128, method=Image.Quantize.FASTOCTREE,
+                                                          dither=Image.Dither.NONE))
+            if progress is not None:
+                progress(i + 1, total)
         images[0].save(fh, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps,
                        loop=0, optimize=False, disposal=1)

@@ -206,6 +206,31 @@ def test_bad_output_and_options_are_refused(runs, tmp_path):
         bearingsim.animate(runs[1], tmp_path / "b.gif", fps=0)
 
 
+@pytest.mark.parametrize("suffix", [".gif", ".mp4"])
+def test_the_output_folder_is_made_as_a_runs_is_and_an_unwritable_one_is_told_before_any_frame(runs, tmp_path,
+                                                                                                  suffix):
+    """A missing folder is created (as ``run`` and ``report`` do); a file where the folder should be, and a
+    folder no file can be created in (/proc), are one-line errors naming the output, told before the first
+    frame is drawn (a GIF drew every frame, then failed on its temporary file's name) and leaving nothing."""
+    out = bearingsim.animate(runs[1], tmp_path / "new" / "sub" / f"a{suffix}", rotations=(0.0, 0.05), fps=8)
+    assert out.is_file() and sorted(p.name for p in out.parent.iterdir()) == [f"a{suffix}"]
+    (tmp_path / "afile").write_text("mine")
+    with pytest.raises(UserError, match=r"afile: cannot create the animation's folder \(.*afile is not a folder\)"):
+        bearingsim.animate(runs[1], tmp_path / "afile" / f"m{suffix}")
+    assert (tmp_path / "afile").read_text() == "mine"
+    drawn = []
+    with pytest.raises(UserError, match=rf"^/proc/m{suffix}: cannot write the animation \("):
+        bearingsim.animate(runs[1], f"/proc/m{suffix}", progress=lambda done, total: drawn.append(done))
+    assert drawn == []
+
+    def interrupt(done, total):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):  # stopped on the way: the folder made for it is removed again
+        bearingsim.animate(runs[1], tmp_path / "gone" / f"m{suffix}", progress=interrupt)
+    assert not (tmp_path / "gone").exists()
+
+
 def test_motion_window_keys_are_checked():
     """A given start must leave the window inside the recorded rotations (naming the key); "last" with a
     window longer than the run stores the whole run; the pose count is bounded."""

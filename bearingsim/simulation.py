@@ -96,13 +96,21 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     t0 = time.perf_counter()
     if dt is not None:
         scenario = scenario.replace(**{"numerics.dt_s": dt})
-    check_run_request(scenario)  # what `bearingsim run` refuses beyond the schema, refused on every path
+    check_run(scenario, dt)  # what `bearingsim run` refuses beyond the schema, refused on every path
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
     result.provenance["wall_time_s"] = time.perf_counter() - t0
     result.notes = plausibility.check(result)
     return result
+
+
+def check_run(scenario: Scenario, dt: float | None = None) -> None:
+    """Refuse, without running, what :func:`run` of ``scenario`` would refuse before its first step:
+    :func:`bearingsim.scenario.check_run_request`, and the model's time step (a given ``numerics.dt_s``
+    far above the stable step, the euler method's limits). ``bearingsim run --dry-run`` checks this."""
+    check_run_request(scenario)
+    model_module(scenario.model).check_step(scenario.parameters, dt)
 
 
 @dataclass

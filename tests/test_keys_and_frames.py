@@ -120,6 +120,20 @@ def test_run_dry_run_runs_and_writes_nothing(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("name", ["multibody_dt_too_large", "reduced_euler_dt_too_large"])
+def test_run_dry_run_refuses_the_time_step_the_run_refuses(tmp_path, name):
+    """A given numerics.dt_s far above the stable step (multibody) or above the euler method's bound is
+    refused by the run before its first step; the dry run, which says what the run would do, refuses it
+    with the same line (it passed, exit 0)."""
+    path = SCENARIOS / "hard" / f"{name}.toml"
+    dry = cli("run", path, "--dry-run", cwd=tmp_path)
+    real = cli("run", path, "--no-plots", "-o", tmp_path / "a.h5")
+    assert_user_error(dry, "numerics.dt_s")
+    assert dry.stderr == real.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
 def test_run_dry_run_gives_the_notes_the_run_gives(tmp_path):
     """The dry run says what the run would do, its notes included: here the time step, which the
     event-driven method does not use, and the cage guidance, which the reduced model does not use."""

@@ -156,6 +156,20 @@ def test_euler_refuses_a_step_that_is_too_large():
         solve_euler(inp, 10 * max_stable_dt(inp))
 
 
+def test_a_step_given_to_run_is_recorded_as_the_scenarios_step():
+    """``bearingsim.run(sc, dt=...)`` of the euler method stores the step as ``numerics.dt_s`` and says so
+    in ``dt_choice`` (it said "event-driven: no time step"), as its archive's rerun takes it."""
+    import bearingsim
+
+    from .conftest import SCENARIOS
+
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml",
+                                  set={"reduced.method": "euler", "numerics.rotations": 1})
+    r = bearingsim.run(sc, dt=1e-6)
+    assert (r.provenance["dt_s"], r.provenance["dt_choice"]) == (1e-6, "numerics.dt_s")
+    assert r.scenario.numerics.dt_s == 1e-6
+
+
 @pytest.mark.parametrize("dt", [-1.0, 0.0, float("nan")])
 def test_euler_refuses_a_step_that_is_not_positive(dt):
     """A zero, negative or NaN step is no step (dt = -1 returned zero impulses; issue 30)."""

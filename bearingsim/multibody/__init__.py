@@ -140,6 +140,12 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     return res
 
 
+def check_step(p, dt: float | None = None) -> None:
+    """Refuse, without running, a time step :func:`simulate` would refuse: a given ``dt`` (or
+    ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`)."""
+    choose_dt(p, dt)
+
+
 def _profile_arrays(prof, extent) -> dict:
     """The wear profile (:data:`bearingsim.multibody.recorder.PROFILE`, (n, 2, bins)) as archive arrays
     ``[face bin, pocket]`` per face, summed over the recorded rotations, with the bins' centres in psi."""

@@ -31,7 +31,7 @@ import numpy as np
 from bearingsim import laws
 from bearingsim.codes import FACE_NAMES as CODE_FACE_NAMES
 from bearingsim.reduced.core import FACE_REAR, PassInputs
-from bearingsim.reduced.euler import default_dt, solve_euler
+from bearingsim.reduced.euler import check_step as euler_check_step, default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_VERSIONS
@@ -214,15 +214,27 @@ def simulate(p, sink=None, progress: bool = False, dt: float | None = None) -> R
     time series to stream and takes milliseconds. ``dt`` [s] overrides ``numerics.dt`` (euler only).
     """
     inp = PassInputs.from_parameters(p)
-    method = p.reduced.method
-    dt_choice = "event-driven: no time step"
-    if method == "euler":
-        if dt is None:
-            dt = p.numerics.dt
-            dt_choice = "numerics.dt_s"
-        if dt is None:
-            dt = default_dt(inp)
-            dt_choice = "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
-    sol = solve_pass(inp, method, dt, automatic=dt_choice.startswith("automatic"))
+    dt, dt_choice = _step(p, inp, dt)
+    sol = solve_pass(inp, p.reduced.method, dt, automatic=dt_choice.startswith("automatic"))
     return ReducedResult.from_solution(p, inp, sol, dt_choice)
+
+
+def _step(p, inp: PassInputs, dt: float | None) -> tuple[float | None, str]:
+    """(the time step [s] of the euler method, how it was chosen); (None, ...) for the event method."""
+    if p.reduced.method != "euler":
+        return None, "event-driven: no time step"
+    if dt is not None:
+        return dt, "numerics.dt_s"
+    if p.numerics.dt is not None:
+        return p.numerics.dt, "numerics.dt_s"
+    return default_dt(inp), "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
+
+
+def check_step(p, dt: float | None = None) -> None:
+    """Refuse, without running, the time step :func:`simulate` would refuse (one line naming the key;
+    :func:`bearingsim.reduced.euler.check_step`); the event method takes none."""
+    if p.reduced.method == "euler":
+        inp = PassInputs.from_parameters(p)
+        step, how = _step(p, inp, dt)
+        euler_check_step(inp, step, automatic=how.startswith("automatic"))
 RESULT = ReducedResult

@@ -780,9 +780,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated)
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
+        kept = getattr(exc, "resume_note", None)  # what a study that resumes kept (bearingsim life)
         if written is not None:
             print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
                   f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
+        elif kept is not None:  # worded as the other studies' (cli_common.report_study)
+            name = "SIGTERM" if isinstance(exc, Terminated) else "SIGINT"
+            print(f"bearingsim: {args.command} interrupted ({name}): {kept}; run the same command again to resume",
+                  file=sys.stderr)
         else:
             print(f"bearingsim: {what}, no archive written", file=sys.stderr)
         return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130

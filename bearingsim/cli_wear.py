@@ -11,6 +11,7 @@ from bearingsim.errors import UserError
 def _cmd_wear(args) -> int:
     from bearingsim import wear
     from bearingsim.archive import check_writable_dir, is_archive
+    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
     from bearingsim.plotting import save_figure
     from bearingsim.simulation import load
 
@@ -20,31 +21,36 @@ def _cmd_wear(args) -> int:
     result = load(path)
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
-    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
-    print(f"{path}: " + wear.format_report(rep))
-    if not args.no_plots:
+    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)  # refusals of the archive and time
+    figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
+    pngs = {}
+    if not args.no_plots:  # the figures' folder and paths checked before anything is printed
         folder = check_writable_dir(args.output) if args.output else path.parent
-        title = result.title()
-        for name, fig in (("wear_profile", wear.plot_wear_profile(rep, title)),
-                          ("wear_volume", wear.plot_wear_volume(rep, title))):
-            print(f"wrote {save_figure(fig, folder / f'{path.stem}_{name}.png')}")
+        pngs = {name: check_replaceable(figure_path(folder / path.stem, name), PNG_SIGNATURE, "figure")
+                for name in figures}
+    print(f"{path}: " + wear.format_report(rep))
+    for name, png in pngs.items():
+        print(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
     return 0
 
 
 def _cmd_life(args) -> int:
-    from bearingsim.archive import check_writable_dir
     from bearingsim.plotting import save_figure
     from bearingsim.scenario import load_scenario
     from bearingsim.studies import life
 
     limit = life.parse_limit(args.limit)
     scenario = load_scenario(args.scenario, args.set)
-    folder = check_writable_dir(args.output or Path("outputs") / f"{scenario.name}_life")
+    folder = Path(args.output or Path("outputs") / f"{scenario.name}_life")  # created by run_life after its checks
     say = None if args.quiet else (lambda line: print(line, file=sys.stderr))
     cols = life.run_life(scenario, folder, limit, stages=args.stages, rotations=args.rotations, force=args.force,
                          mapping=args.mapping, progress=say)
     cols_, attrs = life.read_life(folder / "life.h5")
-    png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
+    try:
+        png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
+    except KeyboardInterrupt as exc:  # the study is complete, only its figure is missing (cli.main says so)
+        exc.resume_note = f"all {len(cols['stage'])} stages done and {folder / 'life.h5'} written, not its figure"
+        raise
     print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
           f"inner-ring rotations in {len(cols['stage'])} stages")
     print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "

@@ -55,6 +55,19 @@ class WearReport:
         return v / (self.bin_area * len(self.psi_deg))
 
 
+#: The longest running time a wear report scales the recorded rotations to [h]: 1e6 h, 114 years of
+#: continuous running. The longest lives rolling bearings are designed for are ~1e5 h (the catalogues'
+#: guideline values of the specification life: 100 000 h and more for machines in continuous operation
+#: with high reliability, such as power stations and mine pumps), so this leaves ten times that; a longer
+#: time is a slip (a unit, an exponent), not a bearing's. It bounds the time, not the worn depth: the
+#: report extrapolates linearly and may wear through a cage bar (5.9 mm on the reference cage) within a
+#: realistic time (3 rotations of multibody_6000rpm at the default k = 5e-6: 7.1 mm deep at an edge after
+#: 100 h), which ``bearingsim life`` follows stage by stage instead. Within the bound every number is finite
+#: by far (that run: at most 2.3e-4 m^3 per face after 1e6 h; the coefficient of variation squares the
+#: volumes, which overflows above ~1e154 m^3: ``--rotations 1e300`` gave 4e284 m^3 and a variation of inf).
+MAX_RUNNING_HOURS = 1e6
+
+
 def has_profile(result) -> bool:
     """True when ``result`` holds a wear profile (multibody archives written since it exists)."""
     return "results/wear/profile_work_front" in result.data
@@ -71,6 +84,10 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     op = result.parameters.operating
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
     shaft = float(rotations) if rotations is not None else float(hours) * rot_per_hour
+    if (float(hours) if hours is not None else shaft / rot_per_hour) > MAX_RUNNING_HOURS:
+        raise UserError(f"{name} {value:g}: more than {MAX_RUNNING_HOURS:g} h of running "
+                        f"({MAX_RUNNING_HOURS * rot_per_hour:.3g} inner-ring rotations at {rot_per_hour / 60:g} rpm), "
+                        f"114 years, ten times the longest life a bearing is designed for; give a shorter running time")
     cage_speed = result.summary.get("cage_speed_mean_rad_s", float("nan"))
     if not (math.isfinite(cage_speed) and cage_speed > 0):
         raise UserError("the run has no measured cage speed (no recorded rotation): no running time can be scaled")

@@ -2,6 +2,9 @@
 from __future__ import annotations
 
 import math
+import os
+import signal
+import time
 
 import numpy as np
 import pytest
@@ -148,10 +151,64 @@ def test_archive_without_profile_reads_and_wear_says_why(fast_run, tmp_path):
 
 
 @pytest.mark.parametrize("kw", [{"hours": -1.0}, {"rotations": 0.0}, {}, {"hours": 1.0, "rotations": 2.0},
-                                {"hours": float("nan")}])
+                                {"hours": float("nan")}, {"rotations": 1e300}, {"hours": 1.0001e6}])
 def test_bad_running_time_is_refused(fast_run, kw):
     with pytest.raises(UserError):
         fast_run[0].wear_report(**kw)
+
+
+def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
+    """Realistic running times and the bound itself (wear.MAX_RUNNING_HOURS, 1e6 h) are reported, every
+    number finite; just beyond it, in hours or in the same inner-ring rotations, refused naming the option."""
+    from bearingsim.wear import MAX_RUNNING_HOURS
+
+    res = fast_run[0]
+    for hours in (0.44, 100.0, MAX_RUNNING_HOURS):
+        rep = res.wear_report(hours=hours)
+        assert rep.hours == pytest.approx(hours, rel=1e-12)
+        assert all(math.isfinite(x) for x in (rep.max_depth, rep.cov("front"), rep.cov("rear")))
+    rotations = MAX_RUNNING_HOURS * 3600 * res.parameters.operating.omega_i / (2 * math.pi)  # at 6000 rpm: 3.6e11
+    assert res.wear_report(rotations=rotations * 0.999).hours == pytest.approx(0.999 * MAX_RUNNING_HOURS, rel=1e-12)
+    for kw, name in (({"hours": MAX_RUNNING_HOURS * 1.001}, "--hours"),
+                     ({"rotations": rotations * 1.001}, "--rotations")):
+        with pytest.raises(UserError, match=f"^{name} .*: more than 1e\\+06 h of running"):
+            res.wear_report(**kw)
+
+
+@pytest.mark.parametrize("option, value", [("--rotations", "1e300"), ("--hours", "1e300"), ("--hours", "2e6")])
+def test_wear_cli_refuses_an_absurd_running_time_in_one_line(fast_run, capsys, option, value):
+    """`bearingsim wear M --rotations 1e300` exited 0 with an overflow warning, a coefficient of variation
+    of inf and depths of 1e296 um: a running time beyond 1e6 h (wear.MAX_RUNNING_HOURS) is refused in one
+    line naming the option, before anything is printed."""
+    from bearingsim.cli import main
+
+    code = main(["wear", str(fast_run[1]), option, value, "--no-plots"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "", (code, out, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"bearingsim: error: {option} ") and "1e+06 h" in lines[0], err
+
+
+def test_wear_cli_checks_its_output_before_printing(fast_run, tmp_path, capsys):
+    """An output that cannot take the figures (-o a plain file; a figure path that is a folder) is refused
+    in one line before the report is printed or a figure written (it printed the whole table, then
+    refused)."""
+    from bearingsim.cli import main
+
+    archive = fast_run[1]
+    afile = tmp_path / "afile"
+    afile.write_text("mine")
+    code = main(["wear", str(archive), "--hours", "1", "-o", str(afile)])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
+    assert "afile: output folder is not writable" in err and afile.read_text() == "mine"
+    figs = tmp_path / "figs"
+    (figs / f"{archive.stem}_wear_volume.png").mkdir(parents=True)
+    code = main(["wear", str(archive), "--hours", "1", "-o", str(figs)])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
+    assert "wear_volume.png: figure path is a directory" in err
+    assert [p.name for p in figs.iterdir()] == [f"{archive.stem}_wear_volume.png"]  # no figure written
 
 
 # --- life ---------------------------------------------------------------------------------------------
@@ -246,6 +303,64 @@ def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     code = main(["life", str(SCENARIOS / "paper_6000rpm.toml"), "--limit", "depth=0.1mm", "-o", str(tmp_path)])
     err = capsys.readouterr().err
     assert code == 2 and "multibody" in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("scenario, extra, words", [
+    ("paper_3000rpm.toml", ["--limit", "depth=0.1mm"], "multibody"),
+    ("wear_test_6000rpm.toml", ["--limit", "clearance=0.1mm"], "--limit clearance=0.1mm"),
+    ("wear_test_6000rpm.toml", ["--limit", "depth=0.1mm", "--stages", "0"], "--stages 0"),
+    ("wear_test_6000rpm.toml", ["--limit", "depth=0.1mm", "--rotations", "0"], "--rotations 0"),
+], ids=["reduced-model", "clearance-below-s", "no-stages", "no-rotations"])
+def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario, extra, words):
+    """A life study refused for its scenario or arguments exits 2 in one line and creates nothing (it left an
+    empty outputs/<name>_life/)."""
+    from bearingsim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    code = main(["life", str(SCENARIOS / scenario), *extra])
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (code, err)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sig, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
+def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeypatch, capsys, sig, code, name):
+    """A signal during a life study's second stage: exit 128 + signal and one line saying the finished
+    stage's archive is kept and the same command resumes, as the other studies say (it said "interrupted,
+    no archive written"); the same command then reuses that stage."""
+    from bearingsim.cli import main
+    from bearingsim.studies import life
+
+    run_stage = life._run_stage
+
+    def signalled(sc, path, progress):
+        if path.name == "stage_01.h5":
+            os.kill(os.getpid(), sig)
+            for _ in range(1000):  # the handler raises here
+                time.sleep(0.01)
+            raise AssertionError("signal not delivered")
+        return run_stage(sc, path, progress)
+
+    monkeypatch.setattr(life, "_run_stage", signalled)
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "2",
+           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    # a suite started as a background job inherits SIGINT ignored: give this process a terminal user's handler
+    # (SIGTERM's is the command line's own)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert main(cmd) == code
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no archive written" not in err[0], err
+    assert err[0] == (f"bearingsim: life interrupted ({name}): 1 of 2 stage archives kept in {tmp_path / 'stages'}; "
+                      f"run the same command again to resume")
+    assert [p.name for p in (tmp_path / "stages").iterdir()] == ["stage_00.h5"]
+    assert not (tmp_path / "life.h5").exists()
+    monkeypatch.setattr(life, "_run_stage", run_stage)
+    assert main(cmd) == 0
+    assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0]
 
 
 def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, capsys):

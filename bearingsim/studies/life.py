@@ -29,6 +29,7 @@ interrupted study resumes where it stopped.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import re
 from dataclasses import dataclass
@@ -166,6 +167,7 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
     as ``folder/life.h5``). ``progress``: a callable given one line per stage run (the CLI prints them).
     ``mapping``: how the wear acts back on the next stage, :data:`MAPPINGS`."""
     from bearingsim import archive
+    from bearingsim.archive import check_writable_dir
     from bearingsim.outputs import FolderLock
     from bearingsim.wear import wear_report
 
@@ -183,12 +185,12 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
         raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                         f"(bearing.pocket_clearance_mm); give a larger one")
     start = _start_depth(scenario)
-    folder = Path(folder)
+    folder = check_writable_dir(folder)  # created only now: a refusal above leaves nothing
     _check_outputs(folder)
     _check_folder(folder, scenario, limit, force, mapping)
     (folder / "stages").mkdir(parents=True, exist_ok=True)
     rows = []
-    with FolderLock(folder):
+    with FolderLock(folder), _resumable(folder, stages):
         st = _State(s0, start)
         for j in range(stages):
             sc = (stage_scenario(scenario, st.depth if j else None, j, rotations) if mapping == "shape"
@@ -239,6 +241,20 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
         "reused": int(reused), "psi_deg": rate.psi_deg,
         "worn_depth_front_um": st.depth[0] * 1e6, "worn_depth_rear_um": st.depth[1] * 1e6,
     }
+
+
+@contextlib.contextmanager
+def _resumable(folder: Path, stages: int):
+    """A signal that stops the stages (SIGINT's KeyboardInterrupt, or SIGTERM's subclass of it) goes on
+    with ``resume_note``, what it leaves for the command line to say: the stage archives in the folder
+    (this run's and an earlier one's: each is written whole or not at all), kept for the same study to
+    resume from."""
+    try:
+        yield
+    except KeyboardInterrupt as exc:
+        kept = sum((folder / "stages" / f"stage_{j:02d}.h5").exists() for j in range(stages))
+        exc.resume_note = f"{kept} of {stages} stage archives kept in {folder / 'stages'}"
+        raise
 
 
 def _check_outputs(folder: Path) -> None:

@@ -111,9 +111,7 @@ def check_output(out) -> Path:
     suffix = out.suffix.lower()
     if suffix not in (".mp4", ".gif"):
         raise UserError(f"{out}: animation path must end in .mp4 or .gif (got {out.suffix or 'no suffix'!r})")
-    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
-    if existing is not None and not existing.is_dir():
-        raise UserError(f"{out.parent}: cannot create the animation's folder ({existing} is not a folder)")
+    outputs.check_folder_can_be_made(out, "animation")
     if suffix == ".gif":
         outputs.check_replaceable(out, b"GIF8", "GIF animation")
     else:

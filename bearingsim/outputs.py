@@ -212,6 +212,15 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     return p
 
 
+def check_folder_can_be_made(out: Path, what: str) -> None:
+    """Refuse (one-line :class:`UserError`) an output ``out`` whose folder, or the nearest of its parents
+    that exists, is not a folder (a file in the way): the folder could never be made. Nothing is
+    created here; ``what`` names the output ("report", "animation")."""
+    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
+    if existing is not None and not existing.is_dir():
+        raise UserError(f"{out.parent}: cannot create the {what}'s folder ({existing} is not a folder)")
+
+
 def missing_folders(folder: Path) -> list[Path]:
     """``folder`` and those of its parents that do not exist yet, deepest first."""
     missing = []

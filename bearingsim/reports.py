@@ -102,16 +102,14 @@ def check_output(out, source=None) -> Path:
     """Refuse, in one line, an output that is not an ``.html`` path bearingsim may write: a folder, a
     link, a file that is not a report bearingsim wrote, the input itself, below a file. Nothing is
     created here: :func:`report` creates the missing folders when the page is ready."""
-    from bearingsim.outputs import check_replaceable
+    from bearingsim.outputs import check_folder_can_be_made, check_replaceable
 
     out = Path(out)
     if out.suffix.lower() not in SUFFIXES:
         raise UserError(f"{out}: report path must end in .html (got {out.suffix or 'no suffix'!r})")
     if source is not None and out.exists() and Path(source).exists() and out.resolve() == Path(source).resolve():
         raise UserError(f"{out}: the report path is the input; choose another -o")
-    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
-    if existing is not None and not existing.is_dir():
-        raise UserError(f"{out.parent}: cannot create the report's folder ({existing} is not a folder)")
+    check_folder_can_be_made(out, "report")
     check_replaceable(out, SIGNATURE, "report")
     return out
 

@@ -142,8 +142,11 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
 
 def check_step(p, dt: float | None = None) -> None:
     """Refuse, without running, a time step :func:`simulate` would refuse: a given ``dt`` (or
-    ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`)."""
-    choose_dt(p, dt)
+    ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`). The
+    automatic step is never refused (at most ``DT_FRACTION`` of the limit, below ``DT_MAX_FACTOR`` of
+    it), so it is not computed here: :func:`simulate` computes it once."""
+    if dt is not None or p.numerics.dt is not None:
+        choose_dt(p, dt)
 
 
 def _profile_arrays(prof, extent) -> dict:

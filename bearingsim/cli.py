@@ -731,8 +731,7 @@ def main(argv: list[str] | None = None) -> int:
     except for ``compare`` and ``rerun``, whose exit code is their verdict (0 identical, 1 differ) and
     stays so (``args.status``, set before they print).
     """
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    args = build_parser().parse_args(argv)
     previous = None
     try:
         previous = signal.signal(signal.SIGTERM, _raise_terminated)
@@ -746,71 +745,88 @@ def main(argv: list[str] | None = None) -> int:
             stream.reconfigure(errors="backslashreplace")
     try:
         with _interrupts_redelivered() as swallowed, outputs.command_line_owns_stderr(), _notes_on_stderr():
-            try:
-                code = args.func(args)
-            except Exception as exc:
-                signum = swallowed.take()
-                if signum is None:
-                    raise
-                # the signal came first, and its exception was swallowed in a callback that then could not
-                # do its work (numba's compiler, called back from LLVM, left without the object it was
-                # handed: "no compiled object yet"); the command failed of that: the signal ends it
-                raise (Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()) from exc
-            try:
-                sys.stdout.flush()  # a reader gone early shows here, not in the interpreter's last flush
-            except BrokenPipeError:
-                raise
-            except OSError as exc:
-                if getattr(args, "written", None) is None:
-                    raise
-                _stdout_lost(exc, args.written)
-            return code
-    except BrokenPipeError:  # output piped into e.g. `head`, which stopped reading: stop quietly
-        _stdout_to_devnull()
-        return getattr(args, "status", 0)  # compare and rerun: their verdict, decided before they print
-    except outputs.ArchiveWriteError as exc:  # HDF5 cannot be torn down cleanly: the line, then out at once
-        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
-        _exit_quietly(exc.exit_code)
-    except UserError as exc:
-        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
-        return exc.exit_code
-    except SimulationUnstable as exc:
-        print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
-        return exc.exit_code
-    except KeyboardInterrupt as exc:  # SIGINT, or SIGTERM (Terminated)
-        what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
-        kept = getattr(exc, "resume_note", None)  # what a study that resumes kept (bearingsim life)
-        if written is not None:
-            print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
-                  f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
-        elif kept is not None:  # worded as the other studies' (cli_common.report_study)
-            name = "SIGTERM" if isinstance(exc, Terminated) else "SIGINT"
-            print(f"bearingsim: {args.command} interrupted ({name}): {kept}; run the same command again to resume",
-                  file=sys.stderr)
-        else:
-            print(f"bearingsim: {what}, no archive written", file=sys.stderr)
-        return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
-    except OSError as exc:  # a file the command reads or writes (validate/bench output folders, ...)
-        if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
-            _stdout_lost(exc, args.written)
-            return 0
-        if exc.filename is None:  # standard output: the files bearingsim writes go through outputs, which names them
-            print(f"bearingsim: error: cannot write to standard output ({_one_line(exc.strerror or exc)})",
-                  file=sys.stderr)
-        else:
-            print(f"bearingsim: error: {_one_line(exc.filename)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
-        return 2
-    except MemoryError:
-        print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
-              "interval", file=sys.stderr)
-        return 2
+            return _run_command(args, swallowed)
+    except (OSError, UserError, SimulationUnstable, KeyboardInterrupt, MemoryError) as exc:
+        return _failed(exc, args)
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
         for name, err in errors.items():
             with contextlib.suppress(AttributeError, ValueError, OSError):
                 getattr(sys, name).reconfigure(errors=err)
+
+
+def _run_command(args, swallowed: _Swallowed) -> int:
+    """The command's own function, then its output flushed (a reader gone early shows here, not in the
+    interpreter's last flush)."""
+    try:
+        code = args.func(args)
+    except Exception as exc:
+        signum = swallowed.take()
+        if signum is None:
+            raise
+        # the signal came first, and its exception was swallowed in a callback that then could not
+        # do its work (numba's compiler, called back from LLVM, left without the object it was
+        # handed: "no compiled object yet"); the command failed of that: the signal ends it
+        raise (Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()) from exc
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        if getattr(args, "written", None) is None:
+            raise
+        _stdout_lost(exc, args.written)
+    return code
+
+
+def _failed(exc: BaseException, args) -> int:
+    """The one line a failed command prints on stderr, and its exit code (:func:`main`'s list)."""
+    if isinstance(exc, BrokenPipeError):  # output piped into e.g. `head`, which stopped reading: stop quietly
+        _stdout_to_devnull()
+        return getattr(args, "status", 0)  # compare and rerun: their verdict, decided before they print
+    if isinstance(exc, outputs.ArchiveWriteError):  # HDF5 cannot be torn down cleanly: the line, then out at once
+        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
+        _exit_quietly(exc.exit_code)
+    if isinstance(exc, UserError):
+        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
+        return exc.exit_code
+    if isinstance(exc, SimulationUnstable):
+        print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
+        return exc.exit_code
+    if isinstance(exc, KeyboardInterrupt):  # SIGINT, or SIGTERM (Terminated)
+        return _interrupted(exc, args)
+    if isinstance(exc, MemoryError):
+        print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
+              "interval", file=sys.stderr)
+        return 2
+    # OSError: a file the command reads or writes (validate/bench output folders, ...)
+    if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
+        _stdout_lost(exc, args.written)
+        return 0
+    if exc.filename is None:  # standard output: the files bearingsim writes go through outputs, which names them
+        print(f"bearingsim: error: cannot write to standard output ({_one_line(exc.strerror or exc)})",
+              file=sys.stderr)
+    else:
+        print(f"bearingsim: error: {_one_line(exc.filename)}: {_one_line(exc.strerror or exc)}", file=sys.stderr)
+    return 2
+
+
+def _interrupted(exc: KeyboardInterrupt, args) -> int:
+    """SIGINT or SIGTERM: what was kept, in one line; exit 130 or 143."""
+    what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+    written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
+    kept = getattr(exc, "resume_note", None)  # what a study that resumes kept (bearingsim life)
+    if written is not None:
+        print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
+              f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
+    elif kept is not None:  # worded as the other studies' (cli_common.report_study)
+        name = "SIGTERM" if isinstance(exc, Terminated) else "SIGINT"
+        print(f"bearingsim: {args.command} interrupted ({name}): {kept}; run the same command again to resume",
+              file=sys.stderr)
+    else:
+        print(f"bearingsim: {what}, no archive written", file=sys.stderr)
+    return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,220 @@
+"""The package's layout rules (docs/architecture.md), read from the source as it stands.
+
+Every ``import`` counts, the ones inside functions too (the command modules import their implementation
+when they run): the rules are about what a module may use, not about when it loads it. Each test names
+the offending files and lines, so a failure says where to look.
+"""
+import ast
+import collections
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = ROOT / "bearingsim"
+
+#: longest function outside the compiled kernels [lines, from ``def`` to its last line]
+MAX_FUNCTION_LINES = 80
+#: functions allowed longer, each with its stated reason (none today)
+LONG_FUNCTIONS: dict[str, str] = {}
+
+
+def _modules(package: Path = PACKAGE) -> dict[str, Path]:
+    """Dotted module name -> source file, for every module of the package (a package is its __init__)."""
+    mods = {}
+    for path in sorted(package.rglob("*.py")):
+        parts = list(path.relative_to(package.parent).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        mods[".".join(parts)] = path
+    return mods
+
+
+def _imports(package: Path = PACKAGE):
+    """(importer, imported, line) for every import of a module of the package by another, and
+    {third-party top-level name: [(importer, line), ...]}. ``from bearingsim.x import y`` names the
+    module ``bearingsim.x.y`` when that is a module, else ``bearingsim.x``."""
+    mods = _modules(package)
+    internal, external = [], collections.defaultdict(list)
+    for name, path in mods.items():
+        here = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = here.split(".")
+                    parts = parts[:len(parts) - node.level + 1]
+                    base = ".".join(parts + ([node.module] if node.module else []))
+                targets = [f"{base}.{a.name}" if f"{base}.{a.name}" in mods else base for a in node.names]
+            else:
+                continue
+            for target in targets:
+                top = target.partition(".")[0]
+                if top != package.name:
+                    external[top].append((name, node.lineno))
+                    continue
+                while target not in mods and "." in target:
+                    target = target.rpartition(".")[0]
+                if target in mods and target != name:
+                    internal.append((name, target, node.lineno))
+    return internal, external
+
+
+def _cycles(edges) -> list[list[str]]:
+    """The strongly connected components of more than one module (Tarjan's algorithm, iterative)."""
+    graph = collections.defaultdict(set)
+    for a, b, _ in edges:
+        graph[a].add(b)
+    index, low, stack, on_stack, found = {}, {}, [], set(), []
+    for start in sorted(set(graph) | {b for bs in graph.values() for b in bs}):
+        if start in index:
+            continue
+        work = [(start, iter(sorted(graph[start])))]
+        index[start] = low[start] = len(index)
+        stack.append(start)
+        on_stack.add(start)
+        while work:
+            node, children = work[-1]
+            child = next(children, None)
+            if child is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    comp = []
+                    while True:
+                        m = stack.pop()
+                        on_stack.discard(m)
+                        comp.append(m)
+                        if m == node:
+                            break
+                    if len(comp) > 1:
+                        found.append(sorted(comp))
+            elif child not in index:
+                index[child] = low[child] = len(index)
+                stack.append(child)
+                on_stack.add(child)
+                work.append((child, iter(sorted(graph[child]))))
+            elif child in on_stack:
+                low[node] = min(low[node], index[child])
+    return found
+
+
+def _where(edges, pred) -> list[str]:
+    return [f"{a} imports {b} (line {line})" for a, b, line in edges if pred(a, b)]
+
+
+def _in(name: str, *prefixes: str) -> bool:
+    return any(name == p or name.startswith(p + ".") for p in prefixes)
+
+
+@pytest.fixture(scope="module")
+def imports():
+    return _imports()
+
+
+def test_no_two_modules_import_each_other_even_through_others(imports):
+    """A lower layer never imports a higher one: the import graph has no circle, so every module stands
+    above all it imports."""
+    cycles = _cycles(imports[0])
+    assert not cycles, "modules that import each other: " + "; ".join(" <-> ".join(c) for c in cycles)
+
+
+def test_a_model_never_sees_the_scenario_file_the_archive_or_what_runs_it(imports):
+    """docs/architecture.md: a model gets ``Parameters`` and a sink and returns a result; the model packages
+    hold models only."""
+    above = ("bearingsim.scenario", "bearingsim.ranges", "bearingsim.archive", "bearingsim.outputs",
+             "bearingsim.simulation", "bearingsim.plausibility", "bearingsim.sweeps", "bearingsim.studies",
+             "bearingsim.reports", "bearingsim.animation", "bearingsim.tables", "bearingsim.keys",
+             "bearingsim.compare")
+    bad = _where(imports[0], lambda a, b: _in(a, "bearingsim.reduced", "bearingsim.multibody")
+                 and (_in(b, *above) or b.startswith("bearingsim.cli")))
+    assert not bad, "; ".join(bad)
+
+
+def test_the_library_never_imports_the_command_line(imports):
+    """Commands are thin subcommands over the API: only command modules import command modules."""
+    commands = ("bearingsim.cli", "bearingsim.cli_common", "bearingsim.cli_sweep", "bearingsim.cli_wear",
+                "bearingsim.cli_sensitivity", "bearingsim.cli_animate", "bearingsim.__main__")
+    bad = _where(imports[0], lambda a, b: _in(b, *commands) and not _in(a, *commands))
+    assert not bad, "; ".join(bad)
+
+
+@pytest.mark.parametrize(("package", "users"), [
+    ("h5py", {"bearingsim.archive"}),  # the only h5py user
+    ("pymunk", {"bearingsim.multibody.chipmunk", "bearingsim.multibody.loop", "bearingsim.multibody.scene"}),
+    ("distributed", {"bearingsim.sweeps.engines"}),  # the optional cluster extra
+    ("dask", {"bearingsim.sweeps.engines"}),
+    ("jinja2", {"bearingsim.reports"}),
+])
+def test_a_third_party_package_is_used_by_its_own_modules_alone(imports, package, users):
+    got = {name for name, _ in imports[1].get(package, [])}
+    assert got <= users, f"{package} imported by {sorted(got - users)}"
+
+
+def test_pandas_and_xarray_are_imported_by_the_frames_module_alone():
+    """The ``frames`` extra: pandas and xarray are loaded by ``bearingsim/frames.py`` through importlib,
+    named nowhere else (so bearingsim works without them)."""
+    bad = []
+    for name, path in _modules().items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            strings = [node.value] if isinstance(node, ast.Constant) and isinstance(node.value, str) else []
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            names += [node.module or ""] if isinstance(node, ast.ImportFrom) else []
+            for text in names + [s for s in strings if s in ("pandas", "xarray")]:
+                if text.partition(".")[0] in ("pandas", "xarray") and name != "bearingsim.frames":
+                    bad.append(f"{name}:{node.lineno}")
+    assert not bad, "pandas or xarray named in " + ", ".join(bad)
+
+
+def _is_compiled_kernel(fn: ast.FunctionDef) -> bool:
+    for deco in fn.decorator_list:
+        target = deco.func if isinstance(deco, ast.Call) else deco
+        name = target.attr if isinstance(target, ast.Attribute) else getattr(target, "id", "")
+        if name in ("njit", "jit"):
+            return True
+    return False
+
+
+def test_no_function_is_longer_than_80_lines_outside_the_compiled_kernels():
+    """A compiled kernel may be long (numba inlines and types one body; splitting it costs calls in the
+    step loop); any other function longer than ``MAX_FUNCTION_LINES`` needs its reason in
+    ``LONG_FUNCTIONS``."""
+    long = []
+    for name, path in _modules().items():
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and not _is_compiled_kernel(node):
+                lines = node.end_lineno - node.lineno + 1
+                key = f"{name}.{node.name}"
+                if lines > MAX_FUNCTION_LINES and key not in LONG_FUNCTIONS:
+                    long.append(f"{key} ({path.relative_to(ROOT)}:{node.lineno}): {lines} lines")
+    assert not long, "; ".join(long)
+
+
+# The checks above must be able to fail: each is run on a small package made to break it.
+
+def _package(tmp_path, files: dict[str, str]) -> Path:
+    pkg = tmp_path / "bearingsim"
+    for rel, text in files.items():
+        (pkg / rel).parent.mkdir(parents=True, exist_ok=True)
+        (pkg / rel).write_text(text)
+    return pkg
+
+
+def test_a_circle_through_a_function_level_import_is_found(tmp_path):
+    pkg = _package(tmp_path, {"__init__.py": "", "a.py": "from bearingsim import b\n",
+                              "b.py": "def f():\n    from bearingsim.c import g\n",
+                              "c.py": "import bearingsim.a\n", "d.py": "from bearingsim import a\n"})
+    edges, _ = _imports(pkg)
+    assert _cycles(edges) == [["bearingsim.a", "bearingsim.b", "bearingsim.c"]]
+
+
+def test_a_relative_import_and_a_name_that_is_not_a_module_are_read_as_python_reads_them(tmp_path):
+    pkg = _package(tmp_path, {"__init__.py": "X = 1\n", "m/__init__.py": "from .core import f\n",
+                              "m/core.py": "from .. import X\nfrom ..m import core\nimport numpy as np\n"})
+    edges, external = _imports(pkg)
+    assert sorted((a, b) for a, b, _ in edges) == [("bearingsim.m", "bearingsim.m.core"),
+                                                   ("bearingsim.m.core", "bearingsim")]
+    assert external == {"numpy": [("bearingsim.m.core", 3)]}

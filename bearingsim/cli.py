@@ -149,10 +149,11 @@ def _resolved_text(scenario, out=None) -> str:
 
 
 def _dry_run(scenario, args) -> int:
-    """``run --dry-run``: the resolved scenario and the archive it would write; nothing run or written."""
-    from bearingsim.simulation import default_output
+    """``run --dry-run``: the resolved scenario and the archive it would write, its output refused as the run
+    would refuse it; nothing run or written."""
+    from bearingsim.simulation import check_output
 
-    out = Path(args.output) if args.output else default_output(scenario)
+    out = check_output(scenario, args.output, figures=not args.no_plots, force=args.force)
     _write_toml(_resolved_text(scenario, out))
     return 0
 
@@ -472,7 +473,8 @@ def _add_run_commands(sub) -> None:
                    help="replace an archive of a different scenario at the output path (default: refused)")
     r.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     r.add_argument("--dry-run", action="store_true",
-                   help="print the resolved scenario (every key, as TOML) and the archive it would write; run nothing")
+                   help="print the resolved scenario (every key, as TOML) and the archive it would write, refusing what "
+                        "the run would refuse before its first step; run and write nothing")
     r.set_defaults(func=_cmd_run)
 
     i = sub.add_parser("inspect", help="print what an archive, a sweep.h5 or a crosscheck.h5 holds")

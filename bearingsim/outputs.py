@@ -221,6 +221,25 @@ def check_folder_can_be_made(out: Path, what: str) -> None:
         raise UserError(f"{out.parent}: cannot create the {what}'s folder ({existing} is not a folder)")
 
 
+def check_writable(path: str | Path) -> None:
+    """Refuse, in the line a run would give (:meth:`OutputLock.acquire`), an output ``path`` whose folder
+    could not be made or would take no new file, without writing anything: the nearest folder of it that
+    exists is probed with an unnamed temporary file, gone when closed (``run --dry-run``)."""
+    import tempfile
+
+    path = Path(path)
+    existing = next((p for p in (path.parent, *path.parent.parents) if p.exists()), None)
+    if existing is None:
+        return
+    try:
+        if not existing.is_dir():
+            raise NotADirectoryError(errno.ENOTDIR, os.strerror(errno.ENOTDIR))
+        with tempfile.TemporaryFile(dir=existing):
+            pass
+    except OSError as exc:
+        raise UserError(f"{path}: output is not writable ({exc.strerror or exc})") from None
+
+
 def missing_folders(folder: Path) -> list[Path]:
     """``folder`` and those of its parents that do not exist yet, deepest first."""
     missing = []

@@ -127,6 +127,32 @@ def default_output(scenario: Scenario, root: str | Path = "outputs") -> Path:
     return outputs.default_output(scenario.name, root)
 
 
+def check_output(scenario: Scenario, out: str | Path | None = None, *, figures: bool = True,
+                 force: bool = False) -> Path:
+    """Refuse, without writing anything, what :func:`run_scenario` would refuse of its output before its
+    first step: the target and its figures (:func:`bearingsim.outputs.check_target`), a folder that could
+    not be made or takes no file (:func:`bearingsim.outputs.check_writable`) and, unless ``force``, an
+    archive there of another scenario (:func:`check_same_scenario`). Returns the archive path.
+    ``bearingsim run --dry-run`` checks this."""
+    from bearingsim import outputs
+
+    out = _target(scenario, out, figures)
+    outputs.check_writable(out)
+    if not force:
+        check_same_scenario(out, scenario)
+    return out
+
+
+def _target(scenario: Scenario, out: str | Path | None, figures: bool) -> Path:
+    """The archive path of a run (default ``outputs/<name>.h5``), checked with the figures it writes
+    beside it (:func:`bearingsim.outputs.check_target`)."""
+    from bearingsim import archive, outputs
+
+    out = Path(out) if out is not None else default_output(scenario)
+    names = model_module(scenario.model).RESULT.FIGURES if figures else ()
+    return outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)
+
+
 def check_same_scenario(out: Path, scenario: Scenario) -> None:
     """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
     ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
@@ -184,9 +210,7 @@ def run_scenario(
     from bearingsim import archive, outputs
     from bearingsim.errors import UserError
 
-    out = Path(out) if out is not None else default_output(scenario)
-    names = model_module(scenario.model).RESULT.FIGURES if figures else ()
-    outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)  # before the lock
+    out = _target(scenario, out, figures)  # before the lock
     made = outputs.missing_folders(out.parent)  # created for this run: removed again if it writes no archive
     try:
         lock = outputs.OutputLock(out).acquire() if exclusive else None  # one writer per target, figures included

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import sys
 import tomllib
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -131,6 +132,37 @@ def test_run_dry_run_refuses_the_time_step_the_run_refuses(tmp_path, name):
     assert_user_error(dry, "numerics.dt_s")
     assert dry.stderr == real.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["a file in the folder's place", "a folder that takes no file",
+                                  "an archive of another scenario"])
+def test_run_dry_run_refuses_the_output_the_run_refuses(tmp_path, case):
+    """What the run refuses of its output before its first step (the target, a folder that cannot be made
+    or takes no file, an archive of another scenario at the target) the dry run refuses with the same line
+    (it said 'would write' and exited 0); it writes nothing, and with --force it passes where the run would."""
+    sets = ["--set", "numerics.rotations=1"]
+    if case == "a file in the folder's place":
+        (tmp_path / "f").write_text("a user's file")
+        out = tmp_path / "f" / "sub" / "a.h5"
+    elif case == "a folder that takes no file":
+        if not (Path("/proc/self").is_dir() and sys.platform.startswith("linux")):
+            pytest.skip("needs Linux's /proc, where no file can be created whoever asks")
+        out = Path("/proc/a.h5")
+    else:
+        out = tmp_path / "a.h5"
+        assert cli("run", PAPER, *sets, "--no-plots", "-q", "-o", out).returncode == 0
+        sets += ["--set", "operating.inner_ring_speed_rpm=2000"]
+    before = sorted(tmp_path.rglob("*"))
+    dry = cli("run", PAPER, *sets, "--dry-run", "--no-plots", "-o", out, cwd=tmp_path)
+    assert sorted(tmp_path.rglob("*")) == before
+    real = cli("run", PAPER, *sets, "--no-plots", "-o", out, cwd=tmp_path)
+    assert_user_error(dry, str(out))
+    assert dry.stderr == real.stderr
+    if case == "an archive of another scenario":
+        assert "--force" in dry.stderr
+        forced = cli("run", PAPER, *sets, "--dry-run", "--no-plots", "--force", "-o", out, cwd=tmp_path)
+        assert forced.returncode == 0 and f"would write {out}" in forced.stdout, forced.stderr
 
 
 @pytest.mark.slow

@@ -818,7 +818,7 @@ def _interrupted(exc: KeyboardInterrupt, args) -> int:
     """SIGINT or SIGTERM: what was kept, in one line; exit 130 or 143."""
     what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
     written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
-    kept = getattr(exc, "resume_note", None)  # what a study that resumes kept (bearingsim life)
+    kept = getattr(exc, "resume_note", None)  # what a study kept, its cases done (studies.run_studies)
     if written is not None:
         print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
               f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)

@@ -35,22 +35,21 @@ def _cmd_wear(args) -> int:
 
 
 def _cmd_life(args) -> int:
-    from bearingsim.plotting import save_figure
+    from bearingsim.cli_common import progress_wanted, report_study
     from bearingsim.scenario import load_scenario
-    from bearingsim.studies import life
+    from bearingsim.studies import life, make_engine, run_studies
 
     limit = life.parse_limit(args.limit)
     scenario = load_scenario(args.scenario, args.set)
-    folder = Path(args.output or Path("outputs") / f"{scenario.name}_life")  # created by run_life after its checks
-    say = None if args.quiet else (lambda line: print(line, file=sys.stderr))
-    cols = life.run_life(scenario, folder, limit, stages=args.stages, rotations=args.rotations, force=args.force,
-                         mapping=args.mapping, progress=say)
-    cols_, attrs = life.read_life(folder / "life.h5")
-    try:
-        png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
-    except KeyboardInterrupt as exc:  # the study is complete, only its figure is missing (cli.main says so)
-        exc.resume_note = f"all {len(cols['stage'])} stages done and {folder / 'life.h5'} written, not its figure"
-        raise
+    study = life.LifeStudy(scenario, limit, stages=args.stages, rotations=args.rotations, mapping=args.mapping,
+                           progress=None if args.quiet else (lambda line: print(line, file=sys.stderr)))
+    engine = make_engine(1, args.scheduler, "--scheduler")
+    folder = Path(args.output or Path("outputs") / f"{scenario.name}_life")  # created after the study's checks
+    outcome = run_studies([study], folder, engine=engine, force=args.force, progress=progress_wanted(args))
+    code = report_study(outcome, "life")
+    if code:
+        return code
+    cols = study.columns()
     print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
           f"inner-ring rotations in {len(cols['stage'])} stages")
     print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
@@ -59,8 +58,8 @@ def _cmd_life(args) -> int:
         print(f"{cols['stage'][i]:>5} {cols['pocket_clearance_mm'][i]:>8.4f} {cols['stage_rotations'][i]:>11.4g} "
               f"{cols['hours_end'][i]:>9.4g} {cols['max_depth_rate_um_per_h'][i]:>18.4g} "
               f"{cols['max_depth_um'][i]:>13.4g} {cols['I_dec_mean_mNs'][i]:>13.4g} {cols['reused'][i]:>6}")
-    print(f"wrote {folder / 'life.h5'}")
-    print(f"wrote {png}")
+    for path in outcome.written:
+        print(f"wrote {path}")
     return 0
 
 
@@ -83,6 +82,8 @@ def add_commands(sub) -> None:
     li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")
     li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
+    li.add_argument("--scheduler", metavar="ADDRESS", help="run the stages on a dask cluster (tcp://host:8786); "
+                                                          "default: one local worker process")
     li.add_argument("--force", action="store_true", help="replace a life study of another scenario or limit")
     li.add_argument("--mapping", choices=("shape", "uniform"), default="shape",
                     help="how a stage's wear acts back: 'shape' (default), the worn depth added to each face where "

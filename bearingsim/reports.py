@@ -433,10 +433,6 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         if failed:
             checks.append(table_block("Failed cases", ["case", "error"], failed))
         first = next((folder / a for a in cols["archive"] if a and (folder / a).is_file()), None)
-    else:  # a life study: its stages' archives
-        first = next(iter(sorted((folder / "stages").glob("stage_*.h5"))), None)
-        checks.append({"kind": "text", "text": "Every stage's archive passed the plausibility checks when it was "
-                                               "written (docs/reliability.md)."})
     sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario",
                                                                         _scenario_blocks(toml, folder))]
     if first is not None:

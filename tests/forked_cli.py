@@ -74,9 +74,11 @@ class _Server:
             raise RuntimeError(f"the command-line server of the tests did not start ({ready!r})")
 
     def close(self) -> None:
+        """End the server (closing twice does nothing)."""
         self.file.close()
         self.sock.close()
-        self.proc.kill()
+        if self.proc.poll() is None:
+            self.proc.kill()
         self.proc.wait()
 
     def run(self, args, cwd, timeout) -> subprocess.CompletedProcess:
@@ -124,7 +126,10 @@ def run(args, cwd=None, timeout=600, fresh_interpreter=False) -> subprocess.Comp
         _server.close()
         _server = None
     if _server is None:
+        import atexit
+
         _server = _Server()
+        atexit.register(_server.close)  # at the worker's exit: no server left running, no socket left open
     return _server.run(args, cwd, timeout)
 
 

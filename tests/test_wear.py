@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import os
 import signal
+import sys
 import time
 
 import numpy as np
@@ -228,6 +229,22 @@ def test_limit_parsing():
     assert parse_limit("volume=2mm3").value == pytest.approx(2e-9)
 
 
+def _stage_path(folder, j: int):
+    """Where stage ``j``'s archive of a life study's folder is, as the folder's case index says."""
+    from bearingsim.sweeps.index import read_index
+
+    cols, _ = read_index(folder / "sweep.h5")
+    (k,) = np.flatnonzero(cols["stage"] == j)
+    return folder / str(cols["archive"][k])
+
+
+def _stage(folder, j: int):
+    """Stage ``j``'s result, read from its archive."""
+    from bearingsim.simulation import load
+
+    return load(_stage_path(folder, j))
+
+
 @pytest.mark.parametrize("mapping", ["uniform", "shape"])
 def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, mapping):
     """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the effective
@@ -235,7 +252,6 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     runs with the wear of the stages before it (uniform: at the grown pocket clearance; shape: with the
     worn depth on each face); the same command again reuses every stage's archive and gives the same
     history bit for bit."""
-    from bearingsim.simulation import load
     from bearingsim.studies.life import parse_limit, run_life
 
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
@@ -245,16 +261,16 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     assert np.all(cols["stage_rotations"] > 0)
     assert cols["clearance_end_mm"][-1] == pytest.approx(0.203, rel=1e-9)
     assert np.all(cols["reused"] == 0)
-    assert load(tmp_path / "stages" / "stage_00.h5").scenario.wear.worn_depth_front_um is None
+    assert _stage(tmp_path, 0).scenario.wear.worn_depth_front_um is None
     if mapping == "uniform":  # stage j runs at the clearance stages 0..j-1 left (rounded to 1e-9 mm)
         for j in (1, 2):
-            stage = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario
+            stage = _stage(tmp_path, j).scenario
             assert stage.wear.worn_depth_front_um is None
             assert stage.bearing.pocket_clearance_mm == pytest.approx(cols["clearance_end_mm"][j - 1], abs=1e-9)
     else:  # stage j runs with the depth accumulated by stages 0..j-1 on each face, per pocket and bin of
         # psi (rounded to 1e-6 um in its scenario), at the given pocket clearance
         for j in (1, 2):
-            stage = load(tmp_path / "stages" / f"stage_{j:02d}.h5").scenario
+            stage = _stage(tmp_path, j).scenario
             assert stage.bearing.pocket_clearance_mm == sc.bearing.pocket_clearance_mm
             for f in ("front", "rear"):
                 np.testing.assert_allclose(np.array(getattr(stage.wear, f"worn_depth_{f}_um")).T,
@@ -323,26 +339,56 @@ def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario,
     assert list(tmp_path.iterdir()) == []
 
 
+#: case hash -> the signal its worker sends the study before it runs the case
+_SIGNAL_AT: dict[str, int] = {}
+_RUN_BATCH = None  # the engine's own run_batch, while a test puts _signalling_batch in its place
+
+
+def _wait_for_the_handler():
+    for _ in range(1000):  # the handler raises here
+        time.sleep(0.01)
+    raise AssertionError("signal not delivered")
+
+
+def _signalling_batch(items, *args, **kw):
+    """The engine's run_batch (in a forked worker process, which has this module's state) sending its study
+    the signal ``_SIGNAL_AT`` names for one of its cases, then running them."""
+    from bearingsim.sweeps import worker
+
+    for h, *_ in items:
+        if h in _SIGNAL_AT:
+            os.kill(os.getppid(), _SIGNAL_AT[h])
+            time.sleep(10)  # the study ends this worker
+    return _RUN_BATCH(items, *args, **kw)
+
+
 @pytest.mark.slow
+@pytest.mark.parametrize("when", ["between stages", "during a stage"])
 @pytest.mark.parametrize("sig, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
-def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeypatch, capsys, sig, code, name):
-    """A signal during a life study's second stage: exit 128 + signal and one line saying the finished
-    stage's archive is kept and the same command resumes, as the other studies say (it said "interrupted,
-    no archive written"); the same command then reuses that stage."""
+def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeypatch, capsys, sig, code, name, when):
+    """A signal while a life study computes its second stage from the first, or while the second stage runs
+    (in the engine's worker process, which sends it to the study as a terminal's Ctrl-C reaches the whole
+    process group): exit 128 + signal and one line, as every study says it, counting the finished stage
+    as kept (it said "interrupted, no archive written" before the stages ran on the study engine); no
+    history is written, and the same command then reuses the finished stage."""
     from bearingsim.cli import main
     from bearingsim.studies import life
+    from bearingsim.sweeps import worker
 
-    run_stage = life._run_stage
+    next_cases = life.LifeStudy.next_cases
 
-    def signalled(sc, path, progress):
-        if path.name == "stage_01.h5":
+    def signalled(self, outdir, records):
+        cases = next_cases(self, outdir, records)
+        if cases and when == "between stages":
             os.kill(os.getpid(), sig)
-            for _ in range(1000):  # the handler raises here
-                time.sleep(0.01)
-            raise AssertionError("signal not delivered")
-        return run_stage(sc, path, progress)
+            _wait_for_the_handler()
+        _SIGNAL_AT.update((c.hash, sig) for c in cases)
+        return cases
 
-    monkeypatch.setattr(life, "_run_stage", signalled)
+    monkeypatch.setattr(life.LifeStudy, "next_cases", signalled)
+    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
+    monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
+    monkeypatch.setattr(worker, "run_batch", _signalling_batch)
     cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "2",
            "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
     # a suite started as a background job inherits SIGINT ignored: give this process a terminal user's handler
@@ -353,14 +399,108 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
     finally:
         signal.signal(signal.SIGINT, previous)
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "no archive written" not in err[0], err
-    assert err[0] == (f"bearingsim: life interrupted ({name}): 1 of 2 stage archives kept in {tmp_path / 'stages'}; "
-                      f"run the same command again to resume")
-    assert [p.name for p in (tmp_path / "stages").iterdir()] == ["stage_00.h5"]
+    assert err == [f"bearingsim: life interrupted ({name}): 1 done, 0 cached, 0 failed, 1 not run, of 2 cases; run "
+                   f"the same command again to resume"]
+    assert list((tmp_path / "cases").iterdir()) == [_stage_path(tmp_path, 0)]
     assert not (tmp_path / "life.h5").exists()
-    monkeypatch.setattr(life, "_run_stage", run_stage)
+    monkeypatch.undo()
     assert main(cmd) == 0
     assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0]
+
+
+def _failing_batch(items, *args, **kw):
+    """The engine's run_batch (in a forked worker) failing the cases ``_SIGNAL_AT`` names, as a case whose
+    run raised does."""
+    return [{"hash": h, "status": "failed", "error": "SimulationUnstable: made to fail", "wall_s": 0.0, "summary": {}}
+            if h in _SIGNAL_AT else _RUN_BATCH([(h, *rest)], *args, **kw)[0] for h, *rest in items]
+
+
+@pytest.mark.slow
+def test_a_failed_stage_ends_the_life_study_keeping_the_stages_before_it(tmp_path, monkeypatch, capsys):
+    """A stage that fails (its run raised) ends the study: exit 1, the engine's line of the failed case and
+    the study's line naming the stage, its error and that the later stages were not run (each needs the one
+    before); no history; the stage before it is kept, and the same command, the failure gone, reuses it."""
+    from bearingsim.cli import main
+    from bearingsim.studies import life
+    from bearingsim.sweeps import worker
+
+    next_cases = life.LifeStudy.next_cases
+
+    def failing(self, outdir, records):
+        cases = next_cases(self, outdir, records)
+        _SIGNAL_AT.update((c.hash, 0) for c in cases if len(self.rows) == 1)  # stage 1 fails
+        return cases
+
+    monkeypatch.setattr(life.LifeStudy, "next_cases", failing)
+    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
+    monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
+    monkeypatch.setattr(worker, "run_batch", _failing_batch)
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "3",
+           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    assert main(cmd) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[0].startswith("failed: case ") and err[0].endswith(" (stage=1): SimulationUnstable: made to fail")
+    assert err[1:] == [f"bearingsim: 1 of 3 cases of the life failed (stage=1: SimulationUnstable: made to fail); the other "
+                   f"cases' numbers are kept (errors in {tmp_path / 'sweep.csv'}); 1 later case not run (each needs "
+                   f"the one before)"]
+    assert not (tmp_path / "life.h5").exists() and list((tmp_path / "cases").iterdir()) == [_stage_path(tmp_path, 0)]
+    monkeypatch.undo()
+    assert main(cmd) == 0
+    assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0, 0]
+
+
+@pytest.mark.slow
+def test_life_refuses_a_folder_of_another_sweep_unless_forced(tmp_path, capsys):
+    """A life study's later stages are not known before they run, so it tells its own earlier run (its first
+    stage in the folder's case index) from another sweep or study itself: another is refused in one line and
+    left as it was; with --force it is replaced."""
+    from bearingsim.cli import main
+
+    assert main(["sweep", str(SCENARIOS / "paper_3000rpm.toml"), "--param", "operating.inner_ring_speed_rpm=1000,2000",
+                 "-q", "--no-plots", "-o", str(tmp_path)]) == 0
+    before = sorted(p.name for p in tmp_path.iterdir())
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.201mm", "--stages", "1",
+           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    assert main(cmd) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "holds another sweep or study" in err[0] and "--force" in err[0], err
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+    assert main([*cmd, "--force"]) == 0
+    from bearingsim.sweeps.index import read_index
+
+    assert read_index(tmp_path / "sweep.h5")[0]["stage"].tolist() == [0]
+    assert len(list((tmp_path / "cases").iterdir())) == 1
+
+
+@pytest.mark.slow
+def test_a_signal_while_a_study_writes_its_table_says_its_cases_are_kept(tmp_path, monkeypatch, capsys):
+    """SIGINT while a study (here a life study) writes its table and figure, its cases all done: exit 130 and
+    one line saying so and that the same command finishes it (not "no archive written"); the same command
+    then reuses every case and writes the history."""
+    from bearingsim.cli import main
+    from bearingsim.studies import life
+
+    plot_life = life.plot_life
+
+    def signalled(cols, attrs):
+        os.kill(os.getpid(), signal.SIGINT)
+        _wait_for_the_handler()
+
+    monkeypatch.setattr(life, "plot_life", signalled)
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "2",
+           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert main(cmd) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"bearingsim: life interrupted (SIGINT): all 2 cases done and kept in {tmp_path}, its tables and "
+                   f"figures not all written; run the same command again to resume"]
+    monkeypatch.setattr(life, "plot_life", plot_life)
+    assert main(cmd) == 0
+    assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
+    assert (tmp_path / "life.png").is_file()
 
 
 def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, capsys):
@@ -384,7 +524,7 @@ def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, c
     from bearingsim.studies.life import read_life
 
     assert read_life(tmp_path / "life" / "life.h5")[1]["mapping"] == "shape"
-    stage = load(tmp_path / "life" / "stages" / "stage_01.h5").scenario
+    stage = _stage(tmp_path / "life", 1).scenario
     assert stage.wear.worn_depth_rear_um is not None
     assert stage.bearing.pocket_clearance_mm == load_scenario(scenario).bearing.pocket_clearance_mm
 

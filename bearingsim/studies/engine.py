@@ -69,20 +69,37 @@ def case_of(scenario, values: dict) -> Case:
 class Study:
     """A list of cases plus a table and figures.
 
-    Subclasses set :attr:`cases` and :attr:`outputs` and define :meth:`finish`.
+    Subclasses set :attr:`cases` and :attr:`outputs` and define :meth:`finish`. A staged study (``staged``
+    True: a life study's stages, each run in the pockets the stages before it wore) knows only its first
+    cases before anything runs and adds the others from the results (:meth:`next_cases`).
 
     Attributes
     ----------
     cases : list of Case
-        What to run (each case once; two studies may share a case).
+        What to run (each case once; two studies may share a case); of a staged study, its first cases.
     outputs : list of (file name, signature, what)
         The files the study writes into the folder, checked before anything runs
         (:func:`bearingsim.outputs.check_replaceable`: a user's file or a link there is refused).
+    planned : int or None
+        How many cases the study will have run when it is done, if that is not ``len(cases)`` (a staged
+        study's stages): what an interrupted study counts its cases against.
     """
 
     name = "study"
     cases: list[Case]
     outputs: list[tuple[str, object, str]]
+    staged = False
+    planned: int | None = None
+
+    def next_cases(self, outdir: Path, records: dict[str, dict]) -> list[Case]:
+        """The cases the finished ones call for (``records`` as in :meth:`finish`): a staged study's next
+        stage, none when it is done. Called after every round of cases, while no case has failed."""
+        return []
+
+    def check_folder(self, outdir: Path, force: bool) -> None:
+        """A staged study's check of what ``outdir`` holds, before anything runs: its later cases are not
+        known yet, so the engine cannot tell its own earlier run from another study's
+        (:func:`bearingsim.sweeps.run.check_same_sweep`); with ``force`` another study's files are removed."""
 
     def finish(self, outdir: Path, records: dict[str, dict]) -> list[Path]:
         """Build the table from the cases' records (``records[hash]``: a row of the case index with
@@ -99,6 +116,7 @@ class StudiesOutcome:
 
     sweep: object  # bearingsim.sweeps.SweepOutcome
     written: list[Path] = field(default_factory=list)
+    planned: int = 0  #: the cases the studies have when done (a staged study's are not all known when it stops)
 
     @property
     def interrupted(self) -> int | None:
@@ -170,31 +188,82 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
     from bearingsim.archive import check_writable_dir
     from bearingsim.outputs import FolderLock
     from bearingsim.sweeps.engines import LocalEngine
-    from bearingsim.sweeps.run import run_sweep
 
     engine = engine or LocalEngine(1)
+    staged = any(s.staged for s in studies)
     try:
         outdir = check_writable_dir(outdir)
         check_outputs(outdir, studies)  # before the lock file: a refusal leaves the folder as it was
-        cases, seen = [], set()
-        for study in studies:
-            for c in study.cases:
-                if c.hash not in seen:
-                    seen.add(c.hash)
-                    cases.append(c)
+        cases = _new_cases([], [c for s in studies for c in s.cases])
     except BaseException:
         engine.stop()
         raise
     with FolderLock(outdir) as lock:
-        sweep = run_sweep(cases, outdir, engine=engine, figures=False, progress=progress, log=log, lock=lock,
-                          desc="+".join(s.name for s in studies), force=force,
-                          archives="all")  # a study's table and figures are made from its cases' archives
-        out = StudiesOutcome(sweep)
+        for study in studies:
+            if study.staged:
+                study.check_folder(outdir, force)
+        sweep = _run_rounds(studies, cases, outdir, engine, lock, dict(progress=progress, log=log, force=force,
+                                                                      check_folder=not staged))
+        out = StudiesOutcome(sweep, planned=max(len(sweep.rows), sum(s.planned or len(s.cases) for s in studies)))
         if sweep.interrupted is None:
             records = {r["case"]: r for r in sweep.rows}
-            for study in studies:
-                out.written += study.finish(outdir, records)
+            try:
+                for study in studies:
+                    out.written += study.finish(outdir, records)
+            except KeyboardInterrupt as exc:  # the cases are done and kept: the same command writes the rest
+                exc.resume_note = (f"all {len(sweep.rows)} cases done and kept in {outdir}, its tables and figures "
+                                   f"not all written")
+                raise
     return out
+
+
+def _new_cases(cases: list[Case], more) -> list[Case]:
+    """``cases`` and those of ``more`` not among them yet (by content hash), in order."""
+    seen = {c.hash for c in cases}
+    out = list(cases)
+    for c in more:
+        if c.hash not in seen:
+            seen.add(c.hash)
+            out.append(c)
+    return out
+
+
+#: what a round of a staged study hands on of each case's row to the next (sweeps.run_sweep's ``earlier``)
+_ROW_KEYS = ("status", "error", "archive", "wall_s", "model_version", "summary")
+
+
+def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options: dict):
+    """Run ``cases`` on the engine; then, while the studies call for more (:meth:`Study.next_cases`) and
+    none has failed or been interrupted, those too, each round indexed with all before it. Returns the
+    last round's sweep outcome."""
+    from bearingsim.sweeps.run import SweepInterrupted, _Signals, run_sweep
+
+    import signal
+
+    desc = "+".join(s.name for s in studies)
+    sweep, earlier = None, {}
+    # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM end the study as one
+    # during a round does: the finished cases kept, the same command resumes
+    with _Signals():
+        try:
+            while True:
+                sweep = run_sweep(cases, outdir, engine=engine, figures=False, lock=lock, desc=desc, archives="all",
+                                  earlier=earlier, **options)  # tables and figures are made from the cases' archives
+                if sweep.interrupted is not None or sweep.failed:
+                    return sweep
+                records = {r["case"]: r for r in sweep.rows}
+                earlier = {h: {k: r[k] for k in _ROW_KEYS} for h, r in records.items()}
+                more = _new_cases(cases, [c for s in studies for c in s.next_cases(outdir, records)])
+                if len(more) == len(cases):
+                    return sweep
+                cases = more
+        except SweepInterrupted as exc:
+            if sweep is not None:
+                sweep.interrupted = exc.signum
+                return sweep
+            first = exc.signum
+    signal.raise_signal(first)  # before any case ran: the signal goes to the handler that was in place
+    raise KeyboardInterrupt(signal.Signals(first).name)  # that handler ignored it: the study is stopped all the same
 
 
 def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: bool = False) -> StudiesOutcome:

@@ -29,7 +29,6 @@ interrupted study resumes where it stopped.
 """
 from __future__ import annotations
 
-import contextlib
 import math
 import re
 from dataclasses import dataclass
@@ -38,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.studies.engine import Study, case_of, load_result
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -140,85 +140,153 @@ def _start_depth(scenario) -> np.ndarray | None:
     return arr.transpose(1, 2, 0).copy()
 
 
-def _run_stage(sc, path: Path, progress):
-    """The result of stage scenario ``sc`` at ``path``: its archive when it stores exactly ``sc`` and was
-    computed by the present version of the model (resume, as a sweep's: :mod:`bearingsim.model_versions`),
-    else a new run."""
-    from bearingsim import archive
-    from bearingsim.model_versions import MODEL_VERSIONS
-    from bearingsim.simulation import load, run_scenario
+class LifeStudy(Study):
+    """A life study (module docstring) as a staged study: stage ``j + 1``'s case is made from stage ``j``'s
+    archive (:meth:`next_cases`), each run by the study engine (:func:`bearingsim.studies.run_studies`);
+    :meth:`finish` writes ``life.h5`` and ``life.png``. Refused here, before anything is created: a
+    scenario of the reduced model, an unknown ``mapping``, ``stages`` outside 1..100, ``rotations`` below
+    1, a clearance limit at or below the pocket clearance, a worn depth of the wrong bins. ``progress``: a
+    callable given one line per stage when its wear is known (the command line prints them)."""
 
-    got = archive.peek(path) if path.exists() else None
-    if (got is not None and got["scenario"] == sc.to_toml()
-            and got["model_version"] == MODEL_VERSIONS.get(got["model"])):
-        return load(path), True
-    if progress:
-        worn = [max(max(row) for row in v) for v in (sc.wear.worn_depth_front_um, sc.wear.worn_depth_rear_um)
-                if v is not None]
-        progress(f"stage {path.stem}: running {sc.numerics.rotations} rotations, deepest worn point "
-                 f"{max(worn, default=0.0):.4g} um")
-    run_scenario(sc, path, figures=False, exclusive=False, notes=False, force=True)
-    return load(path), False
+    name = "life"
+    staged = True
+
+    def __init__(self, scenario, limit: Limit, *, stages: int = 10, rotations: int | None = None,
+                 mapping: str = "shape", progress=None):
+        from bearingsim import archive
+        from bearingsim.outputs import PNG_SIGNATURE
+
+        if scenario.model != "multibody":
+            raise UserError(f"{scenario.source}: model = {scenario.model!r}: wear profiles need the whole bearing "
+                            f"(model = \"multibody\")")
+        if mapping not in MAPPINGS:
+            raise UserError(f"--mapping {mapping}: give one of {', '.join(MAPPINGS)}")
+        if not 1 <= stages <= 100:
+            raise UserError(f"--stages {stages}: give 1 to 100 stages")
+        if rotations is not None and rotations < 1:
+            raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation per stage")
+        s0 = scenario.bearing.pocket_clearance_mm * 1e-3
+        if limit.kind == "clearance" and limit.value <= s0:
+            raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
+                            f"(bearing.pocket_clearance_mm); give a larger one")
+        self.scenario, self.limit, self.planned = scenario, limit, stages
+        self.rotations, self.mapping, self.progress = rotations, mapping, progress
+        self.state = _State(s0, _start_depth(scenario))
+        self.rows: list[dict] = []
+        self.stage_cases = [self._case(0)]
+        self.cases = list(self.stage_cases)
+        self.outputs = [("life.h5", lambda p: archive.is_table_file(p, LIFE_FORMAT), "life history"),
+                        ("life.png", PNG_SIGNATURE, "figure")]
+
+    def _case(self, j: int):
+        st = self.state
+        sc = (stage_scenario(self.scenario, st.depth if j else None, j, self.rotations) if self.mapping == "shape"
+              else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.clearance()))
+        return case_of(sc, {"stage": j})
+
+    def next_cases(self, outdir: Path, records: dict[str, dict]) -> list:
+        """The wear of the last stage run (its archive's wear rate, for as many rotations as bring the
+        limited quantity to its next step), then the next stage's case; none after the last stage."""
+        from bearingsim.wear import wear_report
+
+        j = len(self.rows)
+        record = records[self.stage_cases[j].hash]
+        res = load_result(outdir, record)
+        st = self.state
+        rate = wear_report(res, rotations=1.0)
+        d_rate = np.stack([rate.depth_front, rate.depth_rear])
+        v_rate = np.stack([rate.volume_front, rate.volume_rear])
+        if st.volume is None:
+            st.area = rate.bin_area * len(rate.psi_deg)
+            st.depth = np.zeros_like(d_rate) if st.depth is None else st.depth
+            st.volume = st.depth.sum(axis=1) * rate.bin_area
+        clearance = st.clearance()
+        start = st.s0 if self.limit.kind == "clearance" else 0.0
+        goal = start + (self.limit.value - start) * (j + 1) / self.planned
+        q_now = st.quantity(self.limit.kind, st.depth, st.volume)
+        q_rate = st.quantity(self.limit.kind, d_rate, v_rate) - (st.s0 if self.limit.kind == "clearance" else 0.0)
+        n_stage = _stage_length(q_now, q_rate, goal)
+        st.depth = st.depth + d_rate * n_stage
+        st.volume = st.volume + v_rate * n_stage
+        st.shaft += n_stage
+        st.hours += n_stage * rate.hours
+        self.rows.append(_row(j, clearance, res, rate, n_stage, st, record["status"] == "cached"))
+        if self.progress:
+            self.progress(f"stage {j:02d} of {self.planned}: {'reused' if self.rows[-1]['reused'] else 'run'}, "
+                          f"I_dec {res.summary['I_dec_mean_Ns'] * 1e3:.4g} mN s; worn on for {n_stage:.4g} rotations, "
+                          f"deepest worn point {st.depth.max() * 1e6:.4g} um")
+        if j + 1 == self.planned:
+            return []
+        self.stage_cases.append(self._case(j + 1))
+        return [self.stage_cases[-1]]
+
+    def columns(self) -> dict:
+        """The history's columns, one row per stage run so far."""
+        return {k: np.array([r[k] for r in self.rows]) for k in self.rows[0]}
+
+    def finish(self, outdir: Path, records: dict[str, dict]) -> list[Path]:
+        """``life.h5`` (written atomically) and ``life.png``, once every stage has run (after a failed stage:
+        nothing, the failure is the engine's to tell)."""
+        from bearingsim import archive
+        from bearingsim.plotting import save_figure
+
+        if len(self.rows) < self.planned:
+            return []
+        cols = self.columns()
+        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned,
+                 "scenario": self.scenario.to_toml(), "mapping": self.mapping, "mapping_text": MAPPINGS[self.mapping]}
+        archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
+        return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
+
+    def check_folder(self, outdir: Path, force: bool) -> None:
+        """Refuse a folder that holds another life study (another scenario, limit or mapping in its
+        ``life.h5``) or another sweep or study (a case index without this study's first stage), unless
+        ``force``: then that study's files are removed. This study interrupted before its ``life.h5`` was
+        written (its first stage in the index) resumes."""
+        from bearingsim import archive
+        from bearingsim.sweeps.index import INDEX_FORMAT, read_index
+
+        path = outdir / "life.h5"
+        index = outdir / "sweep.h5"
+        other = None
+        if path.exists():
+            _, attrs = archive.read_table_file(path, LIFE_FORMAT)
+            held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
+            if attrs.get("scenario") != self.scenario.to_toml() or attrs.get("limit") != self.limit.text:
+                other = f"{path}: holds a life study of another scenario or limit; give another folder or --force"
+            elif held != self.mapping:
+                other = (f"{path}: holds a life study with another wear mapping (--mapping {held}; this one: "
+                         f"{self.mapping}); give --mapping {held} to resume it, another folder, or --force")
+        elif (archive.is_table_file(index, INDEX_FORMAT)
+              and self.stage_cases[0].hash not in {str(h) for h in read_index(index)[0]["case"]}):
+            other = (f"{outdir}: holds another sweep or study (its case index has not this life study's first "
+                     f"stage); not mixed in: give another folder, or add --force to replace it")
+        if other is None:
+            return
+        if not force:
+            raise UserError(other)
+        for p in [path, outdir / "life.png", outdir / "sweep.h5", outdir / "sweep.csv", *outdir.glob("cases/*.h5")]:
+            p.unlink(missing_ok=True)
 
 
 def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int | None = None,
-             force: bool = False, progress=None, mapping: str = "shape") -> dict:
-    """Run a life study (module docstring) into ``folder``; return the history's columns (also written
-    as ``folder/life.h5``). ``progress``: a callable given one line per stage run (the CLI prints them).
-    ``mapping``: how the wear acts back on the next stage, :data:`MAPPINGS`."""
-    from bearingsim import archive
-    from bearingsim.archive import check_writable_dir
-    from bearingsim.outputs import FolderLock
-    from bearingsim.wear import wear_report
+             force: bool = False, progress=None, mapping: str = "shape", engine=None) -> dict:
+    """Run a life study (module docstring, :class:`LifeStudy`) into ``folder`` on the study engine (default:
+    one local worker process); return the history's columns (also written as ``folder/life.h5``, with
+    ``life.png``). A stage that fails raises :class:`bearingsim.errors.UserError` with its one-line error
+    (the stages before it are kept); SIGINT/SIGTERM raise KeyboardInterrupt (the same call resumes)."""
+    import signal
 
-    if scenario.model != "multibody":
-        raise UserError(f"{scenario.source}: model = {scenario.model!r}: wear profiles need the whole bearing "
-                        f"(model = \"multibody\")")
-    if mapping not in MAPPINGS:
-        raise UserError(f"--mapping {mapping}: give one of {', '.join(MAPPINGS)}")
-    if not 1 <= stages <= 100:
-        raise UserError(f"--stages {stages}: give 1 to 100 stages")
-    if rotations is not None and rotations < 1:
-        raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation per stage")
-    s0 = scenario.bearing.pocket_clearance_mm * 1e-3
-    if limit.kind == "clearance" and limit.value <= s0:
-        raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
-                        f"(bearing.pocket_clearance_mm); give a larger one")
-    start = _start_depth(scenario)
-    folder = check_writable_dir(folder)  # created only now: a refusal above leaves nothing
-    _check_outputs(folder)
-    _check_folder(folder, scenario, limit, force, mapping)
-    (folder / "stages").mkdir(parents=True, exist_ok=True)
-    rows = []
-    with FolderLock(folder), _resumable(folder, stages):
-        st = _State(s0, start)
-        for j in range(stages):
-            sc = (stage_scenario(scenario, st.depth if j else None, j, rotations) if mapping == "shape"
-                  else stage_scenario(scenario, None, j, rotations, clearance=st.clearance()))
-            res, reused = _run_stage(sc, folder / "stages" / f"stage_{j:02d}.h5", progress)
-            rate = wear_report(res, rotations=1.0)
-            d_rate = np.stack([rate.depth_front, rate.depth_rear])
-            v_rate = np.stack([rate.volume_front, rate.volume_rear])
-            if st.volume is None:
-                st.area = rate.bin_area * len(rate.psi_deg)
-                st.depth = np.zeros_like(d_rate) if st.depth is None else st.depth
-                st.volume = st.depth.sum(axis=1) * rate.bin_area
-            clearance = st.clearance()
-            start = st.s0 if limit.kind == "clearance" else 0.0
-            goal = start + (limit.value - start) * (j + 1) / stages
-            q_now = st.quantity(limit.kind, st.depth, st.volume)
-            q_rate = st.quantity(limit.kind, d_rate, v_rate) - (st.s0 if limit.kind == "clearance" else 0.0)
-            n_stage = _stage_length(q_now, q_rate, goal)
-            st.depth = st.depth + d_rate * n_stage
-            st.volume = st.volume + v_rate * n_stage
-            st.shaft += n_stage
-            st.hours += n_stage * rate.hours
-            rows.append(_row(j, clearance, res, rate, n_stage, st, reused))
-        cols = {k: np.array([r[k] for r in rows]) for k in rows[0]}
-        archive.write_table_file(folder / "life.h5", cols, LIFE_UNITS, {
-            "format": LIFE_FORMAT, "limit": limit.text, "stages": stages, "scenario": scenario.to_toml(),
-            "mapping": mapping, "mapping_text": MAPPINGS[mapping]})
-    return cols
+    from bearingsim.studies.engine import run_studies
+
+    study = LifeStudy(scenario, limit, stages=stages, rotations=rotations, mapping=mapping, progress=progress)
+    out = run_studies([study], folder, engine=engine, progress=False, log=lambda line: None, force=force)
+    if out.interrupted is not None:
+        raise KeyboardInterrupt(signal.Signals(out.interrupted).name)
+    if out.failed:
+        r = out.failed[0]
+        raise UserError(f"life stage {r['values']['stage']} failed: {r['error']}")
+    return study.columns()
 
 
 LIFE_UNITS = {"stage": "1", "pocket_clearance_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
@@ -241,47 +309,6 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
         "reused": int(reused), "psi_deg": rate.psi_deg,
         "worn_depth_front_um": st.depth[0] * 1e6, "worn_depth_rear_um": st.depth[1] * 1e6,
     }
-
-
-@contextlib.contextmanager
-def _resumable(folder: Path, stages: int):
-    """A signal that stops the stages (SIGINT's KeyboardInterrupt, or SIGTERM's subclass of it) goes on
-    with ``resume_note``, what it leaves for the command line to say: the stage archives in the folder
-    (this run's and an earlier one's: each is written whole or not at all), kept for the same study to
-    resume from."""
-    try:
-        yield
-    except KeyboardInterrupt as exc:
-        kept = sum((folder / "stages" / f"stage_{j:02d}.h5").exists() for j in range(stages))
-        exc.resume_note = f"{kept} of {stages} stage archives kept in {folder / 'stages'}"
-        raise
-
-
-def _check_outputs(folder: Path) -> None:
-    """A ``life.h5`` or ``life.png`` in ``folder`` that bearingsim did not write (a user's file, a link, a
-    folder) is refused in one line and kept, before anything is created or run."""
-    from bearingsim import archive
-    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
-
-    check_replaceable(folder / "life.h5", lambda p: archive.is_table_file(p, LIFE_FORMAT), "life history")
-    check_replaceable(folder / "life.png", PNG_SIGNATURE, "figure")
-
-
-def _check_folder(folder: Path, scenario, limit: Limit, force: bool, mapping: str) -> None:
-    """Refuse a folder that holds another life study (another scenario, limit or mapping) unless ``force``."""
-    from bearingsim import archive
-
-    path = folder / "life.h5"
-    if not path.exists() or force:
-        return
-    _, attrs = archive.read_table_file(path, LIFE_FORMAT)
-    held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
-    if attrs.get("scenario") != scenario.to_toml() or attrs.get("limit") != limit.text:
-        raise UserError(f"{path}: holds a life study of another scenario or limit; give another folder "
-                        f"or --force")
-    if held != mapping:
-        raise UserError(f"{path}: holds a life study with another wear mapping (--mapping {held}; "
-                        f"this one: {mapping}); give --mapping {held} to resume it, another folder, or --force")
 
 
 def read_life(path) -> tuple[dict, dict]:

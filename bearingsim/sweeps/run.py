@@ -216,8 +216,12 @@ def _progress(total: int, enabled: bool, initial: int, desc: str = "sweep", unit
                 nrows=max(size.lines, 2), smoothing=0.1, initial=initial)  # cached cases: not in the rate
 
 
-def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str) -> tuple[list[Case], set]:
+def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
+            earlier: dict | None = None) -> tuple[list[Case], set]:
     """Fill ``rows`` with what is already there; return (the cases to run, the hashes of stale ones).
+
+    ``earlier``: the rows of cases an earlier round of the same study ran or took (a staged study), by
+    hash: taken as they are, status included (a case this command ran stays ``done``, not ``cached``).
 
     A case is taken (``cached``) from its archive ``cases/<hash>.h5`` when that stores exactly its
     scenario computed by the current model version (:func:`~bearingsim.sweeps.index.read_cached`);
@@ -231,6 +235,9 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str) ->
     old = read_rows(outdir / "sweep.h5") if any(not keeps_archive(c.model, archives) for c in cases) else {}
     todo, stale = [], set()
     for c, row in zip(cases, rows):
+        if earlier and c.hash in earlier:
+            row.update(earlier[c.hash])
+            continue
         rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
         where = f"cases/{c.hash}.h5"
         if rec is None or rec["status"] == "stale":
@@ -250,7 +257,8 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str) ->
 
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
               progress: bool | None = None, log=None, lock: FolderLock | None = None,
-              desc: str = "sweep", force: bool = False, archives: str = "auto") -> SweepOutcome:
+              desc: str = "sweep", force: bool = False, archives: str = "auto",
+              check_folder: bool = True, earlier: dict[str, dict] | None = None) -> SweepOutcome:
     """Run every case of ``spec`` that has no valid result yet, and index them all.
 
     Parameters
@@ -280,6 +288,13 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         Which cases get an archive in ``outdir/cases/``: ``auto`` (the multibody cases; a reduced
         case's numbers are in the index and, for a product grid, ``map.h5``), ``all`` or ``none``
         (:func:`bearingsim.sweeps.worker.keeps_archive`).
+    check_folder : bool
+        Refuse a folder that holds another sweep or study (:func:`check_same_sweep`). A staged study, whose
+        later cases are not known before the earlier ones have run, checks its folder itself and passes
+        False (:attr:`bearingsim.studies.Study.staged`).
+    earlier : dict, optional
+        A staged study's rows of the cases its earlier rounds ran or took, by case hash: kept as they are
+        (their archives are not read again, and a case run this time stays ``done``).
 
     Returns
     -------
@@ -293,18 +308,13 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
     t0 = time.perf_counter()
     engine = engine or LocalEngine(1)
-    if archives not in ARCHIVE_POLICIES:
-        engine.stop()
-        raise UserError(f"--archives: expected one of {', '.join(ARCHIVE_POLICIES)} (got {archives!r})")
-    grid = grid_axes(spec)
-    try:
+    try:  # however these end, the engine is stopped
+        if archives not in ARCHIVE_POLICIES:
+            raise UserError(f"--archives: expected one of {', '.join(ARCHIVE_POLICIES)} (got {archives!r})")
+        grid = grid_axes(spec)
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
-    except BaseException:
-        engine.stop()
-        raise
-    engine.start()  # an unreachable scheduler stops the sweep before anything is written
-    try:
-        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives)
+        engine.start()  # an unreachable scheduler stops the sweep before anything is written
+        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, check_folder)
     except BaseException:
         engine.stop()
         raise
@@ -317,7 +327,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     index = IndexWriter(outdir, rows, keys, meta)
     with lock if own else contextlib.nullcontext():
         outcome.interrupted = _run_cases(engine, cases, rows, index, outdir / "cases", archives, progress, desc, log,
-                                         lambda: write_map(outcome.map, grid, index.columns, map_attrs) if grid else None)
+                                         lambda: write_map(outcome.map, grid, index.columns, map_attrs) if grid else None,
+                                         earlier)
     outcome.wall_s = time.perf_counter() - t0
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
@@ -326,7 +337,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     return outcome
 
 
-def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map) -> int | None:
+def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map,
+               earlier=None) -> int | None:
     """Resume, run what is left on ``engine`` and keep the index (and, through ``write_map``, the map)
     written however the run ends; the signal number if SIGINT/SIGTERM stopped it, else None."""
     with _Signals() as signals:
@@ -335,10 +347,12 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
-            todo, stale = _resume(cases, rows, cases_dir.parent, archives)
+            todo, stale = _resume(cases, rows, cases_dir.parent, archives, earlier)
             index.write()
-            counts = {"done": 0, "stale": 0, "failed": 0, "cached": len(cases) - len(todo)}
-            bar = _progress(len(cases), progress, counts["cached"], desc)
+            counts = {"done": 0, "stale": 0, "failed": 0, "cached": 0}
+            for r in rows:  # of the cases not to run: cached, or (a staged study's earlier rounds) run this time
+                counts[r["status"]] = counts.get(r["status"], 0) + (r["status"] != "pending")
+            bar = _progress(len(cases), progress, len(cases) - len(todo), desc)
             if bar is not None:
                 bar.set_postfix(counts, refresh=True)
             say = log or ((lambda line: bar.write(line, file=sys.stderr)) if bar is not None else _log.warning)
@@ -360,9 +374,10 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
     return None
 
 
-def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str):
+def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str, check_folder: bool):
     """Check the sweep folder and take its lock (unless the caller holds it): (folder, lock, whether the
-    lock is taken here). Refused: an unwritable folder, foreign files, another sweep or study."""
+    lock is taken here). Refused: an unwritable folder, foreign files, another sweep or study (unless
+    the caller checks that itself: ``check_folder`` False)."""
     from bearingsim.archive import check_writable_dir
     from bearingsim.sweeps.grid import MAP_NAME
     from bearingsim.sweeps.plot import FIGURE_NAMES
@@ -376,7 +391,8 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
         raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")
     try:
         check_sweep_outputs(outdir, figures)
-        check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
+        if check_folder:
+            check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
         if any(keeps_archive(c.model, archives) for c in cases):
             (outdir / "cases").mkdir(exist_ok=True)
     except BaseException:

@@ -101,8 +101,10 @@ def git_commit() -> str:
 
 
 def check_writable_dir(folder: str | Path) -> Path:
-    """Create ``folder`` if needed and make sure files can be written in it, else a one-line UserError."""
-    folder = Path(folder)
+    """Create ``folder`` if needed and make sure files can be written in it, else a one-line UserError
+    (a file where the folder, or one of its parents, should be: :func:`bearingsim.outputs.check_folder_path`,
+    nothing created)."""
+    folder = outputs.check_folder_path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / f".bearingsim-probe-{os.getpid()}"
@@ -167,6 +169,7 @@ def _tmp_name(path: Path) -> Path:
 def _prepare_target(path) -> Path:
     """Check that an archive can be written at ``path`` (one-line UserError if not); return it."""
     path = Path(path)
+    outputs.check_folder_can_be_made(path, "archive")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

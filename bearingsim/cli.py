@@ -368,7 +368,10 @@ def _benchmarks_root() -> Path:
 
 
 def _cmd_bench(args) -> int:
+    from bearingsim.outputs import check_folder_path
+
     _benchmarks_root()
+    check_folder_path(args.output)  # a file in the way: refused in the words of every other command
     if args.map:
         from benchmarks.sweep_bench import run_map_bench
 

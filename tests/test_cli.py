@@ -64,6 +64,63 @@ def test_unwritable_output_names_the_file(tmp_path):
     assert_user_error(res, "blocker")
 
 
+@pytest.fixture(scope="module")
+def archives_to_write_from(tmp_path_factory):
+    """A reduced archive and a short multibody one (rigid raceways, 1 rotation: wear needs its profile)."""
+    folder = tmp_path_factory.mktemp("sources")
+    reduced, multibody = folder / "r.h5", folder / "m.h5"
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", reduced, "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    res = bearingsim("run", SCENARIOS / "wear_test_6000rpm.toml", "-o", multibody, "--no-plots", "-q",
+                     "--set", "numerics.rotations=1", "--set", "multibody.raceway_contact=rigid")
+    assert res.returncode == 0, res.stderr
+    return {"R": reduced, "M": multibody}
+
+
+#: every command that writes into a folder, its output given as {out} (a folder) or {out}/NAME (a file)
+FOLDER_WRITERS = {
+    "run": ["run", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}/x.h5"],
+    "run-no-plots": ["run", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}/x.h5", "--no-plots"],
+    "rerun": ["rerun", "{R}", "-o", "{out}/x.h5"],
+    "plot": ["plot", "{R}", "-o", "{out}"],
+    "report": ["report", "{R}", "-o", "{out}/x.html"],
+    "animate": ["animate", "{M}", "-o", "{out}/x.gif"],
+    "sweep": ["sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "operating.inner_ring_speed_rpm=1000:2000:2",
+              "-o", "{out}"],
+    "crosscheck": ["crosscheck", SCENARIOS / "multibody_3000rpm.toml", "-o", "{out}"],
+    "validate": ["validate", "-o", "{out}"],
+    "sensitivity": ["sensitivity", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}"],
+    "uncertainty": ["uncertainty", SCENARIOS / "paper_3000rpm.toml", "--samples", "4", "-o", "{out}"],
+    "life": ["life", SCENARIOS / "wear_test_6000rpm.toml", "--limit", "depth=0.1mm", "-o", "{out}"],
+    "wear": ["wear", "{M}", "--hours", "1", "-o", "{out}"],
+    "bench-map": ["bench", "--map", "-o", "{out}"],
+    "bench-fast-scene": ["bench", "--fast-scene", "-o", "{out}"],
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("below", [False, True], ids=["file-is-the-folder", "file-above-the-folder"])
+@pytest.mark.parametrize("command", list(FOLDER_WRITERS))
+def test_a_file_where_the_output_folder_should_be_is_named_alike_by_every_command(
+        tmp_path, archives_to_write_from, command, below):
+    """A file where the output's folder (or one of its parents) should be: every command that writes
+    into a folder refuses it in the same words, naming the file in the way, in one line, exit 2, and
+    creates nothing. sweep, plot, rerun and the studies said "not writable (File exists)" or "(Not a
+    directory)", run "cannot check the figure path", without naming the file."""
+    import re
+
+    (tmp_path / "blocker").write_text("my notes\n")
+    out = tmp_path / "blocker" / "sub" if below else tmp_path / "blocker"
+    args = [str(a).format(out=out, **archives_to_write_from) for a in FOLDER_WRITERS[command]]
+    res = bearingsim(*args, cwd=tmp_path)
+    assert_user_error(res)
+    line = res.stderr.strip()
+    assert re.fullmatch(rf"bearingsim: error: {re.escape(str(out))}: cannot create the (output folder|\w+'s folder) "
+                        rf"\({re.escape(str(tmp_path / 'blocker'))} is not a folder\)", line), line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker"]
+    assert (tmp_path / "blocker").read_text() == "my notes\n"
+
+
 @pytest.mark.slow
 def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"

@@ -82,6 +82,11 @@ def _describe_index(path) -> tuple[str, str | None] | None:
     return _describe_study_table(path)
 
 
+#: the files inspect and show read (an archive, then the index files of :func:`_describe_index`)
+_INDEX_KINDS = ("a run archive, a sweep's sweep.h5 or map.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 "
+                "or life.h5")
+
+
 def _describe_study_table(path) -> tuple[str, str | None] | None:
     """The sensitivity, uncertainty and life tables (``sensitivity.h5``, ``uncertainty.h5``, ``life.h5``):
     what each is, its columns, and the scenario it was made from."""
@@ -478,14 +483,15 @@ def _add_run_commands(sub) -> None:
                    help="print the resolved scenario (every key, as TOML) and the archive it would write; run nothing")
     r.set_defaults(func=_cmd_run)
 
-    i = sub.add_parser("inspect", help="print what an archive, a sweep.h5 or a crosscheck.h5 holds")
-    i.add_argument("archive")
+    i = sub.add_parser("inspect", help=f"print what a file holds: {_INDEX_KINDS}")
+    i.add_argument("archive", help=_INDEX_KINDS)
     i.set_defaults(func=_cmd_inspect)
 
-    sh = sub.add_parser("show", help="print the scenario stored in an archive or crosscheck.h5 as TOML (a runnable "
-                                     "scenario file); for a sweep.h5, what it holds as TOML comments; for a "
-                                     "scenario file (.toml), the resolved scenario: every key, before any run")
-    sh.add_argument("archive", help="archive, sweep.h5, crosscheck.h5 or scenario .toml file")
+    sh = sub.add_parser("show", help="print the scenario stored in an archive, map.h5, crosscheck.h5, sensitivity.h5, "
+                                     "uncertainty.h5 or life.h5 as TOML (a runnable scenario file); for a sweep.h5, "
+                                     "what it holds as TOML comments; for a scenario file (.toml), the resolved "
+                                     "scenario: every key, before any run")
+    sh.add_argument("archive", help=f"{_INDEX_KINDS}, or a scenario .toml file")
     sh.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="with a scenario file: override a key, as 'run --set' does (repeatable)")
     sh.set_defaults(func=_cmd_show)

@@ -121,6 +121,23 @@ def test_a_file_where_the_output_folder_should_be_is_named_alike_by_every_comman
     assert (tmp_path / "blocker").read_text() == "my notes\n"
 
 
+@pytest.mark.parametrize("command", ["inspect", "show"])
+def test_help_of_inspect_and_show_names_every_file_they_read(command):
+    """``inspect`` and ``show`` read an archive and every index file of ``cli._describe_index`` (sweep.h5,
+    map.h5, crosscheck.h5 and the study tables); their help named only an archive, sweep.h5 and
+    crosscheck.h5."""
+    kinds = ("archive", "sweep.h5", "map.h5", "crosscheck.h5", "sensitivity.h5", "uncertainty.h5", "life.h5")
+    for args in ([command, "--help"], ["--help"]):
+        res = bearingsim(*args)
+        assert res.returncode == 0, res.stderr
+        text = " ".join(res.stdout.split())
+        if args == ["--help"]:  # the command's line in the list of commands
+            text = text[text.index(f" {command} "):]
+            text = text[:text.index(" plot ")] if command == "show" else text[:text.index(" show ")]
+        missing = [k for k in kinds if k not in text]
+        assert not missing, (args, missing, text)
+
+
 @pytest.mark.slow
 def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"

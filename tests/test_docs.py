@@ -71,3 +71,28 @@ def test_scenario_files_cite_pages_and_sections_that_exist():
                     if not re.search(rf"^#+ .*{re.escape(section)}|\*\*{re.escape(section)}", text, re.M):
                         broken.append(f"{where}: no section {section!r}")
     assert not broken, broken
+
+
+def test_usage_key_table_lists_every_section_and_key():
+    """docs/usage.md's table of scenario keys has a row for every section of a scenario and names every
+    key in it (``bearingsim keys``): it lacked ``[output]`` and ``[ranges.*]``."""
+    from bearingsim.keys import list_keys
+
+    text = (ROOT / "docs" / "usage.md").read_text()
+    table = text[text.index("| section | keys |"):]
+    rows = {}
+    for line in table.splitlines():
+        if not line.startswith("|"):
+            break
+        cells = line.split("|")
+        rows[cells[1].strip()] = cells[2]
+    missing = []
+    for info in list_keys():
+        section, _, name = info.key.rpartition(".")
+        if not section:  # a top-level key, or the [ranges.<section>.<key>] tables
+            row = "`[ranges.<section>.<key>]`" if name == "ranges" else "top level"
+            if row not in rows or (name != "ranges" and f"`{name}`" not in rows[row]):
+                missing.append(info.key)
+        elif f"`{name}`" not in rows.get(f"`[{section}]`", ""):
+            missing.append(info.key)
+    assert not missing, missing

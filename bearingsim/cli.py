@@ -197,6 +197,17 @@ def _cmd_plot(args) -> int:
         for png in crosscheck.plot_crosscheck(path, folder):
             print(f"wrote {png}")
         return 0
+    drawer = _study_table_drawer(path)
+    if drawer is not None:  # sensitivity.h5, uncertainty.h5, life.h5: the study's figure from its table alone
+        folder = check_writable_dir(args.output) if args.output else path.parent
+        for png in drawer(path, folder):
+            print(f"wrote {png}")
+        return 0
+    from bearingsim.sweeps.grid import MAP_FORMAT
+
+    if archive.is_grid_file(path, MAP_FORMAT):  # its figures are drawn from the sweep's index beside it
+        raise UserError(f"{path}: a sweep's map (map.h5), not a run archive; the sweep's figures are drawn from "
+                        f"its index: bearingsim plot {path.parent / 'sweep.h5'}")
     if archive.is_table_file(path, INDEX_FORMAT):  # a sweep's index: its figures
         from bearingsim.sweeps import plot_sweep_index
 
@@ -217,6 +228,24 @@ def _cmd_plot(args) -> int:
     for png in result.save_figures(folder / path.stem):
         print(f"wrote {png}")
     return 0
+
+
+def _study_table_drawer(path):
+    """``draw(table, folder) -> [png]`` for a study's table file (``sensitivity.h5``, ``uncertainty.h5``,
+    ``life.h5``): the figure the study drew, from the table alone; None for any other file."""
+    from bearingsim import archive
+    from bearingsim.studies import life, sensitivity, uncertainty
+
+    def draw_life(table, folder):
+        from bearingsim.plotting import save_figure
+
+        return [save_figure(life.plot_life(*life.read_life(table)), Path(folder) / "life.png")]
+
+    for fmt, draw in ((sensitivity.INDEX_FORMAT, sensitivity.plot_sensitivity),
+                      (uncertainty.INDEX_FORMAT, uncertainty.plot_uncertainty), (life.LIFE_FORMAT, draw_life)):
+        if archive.is_table_file(path, fmt):
+            return draw
+    return None
 
 
 def _cmd_rerun(args) -> int:
@@ -496,9 +525,10 @@ def _add_run_commands(sub) -> None:
                     help="with a scenario file: override a key, as 'run --set' does (repeatable)")
     sh.set_defaults(func=_cmd_show)
 
-    pl = sub.add_parser("plot", help="draw every figure of a run again from its archive alone")
-    pl.add_argument("archive")
-    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the archive)")
+    pl = sub.add_parser("plot", help="draw every figure again from a run's archive, a sweep's sweep.h5, a "
+                                     "crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 alone")
+    pl.add_argument("archive", help="a run archive, sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5")
+    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the file)")
     pl.set_defaults(func=_cmd_plot)
 
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")

@@ -193,6 +193,23 @@ def test_inspect_and_show_read_the_study_tables(tmp_path, capsys):
         assert load_scenario_text(shown) == sc
 
 
+def test_plot_draws_a_study_table_figure_again(tmp_path, capsys):
+    """`plot sensitivity.h5` / `plot uncertainty.h5` said "not a bearingsim archive": they draw the study's
+    figure again from its table alone, the same bytes as the study drew."""
+    from bearingsim.studies.uncertainty import run_uncertainty
+
+    sc = load_scenario(REDUCED)
+    sens.run_sensitivity(sc, tmp_path / "s", KEYS[:1], 0.1)
+    run_uncertainty(sc, tmp_path / "u", samples=4, seed=0, keys=KEYS)
+    for table, png in (("s/sensitivity.h5", "sensitivity.png"), ("u/uncertainty.h5", "uncertainty.png")):
+        out = tmp_path / "again" / table.split("/")[0]
+        code = main(["plot", str(tmp_path / table), "-o", str(out)])
+        captured = capsys.readouterr()
+        assert code == 0 and captured.err == "", captured.err
+        assert captured.out == f"wrote {out / png}\n"
+        assert (out / png).read_bytes() == (tmp_path / table).parent.joinpath(png).read_bytes()
+
+
 def load_scenario_text(text):
     import tomllib
 

@@ -294,6 +294,21 @@ def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, mon
     assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [0]
 
 
+def test_plot_draws_a_life_history_again(tmp_path, capsys):
+    """`plot life.h5` said "not a bearingsim archive": it draws life.png again from the history alone, the
+    same bytes as `bearingsim life` drew."""
+    from bearingsim.cli import main
+
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "depth=1mm", "--stages", "1",
+                 "--rotations", "1", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "l"), "-q"])
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    code = main(["plot", str(tmp_path / "l" / "life.h5"), "-o", str(tmp_path / "again")])
+    captured = capsys.readouterr()
+    assert code == 0 and captured.err == "" and captured.out == f"wrote {tmp_path / 'again' / 'life.png'}\n"
+    assert (tmp_path / "again" / "life.png").read_bytes() == (tmp_path / "l" / "life.png").read_bytes()
+
+
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     from bearingsim.cli import main
 

@@ -41,6 +41,7 @@ from bearingsim._version import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 FORMAT_VERSION = "2.0"
 READABLE_MAJORS = ("1", "2")  # 1.x: one HDF5 attribute per value; 2.x: attrs_json / units_json
@@ -943,7 +944,7 @@ def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[s
         by[str(v)] = by.get(str(v), 0) + 1
     counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
     units = table_units(path)
-    out = [f"{path}: {what}: {n} cases{counts}", *lines, "columns:"]
+    out = [f"{path}: {what}: {counted(n, 'case')}{counts}", *lines, "columns:"]
     for c in columns:
         arr = np.asarray(cols[c])
         kind = "text" if arr.dtype.kind in "OUS" else "number"

@@ -16,6 +16,7 @@ from pathlib import Path
 from bearingsim import __version__, outputs
 from bearingsim.cli_common import progress_wanted, report_study
 from bearingsim.errors import SimulationUnstable, UserError
+from bearingsim.wording import counted
 
 
 def _print_summary(summary) -> None:
@@ -63,7 +64,7 @@ def _describe_index(path) -> tuple[str, str | None] | None:
         n, total = meta["grid_rows"], len(cols["case"])
         lines = [f"sweep mode {meta.get('mode', '?')}; base scenario {meta.get('scenario') or '(none)'}",
                  "swept keys: " + (", ".join(meta["axes"]) or "(none)"),
-                 f"grid of {', '.join(meta['grid']) or '(no axes)'}: {n} cases; extra cases: {total - n}",
+                 f"grid of {', '.join(meta['grid']) or '(no axes)'}: {counted(n, 'case')}; extra cases: {total - n}",
                  "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
                  "without one); 'bearingsim show' of a case archive gives its scenario"]
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
@@ -375,7 +376,8 @@ def _print_validate(args, studies, outcome) -> None:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:
         rows = studies[1].rows
-        print(f"rig scene (pocket 0 flat), 1 warm-up + {args.rig_rotations} rotations, against the reduced model:")
+        print(f"rig scene (pocket 0 flat), 1 warm-up + {counted(args.rig_rotations, 'rotation')}, against the reduced "
+              "model:")
         print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
         for r in rows:
             print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:5.2f} (std) "
@@ -384,7 +386,8 @@ def _print_validate(args, studies, outcome) -> None:
         for p in outcome.written[2:]:
             print(f"wrote {p}")
     if outcome.interrupted is None:
-        print(f"{len(outcome.sweep.rows)} cases: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+        print(f"{counted(len(outcome.sweep.rows), 'case')}: {outcome.counts()}; archives in "
+              f"{Path(args.output) / 'cases'}")
 
 
 def _benchmarks_root() -> Path:
@@ -452,9 +455,9 @@ def _cmd_crosscheck(args) -> int:
                                       force=args.force, progress=progress_wanted(args))
     wall = time.perf_counter() - t0
     if outcome.interrupted is None and not args.quiet:
-        where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
-        print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
-              f"{args.rotations} rotations each, {where}, {wall:.1f} s; impulses per pocket and cage "
+        where = f"dask scheduler {args.scheduler}" if args.scheduler else counted(args.jobs, "process", "processes")
+        print(f"cross-check of {args.scenario}: {counted(len(speeds), 'speed')} x {len(cc.RUNGS)} rungs, 1 warm-up + "
+              f"{counted(args.rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
               f"rotation, mean over all pockets ± batch-means standard error")
         print(cc.format_table(rows))
         for line in cc.verdicts(rows):

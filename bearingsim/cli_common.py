@@ -6,6 +6,8 @@ from __future__ import annotations
 import signal
 import sys
 
+from bearingsim.wording import counted
+
 
 def report_study(outcome, command: str) -> int:
     """The end of a study command: exit 0, 1 if a case failed (named on stderr), 128 + signal if
@@ -13,14 +15,14 @@ def report_study(outcome, command: str) -> int:
     n = len(outcome.sweep.rows)
     if outcome.interrupted is not None:
         print(f"bearingsim: {command} interrupted ({signal.Signals(outcome.interrupted).name}): {outcome.counts()}, "
-              f"{outcome.count('pending')} not run, of {n} cases; run the same command again to resume",
+              f"{outcome.count('pending')} not run, of {counted(n, 'case')}; run the same command again to resume",
               file=sys.stderr)
         return 128 + outcome.interrupted
     if outcome.failed:
         names = "; ".join(f"{', '.join(f'{k}={v}' for k, v in r['values'].items())}: {r['error']}"
                           for r in outcome.failed[:10])
-        print(f"bearingsim: {len(outcome.failed)} of {n} cases of the {command} failed ({names}); the other "
-              f"cases' numbers are kept (errors in {outcome.sweep.csv})", file=sys.stderr)
+        print(f"bearingsim: {len(outcome.failed)} of {counted(n, 'case')} of the {command} failed ({names}); the "
+              f"other cases' numbers are kept (errors in {outcome.sweep.csv})", file=sys.stderr)
         return 1
     return 0
 

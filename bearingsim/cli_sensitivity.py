@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 
 def _keys(text):
@@ -43,7 +44,7 @@ def _cmd_sensitivity(args) -> int:
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"sensitivity of {args.scenario}: {len(study.keys)} keys x 2 runs at x (1 ± {step:.0%}) within each "
+        print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x 2 runs at x (1 ± {step:.0%}) within each "
               f"key's range, {wall:.1f} s")
         print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
         for r in study.rows:
@@ -62,11 +63,12 @@ def _cmd_uncertainty(args) -> int:
     study = Uncertainty(_scenario(args), args.samples, args.seed, _keys(args.keys))
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"uncertainty of {args.scenario}: {len(study.keys)} keys, N = {args.samples} ({len(study.cases)} runs), "
+        print(f"uncertainty of {args.scenario}: {counted(len(study.keys), 'key')}, N = {args.samples} "
+              f"({counted(len(study.cases), 'run')}), "
               f"seed {args.seed}, {wall:.1f} s")
         for s in study.spreads:
             print(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
-                  f"({int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0} runs)")
+                  f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
         print(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
         for r in study.indices:
             print(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 
 def _cmd_wear(args) -> int:
@@ -49,10 +50,11 @@ def _cmd_life(args) -> int:
     try:
         png = save_figure(life.plot_life(cols_, attrs), folder / "life.png")
     except KeyboardInterrupt as exc:  # the study is complete, only its figure is missing (cli.main says so)
-        exc.resume_note = f"all {len(cols['stage'])} stages done and {folder / 'life.h5'} written, not its figure"
+        done = "its one stage" if len(cols["stage"]) == 1 else f"all {len(cols['stage'])} stages"
+        exc.resume_note = f"{done} done and {folder / 'life.h5'} written, not its figure"
         raise
     print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
-          f"inner-ring rotations in {len(cols['stage'])} stages")
+          f"inner-ring rotations in {counted(len(cols['stage']), 'stage')}")
     print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
           f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}")
     for i in range(len(cols["stage"])):

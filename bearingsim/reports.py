@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 #: the first bytes of every report bearingsim writes: what ``-o`` may replace
 SIGNATURE = b"<!DOCTYPE html>\n<!-- bearingsim report"
@@ -426,7 +427,7 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         cols, _ = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
-        checks.append({"kind": "text", "text": f"{len(status)} cases: {counts}. A case's archive is written only when "
+        checks.append({"kind": "text", "text": f"{counted(len(status), 'case')}: {counts}. A case's archive is written only when "
                                                "its run passes the plausibility checks (docs/reliability.md); a "
                                                "failed case keeps its one-line error:"})
         failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]

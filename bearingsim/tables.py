@@ -84,7 +84,9 @@ def table_of_index(path) -> Table:
         names, labels = ["case"], {"case": [str(c) for c in cols["case"]]}
     numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", *FIXED, *axes)
                and np.asarray(cols[k]).dtype.kind == "f"}
-    notes = [f"{path}: {n} cases" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
+    from bearingsim.wording import counted
+
+    notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes)
 
 

@@ -139,6 +139,42 @@ def test_help_of_inspect_and_show_names_every_file_they_read(command):
 
 
 @pytest.mark.slow
+def test_a_count_of_one_is_singular(tmp_path):
+    """Printed counts that can be one read "1 case", "1 rotation", "1 stage", ...: a one-case sweep printed
+    "1 cases", a one-stage life "running 1 rotations" and "in 1 stages", a cross-check at one speed
+    "1 speed(s) ... 1 rotations each, 1 process(es)"."""
+    import re
+
+    from bearingsim.wording import counted
+
+    assert (counted(1, "case"), counted(2, "case"), counted(0, "case")) == ("1 case", "2 cases", "0 cases")
+    assert counted(1, "process", "processes") == "1 process" and counted(3, "process", "processes") == "3 processes"
+    paper, mb = SCENARIOS / "paper_3000rpm.toml", SCENARIOS / "wear_test_6000rpm.toml"
+    rigid = ["--set", "multibody.raceway_contact=rigid"]
+    commands = [
+        ["sweep", paper, "--param", "operating.inner_ring_speed_rpm=1000", "-o", tmp_path / "sw", "-j", "1"],
+        ["table", tmp_path / "sw"],
+        ["inspect", tmp_path / "sw" / "sweep.h5"],
+        ["inspect", tmp_path / "sw" / "map.h5"],
+        ["sensitivity", paper, "--keys", "contact.restitution", "-o", tmp_path / "se", "-j", "1"],
+        ["life", mb, "--limit", "depth=1mm", "--stages", "1", "--rotations", "1", *rigid, "-o", tmp_path / "li"],
+        ["crosscheck", SCENARIOS / "multibody_3000rpm.toml", "--speeds", "3000", "--rotations", "1", *rigid,
+         "-o", tmp_path / "cc", "-j", "1"],
+    ]
+    plural_of_one = re.compile(r"(?<![\d.])1 (cases|rotations|stages|keys|runs|values|speeds|rows|cells|"
+                               r"process\(es\)|speed\(s\))(?!\w)")
+    for args in commands:
+        res = bearingsim(*args)
+        assert res.returncode == 0, (args, res.stderr)
+        found = plural_of_one.findall(res.stdout + res.stderr)
+        assert not found, (args[0], found, res.stdout + res.stderr)
+    res = bearingsim(*commands[0])  # again: every case cached
+    assert "1 case: 0 done, 1 cached" in res.stdout, res.stdout
+    res = bearingsim(*commands[-1])
+    assert "1 speed x 5 rungs, 1 warm-up + 1 rotation each, 1 process," in res.stdout, res.stdout
+
+
+@pytest.mark.slow
 def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"
     f.write_bytes(b"\x00" * 100)

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -155,7 +156,7 @@ def _run_stage(sc, path: Path, progress):
     if progress:
         worn = [max(max(row) for row in v) for v in (sc.wear.worn_depth_front_um, sc.wear.worn_depth_rear_um)
                 if v is not None]
-        progress(f"stage {path.stem}: running {sc.numerics.rotations} rotations, deepest worn point "
+        progress(f"stage {path.stem}: running {counted(sc.numerics.rotations, 'rotation')}, deepest worn point "
                  f"{max(worn, default=0.0):.4g} um")
     run_scenario(sc, path, figures=False, exclusive=False, notes=False, force=True)
     return load(path), False
@@ -311,7 +312,7 @@ def plot_life(cols: dict, attrs: dict):
         ax.set_xlabel("running time [h]")
     _plot_worn_faces(axes[3], cols)
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} inner-ring "
-                 f"rotations, {len(h_end)} stages", fontsize=9)
+                 f"rotations, {counted(len(h_end), 'stage')}", fontsize=9)
     fig.tight_layout()
     return fig
 

@@ -18,6 +18,7 @@ from bearingsim.outputs import PNG_SIGNATURE, write_csv
 from bearingsim.scenario import resolve
 from bearingsim.studies.engine import FINISHED, Study, batch_sem, case_of, load_result
 from bearingsim.studies.fig9 import reference_case
+from bearingsim.wording import counted
 
 RIG_SPEEDS_RPM = (500, 1000, 2000, 3000, 4000)
 RIG_ROTATIONS = 20
@@ -126,7 +127,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     rot = rows[0]["rotations"] if rows else 0
-    ax.set_title(f"The paper's rig as a scene (NU214, 970 N, forward, 1 warm-up + {rot} rotations)\n"
+    ax.set_title(f"The paper's rig as a scene (NU214, 970 N, forward, 1 warm-up + {counted(rot, 'rotation')})\n"
                  "against the reduced model (Fig. 9 analog)", fontsize=9)
     legend_outside(ax)
     png = save_figure(fig, outdir / "rig_idec_vs_speed.png")

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import os
 import signal
 import sys
@@ -380,7 +381,9 @@ def _print_validate(args, studies, outcome) -> None:
               "model:")
         print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
         for r in rows:
-            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:5.2f} (std) "
+            std = r["pocket0_I_dec_std_Ns"] * 1e3
+            std = f"{std:5.2f}" if math.isfinite(std) else "  n/a"  # one rotation: no scatter (tables: n/a)
+            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {std} (std) "
                   f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
                   f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
         for p in outcome.written[2:]:

@@ -39,12 +39,15 @@ def rig_scenario(rpm: float, rotations: int = RIG_ROTATIONS, warmup: int = 1):
 
 
 def rig_row(rpm: float, rotations: int, result, reduced_I_dec_Ns: float) -> dict:
-    """One speed's row of the rig table from the rig scene's result and the reduced model's I_dec."""
+    """One speed's row of the rig table from the rig scene's result and the reduced model's I_dec. Pocket
+    0's scatter over rotations (std) is NaN from fewer than 2 rotations, as its standard error is
+    (:func:`bearingsim.stats.batch_sem`): one rotation has no scatter to show, not a scatter of 0."""
     d = result.per_rotation["I_dec"]
     a = result.per_rotation["I_acc"]
     return {
         "rpm": rpm, "rotations": rotations,
-        "pocket0_I_dec_mean_Ns": float(d[:, 0].mean()), "pocket0_I_dec_std_Ns": float(d[:, 0].std()),
+        "pocket0_I_dec_mean_Ns": float(d[:, 0].mean()),
+        "pocket0_I_dec_std_Ns": float(d[:, 0].std()) if len(d) >= 2 else float("nan"),
         "pocket0_I_dec_sem_Ns": batch_sem(d[:, 0]),
         "pocket0_I_acc_mean_Ns": float(a[:, 0].mean()),
         "arc_pockets_I_dec_mean_Ns": float(d[:, 1:].mean()), "arc_pockets_I_dec_std_Ns": float(d[:, 1:].std()),

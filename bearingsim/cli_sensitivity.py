@@ -36,9 +36,17 @@ def _run(study, args):
     return outcome, time.perf_counter() - t0
 
 
+def _num(v, spec: str) -> str:
+    """``v`` formatted by ``spec``, or ``n/a`` (as wide) where it is not a number."""
+    import math
+
+    width = len(format(0.0, spec))
+    return format(v, spec) if math.isfinite(v) else "n/a".rjust(width)
+
+
 def _cmd_sensitivity(args) -> int:
     from bearingsim.cli_common import report_study
-    from bearingsim.studies.sensitivity import Sensitivity, parse_step
+    from bearingsim.studies.sensitivity import Sensitivity, missing_note, parse_step
 
     step = parse_step(args.step)
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
@@ -46,10 +54,14 @@ def _cmd_sensitivity(args) -> int:
     if outcome.interrupted is None and not args.quiet:
         print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x 2 runs at x (1 ± {step:.0%}) within each "
               f"key's range, {wall:.1f} s")
+        for k, why in study.left_out:
+            print(f"left out: {k}: {why}; give it a nonzero value to vary it")
         print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
         for r in study.rows:
-            print(f"{r['key']:34s} {r['quantity']:18s} {r['sensitivity']:+9.3f} {r['sensitivity_se']:8.3f} "
-                  f"{r['over_range']:+10.3f}")
+            note = missing_note(r)
+            print(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
+                  f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
+                  + (f"  ({note})" if note else ""))
         for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")

@@ -360,12 +360,16 @@ def _sensitivity_sections(table: Path):
     from bearingsim.studies import sensitivity as sens
 
     rows, meta = sens.read_table(table)
-    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range"]
-    cells = [[r["key"], r["quantity"], r["measure"], f"{_cell(r['sensitivity'], digits=3)} ± "
-              f"{_cell(r['sensitivity_se'], digits=2)}", _cell(r["over_range"], digits=3)] for r in rows]
+    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range", "n/a: why"]
+
+    def num(v, digits):
+        return _cell(v, digits=digits) if math.isfinite(float(v)) else "n/a"
+
+    cells = [[r["key"], r["quantity"], r["measure"], f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}",
+              num(r["over_range"], 3), sens.missing_note(r)] for r in rows]
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {meta.get('step', 0):.0%})); log: d ln y / d ln x, "
                           "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
-                          [False, False, False, True, True])]
+                          [False, False, False, True, True, False])]
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))
     sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
     return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")

@@ -193,6 +193,7 @@ def test_inspect_and_show_read_the_study_tables(tmp_path, capsys):
         assert load_scenario_text(shown) == sc
 
 
+@pytest.mark.slow
 def test_plot_draws_a_study_table_figure_again(tmp_path, capsys):
     """`plot sensitivity.h5` / `plot uncertainty.h5` said "not a bearingsim archive": they draw the study's
     figure again from its table alone, the same bytes as the study drew."""

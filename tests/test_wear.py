@@ -294,6 +294,7 @@ def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, mon
     assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [0]
 
 
+@pytest.mark.slow
 def test_plot_draws_a_life_history_again(tmp_path, capsys):
     """`plot life.h5` said "not a bearingsim archive": it draws life.png again from the history alone, the
     same bytes as `bearingsim life` drew."""

@@ -41,6 +41,7 @@ from bearingsim._version import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 FORMAT_VERSION = "2.0"
 READABLE_MAJORS = ("1", "2")  # 1.x: one HDF5 attribute per value; 2.x: attrs_json / units_json
@@ -101,8 +102,10 @@ def git_commit() -> str:
 
 
 def check_writable_dir(folder: str | Path) -> Path:
-    """Create ``folder`` if needed and make sure files can be written in it, else a one-line UserError."""
-    folder = Path(folder)
+    """Create ``folder`` if needed and make sure files can be written in it, else a one-line UserError
+    (a file where the folder, or one of its parents, should be: :func:`bearingsim.outputs.check_folder_path`,
+    nothing created)."""
+    folder = outputs.check_folder_path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / f".bearingsim-probe-{os.getpid()}"
@@ -167,6 +170,7 @@ def _tmp_name(path: Path) -> Path:
 def _prepare_target(path) -> Path:
     """Check that an archive can be written at ``path`` (one-line UserError if not); return it."""
     path = Path(path)
+    outputs.check_folder_can_be_made(path, "archive")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
@@ -940,7 +944,7 @@ def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[s
         by[str(v)] = by.get(str(v), 0) + 1
     counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
     units = table_units(path)
-    out = [f"{path}: {what}: {n} cases{counts}", *lines, "columns:"]
+    out = [f"{path}: {what}: {counted(n, 'case')}{counts}", *lines, "columns:"]
     for c in columns:
         arr = np.asarray(cols[c])
         kind = "text" if arr.dtype.kind in "OUS" else "number"

@@ -8,6 +8,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import os
 import signal
 import sys
@@ -16,6 +17,7 @@ from pathlib import Path
 from bearingsim import __version__, outputs
 from bearingsim.cli_common import progress_wanted, report_study
 from bearingsim.errors import SimulationUnstable, UserError
+from bearingsim.wording import counted
 
 
 def _print_summary(summary) -> None:
@@ -63,7 +65,7 @@ def _describe_index(path) -> tuple[str, str | None] | None:
         n, total = meta["grid_rows"], len(cols["case"])
         lines = [f"sweep mode {meta.get('mode', '?')}; base scenario {meta.get('scenario') or '(none)'}",
                  "swept keys: " + (", ".join(meta["axes"]) or "(none)"),
-                 f"grid of {', '.join(meta['grid']) or '(no axes)'}: {n} cases; extra cases: {total - n}",
+                 f"grid of {', '.join(meta['grid']) or '(no axes)'}: {counted(n, 'case')}; extra cases: {total - n}",
                  "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
                  "without one); 'bearingsim show' of a case archive gives its scenario"]
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
@@ -80,6 +82,11 @@ def _describe_index(path) -> tuple[str, str | None] | None:
         return archive.describe_table(path, "bearingsim cross-check table (one row per rung and speed)", cols,
                                       columns, lines), meta.get("scenario")
     return _describe_study_table(path)
+
+
+#: the files inspect and show read (an archive, then the index files of :func:`_describe_index`)
+_INDEX_KINDS = ("a run archive, a sweep's sweep.h5 or map.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 "
+                "or life.h5")
 
 
 def _describe_study_table(path) -> tuple[str, str | None] | None:
@@ -103,7 +110,7 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
 
                 name = tomllib.loads(meta["scenario"]).get("name")
             lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
-            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages") if k in meta]
+            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "left_out") if k in meta]
             return archive.describe_table(path, what, cols, columns, lines), meta.get("scenario")
     return None
 
@@ -193,6 +200,17 @@ def _cmd_plot(args) -> int:
         for png in crosscheck.plot_crosscheck(path, folder):
             print(f"wrote {png}")
         return 0
+    drawer = _study_table_drawer(path)
+    if drawer is not None:  # sensitivity.h5, uncertainty.h5, life.h5: the study's figure from its table alone
+        folder = check_writable_dir(args.output) if args.output else path.parent
+        for png in drawer(path, folder):
+            print(f"wrote {png}")
+        return 0
+    from bearingsim.sweeps.grid import MAP_FORMAT
+
+    if archive.is_grid_file(path, MAP_FORMAT):  # its figures are drawn from the sweep's index beside it
+        raise UserError(f"{path}: a sweep's map (map.h5), not a run archive; the sweep's figures are drawn from "
+                        f"its index: bearingsim plot {path.parent / 'sweep.h5'}")
     if archive.is_table_file(path, INDEX_FORMAT):  # a sweep's index: its figures
         from bearingsim.sweeps import plot_sweep_index
 
@@ -213,6 +231,24 @@ def _cmd_plot(args) -> int:
     for png in result.save_figures(folder / path.stem):
         print(f"wrote {png}")
     return 0
+
+
+def _study_table_drawer(path):
+    """``draw(table, folder) -> [png]`` for a study's table file (``sensitivity.h5``, ``uncertainty.h5``,
+    ``life.h5``): the figure the study drew, from the table alone; None for any other file."""
+    from bearingsim import archive
+    from bearingsim.studies import life, sensitivity, uncertainty
+
+    def draw_life(table, folder):
+        from bearingsim.plotting import save_figure
+
+        return [save_figure(life.plot_life(*life.read_life(table)), Path(folder) / "life.png")]
+
+    for fmt, draw in ((sensitivity.INDEX_FORMAT, sensitivity.plot_sensitivity),
+                      (uncertainty.INDEX_FORMAT, uncertainty.plot_uncertainty), (life.LIFE_FORMAT, draw_life)):
+        if archive.is_table_file(path, fmt):
+            return draw
+    return None
 
 
 def _cmd_rerun(args) -> int:
@@ -342,16 +378,20 @@ def _print_validate(args, studies, outcome) -> None:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:
         rows = studies[1].rows
-        print(f"rig scene (pocket 0 flat), 1 warm-up + {args.rig_rotations} rotations, against the reduced model:")
+        print(f"rig scene (pocket 0 flat), 1 warm-up + {counted(args.rig_rotations, 'rotation')}, against the reduced "
+              "model:")
         print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
         for r in rows:
-            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {r['pocket0_I_dec_std_Ns'] * 1e3:5.2f} (std) "
+            std = r["pocket0_I_dec_std_Ns"] * 1e3
+            std = f"{std:5.2f}" if math.isfinite(std) else "  n/a"  # one rotation: no scatter (tables: n/a)
+            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {std} (std) "
                   f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
                   f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
         for p in outcome.written[2:]:
             print(f"wrote {p}")
     if outcome.interrupted is None:
-        print(f"{len(outcome.sweep.rows)} cases: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+        print(f"{counted(len(outcome.sweep.rows), 'case')}: {outcome.counts()}; archives in "
+              f"{Path(args.output) / 'cases'}")
 
 
 def _benchmarks_root() -> Path:
@@ -369,7 +409,10 @@ def _benchmarks_root() -> Path:
 
 
 def _cmd_bench(args) -> int:
+    from bearingsim.outputs import check_folder_path
+
     _benchmarks_root()
+    check_folder_path(args.output)  # a file in the way: refused in the words of every other command
     if args.map:
         from benchmarks.sweep_bench import run_map_bench
 
@@ -416,9 +459,9 @@ def _cmd_crosscheck(args) -> int:
                                       force=args.force, progress=progress_wanted(args))
     wall = time.perf_counter() - t0
     if outcome.interrupted is None and not args.quiet:
-        where = f"dask scheduler {args.scheduler}" if args.scheduler else f"{args.jobs} process(es)"
-        print(f"cross-check of {args.scenario}: {len(speeds)} speed(s) x {len(cc.RUNGS)} rungs, 1 warm-up + "
-              f"{args.rotations} rotations each, {where}, {wall:.1f} s; impulses per pocket and cage "
+        where = f"dask scheduler {args.scheduler}" if args.scheduler else counted(args.jobs, "process", "processes")
+        print(f"cross-check of {args.scenario}: {counted(len(speeds), 'speed')} x {len(cc.RUNGS)} rungs, 1 warm-up + "
+              f"{counted(args.rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
               f"rotation, mean over all pockets ± batch-means standard error")
         print(cc.format_table(rows))
         for line in cc.verdicts(rows):
@@ -477,21 +520,23 @@ def _add_run_commands(sub) -> None:
                         "the run would refuse before its first step; run and write nothing")
     r.set_defaults(func=_cmd_run)
 
-    i = sub.add_parser("inspect", help="print what an archive, a sweep.h5 or a crosscheck.h5 holds")
-    i.add_argument("archive")
+    i = sub.add_parser("inspect", help=f"print what a file holds: {_INDEX_KINDS}")
+    i.add_argument("archive", help=_INDEX_KINDS)
     i.set_defaults(func=_cmd_inspect)
 
-    sh = sub.add_parser("show", help="print the scenario stored in an archive or crosscheck.h5 as TOML (a runnable "
-                                     "scenario file); for a sweep.h5, what it holds as TOML comments; for a "
-                                     "scenario file (.toml), the resolved scenario: every key, before any run")
-    sh.add_argument("archive", help="archive, sweep.h5, crosscheck.h5 or scenario .toml file")
+    sh = sub.add_parser("show", help="print the scenario stored in an archive, map.h5, crosscheck.h5, sensitivity.h5, "
+                                     "uncertainty.h5 or life.h5 as TOML (a runnable scenario file); for a sweep.h5, "
+                                     "what it holds as TOML comments; for a scenario file (.toml), the resolved "
+                                     "scenario: every key, before any run")
+    sh.add_argument("archive", help=f"{_INDEX_KINDS}, or a scenario .toml file")
     sh.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="with a scenario file: override a key, as 'run --set' does (repeatable)")
     sh.set_defaults(func=_cmd_show)
 
-    pl = sub.add_parser("plot", help="draw every figure of a run again from its archive alone")
-    pl.add_argument("archive")
-    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the archive)")
+    pl = sub.add_parser("plot", help="draw every figure again from a run's archive, a sweep's sweep.h5, a "
+                                     "crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 alone")
+    pl.add_argument("archive", help="a run archive, sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5")
+    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the file)")
     pl.set_defaults(func=_cmd_plot)
 
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")

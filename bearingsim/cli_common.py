@@ -6,6 +6,8 @@ from __future__ import annotations
 import signal
 import sys
 
+from bearingsim.wording import counted
+
 
 def report_study(outcome, command: str) -> int:
     """The end of a study command: exit 0, 1 if a case failed (named on stderr), 128 + signal if
@@ -14,16 +16,16 @@ def report_study(outcome, command: str) -> int:
     if outcome.interrupted is not None:
         ran = sum(outcome.count(s) for s in ("done", "cached", "stale", "failed"))
         print(f"bearingsim: {command} interrupted ({signal.Signals(outcome.interrupted).name}): {outcome.counts()}, "
-              f"{n - ran} not run, of {n} cases; run the same command again to resume",
+              f"{n - ran} not run, of {counted(n, 'case')}; run the same command again to resume",
               file=sys.stderr)
         return 128 + outcome.interrupted
     if outcome.failed:
         names = "; ".join(f"{', '.join(f'{k}={v}' for k, v in r['values'].items())}: {r['error']}"
                           for r in outcome.failed[:10])
         rest = n - len(outcome.sweep.rows)  # a staged study stops at a failed case
-        later = f"; {rest} later {'case' if rest == 1 else 'cases'} not run (each needs the one before)" if rest else ""
-        print(f"bearingsim: {len(outcome.failed)} of {n} cases of the {command} failed ({names}); the other "
-              f"cases' numbers are kept (errors in {outcome.sweep.csv}){later}", file=sys.stderr)
+        later = f"; {counted(rest, 'later case')} not run (each needs the one before)" if rest else ""
+        print(f"bearingsim: {len(outcome.failed)} of {counted(n, 'case')} of the {command} failed ({names}); the "
+              f"other cases' numbers are kept (errors in {outcome.sweep.csv}){later}", file=sys.stderr)
         return 1
     return 0
 

@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 
 def _keys(text):
@@ -35,20 +36,32 @@ def _run(study, args):
     return outcome, time.perf_counter() - t0
 
 
+def _num(v, spec: str) -> str:
+    """``v`` formatted by ``spec``, or ``n/a`` (as wide) where it is not a number."""
+    import math
+
+    width = len(format(0.0, spec))
+    return format(v, spec) if math.isfinite(v) else "n/a".rjust(width)
+
+
 def _cmd_sensitivity(args) -> int:
     from bearingsim.cli_common import report_study
-    from bearingsim.studies.sensitivity import Sensitivity, parse_step
+    from bearingsim.studies.sensitivity import Sensitivity, missing_note, parse_step
 
     step = parse_step(args.step)
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"sensitivity of {args.scenario}: {len(study.keys)} keys x 2 runs at x (1 ± {step:.0%}) within each "
+        print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x 2 runs at x (1 ± {step:.0%}) within each "
               f"key's range, {wall:.1f} s")
+        for k, why in study.left_out:
+            print(f"left out: {k}: {why}; give it a nonzero value to vary it")
         print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
         for r in study.rows:
-            print(f"{r['key']:34s} {r['quantity']:18s} {r['sensitivity']:+9.3f} {r['sensitivity_se']:8.3f} "
-                  f"{r['over_range']:+10.3f}")
+            note = missing_note(r)
+            print(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
+                  f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
+                  + (f"  ({note})" if note else ""))
         for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
@@ -62,11 +75,12 @@ def _cmd_uncertainty(args) -> int:
     study = Uncertainty(_scenario(args), args.samples, args.seed, _keys(args.keys))
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"uncertainty of {args.scenario}: {len(study.keys)} keys, N = {args.samples} ({len(study.cases)} runs), "
+        print(f"uncertainty of {args.scenario}: {counted(len(study.keys), 'key')}, N = {args.samples} "
+              f"({counted(len(study.cases), 'run')}), "
               f"seed {args.seed}, {wall:.1f} s")
         for s in study.spreads:
             print(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
-                  f"({int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0} runs)")
+                  f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
         print(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
         for r in study.indices:
             print(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "

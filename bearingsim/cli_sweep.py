@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 #: rows of the table printed at the end of a sweep ('bearingsim table DIR' prints them all)
 TABLE_ROWS = 40
@@ -64,12 +65,12 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
         from bearingsim import tables
 
         print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
-        print(f"{n} cases: {counts} ({out.wall_s:.1f} s)")
+        print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s)")
     if out.failed:
         names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"
                           for r in out.failed[:10])
         more = f" and {len(out.failed) - 10} more" if len(out.failed) > 10 else ""
-        print(f"bearingsim: {len(out.failed)} of {n} cases failed: {names}{more} (errors in {out.csv})",
+        print(f"bearingsim: {len(out.failed)} of {counted(n, 'case')} failed: {names}{more} (errors in {out.csv})",
               file=sys.stderr)
         return 1
     return 0

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 
 def _cmd_wear(args) -> int:
@@ -51,7 +52,7 @@ def _cmd_life(args) -> int:
         return code
     cols = study.columns()
     print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
-          f"inner-ring rotations in {len(cols['stage'])} stages")
+          f"inner-ring rotations in {counted(len(cols['stage']), 'stage')}")
     print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
           f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}")
     for i in range(len(cols["stage"])):

@@ -191,6 +191,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     for src in inputs:
         if src and _same_file(p, Path(src)):
             raise UserError(f"{p}: output path is the input scenario file; choose another -o")
+    check_folder_can_be_made(p, "archive")  # a file where the archive's folder should be
     if p.is_dir():
         raise UserError(f"{p}: output path is a directory")
     if p.suffix.lower() not in ARCHIVE_SUFFIXES:
@@ -212,13 +213,24 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     return p
 
 
-def check_folder_can_be_made(out: Path, what: str) -> None:
-    """Refuse (one-line :class:`UserError`) an output ``out`` whose folder, or the nearest of its parents
-    that exists, is not a folder (a file in the way): the folder could never be made. Nothing is
-    created here; ``what`` names the output ("report", "animation")."""
-    existing = next((p for p in (out.parent, *out.parent.parents) if p.exists()), None)
+def check_folder_path(folder: str | Path, what: str = "output folder") -> Path:
+    """Refuse (one-line :class:`UserError`) a ``folder`` to write into that, or the nearest of its
+    parents that exists, is not a folder (a file in the way): it could never be made. Every command
+    that writes into a folder says it in these words, ``{folder}: cannot create the {what} ({file} is
+    not a folder)``. Nothing is created here; ``what`` names the folder ("output folder", "report's
+    folder"). Returns ``folder`` as a :class:`~pathlib.Path`."""
+    folder = Path(folder)
+    existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
     if existing is not None and not existing.is_dir():
-        raise UserError(f"{out.parent}: cannot create the {what}'s folder ({existing} is not a folder)")
+        raise UserError(f"{folder}: cannot create the {what} ({existing} is not a folder)")
+    return folder
+
+
+def check_folder_can_be_made(out: Path, what: str) -> None:
+    """Refuse (one-line :class:`UserError`, :func:`check_folder_path`) an output file ``out`` whose
+    folder, or the nearest of its parents that exists, is not a folder (a file in the way). Nothing is
+    created here; ``what`` names the output ("report", "animation", "archive")."""
+    check_folder_path(Path(out).parent, f"{what}'s folder")
 
 
 def check_writable(path: str | Path) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 
 from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
+from bearingsim.wording import counted
 
 # The mean inner-ring displacement along the load is at most half the diametral clearance plus the
 # approach at the inner and the outer race of a roller that carries the whole load alone; twice that
@@ -124,7 +125,7 @@ def check(result) -> list[str]:
         orbit = result.get("cage_orbit")
         samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
         if samples < MIN_ORBIT_SAMPLES:
-            raise SimulationUnstable(f"{samples} time-series samples recorded; {_few_samples_advice(result)}")
+            raise SimulationUnstable(f"{counted(samples, 'time-series sample')} recorded; {_few_samples_advice(result)}")
         for note in (cage_speed_drift(result), start_transient(result)):
             if note is not None:
                 notes.append(note)

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 #: the first bytes of every report bearingsim writes: what ``-o`` may replace
 SIGNATURE = b"<!DOCTYPE html>\n<!-- bearingsim report"
@@ -359,12 +360,16 @@ def _sensitivity_sections(table: Path):
     from bearingsim.studies import sensitivity as sens
 
     rows, meta = sens.read_table(table)
-    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range"]
-    cells = [[r["key"], r["quantity"], r["measure"], f"{_cell(r['sensitivity'], digits=3)} ± "
-              f"{_cell(r['sensitivity_se'], digits=2)}", _cell(r["over_range"], digits=3)] for r in rows]
+    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range", "n/a: why"]
+
+    def num(v, digits):
+        return _cell(v, digits=digits) if math.isfinite(float(v)) else "n/a"
+
+    cells = [[r["key"], r["quantity"], r["measure"], f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}",
+              num(r["over_range"], 3), sens.missing_note(r)] for r in rows]
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {meta.get('step', 0):.0%})); log: d ln y / d ln x, "
                           "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
-                          [False, False, False, True, True])]
+                          [False, False, False, True, True, False])]
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))
     sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
     return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
@@ -426,7 +431,7 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         cols, _ = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
-        checks.append({"kind": "text", "text": f"{len(status)} cases: {counts}. A case's archive is written only when "
+        checks.append({"kind": "text", "text": f"{counted(len(status), 'case')}: {counts}. A case's archive is written only when "
                                                "its run passes the plausibility checks (docs/reliability.md); a "
                                                "failed case keeps its one-line error:"})
         failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]

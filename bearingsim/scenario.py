@@ -23,6 +23,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 SCHEMA_VERSION = 1
 
@@ -1023,7 +1024,7 @@ def _check_worn(m: ScenarioModel, source: str) -> None:
     bins = {len(row) for _, v in given for row in v}
     for k, v in given:
         if len(v) != b.roller_count:
-            raise UserError(f"{source}: wear.{k}: {len(v)} rows; give one per pocket ({b.roller_count}, "
+            raise UserError(f"{source}: wear.{k}: {counted(len(v), 'row')}; give one per pocket ({b.roller_count}, "
                             f"bearing.roller_count)")
     if len(bins) != 1 or not 1 <= min(bins) <= MAX_WORN_BINS:
         raise UserError(f"{source}: {key}: every row (both faces) must have the same number of bins of psi, "

@@ -84,7 +84,9 @@ def table_of_index(path) -> Table:
         names, labels = ["case"], {"case": [str(c) for c in cols["case"]]}
     numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", *FIXED, *axes)
                and np.asarray(cols[k]).dtype.kind == "f"}
-    notes = [f"{path}: {n} cases" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
+    from bearingsim.wording import counted
+
+    notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes)
 
 
@@ -101,7 +103,7 @@ def table_of_archives(paths) -> Table:
     differ = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
     shown = [k for k in differ if k != "name"][:4]
     names = ["archive", *shown]
-    labels = {"archive": [Path(p).name for p in paths]}
+    labels = {"archive": distinguishing_labels(paths)}
     for k in shown:
         labels[k] = [_text(f.get(k, "(unset)")) for f in flat]
     keys = list(dict.fromkeys(k for r in results for k, v in r.summary.items() if _is_number(v)))
@@ -120,6 +122,21 @@ def table_of_archives(paths) -> Table:
     if not differ:
         notes.append("scenarios: identical")
     return Table(names, labels, numbers, units, notes)
+
+
+def distinguishing_labels(paths) -> list[str]:
+    """A label per path: its file name where that is unique among ``paths``, else the shortest ending of
+    the path (``cases/<hash>.h5``, ``run1/cases/<hash>.h5``) that no other path shares, so two files of
+    one name in different folders get different labels. The same file given twice keeps one label."""
+    import os
+
+    parts = [Path(os.path.abspath(p)).parts for p in paths]  # the folders as given, links not followed
+    labels = []
+    for i, mine in enumerate(parts):
+        others = [q for q in parts if q != mine]
+        k = next((k for k in range(1, len(mine) + 1) if all(q[-k:] != mine[-k:] for q in others)), len(mine))
+        labels.append(str(Path(*mine[-k:])) if k < len(mine) else str(Path(*mine)))
+    return labels
 
 
 def _is_number(v) -> bool:

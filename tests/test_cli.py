@@ -64,6 +64,116 @@ def test_unwritable_output_names_the_file(tmp_path):
     assert_user_error(res, "blocker")
 
 
+@pytest.fixture(scope="module")
+def archives_to_write_from(tmp_path_factory):
+    """A reduced archive and a short multibody one (rigid raceways, 1 rotation: wear needs its profile)."""
+    folder = tmp_path_factory.mktemp("sources")
+    reduced, multibody = folder / "r.h5", folder / "m.h5"
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", reduced, "--no-plots", "-q")
+    assert res.returncode == 0, res.stderr
+    res = bearingsim("run", SCENARIOS / "wear_test_6000rpm.toml", "-o", multibody, "--no-plots", "-q",
+                     "--set", "numerics.rotations=1", "--set", "multibody.raceway_contact=rigid")
+    assert res.returncode == 0, res.stderr
+    return {"R": reduced, "M": multibody}
+
+
+#: every command that writes into a folder, its output given as {out} (a folder) or {out}/NAME (a file)
+FOLDER_WRITERS = {
+    "run": ["run", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}/x.h5"],
+    "run-no-plots": ["run", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}/x.h5", "--no-plots"],
+    "rerun": ["rerun", "{R}", "-o", "{out}/x.h5"],
+    "plot": ["plot", "{R}", "-o", "{out}"],
+    "report": ["report", "{R}", "-o", "{out}/x.html"],
+    "animate": ["animate", "{M}", "-o", "{out}/x.gif"],
+    "sweep": ["sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "operating.inner_ring_speed_rpm=1000:2000:2",
+              "-o", "{out}"],
+    "crosscheck": ["crosscheck", SCENARIOS / "multibody_3000rpm.toml", "-o", "{out}"],
+    "validate": ["validate", "-o", "{out}"],
+    "sensitivity": ["sensitivity", SCENARIOS / "paper_3000rpm.toml", "-o", "{out}"],
+    "uncertainty": ["uncertainty", SCENARIOS / "paper_3000rpm.toml", "--samples", "4", "-o", "{out}"],
+    "life": ["life", SCENARIOS / "wear_test_6000rpm.toml", "--limit", "depth=0.1mm", "-o", "{out}"],
+    "wear": ["wear", "{M}", "--hours", "1", "-o", "{out}"],
+    "bench-map": ["bench", "--map", "-o", "{out}"],
+    "bench-fast-scene": ["bench", "--fast-scene", "-o", "{out}"],
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("below", [False, True], ids=["file-is-the-folder", "file-above-the-folder"])
+@pytest.mark.parametrize("command", list(FOLDER_WRITERS))
+def test_a_file_where_the_output_folder_should_be_is_named_alike_by_every_command(
+        tmp_path, archives_to_write_from, command, below):
+    """A file where the output's folder (or one of its parents) should be: every command that writes
+    into a folder refuses it in the same words, naming the file in the way, in one line, exit 2, and
+    creates nothing. sweep, plot, rerun and the studies said "not writable (File exists)" or "(Not a
+    directory)", run "cannot check the figure path", without naming the file."""
+    import re
+
+    (tmp_path / "blocker").write_text("my notes\n")
+    out = tmp_path / "blocker" / "sub" if below else tmp_path / "blocker"
+    args = [str(a).format(out=out, **archives_to_write_from) for a in FOLDER_WRITERS[command]]
+    res = bearingsim(*args, cwd=tmp_path)
+    assert_user_error(res)
+    line = res.stderr.strip()
+    assert re.fullmatch(rf"bearingsim: error: {re.escape(str(out))}: cannot create the (output folder|\w+'s folder) "
+                        rf"\({re.escape(str(tmp_path / 'blocker'))} is not a folder\)", line), line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker"]
+    assert (tmp_path / "blocker").read_text() == "my notes\n"
+
+
+@pytest.mark.parametrize("command", ["inspect", "show"])
+def test_help_of_inspect_and_show_names_every_file_they_read(command):
+    """``inspect`` and ``show`` read an archive and every index file of ``cli._describe_index`` (sweep.h5,
+    map.h5, crosscheck.h5 and the study tables); their help named only an archive, sweep.h5 and
+    crosscheck.h5."""
+    kinds = ("archive", "sweep.h5", "map.h5", "crosscheck.h5", "sensitivity.h5", "uncertainty.h5", "life.h5")
+    for args in ([command, "--help"], ["--help"]):
+        res = bearingsim(*args)
+        assert res.returncode == 0, res.stderr
+        text = " ".join(res.stdout.split())
+        if args == ["--help"]:  # the command's line in the list of commands
+            text = text[text.index(f" {command} "):]
+            text = text[:text.index(" plot ")] if command == "show" else text[:text.index(" show ")]
+        missing = [k for k in kinds if k not in text]
+        assert not missing, (args, missing, text)
+
+
+@pytest.mark.slow
+def test_a_count_of_one_is_singular(tmp_path):
+    """Printed counts that can be one read "1 case", "1 rotation", "1 stage", ...: a one-case sweep printed
+    "1 cases", a one-stage life "running 1 rotations" and "in 1 stages", a cross-check at one speed
+    "1 speed(s) ... 1 rotations each, 1 process(es)"."""
+    import re
+
+    from bearingsim.wording import counted
+
+    assert (counted(1, "case"), counted(2, "case"), counted(0, "case")) == ("1 case", "2 cases", "0 cases")
+    assert counted(1, "process", "processes") == "1 process" and counted(3, "process", "processes") == "3 processes"
+    paper, mb = SCENARIOS / "paper_3000rpm.toml", SCENARIOS / "wear_test_6000rpm.toml"
+    rigid = ["--set", "multibody.raceway_contact=rigid"]
+    commands = [
+        ["sweep", paper, "--param", "operating.inner_ring_speed_rpm=1000", "-o", tmp_path / "sw", "-j", "1"],
+        ["table", tmp_path / "sw"],
+        ["inspect", tmp_path / "sw" / "sweep.h5"],
+        ["inspect", tmp_path / "sw" / "map.h5"],
+        ["sensitivity", paper, "--keys", "contact.restitution", "-o", tmp_path / "se", "-j", "1"],
+        ["life", mb, "--limit", "depth=1mm", "--stages", "1", "--rotations", "1", *rigid, "-o", tmp_path / "li"],
+        ["crosscheck", SCENARIOS / "multibody_3000rpm.toml", "--speeds", "3000", "--rotations", "1", *rigid,
+         "-o", tmp_path / "cc", "-j", "1"],
+    ]
+    plural_of_one = re.compile(r"(?<![\d.])1 (cases|rotations|stages|keys|runs|values|speeds|rows|cells|"
+                               r"process\(es\)|speed\(s\))(?!\w)")
+    for args in commands:
+        res = bearingsim(*args)
+        assert res.returncode == 0, (args, res.stderr)
+        found = plural_of_one.findall(res.stdout + res.stderr)
+        assert not found, (args[0], found, res.stdout + res.stderr)
+    res = bearingsim(*commands[0])  # again: every case cached
+    assert "1 case: 0 done, 1 cached" in res.stdout, res.stdout
+    res = bearingsim(*commands[-1])
+    assert "1 speed x 5 rungs, 1 warm-up + 1 rotation each, 1 process," in res.stdout, res.stdout
+
+
 @pytest.mark.slow
 def test_inspect_refuses_foreign_file(tmp_path):
     f = tmp_path / "x.h5"

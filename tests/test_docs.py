@@ -47,3 +47,52 @@ def test_help_texts_and_scenarios_carry_no_development_references():
     offenders = [f"{p.relative_to(ROOT)}:{i + 1}" for p in files
                  for i, line in enumerate(p.read_text().splitlines()) if pattern.search(line)]
     assert not offenders, offenders
+
+
+def test_scenario_files_cite_pages_and_sections_that_exist():
+    """A scenario file's comment that points to a page (``docs/sweeps.md``, ``README``) names one that
+    exists, and a quoted section (``docs/sweeps.md, "Many cheap cases, measured"``) is a heading or a
+    bold paragraph of that page: map_speed_clearance.toml cited a README section "Sweeps" that the
+    README does not have."""
+    cite = re.compile(r'(README(?:\.md)?|docs/[\w.-]+\.md)(?:, "([^"]+)")?')
+    broken = []
+    for p in sorted((ROOT / "scenarios").rglob("*.toml")):
+        for i, line in enumerate(p.read_text().splitlines()):
+            if not line.lstrip().startswith("#"):
+                continue
+            for page, section in cite.findall(line):
+                path = ROOT / ("README.md" if page.startswith("README") else page)
+                where = f"{p.relative_to(ROOT)}:{i + 1}: {page}"
+                if not path.is_file():
+                    broken.append(f"{where}: no such page")
+                    continue
+                if section:
+                    text = path.read_text()
+                    if not re.search(rf"^#+ .*{re.escape(section)}|\*\*{re.escape(section)}", text, re.M):
+                        broken.append(f"{where}: no section {section!r}")
+    assert not broken, broken
+
+
+def test_usage_key_table_lists_every_section_and_key():
+    """docs/usage.md's table of scenario keys has a row for every section of a scenario and names every
+    key in it (``bearingsim keys``): it lacked ``[output]`` and ``[ranges.*]``."""
+    from bearingsim.keys import list_keys
+
+    text = (ROOT / "docs" / "usage.md").read_text()
+    table = text[text.index("| section | keys |"):]
+    rows = {}
+    for line in table.splitlines():
+        if not line.startswith("|"):
+            break
+        cells = line.split("|")
+        rows[cells[1].strip()] = cells[2]
+    missing = []
+    for info in list_keys():
+        section, _, name = info.key.rpartition(".")
+        if not section:  # a top-level key, or the [ranges.<section>.<key>] tables
+            row = "`[ranges.<section>.<key>]`" if name == "ranges" else "top level"
+            if row not in rows or (name != "ranges" and f"`{name}`" not in rows[row]):
+                missing.append(info.key)
+        elif f"`{name}`" not in rows.get(f"`[{section}]`", ""):
+            missing.append(info.key)
+    assert not missing, missing

@@ -193,6 +193,24 @@ def test_inspect_and_show_read_the_study_tables(tmp_path, capsys):
         assert load_scenario_text(shown) == sc
 
 
+@pytest.mark.slow
+def test_plot_draws_a_study_table_figure_again(tmp_path, capsys):
+    """`plot sensitivity.h5` / `plot uncertainty.h5` said "not a bearingsim archive": they draw the study's
+    figure again from its table alone, the same bytes as the study drew."""
+    from bearingsim.studies.uncertainty import run_uncertainty
+
+    sc = load_scenario(REDUCED)
+    sens.run_sensitivity(sc, tmp_path / "s", KEYS[:1], 0.1)
+    run_uncertainty(sc, tmp_path / "u", samples=4, seed=0, keys=KEYS)
+    for table, png in (("s/sensitivity.h5", "sensitivity.png"), ("u/uncertainty.h5", "uncertainty.png")):
+        out = tmp_path / "again" / table.split("/")[0]
+        code = main(["plot", str(tmp_path / table), "-o", str(out)])
+        captured = capsys.readouterr()
+        assert code == 0 and captured.err == "", captured.err
+        assert captured.out == f"wrote {out / png}\n"
+        assert (out / png).read_bytes() == (tmp_path / table).parent.joinpath(png).read_bytes()
+
+
 def load_scenario_text(text):
     import tomllib
 
@@ -212,3 +230,58 @@ def test_every_study_command_takes_quiet(tmp_path, capsys):
     assert main(["sensitivity", str(REDUCED), "--keys", KEYS[0], "-o", str(tmp_path), "-j", "1", "-q"]) == 0
     assert capsys.readouterr().out == ""
     assert (tmp_path / "sensitivity.csv").is_file()
+
+
+PAPER_3000 = SCENARIOS / "paper_3000rpm.toml"  # the reduced model's I_acc is 0 there (no front-face impact)
+
+
+def test_a_number_that_is_zero_in_both_runs_says_n_a_and_why(tmp_path, capsys):
+    """The reduced model's I_acc is 0 in both runs of every key at 3000 rpm: its log-sensitivity has no
+    value. The printed table showed "+nan nan +nan"; it says n/a and why, and so does the report's table
+    (NaN stays in sensitivity.h5, an empty field in the CSV)."""
+    from bearingsim import reports
+
+    code = main(["sensitivity", str(PAPER_3000), "--keys", "contact.restitution", "-o", str(tmp_path), "-j", "1"])
+    out = capsys.readouterr().out
+    assert code == 0 and "nan" not in out.lower(), out
+    (row,) = [ln for ln in out.splitlines() if ln.startswith("contact.restitution") and " I_acc " in ln]
+    assert row.split()[2:5] == ["n/a", "n/a", "n/a"], row
+    assert row.endswith("(I_acc is 0 in both runs: no effect, and no relative change to measure)"), row
+    rows, _ = sens.read_table(tmp_path / "sensitivity.h5")
+    i_acc = next(r for r in rows if r["quantity"] == "I_acc")
+    assert math.isnan(i_acc["sensitivity"]) and i_acc["y_minus"] == i_acc["y_plus"] == 0.0
+    _, sections, _ = reports._sensitivity_sections(tmp_path / "sensitivity.h5")
+    cells = {tuple(c[:2]): c for c in sections[0].blocks[0]["rows"]}
+    assert cells[("contact.restitution", "I_acc")][3:] == ["n/a ± n/a", "n/a",
+                                                          "I_acc is 0 in both runs: no effect, and no relative change to measure"]
+    assert cells[("contact.restitution", "I_dec")][5] == ""
+    # the other reasons a number is missing
+    base = {**i_acc, "y_minus": 0.0, "y_plus": 1e-3}
+    assert sens.missing_note(base) == "I_acc is 0 in one run: no relative change (ln 0)"
+    assert sens.missing_note({**base, "status": "failed"}) == "a run failed"
+    finite = {**base, "sensitivity": 0.5, "sensitivity_se": math.nan, "over_range": math.nan}
+    assert sens.missing_note(finite) == ("no standard error from fewer than 2 rotations; the key's range starts at 0: "
+                                         "no change over it on a log scale")
+
+
+def test_a_key_whose_value_is_zero_is_left_out_of_the_default_keys(tmp_path, capsys):
+    """A ranged key at 0 (a user's frictionless or dragless bearing) refused the whole default study with
+    "--keys lubrication.drag_coefficient: its value (0.0) has no relative step", though no --keys was
+    given. It is left out, and said so; named in --keys it is refused as before. The uncertainty study,
+    which samples the ranges themselves, takes it."""
+    from bearingsim.studies.uncertainty import Uncertainty
+
+    zero = ["--set", "lubrication.drag_coefficient=0"]
+    code = main(["sensitivity", str(PAPER_3000), *zero, "-o", str(tmp_path / "s"), "-j", "1"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert ("left out: lubrication.drag_coefficient: its value is 0.0: a relative step x (1 ± step) cannot move it; "
+            "give it a nonzero value to vary it") in captured.out
+    rows, meta = sens.read_table(tmp_path / "s" / "sensitivity.h5")
+    assert "lubrication.drag_coefficient" not in {r["key"] for r in rows} and "drag_coefficient" in meta["left_out"]
+    code = main(["sensitivity", str(PAPER_3000), *zero, "--keys", "lubrication.drag_coefficient", "-o",
+                 str(tmp_path / "k")])
+    err = capsys.readouterr().err
+    assert code == 2 and "--keys lubrication.drag_coefficient: its value (0.0) has no relative step" in err
+    sc = load_scenario(PAPER_3000, ["lubrication.drag_coefficient=0"])
+    assert "lubrication.drag_coefficient" in Uncertainty(sc, 2).keys

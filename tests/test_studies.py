@@ -176,6 +176,32 @@ def test_rig_study_gives_the_row_of_a_direct_run(tmp_path):
     assert (tmp_path / "rig_idec_vs_speed.csv").is_file() and (tmp_path / "rig_pocket0_forces.png").is_file()
 
 
+def test_a_one_rotation_rig_row_shows_no_scatter_rather_than_zero(capsys):
+    """validate --rig-rotations 1 printed "14.27 ±  0.00 (std)": the scatter of one rotation, which reads
+    as an exact value. As the standard error (stats.batch_sem: NaN, tables: n/a), the row's std is NaN
+    from fewer than 2 rotations and the table says n/a; from 2 rotations it is the scatter as before."""
+    from types import SimpleNamespace
+
+    from bearingsim.cli import _print_validate
+    from bearingsim.studies.rig import rig_row
+
+    def fake(per_rotation):
+        d = np.asarray(per_rotation, float)
+        return SimpleNamespace(per_rotation={"I_dec": d, "I_acc": d}, summary={"load_zone_half_angle_deg": 23.5},
+                               get=lambda name: np.zeros((4, len(d[0]))))
+
+    one = rig_row(3000.0, 1, fake([[0.01, 0.02, 0.03]]), 0.005)
+    two = rig_row(3000.0, 2, fake([[0.01, 0.02, 0.03], [0.03, 0.02, 0.01]]), 0.005)
+    assert math.isnan(one["pocket0_I_dec_std_Ns"]) and math.isnan(one["pocket0_I_dec_sem_Ns"])
+    assert two["pocket0_I_dec_std_Ns"] == pytest.approx(0.01)
+    args = SimpleNamespace(rig_rotations=1, output="v")
+    outcome = SimpleNamespace(written=[], interrupted=None, sweep=SimpleNamespace(rows=[]), counts=lambda: "")
+    _print_validate(args, [None, SimpleNamespace(rows=[one, two])], outcome)
+    lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("3000")]
+    assert "± 0.00" not in lines[0] and "±   n/a (std)" in lines[0], lines
+    assert "± 10.00 (std)" in lines[1], lines
+
+
 @pytest.mark.slow
 def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
     """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come

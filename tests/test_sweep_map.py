@@ -176,6 +176,10 @@ def test_inspect_show_and_table_of_a_map_folder(tmp_path):
     res = cli("show", tmp_path / "map.h5")
     assert res.returncode == 0 and res.stdout == load_scenario(BASE).to_toml()
     assert_user_error(cli("table", tmp_path, "--columns", "model_version"), "model_version")
+    # plot of map.h5 said "not a bearingsim archive": it says what the file is and which command draws it
+    res = cli("plot", tmp_path / "map.h5")
+    assert_user_error(res, "map.h5", "a sweep's map", f"bearingsim plot {tmp_path / 'sweep.h5'}")
+    assert not list(tmp_path.glob("*.png"))
 
 
 def test_a_user_file_named_map_h5_is_not_replaced(tmp_path):

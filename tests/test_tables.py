@@ -131,6 +131,26 @@ def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
 
 
 @pytest.mark.slow
+def test_table_labels_archives_of_one_name_in_different_folders_apart(reduced_runs, tmp_path):
+    """Two sweeps' ``cases/<hash>.h5`` (one file name in two folders) were both labelled ``<hash>.h5``:
+    a label is the file name where that is unique, else the shortest ending of the path no other
+    archive shares."""
+    import shutil
+
+    d = reduced_runs
+    for sweep, src in (("sw1", "a.h5"), ("sw2", "c.h5")):
+        (tmp_path / sweep / "cases").mkdir(parents=True)
+        shutil.copy(d / src, tmp_path / sweep / "cases" / "0123abcd.h5")
+    res = cli("table", tmp_path / "sw1" / "cases" / "0123abcd.h5", tmp_path / "sw2" / "cases" / "0123abcd.h5",
+              d / "b.h5", "--columns", "I_dec_mean_Ns")
+    assert res.returncode == 0, res.stderr
+    labels = [ln.split()[0] for ln in res.stdout.splitlines()[1:4]]
+    assert labels == ["sw1/cases/0123abcd.h5", "sw2/cases/0123abcd.h5", "b.h5"], res.stdout
+    assert tables.distinguishing_labels(["a.h5", "b.h5"]) == ["a.h5", "b.h5"]  # unique names unchanged
+    assert tables.distinguishing_labels(["x/c.h5", "x/c.h5"]) == ["c.h5", "c.h5"]  # the same file twice
+
+
+@pytest.mark.slow
 def test_sweep_prints_its_table_and_table_of_the_folder_is_the_same(tmp_path):
     out = tmp_path / "sw"
     res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1", "--no-plots")

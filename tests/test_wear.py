@@ -202,7 +202,7 @@ def test_wear_cli_checks_its_output_before_printing(fast_run, tmp_path, capsys):
     code = main(["wear", str(archive), "--hours", "1", "-o", str(afile)])
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
-    assert "afile: output folder is not writable" in err and afile.read_text() == "mine"
+    assert f"afile: cannot create the output folder ({afile} is not a folder)" in err and afile.read_text() == "mine"
     figs = tmp_path / "figs"
     (figs / f"{archive.stem}_wear_volume.png").mkdir(parents=True)
     code = main(["wear", str(archive), "--hours", "1", "-o", str(figs)])
@@ -308,6 +308,22 @@ def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, mon
     assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [1]
     monkeypatch.setitem(model_versions.MODEL_VERSIONS, "multibody", model_versions.MODEL_VERSIONS["multibody"] + 1)
     assert run_life(sc, tmp_path, lim, stages=1, rotations=1, mapping="shape")["reused"].tolist() == [0]
+
+
+@pytest.mark.slow
+def test_plot_draws_a_life_history_again(tmp_path, capsys):
+    """`plot life.h5` said "not a bearingsim archive": it draws life.png again from the history alone, the
+    same bytes as `bearingsim life` drew."""
+    from bearingsim.cli import main
+
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "depth=1mm", "--stages", "1",
+                 "--rotations", "1", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "l"), "-q"])
+    assert code == 0, capsys.readouterr().err
+    capsys.readouterr()
+    code = main(["plot", str(tmp_path / "l" / "life.h5"), "-o", str(tmp_path / "again")])
+    captured = capsys.readouterr()
+    assert code == 0 and captured.err == "" and captured.out == f"wrote {tmp_path / 'again' / 'life.png'}\n"
+    assert (tmp_path / "again" / "life.png").read_bytes() == (tmp_path / "l" / "life.png").read_bytes()
 
 
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):

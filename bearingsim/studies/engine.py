@@ -211,8 +211,8 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
                 for study in studies:
                     out.written += study.finish(outdir, records)
             except KeyboardInterrupt as exc:  # the cases are done and kept: the same command writes the rest
-                exc.resume_note = (f"all {len(sweep.rows)} cases done and kept in {outdir}, its tables and figures "
-                                   f"not all written")
+                done = "its one case" if len(sweep.rows) == 1 else f"all {len(sweep.rows)} cases"
+                exc.resume_note = f"{done} done and kept in {outdir}, its tables and figures not all written"
                 raise
     return out
 

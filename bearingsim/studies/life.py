@@ -38,6 +38,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 from bearingsim.studies.engine import Study, case_of, load_result
+from bearingsim.wording import counted
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -338,7 +339,7 @@ def plot_life(cols: dict, attrs: dict):
         ax.set_xlabel("running time [h]")
     _plot_worn_faces(axes[3], cols)
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} inner-ring "
-                 f"rotations, {len(h_end)} stages", fontsize=9)
+                 f"rotations, {counted(len(h_end), 'stage')}", fontsize=9)
     fig.tight_layout()
     return fig
 

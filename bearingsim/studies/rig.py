@@ -18,6 +18,7 @@ from bearingsim.outputs import PNG_SIGNATURE, write_csv
 from bearingsim.scenario import resolve
 from bearingsim.studies.engine import FINISHED, Study, batch_sem, case_of, load_result
 from bearingsim.studies.fig9 import reference_case
+from bearingsim.wording import counted
 
 RIG_SPEEDS_RPM = (500, 1000, 2000, 3000, 4000)
 RIG_ROTATIONS = 20
@@ -38,12 +39,15 @@ def rig_scenario(rpm: float, rotations: int = RIG_ROTATIONS, warmup: int = 1):
 
 
 def rig_row(rpm: float, rotations: int, result, reduced_I_dec_Ns: float) -> dict:
-    """One speed's row of the rig table from the rig scene's result and the reduced model's I_dec."""
+    """One speed's row of the rig table from the rig scene's result and the reduced model's I_dec. Pocket
+    0's scatter over rotations (std) is NaN from fewer than 2 rotations, as its standard error is
+    (:func:`bearingsim.stats.batch_sem`): one rotation has no scatter to show, not a scatter of 0."""
     d = result.per_rotation["I_dec"]
     a = result.per_rotation["I_acc"]
     return {
         "rpm": rpm, "rotations": rotations,
-        "pocket0_I_dec_mean_Ns": float(d[:, 0].mean()), "pocket0_I_dec_std_Ns": float(d[:, 0].std()),
+        "pocket0_I_dec_mean_Ns": float(d[:, 0].mean()),
+        "pocket0_I_dec_std_Ns": float(d[:, 0].std()) if len(d) >= 2 else float("nan"),
         "pocket0_I_dec_sem_Ns": batch_sem(d[:, 0]),
         "pocket0_I_acc_mean_Ns": float(a[:, 0].mean()),
         "arc_pockets_I_dec_mean_Ns": float(d[:, 1:].mean()), "arc_pockets_I_dec_std_Ns": float(d[:, 1:].std()),
@@ -126,7 +130,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     ax.set_ylim(bottom=0)
     ax.grid(alpha=0.3)
     rot = rows[0]["rotations"] if rows else 0
-    ax.set_title(f"The paper's rig as a scene (NU214, 970 N, forward, 1 warm-up + {rot} rotations)\n"
+    ax.set_title(f"The paper's rig as a scene (NU214, 970 N, forward, 1 warm-up + {counted(rot, 'rotation')})\n"
                  "against the reduced model (Fig. 9 analog)", fontsize=9)
     legend_outside(ax)
     png = save_figure(fig, outdir / "rig_idec_vs_speed.png")

@@ -86,24 +86,37 @@ def default_keys(scenario) -> list[str]:
             if not any(k == p or (p.endswith(".") and k.startswith(p)) for p in skip)]
 
 
-def check_keys(scenario, keys) -> list[str]:
+def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:
     """``keys`` (None: :func:`default_keys`) checked: each must have a range (one-line UserError
-    naming it otherwise) and a nonzero numeric value."""
+    naming it otherwise) and, with ``relative`` (the sensitivity study's steps x (1 -+ step)), a nonzero
+    numeric value. A default key whose value is 0 is left out (a relative step cannot move it), named with
+    why in ``left_out``; one given in ``keys`` is refused. The uncertainty study samples the ranges
+    themselves (``relative=False``): a key's own value does not matter there."""
     from bearingsim.ranges import ranged_keys, value_of
 
     have = ranged_keys(scenario)
+    given = keys is not None
     keys = default_keys(scenario) if keys is None else list(dict.fromkeys(keys))
     if not keys:
         raise UserError(f"{scenario.source}: no key has a range ([ranges.<section>.<key>] or the preset's); "
                         f"nothing to vary")
+    kept = []
     for k in keys:
         if k not in have:
             raise UserError(f"--keys {k}: no range for this key in {scenario.source} or its preset (give "
                             f"[ranges.{k}] range = [low, high] and reason)")
         x = value_of(scenario, k)
-        if not isinstance(x, (int, float)) or isinstance(x, bool) or x == 0:
-            raise UserError(f"--keys {k}: its value ({x!r}) has no relative step; give the key a nonzero number")
-    return keys
+        if relative and (not isinstance(x, (int, float)) or isinstance(x, bool) or x == 0):
+            if given:
+                raise UserError(f"--keys {k}: its value ({x!r}) has no relative step; give the key a nonzero number")
+            if left_out is not None:
+                left_out.append((k, f"its value is {x!r}: a relative step x (1 ± step) cannot move it"))
+            continue
+        kept.append(k)
+    if not kept:
+        raise UserError(f"{scenario.source}: every ranged key is 0 ({', '.join(keys)}): a relative step cannot "
+                        f"move them; give them nonzero values ('bearingsim uncertainty' samples their ranges)")
+    return kept
 
 
 def perturbed_values(scenario, key: str, step: float) -> tuple[float, float]:
@@ -195,6 +208,32 @@ def sensitivity_of(measure: str, x_minus, x_plus, y_minus, se_minus, y_plus, se_
             math.hypot(se_plus / y_plus, se_minus / y_minus) / abs(dlx))
 
 
+def missing_note(row) -> str:
+    """Why a table row's sensitivity, standard error or change over the range is not a number (NaN in
+    the table: ``n/a`` where it is shown), "" when all three are numbers. A number that is 0 in both runs
+    (the reduced model's I_acc where no roller hits the front face) did not change: it has no relative
+    change to take the logarithm of, and the key no effect on it."""
+    q, measure = row["quantity"], row["measure"]
+    s, se, over = (float(row[k]) for k in ("sensitivity", "sensitivity_se", "over_range"))
+    if row.get("status") == "failed":
+        return "a run failed"
+    if not math.isfinite(s):
+        ym, yp = float(row["y_minus"]), float(row["y_plus"])
+        if not (math.isfinite(ym) and math.isfinite(yp)):
+            return f"no {q} in the runs"
+        if measure == "log" and ym == 0.0 and yp == 0.0:
+            return f"{q} is 0 in both runs: no effect, and no relative change to measure"
+        if measure == "log" and min(ym, yp) <= 0.0:
+            return f"{q} is 0 in one run: no relative change (ln 0)"
+        return f"{q}: no sensitivity"
+    notes = []
+    if not math.isfinite(se):
+        notes.append("no standard error from fewer than 2 rotations")
+    if not math.isfinite(over):
+        notes.append("the key's range starts at 0: no change over it on a log scale")
+    return "; ".join(notes)
+
+
 class Sensitivity(Study):
     """Paired runs of every key (:func:`perturbed_scenarios`); table ``sensitivity.{csv,h5}``, figure
     ``sensitivity.png``.
@@ -215,7 +254,8 @@ class Sensitivity(Study):
         if not (isinstance(step, (int, float)) and 0.0 < step < 1.0):
             raise UserError(f"step {step!r}: the relative step must be above 0 and below 1 (0.1 = 10 %)")
         self.scenario, self.step = scenario, float(step)
-        self.keys = check_keys(scenario, keys)
+        self.left_out: list[tuple[str, str]] = []  # default keys at 0, which a relative step cannot move
+        self.keys = check_keys(scenario, keys, left_out=self.left_out)
         self.runs = {}  # (key, side) -> (value, case)
         cases = []
         for k, side, v, sc in perturbed_scenarios(scenario, self.keys, self.step):
@@ -256,13 +296,14 @@ class Sensitivity(Study):
                              "status": "failed" if failed else "done",
                              "error": "; ".join(r["error"] for r in failed)})
         self.rows = rows
-        paths = write_table(outdir, rows, self.scenario, self.step)
+        paths = write_table(outdir, rows, self.scenario, self.step, self.left_out)
         return [*paths, *plot_sensitivity(outdir / "sensitivity.h5", outdir)]
 
 
-def write_table(outdir, rows, scenario, step) -> tuple[Path, Path]:
+def write_table(outdir, rows, scenario, step, left_out=()) -> tuple[Path, Path]:
     """``sensitivity.csv`` (exactly :data:`COLUMNS`, a failed pair's numbers empty) and
-    ``sensitivity.h5`` (those columns and each pair's archives, status and error) atomically."""
+    ``sensitivity.h5`` (those columns and each pair's archives, status and error; ``left_out``, the
+    default keys not varied and why, in its ``left_out`` attribute) atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
     from bearingsim.studies.engine import table_columns, table_csv
@@ -274,6 +315,8 @@ def write_table(outdir, rows, scenario, step) -> tuple[Path, Path]:
     cols = table_columns(rows, columns)
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
              "scenario_name": scenario.name, "step": float(step)}
+    if left_out:
+        attrs["left_out"] = "; ".join(f"{k} ({why})" for k, why in left_out)
     h5_path = archive.write_table_file(outdir / "sensitivity.h5", cols, UNITS, attrs)
     return csv_path, h5_path
 
@@ -330,11 +373,12 @@ def plot_sensitivity(index_path, outdir) -> list[Path]:
 
 class SensitivityResult:
     """What :func:`bearingsim.sensitivity` returns: ``table`` (rows of :data:`COLUMNS` and each pair's
-    ``status``/``error``), ``outcome`` (the engine's counts) and :meth:`plot_tornado`."""
+    ``status``/``error``; :func:`missing_note` says why a number is NaN), ``outcome`` (the engine's
+    counts), ``left_out`` (default keys not varied: ``(key, why)``) and :meth:`plot_tornado`."""
 
     def __init__(self, study: Sensitivity, outcome):
         self.table, self.outcome, self.step, self.keys = study.rows, outcome, study.step, study.keys
-        self.scenario = study.scenario
+        self.scenario, self.left_out = study.scenario, study.left_out
 
     def plot_tornado(self):
         """The tornado chart (a matplotlib figure)."""

@@ -135,7 +135,7 @@ class Uncertainty(Study):
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise UserError(f"--seed {seed!r}: give a non-negative integer")
         self.scenario, self.samples, self.seed = scenario, samples, seed
-        self.keys = check_keys(scenario, keys)
+        self.keys = check_keys(scenario, keys, relative=False)  # the ranges are sampled: any value of the key
         r = ranged_keys(scenario)
         self.bounds = np.array([r[k][:2] for k in self.keys])
         self.a, self.b, self.ab = design(self.bounds, samples, seed)

@@ -31,6 +31,7 @@ import numpy as np
 
 from bearingsim import archive
 from bearingsim.sweeps.index import name_of, unit_of
+from bearingsim.wording import counted
 
 MAP_FORMAT = "bearingsim sweep map 1"
 MAP_NAME = "map.h5"
@@ -168,7 +169,7 @@ def describe_map(path) -> str:
              "cases: " + (", ".join(f"{k} {v}" for k, v in sorted(by.items())) or "(none)"), "axes:"]
     for d in m.dims:
         unit = f" [{m.units[d]}]" if d in m.units else ""
-        lines.append(f"  {d}{unit}: {len(m.coords[d])} values, {values(m.coords[d])}")
+        lines.append(f"  {d}{unit}: {counted(len(m.coords[d]), 'value')}, {values(m.coords[d])}")
     lines.append("variables:")
     for k, v in m.data.items():
         lines.append(f"  {k:32s} {str(v.shape):14s} {'text' if v.dtype.kind == 'O' else str(v.dtype):8s} "

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.sweeps.index import name_of, read_index, unit_of
+from bearingsim.wording import counted
 
 #: every figure a sweep may draw into its folder (a sweep checks them before it starts)
 FIGURE_NAMES = ("sweep_I.png", "sweep_map.png", "sweep_cases.png")
@@ -74,7 +75,7 @@ def sweep_title(meta: dict, n_cases: int) -> str:
     if extra:
         names = (names + "; " if names else "") + "cases over " + ", ".join(name_of(k) for k in extra)
     zipped = " (zipped)" if meta.get("mode") == "zip" and len(grid) > 1 else ""
-    return f"sweep of {names or 'cases'}{zipped} ({n_cases} cases)"
+    return f"sweep of {names or 'cases'}{zipped} ({counted(n_cases, 'case')})"
 
 
 def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
@@ -221,7 +222,7 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
         ax.set_xlabel(axis_label(xk))
         ax.set_ylabel(axis_label(yk))
         ax.set_title(sym, fontsize=9)
-    fig.suptitle(title + (f" ({n_gap} cells failed or not run: blank)" if n_gap else ""), fontsize=10)
+    fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""), fontsize=10)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 from bearingsim.outputs import FolderLock, write_atomic_bytes
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
@@ -186,7 +187,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figur
     if not other:
         return
     if not force:
-        raise UserError(f"{outdir}: holds another sweep or study ({len(other)} of its {len(old)} cases are not in "
+        raise UserError(f"{outdir}: holds another sweep or study ({len(other)} of its {counted(len(old), 'case')} are not in "
                         f"this one); not mixed in: give another -o folder, or add --force to replace it (the same "
                         f"command as before resumes it)")
     for h in other:

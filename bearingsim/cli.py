@@ -110,7 +110,7 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
 
                 name = tomllib.loads(meta["scenario"]).get("name")
             lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
-            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "left_out") if k in meta]
+            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "rotations", "left_out") if k in meta]
             return archive.describe_table(path, what, cols, columns, lines), meta.get("scenario")
     return None
 

@@ -147,6 +147,13 @@ def pocket_face_extent(pitch_radius, pocket_radius, wall_inner_radius, wall_oute
     return edge(wall_inner_radius), edge(wall_outer_radius)
 
 
+def cage_bar_width(pitch_diameter, roller_diameter, pocket_clearance, roller_count):
+    """Width of the cage bar between two neighbouring pockets at the pitch circle: the chord between their
+    centres, ``d_p sin(pi / Z)``, less one pocket's width ``D + s`` (any length unit in, the same out).
+    What the front and rear faces of a pocket can wear together before the bar is worn through."""
+    return pitch_diameter * math.sin(math.pi / roller_count) - roller_diameter - pocket_clearance
+
+
 def palmgren_stiffness(roller_length: float) -> float:
     """Palmgren line-contact constant K of Q = K delta^(10/9), in SI (N / m^(10/9)).
 

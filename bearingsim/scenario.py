@@ -1033,7 +1033,9 @@ def _check_worn(m: ScenarioModel, source: str) -> None:
         if min(min(row) for row in v) < 0.0:
             raise UserError(f"{source}: wear.{k}: a worn depth is negative; wear only removes material")
     deepest = sum(max(max(row) for row in v) for _, v in given) * 1e-3
-    bar = b.pitch_diameter_mm * math.sin(math.pi / b.roller_count) - b.roller_diameter_mm - b.pocket_clearance_mm
+    from bearingsim.laws import cage_bar_width
+
+    bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count)
     if deepest >= bar:
         raise UserError(f"{source}: {key}: the deepest front and rear worn depths ({deepest:.4g} mm together) "
                         f"reach the cage bar's width ({bar:.4g} mm): the bar would be worn through")

@@ -94,6 +94,15 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     return shaft, shaft / rot_per_hour, shaft * cage_speed / op.omega_i
 
 
+def face_area(p, bins: int = 1) -> float:
+    """The area of one arc pocket face of parameters ``p``, or of one of its ``bins`` equal bins of psi
+    [m^2]: the face's arc on the pocket circle (its extent, ``multibody.pocket_face_extent``) times the
+    roller length."""
+    lo, hi = p.multibody.pocket_face_extent
+    pocket_radius = p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance
+    return pocket_radius * (hi - lo) / bins * p.bearing.roller_length
+
+
 def wear_report(result, *, hours: float | None = None, rotations: float | None = None,
                 wear_coefficient: float | None = None, hardness: float | None = None) -> WearReport:
     """The :class:`WearReport` of ``result`` after a running time (``hours`` or inner-ring ``rotations``),
@@ -108,9 +117,7 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
     recorded = result.per_rotation["I_dec"].shape[0]
     scale = cage_rot / recorded
     psi = result.get("wear/profile_psi_deg")
-    lo, hi = p.multibody.pocket_face_extent
-    pocket_radius = p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance
-    area = pocket_radius * (hi - lo) / len(psi) * p.bearing.roller_length
+    area = face_area(p, len(psi))
     vols = {f: laws.archard_volume_from_work(k, result.get(f"wear/profile_work_{f}") * scale, h)
             for f in ("front", "rear")}
     return WearReport(psi, vols["front"] / area, vols["rear"] / area, vols["front"].sum(axis=0),

@@ -355,6 +355,68 @@ def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario,
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("extra, words", [
+    (["--limit", "depth=6mm"], "--limit depth=6mm: the cage bar between two pockets is 5.821 mm wide"),
+    (["--limit", "depth=10000mm"], "--limit depth=10000mm: the cage bar"),
+    (["--limit", "clearance=6.1mm"], "--limit clearance=6.1mm: the cage bar"),
+    (["--limit", "volume=1000mm3"], "--limit volume=1000mm3: the cage bar"),
+    (["--limit", "depth=0.1mm", "--set", "wear.wear_coefficient=0"], "wear.wear_coefficient = 0: nothing wears"),
+], ids=["depth-beyond-bar", "depth-absurd", "clearance-beyond-bar", "volume-beyond-bar", "no-wear"])
+def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, monkeypatch, capsys, extra, words):
+    """A limit beyond the cage bar between two pockets (the wear-test bearing: 104 mm pitch, 16 rollers of
+    13 mm, s = 0.2 mm: 104 sin(pi/16) - 13.2 = 5.821 mm, which the front and rear faces wear through
+    together), or a wear coefficient of 0, is refused in one line before any stage runs, and nothing is
+    created (a stage ran, then the next stage's scenario was refused naming wear.worn_depth_front_um, or
+    'no wear at this stage'; depth=6mm even ran to the end)."""
+    from bearingsim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--stages", "2", "--rotations", "1",
+                 "--set", "multibody.raceway_contact=rigid", *extra])
+    err = capsys.readouterr().err
+    assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (code, err)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_life_ends_in_one_line_when_the_cage_bar_wears_through_before_the_limit(tmp_path, capsys):
+    """A volume limit whose mean depth fits the bar but whose worn edges do not (the roller-guided cage
+    wears its faces' ends two orders of magnitude more per area than their middle, docs/wear.md): the
+    stage whose pockets would be worn through is refused in one line saying the bar wears through first,
+    when and by how much, naming --limit (it named wear.worn_depth_front_um of the scenario file)."""
+    from bearingsim.cli import main
+
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "volume=30mm3", "--stages", "2",
+                 "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1, err
+    assert err[0].startswith("bearingsim: error: --limit volume=30mm3: the cage bar wears through first: after stage 0 ")
+    assert "beyond the 5.821 mm of the bar between two pockets" in err[0]
+    assert not (tmp_path / "life.h5").exists()
+
+
+@pytest.mark.slow
+def test_life_folder_of_other_stages_or_rotations_is_refused_and_a_limit_in_other_units_resumes(tmp_path, capsys):
+    """The stages and rotations per stage make another study (its stages end elsewhere): refused unless
+    --force (they ran over the history silently); the same limit in other units (depth=100um for
+    depth=0.1mm) is the same study and resumes from its stages."""
+    from bearingsim.cli import main
+    from bearingsim.studies.life import read_life
+
+    base = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--set", "multibody.raceway_contact=rigid", "-q",
+            "-o", str(tmp_path)]
+    assert main([*base, "--limit", "depth=0.1mm", "--stages", "2", "--rotations", "1"]) == 0
+    capsys.readouterr()
+    for extra, words in ((["--stages", "3", "--rotations", "1"], "another number of stages (2; this one: --stages 3)"),
+                         (["--stages", "2", "--rotations", "2"], "another number of rotations per stage (1; this "
+                                                                 "one: --rotations 2)")):
+        assert main([*base, "--limit", "depth=0.1mm", *extra]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and words in err[0] and "--force" in err[0], err
+    assert main([*base, "--limit", "depth=100um", "--stages", "2", "--rotations", "1"]) == 0
+    assert read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
+
+
 #: case hash -> the signal its worker sends the study before it runs the case
 _SIGNAL_AT: dict[str, int] = {}
 _RUN_BATCH = None  # the engine's own run_batch, while a test puts _signalling_batch in its place

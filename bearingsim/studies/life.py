@@ -141,6 +141,30 @@ def _start_depth(scenario) -> np.ndarray | None:
     return arr.transpose(1, 2, 0).copy()
 
 
+def _check_reachable(scenario, limit: Limit) -> None:
+    """Refuse a limit that no wear can reach: with no wear (a wear coefficient of 0), or beyond the cage bar
+    between two pockets, which the front and rear faces of a pocket wear through together (the deepest
+    point of one face, the mean worn depth of both over a face's area, or one face's volume over its
+    area reaching the bar's width: worn through before the limit)."""
+    from bearingsim.laws import cage_bar_width
+    from bearingsim.wear import face_area
+
+    if scenario.wear.wear_coefficient <= 0.0:
+        raise UserError(f"{scenario.source}: wear.wear_coefficient = 0: nothing wears, so no limit is ever reached; "
+                        f"give the pocket faces' wear coefficient (docs/wear.md)")
+    b = scenario.bearing
+    bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+    if limit.kind == "depth":
+        depth = limit.value
+    elif limit.kind == "clearance":
+        depth = limit.value - b.pocket_clearance_mm * 1e-3  # front + rear, mean over the faces
+    else:
+        depth = limit.value / face_area(scenario.parameters)
+    if depth >= bar:
+        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide and would be "
+                        f"worn through before that; give a smaller limit")
+
+
 class LifeStudy(Study):
     """A life study (module docstring) as a staged study: stage ``j + 1``'s case is made from stage ``j``'s
     archive (:meth:`next_cases`), each run by the study engine (:func:`bearingsim.studies.run_studies`);
@@ -170,6 +194,7 @@ class LifeStudy(Study):
         if limit.kind == "clearance" and limit.value <= s0:
             raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                             f"(bearing.pocket_clearance_mm); give a larger one")
+        _check_reachable(scenario, limit)
         self.scenario, self.limit, self.planned = scenario, limit, stages
         self.rotations, self.mapping, self.progress = rotations, mapping, progress
         self.state = _State(s0, _start_depth(scenario))
@@ -181,9 +206,26 @@ class LifeStudy(Study):
 
     def _case(self, j: int):
         st = self.state
+        if j and self.mapping == "shape":
+            self._check_bar(j)
         sc = (stage_scenario(self.scenario, st.depth if j else None, j, self.rotations) if self.mapping == "shape"
               else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.clearance()))
         return case_of(sc, {"stage": j})
+
+    def _check_bar(self, j: int) -> None:
+        """Refuse stage ``j`` when the wear of the stages before it has worn a pocket's faces through the cage
+        bar (the deepest front plus the deepest rear depth, as a worn scenario is checked): the bar ends
+        the life before the limit does."""
+        from bearingsim.laws import cage_bar_width
+
+        b = self.scenario.bearing
+        bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+        worn = float(self.state.depth[0].max() + self.state.depth[1].max())
+        if worn >= bar:
+            raise UserError(f"--limit {self.limit.text}: the cage bar wears through first: after stage {j - 1} "
+                            f"({self.state.hours:.4g} h) the deepest front and rear worn depths are {worn * 1e3:.4g} mm "
+                            f"together, beyond the {bar * 1e3:.4g} mm of the bar between two pockets; give a smaller "
+                            f"limit")
 
     def next_cases(self, outdir: Path, records: dict[str, dict]) -> list:
         """The wear of the last stage run (its archive's wear rate, for as many rotations as bring the
@@ -234,10 +276,33 @@ class LifeStudy(Study):
         if len(self.rows) < self.planned:
             return []
         cols = self.columns()
-        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned,
+        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned, "rotations": self.stage_rotations,
                  "scenario": self.scenario.to_toml(), "mapping": self.mapping, "mapping_text": MAPPINGS[self.mapping]}
         archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
         return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
+
+    def _differs(self, attrs: dict) -> str:
+        """What of a ``life.h5``'s study (its attributes) is not this one's: "" when the same, else what
+        differs (the scenario or the limit, the number of stages, the rotations per stage; a limit is the
+        same in other units: depth=100um is depth=0.1mm)."""
+        try:
+            held = parse_limit(attrs.get("limit", ""))
+        except UserError:
+            held = None
+        same_limit = (held is not None and held.kind == self.limit.kind
+                      and math.isclose(held.value, self.limit.value, rel_tol=1e-12))
+        if attrs.get("scenario") != self.scenario.to_toml() or not same_limit:
+            return "scenario or limit"
+        if int(attrs.get("stages", self.planned)) != self.planned:
+            return f"number of stages ({attrs['stages']}; this one: --stages {self.planned})"
+        if "rotations" in attrs and int(attrs["rotations"]) != self.stage_rotations:
+            return f"number of rotations per stage ({attrs['rotations']}; this one: --rotations {self.stage_rotations})"
+        return ""
+
+    @property
+    def stage_rotations(self) -> int:
+        """The recorded cage rotations of each stage (``--rotations``, or the scenario's)."""
+        return int(self.rotations or self.scenario.numerics.rotations)
 
     def check_folder(self, outdir: Path, force: bool) -> None:
         """Refuse a folder that holds another life study (another scenario, limit or mapping in its
@@ -253,8 +318,9 @@ class LifeStudy(Study):
         if path.exists():
             _, attrs = archive.read_table_file(path, LIFE_FORMAT)
             held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
-            if attrs.get("scenario") != self.scenario.to_toml() or attrs.get("limit") != self.limit.text:
-                other = f"{path}: holds a life study of another scenario or limit; give another folder or --force"
+            what = self._differs(attrs)
+            if what:
+                other = f"{path}: holds a life study of another {what}; give another folder or --force"
             elif held != self.mapping:
                 other = (f"{path}: holds a life study with another wear mapping (--mapping {held}; this one: "
                          f"{self.mapping}); give --mapping {held} to resume it, another folder, or --force")

@@ -158,9 +158,13 @@ def _resolved_text(scenario, out=None) -> str:
 def _dry_run(scenario, args) -> int:
     """``run --dry-run``: the resolved scenario and the archive it would write, its output refused as the run
     would refuse it; nothing run or written."""
+    from bearingsim.scenario import out_of_range_note
     from bearingsim.simulation import check_output
 
     out = check_output(scenario, args.output, figures=not args.no_plots, force=args.force)
+    note = None if args.quiet else out_of_range_note(scenario)  # the run's note of it, given before any step
+    if note:
+        print(note, file=sys.stderr)
     _write_toml(_resolved_text(scenario, out))
     return 0
 

@@ -97,6 +97,12 @@ def check(result) -> list[str]:
     notes = []
     p = result.parameters
     summary = dict(result.summary)
+    if getattr(result, "scenario", None) is not None:
+        from bearingsim.scenario import out_of_range_note
+
+        note = out_of_range_note(result.scenario)
+        if note:
+            notes.append(note)
     bad = _nonfinite(summary)
     no_impact = {"first_impact_speed_m_s", "first_impact_energy_J"}
     if p.model == "multibody" and bad and set(bad) <= no_impact:

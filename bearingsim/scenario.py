@@ -712,6 +712,27 @@ def unused_note(model: str, keys, method: str | None = None) -> str | None:
     return "; ".join(parts) or None
 
 
+def out_of_range_note(scenario) -> str | None:
+    """One line naming the keys of a resolved scenario that are set outside their plausible range (its
+    ``[ranges]``, from the preset or the file: what the sensitivity and uncertainty studies sample),
+    those its model uses; None if there are none. Such a run is valid, of a bearing unlike the one the
+    ranges describe."""
+    from bearingsim.ranges import ranged_keys, value_of
+
+    ranged = ranged_keys(scenario)
+    used = [k for k in ranged if k not in unused_keys(scenario.model, [k], scenario.reduced.method)]
+    out = []
+    for k in used:
+        lo, hi, _ = ranged[k]
+        v = value_of(scenario, k)
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and not lo <= v <= hi:
+            out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g})")
+    if not out:
+        return None
+    return (f"bearingsim: note: {'; '.join(out)}: outside the plausible range of the preset's bearing "
+            f"('bearingsim keys KEY --why' says where it comes from); the run is of another bearing")
+
+
 def given_keys(path, overrides=()) -> list[str]:
     """Every dotted key a scenario file and its ``KEY=VALUE`` overrides set (not its preset's or the
     defaults': those are the model's own)."""

@@ -115,3 +115,25 @@ def test_a_first_rotation_still_in_the_start_transient_gets_a_note():
     assert not [n for n in settled.notes if "first recorded rotation" in n]
     rel, sds, _ = plausibility._first_rotation_offset(settled)
     assert abs(rel) < plausibility.START_TRANSIENT_MIN_REL and sds < plausibility.START_TRANSIENT_SD
+
+
+def test_a_key_set_outside_its_plausible_range_gets_a_note_in_the_run_and_the_dry_run(tmp_path):
+    """The preset's plausible ranges ([ranges], what the sensitivity studies sample) describe its bearing: a
+    run with a key its model uses set outside them (s = 3 mm against 0.16 to 0.24 mm) is valid and gets a
+    note saying so, in ``result.notes`` and on the command line, and in the dry run before it (it said
+    nothing); a key the model does not use (a reduced run's cage bore) and a value inside get none."""
+    from bearingsim.scenario import load_scenario
+    from bearingsim.simulation import run
+
+    paper = PAPER
+    wide = run(load_scenario(paper, ["bearing.pocket_clearance_mm=3"]))
+    assert [n for n in wide.notes if "plausible" in n] == [
+        "bearingsim: note: bearing.pocket_clearance_mm = 3 (plausible 0.16 to 0.24): outside the plausible range of "
+        "the preset's bearing ('bearingsim keys KEY --why' says where it comes from); the run is of another bearing"]
+    for sets in (["bearing.pocket_clearance_mm=0.24"], ["bearing.cage_inner_diameter_mm=80"]):
+        assert not [n for n in run(load_scenario(paper, sets)).notes if "plausible" in n], sets
+    dry = cli("run", paper, "--set", "bearing.pocket_clearance_mm=3", "--dry-run", cwd=tmp_path)
+    real = cli("run", paper, "--set", "bearing.pocket_clearance_mm=3", "--no-plots", "-o", tmp_path / "a.h5")
+    assert dry.returncode == 0 and real.returncode == 0, (dry.stderr, real.stderr)
+    assert [line for line in dry.stderr.splitlines() if "plausible" in line] == [wide.notes[-1]]
+    assert [line for line in real.stderr.splitlines() if "plausible" in line] == [wide.notes[-1]]

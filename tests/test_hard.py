@@ -147,7 +147,25 @@ def test_cage_that_escapes_its_pockets_is_stopped_and_not_written(tmp_path):
                      "--set", "numerics.rotations=3", "-o", out, "--no-plots")
     assert res.returncode == 3, res.stderr
     lines = [line for line in res.stderr.splitlines() if line.strip()]
-    assert len(lines) == 1 and "multibody.pocket_face_half_angle_deg" in lines[0], res.stderr
+    assert len(lines) == 1 and "multibody.pocket_face_half_angle_deg = 10; the cage wall allows up to" in lines[0], res.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_a_cage_that_escapes_faces_already_at_the_wall_is_told_what_holds_it(tmp_path):
+    """A 2 mm pocket clearance (ten times the reference's) lets the roller-guided cage leave the reach of
+    faces that already span the cage wall: the run stops (exit 3, no archive) naming the pocket clearance and
+    the ring land, and does not advise widening the faces, which the wall does not allow (it did: the
+    newcomer's trial was then refused 'at most 21.8' for the half angle it was told to widen)."""
+    res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "bearing.pocket_clearance_mm=2",
+                     "--set", "multibody.raceway_contact=rigid", "--set", "numerics.rotations=2",
+                     "-o", tmp_path / "c.h5", "--no-plots")
+    assert res.returncode == 3, res.stderr
+    lines = [line for line in res.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1, res.stderr
+    assert ("the faces already span the cage wall (multibody.pocket_face_half_angle_deg = 'auto'): give a smaller "
+            "pocket clearance (bearing.pocket_clearance_mm = 2 mm) or guide the cage on a ring land") in lines[0]
+    assert "widen" not in lines[0]
     assert list(tmp_path.iterdir()) == []
 
 

@@ -876,9 +876,28 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
         raise SimulationUnstable(
             f"the cage centre moved {off:.4g} mm off the bearing axis at "
             f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({su.face_reach * 1e3:.4g} mm): the rollers no "
-            f"longer hold it; widen the faces (multibody.pocket_face_half_angle_deg, at most what the cage wall "
-            f"allows) or guide the cage on a ring land (bearing.cage_guidance)")
+            f"longer hold it; {_hold_advice(su.p)}")
     raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
+
+
+def _hold_advice(p) -> str:
+    """What lets the rollers hold a roller-guided cage that got away from them: wider faces where the cage
+    wall allows them, a smaller pocket play, or a ring land to guide the cage."""
+    b, mb = p.bearing, p.multibody
+    rest = (f"give a smaller pocket clearance (bearing.pocket_clearance_mm = {b.pocket_clearance * 1e3:g} mm) or guide "
+            f"the cage on a ring land (bearing.cage_guidance)")
+    if mb.pocket_face_rule != "given":
+        return f"the faces already span the cage wall (multibody.pocket_face_half_angle_deg = 'auto'): {rest}"
+    if b.cage_inner_radius is None or b.cage_outer_radius is None:
+        return f"widen the faces (multibody.pocket_face_half_angle_deg), {rest}"
+    lo, hi = laws.pocket_face_extent(b.pitch_radius, b.roller_radius + 0.5 * b.pocket_clearance, b.cage_inner_radius,
+                                     b.cage_outer_radius)
+    wall = math.degrees(min(-lo, hi))
+    given = math.degrees(min(-mb.pocket_face_extent[0], mb.pocket_face_extent[1]))
+    if given < wall * (1.0 - 1e-9):
+        return (f"widen the faces (multibody.pocket_face_half_angle_deg = {given:.4g}; the cage wall allows up to "
+                f"{wall:.4g} deg, or 'auto'), {rest}")
+    return f"the faces already span the cage wall (multibody.pocket_face_half_angle_deg = {given:.4g} deg): {rest}"
 
 
 def _raw(su: MultibodySetup, pl: _Placed, acc, st, loop_s: float, t_wall0: float) -> MultibodyRaw:

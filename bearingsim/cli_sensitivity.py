@@ -96,7 +96,7 @@ def _common(p, default_out):
     p.add_argument("--keys", metavar="K1,K2,...", help="dotted keys to vary (default: every ranged key the model reads)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key (repeatable)")
     p.add_argument("-o", "--output", default=default_out, help="output folder")
-    p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
+    p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core; at most one per case)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table (failures still said)")
     p.add_argument("--force", action="store_true",

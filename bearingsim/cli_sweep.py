@@ -91,7 +91,7 @@ def add_commands(sub) -> None:
     s.add_argument("--archives", choices=("none", "all"), default=None,
                    help="per-case archives in DIR/cases/: 'all' or 'none' (default: the multibody cases only; "
                         "every case's numbers are in the index sweep.h5 and, for a product grid, map.h5)")
-    s.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core)")
+    s.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core; at most one per case)")
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")
     s.add_argument("--no-plots", action="store_true", help="index only, no figures")

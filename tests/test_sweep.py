@@ -77,6 +77,34 @@ def test_key_twice_or_unknown_is_refused_before_running(tmp_path, args, key):
     assert not (tmp_path / "out").exists()
 
 
+def test_set_on_the_command_line_overrides_the_sweep_files_set():
+    """`--set` adds to a sweep file as it adds to a scenario file: a key the file's [set] also gives takes the
+    command line's value (it was refused, 'numerics.rotations: given twice', so a shipped sweep could not be
+    shortened without copying it); the same key twice on the command line is still refused."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.spec import spec_from_args
+
+    path = SCENARIOS / "sweeps" / "multibody_speed.toml"  # [set] numerics.rotations = 10
+    cases = resolve_cases(spec_from_args(path, [], ["numerics.rotations=2"]))
+    assert len(cases) == 5 and {scenario_from_toml(c.toml).numerics.rotations for c in cases} == {2}
+    assert {scenario_from_toml(c.toml).numerics.rotations for c in resolve_cases(spec_from_args(path, [], []))} == {10}
+    with pytest.raises(UserError, match="numerics.rotations"):
+        resolve_cases(spec_from_args(path, [], ["numerics.rotations=2", "numerics.rotations=3"]))
+
+
+@pytest.mark.parametrize("spec_or_cases", ["spec", "cases"])
+def test_the_pool_has_no_more_workers_than_the_sweep_has_cases(tmp_path, spec_or_cases):
+    """`-j 1000` for a sweep of two cases started a thousand worker processes (the trial's machine ran out
+    of memory); the local pool is as large as -j asks or as the sweep has cases, whichever is fewer, both
+    when the reduced model's workers are warmed up from the sweep's description and when cases are given."""
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [500.0, 600.0])])
+    engine = LocalEngine(16)  # not more: were the pool as large as -j, this test would start that many processes
+    out = run_sweep(spec if spec_or_cases == "spec" else resolve_cases(spec), tmp_path, engine=engine,
+                    figures=False, progress=False)
+    assert [r["status"] for r in out.rows] == ["done", "done"]
+    assert (engine.jobs, engine.workers) == (16, 2)
+
+
 @pytest.mark.slow
 def test_sweep_file_zip_and_extra_cases(tmp_path):
     f = tmp_path / "s.toml"

@@ -51,13 +51,18 @@ class LocalEngine:
     def __init__(self, jobs: int = 1):
         if jobs < 1:
             raise UserError(f"--jobs: must be at least 1 (got {jobs})")
-        self.workers = jobs
+        self.jobs = jobs  #: the worker processes asked for
+        self.workers = jobs  #: the pool's (at most one per case of the sweep it runs: start)
         self._pool = None
 
-    def start(self) -> None:
+    def start(self, cases: int | None = None) -> None:
+        """Start the pool: ``jobs`` worker processes, or as many as the sweep has ``cases`` when that is
+        fewer (a worker with no case to run costs a process and its memory: ``-j 1000`` for two cases
+        started a thousand)."""
         import multiprocessing as mp
 
         if self._pool is None:
+            self.workers = min(self.jobs, cases) if cases else self.jobs
             # fork: workers start in milliseconds and inherit the imported package
             self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
 
@@ -74,7 +79,7 @@ class LocalEngine:
             return
         if base.model != "reduced":
             return
-        self.start()
+        self.start(spec.size)
         text = base.to_toml()
         for _ in range(self.workers):
             self._pool.apply_async(warm_up, (text, keeps_archive("reduced", archives)))
@@ -160,7 +165,8 @@ class DaskEngine:
         self._futures: list = []
         self.workers = 0
 
-    def start(self) -> None:
+    def start(self, cases: int | None = None) -> None:
+        """Connect to the cluster (``cases``: the sweep's, unused: the cluster's workers are the user's)."""
         if self.client is not None:
             return
         try:

@@ -314,7 +314,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
             raise UserError(f"--archives: expected one of {', '.join(ARCHIVE_POLICIES)} (got {archives!r})")
         grid = grid_axes(spec)
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
-        engine.start()  # an unreachable scheduler stops the sweep before anything is written
+        engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
         outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, check_folder)
     except BaseException:
         engine.stop()

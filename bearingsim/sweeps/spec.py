@@ -87,6 +87,14 @@ class SweepSpec:
     origin: str = "--param"
 
     @property
+    def size(self) -> int:
+        """How many cases the sweep describes: the grid's rows (product or zip of the axes) and the extra
+        cases (two of them that are the same scenario are refused when resolved)."""
+        sizes = [len(v) for _, v in self.axes]
+        grid = (math.prod(sizes) if self.mode != "zip" else max(sizes)) if sizes else 0
+        return grid + len(self.extra)
+
+    @property
     def keys(self) -> list[str]:
         """Every swept key: the axes' keys, then keys only set by extra cases, in order of appearance."""
         out = [k for k, _ in self.axes]
@@ -234,7 +242,8 @@ def spec_from_args(target: str | Path, params: list[str], sets: list[str]) -> Sw
     if extra_axes and spec.mode == "zip":
         raise UserError(f"{target}: mode: --param adds a product axis; not allowed with mode = \"zip\"")
     spec.axes = spec.axes + extra_axes
-    spec.sets = spec.sets + list(sets)
+    given = {parse_override(o)[0] for o in sets}  # the command line's --set overrides the file's [set], as
+    spec.sets = [o for o in spec.sets if parse_override(o)[0] not in given] + list(sets)  # run's the scenario's
     return spec
 
 
@@ -296,8 +305,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
     if not spec.axes and not spec.extra:
         raise UserError(f"{where}: nothing to sweep (no axes and no cases)")
     sizes = [len(v) for _, v in spec.axes]
-    total = (math.prod(sizes) if spec.mode != "zip" else max(sizes)) if sizes else 0
-    total += len(spec.extra)
+    total = spec.size
     if total > MAX_SWEEP_CASES:  # counted before any case is built
         shape = (" x " if spec.mode != "zip" else ", ").join(f"{k} ({n})" for (k, _), n in zip(spec.axes, sizes))
         raise UserError(f"{where}: {total} cases ({shape or 'extra cases'}) are more than the {MAX_SWEEP_CASES} a "

@@ -614,7 +614,7 @@ def _add_study_commands(sub) -> None:
     cc.set_defaults(func=_cmd_crosscheck)
     rp = sub.add_parser("report", help="one self-contained HTML page of a run archive, a sweep folder or a study "
                                        "folder: figures, animation, tables, checks, scenario, provenance (docs/report.md)")
-    rp.add_argument("path", help="run archive, or sweep, cross-check, sensitivity, uncertainty or life folder")
+    rp.add_argument("path", help="run archive, or sweep, cross-check, validate, sensitivity, uncertainty or life folder")
     rp.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default report.html)")
     rp.add_argument("--animation", choices=("gif", "mp4", "none"), default="gif",
                     help="embed an archive's animation as a GIF image (default), an MP4 video, or not at all")

@@ -140,7 +140,7 @@ def read_fig9(path) -> dict[str, np.ndarray]:
     return {name: np.array([float(r[j]) for r in rows[1:]]) for j, name in enumerate(rows[0])}
 
 
-def _column_label(col: str) -> str:
+def column_label(col: str) -> str:
     """``I_dec_c0.01_Ns`` -> ``c = 0.01``; ``I_dec_previous_c0.02_Ns`` -> ``previous c = 0.02``."""
     name = col.removeprefix("I_dec_").removesuffix("_Ns")
     prev = name.startswith("previous_")
@@ -151,7 +151,7 @@ def format_table(table: dict[str, np.ndarray]) -> str:
     """The Fig. 9 table for the terminal: one row per speed, I_dec per cage rotation [mN s] of each drag
     coefficient and of the previous model (n/a: a failed case)."""
     cols = [c for c in table if c != "speed_rpm"]
-    labels = [_column_label(c) for c in cols]
+    labels = [column_label(c) for c in cols]
     widths = [max(8, len(x)) for x in labels]
     lines = ["Fig. 9 analog: the reduced model's I_dec per cage rotation [mN s] (NU214, 970 N, φ = 23.5°; "
              "previous: no gravity, no resting contact)",

@@ -8,7 +8,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
-import math
 import os
 import signal
 import sys
@@ -339,11 +338,12 @@ def _compare_many(paths, args) -> int:
 
 
 def _cmd_table(args) -> int:
-    """``bearingsim table DIR|FILES...``: summary numbers side by side (:mod:`bearingsim.tables`)."""
+    """``bearingsim table DIR|FILES...``: summary numbers side by side, or a study's own table
+    (:mod:`bearingsim.tables`)."""
     from bearingsim import tables
 
     columns = [c.strip() for c in args.columns.split(",") if c.strip()] if args.columns else None
-    print(tables.format_table(tables.table_of(args.paths), columns=columns))
+    print(tables.format_paths(args.paths, columns=columns))
     return 0
 
 
@@ -381,16 +381,9 @@ def _print_validate(args, studies, outcome) -> None:
     for p in outcome.written[:2]:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:
-        rows = studies[1].rows
-        print(f"rig scene (pocket 0 flat), 1 warm-up + {counted(args.rig_rotations, 'rotation')}, against the reduced "
-              "model:")
-        print(f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}")
-        for r in rows:
-            std = r["pocket0_I_dec_std_Ns"] * 1e3
-            std = f"{std:5.2f}" if math.isfinite(std) else "  n/a"  # one rotation: no scatter (tables: n/a)
-            print(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {std} (std) "
-                  f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
-                  f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
+        from bearingsim.studies.rig import format_table
+
+        print(format_table(studies[1].rows, args.rig_rotations))
         for p in outcome.written[2:]:
             print(f"wrote {p}")
     if outcome.interrupted is None:
@@ -556,12 +549,16 @@ def _add_run_commands(sub) -> None:
     cp.add_argument("archives", nargs="+", metavar="ARCHIVE")
     cp.set_defaults(func=_cmd_compare)
 
-    tb = sub.add_parser("table", help="summary numbers of a sweep, cross-check or validate folder (its index), or of "
-                                      "archives, as aligned columns with units, standard errors and significance marks")
-    tb.add_argument("paths", nargs="+", metavar="DIR|FILE", help="one folder or sweep.h5, or run archives")
+    tb = sub.add_parser("table", help="summary numbers of a sweep folder (its index sweep.h5) or of archives, as "
+                                      "aligned columns with units, standard errors and significance marks; of a study "
+                                      "folder (cross-check, validate, sensitivity, uncertainty, life) or its table file, "
+                                      "the study's own table")
+    tb.add_argument("paths", nargs="+", metavar="DIR|FILE",
+                    help="one folder, sweep.h5 or study table (crosscheck.h5, sensitivity.h5, uncertainty.h5, life.h5), "
+                         "or run archives")
     tb.add_argument("--columns", metavar="KEY,...",
                     help="summary keys to show (default: I_dec_mean_Ns, I_acc_mean_Ns, first_impact_speed_m_s, "
-                         "cage_slip, load_zone_half_angle_deg, those present)")
+                         "cage_slip, load_zone_half_angle_deg, those present); not for a study's own table")
     tb.set_defaults(func=_cmd_table)
 
     ks = sub.add_parser("keys", help="every scenario key with its unit, type and bounds, default and source")
@@ -621,7 +618,7 @@ def _add_study_commands(sub) -> None:
     cc.set_defaults(func=_cmd_crosscheck)
     rp = sub.add_parser("report", help="one self-contained HTML page of a run archive, a sweep folder or a study "
                                        "folder: figures, animation, tables, checks, scenario, provenance (docs/report.md)")
-    rp.add_argument("path", help="run archive, or sweep, cross-check, sensitivity, uncertainty or life folder")
+    rp.add_argument("path", help="run archive, or sweep, cross-check, validate, sensitivity, uncertainty or life folder")
     rp.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default report.html)")
     rp.add_argument("--animation", choices=("gif", "mp4", "none"), default="gif",
                     help="embed an archive's animation as a GIF image (default), an MP4 video, or not at all")

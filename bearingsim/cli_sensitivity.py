@@ -36,17 +36,9 @@ def _run(study, args):
     return outcome, time.perf_counter() - t0
 
 
-def _num(v, spec: str) -> str:
-    """``v`` formatted by ``spec``, or ``n/a`` (as wide) where it is not a number."""
-    import math
-
-    width = len(format(0.0, spec))
-    return format(v, spec) if math.isfinite(v) else "n/a".rjust(width)
-
-
 def _cmd_sensitivity(args) -> int:
     from bearingsim.cli_common import report_study
-    from bearingsim.studies.sensitivity import Sensitivity, missing_note, parse_step
+    from bearingsim.studies.sensitivity import Sensitivity, format_table, parse_step
 
     step = parse_step(args.step)
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
@@ -56,12 +48,7 @@ def _cmd_sensitivity(args) -> int:
               f"key's range, {wall:.1f} s")
         for k, why in study.left_out:
             print(f"left out: {k}: {why}; give it a nonzero value to vary it")
-        print(f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}")
-        for r in study.rows:
-            note = missing_note(r)
-            print(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
-                  f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
-                  + (f"  ({note})" if note else ""))
+        print(format_table(study.rows))
         for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
@@ -70,7 +57,7 @@ def _cmd_sensitivity(args) -> int:
 
 def _cmd_uncertainty(args) -> int:
     from bearingsim.cli_common import report_study
-    from bearingsim.studies.uncertainty import Uncertainty
+    from bearingsim.studies.uncertainty import Uncertainty, format_table
 
     study = Uncertainty(_scenario(args), args.samples, args.seed, _keys(args.keys))
     outcome, wall = _run(study, args)
@@ -78,13 +65,7 @@ def _cmd_uncertainty(args) -> int:
         print(f"uncertainty of {args.scenario}: {counted(len(study.keys), 'key')}, N = {args.samples} "
               f"({counted(len(study.cases), 'run')}), "
               f"seed {args.seed}, {wall:.1f} s")
-        for s in study.spreads:
-            print(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
-                  f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
-        print(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
-        for r in study.indices:
-            print(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "
-                  f"{r['ST']:+6.3f} [{r['ST_low']:+.3f}, {r['ST_high']:+.3f}]")
+        print(format_table(study.spreads, study.indices))
         for name in ("uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png"):
             print(f"wrote {Path(args.output) / name}")
         print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")

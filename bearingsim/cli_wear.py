@@ -6,7 +6,6 @@ import sys
 from pathlib import Path
 
 from bearingsim.errors import UserError
-from bearingsim.wording import counted
 
 
 def _cmd_wear(args) -> int:
@@ -50,15 +49,7 @@ def _cmd_life(args) -> int:
     code = report_study(outcome, "life")
     if code:
         return code
-    cols = study.columns()
-    print(f"life of {args.scenario} to {limit.text}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} "
-          f"inner-ring rotations in {counted(len(cols['stage']), 'stage')}")
-    print(f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
-          f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}")
-    for i in range(len(cols["stage"])):
-        print(f"{cols['stage'][i]:>5} {cols['pocket_clearance_mm'][i]:>8.4f} {cols['stage_rotations'][i]:>11.4g} "
-              f"{cols['hours_end'][i]:>9.4g} {cols['max_depth_rate_um_per_h'][i]:>18.4g} "
-              f"{cols['max_depth_um'][i]:>13.4g} {cols['I_dec_mean_mNs'][i]:>13.4g} {cols['reused'][i]:>6}")
+    print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}"))
     for path in outcome.written:
         print(f"wrote {path}")
     return 0

@@ -1,5 +1,6 @@
 """One self-contained HTML report of a run archive, a sweep folder or a study folder (cross-check,
-sensitivity, uncertainty, life): ``bearingsim report PATH -o report.html``, ``bearingsim.report(path, out)``.
+validate, sensitivity, uncertainty, life): ``bearingsim report PATH -o report.html``,
+``bearingsim.report(path, out)``.
 
 The page gathers what the other commands print and draw, read from the files alone: the figures
 (the same figure functions as ``bearingsim plot``, the sweeps' and the studies', embedded as PNG data
@@ -32,7 +33,7 @@ SUFFIXES = (".html", ".htm")
 MAX_ROWS = 200
 #: the formats of the embedded animation and how the page shows them
 ANIMATIONS = {"gif": ("image/gif", "img"), "mp4": ("video/mp4", "video")}
-KINDS = ("run", "sweep", "crosscheck", "sensitivity", "uncertainty", "life")
+KINDS = ("run", "sweep", "crosscheck", "validate", "sensitivity", "uncertainty", "life")
 
 
 @dataclass
@@ -48,32 +49,27 @@ class Section:
 # --- what PATH is -------------------------------------------------------------------------------
 def kind_of(path) -> tuple[str, Path]:
     """``(kind, file)`` of ``path``: a run archive (``"run"``, the archive) or a folder (or its table
-    file) of a life study, cross-check, sensitivity or uncertainty study or sweep (the kind and its
-    table file); a one-line UserError for anything else."""
-    from bearingsim import archive
+    file) of a study (life, cross-check, sensitivity, uncertainty, validate:
+    :func:`bearingsim.tables.study_of`) or of a sweep (the kind and its table file; a study folder also
+    holds the sweep index of its cases, reported as a sweep when given as ``DIR/sweep.h5``); a one-line
+    UserError for anything else."""
+    from bearingsim import archive, tables
+    from bearingsim.sweeps.index import INDEX_FORMAT
 
     p = Path(path)
     if not p.exists():
         raise UserError(f"{p}: file or folder not found")
     if p.is_file() and archive.is_archive(p):
         return "run", p
-    folder = p if p.is_dir() else p.parent
-    for kind, name, fmt in _tables():
-        f = folder / name
-        if (p.is_dir() or p.name == name) and f.is_file() and archive.is_table_file(f, fmt):
-            return kind, f
-    raise UserError(f"{p}: not a bearingsim archive, nor a sweep, cross-check, sensitivity, uncertainty or life "
-                    f"folder (no sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
-
-
-def _tables():
-    """(kind, file name, format) of the folders' tables, a study's before the sweep index it also has."""
-    from bearingsim.studies import crosscheck, life, sensitivity, uncertainty
-    from bearingsim.sweeps.index import INDEX_FORMAT
-
-    return (("life", "life.h5", life.LIFE_FORMAT), ("crosscheck", "crosscheck.h5", crosscheck.INDEX_FORMAT),
-            ("sensitivity", "sensitivity.h5", sensitivity.INDEX_FORMAT),
-            ("uncertainty", "uncertainty.h5", uncertainty.INDEX_FORMAT), ("sweep", "sweep.h5", INDEX_FORMAT))
+    found = tables.study_of(p)
+    if found is not None:
+        return found
+    index = p / "sweep.h5" if p.is_dir() else p
+    if index.name == "sweep.h5" and index.is_file() and archive.is_table_file(index, INDEX_FORMAT):
+        return "sweep", index
+    raise UserError(f"{p}: not a bearingsim archive, nor a sweep, cross-check, validate, sensitivity, uncertainty or "
+                    f"life folder (no sweep.h5, crosscheck.h5, fig9_idec_vs_speed.csv, sensitivity.h5, uncertainty.h5 "
+                    f"or life.h5 in it)")
 
 
 # --- the report ---------------------------------------------------------------------------------
@@ -131,10 +127,10 @@ def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
 def _sections(kind: str, file: Path, animation) -> tuple[str, list[Section]]:
     if kind == "run":
         return _run_sections(file, animation)
-    builders = {"sweep": _sweep_sections, "crosscheck": _crosscheck_sections, "sensitivity": _sensitivity_sections,
-                "uncertainty": _uncertainty_sections, "life": _life_sections}
-    title, sections, toml = builders[kind](file)
-    sections += _folder_sections(file.parent, toml)
+    builders = {"sweep": _sweep_sections, "crosscheck": _crosscheck_sections, "validate": _validate_sections,
+                "sensitivity": _sensitivity_sections, "uncertainty": _uncertainty_sections, "life": _life_sections}
+    title, sections, scenario = builders[kind](file)  # scenario: the folder's scenario as TOML, or its blocks
+    sections += _folder_sections(file.parent, scenario)
     return title, sections
 
 
@@ -356,6 +352,79 @@ def _pm(mean, sem) -> str:
     return f"{_cell(mean, 1e3)} ± {_cell(sem, 1e3, 2) if math.isfinite(sem) else 'n/a'}"
 
 
+#: validate's figures in the page, by file name
+VALIDATE_CAPTIONS = {
+    "fig9_idec_vs_speed.png": "fig9_idec_vs_speed.png: the reduced model's I_dec per cage rotation against speed for "
+                              "three drag coefficients and the paper's previous model (Fig. 9 analog)",
+    "rig_idec_vs_speed.png": "rig_idec_vs_speed.png: the rig scene's flat pocket 0 and its 15 arc pockets against the "
+                             "reduced model, mean ± std over rotations",
+    "rig_pocket0_forces.png": "rig_pocket0_forces.png: the mean circumferential force on pocket 0's faces against θ at "
+                              "each speed (Fig. 5 analog)",
+}
+
+
+def _validate_sections(table: Path):
+    """A validate folder: its Fig. 9 table and rig table, the figures the studies drew there (embedded as
+    they are), and a rig case's scenario (every case has its own)."""
+    from bearingsim.studies import validate
+
+    got = validate.read_validate(table.parent)
+    speeds = counted(len(got.fig9["speed_rpm"]), "speed")
+    blocks = [{"kind": "text", "text": f"bearingsim validate: the reduced model's Fig. 9 analog ({speeds}) and the "
+                                       "paper's measurement rig as a whole-bearing scene against it "
+                                       "(docs/validation.md)."}, _fig9_block(got.fig9)]
+    if got.rig is not None:
+        blocks.append(_rig_block(got.rig, got.rig_rotations))
+    else:
+        blocks.append({"kind": "text", "text": "No rig table in this folder (validate --rig-rotations 0, or no rig "
+                                               "speed finished)."})
+    figures = [{"kind": "figure", "src": _data_uri(p.read_bytes(), "image/png"),
+                "caption": VALIDATE_CAPTIONS.get(p.name, p.name)} for p in got.figures]
+    sections = [Section("table", "Validation", blocks), Section("figures", "Figures", figures)]
+    rig = f" and the rig scene ({counted(len(got.rig), 'speed')})" if got.rig else ""
+    return f"Validation against the paper: Fig. 9 analog{rig}", sections, _validate_scenario(table.parent)
+
+
+def _fig9_block(table: dict) -> dict:
+    from bearingsim.studies.fig9 import column_label
+
+    cols = [c for c in table if c != "speed_rpm"]
+    rows = [[_cell(n), *(_cell(table[c][i], 1e3) for c in cols)] for i, n in enumerate(table["speed_rpm"])]
+    return table_block("Fig. 9 analog: the reduced model's I_dec per cage rotation [mN s] (NU214, 970 N, φ = 23.5°; "
+                       "previous: the paper's previous model, no gravity, no resting contact)",
+                       ["rpm", *(column_label(c) for c in cols)], rows, [True] * (len(cols) + 1),
+                       "-: a failed case.")
+
+
+def _rig_block(rows: list[dict], rotations: int) -> dict:
+    cells = [[_cell(r["rpm"]), _cell(r["pocket0_I_dec_mean_Ns"], 1e3),
+              _cell(r["pocket0_I_dec_std_Ns"], 1e3, 2) if math.isfinite(r["pocket0_I_dec_std_Ns"]) else "n/a",
+              _cell(r["reduced_I_dec_Ns"], 1e3), _cell(r["pocket0_I_dec_mean_Ns"] / r["reduced_I_dec_Ns"], digits=3),
+              _cell(r["arc_pockets_I_dec_mean_Ns"], 1e3)] for r in rows]
+    return table_block(f"The rig scene (pocket 0 flat; 1 warm-up + {counted(rotations, 'rotation')}) against the "
+                       "reduced model", ["rpm", "pocket 0 I_dec [mN s]", "std over rotations [mN s]",
+                                         "reduced model [mN s]", "ratio", "arc pockets [mN s]"], cells,
+                       [True] * 6, "std n/a: one recorded rotation has no scatter.")
+
+
+def _validate_scenario(folder: Path) -> list[dict]:
+    """The Scenario section's blocks of a validate folder: every case has its own scenario; shown is the
+    first finished rig case's (else the first finished case's), as its archive stores it."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import read_index
+
+    cols, _ = read_index(folder / "sweep.h5")
+    done = [i for i, s in enumerate(cols["status"]) if str(s) in ("done", "cached", "stale") and cols["archive"][i]]
+    pick = next((i for i in done if str(cols["study"][i]) == "rig"), done[0] if done else None)
+    got = archive.peek(folder / str(cols["archive"][pick])) if pick is not None else None
+    if got is None:
+        return _scenario_blocks(None, folder)
+    where = f"{cols['archive'][pick]} ({cols['study'][pick]} case at {float(cols['rpm'][pick]):g} rpm)"
+    return [{"kind": "text", "text": f"Every case has its own scenario ('bearingsim show DIR/cases/<hash>.h5'). This is "
+                                    f"the resolved scenario of {where}; save it as a .toml file to run it again."},
+            {"kind": "pre", "text": got["scenario"]}]
+
+
 def _sensitivity_sections(table: Path):
     from bearingsim.studies import sensitivity as sens
 
@@ -419,8 +488,8 @@ def _life_sections(table: Path):
 
 
 def _folder_sections(folder: Path, toml) -> list[Section]:
-    """The cases (status counts, failures), the scenario and the provenance of a folder's first case
-    archive."""
+    """The cases (status counts, failures), the scenario (``toml``: the folder's scenario as TOML text,
+    or the Scenario section's blocks) and the provenance of a folder's first case archive."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
 
@@ -438,8 +507,8 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         if failed:
             checks.append(table_block("Failed cases", ["case", "error"], failed))
         first = next((folder / a for a in cols["archive"] if a and (folder / a).is_file()), None)
-    sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario",
-                                                                        _scenario_blocks(toml, folder))]
+    scenario = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
+    sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario", scenario)]
     if first is not None:
         from bearingsim.simulation import load
 

@@ -1,6 +1,6 @@
 """Tables for the terminal: summary numbers of several runs side by side, with units, standard errors
 and significance marks (``bearingsim table``, ``bearingsim compare A B C ...``, the end of
-``bearingsim sweep``).
+``bearingsim sweep``); and a study folder's own table (:func:`study_of`, :func:`study_text`).
 
 A table has one row per run (an archive, or a case of a sweep's or study's index ``sweep.h5``), label
 columns (the file, the swept keys or the scenario keys that differ) and number columns (summary
@@ -143,9 +143,101 @@ def _is_number(v) -> bool:
     return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
 
 
+#: a study's table files, the most specific first: a study folder also holds the case index of its cases
+#: (``sweep.h5``), which a study's table is about; (kind, file name)
+STUDY_TABLES = (("life", "life.h5"), ("crosscheck", "crosscheck.h5"), ("sensitivity", "sensitivity.h5"),
+                ("uncertainty", "uncertainty.h5"), ("validate", "fig9_idec_vs_speed.csv"))
+#: what each kind of study is called in messages
+STUDY_NAMES = {"life": "life study", "crosscheck": "cross-check", "sensitivity": "sensitivity study",
+               "uncertainty": "uncertainty study", "validate": "validate"}
+
+
+def _is_study_table(kind: str, path: Path) -> bool:
+    from bearingsim import archive
+
+    if kind == "validate":
+        from bearingsim.studies.validate import is_validate_table
+
+        return is_validate_table(path)
+    from bearingsim.studies import crosscheck, life, sensitivity, uncertainty
+
+    fmt = {"life": life.LIFE_FORMAT, "crosscheck": crosscheck.INDEX_FORMAT, "sensitivity": sensitivity.INDEX_FORMAT,
+           "uncertainty": uncertainty.INDEX_FORMAT}[kind]
+    return archive.is_table_file(path, fmt)
+
+
+def study_of(path) -> tuple[str, Path] | None:
+    """``(kind, table file)`` of a study folder (life, cross-check, sensitivity, uncertainty or validate:
+    :data:`STUDY_TABLES`) or of its table file; None for anything else (a sweep folder, a case index, an
+    archive)."""
+    p = Path(path)
+    if not p.exists():
+        return None
+    folder = p if p.is_dir() else p.parent
+    for kind, name in STUDY_TABLES:
+        if (p.is_dir() or p.name == name) and _is_study_table(kind, folder / name):
+            return kind, folder / name
+    return None
+
+
+def study_text(kind: str, file: Path) -> str:
+    """A study's own table for the terminal, as its command prints it at its end, under one line naming
+    the file and the study (``kind`` and ``file`` as :func:`study_of` gives them)."""
+    import json
+    import tomllib
+
+    from bearingsim.studies import crosscheck, life, sensitivity, uncertainty
+    from bearingsim.wording import counted
+
+    if kind == "validate":
+        from bearingsim.studies.validate import format_tables, read_validate
+
+        return (f"{file.parent}: validate: the reduced model's Fig. 9 analog and the rig scene against it "
+                f"(docs/validation.md)\n" + format_tables(read_validate(file.parent)))
+    if kind == "crosscheck":
+        rows, meta = crosscheck.read_table(file)
+        speeds = len({r["rpm"] for r in rows})
+        return "\n".join([f"{file}: cross-check of {meta.get('scenario_name', '?')}: {counted(speeds, 'speed')} x "
+                          f"{len(crosscheck.RUNGS)} rungs; impulses per pocket and cage rotation, mean over all pockets ± "
+                          "batch-means standard error", crosscheck.format_table(rows), *crosscheck.verdicts(rows)])
+    if kind == "sensitivity":
+        rows, meta = sensitivity.read_table(file)
+        keys = len(dict.fromkeys(r["key"] for r in rows))
+        head = [f"{file}: sensitivity of {meta.get('scenario_name', '?')}: {counted(keys, 'key')} x 2 runs at x "
+                f"(1 ± {float(meta.get('step', 0)):.0%}) within each key's range"]
+        if meta.get("left_out"):
+            head.append(f"left out: {meta['left_out']}")
+        return "\n".join([*head, sensitivity.format_table(rows)])
+    if kind == "uncertainty":
+        rows, spreads, meta = uncertainty.read_table(file)
+        keys = len(json.loads(meta.get("keys", "[]")))
+        return (f"{file}: uncertainty of {meta.get('scenario_name', '?')}: {counted(keys, 'key')}, N = "
+                f"{meta.get('samples', '?')} ({counted(int(meta.get('runs', 0)), 'run')}), seed {meta.get('seed', '?')}\n"
+                + uncertainty.format_table(spreads, rows))
+    cols, attrs = life.read_life(file)
+    name = tomllib.loads(attrs["scenario"]).get("name", "?") if attrs.get("scenario") else "?"
+    return life.format_history(cols, f"{file}: life of {name} to {attrs.get('limit', '?')}")
+
+
+def format_paths(paths, columns=None) -> str:
+    """What ``bearingsim table PATHS`` prints: for a study folder or its table file, the study's own table
+    (:func:`study_text`; ``columns`` refused: its columns are its own); else the summary table of a
+    sweep folder or index, or of run archives (:func:`table_of`, :func:`format_table`)."""
+    paths = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
+    found = study_of(paths[0]) if len(paths) == 1 else None
+    if found is None:
+        return format_table(table_of(paths), columns=columns)
+    kind, file = found
+    if columns:
+        raise UserError(f"--columns: {file} is a {STUDY_NAMES[kind]}'s table, whose columns are its own; give "
+                        f"{file.parent / 'sweep.h5'} for its cases' summary numbers")
+    return study_text(kind, file)
+
+
 def table_of(paths) -> Table:
-    """``bearingsim table`` of ``paths``: one folder or index file (a sweep's or study's ``sweep.h5``),
-    or run archives (one-line UserError otherwise)."""
+    """The summary table of ``paths``: one folder or index file (a sweep's or study's ``sweep.h5``: one
+    row per case; of a study folder, the case index, which ``bearingsim table`` prints only for
+    ``DIR/sweep.h5``: :func:`format_paths`), or run archives (one-line UserError otherwise)."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT
 

@@ -254,3 +254,25 @@ def test_crosscheck_index_and_table_give_each_rung_one_standard_error(ladder):
             assert row[k] == cols[k][i] == table.numbers[k][0], (row["scene"], k)
     text = tables.format_table(tables.table_of(out))
     assert "rung" in text.splitlines()[1] and text.splitlines()[-1] == tables.RULE
+
+
+def test_table_of_the_folder_prints_the_ladder_and_its_verdicts(ladder, capsys):
+    """``bearingsim table DIR`` of a cross-check folder printed its case index: the rungs in the order they
+    ran (rung 5 first, the reduced rungs last) with every ``*`` against that first row, a meaningless
+    comparison; ``table DIR/crosscheck.h5`` said "not a bearingsim archive". Both print the ladder as
+    ``bearingsim crosscheck`` prints it at its end: rungs by speed, changes, one verdict per speed."""
+    out, _, lines = ladder
+    rows, _ = cc.read_table(out / "crosscheck.h5")
+    expect = [*cc.format_table(rows).splitlines(), *cc.verdicts(rows)]
+    i = lines.index(expect[0])
+    assert lines[i:i + len(expect)] == expect  # what the command printed
+    for path in (out, out / "crosscheck.h5"):
+        assert main(["table", str(path)]) == 0
+        printed = capsys.readouterr().out.splitlines()
+        assert printed[0].startswith(f"{out / 'crosscheck.h5'}: cross-check of multibody_3000rpm: 1 speed x 5 rungs")
+        assert printed[1:] == expect
+    assert main(["table", str(out), "--columns", "I_dec_mean_Ns"]) == 2  # a study's table has its own columns
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--columns" in err and str(out / "sweep.h5") in err
+    assert main(["table", str(out / "sweep.h5")]) == 0  # the case index, as before
+    assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["rpm", "rung", "scene"]

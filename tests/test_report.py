@@ -183,8 +183,8 @@ def test_the_same_archive_gives_the_same_bytes(runs, tmp_path):
 @pytest.fixture(scope="module")
 def folders(tmp_path_factory):
     """A reduced-model sweep (2 speeds, archives kept), sensitivity and uncertainty study (2 keys; N = 2:
-    8 runs), run; a cross-check and a life table written by their own writers from given rows (their
-    runs take minutes)."""
+    8 runs) and validate (its smallest run: 1 rig rotation), run; a cross-check and a life table written
+    by their own writers from given rows (their runs take minutes)."""
     d = tmp_path_factory.mktemp("folders")
     res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "--archives", "all",
               "-o", d / "sweep", "-j", "1", "-q")
@@ -194,6 +194,8 @@ def folders(tmp_path_factory):
     assert res.returncode == 0, res.stderr
     res = cli("uncertainty", PAPER, "--keys", "contact.restitution,lubrication.drag_coefficient", "--samples", "2",
               "-o", d / "unc", "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    res = cli("validate", "--rig-rotations", "1", "-j", "2", "-o", d / "val", "-q")
     assert res.returncode == 0, res.stderr
     _crosscheck_table(d / "cc")
     _life_table(d / "life")
@@ -234,6 +236,7 @@ def _life_table(folder: Path) -> None:
     ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
     ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),
     ("life", "life", ["clearance=0.23mm", "max_depth_um [um]"]),
+    ("val", "validate", ["Fig. 9 analog", "previous c = 0.02", "pocket 0 I_dec", "rig_idec_vs_speed.png"]),
 ])
 def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name, kind, words):
     from bearingsim.reports import kind_of
@@ -246,6 +249,35 @@ def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name
     assert_renders(seen, ["table", "figures", "checks", "scenario"])
     for w in words:
         assert w in seen["text"], w
+
+
+@pytest.mark.slow
+def test_report_of_a_validate_folder_is_its_own_kind(folders, tmp_path):
+    """A validate folder was reported as a sweep: "sweep of cases over study, rpm, drag, variant (41 cases)",
+    one bar chart of every case, the rig rows with "drag nan", `*` marks against the first Fig. 9 case, and
+    none of validate's figures or tables. It is a kind of its own: the Fig. 9 table and the rig table, the
+    three figures validate drew (the same PNG bytes), then the cases, a case's scenario and provenance."""
+    import base64
+
+    from bearingsim import reports
+    from bearingsim.studies import fig9, rig
+
+    folder = folders / "val"
+    assert reports.kind_of(folder) == ("validate", folder / fig9.CSV_NAME)
+    assert reports.kind_of(folder / "sweep.h5")[0] == "sweep"  # the case index alone, as for every study
+    html = bearingsim.report(folder, tmp_path / "v.html").read_text()
+    title = re.search(r"<h1>(.*?)</h1>", html).group(1)
+    assert title.startswith("Validation against the paper") and "sweep" not in title
+    for name in (fig9.PNG_NAME, *rig.FIGURE_NAMES):
+        assert base64.b64encode((folder / name).read_bytes()).decode() in html, name
+    tables = re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1)
+    assert "sweep_cases" not in html and " *<" not in html and "nan" not in tables and "drag" not in tables
+    table = fig9.read_fig9(folder / fig9.CSV_NAME)
+    assert f"<td class=\"num\">{table['I_dec_c0.02_Ns'][0] * 1e3:.4g}</td>" in html  # 500 rpm, c = 0.02
+    rows = rig.read_rig(folder / rig.CSV_NAME)
+    assert len(rows) == 5 and f"{rows[0]['pocket0_over_reduced']:.3g}" in html
+    assert "name = &#34;rig_500rpm&#34;" in html  # the scenario: a rig case's, from its archive (escaped)
+    assert "41 cases: done 41" in html
 
 
 @pytest.mark.slow

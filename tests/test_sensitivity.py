@@ -211,6 +211,26 @@ def test_plot_draws_a_study_table_figure_again(tmp_path, capsys):
         assert (out / png).read_bytes() == (tmp_path / table).parent.joinpath(png).read_bytes()
 
 
+def test_table_prints_a_study_table_as_its_command_did(tmp_path, capsys):
+    """`bearingsim table` of a sensitivity or uncertainty folder printed its case index (every run in the
+    order it ran, marked against the first), and of its sensitivity.h5 or uncertainty.h5 "not a bearingsim
+    archive". Both print the study's table: the lines the study's command printed, after one line naming
+    the file and the study."""
+    runs = {"s": ["sensitivity", str(REDUCED), "--keys", KEYS[0]],
+            "u": ["uncertainty", str(REDUCED), "--keys", ",".join(KEYS), "--samples", "2"]}
+    for folder, argv in runs.items():
+        assert main([*argv, "-o", str(tmp_path / folder), "-j", "1"]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        body = [ln for ln in lines[1:] if not ln.startswith(("wrote ", "runs: "))]  # the command's table
+        table = tmp_path / folder / f"{argv[0]}.h5"
+        for path in (tmp_path / folder, table):
+            assert main(["table", str(path)]) == 0
+            printed = capsys.readouterr().out.splitlines()
+            assert printed[0].startswith(f"{table}: {argv[0]} of paper_6000rpm: ")
+            assert printed[1:] == body, (printed, body)
+        assert any(("S1 [95 % CI]" if folder == "u" else "± SE") in ln for ln in body), body
+
+
 def load_scenario_text(text):
     import tomllib
 

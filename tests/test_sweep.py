@@ -141,6 +141,32 @@ lubrication.drag_coefficient = [0.01, 0.02, 0.03]
 
 
 @pytest.mark.slow
+def test_a_swept_key_a_case_does_not_set_shows_the_value_it_ran_at(tmp_path):
+    """The shipped zip-and-extras sweep: its two [[cases]] set the speed and one other key, not the drag
+    coefficient, and the zipped cases set neither the restitution nor the direction. Those cells were
+    NaN (or empty) in the printed table and the index, although every case ran at a value: its resolved
+    scenario's, the base scenario's here. Now the table, sweep.csv and sweep.h5 show that value."""
+    f = SCENARIOS / "sweeps" / "speed_zip_and_extras.toml"
+    res = bearingsim("sweep", f, "-o", tmp_path, "-j", "1", "--no-plots")
+    assert res.returncode == 0, res.stderr
+    base = load_scenario(BASE)
+    drag, e, way = base.lubrication.drag_coefficient, base.contact.restitution, base.operating.direction
+    cols, meta = read_index(tmp_path / "sweep.h5")
+    assert meta["axes"] == [SPEED, "lubrication.drag_coefficient", "contact.restitution", "operating.direction"]
+    np.testing.assert_array_equal(cols["lubrication.drag_coefficient"], [0.01, 0.015, 0.02, 0.03, drag, drag])
+    np.testing.assert_array_equal(cols["contact.restitution"], [e, e, e, e, 0.6, e])
+    assert list(cols["operating.direction"]) == [way] * 5 + ["reverse"]
+    rows = _rows(tmp_path)
+    assert [float(r["lubrication.drag_coefficient"]) for r in rows[4:]] == [drag, drag]
+    assert [r["operating.direction"] for r in rows] == [way] * 5 + ["reverse"]
+    lines = res.stdout.splitlines()
+    (i,) = [k for k, ln in enumerate(lines) if ln.startswith(SPEED)]
+    table = [ln.split() for ln in lines[i + 1:i + 7]]
+    assert [t[:4] for t in table[4:]] == [["3000", f"{drag:g}", "0.6", way], ["3000", f"{drag:g}", f"{e:g}", "reverse"]]
+    assert "nan" not in res.stdout
+
+
+@pytest.mark.slow
 def test_shipped_sweep_files_resolve():
     files = sorted((SCENARIOS / "sweeps").glob("*.toml"))
     assert len(files) >= 3

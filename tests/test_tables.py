@@ -3,6 +3,7 @@
 estimator for sweep, cross-check and table, and the progress bar only on a terminal."""
 from __future__ import annotations
 
+import csv
 import math
 import os
 import subprocess
@@ -163,6 +164,36 @@ def test_sweep_prints_its_table_and_table_of_the_folder_is_the_same(tmp_path):
     quiet = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1",
                 "--no-plots", "-q")
     assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
+
+
+@pytest.mark.slow
+def test_table_of_a_validate_folder_prints_its_fig9_and_rig_tables(tmp_path):
+    """`bearingsim table DIR` of a validate folder printed its case index: 41 cases in the order they ran,
+    the rig rows with "drag nan", every `*` against the first Fig. 9 case (500 rpm, c = 0.01). It prints
+    validate's own tables: the Fig. 9 analog (speed against the drag coefficients and the previous model)
+    and the rig table as `bearingsim validate` printed it; the case index is `table DIR/sweep.h5`."""
+    out = tmp_path / "v"
+    res = cli("validate", "--rig-rotations", "1", "-j", "2", "-o", out)
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    i = next(k for k, ln in enumerate(lines) if ln.startswith("rig scene"))
+    rig = lines[i:i + 7]  # the heading, the column names and the 5 speeds
+    table = cli("table", out)
+    assert table.returncode == 0, table.stderr
+    printed = table.stdout.splitlines()
+    assert "nan" not in table.stdout and "*" not in table.stdout and "drag" not in table.stdout
+    assert printed[0].startswith(f"{out}: validate")
+    j = printed.index(rig[0])
+    assert printed[j:j + 7] == rig
+    (k,) = [k for k, ln in enumerate(printed) if ln.startswith("Fig. 9 analog")]
+    assert printed[k + 1].split() == ["rpm", "c", "=", "0.01", "c", "=", "0.02", "c", "=", "0.03", "previous", "c", "=",
+                                      "0.02"]
+    with open(out / "fig9_idec_vs_speed.csv", newline="") as fh:
+        first = next(csv.DictReader(fh))
+    assert printed[k + 2].split() == ["500", *(f"{float(first[c]) * 1e3:.3f}" for c in list(first)[1:])]
+    assert len(printed[k + 2:j]) >= 9  # the 9 speeds (then a blank line or a note before the rig table)
+    index = cli("table", out / "sweep.h5")
+    assert index.returncode == 0 and index.stdout.splitlines()[1].split()[:4] == ["study", "rpm", "drag", "variant"]
 
 
 # --- progress only on a terminal ------------------------------------------------------------------

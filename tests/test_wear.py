@@ -311,19 +311,29 @@ def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, mon
 
 
 @pytest.mark.slow
-def test_plot_draws_a_life_history_again(tmp_path, capsys):
+def test_plot_and_table_of_a_life_history_again(tmp_path, capsys):
     """`plot life.h5` said "not a bearingsim archive": it draws life.png again from the history alone, the
-    same bytes as `bearingsim life` drew."""
+    same bytes as `bearingsim life` drew. `table` of the folder printed its case index (the stages' runs,
+    marked against the first) and `table life.h5` "not a bearingsim archive": both print the history as
+    `bearingsim life` printed it (its first line naming the scenario by its name)."""
     from bearingsim.cli import main
 
     code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "depth=1mm", "--stages", "1",
                  "--rotations", "1", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "l"), "-q"])
     assert code == 0, capsys.readouterr().err
-    capsys.readouterr()
+    lines = capsys.readouterr().out.splitlines()
     code = main(["plot", str(tmp_path / "l" / "life.h5"), "-o", str(tmp_path / "again")])
     captured = capsys.readouterr()
     assert code == 0 and captured.err == "" and captured.out == f"wrote {tmp_path / 'again' / 'life.png'}\n"
     assert (tmp_path / "again" / "life.png").read_bytes() == (tmp_path / "l" / "life.png").read_bytes()
+    history = [ln for ln in lines if not ln.startswith("wrote ")]
+    assert history[0].startswith("life of ") and history[1].split()[:2] == ["stage", "s"]
+    for path in (tmp_path / "l", tmp_path / "l" / "life.h5"):
+        assert main(["table", str(path)]) == 0
+        printed = capsys.readouterr().out.splitlines()
+        assert printed[0] == f"{tmp_path / 'l' / 'life.h5'}: " + history[0].replace(
+            str(SCENARIOS / "wear_test_6000rpm.toml"), "wear_test_6000rpm")
+        assert printed[1:] == history[1:]
 
 
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):

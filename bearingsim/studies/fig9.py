@@ -18,6 +18,8 @@ from bearingsim.studies.engine import FINISHED, Study, case_of
 
 FIG9_SPEEDS_RPM = (500, 750, 1000, 1500, 2000, 3000, 4000, 5000, 6000)
 FIG9_DRAG = (0.01, 0.02, 0.03)
+#: the study's table and figure, and the first bytes of the table (its header) as the study writes it
+CSV_NAME, PNG_NAME, CSV_SIGNATURE = "fig9_idec_vs_speed.csv", "fig9_idec_vs_speed.png", b"speed_rpm,"
 
 
 def paper_scenario(rpm: float, drag: float = 0.02, previous: bool = False, direction: str = "forward"):
@@ -71,7 +73,7 @@ class Fig9(Study):
         self.grid = {(col, i): reference_case(n, c, prev)
                      for c, prev in self.variants for col in [column_name(c, prev)] for i, n in enumerate(self.speeds)}
         self.cases = list(self.grid.values())
-        self.outputs = [("fig9_idec_vs_speed.csv", b"speed_rpm,", "Fig. 9 table"), ("fig9_idec_vs_speed.png", PNG_SIGNATURE, "figure")]
+        self.outputs = [(CSV_NAME, CSV_SIGNATURE, "Fig. 9 table"), (PNG_NAME, PNG_SIGNATURE, "figure")]
         self.table: dict[str, np.ndarray] = {}
 
     def finish(self, outdir, records) -> list[Path]:
@@ -106,7 +108,7 @@ def save_fig9(outdir: str | Path, table: dict[str, np.ndarray]) -> list[Path]:
 
     outdir = Path(outdir)
     cols = list(table)
-    csv_path = write_csv(outdir / "fig9_idec_vs_speed.csv", cols,
+    csv_path = write_csv(outdir / CSV_NAME, cols,
                          [[f"{table['speed_rpm'][i]:g}"] + [f"{table[c][i]:.6e}" for c in cols[1:]]
                           for i in range(len(table["speed_rpm"]))])
 
@@ -124,5 +126,38 @@ def save_fig9(outdir: str | Path, table: dict[str, np.ndarray]) -> list[Path]:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    png = save_figure(fig, outdir / "fig9_idec_vs_speed.png", dpi=130, tight=False)
+    png = save_figure(fig, outdir / PNG_NAME, dpi=130, tight=False)
     return [csv_path, png]
+
+
+def read_fig9(path) -> dict[str, np.ndarray]:
+    """The table ``fig9_idec_vs_speed.csv`` holds (as :attr:`Fig9.table`: ``speed_rpm`` and I_dec per
+    rotation [N s] per column; NaN for a failed case)."""
+    import csv
+
+    with open(path, newline="", encoding="utf-8") as fh:
+        rows = list(csv.reader(fh))
+    return {name: np.array([float(r[j]) for r in rows[1:]]) for j, name in enumerate(rows[0])}
+
+
+def column_label(col: str) -> str:
+    """``I_dec_c0.01_Ns`` -> ``c = 0.01``; ``I_dec_previous_c0.02_Ns`` -> ``previous c = 0.02``."""
+    name = col.removeprefix("I_dec_").removesuffix("_Ns")
+    prev = name.startswith("previous_")
+    return ("previous " if prev else "") + "c = " + name.removeprefix("previous_").removeprefix("c")
+
+
+def format_table(table: dict[str, np.ndarray]) -> str:
+    """The Fig. 9 table for the terminal: one row per speed, I_dec per cage rotation [mN s] of each drag
+    coefficient and of the previous model (n/a: a failed case)."""
+    cols = [c for c in table if c != "speed_rpm"]
+    labels = [column_label(c) for c in cols]
+    widths = [max(8, len(x)) for x in labels]
+    lines = ["Fig. 9 analog: the reduced model's I_dec per cage rotation [mN s] (NU214, 970 N, φ = 23.5°; "
+             "previous: no gravity, no resting contact)",
+             f"  {'rpm':>6s}  " + "  ".join(f"{x:>{w}s}" for x, w in zip(labels, widths))]
+    for i, n in enumerate(table["speed_rpm"]):
+        cells = [f"{table[c][i] * 1e3:{w}.3f}" if math.isfinite(table[c][i]) else f"{'n/a':>{w}s}"
+                 for c, w in zip(cols, widths)]
+        lines.append(f"  {n:6g}  " + "  ".join(cells))
+    return "\n".join(lines)

@@ -378,6 +378,22 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
     }
 
 
+def format_history(cols: dict, title: str) -> str:
+    """The history for the terminal, as ``bearingsim life`` prints it: ``title`` (``life of X to LIMIT``)
+    with the life reached, then one row per stage."""
+    from bearingsim.wording import counted
+
+    lines = [f"{title}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations in "
+             f"{counted(len(cols['stage']), 'stage')}",
+             f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
+             f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}"]
+    for i in range(len(cols["stage"])):
+        lines.append(f"{int(cols['stage'][i]):>5} {cols['pocket_clearance_mm'][i]:>8.4f} {cols['stage_rotations'][i]:>11.4g} "
+                     f"{cols['hours_end'][i]:>9.4g} {cols['max_depth_rate_um_per_h'][i]:>18.4g} "
+                     f"{cols['max_depth_um'][i]:>13.4g} {cols['I_dec_mean_mNs'][i]:>13.4g} {int(cols['reused'][i]):>6}")
+    return "\n".join(lines)
+
+
 def read_life(path) -> tuple[dict, dict]:
     """The history's columns and attributes of a ``life.h5``."""
     from bearingsim import archive

@@ -10,6 +10,7 @@ studies run together).
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,8 @@ from bearingsim.wording import counted
 RIG_SPEEDS_RPM = (500, 1000, 2000, 3000, 4000)
 RIG_ROTATIONS = 20
 
-__all__ = ["RIG_ROTATIONS", "RIG_SPEEDS_RPM", "Rig", "batch_sem", "rig_scenario", "rig_table", "save_rig"]
+__all__ = ["RIG_ROTATIONS", "RIG_SPEEDS_RPM", "Rig", "batch_sem", "format_table", "read_rig", "rig_scenario", "rig_table",
+           "save_rig"]
 
 
 def rig_scenario(rpm: float, rotations: int = RIG_ROTATIONS, warmup: int = 1):
@@ -70,9 +72,8 @@ class Rig(Study):
         self.pairs = [(case_of(rig_scenario(n, self.rotations), {"study": "rig", "rpm": n}), reference_case(n))
                       for n in self.speeds]
         self.cases = [c for pair in self.pairs for c in pair]
-        self.outputs = [("rig_idec_vs_speed.csv", b"rpm,rotations,", "rig table"),
-                        ("rig_idec_vs_speed.png", PNG_SIGNATURE, "figure"),
-                        ("rig_pocket0_forces.png", PNG_SIGNATURE, "figure")]
+        self.outputs = [(CSV_NAME, CSV_SIGNATURE, "rig table"),
+                        (FIGURE_NAMES[0], PNG_SIGNATURE, "figure"), (FIGURE_NAMES[1], PNG_SIGNATURE, "figure")]
         self.rows: list[dict] = []
         self.missing: list[float] = []
 
@@ -101,6 +102,32 @@ def rig_table(speeds=RIG_SPEEDS_RPM, rotations: int = RIG_ROTATIONS, jobs: int =
 CSV_COLUMNS = ("rpm", "rotations", "pocket0_I_dec_mean_Ns", "pocket0_I_dec_std_Ns", "pocket0_I_dec_sem_Ns",
                "pocket0_I_acc_mean_Ns", "arc_pockets_I_dec_mean_Ns", "arc_pockets_I_dec_std_Ns", "reduced_I_dec_Ns",
                "pocket0_over_reduced")
+#: the study's table, the first bytes of it (its header) and its figures (I_dec against speed; pocket 0's
+#: forces, the Fig. 5 analog)
+CSV_NAME, CSV_SIGNATURE = "rig_idec_vs_speed.csv", b"rpm,rotations,"
+FIGURE_NAMES = ("rig_idec_vs_speed.png", "rig_pocket0_forces.png")
+
+
+def read_rig(path) -> list[dict]:
+    """The rows ``rig_idec_vs_speed.csv`` holds (the numbers of :attr:`Rig.rows`, :data:`CSV_COLUMNS`)."""
+    import csv
+
+    with open(path, newline="", encoding="utf-8") as fh:
+        return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
+def format_table(rows: list[dict], rotations: int) -> str:
+    """The rig table for the terminal, as ``bearingsim validate`` prints it: pocket 0's I_dec (mean ± std
+    over rotations; n/a from one rotation), the reduced model's, their ratio and the arc pockets' mean."""
+    lines = [f"rig scene (pocket 0 flat), 1 warm-up + {counted(rotations, 'rotation')}, against the reduced model:",
+             f"  {'rpm':>6s} {'pocket 0 I_dec [mN s]':>24s} {'reduced [mN s]':>15s} {'ratio':>6s} {'arc pockets [mN s]':>19s}"]
+    for r in rows:
+        std = r["pocket0_I_dec_std_Ns"] * 1e3
+        std = f"{std:5.2f}" if math.isfinite(std) else "  n/a"  # one rotation: no scatter (tables: n/a)
+        lines.append(f"  {r['rpm']:6g} {r['pocket0_I_dec_mean_Ns'] * 1e3:11.2f} ± {std} (std) "
+                     f"{r['reduced_I_dec_Ns'] * 1e3:15.2f} {r['pocket0_I_dec_mean_Ns'] / r['reduced_I_dec_Ns']:6.2f} "
+                     f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:19.2f}")
+    return "\n".join(lines)
 
 
 def save_rig(outdir, rows: list[dict]) -> list[Path]:
@@ -112,7 +139,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     for r in rows:
         vals = {**r, "pocket0_over_reduced": r["pocket0_I_dec_mean_Ns"] / r["reduced_I_dec_Ns"]}
         cells.append([f"{vals[c]:g}" if c in ("rpm", "rotations") else f"{vals[c]:.6e}" for c in CSV_COLUMNS])
-    csv_path = write_csv(outdir / "rig_idec_vs_speed.csv", CSV_COLUMNS, cells)
+    csv_path = write_csv(outdir / CSV_NAME, CSV_COLUMNS, cells)
 
     n = np.array([r["rpm"] for r in rows])
     fig, ax = subplots(figsize=(8.5, 4.5))
@@ -133,7 +160,7 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     ax.set_title(f"The paper's rig as a scene (NU214, 970 N, forward, 1 warm-up + {counted(rot, 'rotation')})\n"
                  "against the reduced model (Fig. 9 analog)", fontsize=9)
     legend_outside(ax)
-    png = save_figure(fig, outdir / "rig_idec_vs_speed.png")
+    png = save_figure(fig, outdir / FIGURE_NAMES[0])
 
     fig, axes = subplots(len(rows), 1, figsize=(8.5, 1.8 * len(rows) + 0.8), sharex=True, squeeze=False)
     for ax, r in zip(axes[:, 0], rows):
@@ -149,5 +176,5 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
     legend_outside(axes[0, 0])
     axes[-1, 0].set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
     axes[-1, 0].set_xlim(0, 360)
-    png2 = save_figure(fig, outdir / "rig_pocket0_forces.png")
+    png2 = save_figure(fig, outdir / FIGURE_NAMES[1])
     return [csv_path, png, png2]

@@ -321,6 +321,24 @@ def write_table(outdir, rows, scenario, step, left_out=()) -> tuple[Path, Path]:
     return csv_path, h5_path
 
 
+def _num(v, spec: str) -> str:
+    """``v`` formatted by ``spec``, or ``n/a`` (as wide) where it is not a number."""
+    width = len(format(0.0, spec))
+    return format(v, spec) if math.isfinite(v) else "n/a".rjust(width)
+
+
+def format_table(rows: list[dict]) -> str:
+    """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
+    quantity, S ± its standard error and the change over the key's range (n/a and why where missing)."""
+    lines = [f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}"]
+    for r in rows:
+        note = missing_note(r)
+        lines.append(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
+                     f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
+                     + (f"  ({note})" if note else ""))
+    return "\n".join(lines)
+
+
 def read_table(path) -> tuple[list[dict], dict]:
     """Read ``sensitivity.h5``: (rows as dicts, root attributes); one-line UserError if it is not one."""
     from bearingsim import archive

@@ -263,6 +263,21 @@ def read_table(path):
     return rows, json.loads(meta["spread"]), meta
 
 
+def format_table(spreads: list[dict], indices: list[dict]) -> str:
+    """The spreads and Sobol indices for the terminal, as ``bearingsim uncertainty`` prints them."""
+    from bearingsim.wording import counted
+
+    lines = []
+    for s in spreads:
+        lines.append(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
+                     f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
+    lines.append(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
+    for r in indices:
+        lines.append(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "
+                     f"{r['ST']:+6.3f} [{r['ST_low']:+.3f}, {r['ST_high']:+.3f}]")
+    return "\n".join(lines)
+
+
 def plot_uncertainty(index_path, outdir) -> list[Path]:
     """Draw ``uncertainty.png`` from the index alone."""
     from bearingsim.plotting import save_figure

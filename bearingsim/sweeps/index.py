@@ -1,6 +1,8 @@
 """The sweep's index (``sweep.csv`` and ``sweep.h5``) and the resume check of case archives.
 
-One row per case, in the sweep's case order: ``case`` (content hash), the swept keys, ``status``
+One row per case, in the sweep's case order: ``case`` (content hash), the swept keys (the value the
+case ran at: the one it sets, or for a key it does not set, such as an extra case's axes, the value of
+its resolved scenario; empty only where that has none), ``status``
 (``done``: run now; ``cached``: a complete archive of the same scenario, computed by the same version
 of its model (:mod:`bearingsim.model_versions`), was already there; ``stale``: run now because the
 archive of the same scenario there was computed by another version of the model, or by a bearingsim
@@ -90,7 +92,7 @@ class IndexWriter:
         cols = {"case": np.array([r["case"] for r in rows], dtype=object)}
         units = {}
         for k in self.keys:
-            vals = [r["values"].get(k) for r in rows]
+            vals = [_value(r, k) for r in rows]
             if all(v is None or _is_number(v) for v in vals):
                 cols[k] = np.array([math.nan if v is None else float(v) for v in vals])
             else:
@@ -118,7 +120,7 @@ class IndexWriter:
             s = r.get("summary", {})
             buf.seek(0)
             buf.truncate()
-            w.writerow([r["case"], *[r["values"].get(k, "") for k in keys], r["status"], r.get("error", ""),
+            w.writerow([r["case"], *[_cell(_value(r, k)) for k in keys], r["status"], r.get("error", ""),
                         r.get("archive", ""), _fmt(r.get("wall_s")), _version_text(r.get("model_version")),
                         *[_fmt(s.get(k)) for k in summ]])
             self._lines[i] = buf.getvalue()
@@ -145,6 +147,17 @@ class IndexWriter:
     def columns(self) -> dict[str, np.ndarray]:
         """The index's columns as last written (one array per column, in column order)."""
         return {c: self._cols[c] for c in ["case", *self.keys, *FIXED, *(self._summ or [])]}
+
+
+def _value(row: dict, key: str):
+    """A row's value of swept ``key``: the one its case sets, else the one its resolved scenario has
+    (``ran_at``, :attr:`bearingsim.sweeps.spec.Case.ran_at`), else None."""
+    values = row["values"]
+    return values[key] if key in values else row.get("ran_at", {}).get(key)
+
+
+def _cell(v) -> str:
+    return "" if v is None else v
 
 
 def _version_text(v) -> str:

@@ -321,7 +321,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         raise
     if progress is None:
         progress = sys.stderr.isatty()
-    rows = [{"case": c.hash, "values": c.values, "status": "pending", "error": "", "archive": "",
+    rows = [{"case": c.hash, "values": c.values, "ran_at": c.ran_at, "status": "pending", "error": "", "archive": "",
              "wall_s": math.nan, "model_version": None, "summary": {}} for c in cases]
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
                            map=outdir / MAP_NAME if grid else None)

@@ -62,6 +62,10 @@ class Case:
     scenario : optional
         The validated scenario model ``toml`` was written from (:func:`resolve_cases` keeps it, so a
         local pool's worker need not parse and validate the text again); None if not known.
+    ran_at : dict
+        The sweep's other swept keys, those this case does not set (an extra case's axes, a grid case's
+        keys of the extra cases), with the value its resolved scenario has: what the case ran at, shown
+        in the index beside ``values`` (:func:`resolve_cases`; empty where a key has no value).
     """
 
     hash: str
@@ -69,6 +73,7 @@ class Case:
     toml: str
     model: str
     scenario: Any = field(default=None, compare=False, repr=False)
+    ran_at: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def label(self) -> str:
         """``key=value, ...`` of the swept values, for messages."""
@@ -323,6 +328,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         points += [dict(zip(axis_keys, c)) for c in combos]
     points += [dict(c) for c in spec.extra]
     base = load_scenario(spec.scenario, spec.sets)  # the base alone first: its own errors name it
+    keys = spec.keys
     cases: list[Case] = []
     seen: dict[str, int] = {}
     for i, values in enumerate(points):
@@ -336,8 +342,23 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         if h in seen:
             raise UserError(f"{where}: cases {_label(points[seen[h]])} and {_label(values)} are the same scenario")
         seen[h] = i
-        cases.append(Case(hash=h, values=values, toml=text, model=sc.model, scenario=sc.model_))
+        ran_at = {k: v for k in keys if k not in values and (v := resolved_value(sc, k)) is not None}
+        cases.append(Case(hash=h, values=values, toml=text, model=sc.model, scenario=sc.model_, ran_at=ran_at))
     return cases
+
+
+def resolved_value(scenario, key: str) -> Any:
+    """The value of dotted ``key`` in a resolved scenario (``operating.direction`` -> ``"forward"``);
+    None where it has none (a key left unset, such as ``numerics.dt_s`` for the automatic step) or
+    where the key names a table rather than a value."""
+    from pydantic import BaseModel
+
+    node = scenario.model_
+    for part in key.split("."):
+        node = node.get(part) if isinstance(node, dict) else getattr(node, part, None)
+        if node is None:
+            return None
+    return None if isinstance(node, (BaseModel, dict)) else node
 
 
 def _label(values: dict) -> str:

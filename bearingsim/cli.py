@@ -860,6 +860,11 @@ def _failed(exc: BaseException, args) -> int:
     return 2
 
 
+#: what an interrupted command has not written, by command ("no archive written" for the others)
+_NOT_WRITTEN = {"animate": "no animation written", "report": "no report written",
+                "plot": "its figures not all written", "wear": "its figures not all written"}
+
+
 def _interrupted(exc: KeyboardInterrupt, args) -> int:
     """SIGINT or SIGTERM: what was kept, in one line; exit 130 or 143."""
     what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
@@ -873,7 +878,8 @@ def _interrupted(exc: KeyboardInterrupt, args) -> int:
         print(f"bearingsim: {args.command} interrupted ({name}): {kept}; run the same command again to resume",
               file=sys.stderr)
     else:
-        print(f"bearingsim: {what}, no archive written", file=sys.stderr)
+        print(f"bearingsim: {what}, {_NOT_WRITTEN.get(getattr(args, 'command', None), 'no archive written')}",
+              file=sys.stderr)
     return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
 
 

@@ -244,3 +244,29 @@ def test_motion_window_keys_are_checked():
     with pytest.raises(UserError, match="output.motion_rotations"):
         bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
             "output.motion_rotations": 40, "output.motion_samples_per_rotation": 10000})
+
+
+@pytest.mark.parametrize("sig, code, said", [("SIGINT", 130, "bearingsim: interrupted, no animation written"),
+                                             ("SIGTERM", 143, "bearingsim: terminated (SIGTERM), no animation written")])
+def test_an_interrupted_animation_says_no_animation_is_written(runs, tmp_path, monkeypatch, capsys, sig, code, said):
+    """SIGINT or SIGTERM while frames are drawn: exit 130 / 143, one line saying no animation was written (it
+    said "no archive written", of a command that writes none), and nothing left in the folder."""
+    import os
+    import signal
+    import time
+
+    frames = animation._write_gif
+
+    def signalled(out, frame_iter, *a, **kw):
+        os.kill(os.getpid(), getattr(signal, sig))
+        time.sleep(5)  # the handler raises here
+        return frames(out, frame_iter, *a, **kw)
+
+    monkeypatch.setattr(animation, "_write_gif", signalled)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        assert main(["animate", str(runs[1]), "-o", str(tmp_path / "m.gif"), "-q"]) == code
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert capsys.readouterr().err.strip().splitlines() == [said]
+    assert list(tmp_path.iterdir()) == []

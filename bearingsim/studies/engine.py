@@ -15,6 +15,7 @@ same model version (``cached``) and runs only what is missing, failed or stale.
 from __future__ import annotations
 
 import os
+import signal
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -80,16 +81,18 @@ class Study:
     outputs : list of (file name, signature, what)
         The files the study writes into the folder, checked before anything runs
         (:func:`bearingsim.outputs.check_replaceable`: a user's file or a link there is refused).
-    planned : int or None
-        How many cases the study will have run when it is done, if that is not ``len(cases)`` (a staged
-        study's stages): what an interrupted study counts its cases against.
     """
 
     name = "study"
     cases: list[Case]
     outputs: list[tuple[str, object, str]]
     staged = False
-    planned: int | None = None
+
+    def cases_to_come(self, known: set[str]) -> int:
+        """How many of a staged study's cases are not among ``known`` (the hashes of the cases the engine
+        has seen): its later stages, what an interrupted or failed study counts as not run beside the
+        known cases; 0 for a study that is not staged."""
+        return 0
 
     def next_cases(self, outdir: Path, records: dict[str, dict]) -> list[Case]:
         """The cases the finished ones call for (``records`` as in :meth:`finish`): a staged study's next
@@ -116,7 +119,7 @@ class StudiesOutcome:
 
     sweep: object  # bearingsim.sweeps.SweepOutcome
     written: list[Path] = field(default_factory=list)
-    planned: int = 0  #: the cases the studies have when done (a staged study's are not all known when it stops)
+    planned: int = 0  #: the cases known and, of a staged study, still to come (its later stages when it stopped)
 
     @property
     def interrupted(self) -> int | None:
@@ -204,7 +207,8 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
                 study.check_folder(outdir, force)
         sweep = _run_rounds(studies, cases, outdir, engine, lock, dict(progress=progress, log=log, force=force,
                                                                       check_folder=not staged))
-        out = StudiesOutcome(sweep, planned=max(len(sweep.rows), sum(s.planned or len(s.cases) for s in studies)))
+        known = {r["case"] for r in sweep.rows}
+        out = StudiesOutcome(sweep, planned=len(known) + sum(s.cases_to_come(known) for s in studies))
         if sweep.interrupted is None:
             records = {r["case"]: r for r in sweep.rows}
             try:
@@ -238,8 +242,6 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     last round's sweep outcome."""
     from bearingsim.sweeps.run import SweepInterrupted, _Signals, run_sweep
 
-    import signal
-
     desc = "+".join(s.name for s in studies)
     sweep, earlier = None, {}
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM end the study as one
@@ -270,7 +272,6 @@ def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: boo
     """:func:`run_studies` for the Python API: in ``outdir`` or, with None, a temporary folder removed
     afterwards; ``jobs`` local processes unless ``engine`` is given. SIGINT/SIGTERM during the cases
     raise KeyboardInterrupt (finished archives in ``outdir`` are kept)."""
-    import signal
     import tempfile
 
     engine = engine or make_engine(jobs)

@@ -263,6 +263,10 @@ class LifeStudy(Study):
         self.stage_cases.append(self._case(j + 1))
         return [self.stage_cases[-1]]
 
+    def cases_to_come(self, known: set[str]) -> int:
+        """The stages not among ``known`` (each is made from the one before it)."""
+        return self.planned - sum(c.hash in known for c in self.stage_cases)
+
     def columns(self) -> dict:
         """The history's columns, one row per stage run so far."""
         return {k: np.array([r[k] for r in self.rows]) for k in self.rows[0]}

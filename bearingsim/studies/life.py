@@ -141,19 +141,26 @@ def _start_depth(scenario) -> np.ndarray | None:
     return arr.transpose(1, 2, 0).copy()
 
 
+def _bar(scenario) -> float:
+    """The width of the cage bar between two pockets [m] (:func:`bearingsim.laws.cage_bar_width`)."""
+    from bearingsim.laws import cage_bar_width
+
+    b = scenario.bearing
+    return cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+
+
 def _check_reachable(scenario, limit: Limit) -> None:
     """Refuse a limit that no wear can reach: with no wear (a wear coefficient of 0), or beyond the cage bar
     between two pockets, which the front and rear faces of a pocket wear through together (the deepest
     point of one face, the mean worn depth of both over a face's area, or one face's volume over its
     area reaching the bar's width: worn through before the limit)."""
-    from bearingsim.laws import cage_bar_width
     from bearingsim.wear import face_area
 
     if scenario.wear.wear_coefficient <= 0.0:
         raise UserError(f"{scenario.source}: wear.wear_coefficient = 0: nothing wears, so no limit is ever reached; "
                         f"give the pocket faces' wear coefficient (docs/wear.md)")
     b = scenario.bearing
-    bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+    bar = _bar(scenario)
     if limit.kind == "depth":
         depth = limit.value
     elif limit.kind == "clearance":
@@ -161,8 +168,8 @@ def _check_reachable(scenario, limit: Limit) -> None:
     else:
         depth = limit.value / face_area(scenario.parameters)
     if depth >= bar:
-        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide and would be "
-                        f"worn through before that; give a smaller limit")
+        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide and would "
+                        f"be worn through before that; give a smaller limit")
 
 
 class LifeStudy(Study):
@@ -206,7 +213,7 @@ class LifeStudy(Study):
 
     def _case(self, j: int):
         st = self.state
-        if j and self.mapping == "shape":
+        if j:
             self._check_bar(j)
         sc = (stage_scenario(self.scenario, st.depth if j else None, j, self.rotations) if self.mapping == "shape"
               else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.clearance()))
@@ -216,10 +223,7 @@ class LifeStudy(Study):
         """Refuse stage ``j`` when the wear of the stages before it has worn a pocket's faces through the cage
         bar (the deepest front plus the deepest rear depth, as a worn scenario is checked): the bar ends
         the life before the limit does."""
-        from bearingsim.laws import cage_bar_width
-
-        b = self.scenario.bearing
-        bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+        bar = _bar(self.scenario)
         worn = float(self.state.depth[0].max() + self.state.depth[1].max())
         if worn >= bar:
             raise UserError(f"--limit {self.limit.text}: the cage bar wears through first: after stage {j - 1} "
@@ -280,8 +284,9 @@ class LifeStudy(Study):
         if len(self.rows) < self.planned:
             return []
         cols = self.columns()
-        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned, "rotations": self.stage_rotations,
-                 "scenario": self.scenario.to_toml(), "mapping": self.mapping, "mapping_text": MAPPINGS[self.mapping]}
+        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned,
+                 "rotations": self.stage_rotations, "scenario": self.scenario.to_toml(), "mapping": self.mapping,
+                 "mapping_text": MAPPINGS[self.mapping]}
         archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
         return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
 

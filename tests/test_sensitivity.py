@@ -305,3 +305,14 @@ def test_a_key_whose_value_is_zero_is_left_out_of_the_default_keys(tmp_path, cap
     assert code == 2 and "--keys lubrication.drag_coefficient: its value (0.0) has no relative step" in err
     sc = load_scenario(PAPER_3000, ["lubrication.drag_coefficient=0"])
     assert "lubrication.drag_coefficient" in Uncertainty(sc, 2).keys
+
+
+def test_uncertainty_prints_its_spread_in_the_tables_units():
+    """`bearingsim uncertainty` prints the median and 5-95 % interval of the impulses in mN s, as every table
+    does (it printed them in N s without a unit: 0.0145 beside tables of 14.5)."""
+    from bearingsim.studies.uncertainty import format_table
+
+    text = format_table([{"quantity": "I_dec", "median": 0.0145, "p05": 0.0101, "p95": 0.0203, "runs_used": 8.0},
+                         {"quantity": "cage_slip", "median": 0.004, "p05": 0.001, "p95": 0.007, "runs_used": 8.0}], [])
+    assert "I_dec      median 14.5, 5-95 %: 10.1 .. 20.3 mN s (8 runs)" in text
+    assert "cage_slip  median 0.004, 5-95 %: 0.001 .. 0.007 (8 runs)" in text

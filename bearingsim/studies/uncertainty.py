@@ -263,13 +263,20 @@ def read_table(path):
     return rows, json.loads(meta["spread"]), meta
 
 
+#: how the terminal shows a quantity of each SI unit: (factor, unit), as the tables do (impulses in mN s)
+_SHOWN = {"N s": (1e3, "mN s"), "1": (1.0, "")}
+
+
 def format_table(spreads: list[dict], indices: list[dict]) -> str:
     """The spreads and Sobol indices for the terminal, as ``bearingsim uncertainty`` prints them."""
     from bearingsim.wording import counted
 
+    units = {q: unit for q, _, unit in QUANTITIES}
     lines = []
     for s in spreads:
-        lines.append(f"  {s['quantity']:10s} median {s['median']:.4g}, 5-95 %: {s['p05']:.4g} .. {s['p95']:.4g} "
+        scale, label = _SHOWN.get(units.get(s["quantity"]), (1.0, ""))
+        lines.append(f"  {s['quantity']:10s} median {s['median'] * scale:.4g}, 5-95 %: {s['p05'] * scale:.4g} .. "
+                     f"{s['p95'] * scale:.4g}{' ' + label if label else ''} "
                      f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
     lines.append(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
     for r in indices:

@@ -62,8 +62,9 @@ def kind_of(path) -> tuple[str, Path]:
         f = folder / name
         if (p.is_dir() or p.name == name) and f.is_file() and archive.is_table_file(f, fmt):
             return kind, f
-    raise UserError(f"{p}: not a bearingsim archive, nor a sweep, cross-check, sensitivity, uncertainty or life "
-                    f"folder (no sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
+    raise archive.scenario_file_error(p) or UserError(
+        f"{p}: not a bearingsim archive, nor a sweep, cross-check, sensitivity, uncertainty or life folder (no "
+        f"sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
 
 
 def _tables():

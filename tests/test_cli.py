@@ -181,6 +181,40 @@ def test_inspect_refuses_foreign_file(tmp_path):
     assert_user_error(bearingsim("inspect", f), "x.h5")
 
 
+#: every command that reads an archive, given a scenario file {S} (compare: second, then first)
+ARCHIVE_READERS = {
+    "rerun": ["rerun", "{S}"], "inspect": ["inspect", "{S}"], "plot": ["plot", "{S}"],
+    "animate": ["animate", "{S}", "-o", "{tmp}/a.gif"], "compare": ["compare", "{S}", "{S}"],
+    "wear": ["wear", "{S}", "--hours", "1"], "report": ["report", "{S}", "-o", "{tmp}/r.html"],
+    "table": ["table", "{S}"],
+}
+
+
+@pytest.mark.parametrize("named", [".toml", ".txt"])
+@pytest.mark.parametrize("command", list(ARCHIVE_READERS))
+def test_a_scenario_file_given_for_an_archive_names_the_commands_that_read_it(tmp_path, command, named):
+    """The commands that read an archive said "not an HDF5 file (truncated, or not a bearingsim archive)"
+    of a scenario file; they say what it is and which commands read it, as 'run x.h5' hints the other way.
+    A scenario saved under another name is told by its TOML (and 'show' resolves it)."""
+    scenario = tmp_path / f"mine{named}"
+    scenario.write_text((SCENARIOS / "paper_3000rpm.toml").read_text())
+    args = [a.format(S=scenario, tmp=tmp_path) for a in ARCHIVE_READERS[command]]
+    res = bearingsim(*args)
+    assert_user_error(res, f"{scenario}: is a scenario file, not an archive; 'bearingsim run {scenario}' runs it",
+                      f"'bearingsim show {scenario}' prints it resolved")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [scenario.name]
+    if command == "compare":
+        res = bearingsim("compare", SCENARIOS / "paper_3000rpm.toml", tmp_path / "nope.h5")
+        assert_user_error(res, "paper_3000rpm.toml: is a scenario file")
+    if named == ".txt" and command == "inspect":  # what the hint says works
+        res = bearingsim("show", scenario)
+        assert res.returncode == 0 and res.stdout.startswith(f"# resolved from {scenario}"), res.stderr
+    if named == ".txt" and command == "table":  # any other text file keeps the archive reader's line
+        other = tmp_path / "notes.txt"
+        other.write_text("schema = 1\n")
+        assert_user_error(bearingsim("inspect", other), "notes.txt: not an HDF5 file")
+
+
 @pytest.mark.slow
 def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
     """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every

@@ -15,7 +15,8 @@ Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any 
   same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
   the next run takes over: the lock dies with its process);
 * temporary archives ``.<name>.tmp-<pid>`` whose process is gone (a run killed by SIGKILL or a power
-  cut) are removed on the next run into that folder, with a note on stderr.
+  cut; a killed process not yet reaped, a zombie, counts as gone) are removed on the next run into that
+  folder, whichever model it runs, with a note on stderr.
 """
 from __future__ import annotations
 
@@ -282,13 +283,42 @@ def _glob_escape(s: str) -> str:
 
 
 def _pid_alive(pid: int) -> bool:
+    """True while process ``pid`` may still write: it exists and is neither a zombie nor being killed.
+
+    ``kill(pid, 0)`` alone counts a process that SIGKILL ended but no parent has reaped yet (a zombie),
+    or whose SIGKILL is still being delivered, as alive: a run killed by ``timeout -s KILL`` (which kills
+    its own process group, itself included) stays a zombie of the init process for a while, so a quick
+    next run (the reduced model's) kept its temporary file, and only a slower one removed it."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:  # someone else's live process
+    except PermissionError:  # someone else's process: alive unless dying
+        pass
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii", errors="replace") as fh:
+            status = fh.read()
+    except OSError:  # no /proc (not Linux): kill's answer; else the process has just gone, or is unreadable
+        return not Path("/proc/self/status").exists() or Path(f"/proc/{pid}").exists()
+    return not dying(status)
+
+
+def dying(status: str) -> bool:
+    """True when the text of ``/proc/<pid>/status`` is that of a process that will never run again: a
+    zombie or dead (``State: Z`` / ``X``), or one with SIGKILL pending (``ShdPnd`` or ``SigPnd``)."""
+    import signal
+
+    fields = dict(line.split(":", 1) for line in status.splitlines() if ":" in line)
+    if fields.get("State", "").strip()[:1] in ("Z", "X"):
         return True
-    return True
+    kill_bit = 1 << (signal.SIGKILL - 1)
+    for name in ("ShdPnd", "SigPnd"):
+        try:
+            if int(fields.get(name, "0").strip(), 16) & kill_bit:
+                return True
+        except ValueError:
+            continue
+    return False
 
 
 def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:

@@ -9,6 +9,8 @@ Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any 
 * a figure path of the run (``<stem>_<name>.png``) that is a symbolic link, a directory or not a PNG
   file is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
   to a temporary name and renamed over the target (:func:`atomic_file`), never through a link;
+* once a run's archive is written, the figures at its stem of any model that the run does not draw
+  (:func:`remove_figures`: only regular PNG files so named) are removed, being the replaced archive's;
 * one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target (an empty
   regular file, opened with ``O_NOFOLLOW``: a link or a user's file there is refused), held from
   the start of the run until its archive and figures are written, then removed; a second run to the
@@ -276,6 +278,27 @@ def remove_empty(folders: list[Path]) -> None:
 def figure_path(stem: str | Path, name: str) -> Path:
     """Where a run's figure ``name`` goes: ``<stem>_<name>.png``."""
     return Path(f"{stem}_{name}.png")
+
+
+def remove_figures(stem: str | Path, names) -> list[Path]:
+    """Remove the figures ``<stem>_<name>.png`` of ``names`` that are regular PNG files (what
+    :func:`check_replaceable` would let bearingsim replace); a link, a folder or any other file is left
+    alone, and so is a file that cannot be removed. Returns the paths removed."""
+    removed = []
+    for name in names:
+        p = figure_path(stem, name)
+        try:
+            if not stat.S_ISREG(os.lstat(p).st_mode):
+                continue
+            fd = os.open(p, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            with open(fd, "rb") as fh:
+                if fh.read(len(PNG_SIGNATURE)) != PNG_SIGNATURE:
+                    continue
+            p.unlink()
+        except OSError:
+            continue
+        removed.append(p)
+    return removed
 
 
 def _glob_escape(s: str) -> str:

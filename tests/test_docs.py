@@ -141,3 +141,84 @@ def test_the_package_gives_its_submodules_on_first_use_and_no_other_name():
             assert f"has no attribute {name!r}" in str(exc)
         else:
             raise AssertionError(f"{package.__name__}.{name} resolved")
+
+
+def _run_commands(page):
+    """Every ``bearingsim run ...`` command of ``page`` in order, as argument lists after ``run``: from code
+    blocks (fenced or indented; ``\\`` continues a line, ``#`` starts a comment) and inline code spans."""
+    import shlex
+
+    text = page.read_text()
+    spans = []  # (position, command text)
+    for m in re.finditer(r"^```[^\n]*\n(.*?)^```", text, re.S | re.M):
+        joined = re.sub(r"\\\n\s*", " ", m.group(1))
+        spans += [(m.start(), line.split(" #")[0]) for line in joined.splitlines()]
+    for m in re.finditer(r"(?:^ {4}\S.*\n)+", text, re.M):
+        spans += [(m.start(), line.split(" #")[0]) for line in m.group(0).splitlines()]
+    prose = re.sub(r"^```.*?^```", lambda m: " " * len(m.group(0)), text, flags=re.S | re.M)  # same positions
+    spans += [(m.start(), " ".join(m.group(1).split())) for m in re.finditer(r"`([^`]+)`", prose)]
+    out = []
+    for pos, span in sorted(spans, key=lambda s: s[0]):
+        for cmd in re.findall(r"bearingsim run (.*)", span):
+            try:
+                out.append(shlex.split(cmd))
+            except ValueError:  # an unbalanced quote in prose: not a command
+                continue
+    return out
+
+
+def _options(args):
+    """(scenario, [--set values], -o value or None, flags) of a ``bearingsim run`` argument list."""
+    scenario, sets, out, flags = None, [], None, set()
+    it = iter(args)
+    for a in it:
+        if a == "--set":
+            sets.append(next(it, ""))
+        elif a in ("-o", "--output"):
+            out = next(it, None)
+        elif a.startswith("-"):
+            flags.add(a)
+        elif scenario is None:
+            scenario = a
+    return scenario, sets, out, flags
+
+
+def test_every_run_example_with_set_writes_an_archive_of_its_own():
+    """`bearingsim run S --set K=V` writes outputs/<name>.h5 like `bearingsim run S`, and a run of another
+    scenario there is refused ("holds the run of a different scenario"): usage.md's second command was
+    refused after its first, and animation.md's three `run x.toml --set ...` one after the other. Every
+    example that sets a key names its own archive with -o."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    pages.remove(ROOT / "docs" / "reliability.md")  # its commands are bad input, each in an empty folder
+    found, missing = 0, []
+    for page in pages:
+        for args in _run_commands(page):
+            scenario, sets, out, flags = _options(args)
+            if sets and "--dry-run" not in flags:
+                found += 1
+                if out is None:
+                    missing.append(f"{page.name}: bearingsim run {' '.join(args)}")
+    assert found >= 9 and not missing, missing
+
+
+def test_the_run_examples_of_a_page_run_in_order():
+    """Within each page, in order, no `bearingsim run` example writes an archive that an earlier one wrote
+    for another resolved scenario (it would be refused without --force)."""
+    from bearingsim.scenario import load_scenario
+
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    pages.remove(ROOT / "docs" / "reliability.md")  # its commands are bad input, each in an empty folder
+    refused, checked = [], 0
+    for page in pages:
+        written = {}
+        for args in _run_commands(page):
+            scenario, sets, out, flags = _options(args)
+            if scenario is None or "--dry-run" in flags or not (ROOT / scenario).is_file():
+                continue  # a placeholder (x.toml, SCENARIO, <rpm>): checked by the test above
+            sc = load_scenario(ROOT / scenario, sets)
+            target = out or f"outputs/{sc.name}.h5"
+            if target in written and written[target] != sc and "--force" not in flags:
+                refused.append(f"{page.name}: bearingsim run {' '.join(args)}")
+            written[target] = sc
+            checked += 1
+    assert checked >= 10 and not refused, refused

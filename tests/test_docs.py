@@ -143,22 +143,28 @@ def test_the_package_gives_its_submodules_on_first_use_and_no_other_name():
             raise AssertionError(f"{package.__name__}.{name} resolved")
 
 
+def _code_spans(page) -> list[str]:
+    """The code of ``page`` in order: each line of its code blocks (fenced, or indented by 4 spaces; ``\\``
+    continues a line, `` #`` starts a comment) and each inline code span."""
+    text = page.read_text()
+    fences = re.compile(r"^```[^\n]*\n(.*?)^```", re.S | re.M)
+    rest = fences.sub(lambda m: " " * len(m.group(0)), text)  # the prose, at the same positions
+    blocks = [m for m in fences.finditer(text)] + [m for m in re.finditer(r"^ {4}\S.*\n(?:^ {4}.*\n)*", rest, re.M)]
+    spans = []  # (position, code)
+    for m in blocks:
+        joined = re.sub(r"\\\n\s*", " ", m.group(1) if m.re is fences else m.group(0))
+        spans += [(m.start(), line.split(" #")[0]) for line in joined.splitlines()]
+    spans += [(m.start(), " ".join(m.group(1).split())) for m in re.finditer(r"`([^`]+)`", rest)]
+    return [code for _, code in sorted(spans, key=lambda s: s[0])]
+
+
 def _run_commands(page):
-    """Every ``bearingsim run ...`` command of ``page`` in order, as argument lists after ``run``: from code
-    blocks (fenced or indented; ``\\`` continues a line, ``#`` starts a comment) and inline code spans."""
+    """Every ``bearingsim run ...`` command of ``page`` in order (:func:`_code_spans`), as argument lists
+    after ``run``."""
     import shlex
 
-    text = page.read_text()
-    spans = []  # (position, command text)
-    for m in re.finditer(r"^```[^\n]*\n(.*?)^```", text, re.S | re.M):
-        joined = re.sub(r"\\\n\s*", " ", m.group(1))
-        spans += [(m.start(), line.split(" #")[0]) for line in joined.splitlines()]
-    for m in re.finditer(r"(?:^ {4}\S.*\n)+", text, re.M):
-        spans += [(m.start(), line.split(" #")[0]) for line in m.group(0).splitlines()]
-    prose = re.sub(r"^```.*?^```", lambda m: " " * len(m.group(0)), text, flags=re.S | re.M)  # same positions
-    spans += [(m.start(), " ".join(m.group(1).split())) for m in re.finditer(r"`([^`]+)`", prose)]
     out = []
-    for pos, span in sorted(spans, key=lambda s: s[0]):
+    for span in _code_spans(page):
         for cmd in re.findall(r"bearingsim run (.*)", span):
             try:
                 out.append(shlex.split(cmd))
@@ -222,3 +228,20 @@ def test_the_run_examples_of_a_page_run_in_order():
             written[target] = sc
             checked += 1
     assert checked >= 10 and not refused, refused
+
+
+def test_example_outputs_go_where_git_ignores_them():
+    """docs/wear.md's examples wrote into out/ (-o out/wear_test.h5, -o out/life), a folder a checkout does
+    not ignore; every example's -o in the README and docs/ is under outputs/ (ignored by .gitignore), a
+    file in the current folder, or a placeholder (DIR, FILE.html, OUT.h5, {tmp}/...)."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    assert "outputs/*" in (ROOT / ".gitignore").read_text().split()
+    outside, seen = [], 0
+    for page in pages:
+        for span in _code_spans(page):
+            for target in re.findall(r"(?:^|\s)(?:-o|--output) (\S+)", span):
+                seen += 1
+                first = target.split("/")[0]
+                if "/" in target and first not in ("outputs", "") and not (first.isupper() or first.startswith("{")):
+                    outside.append(f"{page.name}: -o {target}")
+    assert seen > 20 and not outside, outside

@@ -309,9 +309,10 @@ def _pid_alive(pid: int) -> bool:
     """True while process ``pid`` may still write: it exists and is neither a zombie nor being killed.
 
     ``kill(pid, 0)`` alone counts a process that SIGKILL ended but no parent has reaped yet (a zombie),
-    or whose SIGKILL is still being delivered, as alive: a run killed by ``timeout -s KILL`` (which kills
-    its own process group, itself included) stays a zombie of the init process for a while, so a quick
-    next run (the reduced model's) kept its temporary file, and only a slower one removed it."""
+    or whose SIGKILL is still being delivered, as alive; a run killed by ``timeout -s KILL`` (which kills
+    its own process group, itself included) stays a zombie of the init process for a while after its
+    parent is gone, and the next run into its folder, however soon it comes, takes it as dead (Linux:
+    ``/proc/<pid>/status``, :func:`dying`; elsewhere ``kill`` alone)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:

@@ -9,6 +9,10 @@ The Python API::
     r = bearingsim.run(sc)            # a Result: r.summary, r.per_rotation["I_dec"], r.impacts, r.plot_*()
     r.save("x.h5")
     r2 = bearingsim.load("x.h5")      # the same result, read back from the archive
+
+Every module and subpackage is an attribute of the package on first use (``bearingsim.outputs.ArchiveWriteError``,
+``bearingsim.studies.life.read_life`` after a plain ``import bearingsim``): imported then, not before
+(PEP 562), so ``import bearingsim`` stays light.
 """
 from bearingsim._version import __version__  # noqa: E402
 from bearingsim.errors import SimulationUnstable, UserError  # noqa: E402
@@ -74,6 +78,37 @@ def animate(path, out, **kw):
     from bearingsim.simulation import animate as _animate
 
     return _animate(path, out, **kw)
+
+
+def _submodule(package: str, name: str):
+    """The submodule ``package.name``, imported on its first use as an attribute of ``package`` (a package's
+    module-level ``__getattr__``, PEP 562); AttributeError when the package has no such submodule."""
+    import importlib
+    import importlib.util
+
+    if not name.startswith("__"):  # dunder probes (copy, pickle, inspect) are never submodules
+        fullname = f"{package}.{name}"
+        try:
+            found = importlib.util.find_spec(fullname) is not None
+        except (ImportError, ValueError):
+            found = False
+        if found:
+            return importlib.import_module(fullname)
+    raise AttributeError(f"module {package!r} has no attribute {name!r}")
+
+
+def _submodule_names(package: str, path) -> list[str]:
+    import pkgutil
+
+    return [m.name for m in pkgutil.iter_modules(path) if not m.name.startswith("__")]
+
+
+def __getattr__(name):
+    return _submodule(__name__, name)
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_submodule_names(__name__, __path__)))
 
 
 __all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load", "sensitivity",

@@ -1011,6 +1011,35 @@ def _check_regular(p: Path) -> None:
         raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not an archive")
 
 
+def is_scenario_file(path) -> bool:
+    """True for a regular file without an HDF5 signature that is named ``.toml`` or holds a TOML table with
+    an integer ``schema_version`` (a scenario saved under another name): what ``show`` resolves as a
+    scenario, and what the commands that read an archive refuse with :func:`scenario_file_error`."""
+    p = Path(path)
+    try:
+        if not p.is_file() or _has_hdf5_signature(p):
+            return False
+        if p.suffix.lower() == ".toml":
+            return True
+        import tomllib
+
+        with open(p, "rb") as f:
+            head = f.read(1 << 20)
+        return isinstance(tomllib.loads(head.decode("utf-8")).get("schema_version"), int)
+    except (OSError, ValueError):  # unreadable, not UTF-8 or not TOML: not a scenario file
+        return False
+
+
+def scenario_file_error(path) -> UserError | None:
+    """The one-line refusal of a scenario file (:func:`is_scenario_file`) given where an archive is read
+    (``rerun``, ``inspect``, ``plot``, ``animate``, ``compare``, ``wear``, ``report``, ``table``), naming the
+    commands that read it; None for any other path."""
+    if not is_scenario_file(path):
+        return None
+    return UserError(f"{path}: is a scenario file, not an archive; 'bearingsim run {path}' runs it and writes an "
+                     f"archive, 'bearingsim show {path}' prints it resolved")
+
+
 def open_archive(path: str | Path):
     """Open a complete bearingsim archive read-only, or raise a one-line :class:`UserError`."""
     h5py = _lazy_h5py()
@@ -1025,7 +1054,7 @@ def open_archive(path: str | Path):
     except OSError:
         ok = False
     if not ok:
-        raise UserError(f"{p}: not an HDF5 file (truncated, or not a bearingsim archive)")
+        raise scenario_file_error(p) or UserError(f"{p}: not an HDF5 file (truncated, or not a bearingsim archive)")
     try:
         f = h5py.File(p, "r")
     except OSError as exc:

@@ -123,12 +123,12 @@ def _cmd_inspect(args) -> int:
 
 
 def _is_scenario_file(path) -> bool:
-    """``show``'s argument is a scenario to resolve: a regular ``.toml`` file that is not HDF5 (an archive
-    is read as one whatever its name; a FIFO or a missing file goes to the archive reader's refusal)."""
-    from bearingsim.archive import is_archive
+    """``show``'s argument is a scenario to resolve: a regular ``.toml`` file, or one holding a scenario's
+    TOML, that is not HDF5 (an archive is read as one whatever its name; a FIFO or a missing file goes to
+    the archive reader's refusal): :func:`bearingsim.archive.is_scenario_file`."""
+    from bearingsim.archive import is_scenario_file
 
-    p = Path(path)
-    return p.suffix.lower() == ".toml" and p.is_file() and not is_archive(p)
+    return is_scenario_file(path)
 
 
 def _write_toml(text: str) -> None:

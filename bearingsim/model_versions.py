@@ -32,3 +32,7 @@ MODEL_VERSIONS = {"reduced": 1, "multibody": 5}
 
 #: the models, by the name a scenario's ``model`` key and an archive's ``/bearingsim@model`` give
 MODELS = tuple(MODEL_VERSIONS)
+
+#: the figures each model's result draws (its ``FIGURES``), written beside an archive as ``<stem>_<name>.png``;
+#: a run removes those of an earlier run at its stem that it does not write itself (bearingsim.simulation)
+MODEL_FIGURES = {"reduced": ("pass",), "multibody": ("forces", "impulses", "orbit", "wear")}

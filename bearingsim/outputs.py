@@ -9,13 +9,16 @@ Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any 
 * a figure path of the run (``<stem>_<name>.png``) that is a symbolic link, a directory or not a PNG
   file is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
   to a temporary name and renamed over the target (:func:`atomic_file`), never through a link;
+* once a run's archive is written, the figures at its stem of any model that the run does not draw
+  (:func:`remove_figures`: only regular PNG files so named) are removed, being the replaced archive's;
 * one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target (an empty
   regular file, opened with ``O_NOFOLLOW``: a link or a user's file there is refused), held from
   the start of the run until its archive and figures are written, then removed; a second run to the
   same target is refused, not interleaved (a run killed by SIGKILL leaves the empty lock file, which
   the next run takes over: the lock dies with its process);
 * temporary archives ``.<name>.tmp-<pid>`` whose process is gone (a run killed by SIGKILL or a power
-  cut) are removed on the next run into that folder, with a note on stderr.
+  cut; a killed process not yet reaped, a zombie, counts as gone) are removed on the next run into that
+  folder, whichever model it runs, with a note on stderr.
 """
 from __future__ import annotations
 
@@ -277,18 +280,69 @@ def figure_path(stem: str | Path, name: str) -> Path:
     return Path(f"{stem}_{name}.png")
 
 
+def remove_figures(stem: str | Path, names) -> list[Path]:
+    """Remove the figures ``<stem>_<name>.png`` of ``names`` that are regular PNG files (what
+    :func:`check_replaceable` would let bearingsim replace); a link, a folder or any other file is left
+    alone, and so is a file that cannot be removed. Returns the paths removed."""
+    removed = []
+    for name in names:
+        p = figure_path(stem, name)
+        try:
+            if not stat.S_ISREG(os.lstat(p).st_mode):
+                continue
+            fd = os.open(p, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            with open(fd, "rb") as fh:
+                if fh.read(len(PNG_SIGNATURE)) != PNG_SIGNATURE:
+                    continue
+            p.unlink()
+        except OSError:
+            continue
+        removed.append(p)
+    return removed
+
+
 def _glob_escape(s: str) -> str:
     return re.sub(r"([*?\[])", r"[\1]", s)
 
 
 def _pid_alive(pid: int) -> bool:
+    """True while process ``pid`` may still write: it exists and is neither a zombie nor being killed.
+
+    ``kill(pid, 0)`` alone counts a process that SIGKILL ended but no parent has reaped yet (a zombie),
+    or whose SIGKILL is still being delivered, as alive; a run killed by ``timeout -s KILL`` (which kills
+    its own process group, itself included) stays a zombie of the init process for a while after its
+    parent is gone, and the next run into its folder, however soon it comes, takes it as dead (Linux:
+    ``/proc/<pid>/status``, :func:`dying`; elsewhere ``kill`` alone)."""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
         return False
-    except PermissionError:  # someone else's live process
+    except PermissionError:  # someone else's process: alive unless dying
+        pass
+    try:
+        with open(f"/proc/{pid}/status", encoding="ascii", errors="replace") as fh:
+            status = fh.read()
+    except OSError:  # no /proc (not Linux): kill's answer; else the process has just gone, or is unreadable
+        return not Path("/proc/self/status").exists() or Path(f"/proc/{pid}").exists()
+    return not dying(status)
+
+
+def dying(status: str) -> bool:
+    """True when the text of ``/proc/<pid>/status`` is that of a process that will never run again: a
+    zombie or dead (``State: Z`` / ``X``), or one with SIGKILL pending (``ShdPnd`` or ``SigPnd``)."""
+    import signal
+
+    fields = dict(line.split(":", 1) for line in status.splitlines() if ":" in line)
+    if fields.get("State", "").strip()[:1] in ("Z", "X"):
         return True
-    return True
+    kill_bit = 1 << (signal.SIGKILL - 1)
+    for name in ("ShdPnd", "SigPnd"):
+        try:
+            if int(fields.get(name, "0").strip(), 16) & kill_bit:
+                return True
+        except ValueError:
+            continue
+    return False
 
 
 def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:

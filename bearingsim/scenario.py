@@ -670,12 +670,15 @@ _TITLE_SKIP_MODEL = {
     "multibody": ("reduced.",),
 }
 # keys a model reads nothing of (set in a scenario of that model they change nothing): the reduced model
-# has no multibody scene, no cage rim and no lands, and solves one pass per rotation (no warm-up, no time
-# series). (The multibody model reads reduced.* in its reduced-equivalent scene, so nothing is listed for it.)
+# has no multibody scene, no cage body (its cage turns at the kinematic speed: no mass, inertia, rim or
+# roller-cage friction) and no lands, and solves one pass per rotation (no warm-up, no time series).
+# (The multibody model reads reduced.* in its reduced-equivalent scene, so nothing is listed for it.)
+# The sensitivity and uncertainty studies refuse these keys in --keys (bearingsim.studies.sensitivity).
 UNUSED_BY_MODEL = {
-    "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_land_clearance_mm",
-                "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm", "contact.land_friction",
-                "numerics.warmup_rotations", "numerics.output_rate_hz", "output."),
+    "reduced": ("multibody.", "bearing.cage_guidance", "bearing.cage_mass_kg", "bearing.cage_inertia_kgm2",
+                "bearing.cage_land_clearance_mm", "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm",
+                "contact.cage_friction", "contact.land_friction", "numerics.warmup_rotations",
+                "numerics.output_rate_hz", "output."),
 }
 # keys the reduced model's method reads nothing of: the event method is event-driven (no time step)
 UNUSED_BY_METHOD = {"event": ("numerics.dt_s",)}

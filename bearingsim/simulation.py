@@ -16,7 +16,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from bearingsim.model_versions import MODELS  # noqa: F401 - the models by name, re-exported here
+from bearingsim.model_versions import MODEL_FIGURES, MODELS  # noqa: F401 - MODELS: the models by name, re-exported here
 from bearingsim.scenario import Scenario, check_run_request
 
 log = logging.getLogger(__name__)  # notes of a plausible run that is not clean (the command line prints them)
@@ -198,7 +198,10 @@ def run_scenario(
     ----------
     scenario : resolved scenario
     out : archive path; default ``outputs/<name>.h5``
-    figures : write PNG figures beside the archive (``<stem>_<figure>.png``)
+    figures : write PNG figures beside the archive (``<stem>_<figure>.png``). Once the archive is written,
+        the figures at its stem of any model that this run does not write (all of them without
+        ``figures``) are removed: they were drawn from the archive it replaced
+        (:func:`bearingsim.outputs.remove_figures`); a run that fails leaves them as they were
     progress : show a progress bar (multibody runs)
     exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
         temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
@@ -230,6 +233,9 @@ def run_scenario(
                     log.info(note)
             archive.write(result, out, spool)
         written = True
+        drawn = type(result).FIGURES if figures else ()  # an earlier run's figures at this stem are not this run's
+        outputs.remove_figures(out.with_suffix(""), [n for names in MODEL_FIGURES.values() for n in names
+                                                     if n not in drawn])
         pngs = []
         if figures:
             try:

@@ -182,6 +182,73 @@ def test_inspect_refuses_foreign_file(tmp_path):
 
 
 @pytest.mark.slow
+def test_a_new_run_over_an_archive_removes_the_figures_it_does_not_write(tmp_path, archives_to_write_from):
+    """`run -o X.h5 --force` over a multibody run's archive left X_forces.png, X_impulses.png, ... beside
+    the reduced run's archive, and a rerun -o (which draws none) left every figure of the run it replaced.
+    Once the new archive is written, the figures of any model at that stem that it does not write are
+    removed: only regular PNG files so named, nothing else; a run that fails first leaves them all."""
+    import shutil
+
+    png = b"\x89PNG\r\n\x1a\n an earlier run's figure"
+    shutil.copy(archives_to_write_from["M"], tmp_path / "X.h5")
+    for name in ("forces", "impulses", "wear"):
+        (tmp_path / f"X_{name}.png").write_bytes(png)
+    (tmp_path / "elsewhere.png").write_bytes(png)
+    (tmp_path / "X_orbit.png").symlink_to(tmp_path / "elsewhere.png")  # a link: the user's
+    kept = {"X_notes.png": png, "X_wear.png.bak": png, "Y_forces.png": png, "X_pass.txt": b"mine"}
+    for name, data in kept.items():
+        (tmp_path / name).write_bytes(data)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    # a run that fails after it started (exit 3, no archive): the old archive and figures as they were
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", tmp_path / "X.h5", "--force",
+                     "--set", "reduced.load_zone_half_angle_deg=179.9")
+    assert res.returncode == 3, res.stderr
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", tmp_path / "X.h5", "--force", "-q")
+    assert res.returncode == 0, res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["X.h5", "X_pass.png", "X_orbit.png", "elsewhere.png", *kept])
+    assert all((tmp_path / name).read_bytes() == data for name, data in kept.items())
+    res = bearingsim("rerun", tmp_path / "X.h5", "-o", tmp_path / "X.h5")  # writes no figures
+    assert res.returncode == 0, res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["X.h5", "X_orbit.png", "elsewhere.png", *kept])
+
+
+#: every command that reads an archive, given a scenario file {S} (compare: second, then first)
+ARCHIVE_READERS = {
+    "rerun": ["rerun", "{S}"], "inspect": ["inspect", "{S}"], "plot": ["plot", "{S}"],
+    "animate": ["animate", "{S}", "-o", "{tmp}/a.gif"], "compare": ["compare", "{S}", "{S}"],
+    "wear": ["wear", "{S}", "--hours", "1"], "report": ["report", "{S}", "-o", "{tmp}/r.html"],
+    "table": ["table", "{S}"],
+}
+
+
+@pytest.mark.parametrize("named", [".toml", ".txt"])
+@pytest.mark.parametrize("command", list(ARCHIVE_READERS))
+def test_a_scenario_file_given_for_an_archive_names_the_commands_that_read_it(tmp_path, command, named):
+    """The commands that read an archive said "not an HDF5 file (truncated, or not a bearingsim archive)"
+    of a scenario file; they say what it is and which commands read it, as 'run x.h5' hints the other way.
+    A scenario saved under another name is told by its TOML (and 'show' resolves it)."""
+    scenario = tmp_path / f"mine{named}"
+    scenario.write_text((SCENARIOS / "paper_3000rpm.toml").read_text())
+    args = [a.format(S=scenario, tmp=tmp_path) for a in ARCHIVE_READERS[command]]
+    res = bearingsim(*args)
+    assert_user_error(res, f"{scenario}: is a scenario file, not an archive; 'bearingsim run {scenario}' runs it",
+                      f"'bearingsim show {scenario}' prints it resolved")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [scenario.name]
+    if command == "compare":
+        res = bearingsim("compare", SCENARIOS / "paper_3000rpm.toml", tmp_path / "nope.h5")
+        assert_user_error(res, "paper_3000rpm.toml: is a scenario file")
+    if named == ".txt" and command == "inspect":  # what the hint says works
+        res = bearingsim("show", scenario)
+        assert res.returncode == 0 and res.stdout.startswith(f"# resolved from {scenario}"), res.stderr
+    if named == ".txt" and command == "table":  # any other text file keeps the archive reader's line
+        other = tmp_path / "notes.txt"
+        other.write_text("schema = 1\n")
+        assert_user_error(bearingsim("inspect", other), "notes.txt: not an HDF5 file")
+
+
+@pytest.mark.slow
 def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
     """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every
     dataset, the resolved scenario) and the Fig. 8 analog PNG; `inspect` reads it back; the same scenario

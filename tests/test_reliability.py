@@ -827,6 +827,44 @@ def test_sigkill_leaves_a_temporary_that_the_next_run_removes(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.h5"]  # the dead run's lock file is gone too
 
 
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="a zombie is told by /proc/<pid>/status")
+def test_a_killed_run_not_yet_reaped_is_gone_for_the_next_run(tmp_path):
+    """A run killed by ``timeout -s KILL`` (which kills itself too) stays a zombie of the init process until
+    it is reaped; ``kill(pid, 0)`` counts a zombie as alive, so a reduced-model run right after kept the
+    dead run's ``.a.h5.tmp-PID`` (a multibody run, slower to reach the clean-up, removed it). Here the dead
+    run is a child of this test left unreaped: a zombie for as long as the test needs."""
+    child = subprocess.Popen([sys.executable, "-c", ""])
+    try:
+        deadline = time.monotonic() + 60
+        status = Path(f"/proc/{child.pid}/status")
+        while "State:\tZ" not in status.read_text() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert "State:\tZ" in status.read_text()
+        stale = tmp_path / f".a.h5.tmp-{child.pid}"
+        stale.write_bytes(b"\x89HDF\r\n\x1a\n half an archive")
+        res = bearingsim("run", PAPER, "-o", tmp_path / "b.h5", "--no-plots")
+        assert res.returncode == 0, res.stderr
+        assert f"removed stale temporary file {stale} of a dead run (pid {child.pid})" in res.stderr
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["b.h5"]
+    finally:
+        child.wait()
+
+
+def test_a_process_being_killed_or_a_zombie_is_dying():
+    """``outputs.dying`` reads /proc/<pid>/status: a zombie, a dead task, a pending SIGKILL (process-wide
+    or of its thread); a sleeping process with other signals pending is not."""
+    from bearingsim.outputs import dying
+
+    def status(state="S (sleeping)", shd="0000000000000000", sig="0000000000000000"):
+        return f"Name:\tbearingsim\nState:\t{state}\nSigPnd:\t{sig}\nShdPnd:\t{shd}\nSigBlk:\t0000000000000000\n"
+
+    assert not dying(status())
+    assert not dying(status(shd="0000000000004002"))  # SIGTERM and SIGINT pending: it may still write
+    assert dying(status("Z (zombie)")) and dying(status("X (dead)"))
+    assert dying(status(shd="0000000000000100")) and dying(status(sig="0000000000000100"))  # SIGKILL (9)
+    assert not dying("") and not dying("State:\tR (running)\nShdPnd:\tzz\n")
+
+
 def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
     """Start a long run (:data:`LONG_RUNS`), signal it once its temporary archive exists, time the exit."""
     with _long_run(tmp, kind) as proc:
@@ -915,7 +953,8 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
     lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
               "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
               "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "
-              "into that folder), a SIGTERM whose handler runs inside a weakref callback (Python cannot raise "
+              "into that folder, whichever model it runs, also while the killed process is a zombie not yet "
+              "reaped, as `timeout -s KILL` leaves it), a SIGTERM whose handler runs inside a weakref callback (Python cannot raise "
               "its exception there; the command gets the signal again and stops, with no traceback; "
               "`tests/test_sweep.py` checks the same for a sweep), a command that fails right after such a "
               "swallowed signal (numba compiling a kernel from a cold cache, its LLVM callback interrupted: \"no "

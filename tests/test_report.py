@@ -152,6 +152,25 @@ def test_the_embedded_clip_is_the_last_half_rotation(whole, tmp_path):
     assert section.blocks[0]["element"] == "video" and section.blocks[0]["src"].startswith("data:video/mp4;base64,")
 
 
+def test_the_page_on_the_report_says_what_clip_it_embeds():
+    """docs/report.md said the animation is bearingsim.animate(archive, ...) "with its defaults" (the whole
+    window at 30 fps); it names the clip's call and numbers, and they are the report's."""
+    import inspect
+
+    from bearingsim import animation, reports
+
+    text = " ".join((ROOT / "docs" / "report.md").read_text().split())
+    rot, fps = reports.REPORT_CLIP_ROTATIONS, reports.REPORT_CLIP_FPS
+    assert "with its defaults, embedded" not in text
+    assert f"the last {rot:g} cage rotation of the stored motion" in text and f"at {fps:g} frames per second" in text
+    assert f"`bearingsim.animate(archive, out, last={rot:g}, fps={fps:g})`" in text
+    frames = round(rot * animation.SECONDS_PER_ROTATION * fps)
+    assert f"{frames / fps:g} s and {frames} frames" in text
+    from bearingsim.simulation import animate  # bearingsim.animate(path, out, **kw) passes them on
+
+    assert {"last", "fps"} <= set(inspect.signature(animate).parameters)
+
+
 @pytest.mark.slow
 def test_markup_in_a_scenario_name_is_shown_as_text(runs, browser, tmp_path):
     """Every value is autoescaped: a name that is an HTML tag adds no element (an unescaped <img src=x>

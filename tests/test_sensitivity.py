@@ -166,6 +166,49 @@ def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("command", ["sensitivity", "uncertainty"])
+@pytest.mark.parametrize("scenario, sets, key, words", [
+    # a misspelt key: the scenario reader's "did you mean", not an invitation to give it a range
+    ("paper_3000rpm", [], "bearing.pocket_clearence_mm",
+     "--keys bearing.pocket_clearence_mm: unknown key (did you mean bearing.pocket_clearance_mm?)"),
+    ("paper_3000rpm", [], "bearing", "--keys bearing: a section, not a key"),
+    # ranged keys the run never reads: both runs of a pair identical (was: S +0.000, I_acc n/a, exit 0)
+    ("paper_3000rpm", [], "bearing.cage_mass_kg",
+     "--keys bearing.cage_mass_kg: {src}: not used by the reduced model, so varying it changes no run; leave it out"),
+    ("paper_3000rpm", [], "contact.cage_friction", "not used by the reduced model"),
+    ("paper_3000rpm", [], "multibody.traction_mu_max", "not used by the reduced model"),
+    ("paper_3000rpm", ["reduced.load_zone_half_angle_deg=30"], "bearing.radial_clearance_mm",
+     "when reduced.load_zone_half_angle_deg is given"),
+    ("multibody_3000rpm", [], "bearing.cage_land_clearance_mm",
+     "--keys bearing.cage_land_clearance_mm: {src}: not used with bearing.cage_guidance = 'rollers'"),
+])
+def test_a_key_that_is_not_one_or_not_read_is_refused_naming_it(tmp_path, capsys, command, scenario, sets, key,
+                                                                 words):
+    src = str(SCENARIOS / f"{scenario}.toml")
+    extra = ["--samples", "4"] if command == "uncertainty" else []
+    code = main([command, src, *[a for s in sets for a in ("--set", s)], "--keys", key, *extra,
+                 "-o", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert words.format(src=src) in err, err
+    assert "range = [low, high]" not in err and not (tmp_path / "o").exists()
+
+
+def test_the_default_keys_are_those_the_model_reads():
+    """The default keys leave out what the run does not read; the refusal of --keys uses the same rule."""
+    reduced = load_scenario(PAPER_3000)
+    assert sens.default_keys(reduced) == ["bearing.roller_diameter_mm", "bearing.pitch_diameter_mm",
+                                          "bearing.pocket_clearance_mm", "lubrication.drag_coefficient",
+                                          "contact.restitution"]
+    multibody = load_scenario(SCENARIOS / "multibody_3000rpm.toml")
+    keys = sens.default_keys(multibody)
+    assert "bearing.cage_mass_kg" in keys and "contact.cage_friction" in keys
+    assert not {"bearing.cage_land_clearance_mm", "contact.land_friction"} & set(keys)
+    land = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["bearing.cage_guidance=outer_land"])
+    assert {"bearing.cage_land_clearance_mm", "contact.land_friction"} <= set(sens.default_keys(land))
+    assert all(sens.unread_because(sc, k) is None for sc in (reduced, multibody, land) for k in sens.default_keys(sc))
+
+
 def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys):
     sc = tmp_path / "mine.toml"
     sc.write_text(REDUCED.read_text() + '\n[ranges.contact.restitution]\nrange = [0.5, 1.2]\nreason = "mine"\n')

@@ -69,7 +69,7 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, choose_dt, paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
-from bearingsim.model_versions import MODEL_VERSIONS
+from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
 from bearingsim.results import MemorySink, Result
 
 __all__ = ["simulate", "MultibodyResult", "MODEL_VERSION"]
@@ -373,7 +373,7 @@ class MultibodyResult(Result):
     stated; ``raw`` holds the step loop's own accumulators on a fresh result (None when read back)."""
 
     model = "multibody"
-    FIGURES = ("forces", "impulses", "orbit", "wear")
+    FIGURES = MODEL_FIGURES["multibody"]
     _PER_ROTATION = ("I_acc", "I_dec", "Jn_front", "Jn_rear", "Jf_front", "Jf_rear", "slide_work_front",
                      "slide_work_rear", "first_impact_speed")
     _LAND = ("land_normal", "land_friction", "land_torque")

@@ -34,7 +34,7 @@ from bearingsim.reduced.core import FACE_REAR, PassInputs
 from bearingsim.reduced.euler import check_step as euler_check_step, default_dt, solve_euler
 from bearingsim.reduced.event import PassSolution, solve_event
 from bearingsim.datatypes import AttrGroup, NamedArray
-from bearingsim.model_versions import MODEL_VERSIONS
+from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
 from bearingsim.results import Result
 
 __all__ = ["simulate", "solve_pass", "ReducedResult", "PassInputs", "PassSolution", "MODEL_VERSION"]
@@ -72,7 +72,7 @@ class ReducedResult(Result):
     """
 
     model = "reduced"
-    FIGURES = ("pass",)
+    FIGURES = MODEL_FIGURES["reduced"]
     _TRACE = ("theta_deg", "l_r", "dl_r_dt", "I_dec_cumulative")
     _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation",
                 "zeno_closure")

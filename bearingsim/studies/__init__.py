@@ -13,3 +13,15 @@ from bearingsim.studies.engine import (StudiesOutcome, Study, batch_sem, case_of
 
 __all__ = ["StudiesOutcome", "Study", "batch_sem", "case_of", "in_folder", "load_result", "make_engine",
            "run_studies"]
+
+
+def __getattr__(name):  # the study modules (bearingsim.studies.life, ...) on first use (PEP 562)
+    from bearingsim import _submodule
+
+    return _submodule(__name__, name)
+
+
+def __dir__():
+    from bearingsim import _submodule_names
+
+    return sorted(set(globals()) | set(_submodule_names(__name__, __path__)))

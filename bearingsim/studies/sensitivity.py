@@ -48,12 +48,6 @@ COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y
 UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
          "over_range": "as sensitivity"}
 
-# ranged keys a model does not read (their paired runs would be identical): left out of the default keys
-_UNUSED = {
-    "reduced": ("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "bearing.cage_outer_diameter_mm",
-                "bearing.cage_inner_diameter_mm", "bearing.cage_land_clearance_mm", "contact.cage_friction",
-                "contact.land_friction", "multibody."),
-}
 _LAND_KEYS = ("bearing.cage_land_clearance_mm", "contact.land_friction")
 
 
@@ -77,13 +71,25 @@ def default_keys(scenario) -> list[str]:
     without the radial clearance when its load zone is given."""
     from bearingsim.ranges import ranged_keys
 
-    skip = list(_UNUSED.get(scenario.model, ())) + ["wear."]  # Archard's k and H scale the wear outputs only
-    if scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
-        skip += _LAND_KEYS
-    if scenario.model == "reduced" and scenario.reduced.load_zone_half_angle_deg != "auto":
-        skip.append("bearing.radial_clearance_mm")
-    return [k for k in ranged_keys(scenario)
-            if not any(k == p or (p.endswith(".") and k.startswith(p)) for p in skip)]
+    return [k for k in ranged_keys(scenario) if not k.startswith("wear.")  # Archard's k and H: wear outputs only
+            and unread_because(scenario, k) is None]
+
+
+def unread_because(scenario, key: str) -> str | None:
+    """Why the scenario's run does not read ``key`` (its paired runs would be identical), or None: a key
+    its model does not use (:data:`bearingsim.scenario.UNUSED_BY_MODEL`), a land key with a roller-guided
+    cage, the reduced model's radial clearance when its load zone is given."""
+    from bearingsim.scenario import unused_keys
+
+    if unused_keys(scenario.model, [key]):
+        return f"not used by the {scenario.model} model"
+    if key in _LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
+        return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
+    if (key == "bearing.radial_clearance_mm" and scenario.model == "reduced"
+            and scenario.reduced.load_zone_half_angle_deg != "auto"):
+        return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
+                "load zone only when 'auto')")
+    return None
 
 
 def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:
@@ -102,6 +108,8 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
                         f"nothing to vary")
     kept = []
     for k in keys:
+        if given:
+            _check_given_key(scenario, k)
         if k not in have:
             raise UserError(f"--keys {k}: no range for this key in {scenario.source} or its preset (give "
                             f"[ranges.{k}] range = [low, high] and reason)")
@@ -117,6 +125,21 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
         raise UserError(f"{scenario.source}: every ranged key is 0 ({', '.join(keys)}): a relative step cannot "
                         f"move them; give them nonzero values ('bearingsim uncertainty' samples their ranges)")
     return kept
+
+
+def _check_given_key(scenario, key: str) -> None:
+    """A one-line UserError naming ``key`` (given to ``--keys``) when no scenario has it (with the closest
+    accepted key) or the scenario's run does not read it (:func:`unread_because`)."""
+    from bearingsim.scenario import did_you_mean, known_keys
+
+    known = known_keys()
+    if key not in known:
+        raise UserError(f"--keys {key}: unknown key{did_you_mean(key)}")
+    if any(k.startswith(key + ".") for k in known):
+        raise UserError(f"--keys {key}: a section, not a key (give its keys, e.g. {key}.<key>)")
+    why = unread_because(scenario, key)
+    if why is not None:
+        raise UserError(f"--keys {key}: {scenario.source}: {why}, so varying it changes no run; leave it out")
 
 
 def perturbed_values(scenario, key: str, step: float) -> tuple[float, float]:

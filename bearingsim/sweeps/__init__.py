@@ -30,10 +30,12 @@ def __getattr__(name):
         value = getattr(importlib.import_module(f"{__name__}.{_SOURCES[name]}"), name)
         globals()[name] = value
         return value
-    if name in {"engines", "grid", "index", "plot", "run", "spec"}:  # the submodules the package imported eagerly
-        return importlib.import_module(f"{__name__}.{name}")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    from bearingsim import _submodule
+
+    return _submodule(__name__, name)  # its submodules (bearingsim.sweeps.worker, ...), or AttributeError
 
 
 def __dir__():
-    return sorted(set(globals()) | set(__all__))
+    from bearingsim import _submodule_names
+
+    return sorted(set(globals()) | set(__all__) | set(_submodule_names(__name__, __path__)))

@@ -121,6 +121,7 @@ def test_a_file_where_the_output_folder_should_be_is_named_alike_by_every_comman
     assert (tmp_path / "blocker").read_text() == "my notes\n"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", ["inspect", "show"])
 def test_help_of_inspect_and_show_names_every_file_they_read(command):
     """``inspect`` and ``show`` read an archive and every index file of ``cli._describe_index`` (sweep.h5,

@@ -21,6 +21,7 @@ REDUCED = SCENARIOS / "paper_6000rpm.toml"
 KEYS = ["lubrication.drag_coefficient", "contact.restitution"]
 
 
+@pytest.mark.slow
 def test_reduced_sensitivities_are_the_event_solvers_central_difference(tmp_path):
     """Each row's S equals (ln I(x+) - ln I(x-)) / (ln x+ - ln x-) with I computed here directly by the
     event solver from Parameters at x (1 -+ 10 %) (the table's values come from the case archives, so
@@ -121,6 +122,7 @@ def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch
         by[(KEYS[1], "I_dec")]["sensitivity"]
 
 
+@pytest.mark.slow
 def test_uncertainty_reads_the_summaries_the_archives_hold(tmp_path):
     """The study's finish step takes each case's summary from the sweep's record (no archive loaded in
     full): its outputs equal, bit for bit, the numbers of every archive loaded in full, both after the
@@ -218,6 +220,7 @@ def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys
     assert "ranges.contact.restitution" in err and "1.2" in err and "less than or equal to 1" in err
 
 
+@pytest.mark.slow
 def test_inspect_and_show_read_the_study_tables(tmp_path, capsys):
     """`inspect` names what a sensitivity.h5 or uncertainty.h5 is and lists its columns; `show` gives the
     scenario it was made from as runnable TOML (as for sweep.h5 and crosscheck.h5)."""
@@ -254,6 +257,7 @@ def test_plot_draws_a_study_table_figure_again(tmp_path, capsys):
         assert (out / png).read_bytes() == (tmp_path / table).parent.joinpath(png).read_bytes()
 
 
+@pytest.mark.slow
 def test_table_prints_a_study_table_as_its_command_did(tmp_path, capsys):
     """`bearingsim table` of a sensitivity or uncertainty folder printed its case index (every run in the
     order it ran, marked against the first), and of its sensitivity.h5 or uncertainty.h5 "not a bearingsim

@@ -245,6 +245,7 @@ def _stage(folder, j: int):
     return load(_stage_path(folder, j))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("mapping", ["uniform", "shape"])
 def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, mapping):
     """Three stages of the fast scene (1 rotation each) to a pocket clearance of 0.203 mm: the effective
@@ -441,8 +442,6 @@ def _wait_for_the_handler():
 def _signalling_batch(items, *args, **kw):
     """The engine's run_batch (in a forked worker process, which has this module's state) sending its study
     the signal ``_SIGNAL_AT`` names for one of its cases, then running them."""
-    from bearingsim.sweeps import worker
-
     for h, *_ in items:
         if h in _SIGNAL_AT:
             os.kill(os.getppid(), _SIGNAL_AT[h])
@@ -461,24 +460,15 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
     history is written, and the same command then reuses the finished stage."""
     from bearingsim.cli import main
     from bearingsim.studies import life
-    from bearingsim.sweeps import worker
 
-    next_cases = life.LifeStudy.next_cases
-
-    def signalled(self, outdir, records):
-        cases = next_cases(self, outdir, records)
+    def signalled(study, cases):
         if cases and when == "between stages":
             os.kill(os.getpid(), sig)
             _wait_for_the_handler()
         _SIGNAL_AT.update((c.hash, sig) for c in cases)
-        return cases
 
-    monkeypatch.setattr(life.LifeStudy, "next_cases", signalled)
-    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
-    monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
-    monkeypatch.setattr(worker, "run_batch", _signalling_batch)
-    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "2",
-           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    _watch_stages(monkeypatch, _signalling_batch, signalled)
+    cmd = _life_cmd(tmp_path, stages=2)
     # a suite started as a background job inherits SIGINT ignored: give this process a terminal user's handler
     # (SIGTERM's is the command line's own)
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
@@ -496,6 +486,31 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
     assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0]
 
 
+def _watch_stages(monkeypatch, batch, on_next) -> None:
+    """``on_next(study, cases)`` sees each stage case a life study makes, before it runs, and the engine's
+    batches go through ``batch`` (a function of this module: the forked worker finds it by name)."""
+    from bearingsim.studies import life
+    from bearingsim.sweeps import worker
+
+    next_cases = life.LifeStudy.next_cases
+
+    def watched(self, outdir, records):
+        cases = next_cases(self, outdir, records)
+        on_next(self, cases)
+        return cases
+
+    monkeypatch.setattr(life.LifeStudy, "next_cases", watched)
+    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
+    monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
+    monkeypatch.setattr(worker, "run_batch", batch)
+
+
+def _life_cmd(folder, stages: int) -> list[str]:
+    """A life study of the fast scene, one rotation a stage, to a pocket clearance of 0.203 mm."""
+    return ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", str(stages),
+            "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(folder)]
+
+
 def _failing_batch(items, *args, **kw):
     """The engine's run_batch (in a forked worker) failing the cases ``_SIGNAL_AT`` names, as a case whose
     run raised does."""
@@ -510,21 +525,12 @@ def test_a_failed_stage_ends_the_life_study_keeping_the_stages_before_it(tmp_pat
     before); no history; the stage before it is kept, and the same command, the failure gone, reuses it."""
     from bearingsim.cli import main
     from bearingsim.studies import life
-    from bearingsim.sweeps import worker
 
-    next_cases = life.LifeStudy.next_cases
+    def failing(study, cases):
+        _SIGNAL_AT.update((c.hash, 0) for c in cases if len(study.rows) == 1)  # stage 1 fails
 
-    def failing(self, outdir, records):
-        cases = next_cases(self, outdir, records)
-        _SIGNAL_AT.update((c.hash, 0) for c in cases if len(self.rows) == 1)  # stage 1 fails
-        return cases
-
-    monkeypatch.setattr(life.LifeStudy, "next_cases", failing)
-    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
-    monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
-    monkeypatch.setattr(worker, "run_batch", _failing_batch)
-    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.203mm", "--stages", "3",
-           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    _watch_stages(monkeypatch, _failing_batch, failing)
+    cmd = _life_cmd(tmp_path, stages=3)
     assert main(cmd) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert err[0].startswith("failed: case ") and err[0].endswith(" (stage=1): SimulationUnstable: made to fail")
@@ -591,6 +597,7 @@ def test_a_signal_while_a_study_writes_its_table_says_its_cases_are_kept(tmp_pat
     assert (tmp_path / "life.png").is_file()
 
 
+@pytest.mark.slow
 def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, capsys):
     """`bearingsim wear ARCHIVE` draws the Fig. 13 and Fig. 14 analogs from the archive alone (a run
     written and read back), `bearingsim life` its history figure from life.h5's columns; without
@@ -608,7 +615,6 @@ def test_wear_and_life_commands_draw_their_figures_from_the_archives(tmp_path, c
     assert main(["life", scenario, "--limit", "clearance=0.203mm", "--stages", "2", "--rotations", "1", "-q",
                  "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "life")]) == 0
     assert (tmp_path / "life" / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    from bearingsim.simulation import load
     from bearingsim.studies.life import read_life
 
     assert read_life(tmp_path / "life" / "life.h5")[1]["mapping"] == "shape"

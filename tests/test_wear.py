@@ -429,8 +429,21 @@ def test_life_folder_of_other_stages_or_rotations_is_refused_and_a_limit_in_othe
 
 
 #: case hash -> the signal its worker sends the study before it runs the case
-_SIGNAL_AT: dict[str, int] = {}
+_MARKS = None  # a JSON file: the worker processes outlive the study's rounds, so they read it at each batch
 _RUN_BATCH = None  # the engine's own run_batch, while a test puts _signalling_batch in its place
+
+
+def _marked() -> dict:
+    """The cases marked for a worker to act on, by hash (signal number, or 0: fail)."""
+    import json
+
+    return json.loads(_MARKS.read_text()) if _MARKS is not None and _MARKS.exists() else {}
+
+
+def _mark(cases, value: int) -> None:
+    import json
+
+    _MARKS.write_text(json.dumps({**_marked(), **{c.hash: value for c in cases}}))
 
 
 def _wait_for_the_handler():
@@ -441,10 +454,11 @@ def _wait_for_the_handler():
 
 def _signalling_batch(items, *args, **kw):
     """The engine's run_batch (in a forked worker process, which has this module's state) sending its study
-    the signal ``_SIGNAL_AT`` names for one of its cases, then running them."""
+    the signal marked for one of its cases, then running them."""
+    marks = _marked()
     for h, *_ in items:
-        if h in _SIGNAL_AT:
-            os.kill(os.getppid(), _SIGNAL_AT[h])
+        if h in marks:
+            os.kill(os.getppid(), marks[h])
             time.sleep(10)  # the study ends this worker
     return _RUN_BATCH(items, *args, **kw)
 
@@ -465,9 +479,9 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
         if cases and when == "between stages":
             os.kill(os.getpid(), sig)
             _wait_for_the_handler()
-        _SIGNAL_AT.update((c.hash, sig) for c in cases)
+        _mark(cases, sig)
 
-    _watch_stages(monkeypatch, _signalling_batch, signalled)
+    _watch_stages(monkeypatch, tmp_path.with_name(tmp_path.name + "-marks.json"), _signalling_batch, signalled)
     cmd = _life_cmd(tmp_path, stages=2)
     # a suite started as a background job inherits SIGINT ignored: give this process a terminal user's handler
     # (SIGTERM's is the command line's own)
@@ -486,7 +500,7 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
     assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0]
 
 
-def _watch_stages(monkeypatch, batch, on_next) -> None:
+def _watch_stages(monkeypatch, marks, batch, on_next) -> None:
     """``on_next(study, cases)`` sees each stage case a life study makes, before it runs, and the engine's
     batches go through ``batch`` (a function of this module: the forked worker finds it by name)."""
     from bearingsim.studies import life
@@ -500,7 +514,7 @@ def _watch_stages(monkeypatch, batch, on_next) -> None:
         return cases
 
     monkeypatch.setattr(life.LifeStudy, "next_cases", watched)
-    monkeypatch.setattr(sys.modules[__name__], "_SIGNAL_AT", {})
+    monkeypatch.setattr(sys.modules[__name__], "_MARKS", marks)
     monkeypatch.setattr(sys.modules[__name__], "_RUN_BATCH", worker.run_batch)
     monkeypatch.setattr(worker, "run_batch", batch)
 
@@ -512,10 +526,11 @@ def _life_cmd(folder, stages: int) -> list[str]:
 
 
 def _failing_batch(items, *args, **kw):
-    """The engine's run_batch (in a forked worker) failing the cases ``_SIGNAL_AT`` names, as a case whose
+    """The engine's run_batch (in a forked worker) failing the cases marked so, as a case whose
     run raised does."""
+    marks = _marked()
     return [{"hash": h, "status": "failed", "error": "SimulationUnstable: made to fail", "wall_s": 0.0, "summary": {}}
-            if h in _SIGNAL_AT else _RUN_BATCH([(h, *rest)], *args, **kw)[0] for h, *rest in items]
+            if h in marks else _RUN_BATCH([(h, *rest)], *args, **kw)[0] for h, *rest in items]
 
 
 @pytest.mark.slow
@@ -527,9 +542,10 @@ def test_a_failed_stage_ends_the_life_study_keeping_the_stages_before_it(tmp_pat
     from bearingsim.studies import life
 
     def failing(study, cases):
-        _SIGNAL_AT.update((c.hash, 0) for c in cases if len(study.rows) == 1)  # stage 1 fails
+        if len(study.rows) == 1:  # stage 1 fails
+            _mark(cases, 0)
 
-    _watch_stages(monkeypatch, _failing_batch, failing)
+    _watch_stages(monkeypatch, tmp_path.with_name(tmp_path.name + "-marks.json"), _failing_batch, failing)
     cmd = _life_cmd(tmp_path, stages=3)
     assert main(cmd) == 1
     err = capsys.readouterr().err.strip().splitlines()

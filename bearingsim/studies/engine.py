@@ -193,7 +193,6 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
     from bearingsim.sweeps.engines import LocalEngine
 
     engine = engine or LocalEngine(1)
-    staged = any(s.staged for s in studies)
     try:
         outdir = check_writable_dir(outdir)
         check_outputs(outdir, studies)  # before the lock file: a refusal leaves the folder as it was
@@ -205,8 +204,7 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         for study in studies:
             if study.staged:
                 study.check_folder(outdir, force)
-        sweep = _run_rounds(studies, cases, outdir, engine, lock, dict(progress=progress, log=log, force=force,
-                                                                      check_folder=not staged))
+        sweep = _run_rounds(studies, cases, outdir, engine, lock, dict(progress=progress, log=log, force=force))
         known = {r["case"] for r in sweep.rows}
         out = StudiesOutcome(sweep, planned=len(known) + sum(s.cases_to_come(known) for s in studies))
         if sweep.interrupted is None:
@@ -240,17 +238,19 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     """Run ``cases`` on the engine; then, while the studies call for more (:meth:`Study.next_cases`) and
     none has failed or been interrupted, those too, each round indexed with all before it. Returns the
     last round's sweep outcome."""
-    from bearingsim.sweeps.run import SweepInterrupted, _Signals, run_sweep
+    from bearingsim.sweeps.run import StagedRound, SweepInterrupted, _Signals, run_sweep
 
     desc = "+".join(s.name for s in studies)
     sweep, earlier = None, {}
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM end the study as one
     # during a round does: the finished cases kept, the same command resumes
+    staged = any(s.staged for s in studies)
     with _Signals():
         try:
-            while True:
+            while True:  # a staged study's rounds share the engine: its workers keep the model they loaded
                 sweep = run_sweep(cases, outdir, engine=engine, figures=False, lock=lock, desc=desc, archives="all",
-                                  earlier=earlier, **options)  # tables and figures are made from the cases' archives
+                                  staged=StagedRound(earlier) if staged else None,
+                                  **options)  # tables and figures are made from the cases' archives
                 if sweep.interrupted is not None or sweep.failed:
                     return sweep
                 records = {r["case"]: r for r in sweep.rows}
@@ -264,6 +264,8 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
                 sweep.interrupted = exc.signum
                 return sweep
             first = exc.signum
+        finally:
+            engine.stop()
     signal.raise_signal(first)  # before any case ran: the signal goes to the handler that was in place
     raise KeyboardInterrupt(signal.Signals(first).name)  # that handler ignored it: the study is stopped all the same
 

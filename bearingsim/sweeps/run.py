@@ -40,6 +40,18 @@ INDEX_TIME_SHARE = 0.02
 _log = logging.getLogger(__name__)  # a failed case, when no progress bar shows it
 
 
+@dataclass(frozen=True)
+class StagedRound:
+    """The cases of :func:`run_sweep` are a round of a staged study (:func:`bearingsim.studies.run_studies`):
+    the study checks its folder itself (its later cases are not known before the earlier ones have run, so
+    :func:`check_same_sweep` cannot tell its own earlier run from another study's); ``earlier``, the rows
+    of the cases earlier rounds ran or took, by hash, are kept as they are (not read again from their
+    archives, and a case run this time stays ``done``); and the engine is left started for the next round
+    (its workers keep the compiled model they have loaded), the caller stopping it."""
+
+    earlier: dict = field(default_factory=dict)
+
+
 class SweepInterrupted(Exception):
     """SIGINT or SIGTERM arrived during a sweep; ``signum`` says which."""
 
@@ -259,7 +271,7 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
               progress: bool | None = None, log=None, lock: FolderLock | None = None,
               desc: str = "sweep", force: bool = False, archives: str = "auto",
-              check_folder: bool = True, earlier: dict[str, dict] | None = None) -> SweepOutcome:
+              staged: StagedRound | None = None) -> SweepOutcome:
     """Run every case of ``spec`` that has no valid result yet, and index them all.
 
     Parameters
@@ -289,13 +301,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         Which cases get an archive in ``outdir/cases/``: ``auto`` (the multibody cases; a reduced
         case's numbers are in the index and, for a product grid, ``map.h5``), ``all`` or ``none``
         (:func:`bearingsim.sweeps.worker.keeps_archive`).
-    check_folder : bool
-        Refuse a folder that holds another sweep or study (:func:`check_same_sweep`). A staged study, whose
-        later cases are not known before the earlier ones have run, checks its folder itself and passes
-        False (:attr:`bearingsim.studies.Study.staged`).
-    earlier : dict, optional
-        A staged study's rows of the cases its earlier rounds ran or took, by case hash: kept as they are
-        (their archives are not read again, and a case run this time stays ``done``).
+    staged : StagedRound, optional
+        These cases are a round of a staged study (:class:`StagedRound`); default: a sweep of its own.
 
     Returns
     -------
@@ -315,7 +322,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         grid = grid_axes(spec)
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
         engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
-        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, check_folder)
+        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None)
     except BaseException:
         engine.stop()
         raise
@@ -329,7 +336,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     with lock if own else contextlib.nullcontext():
         outcome.interrupted = _run_cases(engine, cases, rows, index, outdir / "cases", archives, progress, desc, log,
                                          lambda: write_map(outcome.map, grid, index.columns, map_attrs) if grid else None,
-                                         earlier)
+                                         staged)
     outcome.wall_s = time.perf_counter() - t0
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
@@ -339,7 +346,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
 
 def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map,
-               earlier=None) -> int | None:
+               staged=None) -> int | None:
     """Resume, run what is left on ``engine`` and keep the index (and, through ``write_map``, the map)
     written however the run ends; the signal number if SIGINT/SIGTERM stopped it, else None."""
     with _Signals() as signals:
@@ -348,7 +355,7 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
-            todo, stale = _resume(cases, rows, cases_dir.parent, archives, earlier)
+            todo, stale = _resume(cases, rows, cases_dir.parent, archives, staged.earlier if staged else None)
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": 0}
             for r in rows:  # of the cases not to run: cached, or (a staged study's earlier rounds) run this time
@@ -365,7 +372,8 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
             return exc.signum
         finally:
             try:
-                engine.stop()
+                if staged is None:  # a staged study's next round uses it: its caller stops it
+                    engine.stop()
             finally:
                 if bar is not None:
                     bar.close()

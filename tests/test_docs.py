@@ -207,6 +207,40 @@ def test_every_run_example_with_set_writes_an_archive_of_its_own():
     assert found >= 9 and not missing, missing
 
 
+def test_the_sweep_examples_of_the_pages_do_not_share_a_folder():
+    """A sweep into a folder that holds another sweep is refused; the README's speed sweep, docs/sweeps.md's
+    product sweep and docs/usage.md's (which gave no -o) all went to outputs/sweep, so whichever a reader
+    ran second was refused. Across the README and docs/, two sweep examples that write one folder are the
+    same sweep (the same scenario, --param, --set and sweep file; -j, -q, --scheduler aside)."""
+    import shlex
+
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    pages.remove(ROOT / "docs" / "reliability.md")  # its commands are bad input, each in an empty folder
+    engine = {"-j", "--jobs", "--scheduler"}
+    by_folder, clashes = {}, []
+    for page in pages:
+        for span in _code_spans(page):
+            for cmd in re.findall(r"bearingsim sweep (.*)", span):
+                try:
+                    args = shlex.split(cmd)
+                except ValueError:
+                    continue
+                if not args or not (ROOT / args[0]).is_file():
+                    continue  # a placeholder (SCENARIO, FILE)
+                out, what, it = "outputs/sweep", [], iter(args)
+                for a in it:
+                    if a in ("-o", "--output"):
+                        out = next(it, out)
+                    elif a in engine:
+                        next(it, None)
+                    elif a not in ("-q", "--quiet", "--no-plots"):
+                        what.append(a)
+                seen = by_folder.setdefault(out, (tuple(what), page.name))
+                if seen[0] != tuple(what):
+                    clashes.append(f"{out}: {seen[1]} and {page.name}")
+    assert len(by_folder) >= 4 and not clashes, clashes
+
+
 def test_the_run_examples_of_a_page_run_in_order():
     """Within each page, in order, no `bearingsim run` example writes an archive that an earlier one wrote
     for another resolved scenario (it would be refused without --force)."""

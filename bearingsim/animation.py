@@ -75,7 +75,7 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
     out = check_output(out)
     if MOTION not in result.series:
         raise _no_motion(result, where)
-    fps = _check_number(fps, "fps", 1.0, MAX_FPS)
+    fps = check_number(fps, "fps", 1.0, MAX_FPS)
     motion = _Motion(result)
     a, b = motion.window(rotations, where)
     if last is not None:
@@ -124,7 +124,9 @@ def _is_mp4(path) -> bool:
         return fh.read(8)[4:8] == b"ftyp"
 
 
-def _check_number(value, name, lo, hi) -> float:
+def check_number(value, name, lo, hi) -> float:
+    """``value`` as a float in ``[lo, hi]``, else a one-line UserError naming it ``name`` (the API's keyword,
+    or the command line's option)."""
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -138,7 +140,7 @@ def _exaggeration(p, given) -> float:
     """The factor K the clearances are drawn at: ``given``, or the 1-2-5 number at or below the one that
     makes the drawn pocket play K s / 2 :data:`AUTO_PLAY_FRACTION` of the roller radius (10 for the NU214)."""
     if given is not None:
-        return _check_number(given, "exaggerate", 1.0, MAX_EXAGGERATION)
+        return check_number(given, "exaggerate", 1.0, MAX_EXAGGERATION)
     g = p.bearing
     want = AUTO_PLAY_FRACTION * g.roller_radius / (0.5 * g.pocket_clearance)
     if want <= 1.0:

@@ -23,10 +23,14 @@ def parse_rotations(text: str) -> tuple[float, float]:
 
 
 def _cmd_animate(args) -> int:
+    from bearingsim import animation
     from bearingsim.simulation import animate as render
     from bearingsim.sweeps.run import _progress as progress_bar  # the bar of sweep, crosscheck and validate
 
     rotations = parse_rotations(args.rotations) if args.rotations is not None else None
+    animation.check_number(args.fps, "--fps", 1.0, animation.MAX_FPS)  # named as the user gave them
+    if args.exaggerate is not None:
+        animation.check_number(args.exaggerate, "--exaggerate", 1.0, animation.MAX_EXAGGERATION)
     enabled = not args.quiet and sys.stderr.isatty()
     bar = None
 

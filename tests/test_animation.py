@@ -206,6 +206,16 @@ def test_bad_output_and_options_are_refused(runs, tmp_path):
         bearingsim.animate(runs[1], tmp_path / "b.gif", fps=0)
 
 
+@pytest.mark.parametrize("option, value", [("--fps", "0"), ("--exaggerate", "0.5")])
+def test_the_command_line_names_the_option_given_out_of_range(runs, tmp_path, capsys, option, value):
+    """`animate --fps 0` said "fps: 0.0 is outside ..." (the API's keyword): the command line names its
+    option, in one line, exit 2, and writes nothing."""
+    assert main(["animate", str(runs[1]), "-o", str(tmp_path / "a.gif"), option, value]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"bearingsim: error: {option}: {float(value)!r} is outside"), err
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("suffix", [".gif", ".mp4"])
 def test_the_output_folder_is_made_as_a_runs_is_and_an_unwritable_one_is_told_before_any_frame(runs, tmp_path,
                                                                                                   suffix):

@@ -17,7 +17,8 @@ class Comparison:
     """What differs between two results (empty lists: identical)."""
 
     scenario_keys: list[tuple[str, object, object]] = field(default_factory=list)
-    summary: list[tuple[str, float, float]] = field(default_factory=list)  # every key of either
+    summary: list[tuple[str, float, float]] = field(default_factory=list)  # every key of either (NaN where absent)
+    absent: dict[str, str] = field(default_factory=dict)  # a summary key only one result has: "A" or "B", the other
     summary_differs: list[str] = field(default_factory=list)
     arrays_differ: list[str] = field(default_factory=list)
     versions: list[tuple[str, object, object]] = field(default_factory=list)
@@ -31,9 +32,13 @@ class Comparison:
         """The summary numbers side by side with their absolute and relative difference."""
         rows = [f"{'summary':34s} {'A':>14s} {'B':>14s} {'B - A':>11s} {'(B - A)/|A|':>11s}"]
         for k, a, b in self.summary:
+            mark = "" if k not in self.summary_differs else "  *"
+            if k in self.absent:  # a number of one model only (the multibody model's cage slip, say)
+                cells = [f"{'(none)':>14s}" if self.absent[k] == side else f"{v:14.7g}" for side, v in (("A", a), ("B", b))]
+                rows.append(f"{k:34s} {cells[0]} {cells[1]} {'':>11s} {'':>11s}{mark}")
+                continue
             d = b - a
             rel = d / abs(a) if a not in (0.0,) and math.isfinite(a) else float("nan")
-            mark = "" if k not in self.summary_differs else "  *"
             rows.append(f"{k:34s} {a:14.7g} {b:14.7g} {d:11.3g} {rel:11.3g}{mark}")
         return "\n".join(rows)
 
@@ -46,6 +51,8 @@ def compare_results(a, b) -> Comparison:
     for k in list(sa) + [k for k in sb if k not in sa]:
         va, vb = sa.get(k, float("nan")), sb.get(k, float("nan"))
         c.summary.append((k, va, vb))
+        if k not in sa or k not in sb:
+            c.absent[k] = "A" if k not in sa else "B"
         if k not in sa or k not in sb or not same_value(va, vb):
             c.summary_differs.append(k)
     pa, pb = a.per_rotation, b.per_rotation

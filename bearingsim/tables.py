@@ -119,7 +119,7 @@ def table_of_archives(paths) -> Table:
     if len(differ) > len(shown) + ("name" in differ):
         rest = [k for k in differ if k not in shown and k != "name"]
         notes.append("scenario keys that also differ: " + ", ".join(rest))
-    if not differ:
+    if not differ and len(results) > 1:
         notes.append("scenarios: identical")
     return Table(names, labels, numbers, units, notes)
 

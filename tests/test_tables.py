@@ -242,3 +242,28 @@ def test_no_progress_text_when_stderr_is_not_a_terminal(tmp_path):
     res = cli("validate", "--rig-rotations", "0", "-j", "1", "-o", tmp_path / "v")
     assert res.returncode == 0, res.stderr
     assert "\r" not in res.stderr and "case/s" not in res.stderr and "%|" not in res.stderr, res.stderr
+
+
+def test_a_table_of_one_archive_says_nothing_of_scenarios_it_compares(reduced_runs):
+    """`table a.h5` printed "scenarios: identical" under a one-row table, a comparison with nothing;
+    two archives of one scenario still say so."""
+    one = tables.format_table(tables.table_of_archives([reduced_runs / "a.h5"]))
+    two = tables.format_table(tables.table_of_archives([reduced_runs / "a.h5", reduced_runs / "b.h5"]))
+    assert "scenarios: identical" not in one and "scenarios: identical" in two
+
+
+def test_compare_shows_a_number_only_one_model_has_as_absent_not_nan():
+    """`compare` of a reduced and a multibody archive showed the multibody model's own numbers (cage slip,
+    steps, pockets) against "nan" for the reduced one, as if it had computed a NaN: the side without the
+    number says (none), no difference is printed, and the row is still marked as differing."""
+    from bearingsim.compare import compare_results
+
+    def result(model, summary):
+        return SimpleNamespace(scenario=SimpleNamespace(raw={"model": model}), summary=summary, per_rotation={},
+                               provenance={})
+
+    c = compare_results(result("reduced", {"I_dec_mean_Ns": 0.005}),
+                        result("multibody", {"I_dec_mean_Ns": 0.015, "cage_slip": -0.001}))
+    assert c.absent == {"cage_slip": "A"} and "cage_slip" in c.summary_differs and not c.identical
+    (row,) = [line for line in c.summary_table().splitlines() if line.startswith("cage_slip")]
+    assert row.split() == ["cage_slip", "(none)", "-0.001", "*"]

@@ -59,6 +59,14 @@ def _field_kind(section_model, key: str) -> str | None:
     return "other"
 
 
+def is_continuous(scenario, dotted: str) -> bool:
+    """Whether ``section.key`` of a resolved scenario takes real numbers (what a range, a relative step and
+    a sensitivity need), not a count or a choice."""
+    section, key = dotted.split(".", 1)
+    sec = getattr(scenario.model_, section, None)
+    return sec is not None and hasattr(type(sec), "model_fields") and _field_kind(sec, key) == "float"
+
+
 _BOUND_ERRORS: dict[tuple, str | None] = {}
 
 

@@ -183,6 +183,11 @@ def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
      "when reduced.load_zone_half_angle_deg is given"),
     ("multibody_3000rpm", [], "bearing.cage_land_clearance_mm",
      "--keys bearing.cage_land_clearance_mm: {src}: not used with bearing.cage_guidance = 'rollers'"),
+    # a count or a choice has no range and no derivative (was: "give [ranges.bearing.roller_count] range = ...")
+    ("multibody_3000rpm", [], "bearing.roller_count",
+     "--keys bearing.roller_count: not a continuous number (a count or a choice): it has no range or derivative; "
+     "sweep its values instead (bearingsim sweep --param bearing.roller_count=A,B,...)"),
+    ("multibody_3000rpm", [], "bearing.cage_guidance", "--keys bearing.cage_guidance: not a continuous number"),
 ])
 def test_a_key_that_is_not_one_or_not_read_is_refused_naming_it(tmp_path, capsys, command, scenario, sets, key,
                                                                  words):

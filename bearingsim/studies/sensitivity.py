@@ -140,6 +140,11 @@ def _check_given_key(scenario, key: str) -> None:
     why = unread_because(scenario, key)
     if why is not None:
         raise UserError(f"--keys {key}: {scenario.source}: {why}, so varying it changes no run; leave it out")
+    from bearingsim.ranges import is_continuous
+
+    if not is_continuous(scenario, key):
+        raise UserError(f"--keys {key}: not a continuous number (a count or a choice): it has no range or derivative; "
+                        f"sweep its values instead (bearingsim sweep --param {key}=A,B,...)")
 
 
 def perturbed_values(scenario, key: str, step: float) -> tuple[float, float]:

@@ -80,35 +80,16 @@ def animate(path, out, **kw):
     return _animate(path, out, **kw)
 
 
-def _submodule(package: str, name: str):
-    """The submodule ``package.name``, imported on its first use as an attribute of ``package`` (a package's
-    module-level ``__getattr__``, PEP 562); AttributeError when the package has no such submodule."""
-    import importlib
-    import importlib.util
-
-    if not name.startswith("__"):  # dunder probes (copy, pickle, inspect) are never submodules
-        fullname = f"{package}.{name}"
-        try:
-            found = importlib.util.find_spec(fullname) is not None
-        except (ImportError, ValueError):
-            found = False
-        if found:
-            return importlib.import_module(fullname)
-    raise AttributeError(f"module {package!r} has no attribute {name!r}")
-
-
-def _submodule_names(package: str, path) -> list[str]:
-    import pkgutil
-
-    return [m.name for m in pkgutil.iter_modules(path) if not m.name.startswith("__")]
-
-
 def __getattr__(name):
-    return _submodule(__name__, name)
+    from bearingsim._lazy import submodule
+
+    return submodule(__name__, name)
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_submodule_names(__name__, __path__)))
+    from bearingsim._lazy import submodule_names
+
+    return sorted(set(globals()) | set(submodule_names(__path__)))
 
 
 __all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load", "sensitivity",

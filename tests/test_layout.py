@@ -142,6 +142,16 @@ def test_the_library_never_imports_the_command_line(imports):
     assert not bad, "; ".join(bad)
 
 
+def test_only_the_command_line_imports_the_package_itself(imports):
+    """``bearingsim/__init__.py`` is the Python API, a facade over the orchestration, the studies and the
+    reports: a module below it that imports the package itself (``from bearingsim import name`` of a name
+    that is no module) depends on everything the facade does. Subpackages found their submodules through
+    it (``from bearingsim import _submodule``); that helper is the leaf module ``bearingsim/_lazy.py``."""
+    commands = ("bearingsim.cli", "bearingsim.__main__")
+    bad = _where(imports[0], lambda a, b: b == "bearingsim" and a not in commands)
+    assert not bad, "; ".join(bad)
+
+
 @pytest.mark.parametrize(("package", "users"), [
     ("h5py", {"bearingsim.archive"}),  # the only h5py user
     ("pymunk", {"bearingsim.multibody.chipmunk", "bearingsim.multibody.loop", "bearingsim.multibody.scene"}),

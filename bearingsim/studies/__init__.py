@@ -16,12 +16,12 @@ __all__ = ["StudiesOutcome", "Study", "batch_sem", "case_of", "in_folder", "load
 
 
 def __getattr__(name):  # the study modules (bearingsim.studies.life, ...) on first use (PEP 562)
-    from bearingsim import _submodule
+    from bearingsim._lazy import submodule
 
-    return _submodule(__name__, name)
+    return submodule(__name__, name)
 
 
 def __dir__():
-    from bearingsim import _submodule_names
+    from bearingsim._lazy import submodule_names
 
-    return sorted(set(globals()) | set(_submodule_names(__name__, __path__)))
+    return sorted(set(globals()) | set(submodule_names(__path__)))

@@ -30,12 +30,12 @@ def __getattr__(name):
         value = getattr(importlib.import_module(f"{__name__}.{_SOURCES[name]}"), name)
         globals()[name] = value
         return value
-    from bearingsim import _submodule
+    from bearingsim._lazy import submodule
 
-    return _submodule(__name__, name)  # its submodules (bearingsim.sweeps.worker, ...), or AttributeError
+    return submodule(__name__, name)  # its submodules (bearingsim.sweeps.worker, ...), or AttributeError
 
 
 def __dir__():
-    from bearingsim import _submodule_names
+    from bearingsim._lazy import submodule_names
 
-    return sorted(set(globals()) | set(__all__) | set(_submodule_names(__name__, __path__)))
+    return sorted(set(globals()) | set(__all__) | set(submodule_names(__path__)))

@@ -536,3 +536,42 @@ def test_stop_ends_a_pool_whose_result_queue_lock_is_held(monkeypatch):
     assert not stopper.is_alive()
     assert all(p.exitcode is not None for p in workers)
     assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()
+
+
+def _worker_signals() -> tuple:
+    """In a pool worker: (its parent-death signal, its SIGTERM handler's name, the stop signals it blocks)."""
+    import ctypes
+
+    sig = ctypes.c_int(0)
+    ctypes.CDLL(None, use_errno=True).prctl(2, ctypes.byref(sig))  # PR_GET_PDEATHSIG
+    handler = signal.getsignal(signal.SIGTERM)
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, set()) & {signal.SIGINT, signal.SIGTERM}
+    return sig.value, getattr(handler, "__name__", str(handler)), sorted(int(s) for s in blocked)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG and /proc are Linux's")
+def test_a_worker_ended_by_sigterm_while_it_waits_for_a_task_leaves_the_pool_usable():
+    """SIGTERM to the process group (a batch system's, `timeout`'s) reaches the workers too. A worker waits for
+    its next task holding the pool's task-queue lock; ended there by the default action (or by the SIGKILL
+    that a worker forked by the pool's maintenance thread got as its parent-death signal when that thread
+    ended), it left the lock taken: the worker the pool started in its place waited for it for ever, and
+    terminate too (a life study took 11 s to stop after SIGTERM, once it hung). A worker's SIGTERM now
+    raises an exception that releases the lock and ends it with status 143, its parent-death signal is
+    SIGTERM, and a worker gets the stop signals only once its handlers are in (unblocked by its initializer)."""
+    import os
+
+    engine = LocalEngine(1)
+    engine.start(1)
+    try:
+        pool = engine._pool
+        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [])
+        (first,) = pool._pool
+        time.sleep(0.2)  # idle: waiting for its next task, holding the task queue's lock
+        os.kill(first.pid, signal.SIGTERM)
+        first.join(30)
+        assert first.exitcode == 143
+        # the worker the pool starts in its place (forked by its maintenance thread) takes the next task
+        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [])
+        assert all(p.pid != first.pid for p in pool._pool)
+    finally:
+        engine.stop()

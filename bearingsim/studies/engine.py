@@ -245,7 +245,7 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM end the study as one
     # during a round does: the finished cases kept, the same command resumes
     staged = any(s.staged for s in studies)
-    with _Signals():
+    with _Signals() as outer:
         try:
             while True:  # a staged study's rounds share the engine: its workers keep the model they loaded
                 sweep = run_sweep(cases, outdir, engine=engine, figures=False, lock=lock, desc=desc, archives="all",
@@ -256,6 +256,8 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
                 records = {r["case"]: r for r in sweep.rows}
                 earlier = {h: {k: r[k] for k in _ROW_KEYS} for h, r in records.items()}
                 more = _new_cases(cases, [c for s in studies for c in s.next_cases(outdir, records)])
+                if outer.fired is not None:  # its exception was swallowed (raised inside a callback)
+                    raise SweepInterrupted(outer.fired)
                 if len(more) == len(cases):
                     return sweep
                 cases = more

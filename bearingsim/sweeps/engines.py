@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 import signal
+import sys
 import time
 from collections.abc import Iterator
 
@@ -19,15 +20,51 @@ from bearingsim.errors import UserError
 STOP_WAIT_S = 10.0
 
 
+#: the signals a sweep process acts on; blocked while it forks workers, until they have their own handlers
+_STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
+
+
+class _WorkerStop(SystemExit):
+    """SIGTERM in a worker process: it ends the worker (raised by the signal's handler)."""
+
+
+def _exit_worker(signum, frame):
+    raise _WorkerStop(128 + signum)
+
+
+def _stop_again(unraisable, previous=sys.unraisablehook) -> None:
+    """A worker's ``sys.unraisablehook``: a SIGTERM whose exception Python could not raise (its handler ran
+    inside a weakref callback, say) is set pending again 20 ms later, from a helper thread, when the worker
+    has left the callback; any other unraisable exception goes on to ``previous``."""
+    if not isinstance(unraisable.exc_value, _WorkerStop):
+        previous(unraisable)
+        return
+    import _thread
+    import threading
+
+    threading.Timer(0.02, _thread.interrupt_main, (signal.SIGTERM,)).start()
+
+
 def _pool_worker_init() -> None:
     # Ctrl-C reaches the whole process group: only the sweep process acts on it and then ends the
     # pool, so a worker must not die half-way through writing on its own.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_DFL)
-    try:  # Linux: die with the parent even if it is killed with SIGKILL
+    # SIGTERM (the pool's terminate, or a batch system's to the process group) ends a worker by an
+    # exception, not at once: an idle worker waits for its next task holding the pool's task queue lock,
+    # and a worker killed holding it left the lock taken, so the pool could not be ended (the sweep waited
+    # STOP_WAIT_S, then killed) and a worker the pool started in its place waited for it for ever
+    signal.signal(signal.SIGTERM, _exit_worker)
+    sys.unraisablehook = _stop_again
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, _STOP_SIGNALS)  # blocked by the sweep process while it forked
+    # Linux: end with the parent even if it is killed with SIGKILL. The signal is SIGTERM, whose handler ends
+    # the worker cleanly: the kernel sends it when the *thread* that forked the worker ends, and a worker the
+    # pool started in place of a dead one was forked by the pool's maintenance thread, which ends when the
+    # pool is terminated; SIGKILL then killed it while it waited for a task holding the task queue's lock,
+    # and terminate waited on that lock (STOP_WAIT_S)
+    try:
         import ctypes
 
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
+        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
         if os.getppid() == 1:
             os._exit(0)
     except (OSError, AttributeError):  # pragma: no cover - not Linux
@@ -63,8 +100,15 @@ class LocalEngine:
 
         if self._pool is None:
             self.workers = min(self.jobs, cases) if cases else self.jobs
-            # fork: workers start in milliseconds and inherit the imported package
-            self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
+            # fork: workers start in milliseconds and inherit the imported package. With SIGINT and SIGTERM
+            # blocked while the pool starts, its threads (which fork the workers that replace dead ones)
+            # keep them blocked, and a worker gets a signal only once it has its own handlers (it ran the
+            # sweep's handler, which raised SweepInterrupted in the worker, with a traceback)
+            blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
+            try:
+                self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
+            finally:
+                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
     def warm_up(self, spec, archives: str = "all") -> None:
         """Start the pool and, if the sweep's base scenario is a reduced-model one, have the workers run

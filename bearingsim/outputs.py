@@ -236,6 +236,47 @@ def check_folder_can_be_made(out: Path, what: str) -> None:
     check_folder_path(Path(out).parent, f"{what}'s folder")
 
 
+#: every file a sweep or a study writes into its folder beside ``cases/`` (the sweep's index, map and figures;
+#: each study's table and figures: tests/test_studies.py checks that every study's outputs are listed): what
+#: ``--force`` removes of another sweep or study in the folder (:func:`remove_folder_files`)
+FOLDER_FILES = ("sweep.csv", "sweep.h5", "map.h5", "sweep_I.png", "sweep_map.png", "sweep_cases.png",
+                "crosscheck.csv", "crosscheck.h5", "crosscheck.png",
+                "fig9_idec_vs_speed.csv", "fig9_idec_vs_speed.png",
+                "rig_idec_vs_speed.csv", "rig_idec_vs_speed.png", "rig_pocket0_forces.png",
+                "sensitivity.csv", "sensitivity.h5", "sensitivity.png",
+                "uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png",
+                "life.h5", "life.png")
+
+
+def _written_by_bearingsim(path: Path) -> bool:
+    """A regular file (not a link) of the kind its name says, as bearingsim writes it: a PNG, an HDF5 file,
+    or a CSV text (a header line of comma-separated names, no NUL byte)."""
+    if path.is_symlink() or not path.is_file():
+        return False
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    if path.suffix == ".png":
+        return head.startswith(PNG_SIGNATURE)
+    if path.suffix == ".h5":
+        return head.startswith(_HDF5_SIGNATURE)
+    first = head.split(b"\n", 1)[0]
+    return path.suffix == ".csv" and b"," in first and b"\0" not in head
+
+
+def remove_folder_files(folder: str | Path) -> list[Path]:
+    """Remove from ``folder`` the files a sweep or study writes there (:data:`FOLDER_FILES`) that bearingsim
+    wrote (never a link, a folder or a user's file of another kind; :func:`_written_by_bearingsim`): what
+    ``--force`` does to the sweep or study it replaces, so that no table or figure of it is left to be read
+    as the new one's. Returns the files removed."""
+    removed = []
+    for name in FOLDER_FILES:
+        p = Path(folder) / name
+        if _written_by_bearingsim(p):
+            p.unlink()
+            removed.append(p)
+    return removed
+
+
 def check_writable(path: str | Path) -> None:
     """Refuse, in the line a run would give (:meth:`OutputLock.acquire`), an output ``path`` whose folder
     could not be made or would take no new file, without writing anything: the nearest folder of it that

@@ -219,3 +219,57 @@ def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
     assert outcome.count("done") == 5
     assert (tmp_path / "local" / "crosscheck.csv").read_bytes() == (tmp_path / "dask" / "crosscheck.csv").read_bytes()
     assert [r["archive"] for r in local] == [r["archive"] for r in remote]
+
+
+def test_every_file_a_sweep_or_study_writes_into_its_folder_is_one_force_removes():
+    """`--force` removes the sweep or study it replaces (bearingsim.outputs.FOLDER_FILES): a file a study
+    writes that the list lacks would be left to be read as the new one's (a life study's life.h5 made
+    `table` and `report` of the folder show a life study after a sweep had replaced it)."""
+    import bearingsim
+    from bearingsim.outputs import FOLDER_FILES
+    from bearingsim.studies.crosscheck import CrossCheck
+    from bearingsim.studies.fig9 import Fig9
+    from bearingsim.studies.life import LifeStudy, parse_limit
+    from bearingsim.studies.rig import Rig
+    from bearingsim.studies.sensitivity import Sensitivity
+    from bearingsim.studies.uncertainty import Uncertainty
+    from bearingsim.sweeps.grid import MAP_NAME
+    from bearingsim.sweeps.plot import FIGURE_NAMES
+
+    reduced = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")
+    multibody = bearingsim.load_scenario(SCENARIOS / "wear_test_6000rpm.toml")
+    studies = [CrossCheck(bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml"), speeds=[3000], rotations=1),
+               Rig(speeds=[2000], rotations=1), Fig9(), Sensitivity(reduced), Uncertainty(reduced, 2),
+               LifeStudy(multibody, parse_limit("depth=0.1mm"), stages=1)]
+    written = {name for s in studies for name, _, _ in s.outputs} | set(FIGURE_NAMES) | {MAP_NAME, "sweep.csv", "sweep.h5"}
+    assert written <= set(FOLDER_FILES), sorted(written - set(FOLDER_FILES))
+
+
+def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path, capsys):
+    """A sweep run with --force into the folder of another study removes that study's table and figure
+    (they were left: `table` and `report` of the folder then showed a life study the sweep had replaced);
+    a user's file in the folder, and a file of a study's name that bearingsim did not write, are kept."""
+    import numpy as np
+
+    from bearingsim import archive
+    from bearingsim.cli import main
+    from bearingsim.outputs import PNG_SIGNATURE
+    from bearingsim.studies import life
+
+    sweep = ["sweep", str(SCENARIOS / "paper_3000rpm.toml"), "-q", "--no-plots", "-o", str(tmp_path)]
+    assert main([*sweep, "--param", "operating.inner_ring_speed_rpm=1000,2000"]) == 0
+    cols = {"stage": np.arange(1), "I_dec_mean_mNs": np.array([14.0])}
+    archive.write_table_file(tmp_path / "life.h5", cols, life.LIFE_UNITS, {"format": life.LIFE_FORMAT, "limit": "x"})
+    (tmp_path / "life.png").write_bytes(PNG_SIGNATURE + b"\0" * 16)
+    (tmp_path / "crosscheck.csv").write_bytes(b"\x00\x01 not a table")  # a study's name, not bearingsim's file
+    (tmp_path / "notes.txt").write_text("mine")
+    capsys.readouterr()
+    assert main([*sweep, "--param", "operating.inner_ring_speed_rpm=3000,4000"]) == 2  # another sweep: refused
+    assert "--force" in capsys.readouterr().err and (tmp_path / "life.h5").exists()
+    assert main([*sweep, "--param", "operating.inner_ring_speed_rpm=3000,4000", "--force"]) == 0
+    assert not (tmp_path / "life.h5").exists() and not (tmp_path / "life.png").exists()
+    assert (tmp_path / "crosscheck.csv").read_bytes() == b"\x00\x01 not a table"
+    assert (tmp_path / "notes.txt").read_text() == "mine"
+    capsys.readouterr()
+    assert main(["table", str(tmp_path)]) == 0
+    assert "3000" in capsys.readouterr().out

@@ -341,8 +341,11 @@ class LifeStudy(Study):
             return
         if not force:
             raise UserError(other)
-        for p in [path, outdir / "life.png", outdir / "sweep.h5", outdir / "sweep.csv", *outdir.glob("cases/*.h5")]:
-            p.unlink(missing_ok=True)
+        from bearingsim.outputs import remove_folder_files
+
+        for p in outdir.glob("cases/*.h5"):
+            p.unlink()
+        remove_folder_files(outdir)
 
 
 def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int | None = None,

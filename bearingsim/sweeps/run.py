@@ -23,7 +23,7 @@ from pathlib import Path
 
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
-from bearingsim.outputs import FolderLock, write_atomic_bytes
+from bearingsim.outputs import FolderLock, remove_folder_files, write_atomic_bytes
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
@@ -174,11 +174,12 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
                         f"{'a symbolic link' if cases.is_symlink() else 'not a folder'}; not used (remove it)")
 
 
-def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figures=()) -> None:
+def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> None:
     """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``; failed ones,
-    which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same sweep (or one that only adds cases)
-    passes. With ``force`` the other sweep's case archives and the sweep figures ``figures`` are removed
-    instead, so that nothing of it is mixed into the new one (the index is rewritten by the sweep)."""
+    which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same
+    sweep (or one that only adds cases) passes. With ``force`` the other sweep's or study's case archives,
+    index, map, figures and tables are removed instead (:func:`bearingsim.outputs.remove_folder_files`), so
+    that nothing of it is mixed into the new one or read as its."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
 
@@ -204,10 +205,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, figur
                         f"command as before resumes it)")
     for h in other:
         (cases_dir / f"{h}.h5").unlink(missing_ok=True)
-    for name in figures:
-        p = outdir / name
-        if p.is_file() and not p.is_symlink():
-            p.unlink()
+    remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
 
 
 def _clean_temporaries(cases_dir: Path) -> None:
@@ -388,8 +386,6 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
     lock is taken here). Refused: an unwritable folder, foreign files, another sweep or study (unless
     the caller checks that itself: ``check_folder`` False)."""
     from bearingsim.archive import check_writable_dir
-    from bearingsim.sweeps.grid import MAP_NAME
-    from bearingsim.sweeps.plot import FIGURE_NAMES
     from bearingsim.sweeps.worker import keeps_archive
 
     outdir = check_writable_dir(outdir)
@@ -401,7 +397,7 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
     try:
         check_sweep_outputs(outdir, figures)
         if check_folder:
-            check_same_sweep(outdir, cases, force, (*FIGURE_NAMES, MAP_NAME))
+            check_same_sweep(outdir, cases, force)
         if any(keeps_archive(c.model, archives) for c in cases):
             (outdir / "cases").mkdir(exist_ok=True)
     except BaseException:

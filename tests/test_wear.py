@@ -390,19 +390,25 @@ def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, m
 
 
 @pytest.mark.slow
-def test_life_ends_in_one_line_when_the_cage_bar_wears_through_before_the_limit(tmp_path, capsys):
-    """A volume limit whose mean depth fits the bar but whose worn edges do not (the roller-guided cage
-    wears its faces' ends two orders of magnitude more per area than their middle, docs/wear.md): the
-    stage whose pockets would be worn through is refused in one line saying the bar wears through first,
-    when and by how much, naming --limit (it named wear.worn_depth_front_um of the scenario file)."""
+@pytest.mark.parametrize("limit, stages", [("volume=30mm3", 2), ("depth=5.8mm", 1), ("depth=5.8mm", 2)])
+def test_life_ends_in_one_line_when_the_cage_bar_wears_through_before_the_limit(tmp_path, capsys, limit, stages):
+    """A limit whose mean depth fits the bar but whose worn edges do not (the roller-guided cage wears its
+    faces' ends two orders of magnitude more per area than their middle, docs/wear.md), or a depth just
+    short of the bar's width: the study ends in one line saying the bar wears through first, when (within
+    the stage that does it, the last one included) and naming --limit. It named wear.worn_depth_front_um
+    of the scenario file, and with the wear-through in the last stage it reported the limit reached (exit
+    0 for --stages 1 and 2, exit 2 for 4)."""
+    import re
+
     from bearingsim.cli import main
 
-    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "volume=30mm3", "--stages", "2",
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", limit, "--stages", str(stages),
                  "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1, err
-    assert err[0].startswith("bearingsim: error: --limit volume=30mm3: the cage bar wears through first: after stage 0 ")
-    assert "beyond the 5.821 mm of the bar between two pockets" in err[0]
+    assert re.fullmatch(rf"bearingsim: error: --limit {limit}: the cage bar wears through first, after about "
+                        r"[0-9.]+ h \(in stage [0-9]+\): the deepest front and rear worn depths reach the 5\.821 mm "
+                        r"of the bar between two pockets; give a smaller limit", err[0]), err[0]
     assert not (tmp_path / "life.h5").exists()
 
 

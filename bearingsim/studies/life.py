@@ -213,23 +213,33 @@ class LifeStudy(Study):
 
     def _case(self, j: int):
         st = self.state
-        if j:
-            self._check_bar(j)
         sc = (stage_scenario(self.scenario, st.depth if j else None, j, self.rotations) if self.mapping == "shape"
               else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.clearance()))
         return case_of(sc, {"stage": j})
 
-    def _check_bar(self, j: int) -> None:
-        """Refuse stage ``j`` when the wear of the stages before it has worn a pocket's faces through the cage
-        bar (the deepest front plus the deepest rear depth, as a worn scenario is checked): the bar ends
-        the life before the limit does."""
+    def _check_bar(self, j: int, d_rate, n_stage: float, hours_per_rotation: float) -> None:
+        """End the study when stage ``j``'s wear (``d_rate`` per inner-ring rotation for ``n_stage`` rotations,
+        on the depth the stages before it left) wears a pocket's faces through the cage bar (the deepest
+        front plus the deepest rear depth, as a worn scenario is checked), the last stage's included: the bar
+        ends the life before the limit does. The time it does so is found within the stage (the depths grow
+        linearly in it; bisection to 1e-9 of the stage)."""
         bar = _bar(self.scenario)
-        worn = float(self.state.depth[0].max() + self.state.depth[1].max())
-        if worn >= bar:
-            raise UserError(f"--limit {self.limit.text}: the cage bar wears through first: after stage {j - 1} "
-                            f"({self.state.hours:.4g} h) the deepest front and rear worn depths are {worn * 1e3:.4g} mm "
-                            f"together, beyond the {bar * 1e3:.4g} mm of the bar between two pockets; give a smaller "
-                            f"limit")
+        depth = self.state.depth
+
+        def worn(n):
+            d = depth + d_rate * n
+            return float(d[0].max() + d[1].max())
+
+        if worn(n_stage) < bar:
+            return
+        lo, hi = 0.0, n_stage
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if worn(mid) < bar else (lo, mid)
+        hours = self.state.hours + hi * hours_per_rotation
+        raise UserError(f"--limit {self.limit.text}: the cage bar wears through first, after about {hours:.4g} h (in "
+                        f"stage {j}): the deepest front and rear worn depths reach the {bar * 1e3:.4g} mm of the bar "
+                        f"between two pockets; give a smaller limit")
 
     def next_cases(self, outdir: Path, records: dict[str, dict]) -> list:
         """The wear of the last stage run (its archive's wear rate, for as many rotations as bring the
@@ -253,6 +263,7 @@ class LifeStudy(Study):
         q_now = st.quantity(self.limit.kind, st.depth, st.volume)
         q_rate = st.quantity(self.limit.kind, d_rate, v_rate) - (st.s0 if self.limit.kind == "clearance" else 0.0)
         n_stage = _stage_length(q_now, q_rate, goal)
+        self._check_bar(j, d_rate, n_stage, rate.hours)
         st.depth = st.depth + d_rate * n_stage
         st.volume = st.volume + v_rate * n_stage
         st.shaft += n_stage

@@ -467,16 +467,14 @@ def _uncertainty_sections(table: Path):
 
 
 def _life_sections(table: Path):
-    from bearingsim import archive
     from bearingsim.studies import life
 
     cols, attrs = life.read_life(table)
-    units = archive.table_units(table)
-    names = list(cols)
-    head = [n + (f" [{units[n]}]" if units.get(n, "1") != "1" else "") for n in names]
-    rows = [[_cell(cols[n][i]) for n in names] for i in range(len(cols[names[0]]))]
+    head = [h for _, h, _, _ in life.HISTORY_TABLE]
     blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; {attrs.get('mapping', '')}."},
-              table_block("The life history, one row per stage (docs/wear.md)", head, rows, [True] * len(names))]
+              table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); the "
+                          "worn depth over each face at each stage's end is the figure's", head,
+                          life.history_rows(cols), [True] * len(head))]
     figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "
                                                          "running time, stage by stage")]
     import tomllib

@@ -242,7 +242,8 @@ def _life_table(folder: Path) -> None:
             "rotations_end": [1e6, 2e6, 3e6], "hours_end": [10.0, 20.0, 30.0], "max_depth_rate_um_per_h": [1.0] * n,
             "max_volume_rate_mm3_per_h": [1e-3] * n, "max_depth_um": [10.0, 20.0, 30.0],
             "max_volume_mm3": [0.01, 0.02, 0.03], "clearance_end_mm": [0.21, 0.22, 0.23],
-            "I_dec_mean_mNs": [14.0] * n, "reused": [0] * n}
+            "I_dec_mean_mNs": [14.0] * n, "reused": [0] * n, "psi_deg": [np.linspace(-30.0, 25.0, 32)] * n,
+            "worn_depth_front_um": np.full((n, 32, 16), 1.25), "worn_depth_rear_um": np.full((n, 32, 16), 2.5)}
     archive.write_table_file(folder / "life.h5", {k: np.asarray(v) for k, v in cols.items()}, life.LIFE_UNITS, {
         "format": life.LIFE_FORMAT, "limit": "clearance=0.23mm", "stages": n,
         "scenario": bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml").to_toml(), "mapping": "test rows"})
@@ -254,7 +255,7 @@ def _life_table(folder: Path) -> None:
     ("sens", "sensitivity", ["contact.restitution", "lubrication.drag_coefficient", "d ln y / d ln x"]),
     ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
     ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),
-    ("life", "life", ["clearance=0.23mm", "max_depth_um [um]"]),
+    ("life", "life", ["clearance=0.23mm", "deepest [um]", "depth rate [um/h]"]),
     ("val", "validate", ["Fig. 9 analog", "previous c = 0.02", "pocket 0 I_dec", "rig_idec_vs_speed.png"]),
 ])
 def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name, kind, words):
@@ -369,3 +370,21 @@ def test_a_check_that_fails_is_shown_as_failed(runs):
     assert [(r["name"], r["passed"]) for r in blocks[0]["rows"]] == [("summary numbers finite", True),
                                                                       ("I_dec and I_acc per rotation finite", False)]
     assert blocks[1]["text"].startswith("This archive does NOT pass the checks: non-finite I_dec per rotation")
+
+
+@pytest.mark.slow
+def test_the_life_history_of_a_report_is_the_table_the_command_prints(folders, tmp_path):
+    """The report of a life folder put every column of life.h5 into its table, the worn-depth profiles
+    (32 bins x 16 pockets a stage) as numpy's text ("[[1.25 1.25 ...") and the columns in the file's order;
+    it is the table `bearingsim life` and `bearingsim table` print, a row per stage (the profiles are the
+    figure's)."""
+    from bearingsim.studies import life
+
+    html = bearingsim.report(folders / "life", tmp_path / "l.html").read_text()
+    table = re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1)
+    heads = re.findall(r"<th(?:\s[^>]*)?>(.*?)</th>", table)
+    assert heads == [h for _, h, _, _ in life.HISTORY_TABLE], heads
+    assert "[[" not in table and "1.25" not in table and "..." not in table
+    cols, _ = life.read_life(folders / "life" / "life.h5")
+    for row in life.history_rows(cols):
+        assert "".join(f"<td class=\"num\">{c}</td>" for c in row) in re.sub(r"\s+<", "<", table)

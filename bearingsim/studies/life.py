@@ -401,6 +401,20 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
     }
 
 
+#: the history as a table, a row per stage (the command's, ``table``'s and the report's): (column, header,
+#: width on the terminal, format); the worn-depth profiles of each stage are the figure's
+HISTORY_TABLE = (("stage", "stage", 5, "d"), ("pocket_clearance_mm", "s [mm]", 8, ".4f"),
+                 ("stage_rotations", "rotations", 11, ".4g"), ("hours_end", "h at end", 9, ".4g"),
+                 ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
+                 ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
+
+
+def history_rows(cols: dict) -> list[list[str]]:
+    """The cells of :data:`HISTORY_TABLE`, a row per stage."""
+    return [[format(int(cols[c][i]) if f == "d" else float(cols[c][i]), f) for c, _, _, f in HISTORY_TABLE]
+            for i in range(len(cols["stage"]))]
+
+
 def format_history(cols: dict, title: str) -> str:
     """The history for the terminal, as ``bearingsim life`` prints it: ``title`` (``life of X to LIMIT``)
     with the life reached, then one row per stage."""
@@ -408,12 +422,9 @@ def format_history(cols: dict, title: str) -> str:
 
     lines = [f"{title}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations in "
              f"{counted(len(cols['stage']), 'stage')}",
-             f"{'stage':>5} {'s [mm]':>8} {'rotations':>11} {'h at end':>9} {'depth rate [um/h]':>18} "
-             f"{'deepest [um]':>13} {'I_dec [mN s]':>13} {'reused':>6}"]
-    for i in range(len(cols["stage"])):
-        lines.append(f"{int(cols['stage'][i]):>5} {cols['pocket_clearance_mm'][i]:>8.4f} {cols['stage_rotations'][i]:>11.4g} "
-                     f"{cols['hours_end'][i]:>9.4g} {cols['max_depth_rate_um_per_h'][i]:>18.4g} "
-                     f"{cols['max_depth_um'][i]:>13.4g} {cols['I_dec_mean_mNs'][i]:>13.4g} {int(cols['reused'][i]):>6}")
+             " ".join(f"{head:>{width}}" for _, head, width, _ in HISTORY_TABLE)]
+    lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, HISTORY_TABLE))
+              for row in history_rows(cols)]
     return "\n".join(lines)
 
 

@@ -573,8 +573,9 @@ def read_toml_file(path: str | Path) -> dict[str, Any]:
                 raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not a scenario file")
             data = fh.read(MAX_SCENARIO_BYTES + 1)
         if data.startswith(b"\x89HDF"):  # an HDF5 file, a bearingsim archive most likely
-            raise UserError(f"{p}: is an HDF5 file (a bearingsim archive?), not a scenario file; 'bearingsim rerun "
-                            f"{p}' runs an archive again, 'bearingsim show {p} > scenario.toml' gives its scenario")
+            raise UserError(f"{p}: is an HDF5 file, not a scenario file; 'bearingsim inspect {p}' says what it is, "
+                            f"'bearingsim rerun {p}' runs a run's archive again, 'bearingsim show {p}' prints the "
+                            f"scenario an archive or a study's table stores")
         if len(data) > MAX_SCENARIO_BYTES:
             raise UserError(f"{p}: larger than {MAX_SCENARIO_BYTES} bytes, not a scenario file")
         text = data.decode("utf-8")

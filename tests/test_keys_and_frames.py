@@ -192,8 +192,24 @@ def test_an_archive_given_as_a_scenario_is_refused_with_the_commands_that_read_i
     path = tmp_path / "big.h5"
     with h5py.File(path, "w") as f:
         f["x"] = np.zeros(300_000)  # 2.4 MB
-    with pytest.raises(UserError, match=r"big\.h5: is an HDF5 file .*'bearingsim rerun .*big\.h5' runs"):
+    with pytest.raises(UserError, match=r"big\.h5: is an HDF5 file, not a scenario file.*'bearingsim rerun .*big\.h5' runs"):
         load_scenario(path)
+
+
+def test_a_study_table_given_as_a_scenario_gets_advice_that_works_for_it(tmp_path, capsys):
+    """A sweep's index given where a scenario belongs was told to 'bearingsim rerun' it, which refuses a table
+    ("not a bearingsim archive"): the line names 'bearingsim inspect', which says what any of bearingsim's
+    files is, and says rerun is for a run's archive."""
+    from bearingsim.cli import main
+
+    assert main(["sweep", str(PAPER), "--param", "operating.inner_ring_speed_rpm=1000,2000", "-q", "--no-plots",
+                 "-o", str(tmp_path)]) == 0
+    index = tmp_path / "sweep.h5"
+    assert main(["run", str(index)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and f"'bearingsim inspect {index}' says what it is" in err[0], err
+    assert "runs a run's archive again" in err[0]
+    assert main(["inspect", str(index)]) == 0 and "sweep index" in capsys.readouterr().out
 
 
 # --- DataFrames and Datasets --------------------------------------------------------------------------

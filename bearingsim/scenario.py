@@ -624,15 +624,32 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     raw = read_toml_file(path)
     if not isinstance(raw.get("name", ""), str):
         raise UserError(f"{path}: name: must be a string")
+    given = {}  # key -> the override that set it, as the user wrote it
     for item in overrides or []:
         key, value = parse_override(item)
         _set_dotted(raw, key, value, origin="--set")
+        given[key] = item.strip()
     for key, value in (values or {}).items():
         if not isinstance(key, str) or not key or any(not part for part in key.split(".")):
             raise UserError(f"set: {key!r}: expected a dotted key such as operating.inner_ring_speed_rpm")
         _set_dotted(raw, key, value, origin="set")
+        given[key] = f"{key}={value!r}"
     raw.setdefault("name", Path(path).stem)
-    return resolve(raw, str(path))
+    try:
+        return resolve(raw, str(path))
+    except UserError as exc:
+        raise _with_override(exc, str(path), given) from None
+
+
+def _with_override(exc: UserError, source: str, given: dict[str, str]) -> UserError:
+    """``exc`` of the scenario file ``source`` ("FILE: KEY: why"), saying the override that gave KEY its value
+    when one did ("FILE with KEY=VALUE: KEY: why"): the file does not hold that value."""
+    text = str(exc)
+    head = f"{source}: "
+    key = text[len(head):].split(":", 1)[0] if text.startswith(head) else None
+    if key not in given:
+        return exc
+    return type(exc)(f"{source} with {given[key]}: {text[len(head):]}")
 
 
 def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:

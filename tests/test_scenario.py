@@ -216,3 +216,23 @@ def test_a_scenario_is_frozen(base_reduced):
     assert pickle.loads(pickle.dumps(sc)) == sc and copy.deepcopy(sc) == sc
     with pytest.raises(UserError, match="name"):
         sc.replace(name="../../x")
+
+
+@pytest.mark.parametrize("sets, words", [
+    (["contact.restitution=1.5"], "paper_3000rpm.toml with contact.restitution=1.5: contact.restitution: must be "
+                                  "less than or equal to 1 (got 1.5)"),
+    (["numerics.rotation=1"], "paper_3000rpm.toml with numerics.rotation=1: numerics.rotation: unknown key (did you "
+                              "mean numerics.rotations?)"),
+    (["bearing.pocket_clearance_mm=20"], "paper_3000rpm.toml with bearing.pocket_clearance_mm=20: "
+                                         "bearing.pocket_clearance_mm: 20.0 mm is not smaller than the roller"),
+])
+def test_a_bad_override_is_named_as_the_override_not_as_the_file(sets, words):
+    """A value a --set gave was refused as the scenario file's ("scenarios/paper_3000rpm.toml: contact.restitution:
+    must be ...", a value the file does not hold): the line says the override that gave it."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError) as got:
+        load_scenario(SCENARIOS / "paper_3000rpm.toml", sets)
+    assert words in str(got.value)
+    with pytest.raises(UserError, match=r"paper_3000rpm\.toml with contact\.restitution=1\.5: contact\.restitution"):
+        load_scenario(SCENARIOS / "paper_3000rpm.toml", values={"contact.restitution": 1.5})

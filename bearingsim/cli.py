@@ -862,7 +862,7 @@ def _failed(exc: BaseException, args) -> int:
 
 #: what an interrupted command has not written, by command ("no archive written" for the others)
 _NOT_WRITTEN = {"animate": "no animation written", "report": "no report written",
-                "plot": "its figures not all written", "wear": "its figures not all written"}
+                "plot": "its figures not all written", "wear": "its figures not all written", "life": "no stage run"}
 
 
 def _interrupted(exc: KeyboardInterrupt, args) -> int:

@@ -76,7 +76,9 @@ def add_commands(sub) -> None:
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
     li.add_argument("--scheduler", metavar="ADDRESS", help="run the stages on a dask cluster (tcp://host:8786); "
                                                           "default: one local worker process")
-    li.add_argument("--force", action="store_true", help="replace a life study of another scenario or limit")
+    li.add_argument("--force", action="store_true",
+                    help="replace what the folder holds: a life study of another scenario, limit, mapping, number "
+                         "of stages or rotations per stage, or another sweep or study")
     li.add_argument("--mapping", choices=("shape", "uniform"), default="shape",
                     help="how a stage's wear acts back: 'shape' (default), the worn depth added to each face where "
                          "it wore; 'uniform', every pocket's clearance grows by the worst pocket's mean worn depth "

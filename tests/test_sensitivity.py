@@ -368,3 +368,15 @@ def test_uncertainty_prints_its_spread_in_the_tables_units():
                          {"quantity": "cage_slip", "median": 0.004, "p05": 0.001, "p95": 0.007, "runs_used": 8.0}], [])
     assert "I_dec      median 14.5, 5-95 %: 10.1 .. 20.3 mN s (8 runs)" in text
     assert "cage_slip  median 0.004, 5-95 %: 0.001 .. 0.007 (8 runs)" in text
+
+
+def test_uncertainty_shows_indices_it_cannot_give_as_n_a():
+    """A quantity that does not vary over the samples (the reduced model's I_acc, 0 in every run) has no
+    Sobol indices: `uncertainty` printed "+nan [+nan, +nan]", where `sensitivity` says n/a and why."""
+    from bearingsim.studies.uncertainty import format_table
+
+    nan = float("nan")
+    row = {"quantity": "I_acc", "key": "lubrication.drag_coefficient", **dict.fromkeys(
+        ("S1", "S1_low", "S1_high", "ST", "ST_low", "ST_high"), nan)}
+    text = format_table([], [row])
+    assert "nan" not in text and "n/a" in text and "its variance is 0 or unknown" in text

@@ -280,6 +280,9 @@ def format_table(spreads: list[dict], indices: list[dict]) -> str:
                      f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")
     lines.append(f"{'quantity':10s} {'key':34s} {'S1 [95 % CI]':>24s} {'ST [95 % CI]':>24s}")
     for r in indices:
+        if not all(math.isfinite(r[k]) for k in ("S1", "S1_low", "S1_high", "ST", "ST_low", "ST_high")):
+            lines.append(f"{r['quantity']:10s} {r['key']:34s} {'n/a':>24s} {'n/a':>24s}  (its variance is 0 or unknown)")
+            continue
         lines.append(f"{r['quantity']:10s} {r['key']:34s} {r['S1']:+6.3f} [{r['S1_low']:+.3f}, {r['S1_high']:+.3f}] "
                      f"{r['ST']:+6.3f} [{r['ST_low']:+.3f}, {r['ST_high']:+.3f}]")
     return "\n".join(lines)

@@ -237,41 +237,35 @@ def check_folder_can_be_made(out: Path, what: str) -> None:
 
 
 #: every file a sweep or a study writes into its folder beside ``cases/`` (the sweep's index, map and figures;
-#: each study's table and figures: tests/test_studies.py checks that every study's outputs are listed): what
-#: ``--force`` removes of another sweep or study in the folder (:func:`remove_folder_files`)
-FOLDER_FILES = ("sweep.csv", "sweep.h5", "map.h5", "sweep_I.png", "sweep_map.png", "sweep_cases.png",
-                "crosscheck.csv", "crosscheck.h5", "crosscheck.png",
-                "fig9_idec_vs_speed.csv", "fig9_idec_vs_speed.png",
-                "rig_idec_vs_speed.csv", "rig_idec_vs_speed.png", "rig_pocket0_forces.png",
-                "sensitivity.csv", "sensitivity.h5", "sensitivity.png",
-                "uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png",
-                "life.h5", "life.png")
-
-
-def _written_by_bearingsim(path: Path) -> bool:
-    """A regular file (not a link) of the kind its name says, as bearingsim writes it: a PNG, an HDF5 file,
-    or a CSV text (a header line of comma-separated names, no NUL byte)."""
-    if path.is_symlink() or not path.is_file():
-        return False
-    with open(path, "rb") as fh:
-        head = fh.read(4096)
-    if path.suffix == ".png":
-        return head.startswith(PNG_SIGNATURE)
-    if path.suffix == ".h5":
-        return head.startswith(_HDF5_SIGNATURE)
-    first = head.split(b"\n", 1)[0]
-    return path.suffix == ".csv" and b"," in first and b"\0" not in head
+#: each study's table and figures: tests/test_studies.py checks that every study's outputs are listed), with
+#: the first bytes bearingsim writes it with (a CSV's header, a PNG's or HDF5's signature): what ``--force``
+#: removes of another sweep or study in the folder (:func:`remove_folder_files`)
+FOLDER_FILES = {
+    "sweep.csv": b"case,", "sweep.h5": _HDF5_SIGNATURE, "map.h5": _HDF5_SIGNATURE,
+    "sweep_I.png": PNG_SIGNATURE, "sweep_map.png": PNG_SIGNATURE, "sweep_cases.png": PNG_SIGNATURE,
+    "crosscheck.csv": b"rpm,rung,", "crosscheck.h5": _HDF5_SIGNATURE, "crosscheck.png": PNG_SIGNATURE,
+    "fig9_idec_vs_speed.csv": b"speed_rpm,", "fig9_idec_vs_speed.png": PNG_SIGNATURE,
+    "rig_idec_vs_speed.csv": b"rpm,rotations,", "rig_idec_vs_speed.png": PNG_SIGNATURE,
+    "rig_pocket0_forces.png": PNG_SIGNATURE,
+    "sensitivity.csv": b"key,quantity,", "sensitivity.h5": _HDF5_SIGNATURE, "sensitivity.png": PNG_SIGNATURE,
+    "uncertainty.csv": b"quantity,key,", "uncertainty_spread.csv": b"quantity,median,",
+    "uncertainty.h5": _HDF5_SIGNATURE, "uncertainty.png": PNG_SIGNATURE,
+    "life.h5": _HDF5_SIGNATURE, "life.png": PNG_SIGNATURE,
+}
 
 
 def remove_folder_files(folder: str | Path) -> list[Path]:
-    """Remove from ``folder`` the files a sweep or study writes there (:data:`FOLDER_FILES`) that bearingsim
-    wrote (never a link, a folder or a user's file of another kind; :func:`_written_by_bearingsim`): what
+    """Remove from ``folder`` the files a sweep or study writes there (:data:`FOLDER_FILES`) that start as
+    bearingsim writes them (never a link, a folder or a file of another content): what
     ``--force`` does to the sweep or study it replaces, so that no table or figure of it is left to be read
     as the new one's. Returns the files removed."""
     removed = []
-    for name in FOLDER_FILES:
+    for name, head in FOLDER_FILES.items():
         p = Path(folder) / name
-        if _written_by_bearingsim(p):
+        if p.is_file() and not p.is_symlink():
+            with open(p, "rb") as fh:
+                if fh.read(len(head)) != head:
+                    continue
             p.unlink()
             removed.append(p)
     return removed

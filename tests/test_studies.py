@@ -243,6 +243,9 @@ def test_every_file_a_sweep_or_study_writes_into_its_folder_is_one_force_removes
                LifeStudy(multibody, parse_limit("depth=0.1mm"), stages=1)]
     written = {name for s in studies for name, _, _ in s.outputs} | set(FIGURE_NAMES) | {MAP_NAME, "sweep.csv", "sweep.h5"}
     assert written <= set(FOLDER_FILES), sorted(written - set(FOLDER_FILES))
+    for name, signature, _ in (o for s in studies for o in s.outputs):  # a table's header starts as listed
+        if isinstance(signature, bytes):
+            assert signature.startswith(FOLDER_FILES[name]), name
 
 
 def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path, capsys):

@@ -259,16 +259,8 @@ def remove_folder_files(folder: str | Path) -> list[Path]:
     bearingsim writes them (never a link, a folder or a file of another content): what
     ``--force`` does to the sweep or study it replaces, so that no table or figure of it is left to be read
     as the new one's. Returns the files removed."""
-    removed = []
-    for name, head in FOLDER_FILES.items():
-        p = Path(folder) / name
-        if p.is_file() and not p.is_symlink():
-            with open(p, "rb") as fh:
-                if fh.read(len(head)) != head:
-                    continue
-            p.unlink()
-            removed.append(p)
-    return removed
+    return [Path(folder) / name for name, head in FOLDER_FILES.items()
+            if _remove_if_it_starts(Path(folder) / name, head)]
 
 
 def check_writable(path: str | Path) -> None:
@@ -319,21 +311,24 @@ def remove_figures(stem: str | Path, names) -> list[Path]:
     """Remove the figures ``<stem>_<name>.png`` of ``names`` that are regular PNG files (what
     :func:`check_replaceable` would let bearingsim replace); a link, a folder or any other file is left
     alone, and so is a file that cannot be removed. Returns the paths removed."""
-    removed = []
-    for name in names:
-        p = figure_path(stem, name)
-        try:
-            if not stat.S_ISREG(os.lstat(p).st_mode):
-                continue
-            fd = os.open(p, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-            with open(fd, "rb") as fh:
-                if fh.read(len(PNG_SIGNATURE)) != PNG_SIGNATURE:
-                    continue
-            p.unlink()
-        except OSError:
-            continue
-        removed.append(p)
-    return removed
+    paths = [figure_path(stem, name) for name in names]
+    return [p for p in paths if _remove_if_it_starts(p, PNG_SIGNATURE)]
+
+
+def _remove_if_it_starts(path: Path, head: bytes) -> bool:
+    """Remove ``path`` if it is a regular file (not a link: never followed) whose first bytes are ``head``,
+    as bearingsim writes it; anything else, or a file that cannot be removed, is left. True if removed."""
+    try:
+        if not stat.S_ISREG(os.lstat(path).st_mode):
+            return False
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+        with open(fd, "rb") as fh:
+            if fh.read(len(head)) != head:
+                return False
+        path.unlink()
+    except OSError:
+        return False
+    return True
 
 
 def _glob_escape(s: str) -> str:

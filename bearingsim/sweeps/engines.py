@@ -28,16 +28,24 @@ class _WorkerStop(SystemExit):
     """SIGTERM in a worker process: it ends the worker (raised by the signal's handler)."""
 
 
+_stopping = False  # a worker's: SIGTERM came, the worker is ending
+
+
 def _exit_worker(signum, frame):
+    global _stopping
+    _stopping = True
     raise _WorkerStop(128 + signum)
 
 
 def _stop_again(unraisable, previous=sys.unraisablehook) -> None:
     """A worker's ``sys.unraisablehook``: a SIGTERM whose exception Python could not raise (its handler ran
     inside a weakref callback, say) is set pending again 20 ms later, from a helper thread, when the worker
-    has left the callback; any other unraisable exception goes on to ``previous``."""
+    has left the callback. Once a worker is ending, what its objects say as they go is dropped (the stop's
+    exception, raised wherever the worker was, can leave an object half made: llvmlite's ``OutputString``
+    then failed in ``__del__`` with a traceback on the sweep's stderr); before, it goes on to ``previous``."""
     if not isinstance(unraisable.exc_value, _WorkerStop):
-        previous(unraisable)
+        if not _stopping:
+            previous(unraisable)
         return
     import _thread
     import threading

@@ -63,7 +63,7 @@ def _cmd_uncertainty(args) -> int:
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
         print(f"uncertainty of {args.scenario}: {counted(len(study.keys), 'key')}, N = {args.samples} "
-              f"({counted(len(study.cases), 'run')}), "
+              f"({counted(study.runs, 'run')}), "
               f"seed {args.seed}, {wall:.1f} s")
         print(format_table(study.spreads, study.indices))
         for name in ("uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png"):
@@ -94,6 +94,6 @@ def add_parsers(sub) -> None:
     u = sub.add_parser("uncertainty", help="every ranged key sampled over its range: median, 5-95 %% interval and "
                                            "Sobol indices (docs/sensitivity.md; run again to resume)")
     _common(u, "outputs/uncertainty")
-    u.add_argument("--samples", type=int, required=True, help="base sample N (N (keys + 2) runs; a power of 2 is best)")
+    u.add_argument("--samples", type=int, required=True, help="base sample N (N (keys + 2) runs, 2N for one key; a power of 2 is best)")
     u.add_argument("--seed", type=int, default=0, help="seed of the Sobol' scrambling and the bootstrap (default 0)")
     u.set_defaults(func=_cmd_uncertainty)

@@ -380,3 +380,20 @@ def test_uncertainty_shows_indices_it_cannot_give_as_n_a():
         ("S1", "S1_low", "S1_high", "ST", "ST_low", "ST_high"), nan)}
     text = format_table([], [row])
     assert "nan" not in text and "n/a" in text and "its variance is 0 or unknown" in text
+
+
+@pytest.mark.slow
+def test_uncertainty_of_one_key_counts_the_runs_it_makes(tmp_path, capsys):
+    """With one key, AB_0 is A with its only column from B: B itself. The engine runs a case once (by content
+    hash), so N (k + 2) = 3N cases are 2N runs; the command line and the table's ``runs`` said 3N."""
+    from bearingsim.studies.uncertainty import Uncertainty, read_table
+
+    key = "bearing.pocket_clearance_mm"
+    study = Uncertainty(load_scenario(REDUCED), 2, keys=[key])
+    assert len(study.cases) == 6 and study.runs == 4
+    assert np.array_equal(study.ab[0], study.b)  # the reason: AB_0 is B
+    assert main(["uncertainty", str(REDUCED), "--keys", key, "--samples", "2", "-j", "1",
+                 "-o", str(tmp_path / "u")]) == 0
+    out = capsys.readouterr().out
+    assert "N = 2 (4 runs)" in out and "runs: 4 done, 0 cached, 0 failed" in out
+    assert read_table(tmp_path / "u" / "uncertainty.h5")[2]["runs"] == 4

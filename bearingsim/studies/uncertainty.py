@@ -117,7 +117,8 @@ class Uncertainty(Study):
     Parameters
     ----------
     scenario : resolved scenario with ranges.
-    samples : N, the base sample (N (k + 2) runs).
+    samples : N, the base sample (N (k + 2) cases; ``runs``, the distinct ones, is 2N for one key, whose
+        AB_0 is B).
     seed : seed of the Sobol' scrambling and the bootstrap.
     keys : dotted keys (None: every ranged key the model reads, as the sensitivity study's default).
     """
@@ -148,6 +149,8 @@ class Uncertainty(Study):
                 self.grid[(block, j)] = c
                 cases.append(c)
         self.cases = cases
+        # the runs are the distinct cases (the engine runs a case once): with one key AB_0 is B, 2N runs
+        self.runs = len({c.hash for c in cases})
         self.outputs = [("uncertainty.csv", ",".join(COLUMNS).encode(), "uncertainty table"),
                         ("uncertainty_spread.csv", ",".join(SPREAD_COLUMNS).encode(), "uncertainty table"),
                         ("uncertainty.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "uncertainty table"),
@@ -218,7 +221,7 @@ def write_tables(outdir, indices, spreads, study) -> list[Path]:
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(COLUMNS), "scenario": study.scenario.to_toml(),
              "scenario_name": study.scenario.name, "samples": study.samples, "seed": study.seed,
              "keys": json.dumps(study.keys), "bounds": json.dumps(study.bounds.tolist()),
-             "spread": json.dumps(spreads), "runs": study.samples * (len(study.keys) + 2)}
+             "spread": json.dumps(spreads), "runs": study.runs}
     p3 = archive.write_table_file(outdir / "uncertainty.h5", cols, {c: "1" for c in COLUMNS[2:]}, attrs)
     return [p1, p2, p3]
 

@@ -183,10 +183,12 @@ def _fmt(v):
 
 
 def _markdown(rows: list[dict]) -> str:
-    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "pymunk_step_s", "rel_error", "unit_of_work")
+    """The table printed and written to ``bench.md``; ``notes`` says why a row has no numbers (a run stopped
+    at too long a step) or what a row measures."""
+    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "pymunk_step_s", "rel_error", "unit_of_work", "notes")
     out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
-        out.append("| " + " | ".join(_fmt(r.get(c, "")) for c in cols) + " |")
+        out.append("| " + " | ".join(_fmt(r.get(c, "")).replace("|", "/") for c in cols) + " |")
     return "\n".join(out)
 
 

@@ -184,6 +184,9 @@ def goal_lines(rows: list[dict]) -> list[str]:
     ok = [r for r in full if r["rel_error"] <= GOAL_ERROR]  # NaN (the reference row) compares False
     best = min(ok, key=lambda r: r["wall_s"]) if ok else None
     for r in sorted(full, key=lambda r: -r["dt_s"]):
+        if not r["wall_s"] == r["wall_s"]:  # a run stopped at too long a step: its reason, no numbers
+            lines.append(f"6000 rpm full scene, dt = {r['dt_s']:.1e} s: {r.get('notes') or 'no result'}")
+            continue
         py = r["wall_s"] - r["pymunk_step_s"]
         lines.append(f"6000 rpm full scene, dt = {r['dt_s']:.1e} s: {r['wall_s']:.3f} s per cage rotation, of which "
                      f"pymunk Space.step {r['pymunk_step_s']:.3f} s (rest of the step / pymunk = "

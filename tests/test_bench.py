@@ -82,3 +82,19 @@ def test_geometry_and_cost_lines_read_their_own_rows():
     assert "1.10 x the 3-segment polyline" in lines[1] and "met" in lines[1] and "not met" not in lines[1]
     assert "1.30 x" in lines[2] and "not met" in lines[2]
     assert goal_lines(rows)[:3] == lines
+
+
+def test_a_row_stopped_at_too_long_a_step_says_why():
+    """A full-scene run stopped at too long a step (overlap or stability bound) is a row without numbers:
+    the printed table and the 6000 rpm goal lines give its reason where they gave '-' and 'nan'."""
+    from benchmarks.bench import _markdown
+    from benchmarks.multibody_bench import _failed_row, goal_lines
+
+    stopped = _failed_row("full", 6000, 6e-6, 3, "roller 4 overlaps the cage by 0.2 mm | step too long")
+    ran = dict(stopped, wall_s=0.3, pymunk_step_s=0.1, I_dec_Ns=0.015, rel_error=0.004, dt_s=4e-6, notes="")
+    table = _markdown([stopped, ran]).splitlines()
+    assert "stopped: roller 4 overlaps the cage by 0.2 mm / step too long" in table[2]  # '|' kept out of the cells
+    assert all(line.count("|") == table[0].count("|") for line in table)
+    lines = goal_lines([stopped, ran])
+    assert "6000 rpm full scene, dt = 6.0e-06 s: stopped: roller 4 overlaps the cage by 0.2 mm | step too long" in lines
+    assert not any("nan" in line for line in lines)

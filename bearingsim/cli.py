@@ -470,7 +470,7 @@ def _cmd_crosscheck(args) -> int:
 
 
 def _cmd_report(args) -> int:
-    """``bearingsim report PATH -o report.html`` (:mod:`bearingsim.reports`)."""
+    """``bearingsim report PATH [-o FILE.html]`` (:mod:`bearingsim.reports`)."""
     from bearingsim.reports import report
 
     out = report(args.path, args.output, animation=None if args.animation == "none" else args.animation)
@@ -619,7 +619,8 @@ def _add_study_commands(sub) -> None:
     rp = sub.add_parser("report", help="one self-contained HTML page of a run archive, a sweep folder or a study "
                                        "folder: figures, animation, tables, checks, scenario, provenance (docs/report.md)")
     rp.add_argument("path", help="run archive, or sweep, cross-check, validate, sensitivity, uncertainty or life folder")
-    rp.add_argument("-o", "--output", default="report.html", help="the HTML file to write (default report.html)")
+    rp.add_argument("-o", "--output", help="the HTML file to write (default: beside PATH, named after it: "
+                                           "outputs/run.h5 -> outputs/run.html, outputs/sweep -> outputs/sweep.html)")
     rp.add_argument("--animation", choices=("gif", "mp4", "none"), default="gif",
                     help="embed an archive's animation as a GIF image (default), an MP4 video, or not at all")
     rp.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")

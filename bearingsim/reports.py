@@ -73,16 +73,17 @@ def kind_of(path) -> tuple[str, Path]:
 
 
 # --- the report ---------------------------------------------------------------------------------
-def report(path, out, *, animation: str | None = "gif") -> Path:
-    """Write the report of ``path`` (a run archive, or a sweep or study folder) to ``out`` (``.html``),
-    atomically; return ``out``. ``animation``: the format of an archive's embedded animation, ``"gif"``
-    (an image: every browser, printed as its frame) or ``"mp4"`` (a video, smaller), None for none.
-    One-line UserError for a PATH that is none of these and for an output that cannot be written."""
+def report(path, out=None, *, animation: str | None = "gif") -> Path:
+    """Write the report of ``path`` (a run archive, or a sweep or study folder) to ``out`` (``.html``;
+    None: :func:`default_output`, beside ``path``), atomically; return ``out``. ``animation``: the format
+    of an archive's embedded animation, ``"gif"`` (an image: every browser, printed as its frame) or
+    ``"mp4"`` (a video, smaller), None for none. One-line UserError for a PATH that is none of these and
+    for an output that cannot be written."""
     from bearingsim.outputs import atomic_file
 
     if animation is not None and animation not in ANIMATIONS:
         raise UserError(f"animation {animation!r}: give one of {', '.join(ANIMATIONS)} or None")
-    out = check_output(out, path)
+    out = check_output(default_output(path) if out is None else out, path)
     kind, file = kind_of(path)
     title, sections = _sections(kind, file, animation)
     html = render(title, str(path), kind, sections)
@@ -93,6 +94,15 @@ def report(path, out, *, animation: str | None = "gif") -> Path:
     except OSError as exc:
         raise UserError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
     return out
+
+
+def default_output(path) -> Path:
+    """Where the report of ``path`` goes by default: beside it, named after it (``outputs/run.h5`` ->
+    ``outputs/run.html``, the folder ``outputs/sweep`` -> ``outputs/sweep.html``)."""
+    p = Path(path)
+    if p.name in ("", ".", ".."):  # "." or "..": the folder's own name
+        p = p.resolve()
+    return p.with_suffix(".html") if p.is_file() else p.with_name(p.name + ".html")
 
 
 def check_output(out, source=None) -> Path:

@@ -332,6 +332,34 @@ def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dir.html", "mine.html"]
 
 
+def test_the_default_report_goes_beside_what_it_reports(tmp_path, monkeypatch):
+    """Without -o the page goes beside PATH, named after it, as the docs' examples write it: an archive
+    X.h5 gives X.html, a folder DIR gives DIR.html beside it, "." its own name in the folder above. (It
+    went to ./report.html: into whatever folder the command ran in, the same file for every report.)"""
+    from bearingsim.reports import default_output
+
+    (tmp_path / "outputs" / "sweep.v2").mkdir(parents=True)
+    (tmp_path / "outputs" / "run.h5").write_bytes(b"")
+    monkeypatch.chdir(tmp_path / "outputs")
+    assert default_output("run.h5") == Path("run.html")
+    assert default_output(tmp_path / "outputs" / "run.h5") == tmp_path / "outputs" / "run.html"
+    assert default_output("sweep.v2") == Path("sweep.v2.html")  # a folder's name is kept whole
+    assert default_output("sweep.v2/") == Path("sweep.v2.html")
+    assert default_output(".") == tmp_path / "outputs.html"
+
+
+@pytest.mark.slow
+def test_report_without_output_writes_beside_the_archive(runs, tmp_path):
+    import shutil
+
+    shutil.copy(runs / "r.h5", tmp_path / "r.h5")
+    res = cli("report", "r.h5", "--animation", "none", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.strip() == "wrote r.html"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.h5", "r.html"]
+    assert "<html" in (tmp_path / "r.html").read_text()
+
+
 @pytest.mark.slow
 def test_a_report_replaces_its_own_earlier_report(runs, tmp_path):
     out = tmp_path / "r.html"

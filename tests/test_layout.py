@@ -228,3 +228,45 @@ def test_a_relative_import_and_a_name_that_is_not_a_module_are_read_as_python_re
     assert sorted((a, b) for a, b, _ in edges) == [("bearingsim.m", "bearingsim.m.core"),
                                                    ("bearingsim.m.core", "bearingsim")]
     assert external == {"numpy": [("bearingsim.m.core", 3)]}
+
+
+# --- a run computes its set-up once ------------------------------------------------------------------
+def _calls_during(fn, names):
+    """Run ``fn()`` and count the calls of the package's Python functions named in ``names``
+    ({"module/file.py:function": n}); the compiled kernels are not Python frames and not counted."""
+    import sys
+
+    counts = collections.Counter()
+
+    def profile(frame, event, arg):
+        if event == "call" and frame.f_code.co_name in names:
+            path = Path(frame.f_code.co_filename)
+            if PACKAGE in path.parents:
+                counts[f"{path.relative_to(PACKAGE).as_posix()}:{frame.f_code.co_name}"] += 1
+
+    previous = sys.getprofile()
+    sys.setprofile(profile)
+    try:
+        result = fn()
+    finally:
+        sys.setprofile(previous)
+    return result, counts
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scenario, steps", [("multibody_6000rpm.toml", {"multibody/core.py:choose_dt": 1}),
+                                             ("paper_3000rpm.toml", {})])
+def test_bearingsim_run_builds_its_parameters_and_its_time_step_once(tmp_path, scenario, steps):
+    """`bearingsim run` (its checks, the dry-run's checks it shares, the model, the archive, the
+    plausibility checks) builds the SI parameters once (``Scenario.parameters``, frozen) and the whole
+    bearing chooses its time step once (``multibody.core.choose_dt``): the set-up is computed once per
+    run and handed down. ``--no-plots``: the figures are drawn from the archive read back, a second
+    scenario with parameters of its own."""
+    from bearingsim.cli import main
+
+    root = ROOT / "scenarios" / scenario
+    code, counts = _calls_during(
+        lambda: main(["run", str(root), "--set", "numerics.rotations=1", "-o", str(tmp_path / "r.h5"), "--no-plots", "-q"]),
+        {"from_scenario", "choose_dt"})
+    assert code == 0
+    assert counts == collections.Counter({"parameters.py:from_scenario": 1, **steps})

@@ -10,15 +10,13 @@ from bearingsim.errors import UserError
 
 def _cmd_wear(args) -> int:
     from bearingsim import wear
-    from bearingsim.archive import check_writable_dir, is_archive, scenario_file_error
+    from bearingsim.archive import check_writable_dir
     from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
     from bearingsim.plotting import save_figure
     from bearingsim.simulation import load
 
     path = Path(args.archive)
-    if not is_archive(path):
-        raise scenario_file_error(path) or UserError(f"{path}: not a bearingsim archive")
-    result = load(path)
+    result = load(path)  # a missing file, a folder, a scenario file, a foreign file: one line saying which
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
     rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)  # refusals of the archive and time

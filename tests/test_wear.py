@@ -678,3 +678,23 @@ def test_bad_worn_depth_is_refused_naming_the_key(over, words):
     with pytest.raises(UserError, match=r"wear\.worn_depth_(front|rear)_um") as exc:
         sc.replace(**over)
     assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+@pytest.mark.parametrize("make, words", [
+    (lambda p: None, "file not found"),
+    (lambda p: p.mkdir(), "is a directory, not an archive"),
+    (lambda p: p.write_text("not hdf5"), "not an HDF5 file"),
+    (lambda p: p.write_text('schema_version = 1\nname = "x"\n'), "is a scenario file, not an archive"),
+])
+def test_wear_cli_says_what_is_wrong_with_its_input(tmp_path, capsys, make, words):
+    """`bearingsim wear missing.h5 --hours 1` said "missing.h5: not a bearingsim archive" for a file that is
+    not there (and the same for a folder or a text file), where every other archive command says which:
+    "file not found", "is a directory", "not an HDF5 file"."""
+    from bearingsim.cli import main
+
+    path = tmp_path / "a.h5"
+    make(path)
+    code = main(["wear", str(path), "--hours", "1", "--no-plots"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
+    assert err.startswith(f"bearingsim: error: {path}: {words}"), err

@@ -102,6 +102,17 @@ def _bounds_note(section: str, name: str) -> str:
     }.get((section, name), "")
 
 
+def _validated_kind(section: str, name: str) -> str:
+    """Type and bounds of a key whose validator raises the field's own bound (the field keeps its looser lower
+    bound, so that the validator's message, which says why, is the one a user sees)."""
+    from bearingsim.scenario import MIN_ROLLER_COUNT
+
+    return {
+        ("bearing", "roller_count"): f"int >= {MIN_ROLLER_COUNT}",
+        ("numerics", "warmup_rotations"): "int >= 0, >= 1 to run the multibody model",  # check_run_request
+    }.get((section, name), "")
+
+
 def list_keys(preset: str = "NU214-Suzuki2023") -> list[KeyInfo]:
     """Every key a scenario accepts, in schema order, with the defaults of the package and ``preset``."""
     from bearingsim.scenario import DEFAULTS, UNUSED_BY_MODEL, ScenarioModel, load_preset
@@ -121,7 +132,7 @@ def list_keys(preset: str = "NU214-Suzuki2023") -> list[KeyInfo]:
 
 
 def _info(key, field, section, name, defaults, preset_values, sources, preset, unused) -> KeyInfo:
-    kind = _kind(field)
+    kind = (_validated_kind(section, name) if section else "") or _kind(field)
     extra = _bounds_note(section, name) if section else ""
     if extra:
         kind = kind.replace("float", f"float {extra}", 1)

@@ -74,13 +74,43 @@ def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_s
     assert set(resolved) <= set(keys), set(resolved) - set(keys)
     assert keys["bearing.pocket_clearance_mm"].plausible == "0.16..0.24"  # the preset's range, shown
     rc = keys["bearing.roller_count"]
-    assert (rc.kind, rc.default) == ("int >= 1", "16") and rc.source.startswith("preset NU214-Suzuki2023: paper")
+    assert (rc.kind, rc.default) == ("int >= 3", "16") and rc.source.startswith("preset NU214-Suzuki2023: paper")
     d = keys["bearing.roller_diameter_mm"]
     assert d.unit == "mm" and d.kind == "float > 0" and "reconstructed" in d.source and "13 g" in d.why
     assert keys["contact.restitution"].kind == "float >= 0, <= 1"
     assert keys["multibody.raceway_contact"].kind == '"hertz" | "rigid"'
     assert keys["numerics.rotations"].default == "5" and keys["numerics.rotations"].source == "package default"
     assert keys["multibody.scene"].unused_by == ("reduced",)
+
+
+@pytest.mark.parametrize("scenario", ["multibody_3000rpm.toml", "paper_3000rpm.toml"])
+def test_keys_gives_the_lower_bound_of_an_integer_key_that_a_run_enforces(scenario):
+    """`bearingsim keys roller_count` said `int >= 1` where 1 and 2 rollers are refused ("at least 3
+    rollers"), and `keys warmup_rotations` `int >= 0` where a multibody run refuses 0: the least value
+    keys gives for an integer key runs, one less is refused."""
+    import re
+
+    from bearingsim.errors import UserError
+    from bearingsim.keys import list_keys
+    from bearingsim.scenario import check_run_request
+
+    def runs(key, value):
+        try:
+            check_run_request(load_scenario(SCENARIOS / scenario, values={key: value}))
+        except UserError:
+            return False
+        return True
+
+    model = "multibody" if scenario.startswith("multibody") else "reduced"
+    bounds = {}
+    for k in list_keys():
+        m = re.match(r"int >= (\d+)(?:, >= (\d+) to run the (\w+) model)?", k.kind)
+        if m and model not in k.unused_by:
+            bounds[k.key] = int(m[2]) if m[2] and m[3] == model else int(m[1])
+    assert bounds["bearing.roller_count"] == 3 and bounds.get("numerics.warmup_rotations") == \
+        (1 if model == "multibody" else None)  # the reduced model does not read it
+    for key, least in bounds.items():
+        assert runs(key, least) and not runs(key, least - 1), (key, least)
 
 
 @pytest.mark.slow

@@ -425,7 +425,7 @@ class MultibodyResult(Result):
         data["results/cage_orbit"] = NamedArray(orbit[np.isfinite(orbit[:, 0])], "s, m, m",
                                                 "last recorded samples of the cage centre: columns time, x, y")
         groups = {"results/summary": AttrGroup({**summary, "scene": raw.setup.scene,
-                                                "pockets": p.bearing.roller_count}, units)}
+                                                "pockets": p.bearing.roller_count}, {**units, "pockets": "1"})}
         tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
                                      "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "
                                      "pocket centre; rotation = row of /results/per_rotation the impact counts in"}

@@ -888,6 +888,8 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
             msg = "missing (set it in the scenario or name a [bearing] preset)"
         elif err["type"] == "extra_forbidden":
             msg = "unknown key" + did_you_mean(key)
+        elif err["type"] == "model_type":  # a section given as one value: pydantic would name its class
+            msg = f"must be a table of keys ([{key}] in a file, {key}.KEY=VALUE with --set) (got {err['input']!r})"
         else:
             msg = err["msg"].replace("Input should be", "must be").replace("Value error, ", "")
             if "input" in err and not isinstance(err["input"], dict):

@@ -85,6 +85,18 @@ def test_bad_values_name_the_key(override, key):
     assert f": {key}:" in msg, msg
 
 
+@pytest.mark.parametrize("override", ["bearing=5", 'operating="fast"', "multibody=[1, 2]"])
+def test_a_section_given_as_a_value_is_refused_in_the_scenarios_words(override):
+    """`run --set bearing=5` said "bearing: must be a valid dictionary or instance of BearingSection": the
+    name of a class inside the package. It says the section must be a table, and how to give its keys."""
+    section = override.split("=")[0]
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
+    msg = str(err.value)
+    assert f": {section}: must be a table of keys ([{section}] in a file, {section}.KEY=VALUE with --set)" in msg, msg
+    assert "Section" not in msg and "instance" not in msg, msg
+
+
 def test_overlapping_pockets_name_both_keys():
     # 16 pockets of 80 + 0.2 mm on a 97.5 mm pitch circle overlap (chord 2 r_p sin(pi/16) = 19.0 mm)
     with pytest.raises(UserError) as err:

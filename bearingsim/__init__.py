@@ -64,9 +64,10 @@ def uncertainty(scenario, samples: int, outdir=None, *, seed: int = 0, keys=None
     return run_uncertainty(scenario, outdir, samples, seed, keys, jobs=jobs, engine=engine)
 
 
-def report(path, out="report.html", *, animation: str | None = "gif"):
+def report(path, out=None, *, animation: str | None = "gif"):
     """Write one self-contained HTML report of a run archive, or of a sweep or study folder, to ``out``
-    and return its path (:func:`bearingsim.reports.report`, docs/report.md)."""
+    (None: beside ``path``, named after it) and return its path (:func:`bearingsim.reports.report`,
+    docs/report.md)."""
     from bearingsim.reports import report as _report
 
     return _report(path, out, animation=animation)

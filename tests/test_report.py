@@ -361,6 +361,19 @@ def test_report_without_output_writes_beside_the_archive(runs, tmp_path):
 
 
 @pytest.mark.slow
+def test_the_apis_report_without_output_goes_beside_the_archive(runs, tmp_path, monkeypatch):
+    """`bearingsim.report(path)` wrote ./report.html in the folder Python ran in, where the command line
+    and docs/report.md put the page beside PATH, named after it."""
+    import shutil
+
+    shutil.copy(runs / "r.h5", tmp_path / "r.h5")
+    (tmp_path / "cwd").mkdir()
+    monkeypatch.chdir(tmp_path / "cwd")
+    assert bearingsim.report(tmp_path / "r.h5", animation=None) == tmp_path / "r.html"
+    assert "<html" in (tmp_path / "r.html").read_text() and list((tmp_path / "cwd").iterdir()) == []
+
+
+@pytest.mark.slow
 def test_a_report_replaces_its_own_earlier_report(runs, tmp_path):
     out = tmp_path / "r.html"
     bearingsim.report(runs / "r.h5", out)

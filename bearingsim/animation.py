@@ -76,6 +76,8 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
     if MOTION not in result.series:
         raise _no_motion(result, where)
     fps = check_number(fps, "fps", 1.0, MAX_FPS)
+    if last is not None and not _as_number(last, "last") > 0:  # NaN too
+        raise UserError(f"last: {last!r} is not a positive number of cage rotations")
     motion = _Motion(result)
     a, b = motion.window(rotations, where)
     if last is not None:
@@ -127,13 +129,18 @@ def _is_mp4(path) -> bool:
 def check_number(value, name, lo, hi) -> float:
     """``value`` as a float in ``[lo, hi]``, else a one-line UserError naming it ``name`` (the API's keyword,
     or the command line's option)."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise UserError(f"{name}: expected a number, got {value!r}") from None
+    v = _as_number(value, name)
     if not (lo <= v <= hi):
         raise UserError(f"{name}: {value!r} is outside {lo:g} .. {hi:g}")
     return v
+
+
+def _as_number(value, name) -> float:
+    """``value`` as a float, else a one-line UserError naming it ``name``."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise UserError(f"{name}: expected a number, got {value!r}") from None
 
 
 def _exaggeration(p, given) -> float:

@@ -206,6 +206,17 @@ def test_bad_output_and_options_are_refused(runs, tmp_path):
         bearingsim.animate(runs[1], tmp_path / "b.gif", fps=0)
 
 
+@pytest.mark.parametrize("last, words", [(-1, "last: -1 is not a positive"), (0, "last: 0 is not a positive"),
+                                         (float("nan"), "last: nan is not a positive"), ("x", "last: expected a number")])
+def test_a_bad_last_is_refused_in_one_line(runs, tmp_path, last, words):
+    """`bearingsim.animate(path, out, last=-1)` (or 0) wrote a one-frame animation of a pose past the stored
+    window, `last=nan` the whole window, and `last="x"` raised ValueError: `last`, the cage rotations at the
+    end of the window to show, is a positive number, else a UserError naming it; nothing is written."""
+    with pytest.raises(UserError, match=f"^{words}"):
+        bearingsim.animate(runs[1], tmp_path / "a.gif", last=last)
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.parametrize("option, value", [("--fps", "0"), ("--exaggerate", "0.5")])
 def test_the_command_line_names_the_option_given_out_of_range(runs, tmp_path, capsys, option, value):
     """`animate --fps 0` said "fps: 0.0 is outside ..." (the API's keyword): the command line names its

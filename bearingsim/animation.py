@@ -108,8 +108,9 @@ def check_output(out) -> Path:
     can be made one (a missing folder is created when the animation is written, as a run's is) and it is
     not a file bearingsim did not write."""
     from bearingsim import outputs
+    from bearingsim.errors import check_path
 
-    out = Path(out)
+    out = Path(check_path(out, "out", "the animation (.mp4 or .gif)"))
     suffix = out.suffix.lower()
     if suffix not in (".mp4", ".gif"):
         raise UserError(f"{out}: animation path must end in .mp4 or .gif (got {out.suffix or 'no suffix'!r})")

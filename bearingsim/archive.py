@@ -40,7 +40,7 @@ import numpy as np
 from bearingsim._version import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
-from bearingsim.errors import UserError
+from bearingsim.errors import UserError, check_path
 from bearingsim.wording import counted
 
 FORMAT_VERSION = "2.0"
@@ -253,7 +253,7 @@ def write(result, path, spool: Spool | None = None) -> Path:
     interpreter could crash at exit).
     """
     if spool is None:
-        path = _prepare_target(path)
+        path = _prepare_target(check_path(path, "path", "the archive (.h5)"))
         try:
             outputs.write_atomic_bytes(path, to_bytes(result))
         except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file

@@ -7,6 +7,16 @@ class UserError(Exception):
     exit_code = 2
 
 
+def check_path(value, name: str, what: str):
+    """``value`` when it is a path (a ``str`` or an ``os.PathLike``), else a one-line :class:`UserError`
+    naming the argument ``name`` of the API and saying what it is the path of (``what``)."""
+    import os
+
+    if not isinstance(value, (str, os.PathLike)):
+        raise UserError(f"{name}: expected the path of {what}, a str or a pathlib.Path (got {type(value).__name__})")
+    return value
+
+
 class SimulationUnstable(Exception):
     """A run diverged (non-finite state, penetration or energy growth). Never written as a result."""
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.errors import UserError
+from bearingsim.errors import UserError, check_path
 from bearingsim.wording import counted
 
 #: the first bytes of every report bearingsim writes: what ``-o`` may replace
@@ -83,6 +83,9 @@ def report(path, out=None, *, animation: str | None = "gif") -> Path:
 
     if animation is not None and animation not in ANIMATIONS:
         raise UserError(f"animation {animation!r}: give one of {', '.join(ANIMATIONS)} or None")
+    check_path(path, "path", "an archive, a sweep or a study folder")
+    if out is not None:
+        check_path(out, "out", "the report (.html)")
     out = check_output(default_output(path) if out is None else out, path)
     kind, file = kind_of(path)
     title, sections = _sections(kind, file, animation)

@@ -42,7 +42,9 @@ def load(path, only=None):
     """Read an archive back into the result class of its model (``only``: the datasets to read, see
     :func:`bearingsim.archive.read`; None: all)."""
     from bearingsim import archive
+    from bearingsim.errors import check_path
 
+    check_path(path, "path", "an archive")
     return archive.read(path, model_module(archive.model_of(path)).RESULT, only=only)
 
 

@@ -27,13 +27,13 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import given_keys, load_scenario, unused_note
+    from bearingsim.scenario import given_keys, load_scenario, unread_note
     from bearingsim.simulation import check_run, run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
     check_run(scenario)  # what the run would refuse before its first step: the dry run refuses it too
     if not args.quiet:  # the keys given that have no effect on the run, noted by the dry run too
-        note = unused_note(scenario.model, given_keys(args.scenario, args.set), scenario.reduced.method)
+        note = unread_note(scenario, given_keys(args.scenario, args.set))
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     if args.dry_run:

@@ -733,6 +733,45 @@ def unused_note(model: str, keys, method: str | None = None) -> str | None:
     return "; ".join(parts) or None
 
 
+#: the keys only a land-guided cage reads (the cage's rim running on a ring land)
+LAND_KEYS = ("bearing.cage_land_clearance_mm", "contact.land_friction")
+
+
+def _unread_by_setting(scenario, key: str) -> str | None:
+    """Why a key the model uses is not read with this scenario's settings, or None."""
+    if key in LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
+        return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
+    if (key == "bearing.radial_clearance_mm" and scenario.model == "reduced"
+            and scenario.reduced.load_zone_half_angle_deg != "auto"):
+        return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
+                "load zone only when 'auto')")
+    return None
+
+
+def unread_because(scenario, key: str) -> str | None:
+    """Why the resolved scenario's run does not read ``key`` (a run with another value of it gives the same
+    numbers), or None: a key its model does not use (:data:`UNUSED_BY_MODEL`), a land key with a
+    roller-guided cage, the reduced model's radial clearance when its load zone is given."""
+    if unused_keys(scenario.model, [key]):
+        return f"not used by the {scenario.model} model"
+    return _unread_by_setting(scenario, key)
+
+
+def unread_note(scenario, keys) -> str | None:
+    """One line saying which of ``keys`` the resolved scenario's run does not read: :func:`unused_note` of
+    its model and method, and the keys its settings leave unread (:func:`unread_because`); None if it
+    reads them all."""
+    note = unused_note(scenario.model, keys, scenario.reduced.method)
+    unused = unused_keys(scenario.model, keys, scenario.reduced.method)
+    by_setting: dict[str, list[str]] = {}
+    for k in dict.fromkeys(keys):
+        why = None if k in unused else _unread_by_setting(scenario, k)
+        if why is not None:
+            by_setting.setdefault(why, []).append(k)
+    parts = ([note] if note else []) + [f"{', '.join(ks)}: {why}; no effect on the run" for why, ks in by_setting.items()]
+    return "; ".join(parts) or None
+
+
 def out_of_range_note(scenario) -> str | None:
     """One line naming the keys of a resolved scenario that are set outside their plausible range (its
     ``[ranges]``, from the preset or the file: what the sensitivity and uncertainty studies sample),
@@ -741,7 +780,8 @@ def out_of_range_note(scenario) -> str | None:
     from bearingsim.ranges import ranged_keys, value_of
 
     ranged = ranged_keys(scenario)
-    used = [k for k in ranged if k not in unused_keys(scenario.model, [k], scenario.reduced.method)]
+    used = [k for k in ranged if k not in unused_keys(scenario.model, [k], scenario.reduced.method)
+            and _unread_by_setting(scenario, k) is None]
     out = []
     for k in used:
         lo, hi, _ = ranged[k]
@@ -1003,7 +1043,9 @@ def _check_cage_inertia(b: "BearingSection", source: str) -> None:
     if not lo <= b.cage_inertia_kgm2 <= hi:
         raise UserError(f"{source}: bearing.cage_inertia_kgm2: {b.cage_inertia_kgm2:g} kg m^2 is impossible for a "
                         f"{b.cage_mass_kg:g} kg cage ring between radii {r_in * 1e3:.4g} and {r_out * 1e3:.4g} mm "
-                        f"(m r_in^2 = {lo:.3g} .. m r_out^2 = {hi:.3g} kg m^2)")
+                        f"(m r_in^2 = {lo:.3g} .. m r_out^2 = {hi:.3g} kg m^2); the cage's mass and inertia go "
+                        f"together: a uniform ring of this mass has m (r_in^2 + r_out^2) / 2 = "
+                        f"{0.5 * (lo + hi):.4g} kg m^2")
 
 
 def _check_geometry(m: ScenarioModel, source: str) -> None:

@@ -248,3 +248,45 @@ def test_a_bad_override_is_named_as_the_override_not_as_the_file(sets, words):
     assert words in str(got.value)
     with pytest.raises(UserError, match=r"paper_3000rpm\.toml with contact\.restitution=1\.5: contact\.restitution"):
         load_scenario(SCENARIOS / "paper_3000rpm.toml", values={"contact.restitution": 1.5})
+
+
+def test_a_key_the_settings_leave_unread_is_noted_as_unused_not_as_out_of_range():
+    """A land key with a roller-guided cage (the preset's) changes nothing: `run` notes it as unused, and the
+    plausible-range note leaves it out (it said the run "is of another bearing" and nothing of its being
+    unused). With a land-guided cage the same values are read: no unused note, and the range note names the
+    clearance outside its range. The reduced model's radial clearance with a given load zone is unread too."""
+    from bearingsim.scenario import out_of_range_note, unread_note
+
+    keys = ["bearing.cage_land_clearance_mm", "contact.land_friction"]
+    sets = ["bearing.cage_land_clearance_mm=0.001", "contact.land_friction=0.2"]
+    rollers = load_scenario(SCENARIOS / "multibody_3000rpm.toml", sets)
+    assert unread_note(rollers, keys) == ("bearing.cage_land_clearance_mm, contact.land_friction: not used with "
+                                          "bearing.cage_guidance = 'rollers' (no land to run on); no effect on the run")
+    assert out_of_range_note(rollers) is None
+    land = load_scenario(SCENARIOS / "multibody_3000rpm.toml", [*sets, "bearing.cage_guidance=outer_land"])
+    assert unread_note(land, keys) is None
+    assert "bearing.cage_land_clearance_mm = 0.001 (plausible 0.2 to 0.5)" in out_of_range_note(land)
+    given = load_scenario(SCENARIOS / "paper_3000rpm.toml", ["reduced.load_zone_half_angle_deg=20"])
+    note = unread_note(given, ["bearing.radial_clearance_mm", "bearing.cage_mass_kg", "numerics.dt_s"])
+    assert note.startswith("bearing.cage_mass_kg: not used by the reduced model")
+    assert "numerics.dt_s: not used by reduced.method = 'event'" in note
+    assert "bearing.radial_clearance_mm: not used by the reduced model when reduced.load_zone_half_angle_deg" in note
+    auto = load_scenario(SCENARIOS / "paper_3000rpm.toml", ["reduced.load_zone_half_angle_deg=auto"])
+    assert unread_note(auto, ["bearing.radial_clearance_mm"]) is None
+
+
+def test_a_cage_mass_without_its_inertia_is_refused_with_the_inertia_a_ring_of_it_has():
+    """Another cage material is another mass; its inertia must follow (a ring between its radii). The
+    refusal names the inertia key and gives what a uniform ring of the new mass has, m (r_in^2 + r_out^2) / 2,
+    which the check then accepts (it lies between m r_in^2 and m r_out^2)."""
+    import re
+
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["bearing.cage_mass_kg=0.5"])
+    text = str(err.value)
+    assert "bearing.cage_inertia_kgm2" in text and "a uniform ring of this mass has" in text
+    r_in, r_out = 0.0455, 0.052  # the preset cage's bore and outside radii [m]
+    ring = float(re.search(r"/ 2 = ([0-9.e-]+) kg m\^2", text).group(1))
+    assert ring == pytest.approx(0.5 * (r_in**2 + r_out**2) / 2, rel=5e-4)  # printed to 4 digits
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["bearing.cage_mass_kg=0.5", f"bearing.cage_inertia_kgm2={ring}"])
+    assert sc.bearing.cage_inertia_kgm2 == ring

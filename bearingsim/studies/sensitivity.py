@@ -48,9 +48,6 @@ COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y
 UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
          "over_range": "as sensitivity"}
 
-_LAND_KEYS = ("bearing.cage_land_clearance_mm", "contact.land_friction")
-
-
 def parse_step(text) -> float:
     """``"10%"`` or ``"0.1"`` -> 0.1; a one-line UserError naming ``--step`` unless 0 < step < 1."""
     raw = str(text).strip()
@@ -76,20 +73,11 @@ def default_keys(scenario) -> list[str]:
 
 
 def unread_because(scenario, key: str) -> str | None:
-    """Why the scenario's run does not read ``key`` (its paired runs would be identical), or None: a key
-    its model does not use (:data:`bearingsim.scenario.UNUSED_BY_MODEL`), a land key with a roller-guided
-    cage, the reduced model's radial clearance when its load zone is given."""
-    from bearingsim.scenario import unused_keys
+    """Why the scenario's run does not read ``key`` (its paired runs would be identical), or None
+    (:func:`bearingsim.scenario.unread_because`)."""
+    from bearingsim.scenario import unread_because as why
 
-    if unused_keys(scenario.model, [key]):
-        return f"not used by the {scenario.model} model"
-    if key in _LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
-        return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
-    if (key == "bearing.radial_clearance_mm" and scenario.model == "reduced"
-            and scenario.reduced.load_zone_half_angle_deg != "auto"):
-        return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
-                "load zone only when 'auto')")
-    return None
+    return why(scenario, key)
 
 
 def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:

@@ -111,8 +111,13 @@ def check_run(scenario: Scenario, dt: float | None = None) -> None:
     """Refuse, without running, what :func:`run` of ``scenario`` would refuse before its first step:
     :func:`bearingsim.scenario.check_run_request`, and the model's time step (a given ``numerics.dt_s``
     far above the stable step, the euler method's limits). ``bearingsim run --dry-run`` checks this."""
+    from bearingsim.errors import UserError
+
     check_run_request(scenario)
-    model_module(scenario.model).check_step(scenario.parameters, dt)
+    try:
+        model_module(scenario.model).check_step(scenario.parameters, dt)
+    except UserError as exc:  # the model names the key; the scenario's refusals name its file too
+        raise UserError(f"{scenario.source}: {exc}") from None
 
 
 @dataclass

@@ -255,6 +255,19 @@ def test_dt_far_too_large_is_user_error():
         simulate(sc)
 
 
+@pytest.mark.parametrize("scenario, sets", [("multibody_3000rpm.toml", ["numerics.dt_s=1"]),
+                                           ("paper_3000rpm.toml", ["reduced.method=euler", "numerics.dt_s=1"])])
+def test_a_time_step_refused_before_the_run_names_the_scenario_file(capsys, scenario, sets):
+    """The run's refusal of a step far above the stable one names the file, as the scenario's own refusals
+    do (it named the key alone): one line, exit 2, nothing written."""
+    from bearingsim.cli import main
+
+    args = ["run", str(SCENARIOS / scenario), "--dry-run", "-q"] + [a for s in sets for a in ("--set", s)]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"bearingsim: error: {SCENARIOS / scenario}: numerics.dt_s")
+
+
 @pytest.mark.slow
 def test_cli_main_job(tmp_path):
     """The README's main job writes an archive with the public names and units."""

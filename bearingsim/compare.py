@@ -40,7 +40,13 @@ class Comparison:
             d = b - a
             rel = d / abs(a) if a not in (0.0,) and math.isfinite(a) else float("nan")
             rows.append(f"{k:34s} {a:14.7g} {b:14.7g} {d:11.3g} {rel:11.3g}{mark}")
+        if self.summary_differs:
+            rows.append(f"* : not bit-identical, however small the difference; {SIGNIFICANCE_HINT}")
         return "\n".join(rows)
+
+
+#: where a difference is judged against the runs' scatter (the marks of this module are bit-for-bit)
+SIGNIFICANCE_HINT = "'bearingsim table A B' marks the differences beyond the runs' standard errors"
 
 
 def compare_results(a, b) -> Comparison:

@@ -267,3 +267,23 @@ def test_compare_shows_a_number_only_one_model_has_as_absent_not_nan():
     assert c.absent == {"cage_slip": "A"} and "cage_slip" in c.summary_differs and not c.identical
     (row,) = [line for line in c.summary_table().splitlines() if line.startswith("cage_slip")]
     assert row.split() == ["cage_slip", "(none)", "-0.001", "*"]
+
+
+def test_compare_of_two_says_what_its_mark_means():
+    """`compare A B` marks a number that is not bit-identical, however small the difference (-0.07 % of the
+    cage orbit is marked); `table` and `compare A B C` mark significance with a legend. The two-archive
+    table says what its mark means and where significance is judged; bit-identical results get no legend."""
+    from bearingsim.compare import compare_results
+
+    def result(summary):
+        return SimpleNamespace(scenario=SimpleNamespace(raw={"model": "multibody"}), summary=summary,
+                               per_rotation={}, provenance={})
+
+    c = compare_results(result({"cage_orbit_max_m": 1.0e-4, "I_dec_mean_Ns": 0.015}),
+                        result({"cage_orbit_max_m": 0.9993e-4, "I_dec_mean_Ns": 0.015}))
+    lines = c.summary_table().splitlines()
+    assert [line.split()[0] for line in lines if line.endswith("*")] == ["cage_orbit_max_m"]
+    assert lines[-1].startswith("* : not bit-identical, however small the difference;")
+    assert "bearingsim table A B" in lines[-1]
+    same = compare_results(result({"I_dec_mean_Ns": 0.015}), result({"I_dec_mean_Ns": 0.015}))
+    assert same.identical and not any("*" in line for line in same.summary_table().splitlines())

@@ -19,7 +19,7 @@ def _cmd_wear(args) -> int:
     result = load(path)  # a missing file, a folder, a scenario file, a foreign file: one line saying which
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
-    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)  # refusals of the archive and time
+    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations, names=("--hours", "--rotations"))  # refusals of the archive and time
     figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
     pngs = {}
     if not args.no_plots:  # the figures' folder and paths checked before anything is printed

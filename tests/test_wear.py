@@ -170,10 +170,14 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
         assert all(math.isfinite(x) for x in (rep.max_depth, rep.cov("front"), rep.cov("rear")))
     rotations = MAX_RUNNING_HOURS * 3600 * res.parameters.operating.omega_i / (2 * math.pi)  # at 6000 rpm: 3.6e11
     assert res.wear_report(rotations=rotations * 0.999).hours == pytest.approx(0.999 * MAX_RUNNING_HOURS, rel=1e-12)
-    for kw, name in (({"hours": MAX_RUNNING_HOURS * 1.001}, "--hours"),
-                     ({"rotations": rotations * 1.001}, "--rotations")):
+    for kw, name in (({"hours": MAX_RUNNING_HOURS * 1.001}, "hours"),
+                     ({"rotations": rotations * 1.001}, "rotations")):  # the API names its keywords
         with pytest.raises(UserError, match=f"^{name} .*: more than 1e\\+06 h of running"):
             res.wear_report(**kw)
+    with pytest.raises(UserError, match="^hours 'x': must be a positive number$"):  # it said "--hours x"
+        res.wear_report(hours="x")
+    with pytest.raises(UserError, match="^give the running time as hours or as inner-ring rotations"):
+        res.wear_report()
 
 
 @pytest.mark.parametrize("option, value", [("--rotations", "1e300"), ("--hours", "1e300"), ("--hours", "2e6")])

@@ -44,6 +44,10 @@ def _cmd_animate(args) -> int:
     try:
         out = render(args.archive, args.output, rotations=rotations, exaggerate=args.exaggerate, fps=args.fps,
                      progress=progress)
+    except UserError as exc:
+        if str(exc).startswith("rotations "):  # the library names its keyword; the user gave the option
+            raise UserError(f"--{exc}") from None
+        raise
     finally:
         if bar is not None:
             bar.close()

@@ -116,7 +116,7 @@ def check_output(out, source=None) -> Path:
 
     out = Path(out)
     if out.suffix.lower() not in SUFFIXES:
-        raise UserError(f"{out}: report path must end in .html (got {out.suffix or 'no suffix'!r})")
+        raise UserError(f"{out}: report path must end in .html or .htm (got {out.suffix or 'no suffix'!r})")
     if source is not None and out.exists() and Path(source).exists() and out.resolve() == Path(source).resolve():
         raise UserError(f"{out}: the report path is the input; choose another -o")
     check_folder_can_be_made(out, "report")

@@ -183,11 +183,11 @@ def test_an_archive_without_motion_is_refused_in_one_line(runs, tmp_path, capsys
                                            ("nan:1", "a < b"), ("3:4", "outside the stored motion")])
 def test_bad_rotations_are_refused_in_one_line(runs, tmp_path, capsys, window, words):
     """A window that is not a:b, not increasing, or outside the stored poses (recorded rotations 0..1 here):
-    exit 2, one line naming --rotations or the window, nothing written."""
+    exit 2, one line naming --rotations (the window outside the poses said "rotations 3:4"), nothing written."""
     out = tmp_path / "x.gif"
     assert main(["animate", str(runs[1]), "-o", str(out), "--rotations", window]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and words in err
+    assert len(err.splitlines()) == 1 and words in err and err.startswith("bearingsim: error: --rotations")
     assert list(tmp_path.iterdir()) == []
 
 

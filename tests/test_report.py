@@ -325,7 +325,7 @@ def test_unwritable_outputs_are_one_line_and_keep_what_is_there(runs, tmp_path):
     user.write_text("<html>my own page</html>")
     assert_user_error(cli("report", src, "-o", user), "mine.html", "not replaced")
     assert user.read_text() == "<html>my own page</html>"
-    assert_user_error(cli("report", src, "-o", tmp_path / "r.pdf"), "must end in .html")
+    assert_user_error(cli("report", src, "-o", tmp_path / "r.pdf"), "must end in .html or .htm")  # both taken
     (tmp_path / "dir.html").mkdir()
     assert_user_error(cli("report", src, "-o", tmp_path / "dir.html"), "dir.html", "directory")
     assert_user_error(cli("report", src, "-o", user / "sub" / "r.html"), "cannot create the report's folder")

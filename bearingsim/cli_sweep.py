@@ -53,19 +53,24 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
               f"{out.count('pending')} not run, of {n}; index {out.h5}; run the same command again to resume",
               file=sys.stderr)
         return 128 + out.interrupted
-    if not quiet:
-        print(f"wrote {out.csv}")
-        print(f"wrote {out.h5}")
-        if out.map is not None:
-            print(f"wrote {out.map}")
-        for p in out.figures:
-            print(f"wrote {p}")
-        for line in out.figure_notes:
-            print(f"bearingsim: note: {line}", file=sys.stderr)
-        from bearingsim import tables
+    try:
+        if not quiet:
+            print(f"wrote {out.csv}")
+            print(f"wrote {out.h5}")
+            if out.map is not None:
+                print(f"wrote {out.map}")
+            for p in out.figures:
+                print(f"wrote {p}")
+            for line in out.figure_notes:
+                print(f"bearingsim: note: {line}", file=sys.stderr)
+            from bearingsim import tables
 
-        print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
-        print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s)")
+            print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
+            print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s)")
+    except KeyboardInterrupt as exc:  # the cases, index and figures are written: the command line says so
+        exc.resume_note = (f"{counted(n, 'case')} indexed in {out.h5}, the table not all printed "
+                           f"('bearingsim table {out.outdir}' prints it)")
+        raise
     if out.failed:
         names = ", ".join(f"{r['case']} ({', '.join(f'{k}={v}' for k, v in r['values'].items())})"
                           for r in out.failed[:10])

@@ -603,3 +603,34 @@ def test_a_worker_that_is_ending_says_nothing_of_objects_its_stop_left_half_made
     assert len(printed) == 1
     with pytest.raises(SystemExit):
         engines._exit_worker(signal.SIGTERM, None)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stage", ["figures", "table"])
+def test_a_signal_after_the_cases_says_they_are_indexed(tmp_path, monkeypatch, capsys, stage):
+    """SIGINT while a finished sweep draws its figures or prints its table said "interrupted, no archive
+    written", though every case had run and the index was written: exit 130 and one line naming the
+    index and what draws or prints the rest."""
+    from bearingsim import cli, tables
+    from bearingsim.sweeps import plot
+
+    def signalled(*args, **kw):
+        os.kill(os.getpid(), signal.SIGINT)
+        for _ in range(1000):  # the handler raises here
+            time.sleep(0.01)
+        raise AssertionError("signal not delivered")
+
+    monkeypatch.setattr(plot, "plot_sweep_index", signalled) if stage == "figures" else \
+        monkeypatch.setattr(tables, "format_table", signalled)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        code = cli.main(["sweep", str(BASE), "--param", f"{SPEED}=1000,2000", "-j", "1", "-o", str(tmp_path)])
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert code == 130
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert len(err) == 1 and "no archive written" not in err[0], err
+    assert err[0].startswith("bearingsim: sweep interrupted (SIGINT): 2 cases indexed in "
+                             f"{tmp_path / 'sweep.h5'}, "), err
+    assert ("'bearingsim plot" if stage == "figures" else "'bearingsim table") in err[0]
+    assert [r["status"] for r in _rows(tmp_path)] == ["done", "done"]

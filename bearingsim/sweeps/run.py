@@ -339,7 +339,12 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     if figures and outcome.interrupted is None:
         from bearingsim.sweeps.plot import plot_sweep_index
 
-        outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
+        try:
+            outcome.figures = plot_sweep_index(outcome.h5, outdir, notes=outcome.figure_notes)
+        except KeyboardInterrupt as exc:  # the cases are run and indexed: the command line says so
+            exc.resume_note = (f"{counted(len(rows), 'case')} indexed in {outcome.h5}, its figures not all written "
+                               f"('bearingsim plot {outcome.h5}' draws them)")
+            raise
     return outcome
 
 

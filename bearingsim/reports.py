@@ -461,10 +461,15 @@ def _uncertainty_sections(table: Path):
     from bearingsim.studies import uncertainty as unc
 
     rows, spreads, meta = unc.read_table(table)
+
+    def spread_row(s):  # in the unit the command prints it in (impulses in mN s)
+        scale, unit = unc.shown(s["quantity"])
+        return [f"{s['quantity']} [{unit}]" if unit else s["quantity"],
+                *(_cell(s[c], scale) for c in ("median", "p05", "p95", "mean", "std")), _cell(s["runs_used"])]
+
     spread = table_block("Each output over the sampled ranges", ["quantity", "median", "5 %", "95 %", "mean", "std",
                                                                   "runs used"],
-                         [[s["quantity"], *(_cell(s[c]) for c in ("median", "p05", "p95", "mean", "std")),
-                           _cell(s["runs_used"])] for s in spreads], [False] + [True] * 6)
+                         [spread_row(s) for s in spreads], [False] + [True] * 6)
     ci = f"{unc.CONFIDENCE:.0%}"
     index = table_block(f"Sobol indices with {ci} bootstrap intervals (docs/sensitivity.md)",
                         ["quantity", "key", "S1", f"S1 {ci}", "ST", f"ST {ci}"],

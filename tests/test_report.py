@@ -429,3 +429,23 @@ def test_the_life_history_of_a_report_is_the_table_the_command_prints(folders, t
     cols, _ = life.read_life(folders / "life" / "life.h5")
     for row in life.history_rows(cols):
         assert "".join(f"<td class=\"num\">{c}</td>" for c in row) in re.sub(r"\s+<", "<", table)
+
+
+@pytest.mark.slow
+def test_an_uncertainty_reports_its_spread_in_the_units_the_command_prints(tmp_path):
+    """The report of an uncertainty folder gave the spread of I_dec and I_acc as bare numbers in N s
+    (0.005934), under no unit, while the command and `table` print them in mN s (5.934 mN s); it gives
+    them as the command does, with the unit."""
+    from bearingsim.studies import uncertainty as unc
+
+    res = cli("uncertainty", PAPER, "--keys", "contact.restitution", "--samples", "2", "-o", tmp_path / "unc",
+              "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    html = bearingsim.report(tmp_path / "unc", tmp_path / "u.html").read_text()
+    spreads = unc.read_table(tmp_path / "unc" / "uncertainty.h5")[1]
+    cells = re.findall(r"<tr><td>(I_dec[^<]*)</td>((?:<td[^>]*>[^<]*</td>)+)</tr>", html)
+    label, numbers = cells[0]  # the spread's row (the Sobol indices' rows follow)
+    assert label == "I_dec [mN s]"
+    median = re.findall(r">([^<]*)<", numbers)[0]
+    spread = next(s for s in spreads if s["quantity"] == "I_dec")
+    assert median == f"{spread['median'] * 1e3:.4g}"

@@ -270,14 +270,19 @@ def read_table(path):
 _SHOWN = {"N s": (1e3, "mN s"), "1": (1.0, "")}
 
 
+def shown(quantity: str) -> tuple[float, str]:
+    """(factor, unit) in which the tables show ``quantity`` (``I_dec``: 1e3, ``mN s``; ``cage_slip``: 1, "")."""
+    units = {q: unit for q, _, unit in QUANTITIES}
+    return _SHOWN.get(units.get(quantity), (1.0, ""))
+
+
 def format_table(spreads: list[dict], indices: list[dict]) -> str:
     """The spreads and Sobol indices for the terminal, as ``bearingsim uncertainty`` prints them."""
     from bearingsim.wording import counted
 
-    units = {q: unit for q, _, unit in QUANTITIES}
     lines = []
     for s in spreads:
-        scale, label = _SHOWN.get(units.get(s["quantity"]), (1.0, ""))
+        scale, label = shown(s["quantity"])
         lines.append(f"  {s['quantity']:10s} median {s['median'] * scale:.4g}, 5-95 %: {s['p05'] * scale:.4g} .. "
                      f"{s['p95'] * scale:.4g}{' ' + label if label else ''} "
                      f"({counted(int(s['runs_used']) if s['runs_used'] == s['runs_used'] else 0, 'run')})")

@@ -246,7 +246,7 @@ def table_of(paths) -> Table:
         index = paths[0] / "sweep.h5"
         if not index.is_file():
             raise UserError(f"{paths[0]}: holds no sweep.h5 (not a sweep or study folder); give the folder of a "
-                            f"sweep, cross-check or validate run, or archives")
+                            f"sweep or of a study ({', '.join(STUDY_NAMES.values())}), or archives")
         return table_of_index(index)
     indexes = [p for p in paths if archive.is_table_file(p, INDEX_FORMAT)]
     if indexes and len(paths) == 1:

@@ -287,3 +287,15 @@ def test_compare_of_two_says_what_its_mark_means():
     assert "bearingsim table A B" in lines[-1]
     same = compare_results(result({"I_dec_mean_Ns": 0.015}), result({"I_dec_mean_Ns": 0.015}))
     assert same.identical and not any("*" in line for line in same.summary_table().splitlines())
+
+
+def test_a_folder_of_nothing_names_every_folder_table_reads(tmp_path):
+    """`bearingsim table EMPTY_DIR` said "give the folder of a sweep, cross-check or validate run, or archives",
+    leaving out the sensitivity, uncertainty and life folders whose tables it prints as well."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError) as err:
+        tables.format_paths([tmp_path])
+    assert str(err.value).startswith(f"{tmp_path}: holds no sweep.h5")
+    for kind in tables.STUDY_NAMES.values():
+        assert kind in str(err.value), kind

@@ -634,3 +634,19 @@ def test_a_signal_after_the_cases_says_they_are_indexed(tmp_path, monkeypatch, c
                              f"{tmp_path / 'sweep.h5'}, "), err
     assert ("'bearingsim plot" if stage == "figures" else "'bearingsim table") in err[0]
     assert [r["status"] for r in _rows(tmp_path)] == ["done", "done"]
+
+
+@pytest.mark.parametrize("table, got", [("{ start = 0.1, num = 3 }", "start, num"),
+                                        ("{ start = 0.1, stop = 0.3, nums = 3 }", "start, stop, nums")])
+def test_a_range_with_a_key_missing_or_misspelt_names_its_axis(tmp_path, table, got):
+    """A sweep file's `{ start, stop, num }` with a key missing or misspelt was read as a nested table and
+    refused as "axes: bearing.pocket_clearance_mm.start: must be a non-empty list ...", a key that does not
+    exist; it names the axis and the range's keys."""
+    from bearingsim.errors import UserError
+
+    f = tmp_path / "s.toml"
+    f.write_text(f'scenario = "{BASE}"\n[axes]\n"bearing.pocket_clearance_mm" = {table}\n')
+    with pytest.raises(UserError) as err:
+        load_sweep_file(f)
+    assert str(err.value) == (f"{f}: axes: bearing.pocket_clearance_mm: {{ start, stop, num }} needs exactly these "
+                              f"three keys (got {got})")

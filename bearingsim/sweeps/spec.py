@@ -194,8 +194,11 @@ def _flatten(table: dict, where: str, prefix: str = "") -> dict[str, Any]:
     return out
 
 
+_RANGE_KEYS = ("start", "stop", "num")
+
+
 def _is_range(v) -> bool:
-    return isinstance(v, dict) and set(v) == {"start", "stop", "num"}
+    return isinstance(v, dict) and set(v) == set(_RANGE_KEYS)
 
 
 class _Range:
@@ -276,6 +279,11 @@ def load_sweep_file(path: str | Path) -> SweepSpec:
         raise UserError(f"{path}: cases: must be an array of tables ([[cases]])")
     sets = _flatten(sets_tab, f"{path}: set")
     axes = _flatten(axes_tab, f"{path}: axes")
+    for k in axes:
+        parent, _, last = k.rpartition(".")
+        if last in _RANGE_KEYS and parent:  # a range with a key missing or misspelt was read as a nested table
+            got = ", ".join(kk.rpartition(".")[2] for kk in axes if kk.rpartition(".")[0] == parent)
+            raise UserError(f"{path}: axes: {parent}: {{ start, stop, num }} needs exactly these three keys (got {got})")
     for k, v in axes.items():
         if _is_range(v):
             axes[k] = _Range(v).values(f"{path}: axes: {k}")

@@ -167,6 +167,17 @@ def test_rung_scenarios():
     assert full.raw == expect
 
 
+@pytest.mark.parametrize("contact, named", [("hertz", "(Hertz;"), ("rigid", "(rigid raceways;")])
+def test_each_rung_says_the_raceway_contacts_its_scenario_has(contact, named):
+    """Rung 3's description names the raceway contacts the rungs run with: a cross-check of the fast scene
+    (multibody.raceway_contact = "rigid") wrote "raceway contacts (Hertz; ...)" into its table; every rung
+    but the reduced one keeps the scenario's raceway contact."""
+    sc = load_scenario(REFERENCE, [f"multibody.raceway_contact={contact}"])
+    rungs = cc.rung_scenarios(sc, 1000, 7)
+    assert named in rungs[2][2] and "{" not in "".join(r[2] for r in rungs)
+    assert all(r[3].multibody.raceway_contact == contact for r in rungs[1:])
+
+
 @pytest.mark.parametrize("argv, words", [
     (["crosscheck", str(SCENARIOS / "paper_3000rpm.toml")], "model = 'reduced'"),
     (["crosscheck", str(REFERENCE), "--set", "multibody.scene=reduced_equivalent"], "multibody.scene"),

@@ -228,7 +228,7 @@ def _crosscheck_table(folder: Path) -> None:
     rows = [{"rpm": 3000.0, "rung": k, "scene": scene, "relaxed": what, "I_dec_mean_Ns": 5e-3 * k,
              "I_dec_sem_Ns": 2e-4, "I_acc_mean_Ns": 3e-3, "I_acc_sem_Ns": 1e-4, "first_impact_speed_m_s": 0.1,
              "cage_slip": 0.01, "archive": "", "wall_s": 1.0, "status": "done", "error": ""}
-            for k, scene, what in cc.RUNGS]
+            for k, scene, what in cc.rungs()]
     cc.write_table(folder, cc.add_changes(rows), bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
 
 

@@ -44,14 +44,21 @@ INDEX_FORMAT = "bearingsim crosscheck index 1"
 DEFAULT_SPEEDS_RPM = (1000.0, 3000.0, 6000.0)
 DEFAULT_ROTATIONS = 10
 
-#: (rung, scene, the assumption of the paper's model this rung drops)
+#: (rung, scene, the assumption of the paper's model this rung drops; ``{raceways}``: :func:`rungs` names them)
 RUNGS = (
     (1, "reduced", "none: the paper's reduced model (one pocket; cage at the epicyclic speed)"),
     (2, "reduced_equivalent", "one pocket: every pocket in the plane (pymunk)"),
-    (3, "kinematic_cage", "rollers carried through the load zone: raceway contacts (Hertz; traction; inner ring)"),
+    (3, "kinematic_cage", "rollers carried through the load zone: raceway contacts ({raceways}; traction; inner ring)"),
     (4, "centred_cage", "cage speed prescribed: the cage turns under its contact torques"),
     (5, "full", "cage centre on the axis: the cage free in the plane"),
 )
+
+
+def rungs(raceway_contact: str = "hertz") -> list[tuple[int, str, str]]:
+    """:data:`RUNGS` with the raceway contacts of a scenario's ``multibody.raceway_contact`` named."""
+    raceways = {"hertz": "Hertz", "rigid": "rigid raceways"}[raceway_contact]
+    return [(rung, scene, relaxed.format(raceways=raceways)) for rung, scene, relaxed in RUNGS]
+
 
 COLUMNS = ("rpm", "rung", "scene", "relaxed", "I_dec_mean_Ns", "I_dec_sem_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns",
            "first_impact_speed_m_s", "cage_slip", "change_from_previous")
@@ -100,7 +107,7 @@ def rung_scenarios(scenario, rpm: float, rotations: int | None = None) -> list[t
         over["numerics.rotations"] = int(rotations)
     full = scenario.replace(**over)
     out = []
-    for rung, scene, relaxed in RUNGS:
+    for rung, scene, relaxed in rungs(scenario.multibody.raceway_contact):
         if scene == "full":
             sc = full
         elif scene == "reduced":

@@ -14,6 +14,7 @@ import time
 from collections.abc import Iterator
 
 from bearingsim.errors import UserError
+from bearingsim.sweeps import worker as _worker
 
 #: how long LocalEngine.stop waits for the pool to end itself before it ends the workers directly [s]
 #: (the pool ends in well under a second when its result queue's lock is free)
@@ -24,17 +25,9 @@ STOP_WAIT_S = 10.0
 _STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
-class _WorkerStop(SystemExit):
-    """SIGTERM in a worker process: it ends the worker (raised by the signal's handler)."""
-
-
-_stopping = False  # a worker's: SIGTERM came, the worker is ending
-
-
 def _exit_worker(signum, frame):
-    global _stopping
-    _stopping = True
-    raise _WorkerStop(128 + signum)
+    _worker.ending = True  # a worker's: SIGTERM came, the worker is ending
+    raise _worker.WorkerStop(128 + signum)
 
 
 def _stop_again(unraisable, previous=sys.unraisablehook) -> None:
@@ -43,8 +36,8 @@ def _stop_again(unraisable, previous=sys.unraisablehook) -> None:
     has left the callback. Once a worker is ending, what its objects say as they go is dropped (the stop's
     exception, raised wherever the worker was, can leave an object half made: llvmlite's ``OutputString``
     then failed in ``__del__`` with a traceback on the sweep's stderr); before, it goes on to ``previous``."""
-    if not isinstance(unraisable.exc_value, _WorkerStop):
-        if not _stopping:
+    if not isinstance(unraisable.exc_value, _worker.WorkerStop):
+        if not _worker.ending:
             previous(unraisable)
         return
     import _thread
@@ -168,9 +161,9 @@ class LocalEngine:
         ``Pool.terminate`` can wait forever: a worker ended while it held the result queue's lock (sending
         a finished task's result, e.g. a warm-up's) leaves the lock taken, and the pool's task handler then
         waits for it before it exits, and terminate for the task handler. So the pool is ended in a
-        thread of its own; if that has not finished within :data:`STOP_WAIT_S`, the workers are ended
-        (SIGKILL) and reaped here, and the stuck thread is left behind (a daemon: it holds nothing the
-        process needs)."""
+        thread of its own, and this returns when it has finished or every worker process has exited; if
+        neither within :data:`STOP_WAIT_S`, the workers are ended (SIGKILL) and reaped here. A thread
+        left waiting is a daemon: it holds nothing the process needs."""
         import threading
 
         pool, self._pool = self._pool, None
@@ -185,7 +178,18 @@ class LocalEngine:
             ended.set()
 
         threading.Thread(target=end, name="bearingsim-pool-stop", daemon=True).start()
-        if ended.wait(STOP_WAIT_S):
+        deadline = time.monotonic() + STOP_WAIT_S
+        while not ended.wait(0.05):
+            # every worker gone: nothing of the sweep runs any more. The pool's own threads may wait for
+            # ever on a pipe no worker reads: terminate drains the task pipe once, and a task handler that
+            # was half-way through sending a batch (larger than the pipe) then fills it again, and
+            # terminate waits for it (it took STOP_WAIT_S in about a third of the interrupts of a large
+            # sweep); that thread is a daemon and holds nothing the process needs
+            if all(p.exitcode is not None for p in [*workers, *list(pool._pool)]):
+                return
+            if time.monotonic() > deadline:
+                break
+        else:
             return
         for p in workers:
             if p.is_alive():

@@ -6,6 +6,7 @@ no file system shared with the client: with ``return_bytes`` the archive comes b
 from __future__ import annotations
 
 import logging
+import signal
 import tempfile
 import time
 from pathlib import Path
@@ -70,6 +71,18 @@ def _run_in_memory(scenario, notes: bool = True, archive: bool = True):
     return result, (archive_module.to_bytes(result) if archive else None)
 
 
+#: True in a pool worker once it has been told to end (SIGTERM, :mod:`bearingsim.sweeps.engines`): the stop's
+#: exception is raised wherever the worker is, and the code it lands in may turn it into another (numba's
+#: compiled code, while it calls back into Python: "SystemError: CPUDispatcher(...) returned a result with
+#: an exception set"), which a case would record as its failure before the worker went on to wait for a task
+ending = False
+
+
+class WorkerStop(SystemExit):
+    """SIGTERM in a worker process: it ends the worker (raised by the signal's handler, and by
+    :func:`run_case` for an exception that the stop's turned into)."""
+
+
 def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, archives: str = "all") -> dict:
     """Run one case into the archive ``target`` (written atomically), or with ``target`` None return
     the archive's bytes under ``"archive"``; a case that keeps no archive under the policy
@@ -114,6 +127,8 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
             rec["archive"] = data
         return rec
     except Exception as exc:  # noqa: BLE001 - a failing case is recorded, the sweep goes on
+        if ending:  # the stop's exception, turned into another: not the case's failure; the worker ends
+            raise WorkerStop(128 + signal.SIGTERM) from None
         return {"hash": case_hash, "status": "failed", "error": one_line_error(exc),
                 "wall_s": time.perf_counter() - t0, "summary": {}}
 

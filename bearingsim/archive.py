@@ -1006,9 +1006,19 @@ def _check_regular(p: Path) -> None:
     except OSError as exc:
         raise UserError(f"{p}: cannot open ({exc.strerror or exc.__class__.__name__})") from None
     if stat.S_ISDIR(mode):
-        raise UserError(f"{p}: is a directory, not an archive")
+        raise _directory_error(p)
     if not stat.S_ISREG(mode):
         raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not an archive")
+
+
+def _directory_error(p: Path) -> UserError:
+    """The refusal of a folder given where an archive is read; a sweep's or a study's folder (its index
+    ``sweep.h5``) is named as one, with the commands that read it."""
+    if (p / "sweep.h5").is_file():
+        return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}' and 'bearingsim "
+                         f"report {p}' read it, 'bearingsim plot {p / 'sweep.h5'}' draws its figures; its cases' "
+                         f"archives are in {p / 'cases'}")
+    return UserError(f"{p}: is a directory, not an archive")
 
 
 def is_scenario_file(path) -> bool:
@@ -1047,7 +1057,7 @@ def open_archive(path: str | Path):
     if not p.exists():
         raise UserError(f"{p}: file not found")
     if p.is_dir():
-        raise UserError(f"{p}: is a directory, not an archive")
+        raise _directory_error(p)
     _check_regular(p)
     try:
         ok = h5py.is_hdf5(p)

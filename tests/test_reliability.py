@@ -327,6 +327,9 @@ CASES: list[Case] = [
     # archives given to inspect
     Case("inspect-missing", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("a.h5", "not found")),
     Case("inspect-directory", "inspect", ["inspect", "{tmp}"], 2, ("is a directory, not an archive",)),
+    Case("plot-sweep-folder", "inspect", ["plot", "{tmp}/s"], 2,
+         ("is a sweep or study folder, not an archive", "bearingsim table {tmp}/s", "bearingsim plot {tmp}/s/sweep.h5"),
+         setup=lambda t: ((t / "s").mkdir(), (t / "s" / "sweep.h5").write_bytes(b""))),
     Case("inspect-zeros", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("a.h5", "not an HDF5"),
          setup=lambda t: (t / "a.h5").write_bytes(b"\0" * 100)),
     Case("inspect-foreign-hdf5", "inspect", ["inspect", "{tmp}/a.h5"], 2, ("not a bearingsim archive",),

@@ -934,9 +934,11 @@ def table_units(path) -> dict[str, str]:
         return {name: _plain(ds.attrs["unit"]) for name, ds in f["index"].items() if "unit" in ds.attrs}
 
 
-def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[str], lines: list[str]) -> str:
+def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[str], lines: list[str],
+                   noun: str = "row") -> str:
     """Listing of an index table (a sweep's ``sweep.h5``, a cross-check's ``crosscheck.h5``): what it is,
-    how many rows and by status, the ``lines`` the caller adds, then every column with its unit."""
+    how many rows (counted as ``noun``: a sweep's are cases, a life history's stages) and by status, the
+    ``lines`` the caller adds, then every column with its unit."""
     n = len(cols[columns[0]]) if columns else 0
     status = cols.get("status")
     by = {}
@@ -944,7 +946,7 @@ def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[s
         by[str(v)] = by.get(str(v), 0) + 1
     counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
     units = table_units(path)
-    out = [f"{path}: {what}: {counted(n, 'case')}{counts}", *lines, "columns:"]
+    out = [f"{path}: {what}: {counted(n, noun)}{counts}", *lines, "columns:"]
     for c in columns:
         arr = np.asarray(cols[c])
         kind = "text" if arr.dtype.kind in "OUS" else "number"

@@ -68,7 +68,7 @@ def _describe_index(path) -> tuple[str, str | None] | None:
                  "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
                  "without one); 'bearingsim show' of a case archive gives its scenario"]
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
-                                      meta["columns"], lines), None
+                                      meta["columns"], lines, noun="case"), None
     from bearingsim.sweeps.grid import MAP_FORMAT, describe_map, read_map
 
     if archive.is_grid_file(path, MAP_FORMAT):
@@ -96,10 +96,11 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
     from bearingsim import archive
     from bearingsim.studies import life, sensitivity, uncertainty
 
-    kinds = ((sensitivity.INDEX_FORMAT, "bearingsim sensitivity table (one row per key and quantity)"),
-             (uncertainty.INDEX_FORMAT, "bearingsim uncertainty table (Sobol indices, one row per key and quantity)"),
-             (life.LIFE_FORMAT, "bearingsim life history (one row per stage)"))
-    for fmt, what in kinds:
+    kinds = ((sensitivity.INDEX_FORMAT, "bearingsim sensitivity table (one row per key and quantity)", "row"),
+             (uncertainty.INDEX_FORMAT, "bearingsim uncertainty table (Sobol indices, one row per key and quantity)",
+              "row"),
+             (life.LIFE_FORMAT, "bearingsim life history (one row per stage)", "stage"))
+    for fmt, what, noun in kinds:
         if archive.is_table_file(path, fmt):
             cols, meta = archive.read_table_file(path, fmt)
             columns = json.loads(meta["columns"]) if "columns" in meta else list(cols)
@@ -110,7 +111,7 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
                 name = tomllib.loads(meta["scenario"]).get("name")
             lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
             lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "rotations", "left_out") if k in meta]
-            return archive.describe_table(path, what, cols, columns, lines), meta.get("scenario")
+            return archive.describe_table(path, what, cols, columns, lines, noun=noun), meta.get("scenario")
     return None
 
 

@@ -56,7 +56,7 @@ def test_inspect_and_show_describe_a_crosscheck_table(tmp_path):
     h5, sc = _crosscheck_index(tmp_path)
     res = bearingsim("inspect", h5)
     assert res.returncode == 0, res.stderr
-    assert "bearingsim cross-check table" in res.stdout and "2 cases (done 2)" in res.stdout
+    assert "bearingsim cross-check table" in res.stdout and "2 rows (done 2)" in res.stdout  # a rung at a speed
     assert "change_from_previous" in res.stdout and "speeds [rpm]: 3000" in res.stdout
     res = bearingsim("show", h5)
     assert res.returncode == 0, res.stderr

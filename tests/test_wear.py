@@ -298,6 +298,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     assert main(["inspect", str(tmp_path / "life.h5")]) == 0  # bearingsim's own table file: described
     text = capsys.readouterr().out
     assert "life history" in text and "wear_test_6000rpm" in text and "limit: clearance=0.203mm" in text
+    assert f"(one row per stage): {len(cols['stage'])} stages" in text  # its rows are stages (it said "cases")
 
 
 @pytest.mark.slow

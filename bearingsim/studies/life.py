@@ -22,10 +22,11 @@ Limits: ``depth`` (the deepest point of any
 face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
 **mean** worn depth: worn volume / face area), ``volume`` (the largest worn volume of one face).
 
-Stages run in sequence in one folder under :class:`bearingsim.outputs.FolderLock`: ``stages/stage_NN.h5``
-(each a normal archive) and ``life.h5`` (the history, written atomically at the end). A stage archive
-that stores exactly its stage's scenario and was computed by the present model version is reused: an
-interrupted study resumes where it stopped.
+The stages are the cases of a staged study on the study engine (:mod:`bearingsim.studies.engine`), run in
+sequence in one folder: ``cases/<hash>.h5`` (each a normal archive, named by its scenario's content hash),
+the case index ``sweep.csv``/``sweep.h5``, and ``life.h5`` (the history, written atomically at the end)
+with ``life.png``. A stage archive that stores exactly its stage's scenario and was computed by the
+present model version is reused: an interrupted study resumes where it stopped.
 """
 from __future__ import annotations
 

@@ -8,6 +8,7 @@ import subprocess
 import sys
 import time
 import warnings
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -23,7 +24,7 @@ from bearingsim.sweeps.run import make_batches
 from bearingsim.sweeps.spec import Case, load_sweep_file, scenario_from_toml
 from bearingsim.sweeps.worker import standard_errors
 
-from .conftest import SCENARIOS, started
+from .conftest import ROOT, SCENARIOS, started
 from .test_cli import assert_user_error, bearingsim
 
 BASE = SCENARIOS / "paper_3000rpm.toml"
@@ -710,3 +711,13 @@ def test_a_range_with_a_key_missing_or_misspelt_names_its_axis(tmp_path, table, 
         load_sweep_file(f)
     assert str(err.value) == (f"{f}: axes: bearing.pocket_clearance_mm: {{ start, stop, num }} needs exactly these "
                               f"three keys (got {got})")
+
+
+def test_a_sweep_files_base_scenario_is_named_without_a_detour(monkeypatch):
+    """A sweep file names its base scenario relative to itself ("../paper_3000rpm.toml"); the sweep's index
+    showed it as "scenarios/sweeps/../paper_3000rpm.toml". It is the same file, named the short way."""
+    from bearingsim.sweeps.spec import load_sweep_file
+
+    monkeypatch.chdir(ROOT)
+    spec = load_sweep_file(Path("scenarios/sweeps/map_speed_clearance.toml"))
+    assert spec.scenario == Path("scenarios/paper_3000rpm.toml") and spec.scenario.is_file()

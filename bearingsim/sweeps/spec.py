@@ -29,6 +29,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -290,7 +291,8 @@ def load_sweep_file(path: str | Path) -> SweepSpec:
         elif not isinstance(v, list) or not v:
             raise UserError(f"{path}: axes: {k}: must be a non-empty list of values or {{ start, stop, num }}")
     extra = [_flatten(c, f"{path}: cases[{i}]") for i, c in enumerate(cases)]
-    return SweepSpec(scenario=(path.parent / base), sets=[f"{k}={toml_value(v)}" for k, v in sets.items()],
+    # its folder joined to the file's own reference, "../paper_3000rpm.toml" resolved: the path the index shows
+    return SweepSpec(scenario=Path(os.path.normpath(path.parent / base)), sets=[f"{k}={toml_value(v)}" for k, v in sets.items()],
                      axes=list(axes.items()), mode=mode, extra=extra, origin=str(path))
 
 

@@ -660,7 +660,8 @@ def test_stop_returns_once_every_worker_has_exited_though_the_pool_still_waits(m
     try:
         stopper.join(120)
         assert not stopper.is_alive(), "stop() waited for the pool although every worker had exited"
-        assert [p.exitcode for p in workers] == [143, 143]  # ended by their SIGTERM, not killed
+        # ended by the pool (the worker handler's sentinel, 0, or the SIGTERM, 143), not killed (-9)
+        assert all(p.exitcode in (0, 143) for p in workers), [p.exitcode for p in workers]
     finally:
         release.set()
         real_terminate()

@@ -111,7 +111,14 @@ def check(result) -> list[str]:
                      "first_impact_speed_m_s and first_impact_energy_J are NaN (none)")
         bad = []
     if bad:
-        if p.model == "reduced" and set(bad) <= {"first_impact_speed_m_s", "first_impact_energy_J"}:
+        if (p.model == "reduced" and set(bad) <= {"first_impact_speed_m_s", "first_impact_energy_J"}
+                and p.contact.drag_coefficient == 0.0 and p.operating.gravity == 0.0):
+            # Eq. 1 with F_o = 0 and g = 0: nothing moves the roller off the front face it starts on, at
+            # any half angle, so naming the pass's length would send the user after the wrong key
+            advice = ("the no-load pass has no rear-face impact; with lubrication.drag_coefficient = 0 and "
+                      "operating.gravity = false no force acts on the roller in its pocket (Eq. 1), so it stays "
+                      "on the front face it starts on: give the drag coefficient a value or switch gravity on")
+        elif p.model == "reduced" and set(bad) <= {"first_impact_speed_m_s", "first_impact_energy_J"}:
             advice = ("the no-load pass has no rear-face impact; reduced.load_zone_half_angle_deg "
                       f"= {summary.get('load_zone_half_angle_deg', float('nan')):.4g} deg leaves too short a pass")
         else:

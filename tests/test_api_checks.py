@@ -156,3 +156,19 @@ def test_a_key_set_outside_its_plausible_range_gets_a_note_in_the_run_and_the_dr
     assert dry.returncode == 0 and real.returncode == 0, (dry.stderr, real.stderr)
     assert [line for line in dry.stderr.splitlines() if "plausible" in line] == [wide.notes[-1]]
     assert [line for line in real.stderr.splitlines() if "plausible" in line] == [wide.notes[-1]]
+
+
+@pytest.mark.slow  # the reduced model's kernels load in a few seconds in a fresh process
+@pytest.mark.parametrize("half_angle", [0, 23.5])
+def test_a_pass_with_no_force_on_the_roller_is_refused_naming_drag_and_gravity(half_angle):
+    """Eq. 1 with c = 0 (no oil-film drag F_o) and gravity off leaves no force on the roller in the no-load
+    zone: it stays on the front face it starts on and never reaches the rear face, whatever the pass's
+    length. Was: the refusal said that reduced.load_zone_half_angle_deg "= 0 deg leaves too short a
+    pass", for the longest pass there is."""
+    sc = bearingsim.load_scenario(PAPER, set={"lubrication.drag_coefficient": 0, "operating.gravity": False,
+                                              "reduced.load_zone_half_angle_deg": half_angle})
+    with pytest.raises(bearingsim.SimulationUnstable) as err:
+        bearingsim.run(sc)
+    msg = str(err.value)
+    assert "lubrication.drag_coefficient" in msg and "operating.gravity" in msg
+    assert "too short a pass" not in msg and "\n" not in msg

@@ -884,8 +884,26 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
     return out
 
 
+# The tags pydantic appends to an error's location for the branch of a union it tried (``float |
+# Literal["auto"]`` reports ('reduced', 'load_zone_half_angle_deg', 'float') and (..., "literal['auto']")):
+# not keys of the scenario.
+_BRANCH_TAGS = ("float", "int", "str", "bool")
+
+
 def _loc(err) -> str:
-    return ".".join(str(p) for p in err["loc"] if not str(p).startswith(("function-", "literal[")))
+    return ".".join(str(p) for p in err["loc"]
+                    if not str(p).startswith(("function-", "literal[")) and str(p) not in _BRANCH_TAGS)
+
+
+def _union_message(errors, err) -> str | None:
+    """What a value refused by both branches of a ``float | Literal[...]`` key must be, e.g. "must be a
+    number or 'auto'" (pydantic gives one error per branch, each naming only its own), or None."""
+    loc = err["loc"]
+    if err["type"] not in ("float_type", "float_parsing") or not loc or loc[-1] != "float":
+        return None
+    words = [e["msg"].replace("Input should be ", "") for e in errors
+             if e["type"] == "literal_error" and e["loc"][:-1] == loc[:-1]]
+    return f"must be a number or {' or '.join(words)}" if words else None
 
 
 def known_keys() -> list[str]:
@@ -931,7 +949,8 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
         elif err["type"] == "model_type":  # a section given as one value: pydantic would name its class
             msg = f"must be a table of keys ([{key}] in a file, {key}.KEY=VALUE with --set) (got {err['input']!r})"
         else:
-            msg = err["msg"].replace("Input should be", "must be").replace("Value error, ", "")
+            msg = _union_message(errors, err) or \
+                err["msg"].replace("Input should be", "must be").replace("Value error, ", "")
             if "input" in err and not isinstance(err["input"], dict):
                 msg += f" (got {err['input']!r})"
         raise UserError(f"{source}: {key}: {msg}") from None

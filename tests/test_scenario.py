@@ -97,6 +97,24 @@ def test_a_section_given_as_a_value_is_refused_in_the_scenarios_words(override):
     assert "Section" not in msg and "instance" not in msg, msg
 
 
+@pytest.mark.parametrize("override, alternative", [
+    ("reduced.load_zone_half_angle_deg=autox", "'auto'"),
+    ("multibody.pocket_face_half_angle_deg=wide", "'auto'"),
+    ("multibody.inner_ring_mass_kg=heavy", "'auto'"),
+    ("output.motion_start_rotation=first", "'last'"),
+])
+def test_a_key_that_takes_a_number_or_a_word_is_named_as_the_key(override, alternative):
+    """A key typed ``float | "auto"`` refused a bad word as "reduced.load_zone_half_angle_deg.float: must be
+    a valid number": a key that does not exist (pydantic's tag for the branch of the union it tried), and
+    half of what the key takes. It names the key and both kinds of value."""
+    key = override.split("=")[0]
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
+    msg = str(err.value)
+    assert f": {key}: must be a number or {alternative} (got " in msg, msg
+    assert ".float" not in msg and "\n" not in msg, msg
+
+
 def test_overlapping_pockets_name_both_keys():
     # 16 pockets of 80 + 0.2 mm on a 97.5 mm pitch circle overlap (chord 2 r_p sin(pi/16) = 19.0 mm)
     with pytest.raises(UserError) as err:

@@ -122,6 +122,17 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
             raw = run(p, sink=sink, progress=progress, dt=dt)
             break
         except PenetrationExceeded as exc:
+            if exc.t <= 1.5 * exc.dt:
+                # the overlap was there after the first step, in which the bodies, assembled moving with
+                # the cage, cover far less than it (~ g dt^2): it is the assembled state, which no
+                # shorter step removes (each restart would shorten the step by the ratio of the overlap
+                # to the limit again, down to steps of 1e-13 s that never end)
+                raise SimulationUnstable(
+                    f"{exc}: in the first step, so the bearing as assembled (rollers on the outer race, cage "
+                    f"centred) already overlaps a pocket face by more than {PENETRATION_LIMIT:.0%} of the "
+                    f"pocket clearance, which no shorter step removes; bearing.pocket_clearance_mm = "
+                    f"{p.bearing.pocket_clearance * 1e3:.4g} is too small for this bearing's radial play "
+                    f"(bearing.radial_clearance_mm = {p.bearing.radial_clearance * 1e3:.4g})") from None
             first_how = first_how or exc.how
             new_dt = exc.suggested_dt()
             if not auto or len(retries) >= MAX_DT_RETRIES:

@@ -131,6 +131,7 @@ class TimeSeries:
         chunk_rows = max(16, min(65536, _CHUNK_BYTES // row_bytes))
         kw = dict(compression="gzip", compression_opts=4, shuffle=True)
         self._step = group.create_dataset("step", (0,), maxshape=(None,), dtype="i8", chunks=(chunk_rows,), **kw)
+        self._step.attrs["unit"] = "1"  # a count (docs/archive.md: every dataset has a unit)
         self._time = group.create_dataset("time", (0,), maxshape=(None,), dtype="f8", chunks=(chunk_rows,), **kw)
         self._time.attrs["unit"] = "s"
         self._value = group.create_dataset(

@@ -45,6 +45,14 @@ def test_complete_archive_has_header_scenario_provenance_units(tmp_path, base_re
         assert ts["value"].shape == (10000,) and ts["value"][-1] == 100.0 + 9999
         assert ts["value"].attrs["unit"] == "rad/s" and ts["time"].attrs["unit"] == "s"
         assert f["results/per_rotation/I_dec"].attrs["unit"] == "N s"
+    # docs/archive.md: "Every dataset under /results and /observables has a unit attribute (1 for
+    # dimensionless or counts)": the H5MD step counter too (it had none)
+    with open_archive(path) as f:
+        missing = []
+        f.visititems(lambda name, obj: missing.append(name) if isinstance(obj, h5py.Dataset) and name.startswith(
+            ("results/", "observables/")) and "unit" not in obj.attrs else None)
+        assert missing == [], missing
+        assert f["observables/cage_angular_speed/step"].attrs["unit"] == "1"
     # The stored scenario reproduces the run's inputs exactly.
     import tomllib
 

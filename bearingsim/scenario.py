@@ -943,7 +943,8 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
         err = next((e for e in errors if e["type"] == "extra_forbidden"), errors[0])
         key = _loc(err)
         if err["type"] == "missing":
-            msg = "missing (set it in the scenario or name a [bearing] preset)"
+            # a preset gives the bearing's keys only
+            msg = "missing (set it in the scenario" + (" or name a [bearing] preset)" if key.startswith("bearing.") else ")")
         elif err["type"] == "extra_forbidden":
             msg = "unknown key" + did_you_mean(key)
         elif err["type"] == "model_type":  # a section given as one value: pydantic would name its class

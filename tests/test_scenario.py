@@ -308,3 +308,16 @@ def test_a_cage_mass_without_its_inertia_is_refused_with_the_inertia_a_ring_of_i
     assert ring == pytest.approx(0.5 * (r_in**2 + r_out**2) / 2, rel=5e-4)  # printed to 4 digits
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["bearing.cage_mass_kg=0.5", f"bearing.cage_inertia_kgm2={ring}"])
     assert sc.bearing.cage_inertia_kgm2 == ring
+
+
+def test_a_missing_key_is_told_to_name_a_preset_only_where_a_preset_gives_it():
+    """A preset gives the bearing's keys only: a missing operating key was told "set it in the scenario or
+    name a [bearing] preset", which cannot give it (`--set 'operating={radial_load_N=3}'` replaces the
+    file's [operating] table, the speed with it)."""
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "paper_3000rpm.toml", ["operating={radial_load_N=3}"])
+    assert str(err.value).endswith("operating.inner_ring_speed_rpm: missing (set it in the scenario)")
+    with pytest.raises(UserError) as err:
+        resolve({"schema_version": 1, "name": "x", "model": "reduced", "bearing": {"roller_count": 16},
+                 "operating": {"inner_ring_speed_rpm": 3000.0, "radial_load_N": 970.0}}, "<test>")
+    assert "bearing." in str(err.value) and "missing (set it in the scenario or name a [bearing] preset)" in str(err.value)

@@ -1,0 +1,69 @@
+"""How long a large sweep takes to stop on a signal: ``python -m benchmarks.interrupt_bench [--tries N]``.
+
+Each try starts ``bearingsim sweep scenarios/sweeps/map_speed_clearance.toml -j 2 --no-plots -q`` (the
+100 x 100 reduced-model map) in a fresh folder, waits until the sweep has written its index ``sweep.h5``
+(its workers are then running cases), waits a further 4-6 s (seeded, so the same tries land at the same
+moments of the sweep as nearly as the machine allows), sends the signal to the sweep process and measures
+the time until it has exited. Prints one row per try (seconds, exit code, the sweep's last line on
+stderr) and the minimum, median and maximum. docs/sweeps.md says a sweep exits "within a second or so".
+"""
+from __future__ import annotations
+
+import argparse
+import random
+import signal
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+SWEEP = ROOT / "scenarios" / "sweeps" / "map_speed_clearance.toml"
+
+
+def one_try(wait_s: float, signum: int, folder: Path) -> tuple[float, int, str]:
+    """(seconds from the signal to the sweep's exit, its exit code, its last stderr line)."""
+    out = folder / "s"
+    with open(folder / "err", "w+") as err:
+        proc = subprocess.Popen([sys.executable, "-m", "bearingsim", "sweep", str(SWEEP), "-o", str(out), "-j", "2",
+                                 "--no-plots", "-q"], stdout=subprocess.DEVNULL, stderr=err, cwd=ROOT)
+        start = time.monotonic()
+        while not (out / "sweep.h5").is_file():
+            if proc.poll() is not None or time.monotonic() - start > 300:
+                proc.kill()
+                raise SystemExit(f"the sweep ended or stalled before it wrote {out / 'sweep.h5'}")
+            time.sleep(0.05)
+        time.sleep(wait_s)
+        t0 = time.monotonic()
+        proc.send_signal(signum)
+        code = proc.wait()
+        took = time.monotonic() - t0
+        err.seek(0)
+        lines = [line.strip() for line in err if line.strip()]
+    return took, code, lines[-1] if lines else ""
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.interrupt_bench", description=__doc__.splitlines()[0])
+    ap.add_argument("--tries", type=int, default=10)
+    ap.add_argument("--signal", choices=("INT", "TERM"), default="INT")
+    ap.add_argument("--seed", type=int, default=0)
+    args = ap.parse_args(argv)
+    rng = random.Random(args.seed)
+    signum = getattr(signal, f"SIG{args.signal}")
+    times = []
+    print(f"{'try':>3}  {'s to exit':>9}  {'exit':>4}  last line")
+    for i in range(1, args.tries + 1):
+        with tempfile.TemporaryDirectory(prefix="bearingsim-interrupt-") as d:
+            took, code, last = one_try(4.0 + 2.0 * rng.random(), signum, Path(d))
+        times.append(took)
+        print(f"{i:>3}  {took:9.2f}  {code:>4}  {last[:110]}", flush=True)
+    print(f"SIG{args.signal}, {args.tries} tries: min {min(times):.2f} s, median {statistics.median(times):.2f} s, "
+          f"max {max(times):.2f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

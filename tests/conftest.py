@@ -31,6 +31,21 @@ def base_reduced() -> dict:
     }
 
 
+def archive_summary_table() -> tuple[str, dict[str, str]]:
+    """docs/archive.md's table of the summary attributes: (its text, {name: unit} of every name in a row's
+    first cell)."""
+    import re
+
+    text = (ROOT / "docs" / "archive.md").read_text()
+    table = text[text.index("### Summary attributes"):text.index("## Sign conventions")]
+    units = {}
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 3:
+            units.update((name, cells[1]) for name in re.findall(r"`([a-zA-Z_]+)`", cells[0]))
+    return table, units
+
+
 def si(scenario):
     """The SI parameters of a resolved scenario (what the models take)."""
     from bearingsim.parameters import Parameters

@@ -121,20 +121,11 @@ def test_unused_keys_per_model():
 
 
 def test_every_summary_key_is_documented_with_its_unit():
-    import re
-
     from bearingsim import multibody, reduced
     from bearingsim.sweeps.worker import standard_errors
-    from .conftest import ROOT
+    from .conftest import archive_summary_table
 
-    text = (ROOT / "docs" / "archive.md").read_text()
-    table = text[text.index("### Summary attributes"):text.index("## Sign conventions")]
-    rows = {}
-    for line in table.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 3:
-            for name in re.findall(r"`([a-zA-Z_]+)`", cells[0]):
-                rows[name] = cells[1]
+    table, rows = archive_summary_table()
     units = {**reduced.SUMMARY_UNITS, **multibody.SUMMARY_UNITS, **multibody.RIGID_SUMMARY_UNITS,
              **multibody.LAND_SUMMARY_UNITS, **{k: "N s" for k in standard_errors([1.0, 2.0], [1.0, 2.0])}}
     missing = [k for k in [*units, "scene", "pockets"] if k not in rows and k not in table]

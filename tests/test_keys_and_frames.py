@@ -270,17 +270,9 @@ def test_every_summary_number_has_the_unit_the_archive_page_gives(multibody_resu
     """`bearingsim inspect` showed the summary number `pockets` without a unit (and `to_dataframe("summary")`
     had none for it), where docs/archive.md gives `1` as for `steps`: every number carries its unit,
     in the result and in the archive written from it."""
-    import re
+    from .conftest import archive_summary_table
 
-    from .conftest import ROOT
-
-    text = (ROOT / "docs" / "archive.md").read_text()
-    table = text[text.index("### Summary attributes"):text.index("## Sign conventions")]
-    documented = {}
-    for line in table.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if len(cells) == 3:
-            documented.update((name, cells[1]) for name in re.findall(r"`([a-zA-Z_]+)`", cells[0]))
+    documented = archive_summary_table()[1]
     path = multibody_result.save(tmp_path / "m.h5")
     for r in (multibody_result, bearingsim.load(path)):
         numbers = [k for k, v in r.summary.items() if not isinstance(v, str)]

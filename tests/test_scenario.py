@@ -85,14 +85,19 @@ def test_bad_values_name_the_key(override, key):
     assert f": {key}:" in msg, msg
 
 
+def _refusal_of(override: str) -> str:
+    """The one-line refusal of the whole-bearing scenario with the ``--set`` ``override``."""
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
+    return str(err.value)
+
+
 @pytest.mark.parametrize("override", ["bearing=5", 'operating="fast"', "multibody=[1, 2]"])
 def test_a_section_given_as_a_value_is_refused_in_the_scenarios_words(override):
     """`run --set bearing=5` said "bearing: must be a valid dictionary or instance of BearingSection": the
     name of a class inside the package. It says the section must be a table, and how to give its keys."""
     section = override.split("=")[0]
-    with pytest.raises(UserError) as err:
-        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
-    msg = str(err.value)
+    msg = _refusal_of(override)
     assert f": {section}: must be a table of keys ([{section}] in a file, {section}.KEY=VALUE with --set)" in msg, msg
     assert "Section" not in msg and "instance" not in msg, msg
 
@@ -108,9 +113,7 @@ def test_a_key_that_takes_a_number_or_a_word_is_named_as_the_key(override, alter
     a valid number": a key that does not exist (pydantic's tag for the branch of the union it tried), and
     half of what the key takes. It names the key and both kinds of value."""
     key = override.split("=")[0]
-    with pytest.raises(UserError) as err:
-        load_scenario(SCENARIOS / "multibody_3000rpm.toml", [override])
-    msg = str(err.value)
+    msg = _refusal_of(override)
     assert f": {key}: must be a number or {alternative} (got " in msg, msg
     assert ".float" not in msg and "\n" not in msg, msg
 

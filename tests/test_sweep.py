@@ -628,6 +628,60 @@ def test_a_case_that_fails_while_its_worker_is_ending_ends_the_worker_and_is_not
     assert stop.value.code == 128 + signal.SIGTERM
 
 
+def test_a_signal_while_the_sweep_writes_its_index_lets_it_finish_and_is_reported(tmp_path, monkeypatch):
+    """A signal that landed while a sweep ended its workers or wrote its index and map (the clean-up after the
+    cases) raised out of it: `bearingsim sweep` exited 1 with a traceback (1 of 6 SIGINTs of
+    benchmarks.interrupt_bench). The clean-up finishes, the index holds every case, and the sweep reports
+    the signal as an interruption."""
+    import bearingsim.sweeps.run as run_module
+
+    clean = run_module._clean_temporaries
+    calls = []
+
+    def clean_then_signal(cases_dir):  # the second call is the clean-up's: the signal lands there
+        calls.append(cases_dir)
+        if len(calls) == 2:
+            os.kill(os.getpid(), signal.SIGINT)
+        clean(cases_dir)
+
+    monkeypatch.setattr(run_module, "_clean_temporaries", clean_then_signal)
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0])])
+    out = run_sweep(spec, tmp_path / "s", engine=LocalEngine(1), figures=False, progress=False)
+    assert len(calls) == 2 and out.interrupted == signal.SIGINT
+    cols, _ = read_index(tmp_path / "s" / "sweep.h5")
+    assert [str(x) for x in cols["status"]] == ["done", "done"]  # the index written to its end
+    assert (tmp_path / "s" / "map.h5").is_file()
+
+
+def test_a_worker_told_to_end_takes_no_further_case_and_waits_for_no_further_batch(monkeypatch):
+    """A worker's SIGTERM whose exception was swallowed where it landed (a callback of compiled code) leaves
+    the worker running its case; it then took the batch's next case, and waited for the next batch, until
+    the sweep killed it after STOP_WAIT_S (a cross-check stopped by SIGTERM took 10.1 s once). A worker that is
+    ending finishes the case it is in and ends (WorkerStop, exit status 143)."""
+    from bearingsim.sweeps import worker
+
+    ran = []
+
+    def case(h, *args):  # the stop comes while the first case runs
+        ran.append(h)
+        worker.ending = True
+        return {"hash": h, "status": "done"}
+
+    monkeypatch.setattr(worker, "ending", False)
+    monkeypatch.setattr(worker, "run_case", case)
+    with pytest.raises(worker.WorkerStop) as stop:
+        worker.run_batch([("a", "x"), ("b", "x")])
+    assert ran == ["a"] and stop.value.code == 128 + signal.SIGTERM
+    ran.clear()
+    worker.ending = False  # (monkeypatch restores it)
+    with pytest.raises(worker.WorkerStop):  # a one-case batch: no wait for the next one
+        worker.run_batch([("c", "x")])
+    assert ran == ["c"]
+    with pytest.raises(worker.WorkerStop):  # already ending: no case at all
+        worker.run_batch([("d", "x")])
+    assert ran == ["c"]
+
+
 def test_stop_returns_once_every_worker_has_exited_though_the_pool_still_waits(monkeypatch):
     """Pool.terminate drains the task pipe once; a task handler half-way through sending a batch larger than
     the pipe then fills it again, no worker reads it, and terminate waits for the handler for ever: stop()

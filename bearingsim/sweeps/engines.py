@@ -16,9 +16,11 @@ from collections.abc import Iterator
 from bearingsim.errors import UserError
 from bearingsim.sweeps import worker as _worker
 
-#: how long LocalEngine.stop waits for the pool to end itself before it ends the workers directly [s]
-#: (the pool ends in well under a second when its result queue's lock is free)
-STOP_WAIT_S = 10.0
+#: how long LocalEngine.stop waits for the workers to exit before it ends them directly [s]: a worker
+#: exits within milliseconds of its SIGTERM, unless the signal's handler cannot run (a worker inside a
+#: long call into compiled code, numba compiling a kernel on a cold cache) or its exception was swallowed
+#: where it landed; a worker killed then leaves at most a temporary file, which the sweep removes
+STOP_WAIT_S = 3.0
 
 
 #: the signals a sweep process acts on; blocked while it forks workers, until they have their own handlers

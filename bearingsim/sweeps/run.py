@@ -127,10 +127,23 @@ class _Signals:
         self.old_hook = None
         self.fired: int | None = None
 
+    _held = False
+
     def _handler(self, signum, frame):
         if self.fired is None:
             self.fired = signum
-            raise SweepInterrupted(signum)
+            if not self._held:
+                raise SweepInterrupted(signum)
+
+    @contextlib.contextmanager
+    def held(self):
+        """Within it a signal is recorded in ``fired``, not raised: a clean-up that must finish (the index
+        and the map written, the workers ended) is not cut short by it."""
+        self._held = True
+        try:
+            yield
+        finally:
+            self._held = False
 
     def _unraisable(self, unraisable):
         if not isinstance(unraisable.exc_value, SweepInterrupted):
@@ -355,6 +368,7 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
     with _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
         bar = None
+        interrupted = None
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
@@ -372,18 +386,19 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
             if signals.fired is not None:
                 raise SweepInterrupted(signals.fired)
         except SweepInterrupted as exc:
-            return exc.signum
+            interrupted = exc.signum
         finally:
-            try:
-                if staged is None:  # a staged study's next round uses it: its caller stops it
-                    engine.stop()
-            finally:
-                if bar is not None:
-                    bar.close()
-                _clean_temporaries(cases_dir)
-                index.write()
-                write_map()
-    return None
+            with signals.held():  # a signal from here on (it cut the index's writing short once) is only noted
+                try:
+                    if staged is None:  # a staged study's next round uses it: its caller stops it
+                        engine.stop()
+                finally:
+                    if bar is not None:
+                        bar.close()
+                    _clean_temporaries(cases_dir)
+                    index.write()
+                    write_map()
+    return interrupted if interrupted is not None else signals.fired
 
 
 def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str, check_folder: bool):

@@ -179,5 +179,12 @@ def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archiv
     archives : str
         Which cases get an archive (:func:`keeps_archive`): ``all``, ``none`` or ``auto``.
     """
-    return [run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
-                     model[0] if model else None, archives) for h, text, *model in items]
+    records = []
+    for h, text, *model in items:
+        if ending:  # told to end while a case ran (its exception swallowed where it landed): no next case
+            raise WorkerStop(128 + signal.SIGTERM)
+        records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
+                                model[0] if model else None, archives))
+    if ending:  # nor a wait for the next batch: the sweep that stopped it reads no more records
+        raise WorkerStop(128 + signal.SIGTERM)
+    return records

@@ -24,6 +24,7 @@ def parse_rotations(text: str) -> tuple[float, float]:
 
 def _cmd_animate(args) -> int:
     from bearingsim import animation
+    from bearingsim.cli_common import options_named
     from bearingsim.simulation import animate as render
     from bearingsim.sweeps.run import _progress as progress_bar  # the bar of sweep, crosscheck and validate
 
@@ -42,12 +43,9 @@ def _cmd_animate(args) -> int:
             bar.update(done - bar.n)
 
     try:
-        out = render(args.archive, args.output, rotations=rotations, exaggerate=args.exaggerate, fps=args.fps,
-                     progress=progress)
-    except UserError as exc:
-        if str(exc).startswith("rotations "):  # the library names its keyword; the user gave the option
-            raise UserError(f"--{exc}") from None
-        raise
+        with options_named("rotations"):
+            out = render(args.archive, args.output, rotations=rotations, exaggerate=args.exaggerate, fps=args.fps,
+                         progress=progress)
     finally:
         if bar is not None:
             bar.close()

@@ -1,12 +1,27 @@
-"""What the subcommands share: a study's exit code, whether a progress bar is drawn. Imported by
-:mod:`bearingsim.cli` and the command modules beside it (``cli_sweep``, ``cli_sensitivity``,
-``cli_wear``), none of which import each other."""
+"""What the subcommands share: a study's exit code, whether a progress bar is drawn, the options a
+library refusal names. Imported by :mod:`bearingsim.cli` and the command modules beside it (``cli_sweep``,
+``cli_sensitivity``, ``cli_wear``, ``cli_animate``), none of which import each other."""
 from __future__ import annotations
 
+import contextlib
 import signal
 import sys
 
+from bearingsim.errors import UserError
 from bearingsim.wording import counted
+
+
+@contextlib.contextmanager
+def options_named(*keywords: str):
+    """Within it, a library refusal that starts with one of its ``keywords`` ("rotations 3:4: outside ...",
+    "hours 'x': must be ...") names the command line's option instead ("--rotations 3:4: ..."): the library
+    names its keywords, the user gave options."""
+    try:
+        yield
+    except UserError as exc:
+        if any(str(exc).startswith(k + " ") for k in keywords):
+            raise UserError(f"--{exc}") from None
+        raise
 
 
 def report_study(outcome, command: str) -> int:

@@ -11,6 +11,7 @@ from bearingsim.errors import UserError
 def _cmd_wear(args) -> int:
     from bearingsim import wear
     from bearingsim.archive import check_writable_dir
+    from bearingsim.cli_common import options_named
     from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
     from bearingsim.plotting import save_figure
     from bearingsim.simulation import load
@@ -19,7 +20,8 @@ def _cmd_wear(args) -> int:
     result = load(path)  # a missing file, a folder, a scenario file, a foreign file: one line saying which
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
-    rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations, names=("--hours", "--rotations"))  # refusals of the archive and time
+    with options_named("hours", "rotations"):  # refusals of the archive and the running time
+        rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
     figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
     pngs = {}
     if not args.no_plots:  # the figures' folder and paths checked before anything is printed

@@ -73,14 +73,13 @@ def has_profile(result) -> bool:
     return "results/wear/profile_work_front" in result.data
 
 
-def running_time(result, *, hours: float | None = None, rotations: float | None = None,
-                 names: tuple[str, str] = ("hours", "rotations")) -> tuple[float, float, float]:
+def running_time(result, *, hours: float | None = None, rotations: float | None = None) -> tuple[float, float, float]:
     """(shaft rotations, hours, cage rotations) of a running time given as ``hours`` or inner-ring
-    ``rotations`` (exactly one); the cage rotations at the run's measured mean cage speed. ``names``: how
-    a refusal names the two (the API's keywords; the command line passes its options)."""
+    ``rotations`` (exactly one); the cage rotations at the run's measured mean cage speed. A refusal starts
+    with the keyword it is about (the command line names its option there)."""
     if (hours is None) == (rotations is None):
-        raise UserError(f"give the running time as {names[0]} or as inner-ring {names[1]} (exactly one)")
-    value, name = (hours, names[0]) if hours is not None else (rotations, names[1])
+        raise UserError("give the running time as hours or as inner-ring rotations (exactly one)")
+    value, name = (hours, "hours") if hours is not None else (rotations, "rotations")
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
         raise UserError(f"{name} {value!r}: must be a positive number")
     op = result.parameters.operating
@@ -106,18 +105,16 @@ def face_area(p, bins: int = 1) -> float:
 
 
 def wear_report(result, *, hours: float | None = None, rotations: float | None = None,
-                wear_coefficient: float | None = None, hardness: float | None = None,
-                names: tuple[str, str] = ("hours", "rotations")) -> WearReport:
+                wear_coefficient: float | None = None, hardness: float | None = None) -> WearReport:
     """The :class:`WearReport` of ``result`` after a running time (``hours`` or inner-ring ``rotations``),
-    with Archard's k and H of the result's scenario (``[wear]``) unless given; ``names``: how a refusal
-    of the running time names the two (:func:`running_time`)."""
+    with Archard's k and H of the result's scenario (``[wear]``) unless given."""
     if not has_profile(result):
         raise UserError("this archive has no wear profile (written before bearingsim recorded one, or not a "
                         "multibody run): run its scenario again ('bearingsim rerun' or 'bearingsim run')")
     p = result.parameters
     k = p.wear.wear_coefficient if wear_coefficient is None else wear_coefficient
     h = p.wear.hardness if hardness is None else hardness
-    shaft, hrs, cage_rot = running_time(result, hours=hours, rotations=rotations, names=names)
+    shaft, hrs, cage_rot = running_time(result, hours=hours, rotations=rotations)
     recorded = result.per_rotation["I_dec"].shape[0]
     scale = cage_rot / recorded
     psi = result.get("wear/profile_psi_deg")

@@ -33,6 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.scenario import unread_because  # why a key's paired runs would be identical
 from bearingsim.studies.engine import Study, batch_sem, case_of, load_result
 
 INDEX_FORMAT = "bearingsim sensitivity index 1"
@@ -72,14 +73,6 @@ def default_keys(scenario) -> list[str]:
             and unread_because(scenario, k) is None]
 
 
-def unread_because(scenario, key: str) -> str | None:
-    """Why the scenario's run does not read ``key`` (its paired runs would be identical), or None
-    (:func:`bearingsim.scenario.unread_because`)."""
-    from bearingsim.scenario import unread_because as why
-
-    return why(scenario, key)
-
-
 def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:
     """``keys`` (None: :func:`default_keys`) checked: each must have a range (one-line UserError
     naming it otherwise) and, with ``relative`` (the sensitivity study's steps x (1 -+ step)), a nonzero
@@ -117,7 +110,7 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
 
 def _check_given_key(scenario, key: str) -> None:
     """A one-line UserError naming ``key`` (given to ``--keys``) when no scenario has it (with the closest
-    accepted key) or the scenario's run does not read it (:func:`unread_because`)."""
+    accepted key) or the scenario's run does not read it (:func:`bearingsim.scenario.unread_because`)."""
     from bearingsim.scenario import did_you_mean, known_keys
 
     known = known_keys()

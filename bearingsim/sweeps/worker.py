@@ -80,7 +80,13 @@ ending = False
 
 class WorkerStop(SystemExit):
     """SIGTERM in a worker process: it ends the worker (raised by the signal's handler, and by
-    :func:`run_case` for an exception that the stop's turned into)."""
+    :func:`end_if_told` once the worker is ending)."""
+
+
+def end_if_told() -> None:
+    """End this worker (:class:`WorkerStop`, exit status 143 as SIGTERM's own) if it has been told to."""
+    if ending:
+        raise WorkerStop(128 + signal.SIGTERM)
 
 
 def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, archives: str = "all") -> dict:
@@ -127,8 +133,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
             rec["archive"] = data
         return rec
     except Exception as exc:  # noqa: BLE001 - a failing case is recorded, the sweep goes on
-        if ending:  # the stop's exception, turned into another: not the case's failure; the worker ends
-            raise WorkerStop(128 + signal.SIGTERM) from None
+        end_if_told()  # the stop's exception, turned into another, is not the case's failure
         return {"hash": case_hash, "status": "failed", "error": one_line_error(exc),
                 "wall_s": time.perf_counter() - t0, "summary": {}}
 
@@ -181,10 +186,8 @@ def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archiv
     """
     records = []
     for h, text, *model in items:
-        if ending:  # told to end while a case ran (its exception swallowed where it landed): no next case
-            raise WorkerStop(128 + signal.SIGTERM)
+        end_if_told()  # told to end while a case ran (its exception swallowed where it landed): no next case
         records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
                                 model[0] if model else None, archives))
-    if ending:  # nor a wait for the next batch: the sweep that stopped it reads no more records
-        raise WorkerStop(128 + signal.SIGTERM)
+    end_if_told()  # nor a wait for the next batch: the sweep that stopped it reads no more records
     return records

@@ -270,3 +270,33 @@ def test_bearingsim_run_builds_its_parameters_and_its_time_step_once(tmp_path, s
         {"from_scenario", "choose_dt"})
     assert code == 0
     assert counts == collections.Counter({"parameters.py:from_scenario": 1, **steps})
+
+
+#: what the checkout holds at its top level (the package, its scenarios, tests, docs, benchmarks and CI):
+#: anything else committed is a stray
+TOP_LEVEL = {".ci", ".gitignore", "CHANGELOG.md", "README.md", "bearingsim", "benchmarks", "docs", "outputs",
+             "pyproject.toml", "scenarios", "tests"}
+#: the kinds of file a run writes; committed only as the docs' pictures (docs/) and the tests' data (tests/data/)
+RESULT_SUFFIXES = {".h5", ".png", ".gif", ".html", ".csv", ".nc"}
+
+
+def _tracked_files() -> list[str]:
+    import shutil
+    import subprocess
+
+    if not (ROOT / ".git").exists() or shutil.which("git") is None:
+        pytest.skip("not a git checkout (an installed copy has no committed files to check)")
+    out = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z"], capture_output=True, check=True)
+    return [f for f in out.stdout.decode().split("\0") if f]
+
+
+def test_the_checkout_commits_no_results_and_nothing_beside_its_layout():
+    """A run's archive or figure committed by mistake (outside docs/ and tests/data/) is found, and so is
+    a top-level entry the layout does not have."""
+    files = _tracked_files()
+    strays = sorted({f.split("/")[0] for f in files} - TOP_LEVEL)
+    results = [f for f in files if Path(f).suffix.lower() in RESULT_SUFFIXES
+               and not f.startswith(("docs/", "tests/data/"))]
+    assert not strays, f"committed outside the layout: {strays}"
+    assert not results, f"results committed (outputs/ is for them, ignored by git): {results}"
+    assert [f for f in files if f.startswith("outputs/")] == ["outputs/.gitkeep"]

@@ -115,7 +115,7 @@ def check_run(scenario: Scenario, dt: float | None = None) -> None:
 
     check_run_request(scenario)
     try:
-        model_module(scenario.model).check_step(scenario.parameters, dt)
+        model_module(scenario.model).check_start(scenario.parameters, dt)
     except UserError as exc:  # the model names the key; the scenario's refusals name its file too
         raise UserError(f"{scenario.source}: {exc}") from None
 

@@ -164,6 +164,20 @@ def test_run_dry_run_refuses_the_time_step_the_run_refuses(tmp_path, name):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_run_dry_run_refuses_a_pocket_too_tight_for_the_assembled_bearing(tmp_path):
+    """Rollers that overlap their pocket faces as assembled (pocket clearance 5 um against a radial play
+    of 80 um: tests/test_multibody.py) are refused by the run before its first step and by the dry run with
+    the same line, naming the file and the clearance (the dry run passed, exit 0, and the run refused it
+    in its first step, exit 3)."""
+    setting = "bearing.pocket_clearance_mm=0.005"
+    path = SCENARIOS / "multibody_3000rpm.toml"
+    dry = cli("run", path, "--set", setting, "--dry-run", cwd=tmp_path)
+    real = cli("run", path, "--set", setting, "--no-plots", "-o", tmp_path / "a.h5")
+    assert_user_error(dry, str(path), "bearing.pocket_clearance_mm = 0.005 is too small", "overlap a pocket face")
+    assert dry.stderr == real.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("case", ["a file in the folder's place", "a folder that takes no file",
                                   "an archive of another scenario"])

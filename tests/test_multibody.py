@@ -5,6 +5,7 @@ Runs are short (a few cage rotations) and shared through module-scoped fixtures.
 from __future__ import annotations
 
 import math
+import re
 import subprocess
 import sys
 
@@ -301,22 +302,68 @@ def test_cli_main_job(tmp_path):
             assert f[f"/results/wear/{k}"].attrs["unit"] == "m^3"
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("extra", [[], ["numerics.dt_s=1e-6"], ["multibody.raceway_contact=rigid"]])
-def test_a_pocket_too_tight_for_the_assembled_bearing_is_refused_naming_the_clearance(extra, monkeypatch):
-    """Geometry, not time step: the rollers start on the outer race, P_d/4 = 20 um outside the pitch circle,
-    in pockets centred on it, so a roller reaches into the rim end of its arc face (psi = +26.2 deg) by about
-    (P_d/4) sin 26.2 deg - s/2 = 6.4 um at s = 5 um, far above the 1 % of s allowed, before anything moves.
-    Was: with the automatic step every restart shortened the step by overlap / limit (1.76e-6, 1.09e-8,
-    6.8e-11, 4.2e-13 s) and the run went on for hours; with a given step it asked for numerics.dt_s <= 1.09e-8 s.
-    (MAX_DT_RETRIES = 0 keeps the old code from those hours here: it then names the step at once.)"""
-    import bearingsim
-    import bearingsim.multibody as mb
+TIGHT = ([], ["numerics.dt_s=1e-6"], ["multibody.raceway_contact=rigid"])
 
-    monkeypatch.setattr(mb, "MAX_DT_RETRIES", 0)
+
+@pytest.mark.parametrize("extra", TIGHT)
+def test_a_pocket_too_tight_for_the_assembled_bearing_is_refused_before_the_run_naming_the_clearance(extra):
+    """Geometry, not time step: the rollers start on the outer race, P_d/4 = 20 um outside the pitch circle,
+    in pockets centred on it, so a roller reaches into the rim end of its arc face (psi = +26.7 deg, the wall's
+    end for this R = r + s/2) by (P_d/4) sin 26.7 deg - s/2 + O(delta^2 / R) = 6.45 um at s = 5 um, far above
+    the 1 % of s allowed, before anything moves; no time step removes it, so the run refuses it before its first step (a UserError,
+    exit 2), whatever the step or the raceways."""
+    import bearingsim
+
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml",
                        ["bearing.pocket_clearance_mm=0.005", "numerics.rotations=1", *extra])
-    with pytest.raises(bearingsim.SimulationUnstable) as err:
+    with pytest.raises(bearingsim.UserError) as err:
         simulate(sc)
     msg = str(err.value)
-    assert "bearing.pocket_clearance_mm = 0.005" in msg and "numerics.dt_s <=" not in msg, msg
+    assert "bearing.pocket_clearance_mm = 0.005 is too small" in msg and "numerics.dt_s <=" not in msg, msg
+    # 6.45 um; 6.47 um with rigid raceways, whose rollers are not pressed into the race by their weight
+    assert float(re.search(r"overlap a pocket face by (\S+) m", msg)[1]) == pytest.approx(6.46e-6, abs=0.02e-6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("extra", TIGHT)
+def test_the_assembled_overlap_is_the_overlap_the_first_step_finds(extra):
+    """core.assembly_overlap (the check before the run) against the simulator's own contact detection: the
+    model run without the check stops in its first step (PenetrationExceeded) with the overlap it measured,
+    which is the assembled one to 0.1 % (in one step of ~2e-6 s the bodies, moving with the cage, change
+    their distance by ~g dt^2 ~ 4e-11 m, 1e-5 of it)."""
+    from bearingsim.multibody import core
+
+    p = si(load_scenario(SCENARIOS / "multibody_3000rpm.toml",
+                         ["bearing.pocket_clearance_mm=0.005", "numerics.rotations=1", *extra]))
+    with pytest.raises(core.PenetrationExceeded) as err:
+        core.run(p)
+    assert err.value.t <= 1.5 * err.value.dt  # the first step
+    assert core.assembly_overlap(p) == pytest.approx(err.value.pen, rel=1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scenario", ["multibody_3000rpm.toml", "rig_1000rpm.toml"])
+def test_the_tightest_pocket_the_check_passes_is_the_tightest_the_first_step_passes(scenario):
+    """The clearance s* at which the assembled overlap is 1 % of s (found by root search on
+    core.assembly_overlap) is the simulator's own bound: 3 % below it the model run without the check
+    stops in its first step; 3 % above it the run completes (one warm-up and one recorded rotation). So the
+    check refuses nothing the run would accept, and the free cage's and the rig's pockets (exact arcs of
+    their own extents) both agree."""
+    from scipy.optimize import brentq
+
+    from bearingsim.multibody import core, simulate as model_run
+
+    def params(s_mm):
+        return si(load_scenario(SCENARIOS / scenario, [f"bearing.pocket_clearance_mm={s_mm!r}",
+                                                        "numerics.rotations=1", "numerics.warmup_rotations=1"]))
+
+    def excess(s_mm):
+        p = params(s_mm)
+        return core.assembly_overlap(p) - core.PENETRATION_LIMIT * p.bearing.pocket_clearance
+
+    s_star = brentq(excess, 0.001, 0.2, xtol=1e-9)
+    assert 0.01 < s_star < 0.03  # ~ (P_d/4) sin(psi_hi) / (1/2 + 1 %) = 17.5 um for P_d = 80 um
+    with pytest.raises(core.PenetrationExceeded) as err:
+        core.run(params(0.97 * s_star))
+    assert err.value.t <= 1.5 * err.value.dt
+    assert model_run(params(1.03 * s_star)).per_rotation["I_dec"].shape[0] == 1

@@ -67,7 +67,8 @@ from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
-                                       PenetrationExceeded, choose_dt, paper_assumptions, run)
+                                       PenetrationExceeded, assembly_refusal, check_assembly, choose_dt,
+                                       paper_assumptions, run)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
 from bearingsim.results import MemorySink, Result
@@ -127,12 +128,8 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
                 # the cage, cover far less than it (~ g dt^2): it is the assembled state, which no
                 # shorter step removes (each restart would shorten the step by the ratio of the overlap
                 # to the limit again, down to steps of 1e-13 s that never end)
-                raise SimulationUnstable(
-                    f"{exc}: in the first step, so the bearing as assembled (rollers on the outer race, cage "
-                    f"centred) already overlaps a pocket face by more than {PENETRATION_LIMIT:.0%} of the "
-                    f"pocket clearance, which no shorter step removes; bearing.pocket_clearance_mm = "
-                    f"{p.bearing.pocket_clearance * 1e3:.4g} is too small for this bearing's radial play "
-                    f"(bearing.radial_clearance_mm = {p.bearing.radial_clearance * 1e3:.4g})") from None
+                raise SimulationUnstable(f"{exc}: in the first step, so "
+                                         + assembly_refusal(p, "already overlap a pocket face")) from None
             first_how = first_how or exc.how
             new_dt = exc.suggested_dt()
             if not auto or len(retries) >= MAX_DT_RETRIES:
@@ -151,11 +148,13 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     return res
 
 
-def check_step(p, dt: float | None = None) -> None:
-    """Refuse, without running, a time step :func:`simulate` would refuse: a given ``dt`` (or
+def check_start(p, dt: float | None = None) -> None:
+    """Refuse, without running, what :func:`simulate` would refuse before its first step: rollers that
+    overlap their pockets' faces as assembled (:func:`core.check_assembly`), and a given ``dt`` (or
     ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`). The
     automatic step is never refused (at most ``DT_FRACTION`` of the limit, below ``DT_MAX_FACTOR`` of
     it), so it is not computed here: :func:`simulate` computes it once."""
+    check_assembly(p)
     if dt is not None or p.numerics.dt is not None:
         choose_dt(p, dt)
 

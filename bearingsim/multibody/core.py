@@ -496,6 +496,72 @@ def face_radial_reach(p) -> float:
     return (p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance + deepest) * math.sin(min(-lo, hi))
 
 
+def centrifugal_load(p) -> float:
+    """A roller's centrifugal load on the outer race at the cage's epicyclic speed, plus 1 mN [N]."""
+    return p.bearing.roller_mass * p.bearing.pitch_radius * p.operating.omega_c**2 + 1e-3
+
+
+def roller_start_radius(p) -> float:
+    """Radius [m] of the roller centres at t = 0: on the outer race, pressed into it by their centrifugal
+    load (rigid raceways: :func:`rigid_radius`; the reduced-equivalent scene's race has no clearance)."""
+    if rigid(p):
+        return rigid_radius(p)
+    g = p.bearing
+    pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
+    return g.outer_race_radius + 0.25 * pd - g.roller_radius - (
+        centrifugal_load(p) / laws.palmgren_stiffness(g.roller_length)) ** 0.9
+
+
+def assembly_overlap(p) -> float:
+    """Largest overlap [m] of a roller with a face of its pocket as the bearing is assembled: the roller at
+    :func:`roller_start_radius`, ``delta`` off its pocket centre along the radius, the cage centred (0: none).
+
+    A face's nearest point to the roller is the end of its extent on the side the roller moved to: exactly
+    so for an arc face (the distance from ``(0, delta)`` to ``R (cos psi, sin psi)`` falls as sin psi
+    grows); for a polyline or a worn face the end is taken too (a chord or a worn stretch can come nearer,
+    which the first step's overlap check still finds). Flat faces stay ``s / 2`` away."""
+    lo, hi = p.multibody.pocket_face_extent
+    g = p.bearing
+    delta = roller_start_radius(p) - g.pitch_radius
+    rr = g.roller_radius
+    radius = rr + 0.5 * g.pocket_clearance
+    end = hi if delta >= 0.0 else lo
+    worn = worn_array(p)
+    n_seg = p.multibody.pocket_face_segments
+    if worn is not None:
+        knots, h = worn_lines((lo, hi), radius, worn)
+        r_end = worn_radius(knots, h, np.array([end]))[..., 0]  # (n, 2): each face's edge
+    elif n_seg > 0:
+        r_end = np.full((g.roller_count, 2), radius / math.cos(0.5 * (hi - lo) / n_seg))  # the polyline's end
+    else:
+        r_end = np.full((g.roller_count, 2), radius)
+    arc = np.ones(g.roller_count, dtype=bool)
+    arc[list(p.multibody.flat_pockets)] = False  # a flat face spans the whole pocket: s / 2 away
+    if not arc.any():
+        return 0.0
+    r_end = r_end[arc]
+    dist = np.sqrt(r_end**2 + delta**2 - 2.0 * r_end * delta * math.sin(end))
+    return max(float(rr - dist.min()), 0.0)
+
+
+def check_assembly(p) -> None:
+    """Refuse a bearing whose rollers, as assembled, already overlap a pocket face by more than
+    ``PENETRATION_LIMIT`` of the pocket clearance (:func:`assembly_overlap`): no time step removes it."""
+    overlap = assembly_overlap(p)
+    if overlap > PENETRATION_LIMIT * p.bearing.pocket_clearance:
+        raise UserError(assembly_refusal(p, f"overlap a pocket face by {overlap:.3g} m"))
+
+
+def assembly_refusal(p, what: str) -> str:
+    """The refusal of a bearing whose rollers, as assembled, ``what`` (the check before the run and the
+    first step's overlap say the same)."""
+    g = p.bearing
+    return (f"bearing.pocket_clearance_mm = {g.pocket_clearance * 1e3:.4g} is too small for this bearing's radial "
+            f"play (bearing.radial_clearance_mm = {g.radial_clearance * 1e3:.4g}): the rollers as assembled (on "
+            f"the outer race, cage centred) {what}, more than {PENETRATION_LIMIT:.0%} of the pocket clearance, "
+            f"which no shorter step removes")
+
+
 class MultibodySetup(NamedTuple):
     """What one run fixes before its first step, computed once from the parameters by :func:`make_setup`
     (SI). The step loop's named inputs (``prm``, ``cfg``, ``land``, ``limits``, ``hold_rule``) are built
@@ -543,19 +609,17 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         check_rigid(p)
     h, dt_how, dt_lim, t_start, h_start = _steps(p, dt, is_rigid)
     s = geo.pocket_clearance
-    rr = geo.roller_radius
     rp = geo.pitch_radius
     K = laws.palmgren_stiffness(geo.roller_length)
     # the reduced-equivalent scene keeps the paper's roller path on the pitch circle (no clearance)
     pd = 0.0 if reduced_eq else geo.radial_clearance
-    ro_race = geo.outer_race_radius + 0.25 * pd
     # rigid raceways: roller centres on the outer race, at most r_c from the axis (a unilateral joint);
     # the inner-race contact carries both contacts' compliance in series, Q = K 2^(-10/9) delta^(10/9)
     r_c = rigid_radius(p)
     K_race = K * 2.0 ** (-10.0 / 9.0) if is_rigid else K
     # rollers start on the outer race (centrifugal), moving with the cage
-    n_centrifugal = geo.roller_mass * rp * op.omega_c**2 + 1e-3
-    r0 = r_c if is_rigid else ro_race - rr - (n_centrifugal / K) ** 0.9
+    n_centrifugal = centrifugal_load(p)
+    r0 = roller_start_radius(p)
     ring_mass, ring_how = inner_ring_model(p)
     prm = _raceway_params(p, reduced_eq, is_rigid, pd, r_c, K_race, ring_mass)
     nrot = p.numerics.rotations

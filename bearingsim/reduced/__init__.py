@@ -230,9 +230,9 @@ def _step(p, inp: PassInputs, dt: float | None) -> tuple[float | None, str]:
     return default_dt(inp), "automatic: 1/1000 of the largest allowed step (euler.max_stable_dt)"
 
 
-def check_step(p, dt: float | None = None) -> None:
-    """Refuse, without running, the time step :func:`simulate` would refuse (one line naming the key;
-    :func:`bearingsim.reduced.euler.check_step`); the event method takes none."""
+def check_start(p, dt: float | None = None) -> None:
+    """Refuse, without running, what :func:`simulate` would refuse before its first step: the time step
+    (one line naming the key; :func:`bearingsim.reduced.euler.check_step`); the event method takes none."""
     if p.reduced.method == "euler":
         inp = PassInputs.from_parameters(p)
         step, how = _step(p, inp, dt)

@@ -135,6 +135,9 @@ def check(result) -> list[str]:
             raise SimulationUnstable(
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
                 f"for this load and clearance; {_advice(result)}")
+        note = _unloaded_ring_note(result)
+        if note is not None:
+            notes.append(note)
         orbit = result.get("cage_orbit")
         samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
         if samples < MIN_ORBIT_SAMPLES:
@@ -152,6 +155,20 @@ def check(result) -> list[str]:
                     "multibody.inner_ring=dynamic")
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def _unloaded_ring_note(result) -> str | None:
+    """Without radial load nothing acts on the inner ring (the load W is the only force on it, quasi-static
+    or dynamic): any place in the radial clearance where no roller touches it balances, so the displacement
+    the run reports is where it was started and drifted to, not a result."""
+    p = result.parameters
+    if p.operating.radial_load > 0.0 or str(result.provenance.get("inner_ring", "none")).startswith("none"):
+        return None
+    disp = abs(float(result.summary.get("inner_ring_displacement_m", 0.0)))
+    return (f"bearingsim: note: operating.radial_load_N = 0: no force places the inner ring within the radial "
+            f"clearance, so inner_ring_displacement_m = {disp:.3g} m is where the run started it (P_d/2 = "
+            f"{0.5 * p.bearing.radial_clearance:.3g} m) and let it drift, not a result; a radial load as small as "
+            "the rotor's weight places it")
 
 
 def checks_made(result) -> list[tuple[str, str, bool]]:

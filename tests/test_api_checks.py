@@ -136,6 +136,31 @@ def test_a_first_rotation_still_in_the_start_transient_gets_a_note():
     assert abs(rel) < plausibility.START_TRANSIENT_MIN_REL and sds < plausibility.START_TRANSIENT_SD
 
 
+@pytest.mark.slow
+def test_without_radial_load_the_inner_ring_displacement_is_noted_as_no_result():
+    """The radial load W is the only force on the inner ring (forces.py: quasi-static, sum Q N = (0, -W);
+    dynamic, M a = sum Q N + (0, -W)), so at W = 0 every place in the radial clearance where no roller
+    touches the ring balances: the reported displacement is where the run started the ring (P_d/2 = 40 um)
+    and let it drift, which the two ring models do differently (1 rotation: 39.2 and 28.8 um, more than
+    5 um apart). Each gets one note naming the load and its displacement; a loaded ring and the
+    reduced-equivalent scene (no ring) get none."""
+    from bearingsim.scenario import load_scenario
+
+    def run(*extra):
+        r = bearingsim.run(load_scenario(MULTIBODY, ["numerics.rotations=1", *extra]))
+        return r, [n for n in r.notes if "operating.radial_load_N = 0" in n]
+
+    dynamic = ("multibody.inner_ring=dynamic", "multibody.inner_ring_mass_kg=5")
+    quasi, q_notes = run("operating.radial_load_N=0")
+    dyn, d_notes = run("operating.radial_load_N=0", *dynamic)
+    for r, notes in ((quasi, q_notes), (dyn, d_notes)):
+        disp = r.summary["inner_ring_displacement_m"]
+        assert len(notes) == 1 and f"inner_ring_displacement_m = {disp:.3g} m" in notes[0], notes
+    assert abs(quasi.summary["inner_ring_displacement_m"] - dyn.summary["inner_ring_displacement_m"]) > 5e-6
+    assert run("operating.radial_load_N=0", "multibody.scene=reduced_equivalent")[1] == []
+    assert run("operating.radial_load_N=970", *dynamic)[1] == []
+
+
 def test_a_key_set_outside_its_plausible_range_gets_a_note_in_the_run_and_the_dry_run(tmp_path):
     """The preset's plausible ranges ([ranges], what the sensitivity studies sample) describe its bearing: a
     run with a key its model uses set outside them (s = 3 mm against 0.16 to 0.24 mm) is valid and gets a

@@ -143,7 +143,10 @@ class Result:
         return render_result(self, out, **kw)
 
     def save(self, path) -> Path:
-        """Write this result as an archive at ``path`` (atomically); return the path."""
+        """Write this result as an archive at ``path`` (``.h5`` or ``.hdf5``; atomically: a temporary file
+        renamed when complete) and return the path. Missing folders are created; a bearingsim archive at
+        ``path`` is replaced, any other file there is refused (:class:`bearingsim.UserError`, nothing
+        written)."""
         from bearingsim import archive
 
         return archive.write(self, path)

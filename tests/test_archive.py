@@ -107,6 +107,25 @@ def test_foreign_truncated_and_incomplete_files_are_refused(tmp_path, base_reduc
         open_archive(tmp_path / "missing.h5")
 
 
+def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(tmp_path, base_reduced):
+    """Result.save as its docstring says: missing folders are made; a bearingsim archive at the path is
+    replaced (by this result's); a file that is not one is refused with one line and left as it was."""
+    import bearingsim
+
+    r = bearingsim.run(resolve(base_reduced))
+    path = tmp_path / "a" / "b" / "r.h5"
+    assert r.save(path) == path and bearingsim.load(path).summary == r.summary
+    other = bearingsim.run(resolve({**base_reduced, "name": "other"}))
+    other.save(path)
+    assert bearingsim.load(path).scenario.name == "other"
+    mine = tmp_path / "mine.h5"
+    mine.write_text("my notes\n")
+    with pytest.raises(UserError, match="exists and is not a bearingsim archive; not replaced"):
+        r.save(mine)
+    assert mine.read_text() == "my notes\n"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["a", "b", "mine.h5", "r.h5"]
+
+
 @pytest.mark.slow
 def test_read_gives_back_the_written_result(tmp_path, base_reduced):
     """write(result) then read(path): same class, scenario, summary, arrays, units and time series."""

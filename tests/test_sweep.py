@@ -774,6 +774,23 @@ def test_a_range_with_a_key_missing_or_misspelt_names_its_axis(tmp_path, table, 
                               f"three keys (got {got})")
 
 
+def test_a_range_of_one_value_between_two_ends_is_refused_and_one_at_one_end_runs(tmp_path):
+    """"both ends included" cannot hold for num = 1 with start != stop: it gave the start alone, dropping
+    the stop without a word (1000:6000:1 ran 1000 rpm only). It is refused, in a sweep file and on the
+    command line, naming both ends; start = stop with num = 1 is the one value."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.spec import parse_param
+
+    with pytest.raises(UserError, match=r"num = 1 is one value, and start 1000 and stop 6000 differ"):
+        parse_param("operating.inner_ring_speed_rpm=1000:6000:1")
+    assert parse_param("operating.inner_ring_speed_rpm=1000:1000:1") == ("operating.inner_ring_speed_rpm", [1000.0])
+    assert parse_param("operating.inner_ring_speed_rpm=1000:6000:2")[1] == [1000.0, 6000.0]
+    f = tmp_path / "s.toml"
+    f.write_text(f'scenario = "{BASE}"\n[axes]\n"bearing.pocket_clearance_mm" = {{ start = 0.1, stop = 0.3, num = 1 }}\n')
+    with pytest.raises(UserError, match=r"bearing.pocket_clearance_mm: num = 1 is one value, and start 0.1 and stop 0.3"):
+        load_sweep_file(f)
+
+
 def test_a_sweep_files_base_scenario_is_named_without_a_detour(monkeypatch):
     """A sweep file names its base scenario relative to itself ("../paper_3000rpm.toml"); the sweep's index
     showed it as "scenarios/sweeps/../paper_3000rpm.toml". It is the same file, named the short way."""

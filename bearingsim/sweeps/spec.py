@@ -219,6 +219,9 @@ class _Range:
         if num > MAX_SWEEP_CASES:
             raise UserError(f"{where}: num = {num} is more than the {MAX_SWEEP_CASES} cases a sweep may have; "
                             "split it into several sweeps")
+        if num == 1 and float(start) != float(stop):  # one value cannot include both ends
+            raise UserError(f"{where}: num = 1 is one value, and start {start:g} and stop {stop:g} differ: both ends "
+                            "are included from num = 2 (one value: start = stop, or a list)")
         return [float(x) for x in np.linspace(float(start), float(stop), num)]
 
 

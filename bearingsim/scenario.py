@@ -735,13 +735,17 @@ def unused_note(model: str, keys, method: str | None = None) -> str | None:
 
 #: the keys only a land-guided cage reads (the cage's rim running on a ring land)
 LAND_KEYS = ("bearing.cage_land_clearance_mm", "contact.land_friction")
+#: the keys the reduced model reads only to find its load zone (``reduced.load_zone_half_angle_deg = "auto"``,
+#: the quasi-static load distribution): with the half angle given its single pocket's pass reads none of them
+LOAD_ZONE_KEYS = ("operating.radial_load_N", "bearing.roller_count", "bearing.roller_length_mm",
+                  "bearing.radial_clearance_mm")
 
 
 def _unread_by_setting(scenario, key: str) -> str | None:
     """Why a key the model uses is not read with this scenario's settings, or None."""
     if key in LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
         return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
-    if (key == "bearing.radial_clearance_mm" and scenario.model == "reduced"
+    if (key in LOAD_ZONE_KEYS and scenario.model == "reduced"
             and scenario.reduced.load_zone_half_angle_deg != "auto"):
         return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
                 "load zone only when 'auto')")
@@ -751,20 +755,28 @@ def _unread_by_setting(scenario, key: str) -> str | None:
 def unread_because(scenario, key: str) -> str | None:
     """Why the resolved scenario's run does not read ``key`` (a run with another value of it gives the same
     numbers), or None: a key its model does not use (:data:`UNUSED_BY_MODEL`), a land key with a
-    roller-guided cage, the reduced model's radial clearance when its load zone is given."""
+    roller-guided cage, the reduced model's load, roller count, roller length and radial clearance when its
+    load zone is given (:data:`LOAD_ZONE_KEYS`)."""
     if unused_keys(scenario.model, [key]):
         return f"not used by the {scenario.model} model"
     return _unread_by_setting(scenario, key)
 
 
-def unread_note(scenario, keys) -> str | None:
+#: the settings that decide whether a key the model uses is read (:func:`_unread_by_setting`)
+UNREAD_SETTINGS = ("bearing.cage_guidance", "reduced.load_zone_half_angle_deg")
+
+
+def unread_note(scenario, keys, method: str | None = "", settings: bool = True) -> str | None:
     """One line saying which of ``keys`` the resolved scenario's run does not read: :func:`unused_note` of
     its model and method, and the keys its settings leave unread (:func:`unread_because`); None if it
-    reads them all."""
-    note = unused_note(scenario.model, keys, scenario.reduced.method)
-    unused = unused_keys(scenario.model, keys, scenario.reduced.method)
+    reads them all. ``method``: the reduced model's method to judge by (default: the scenario's; None: none,
+    as for a sweep that varies it); ``settings=False`` leaves out the keys unread by a setting (a sweep
+    that varies one of :data:`UNREAD_SETTINGS`)."""
+    method = scenario.reduced.method if method == "" else method
+    note = unused_note(scenario.model, keys, method)
+    unused = unused_keys(scenario.model, keys, method)
     by_setting: dict[str, list[str]] = {}
-    for k in dict.fromkeys(keys):
+    for k in dict.fromkeys(keys) if settings else ():
         why = None if k in unused else _unread_by_setting(scenario, k)
         if why is not None:
             by_setting.setdefault(why, []).append(k)
@@ -796,8 +808,13 @@ def out_of_range_note(scenario) -> str | None:
 
 def given_keys(path, overrides=()) -> list[str]:
     """Every dotted key a scenario file and its ``KEY=VALUE`` overrides set (not its preset's or the
-    defaults': those are the model's own)."""
-    return list(flatten(read_toml_file(path))) + [parse_override(o)[0] for o in overrides]
+    defaults': those are the model's own), the keys whose effect a run notes. A file that gives the reduced
+    model's load zone itself states the load it is of beside it (the paper scenarios: 970 N, 23.5°), so its
+    own :data:`LOAD_ZONE_KEYS` are left out; an override of them is kept."""
+    in_file = flatten(read_toml_file(path))
+    if in_file.get("reduced.load_zone_half_angle_deg", "auto") != "auto":
+        in_file = {k: v for k, v in in_file.items() if k not in LOAD_ZONE_KEYS}
+    return list(in_file) + [parse_override(o)[0] for o in overrides]
 
 
 # compact wording of the differences most often made (others: ``key = value`` by the key's last part)

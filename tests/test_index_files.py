@@ -112,6 +112,23 @@ def test_keys_the_reduced_model_does_not_use_are_noted(tmp_path):
     assert res.returncode == 0 and "note" not in res.stderr, res.stderr
 
 
+@pytest.mark.slow
+def test_a_sweep_of_a_key_its_settings_leave_unread_is_noted(tmp_path):
+    """A sweep of the load on a paper scenario (load zone given) gives the same case three times: noted, as
+    `run` notes it (the sweep printed nothing). Sweeping the load zone's setting too, some cases read the
+    load: no note."""
+    base = SCENARIOS / "paper_3000rpm.toml"
+    res = bearingsim("sweep", base, "--param", "operating.radial_load_N=500,2000", "--no-plots", "-o", tmp_path / "s",
+                     "-j", "1")
+    assert res.returncode == 0, res.stderr
+    assert [line for line in res.stderr.splitlines() if "note" in line] == [
+        "bearingsim: note: operating.radial_load_N: not used by the reduced model when "
+        "reduced.load_zone_half_angle_deg is given (it sets the load zone only when 'auto'); no effect on the run"]
+    res = bearingsim("sweep", base, "--param", "operating.radial_load_N=500,2000", "--param",
+                     "reduced.load_zone_half_angle_deg=auto,23.5", "--no-plots", "-o", tmp_path / "t", "-j", "1")
+    assert res.returncode == 0 and "note" not in res.stderr, res.stderr
+
+
 def test_unused_keys_per_model():
     from bearingsim.scenario import unused_keys
 

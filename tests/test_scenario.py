@@ -296,6 +296,25 @@ def test_a_key_the_settings_leave_unread_is_noted_as_unused_not_as_out_of_range(
     assert unread_note(auto, ["bearing.radial_clearance_mm"]) is None
 
 
+def test_the_reduced_models_load_zone_inputs_are_noted_unread_when_its_load_zone_is_given():
+    """With reduced.load_zone_half_angle_deg given (the paper scenarios: 23.5), the load, the roller count and
+    length and the radial clearance only found the load zone, so a what-if of any of them gives the paper's
+    numbers unchanged: each is noted as unread (the load and roller count were not: a 2000 N run printed
+    nothing and the same I_dec). With "auto" they set the load zone: no note."""
+    from bearingsim.scenario import unread_note
+
+    keys = ["operating.radial_load_N", "bearing.roller_count", "bearing.roller_length_mm", "bearing.radial_clearance_mm"]
+    given = load_scenario(SCENARIOS / "paper_3000rpm.toml", ["operating.radial_load_N=2000", "bearing.roller_count=12"])
+    assert unread_note(given, keys) == (
+        "operating.radial_load_N, bearing.roller_count, bearing.roller_length_mm, bearing.radial_clearance_mm: not used "
+        "by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the load zone only when 'auto'); "
+        "no effect on the run")
+    auto = given.replace(**{"reduced.load_zone_half_angle_deg": "auto"})
+    assert unread_note(auto, keys) is None
+    multibody = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["operating.radial_load_N=2000"])
+    assert unread_note(multibody, keys) is None
+
+
 def test_a_cage_mass_without_its_inertia_is_refused_with_the_inertia_a_ring_of_it_has():
     """Another cage material is another mass; its inertia must follow (a ring between its radii). The
     refusal names the inertia key and gives what a uniform ring of the new mass has, m (r_in^2 + r_out^2) / 2,

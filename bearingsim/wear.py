@@ -170,9 +170,9 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
         ax.fill_between(rep.psi_deg, d.min(axis=1), d.max(axis=1), step="mid", color=c, alpha=0.25,
                         label="least to most worn pocket")
         ax.step(rep.psi_deg, d.mean(axis=1), where="mid", color=c, lw=1.5, label="mean over pockets")
-        ax.set_xlabel("ψ on the face: bore end ← 0 (middle) → rim end [deg]")
+        ax.set_xlabel("ψ: bore end ← 0 (middle) → rim end [deg]")
         ax.set_title(f"{f} face", fontsize=9)
-        ax.set_ylim(bottom=0.0)
+    axes[0].set_ylim(bottom=0.0)  # shared: after both faces are drawn, so the deeper face's ends stay on the figure
     axes[0].set_ylabel("worn depth [µm]")
     legend_outside(axes[1])
     fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "

@@ -697,6 +697,8 @@ UNUSED_BY_MODEL = {
                 "bearing.cage_land_clearance_mm", "bearing.cage_outer_diameter_mm", "bearing.cage_inner_diameter_mm",
                 "contact.cage_friction", "contact.land_friction", "numerics.warmup_rotations",
                 "numerics.output_rate_hz", "output."),
+    # the multibody model reads of [reduced] only the load zone, and only in its reduced-equivalent scene
+    "multibody": ("reduced.method", "reduced.resting_contact"),
 }
 # keys the reduced model's method reads nothing of: the event method is event-driven (no time step)
 UNUSED_BY_METHOD = {"event": ("numerics.dt_s",)}
@@ -749,6 +751,10 @@ def _unread_by_setting(scenario, key: str) -> str | None:
             and scenario.reduced.load_zone_half_angle_deg != "auto"):
         return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
                 "load zone only when 'auto')")
+    if (key == "reduced.load_zone_half_angle_deg" and scenario.model == "multibody"
+            and scenario.multibody.scene != "reduced_equivalent"):
+        return (f"not used by the multibody model's {scenario.multibody.scene!r} scene (its load zone comes out of "
+                f"the raceway contacts; only multibody.scene = 'reduced_equivalent' reads it)")
     return None
 
 
@@ -756,14 +762,14 @@ def unread_because(scenario, key: str) -> str | None:
     """Why the resolved scenario's run does not read ``key`` (a run with another value of it gives the same
     numbers), or None: a key its model does not use (:data:`UNUSED_BY_MODEL`), a land key with a
     roller-guided cage, the reduced model's load, roller count, roller length and radial clearance when its
-    load zone is given (:data:`LOAD_ZONE_KEYS`)."""
+    load zone is given (:data:`LOAD_ZONE_KEYS`), the load zone in a multibody scene that makes its own."""
     if unused_keys(scenario.model, [key]):
         return f"not used by the {scenario.model} model"
     return _unread_by_setting(scenario, key)
 
 
 #: the settings that decide whether a key the model uses is read (:func:`_unread_by_setting`)
-UNREAD_SETTINGS = ("bearing.cage_guidance", "reduced.load_zone_half_angle_deg")
+UNREAD_SETTINGS = ("bearing.cage_guidance", "reduced.load_zone_half_angle_deg", "multibody.scene")
 
 
 def unread_note(scenario, keys, method: str | None = "", settings: bool = True) -> str | None:

@@ -315,6 +315,24 @@ def test_the_reduced_models_load_zone_inputs_are_noted_unread_when_its_load_zone
     assert unread_note(multibody, keys) is None
 
 
+def test_the_reduced_keys_a_multibody_run_does_not_read_are_noted():
+    """The multibody model reads nothing of reduced.method and reduced.resting_contact, and the load zone's
+    half angle only in its reduced-equivalent scene (the others' load zone comes out of the raceway
+    contacts): `--set reduced.load_zone_half_angle_deg=40` on the whole bearing gave the same numbers and
+    no note. Each is noted now; the reduced-equivalent scene's load zone is not."""
+    from bearingsim.scenario import unread_because, unread_note
+
+    full = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["reduced.load_zone_half_angle_deg=40"])
+    assert unread_because(full, "reduced.method") == "not used by the multibody model"
+    assert unread_because(full, "reduced.resting_contact") == "not used by the multibody model"
+    note = unread_note(full, ["reduced.load_zone_half_angle_deg", "bearing.pocket_clearance_mm"])
+    assert note == ("reduced.load_zone_half_angle_deg: not used by the multibody model's 'full' scene (its load zone "
+                    "comes out of the raceway contacts; only multibody.scene = 'reduced_equivalent' reads it); no "
+                    "effect on the run")
+    equivalent = load_scenario(SCENARIOS / "multibody_reduced_equivalent_3000rpm.toml")
+    assert unread_note(equivalent, ["reduced.load_zone_half_angle_deg"]) is None
+
+
 def test_a_cage_mass_without_its_inertia_is_refused_with_the_inertia_a_ring_of_it_has():
     """Another cage material is another mass; its inertia must follow (a ring between its radii). The
     refusal names the inertia key and gives what a uniform ring of the new mass has, m (r_in^2 + r_out^2) / 2,

@@ -907,6 +907,27 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
     return out
 
 
+def sweep_context(scenario: "Scenario", swept) -> str:
+    """What a sweep's cases share, for its figures' titles: ``multibody_6000rpm: multibody, full scene,
+    6000 rpm forward, 970 N, 1 warm-up + 3 rotations; raceway rigid``. The speed, direction and load are
+    named unless ``swept`` (the varied keys) holds them; the base's differences from its preset
+    (:func:`differences_from_preset`) leave the swept keys out."""
+    op, swept = scenario.operating, set(swept)
+    what = (f"multibody, {scenario.multibody.scene} scene" if scenario.model == "multibody"
+            else f"reduced model ({scenario.reduced.method})")
+    point = " ".join(x for k, x in (("operating.inner_ring_speed_rpm", f"{op.inner_ring_speed_rpm:g} rpm"),
+                                    ("operating.direction", op.direction)) if k not in swept)
+    parts = [what] + ([point] if point else []) + (
+        [f"{op.radial_load_N:g} N"] if "operating.radial_load_N" not in swept else [])
+    n = scenario.numerics
+    if scenario.model == "multibody":
+        parts.append(f"{n.warmup_rotations} warm-up + {n.rotations} rotations")
+    flat = flatten(scenario.raw)
+    skip = {_title_value(k, flat[k]) for k in swept if k in flat}
+    diffs = [d for d in differences_from_preset(scenario) if d not in skip]
+    return f"{scenario.name}: {', '.join(parts)}" + (f"; {', '.join(diffs)}" if diffs else "")
+
+
 # The tags pydantic appends to an error's location for the branch of a union it tried (``float |
 # Literal["auto"]`` reports ('reduced', 'load_zone_half_angle_deg', 'float') and (..., "literal['auto']")):
 # not keys of the scenario.

@@ -9,6 +9,7 @@ import pytest
 from bearingsim.sweeps.index import write_index
 from bearingsim.sweeps.plot import plot_sweep_index
 
+from .conftest import SCENARIOS
 from .test_cli import assert_user_error, bearingsim
 
 SPEED = "operating.inner_ring_speed_rpm"
@@ -122,6 +123,25 @@ def test_title_names_the_swept_keys_not_the_base_scenario(tmp_path, figures):
     plot_sweep_index(_index(tmp_path, points, [SPEED, CLEAR]), tmp_path / "f")
     title = figures["sweep_map.png"]["title"]
     assert "inner ring speed × pocket clearance" in title and "4 cases" in title and "paper_3000rpm" not in title
+
+
+def test_title_says_what_the_cases_share(tmp_path, figures):
+    """A sweep's figure named the swept keys only: the speed, load, model and what the base scenario and
+    --set changed (here the paper scenario at 6000 rpm, pockets of 0.3 mm) were on no figure, so it could
+    not go into a report. The second title line says them, leaving out the swept key's base value (the
+    paper scenario's load zone, 23.5°)."""
+    from bearingsim.scenario import load_scenario, sweep_context
+
+    res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "reduced.load_zone_half_angle_deg=20,30",
+                     "--set", "operating.inner_ring_speed_rpm=6000", "--set", "bearing.pocket_clearance_mm=0.3",
+                     "--no-plots", "-q", "-o", tmp_path / "s", "-j", "1")
+    assert res.returncode == 0, res.stderr
+    plot_sweep_index(tmp_path / "s" / "sweep.h5", tmp_path / "f")
+    context = figures["sweep_I.png"]["title"].split("\n")[1]
+    assert context == "paper_3000rpm: reduced model (event), 6000 rpm forward, 970 N; s = 0.3 mm"
+    speed = sweep_context(load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["multibody.raceway_contact=rigid"]),
+                          ["operating.inner_ring_speed_rpm"])
+    assert speed == "multibody_3000rpm: multibody, full scene, forward, 970 N, 1 warm-up + 4 rotations; raceway rigid"
 
 
 @pytest.mark.slow

@@ -75,7 +75,8 @@ def sweep_title(meta: dict, n_cases: int) -> str:
     if extra:
         names = (names + "; " if names else "") + "cases over " + ", ".join(name_of(k) for k in extra)
     zipped = " (zipped)" if meta.get("mode") == "zip" and len(grid) > 1 else ""
-    return f"sweep of {names or 'cases'}{zipped} ({counted(n_cases, 'case')})"
+    context = f"\n{meta['context']}" if meta.get("context") else ""  # what the cases share (older indexes: none)
+    return f"sweep of {names or 'cases'}{zipped} ({counted(n_cases, 'case')}){context}"
 
 
 def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,

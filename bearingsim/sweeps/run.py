@@ -476,8 +476,11 @@ def _resolve(spec, engine, archives: str, grid) -> tuple[list[Case], list[str], 
     if warm_up is not None:  # a local pool's workers load the model while the cases are resolved
         warm_up(spec, archives)
     cases = resolve_cases(spec)
+    from bearingsim.scenario import load_scenario, sweep_context
+
     meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
-            "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra)}
+            "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra),
+            "context": sweep_context(load_scenario(spec.scenario, spec.sets), spec.keys)}
     return cases, spec.keys, meta, (_map_attrs(spec) if grid else {})
 
 

@@ -157,7 +157,7 @@ def test_ranges_are_stored_in_the_archive_and_shown(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("args, words", [
-    (["--keys", "bearing.roller_length_mm"], "--keys bearing.roller_length_mm: no range"),  # continuous, unranged
+    (["--keys", "bearing.roller_mass_kg"], "--keys bearing.roller_mass_kg: no range"),  # continuous, unranged, read
     (["--step", "0"], "--step '0'"),
     (["--step", "150%"], "--step '150%'"),
 ])

@@ -258,7 +258,7 @@ def _study_table_drawer(path):
 def _cmd_rerun(args) -> int:
     from bearingsim.archive import package_versions
     from bearingsim.simulation import load as read
-    from bearingsim.compare import compare_results
+    from bearingsim.compare import compare_results, compared_arrays, other_numbers
     from bearingsim.simulation import COMPARED, run, run_scenario
 
     old = read(args.archive, only=COMPARED)
@@ -278,7 +278,7 @@ def _cmd_rerun(args) -> int:
         print(f"wrote {args.output}")
     if c.identical:
         print(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
-              f"{len(old.per_rotation)} per-rotation arrays)")
+              f"{len(compared_arrays(old))} arrays, {len(other_numbers(old))} other numbers)")
         return 0
     print(f"{args.archive}: rerun differs")
     print(c.summary_table())

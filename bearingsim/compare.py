@@ -1,4 +1,5 @@
-"""Comparing two results: scenario keys, summary numbers and per-rotation arrays, bit for bit.
+"""Comparing two results: scenario keys, summary numbers, the results' other stored numbers (attribute groups:
+the reduced model's wear rates, pass and operating point) and their per-rotation and wear arrays, bit for bit.
 
 Used by ``bearingsim compare A.h5 B.h5`` and ``bearingsim rerun ARCHIVE``.
 """
@@ -25,7 +26,7 @@ class Comparison:
 
     @property
     def identical(self) -> bool:
-        """True when every summary number and per-rotation array is bit-identical."""
+        """True when every summary number, other stored number and compared array is bit-identical."""
         return not self.summary_differs and not self.arrays_differ
 
     def summary_table(self) -> str:
@@ -61,14 +62,36 @@ def compare_results(a, b) -> Comparison:
             c.absent[k] = "A" if k not in sa else "B"
         if k not in sa or k not in sb or not same_value(va, vb):
             c.summary_differs.append(k)
-    pa, pb = a.per_rotation, b.per_rotation
+    pa, pb = compared_arrays(a), compared_arrays(b)
     for k in list(pa) + [k for k in pb if k not in pa]:
         x, y = pa.get(k), pb.get(k)
         if x is None or y is None or x.shape != y.shape or not np.array_equal(x, y, equal_nan=x.dtype.kind == "f"):
-            c.arrays_differ.append(f"per_rotation/{k}")
+            c.arrays_differ.append(k)
+    ga, gb = other_numbers(a), other_numbers(b)
+    for k in list(ga) + [k for k in gb if k not in ga]:
+        if k not in ga or k not in gb or not same_value(ga[k], gb[k]):
+            c.arrays_differ.append(k)
     va = {k: v for k, v in a.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
     vb = {k: v for k, v in b.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
     for k in sorted(set(va) | set(vb)):
         if va.get(k) != vb.get(k):
             c.versions.append((k, va.get(k, "?"), vb.get(k, "?")))
     return c
+
+
+def compared_arrays(result) -> dict[str, np.ndarray]:
+    """The arrays compared bit for bit (:data:`bearingsim.simulation.COMPARED`: per rotation and wear), by
+    their name under ``results/``."""
+    from bearingsim.simulation import COMPARED
+
+    under = tuple(f"{p}/" for p in COMPARED)
+    return {k.removeprefix("results/"): np.asarray(v.data) for k, v in result.data.items() if k.startswith(under)}
+
+
+def other_numbers(result) -> dict[str, object]:
+    """Every stored number of the result's attribute groups but the summary (compared on its own), by
+    ``group/name`` under ``results/``: the reduced model's wear rates, its pass and operating point."""
+    from bearingsim.results import SUMMARY
+
+    return {f"{g.removeprefix('results/')}/{k}": v for g, group in result.groups.items() if g != SUMMARY
+            for k, v in group.attrs.items()}

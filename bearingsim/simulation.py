@@ -66,9 +66,11 @@ def animate(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None
 
 
 #: what each archive command reads besides the scenario, the summary and the provenance
-#: (``show`` prints the scenario; ``compare`` and ``rerun`` compare summaries and per-rotation arrays)
+#: (``show`` prints the scenario; ``compare`` and ``rerun`` compare the attribute groups, the summary among
+#: them, and these datasets: per-rotation arrays and wear, the results an archive's readers take; not the
+#: time series or the figures' tables, which the compared numbers come from)
 SCENARIO_ONLY: tuple[str, ...] = ()
-COMPARED = ("results/per_rotation",)
+COMPARED = ("results/per_rotation", "results/wear")
 
 
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):

@@ -116,6 +116,38 @@ def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
 
 
 @pytest.mark.slow
+def test_compare_and_rerun_see_a_stored_number_outside_the_summary(tmp_path, reduced_archive):
+    """"results: identical" covers every stored result, not only the summary and the per-rotation arrays:
+    the reduced model's wear rates (/results/wear), pass and operating point are attribute groups, and a
+    multibody archive's wear profiles are arrays. Two runs of other wear keys, whose summaries and impulses
+    are the same, said "results: identical" (exit 0); a tampered wear rate, or wear profile, gave a clean
+    rerun."""
+    wear = tmp_path / "wear.h5"
+    assert cli("run", SCENARIOS / "paper_1000rpm.toml", "--set", "wear.wear_coefficient=1e-4", "-o", wear, "-q",
+               "--no-plots").returncode == 0
+    res = cli("compare", reduced_archive, wear)
+    assert res.returncode == 1 and "results: differ" in res.stdout, res.stdout
+    assert "differs: wear/rear_per_hour_m3_h" in res.stdout and "differs: per_rotation" not in res.stdout
+    assert "  *" not in res.stdout.split("results:")[0]  # the summary itself is bit-identical
+    tampered = tmp_path / "t.h5"
+    shutil.copy(reduced_archive, tampered)
+    with h5py.File(tampered, "r+") as f:
+        _edit_json_attr(f["results/wear"], "rear_per_hour_m3_h", lambda v: v * (1.0 + 1e-12))
+    res = cli("rerun", tampered)
+    assert res.returncode == 1 and "differs: wear/rear_per_hour_m3_h" in res.stdout, res.stdout
+
+
+@pytest.mark.slow
+def test_rerun_sees_a_changed_wear_profile_of_a_multibody_archive(tmp_path, multibody_archive):
+    tampered = tmp_path / "t.h5"
+    shutil.copy(multibody_archive, tampered)
+    with h5py.File(tampered, "r+") as f:
+        f["results/wear/profile_work_rear"][0, 0] += 1e-9
+    res = cli("rerun", tampered)
+    assert res.returncode == 1 and "differs: wear/profile_work_rear" in res.stdout, res.stdout
+
+
+@pytest.mark.slow
 def test_show_gives_a_runnable_scenario_with_the_same_results(tmp_path, reduced_archive):
     res = cli("show", reduced_archive)
     assert res.returncode == 0

@@ -123,7 +123,8 @@ def archive_with_unread_data(tmp_path_factory):
 def test_archive_commands_read_only_the_datasets_they_need(archive_with_unread_data, tmp_path, monkeypatch,
                                                            capsys, command, reads):
     """Every dataset a command reads is recorded (``h5py.Dataset.__getitem__``): ``show`` reads the
-    scenario alone, ``compare`` and ``rerun`` the per-rotation arrays, ``plot`` what its figure draws; none
+    scenario alone, ``compare`` and ``rerun`` the per-rotation and wear arrays (a reduced archive has none of the
+    latter), ``plot`` what its figure draws; none
     decompresses the time series, the impact table or an array it does not use."""
     import h5py
 

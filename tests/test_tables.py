@@ -259,7 +259,7 @@ def test_compare_shows_a_number_only_one_model_has_as_absent_not_nan():
     from bearingsim.compare import compare_results
 
     def result(model, summary):
-        return SimpleNamespace(scenario=SimpleNamespace(raw={"model": model}), summary=summary, per_rotation={},
+        return SimpleNamespace(scenario=SimpleNamespace(raw={"model": model}), summary=summary, data={}, groups={},
                                provenance={})
 
     c = compare_results(result("reduced", {"I_dec_mean_Ns": 0.005}),
@@ -277,7 +277,7 @@ def test_compare_of_two_says_what_its_mark_means():
 
     def result(summary):
         return SimpleNamespace(scenario=SimpleNamespace(raw={"model": "multibody"}), summary=summary,
-                               per_rotation={}, provenance={})
+                               data={}, groups={}, provenance={})
 
     c = compare_results(result({"cage_orbit_max_m": 1.0e-4, "I_dec_mean_Ns": 0.015}),
                         result({"cage_orbit_max_m": 0.9993e-4, "I_dec_mean_Ns": 0.015}))

@@ -1053,6 +1053,27 @@ def scenario_file_error(path) -> UserError | None:
                      f"archive, 'bearingsim show {path}' prints it resolved")
 
 
+#: what each of bearingsim's own files that is not a run archive is, by its root ``format`` attribute less
+#: its version (the sweep index and map, the studies' tables)
+OWN_FILES = {"bearingsim sweep index": "a sweep's index", "bearingsim sweep map": "a sweep's map",
+             "bearingsim crosscheck index": "a cross-check's table",
+             "bearingsim sensitivity index": "a sensitivity study's table",
+             "bearingsim uncertainty index": "an uncertainty study's table", "bearingsim life": "a life study's table"}
+
+
+def _own_file_error(p: Path, fmt) -> UserError | None:
+    """The one-line refusal of one of bearingsim's own files that is not a run archive (a sweep's
+    ``sweep.h5`` or ``map.h5``, a study's table: root attribute ``format``) given where a run's archive
+    is read, naming the commands that read it; None for any other file."""
+    fmt = _plain(fmt) if fmt is not None else None
+    if not isinstance(fmt, str) or not fmt.startswith("bearingsim "):
+        return None
+    kind = fmt.rstrip("0123456789. ")
+    what = OWN_FILES.get(kind, f"a {kind} file")
+    return UserError(f"{p}: {what} written by bearingsim, not a run archive; 'bearingsim inspect {p}' says what "
+                     f"it holds, 'bearingsim table {p.parent}' prints its folder's table")
+
+
 def open_archive(path: str | Path):
     """Open a complete bearingsim archive read-only, or raise a one-line :class:`UserError`."""
     h5py = _lazy_h5py()
@@ -1075,7 +1096,8 @@ def open_archive(path: str | Path):
     try:
         g = f.get("bearingsim")
         if g is None or "format_version" not in g.attrs:
-            raise UserError(f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
+            raise _own_file_error(p, f.attrs.get("format")) or UserError(
+                f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
         complete = _plain(g.attrs.get("complete", False))
         if not isinstance(complete, bool):
             raise _damaged(p, f"/bearingsim@complete is {outputs.printable(repr(complete))[:40]}, not a boolean")

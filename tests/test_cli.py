@@ -250,6 +250,25 @@ def test_a_scenario_file_given_for_an_archive_names_the_commands_that_read_it(tm
 
 
 @pytest.mark.slow
+def test_a_sweep_file_given_for_an_archive_says_what_it_is(tmp_path):
+    """A sweep's sweep.h5 or map.h5 given to a command that reads a run's archive (rerun, compare, wear,
+    animate, table of the map) was "HDF5 file but not a bearingsim archive (no /bearingsim group)", of a
+    file bearingsim wrote; the line says which of its files it is and names the commands that read it."""
+    res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "operating.inner_ring_speed_rpm=1000,2000",
+                     "--param", "bearing.pocket_clearance_mm=0.1,0.2", "-q", "--no-plots", "-o", tmp_path / "sw")
+    assert res.returncode == 0, res.stderr
+    index, grid = tmp_path / "sw" / "sweep.h5", tmp_path / "sw" / "map.h5"
+    for args, path, what in ((["rerun", grid], grid, "a sweep's map"), (["compare", index, index], index, "a sweep's index"),
+                             (["wear", grid, "--hours", "1"], grid, "a sweep's map"),
+                             (["animate", index, "-o", tmp_path / "a.gif"], index, "a sweep's index"),
+                             (["table", grid], grid, "a sweep's map")):
+        assert_user_error(bearingsim(*args), f"{path}: {what} written by bearingsim, not a run archive",
+                          f"'bearingsim inspect {path}' says what it holds", f"'bearingsim table {path.parent}'")
+    assert not (tmp_path / "a.gif").exists()
+    assert bearingsim("inspect", grid).returncode == 0 and bearingsim("table", tmp_path / "sw").returncode == 0
+
+
+@pytest.mark.slow
 def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
     """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every
     dataset, the resolved scenario) and the Fig. 8 analog PNG; `inspect` reads it back; the same scenario

@@ -1018,9 +1018,10 @@ def _directory_error(p: Path) -> UserError:
     """The refusal of a folder given where an archive is read; a sweep's or a study's folder (its index
     ``sweep.h5``) is named as one, with the commands that read it."""
     if (p / "sweep.h5").is_file():
+        cases = (f"its cases' archives are in {p / 'cases'}" if (p / "cases").is_dir()
+                 else "its cases kept no archives (sweep --archives all keeps them)")
         return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}' and 'bearingsim "
-                         f"report {p}' read it, 'bearingsim plot {p / 'sweep.h5'}' draws its figures; its cases' "
-                         f"archives are in {p / 'cases'}")
+                         f"report {p}' read it, 'bearingsim plot {p / 'sweep.h5'}' draws its figures; {cases}")
     return UserError(f"{p}: is a directory, not an archive")
 
 

@@ -269,6 +269,25 @@ def test_a_sweep_file_given_for_an_archive_says_what_it_is(tmp_path):
 
 
 @pytest.mark.slow
+def test_a_sweep_folder_given_for_an_archive_sends_to_case_archives_only_when_there_are_some(tmp_path):
+    """A sweep folder given to `inspect` said "its cases' archives are in DIR/cases" of a reduced-model sweep,
+    whose cases keep no archive by default: there is no DIR/cases. The line says so, and names the folder
+    where the cases did keep their archives (--archives all)."""
+    for archives, kept in (([], False), (["--archives", "all"], True)):
+        folder = tmp_path / ("kept" if kept else "none")
+        res = bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "operating.inner_ring_speed_rpm=1000,2000",
+                         *archives, "-q", "--no-plots", "-o", folder)
+        assert res.returncode == 0, res.stderr
+        assert (folder / "cases").is_dir() == kept
+        res = bearingsim("inspect", folder)
+        assert_user_error(res, f"{folder}: is a sweep or study folder, not an archive")
+        if kept:
+            assert f"its cases' archives are in {folder / 'cases'}" in res.stderr
+        else:
+            assert "cases' archives are in" not in res.stderr and "its cases kept no archives" in res.stderr
+
+
+@pytest.mark.slow
 def test_reduced_run_writes_archive_with_public_names_and_figure(tmp_path):
     """`bearingsim run` on a paper scenario writes the archive (public names of issue 2, a unit on every
     dataset, the resolved scenario) and the Fig. 8 analog PNG; `inspect` reads it back; the same scenario

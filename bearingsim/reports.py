@@ -516,10 +516,11 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         cols, _ = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
+        failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]
         checks.append({"kind": "text", "text": f"{counted(len(status), 'case')}: {counts}. A case's archive is written only when "
                                                "its run passes the plausibility checks (docs/reliability.md); a "
-                                               "failed case keeps its one-line error:"})
-        failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]
+                                               "failed case keeps its one-line error" +
+                                               (":" if failed else ". No case failed.")})
         if failed:
             checks.append(table_block("Failed cases", ["case", "error"], failed))
         first = next((folder / a for a in cols["archive"] if a and (folder / a).is_file()), None)

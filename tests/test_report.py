@@ -301,6 +301,28 @@ def test_report_of_a_validate_folder_is_its_own_kind(folders, tmp_path):
 
 
 @pytest.mark.slow
+def test_a_sweep_page_says_when_no_case_failed(tmp_path):
+    """A sweep's page said "a failed case keeps its one-line error:" and nothing after the colon when no
+    case had failed; it says no case failed, and lists the failed cases under that line when some did."""
+    def checks_text(folder):
+        html = bearingsim.report(folder, tmp_path / f"{folder.name}.html").read_text()
+        section = re.search(r'<section id="checks">(.*?)</section>', html, re.S).group(1)
+        return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section))
+
+    res = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=500,1000", "-o", tmp_path / "ok", "-q",
+              "--no-plots")
+    assert res.returncode == 0, res.stderr
+    text = checks_text(tmp_path / "ok")
+    assert "2 cases: done 2." in text and "one-line error. No case failed." in text and "error:" not in text, text
+    res = cli("sweep", PAPER, "--set", "reduced.method=euler", "--set", "numerics.dt_s=0.0002", "--param",
+              "operating.inner_ring_speed_rpm=500,6000", "-o", tmp_path / "one_failed", "-q", "--no-plots")
+    assert res.returncode == 1, res.stderr
+    text = checks_text(tmp_path / "one_failed")
+    assert "done 1, failed 1" in text and "one-line error: Failed cases" in text and "No case failed" not in text, text
+    assert "too large for the euler method" in text
+
+
+@pytest.mark.slow
 def test_a_table_file_reports_its_folder(folders):
     from bearingsim.reports import kind_of
 

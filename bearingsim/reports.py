@@ -250,12 +250,17 @@ def _run_figures(result) -> list[dict]:
 def _pocket_table(result) -> dict:
     i_dec, i_acc = (np.asarray(result.per_rotation[k], float) for k in ("I_dec", "I_acc"))
     n = i_dec.shape[0]
+
+    def spread(x):  # one rotation has no spread to show: "-", not a standard deviation of 0
+        return np.nanstd(x) if n > 1 else math.nan
+
     with np.errstate(invalid="ignore"):
-        rows = [[str(j), _cell(np.nanmean(i_dec[:, j]), 1e3), _cell(np.nanstd(i_dec[:, j]), 1e3),
-                 _cell(np.nanmean(i_acc[:, j]), 1e3), _cell(np.nanstd(i_acc[:, j]), 1e3)]
+        rows = [[str(j), _cell(np.nanmean(i_dec[:, j]), 1e3), _cell(spread(i_dec[:, j]), 1e3),
+                 _cell(np.nanmean(i_acc[:, j]), 1e3), _cell(spread(i_acc[:, j]), 1e3)]
                 for j in range(i_dec.shape[1])]
-    return table_block(f"Impulse per cage rotation of each pocket, mean and standard deviation over {n} recorded "
-                       "rotations [mN s]", ["pocket", "I_dec mean", "I_dec std", "I_acc mean", "I_acc std"], rows,
+    return table_block(f"Impulse per cage rotation of each pocket, mean and standard deviation over "
+                       f"{counted(n, 'recorded rotation')} [mN s]" + (" (one rotation: no standard deviation)" if n == 1 else ""),
+                       ["pocket", "I_dec mean", "I_dec std", "I_acc mean", "I_acc std"], rows,
                        [False, True, True, True, True])
 
 

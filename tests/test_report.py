@@ -300,6 +300,24 @@ def test_report_of_a_validate_folder_is_its_own_kind(folders, tmp_path):
     assert "41 cases: done 41" in html
 
 
+def test_the_per_pocket_table_of_one_rotation_shows_no_standard_deviation(tmp_path):
+    """A run of one recorded rotation was reported "mean and standard deviation over 1 recorded rotations"
+    with a standard deviation of 0 in every pocket, a spread that one rotation cannot show; it says
+    "1 recorded rotation" and shows "-" for the deviations, as for any number it cannot give."""
+    def pocket_rows(rotations):
+        r = bearingsim.run(bearingsim.load_scenario(PAPER, {"numerics.rotations": rotations}))
+        path = r.save(tmp_path / f"r{rotations}.h5")
+        html = bearingsim.report(path, tmp_path / f"r{rotations}.html").read_text()
+        section = re.search(r'<section id="pockets">(.*?)</section>', html, re.S).group(1)
+        return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section))
+
+    one = pocket_rows(1)
+    assert "over 1 recorded rotation [mN s]" in one and "rotations [mN s]" not in one, one
+    assert re.search(r" 0 [0-9.]+ - [0-9.]+ - ", one), one
+    two = pocket_rows(2)
+    assert "over 2 recorded rotations [mN s]" in two and re.search(r" 0 [0-9.]+ 0 [0-9.]+ 0 ", two), two
+
+
 @pytest.mark.slow
 def test_a_sweep_page_says_when_no_case_failed(tmp_path):
     """A sweep's page said "a failed case keeps its one-line error:" and nothing after the colon when no

@@ -222,7 +222,9 @@ class _Range:
         if num == 1 and float(start) != float(stop):  # one value cannot include both ends
             raise UserError(f"{where}: num = 1 is one value, and start {start:g} and stop {stop:g} differ: both ends "
                             "are included from num = 2 (one value: start = stop, or a list)")
-        return [float(x) for x in np.linspace(float(start), float(stop), num)]
+        # to 15 significant digits, as the ends are written: 0.05:0.5:10 gives 0.15, not 0.15000000000000002
+        # (a value a reader of the map selects by, xarray's .sel(0.15), and that names the case)
+        return [float(f"{x:.15g}") for x in np.linspace(float(start), float(stop), num)]
 
 
 def _check_unique(keys: list[str], where: str) -> None:

@@ -166,7 +166,7 @@ PosFloat = Field(gt=0.0, allow_inf_nan=False)
 
 class BearingSection(_Section):
     preset: str | None = None
-    roller_count: int = Field(ge=1)
+    roller_count: int  # at least MIN_ROLLER_COUNT: _check_geometry says why
     roller_diameter_mm: float = Field(gt=0.0)
     roller_length_mm: float = Field(gt=0.0)
     roller_mass_kg: float = Field(gt=0.0)

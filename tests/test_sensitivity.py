@@ -399,3 +399,33 @@ def test_uncertainty_of_one_key_counts_the_runs_it_makes(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "N = 2 (4 runs)" in out and "runs: 4 done, 0 cached, 0 failed" in out
     assert read_table(tmp_path / "u" / "uncertainty.h5")[2]["runs"] == 4
+
+
+def test_the_tornado_draws_the_change_across_each_range_it_is_ordered_by():
+    """The chart ranks keys by over_range = S ln(high / low) (docs/sensitivity.md) and its bars are that
+    number, ± SE(S) |ln(high / low)|: a key of slope -0.2 over a 1 % range (pitch diameter) sits below one
+    of slope +0.3 over a factor-4 range, with the shorter bar. (The bars were the local slopes S, which put
+    the longest bar on a key ranked low.) A range from 0 has no bar and says so in its label."""
+    import math
+
+    from bearingsim.studies.sensitivity import plot_tornado
+
+    def row(key, q, s, se, ratio):
+        return {"key": key, "quantity": q, "sensitivity": s, "sensitivity_se": se,
+                "over_range": s * math.log(ratio) if ratio else math.nan}
+
+    rows = [row("bearing.pitch_diameter_mm", "I_dec", -0.2, 0.01, 1.01),
+            row("lubrication.drag_coefficient", "I_dec", 0.3, 0.02, 4.0),
+            row("contact.cage_friction", "I_dec", 0.5, 0.05, None)]
+    fig = plot_tornado(rows)
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_yticklabels()]  # top first (ticks from the top down)
+    bars = sorted(ax.patches, key=lambda b: -b.get_y())  # top first, the order of the labels from the top
+    assert labels == ["lubrication.drag_coefficient", "bearing.pitch_diameter_mm",
+                            "contact.cage_friction (range from 0)"]
+    assert [b.get_width() for b in bars] == pytest.approx([0.3 * math.log(4.0), -0.2 * math.log(1.01), 0.0])
+    assert ax.get_xlabel() == "change of ln y across the range" and ax.get_title() == "I_dec"
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+

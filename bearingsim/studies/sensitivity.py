@@ -360,8 +360,10 @@ def read_table(path) -> tuple[list[dict], dict]:
 
 
 def plot_tornado(rows, title: str = ""):
-    """A tornado chart: one panel per headline number, one bar per key, ± 1 SE; keys ordered by the
-    change of ln I_dec across their plausible range (``over_range``), the largest on top."""
+    """A tornado chart: one panel per headline number, one bar per key: the change of ln y (of y for the
+    cage slip) across the key's plausible range, ``over_range`` = S ln(high / low), ± 1 SE scaled alike;
+    keys ordered by that change of ln I_dec, the largest on top. A key whose range starts at 0 has no
+    such change (no bar; its label says so); its local slope S is in the table."""
     from bearingsim.plotting import subplots
 
     quantities = [q for q in QUANTITIES if any(r["quantity"] == q[0] for r in rows)]
@@ -373,14 +375,18 @@ def plot_tornado(rows, title: str = ""):
     for ax, (q, unit, measure) in zip(axes[0], quantities):
         by = {r["key"]: r for r in rows if r["quantity"] == q}
         y = np.arange(len(order))[::-1]
-        s = np.array([by[k]["sensitivity"] for k in order])
-        se = np.array([by[k]["sensitivity_se"] for k in order])
-        ax.barh(y, np.nan_to_num(s), xerr=np.nan_to_num(se), color=np.where(s >= 0, "C3", "C0"), capsize=2)
+        over = np.array([by[k]["over_range"] for k in order], dtype=float)
+        s = np.array([by[k]["sensitivity"] for k in order], dtype=float)
+        with np.errstate(invalid="ignore", divide="ignore"):  # ln(high / low) = over / S
+            se = np.array([by[k]["sensitivity_se"] for k in order], dtype=float) * np.abs(over / s)
+        ax.barh(y, np.nan_to_num(over), xerr=np.nan_to_num(se), color=np.where(over >= 0, "C3", "C0"), capsize=2)
         ax.axvline(0.0, color="0.3", lw=0.6)
         ax.set_yticks(y)
-        ax.set_yticklabels(order if ax is axes[0][0] else [""] * len(order), fontsize=8)
-        ax.set_xlabel("d ln y / d ln x" if measure == "log" else "d y / d ln x")
-        ax.set_title(q.replace("_", " "), fontsize=9)
+        ranged = [k if np.isfinite(next(r["over_range"] for r in rows if r["key"] == k)) else f"{k} (range from 0)"
+                  for k in order]
+        ax.set_yticklabels(ranged if ax is axes[0][0] else [""] * len(order), fontsize=8)
+        ax.set_xlabel("change of ln y across the range" if measure == "log" else "change of y across the range")
+        ax.set_title(q, fontsize=9)
         ax.grid(axis="x", alpha=0.3)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
@@ -393,8 +399,8 @@ def plot_sensitivity(index_path, outdir) -> list[Path]:
 
     rows, meta = read_table(index_path)
     fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {meta['step']:.0%}) within each key's "
-                             "range, "
-                             "bars ± 1 standard error (batch means over rotations)")
+                             "range; bars: S ln(high / low), the change across the key's plausible range if linear, "
+                             "± 1 standard error (batch means over rotations)")
     return [save_figure(fig, Path(outdir) / "sensitivity.png")]
 
 

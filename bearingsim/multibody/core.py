@@ -512,35 +512,42 @@ def roller_start_radius(p) -> float:
         centrifugal_load(p) / laws.palmgren_stiffness(g.roller_length)) ** 0.9
 
 
+#: directions from the pocket centre at which :func:`assembly_overlap` measures a face's distance
+ASSEMBLY_DIRECTIONS = 361
+
+
 def assembly_overlap(p) -> float:
     """Largest overlap [m] of a roller with a face of its pocket as the bearing is assembled: the roller at
     :func:`roller_start_radius`, ``delta`` off its pocket centre along the radius, the cage centred (0: none).
 
-    A face's nearest point to the roller is the end of its extent on the side the roller moved to: exactly
-    so for an arc face (the distance from ``(0, delta)`` to ``R (cos psi, sin psi)`` falls as sin psi
-    grows); for a polyline or a worn face the end is taken too (a chord or a worn stretch can come nearer,
-    which the first step's overlap check still finds). Flat faces stay ``s / 2`` away."""
+    A face point in the direction ``e`` from the pocket centre lies at the face's polar radius ``r(e)``
+    (``R = r_r + s/2`` for an arc, the circumscribed polyline's ``R / cos(e - m)`` with ``m`` the middle of
+    its segment, :func:`worn_radius` for a worn face), so its distance from the roller centre ``(0, delta)``
+    is ``sqrt(r^2 + delta^2 - 2 r delta sin e)``; the least over :data:`ASSEMBLY_DIRECTIONS` directions
+    spanning the face's extent, its ends included, is the nearest. (For an arc face that is the end the
+    roller moved to: the distance falls as sin e grows.) Flat faces stay ``s / 2`` away."""
     lo, hi = p.multibody.pocket_face_extent
     g = p.bearing
     delta = roller_start_radius(p) - g.pitch_radius
     rr = g.roller_radius
     radius = rr + 0.5 * g.pocket_clearance
-    end = hi if delta >= 0.0 else lo
-    worn = worn_array(p)
-    n_seg = p.multibody.pocket_face_segments
-    if worn is not None:
-        knots, h = worn_lines((lo, hi), radius, worn)
-        r_end = worn_radius(knots, h, np.array([end]))[..., 0]  # (n, 2): each face's edge
-    elif n_seg > 0:
-        r_end = np.full((g.roller_count, 2), radius / math.cos(0.5 * (hi - lo) / n_seg))  # the polyline's end
-    else:
-        r_end = np.full((g.roller_count, 2), radius)
     arc = np.ones(g.roller_count, dtype=bool)
     arc[list(p.multibody.flat_pockets)] = False  # a flat face spans the whole pocket: s / 2 away
     if not arc.any():
         return 0.0
-    r_end = r_end[arc]
-    dist = np.sqrt(r_end**2 + delta**2 - 2.0 * r_end * delta * math.sin(end))
+    e = np.linspace(lo, hi, ASSEMBLY_DIRECTIONS)
+    worn = worn_array(p)
+    n_seg = p.multibody.pocket_face_segments
+    if worn is not None:
+        knots, h = worn_lines((lo, hi), radius, worn[arc])
+        r = worn_radius(knots, h, e)  # (pockets, 2, directions)
+    elif n_seg > 0:
+        width = (hi - lo) / n_seg
+        middle = lo + width * (np.minimum(np.floor((e - lo) / width), n_seg - 1) + 0.5)
+        r = radius / np.cos(e - middle)
+    else:
+        r = np.full(e.shape, radius)
+    dist = np.sqrt(r**2 + delta**2 - 2.0 * r * delta * np.sin(e))
     return max(float(rr - dist.min()), 0.0)
 
 

@@ -197,3 +197,23 @@ def test_a_pass_with_no_force_on_the_roller_is_refused_naming_drag_and_gravity(h
     msg = str(err.value)
     assert "lubrication.drag_coefficient" in msg and "operating.gravity" in msg
     assert "too short a pass" not in msg and "\n" not in msg
+
+
+def test_a_classical_half_angle_of_zero_under_load_is_noted_as_no_result():
+    """load_zone_half_angle_deg is arccos(P_d / 2 delta_r) of the mean ring displacement along the load, 0
+    when delta_r <= P_d/2 ("no roller loaded"). With 3 rollers (scenarios/hard/multibody_rollers_3.toml) the
+    dynamic ring rides from roller to roller, its mean displacement along the load is 24.6 um < P_d/2 = 40
+    um, and the run reported a half angle of 0 for a bearing carrying 970 N (the inner race loaded over
+    +-18.5 deg: load_zone_contact_half_angle_deg), without a word. It gets a note; a run whose ring rests
+    in a load zone (16 rollers) gets none, nor an unloaded one (no roller loaded: 0 is right)."""
+    from bearingsim.scenario import load_scenario
+
+    def notes(path, *extra):
+        r = bearingsim.run(load_scenario(path, list(extra)))
+        return r, [n for n in r.notes if "load_zone_half_angle_deg = 0" in n]
+
+    three, found = notes(SCENARIOS / "hard" / "multibody_rollers_3.toml")
+    assert three.summary["load_zone_half_angle_deg"] == 0.0 and three.summary["load_zone_contact_half_angle_deg"] > 0
+    assert len(found) == 1 and "load_zone_contact_half_angle_deg" in found[0], three.notes
+    assert notes(MULTIBODY, *RIGID)[1] == []
+    assert notes(MULTIBODY, *RIGID, "operating.radial_load_N=0")[1] == []

@@ -138,7 +138,7 @@ def check(result) -> list[str]:
             raise SimulationUnstable(
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
                 f"for this load and clearance; {_advice(result)}")
-        for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result)):
+        for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result), _pinched_note(result)):
             if note is not None:
                 notes.append(note)
         orbit = result.get("cage_orbit")
@@ -193,6 +193,24 @@ def _no_classical_load_zone_note(result) -> str | None:
             f"({0.5 * p.bearing.radial_clearance * 1e6:.3g} um), so arccos(P_d / 2 delta_r) finds no roller loaded, "
             f"while the inner race carried load over +-{contact:.3g} deg (load_zone_contact_half_angle_deg): the "
             f"ring ({str(result.provenance.get('inner_ring', '?')).split(';')[0]}) did not rest in a load zone")
+
+
+def _pinched_note(result) -> str | None:
+    """Rollers pinched by their pockets in the load zone (:func:`bearingsim.multibody.core.pinch`): the run
+    is of jammed pockets, which a pocket clearance larger by about twice the overlap frees (the rim-end gap
+    grows by half the clearance's growth)."""
+    from bearingsim.multibody.core import max_roller_load, pinch
+
+    p = result.parameters
+    depth = pinch(p)
+    if depth <= 0.0:
+        return None
+    s_mm = p.bearing.pocket_clearance * 1e3
+    return (f"bearingsim: note: the most loaded roller (about {max_roller_load(p):.0f} N: 5 W / Z and its centrifugal "
+            f"load), pressed into the outer race, reaches {depth * 1e6:.2g} um into the rim ends of its pocket's faces: "
+            f"in the load zone the pockets pinch their rollers, so the impulses are those of jammed pockets, not of "
+            f"rollers free in them (docs/stability.md); a bearing.pocket_clearance_mm above about "
+            f"{s_mm + 2e3 * depth:.4g} (now {s_mm:.4g}) frees them")
 
 
 def checks_made(result) -> list[tuple[str, str, bool]]:

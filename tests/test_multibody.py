@@ -372,3 +372,29 @@ def test_the_tightest_pocket_the_check_passes_is_the_tightest_the_first_step_pas
         core.run(params(0.97 * s_star))
     assert err.value.t <= 1.5 * err.value.dt
     assert model_run(params(1.03 * s_star)).per_rotation["I_dec"].shape[0] == 1
+
+
+@pytest.mark.slow
+def test_pockets_that_pinch_their_most_loaded_roller_jam_and_say_so():
+    """core.pinch: the most loaded roller (Stribeck's 5 W / Z plus its centrifugal load, 316 N at 970 N)
+    pressed into the outer race by its Palmgren approach (0.88 um) reaches into the rim ends of its faces
+    below a clearance s_free = 0.01866 mm on the reference bearing, where the roller at rest leaves a gap.
+    The runs agree with that bound, which nothing was fitted to: 2 % below it the pockets jam (I_dec about
+    ten times a roomy pocket's: 276 against 26.8 mN s at 3000 rpm, 1 rotation; bound 5x), 2 % above it
+    I_dec is a free pocket's (28.9 mN s; bound 1.2x). Only the pinched run gets the note."""
+    from scipy.optimize import brentq
+
+    from bearingsim.multibody import core
+
+    def scenario(s_mm):
+        return load_scenario(SCENARIOS / "multibody_3000rpm.toml",
+                             [f"bearing.pocket_clearance_mm={s_mm!r}", "numerics.rotations=1"])
+
+    s_free = brentq(lambda s_mm: core.pinch(si(scenario(s_mm))) - 1e-15, 0.0176, 0.03, xtol=1e-9)
+    assert s_free == pytest.approx(0.01866, abs=2e-5)
+    roomy, pinched, free = (simulate(scenario(s)) for s in (0.03, 0.98 * s_free, 1.02 * s_free))
+    assert pinched.summary["I_dec_mean_Ns"] > 5.0 * roomy.summary["I_dec_mean_Ns"]
+    assert free.summary["I_dec_mean_Ns"] < 1.2 * roomy.summary["I_dec_mean_Ns"]
+    assert [n for n in pinched.notes if "pinch their rollers" in n] and not [
+        n for r in (roomy, free) for n in r.notes if "pinch" in n]
+

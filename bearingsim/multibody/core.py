@@ -516,9 +516,10 @@ def roller_start_radius(p) -> float:
 ASSEMBLY_DIRECTIONS = 361
 
 
-def assembly_overlap(p) -> float:
+def assembly_overlap(p, outward: float = 0.0) -> float:
     """Largest overlap [m] of a roller with a face of its pocket as the bearing is assembled: the roller at
-    :func:`roller_start_radius`, ``delta`` off its pocket centre along the radius, the cage centred (0: none).
+    :func:`roller_start_radius` (plus ``outward`` [m]), ``delta`` off its pocket centre along the radius, the
+    cage centred (0: none).
 
     A face point in the direction ``e`` from the pocket centre lies at the face's polar radius ``r(e)``
     (``R = r_r + s/2`` for an arc, the circumscribed polyline's ``R / cos(e - m)`` with ``m`` the middle of
@@ -528,7 +529,7 @@ def assembly_overlap(p) -> float:
     roller moved to: the distance falls as sin e grows.) Flat faces stay ``s / 2`` away."""
     lo, hi = p.multibody.pocket_face_extent
     g = p.bearing
-    delta = roller_start_radius(p) - g.pitch_radius
+    delta = roller_start_radius(p) - g.pitch_radius + outward
     rr = g.roller_radius
     radius = rr + 0.5 * g.pocket_clearance
     arc = np.ones(g.roller_count, dtype=bool)
@@ -549,6 +550,17 @@ def assembly_overlap(p) -> float:
         r = np.full(e.shape, radius)
     dist = np.sqrt(r**2 + delta**2 - 2.0 * r * delta * np.sin(e))
     return max(float(rr - dist.min()), 0.0)
+
+
+def pinch(p) -> float:
+    """Overlap [m] of the most loaded roller with its pocket's faces (0: none): the assembled roller pressed
+    further into the outer race by its Palmgren approach under :func:`max_roller_load` (rigid raceways hold
+    it at :func:`rigid_radius`). Above 0 the rim ends of its faces pinch it in the load zone: a jammed
+    pocket, whose impulses are those of the rollers' raceway loads, not of a roller free in its pocket."""
+    if paper_assumptions(p.multibody.scene):  # rollers held on the pitch circle: no raceway presses them out
+        return 0.0
+    approach = 0.0 if rigid(p) else (max_roller_load(p) / laws.palmgren_stiffness(p.bearing.roller_length)) ** 0.9
+    return assembly_overlap(p, approach)
 
 
 def check_assembly(p) -> None:

@@ -6,6 +6,7 @@ import os
 import signal
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -316,6 +317,28 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     text = capsys.readouterr().out
     assert "life history" in text and "wear_test_6000rpm" in text and "limit: clearance=0.203mm" in text
     assert f"(one row per stage): {len(cols['stage'])} stages" in text  # its rows are stages (it said "cases")
+
+
+@pytest.mark.slow
+def test_life_uniform_mapping_counts_a_worn_start_once(tmp_path):
+    """The uniform mapping from a scenario with worn faces of its own (tests/data/worn_stage05_rigid.toml,
+    about 5 um mean depth): every stage keeps those faces, so stage 1's pocket clearance grows by stage 0's
+    wear alone (the worst pocket's mean front + rear depth). It grew by the start's depth as well, which
+    then acted twice on the stage's pocket (once on its faces, once in s)."""
+    from bearingsim.studies.life import parse_limit, run_life
+
+    sc = load_scenario(str(Path(__file__).parent / "data" / "worn_stage05_rigid.toml"))
+    start = {f: np.array(getattr(sc.wear, f"worn_depth_{f}_um")).T for f in ("front", "rear")}  # [bin, pocket] um
+    cols = run_life(sc, tmp_path, parse_limit("clearance=0.215mm"), stages=2, rotations=1, mapping="uniform")
+    stage1 = _stage(tmp_path, 1).scenario
+    for f in ("front", "rear"):
+        np.testing.assert_array_equal(np.array(getattr(stage1.wear, f"worn_depth_{f}_um")).T, start[f])
+    grown = sum((cols[f"worn_depth_{f}_um"][0] - start[f]).mean(axis=0) for f in ("front", "rear")).max()
+    assert grown > 0
+    assert stage1.bearing.pocket_clearance_mm == pytest.approx(sc.bearing.pocket_clearance_mm + grown * 1e-3, abs=2e-9)
+    # the history's effective clearance holds the start's depth once
+    start_mean = sum(start[f].mean(axis=0) for f in ("front", "rear")).max()
+    assert cols["pocket_clearance_mm"][0] == pytest.approx(sc.bearing.pocket_clearance_mm + start_mean * 1e-3, abs=1e-9)
 
 
 @pytest.mark.slow

@@ -17,6 +17,7 @@ How the wear maps onto the next stage's geometry (``mapping``, :data:`MAPPINGS`)
 * ``uniform``: the pockets stay arcs and every pocket's clearance ``s`` grows by the worn depth of the
   worst pocket, front plus rear, each face's depth its mean over the face (worn volume / face area, so the
   model's pocket removes as much brass as wore): the clearance growth alone, without where the wear is.
+  A scenario's own worn depth stays on its faces in every stage; ``s`` grows by the stages' wear only.
 
 Limits: ``depth`` (the deepest point of any
 face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
@@ -87,6 +88,7 @@ class _State:
         self.s0 = s0
         self.depth = start  # (2, bins, pockets) front, rear [m]; the scenario's own worn depth or None
         self.volume = None  # (2, pockets) [m^3]
+        self.start_volume = None  # (2, pockets) [m^3]: the scenario's own worn depth's volume (0 without one)
         self.shaft = 0.0
         self.hours = 0.0
         self.area = 0.0  # one face's area [m^2]
@@ -103,6 +105,14 @@ class _State:
         if self.volume is None:
             return self.s0
         return float(self.s0 + self.volume.sum(axis=0).max() / self.area)
+
+    def grown_clearance(self) -> float:
+        """The pocket clearance of the uniform mapping's next stage: ``s`` grown by the worst pocket's mean
+        worn depth (front + rear) of the stages run, without the scenario's own worn depth, which every
+        stage's scenario keeps on its faces (counted once, not again in ``s``)."""
+        if self.volume is None:
+            return self.s0
+        return float(self.s0 + (self.volume - self.start_volume).sum(axis=0).max() / self.area)
 
 
 def _stage_length(q_now, q_rate, target) -> float:
@@ -215,7 +225,7 @@ class LifeStudy(Study):
     def _case(self, j: int):
         st = self.state
         sc = (stage_scenario(self.scenario, st.depth if j else None, j, self.rotations) if self.mapping == "shape"
-              else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.clearance()))
+              else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.grown_clearance()))
         return case_of(sc, {"stage": j})
 
     def _check_bar(self, j: int, d_rate, n_stage: float, hours_per_rotation: float) -> None:
@@ -258,6 +268,7 @@ class LifeStudy(Study):
             st.area = rate.bin_area * len(rate.psi_deg)
             st.depth = np.zeros_like(d_rate) if st.depth is None else st.depth
             st.volume = st.depth.sum(axis=1) * rate.bin_area
+            st.start_volume = st.volume.copy()
         clearance = st.clearance()
         start = st.s0 if self.limit.kind == "clearance" else 0.0
         goal = start + (self.limit.value - start) * (j + 1) / self.planned

@@ -342,6 +342,27 @@ def test_life_uniform_mapping_counts_a_worn_start_once(tmp_path):
 
 
 @pytest.mark.slow
+def test_life_from_worn_faces_steps_from_their_depth_to_the_limit(tmp_path):
+    """A life study from a scenario with worn faces of its own (50 um deepest) to depth=0.1mm in 2 stages
+    wears on from 50 um: 75 um after stage 0, 100 um after stage 1, every stage forwards in time. The
+    stages' steps were fractions of the limit from 0 (stage 0's goal 50 um, the start's depth: a stage of
+    negative rotations, worn faces of negative depth next). A limit the start reaches already is refused
+    in one line, no folder made."""
+    from bearingsim.studies.life import parse_limit, run_life
+
+    sc = load_scenario(str(Path(__file__).parent / "data" / "worn_stage05_rigid.toml"))
+    start = max(np.max(getattr(sc.wear, f"worn_depth_{f}_um")) for f in ("front", "rear"))
+    assert start == pytest.approx(50.0, abs=1e-5)
+    cols = run_life(sc, tmp_path / "life", parse_limit("depth=0.1mm"), stages=2, rotations=1)
+    assert np.all(cols["stage_rotations"] > 0) and np.all(np.diff(cols["hours_end"]) > 0)
+    np.testing.assert_allclose(cols["max_depth_um"], [start + 25.0, 100.0], rtol=1e-9)
+    for kind in ("depth=0.04mm", "clearance=0.205mm"):
+        with pytest.raises(UserError, match=f"--limit {kind}: .*own worn faces .* are there already"):
+            run_life(sc, tmp_path / "refused", parse_limit(kind), stages=2, rotations=1)
+    assert not (tmp_path / "refused").exists()
+
+
+@pytest.mark.slow
 def test_life_runs_again_a_stage_computed_by_another_model_version(tmp_path, monkeypatch):
     """A stage archive that stores the stage's scenario but was computed by another version of the model
     (bearingsim.model_versions: its numbers moved since) is run again, not reused, as a sweep's case is."""

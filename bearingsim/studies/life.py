@@ -19,8 +19,9 @@ How the wear maps onto the next stage's geometry (``mapping``, :data:`MAPPINGS`)
   model's pocket removes as much brass as wore): the clearance growth alone, without where the wear is.
   A scenario's own worn depth stays on its faces in every stage; ``s`` grows by the stages' wear only.
 
-Limits: ``depth`` (the deepest point of any
-face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
+The stages split the way from the limited quantity at the start (the scenario's own worn faces, if
+any; refused when they reach the limit already) to the limit into equal steps. Limits: ``depth`` (the
+deepest point of any face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
 **mean** worn depth: worn volume / face area), ``volume`` (the largest worn volume of one face).
 
 The stages are the cases of a staged study on the study engine (:mod:`bearingsim.studies.engine`), run in
@@ -183,6 +184,31 @@ def _check_reachable(scenario, limit: Limit) -> None:
                         f"be worn through before that; give a smaller limit")
 
 
+def _start_value(scenario, limit: Limit, s0: float, start) -> float:
+    """The limited quantity before the first stage (SI): 0 (depth, volume) or ``s0`` (clearance) for unworn
+    faces; with the scenario's own worn depth ``start`` ((2, bins, pockets) [m]) its deepest point, largest
+    face volume or worst pocket's effective clearance, as the stages measure them."""
+    if start is None:
+        return s0 if limit.kind == "clearance" else 0.0
+    from bearingsim.wear import face_area
+
+    if limit.kind == "depth":
+        return float(start.max())
+    volume = start.sum(axis=1) * face_area(scenario.parameters, start.shape[1])  # (2, pockets)
+    if limit.kind == "volume":
+        return float(volume.max())
+    return float(s0 + volume.sum(axis=0).max() / face_area(scenario.parameters))
+
+
+def _limit_text(kind: str, value: float) -> str:
+    """A limited quantity in the units of its limit: ``deepest 50 um`` and the like."""
+    if kind == "depth":
+        return f"deepest point {value * 1e6:.4g} um"
+    if kind == "volume":
+        return f"largest face volume {value * 1e9:.4g} mm3"
+    return f"effective pocket clearance {value * 1e3:.4g} mm"
+
+
 class LifeStudy(Study):
     """A life study (module docstring) as a staged study: stage ``j + 1``'s case is made from stage ``j``'s
     archive (:meth:`next_cases`), each run by the study engine (:func:`bearingsim.studies.run_studies`);
@@ -213,9 +239,14 @@ class LifeStudy(Study):
             raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                             f"(bearing.pocket_clearance_mm); give a larger one")
         _check_reachable(scenario, limit)
+        start = _start_depth(scenario)
+        self.start_value = _start_value(scenario, limit, s0, start)
+        if self.start_value >= limit.value:
+            raise UserError(f"--limit {limit.text}: {scenario.source}'s own worn faces ([wear] worn_depth_*_um) are "
+                            f"there already ({_limit_text(limit.kind, self.start_value)}); give a larger limit")
         self.scenario, self.limit, self.planned = scenario, limit, stages
         self.rotations, self.mapping, self.progress = rotations, mapping, progress
-        self.state = _State(s0, _start_depth(scenario))
+        self.state = _State(s0, start)
         self.rows: list[dict] = []
         self.stage_cases = [self._case(0)]
         self.cases = list(self.stage_cases)
@@ -270,7 +301,7 @@ class LifeStudy(Study):
             st.volume = st.depth.sum(axis=1) * rate.bin_area
             st.start_volume = st.volume.copy()
         clearance = st.clearance()
-        start = st.s0 if self.limit.kind == "clearance" else 0.0
+        start = self.start_value  # the limited quantity at the start: the scenario's own worn faces, if any
         goal = start + (self.limit.value - start) * (j + 1) / self.planned
         q_now = st.quantity(self.limit.kind, st.depth, st.volume)
         q_rate = st.quantity(self.limit.kind, d_rate, v_rate) - (st.s0 if self.limit.kind == "clearance" else 0.0)

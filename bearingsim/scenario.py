@@ -150,7 +150,7 @@ MIN_ROLLER_COUNT = 3
 # Narrowest cage bar between two adjacent pockets, as a fraction of the roller diameter. Both models
 # take the cage as rigid; the bar carries the roller impacts. The narrowest gap between two circular
 # pockets of diameter D + s whose centres lie 2 r_p sin(pi/Z) apart on the pitch circle is that chord
-# minus D + s. The NU214 cage's bars are 5.9 mm there (45 % of its 13 mm rollers), those of the
+# minus D + s. The NU214 cage's bars are 5.8 mm there (45 % of its 13 mm rollers), those of the
 # 30-roller case of scenarios/hard 2.0 mm (25 %); a bar below a tenth of the roller it separates
 # (1.3 mm for 13 mm rollers) is a foil, not a rigid cage bar, and no cage is made that thin (a
 # judgement: bearing catalogues give no minimum).

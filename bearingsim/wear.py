@@ -60,7 +60,7 @@ class WearReport:
 #: guideline values of the specification life: 100 000 h and more for machines in continuous operation
 #: with high reliability, such as power stations and mine pumps), so this leaves ten times that; a longer
 #: time is a slip (a unit, an exponent), not a bearing's. It bounds the time, not the worn depth: the
-#: report extrapolates linearly and may wear through a cage bar (5.9 mm on the reference cage) within a
+#: report extrapolates linearly and may wear through a cage bar (5.821 mm on the reference cage) within a
 #: realistic time (3 rotations of multibody_6000rpm at the default k = 5e-6: 7.1 mm deep at an edge after
 #: 100 h), which ``bearingsim life`` follows stage by stage instead. Within the bound every number is finite
 #: by far (that run: at most 2.3e-4 m^3 per face after 1e6 h; the coefficient of variation squares the

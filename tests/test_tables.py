@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import threading
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -78,6 +79,26 @@ def test_batch_means_error_of_independent_rotations_is_the_plain_one_on_average(
         x = rng.normal(size=20)
         ratios.append(batch_sem(x) / (x.std(ddof=1) / math.sqrt(20)))
     assert np.mean(ratios) == pytest.approx(0.9400 / 0.9869, rel=0.05)
+
+
+def test_the_statistics_pages_start_transient_arithmetic_follows_its_table():
+    """docs/statistics.md reads its replica table: the first rotation's excess over 5 and over 40
+    rotations, against the 3000 rpm rigid row's mean and median ±. It said 10.3 % / 5 "≈ 2.16 %" and
+    the 40-rotation weight (0.037 mN s) "about half" of the ± (0.046 mN s): 0.8 of it."""
+    import re
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "statistics.md").read_text()
+    row = re.search(r"\| rigid \| 3000 \| ([0-9.]+) \| [0-9.]+ \| ([0-9.]+) \|.*\| \+([0-9.]+) ± [0-9.]+ % \| "
+                    r"\+([0-9.]+) ± ([0-9.]+) % \|", text)
+    mean, pm, first, five, five_se = (float(x) for x in row.groups())
+    quoted = re.search(r"10\.3 % / 5 = ([0-9.]+) %", text)
+    assert quoted and float(quoted.group(1)) == pytest.approx(first / 5, abs=0.005)
+    assert abs(first / 5 - five) <= 2 * five_se
+    weight = re.search(r"weighs 1/40 \(\+([0-9.]+) % at 3000 rpm, ([0-9.]+) mN s: about ([0-9.]+) of a run's ±, ([0-9.]+) mN s\)",
+                       text)
+    rel, abs_, share, pm_quoted = (float(x) for x in weight.groups())
+    assert rel == pytest.approx(first / 40, abs=0.005) and abs_ == pytest.approx(mean * rel / 100, abs=5e-4)
+    assert pm_quoted == pm and share == pytest.approx(abs_ / pm, abs=0.05)
 
 
 def test_reduced_model_error_is_zero_and_one_rotation_has_none():

@@ -440,8 +440,8 @@ def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario,
     (["--limit", "depth=0.1mm", "--set", "wear.wear_coefficient=0"], "wear.wear_coefficient = 0: nothing wears"),
 ], ids=["depth-beyond-bar", "depth-absurd", "clearance-beyond-bar", "volume-beyond-bar", "no-wear"])
 def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, monkeypatch, capsys, extra, words):
-    """A limit beyond the cage bar between two pockets (the wear-test bearing: 104 mm pitch, 16 rollers of
-    13 mm, s = 0.2 mm: 104 sin(pi/16) - 13.2 = 5.821 mm, which the front and rear faces wear through
+    """A limit beyond the cage bar between two pockets (the wear-test bearing: 97.5 mm pitch, 16 rollers of
+    13 mm, s = 0.2 mm: 97.5 sin(pi/16) - 13.2 = 5.821 mm, which the front and rear faces wear through
     together), or a wear coefficient of 0, is refused in one line before any stage runs, and nothing is
     created (a stage ran, then the next stage's scenario was refused naming wear.worn_depth_front_um, or
     'no wear at this stage'; depth=6mm even ran to the end)."""
@@ -453,6 +453,24 @@ def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, m
     err = capsys.readouterr().err
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (code, err)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_pages_cage_bar_width_is_the_wear_test_bearings():
+    """docs/wear.md gives the cage bar's width as d_p sin(pi/Z) - D - s = 5.821 mm with the wear-test
+    bearing's numbers: each of them is the scenario's, and the arithmetic is laws.cage_bar_width's. The page
+    gave 104 (the cage's outer diameter) for the pitch diameter, 97.5 mm, whose bar 5.821 mm is."""
+    import re
+
+    from .conftest import ROOT
+
+    b = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml")).bearing
+    text = (ROOT / "docs" / "wear.md").read_text()
+    found = re.findall(r"([0-9.]+) sin\(π/(\d+)\) − ([0-9.]+) − ([0-9.]+) = ([0-9.]+) mm", text)
+    assert found, "the page's cage-bar arithmetic"
+    for dp, z, d, s, width in found:
+        assert (float(dp), int(z), float(d), float(s)) == (b.pitch_diameter_mm, b.roller_count, b.roller_diameter_mm,
+                                                           b.pocket_clearance_mm)
+        assert float(width) == round(laws.cage_bar_width(float(dp), float(d), float(s), int(z)), 3)
 
 
 @pytest.mark.slow
@@ -738,7 +756,7 @@ def test_life_keeps_a_users_file_in_its_folder(tmp_path, capsys, name):
 ])
 def test_bad_worn_depth_is_refused_naming_the_key(over, words):
     """A worn-depth profile that does not fit the bearing is refused in one line naming the key: a row per
-    pocket (16), equal rows, no negative depth, a cage bar (5.9 mm) not worn through by its front and
+    pocket (16), equal rows, no negative depth, a cage bar (5.821 mm) not worn through by its front and
     rear faces together, exact arc faces, the multibody model."""
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"))
     with pytest.raises(UserError, match=r"wear\.worn_depth_(front|rear)_um") as exc:

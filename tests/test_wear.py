@@ -275,7 +275,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     runs with the wear of the stages before it (uniform: at the grown pocket clearance; shape: with the
     worn depth on each face); the same command again reuses every stage's archive and gives the same
     history bit for bit."""
-    from bearingsim.studies.life import parse_limit, run_life
+    from bearingsim.studies.life import HISTORY_TABLE, parse_limit, run_life
 
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
     lim = parse_limit("clearance=0.203mm")
@@ -295,6 +295,10 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
         for j in (1, 2):
             stage = _stage(tmp_path, j).scenario
             assert stage.bearing.pocket_clearance_mm == sc.bearing.pocket_clearance_mm
+            # the history's clearance is the effective one, which its header says (it was "s [mm]", read
+            # as the scenario's s, which these stages keep at 0.2 mm)
+            assert cols["pocket_clearance_mm"][j] > stage.bearing.pocket_clearance_mm
+            assert ("pocket_clearance_mm", "s_eff [mm]") in [c[:2] for c in HISTORY_TABLE]
             for f in ("front", "rear"):
                 np.testing.assert_allclose(np.array(getattr(stage.wear, f"worn_depth_{f}_um")).T,
                                            cols[f"worn_depth_{f}_um"][j - 1], rtol=0, atol=5e-7)
@@ -394,7 +398,7 @@ def test_plot_and_table_of_a_life_history_again(tmp_path, capsys):
     assert code == 0 and captured.err == "" and captured.out == f"wrote {tmp_path / 'again' / 'life.png'}\n"
     assert (tmp_path / "again" / "life.png").read_bytes() == (tmp_path / "l" / "life.png").read_bytes()
     history = [ln for ln in lines if not ln.startswith("wrote ")]
-    assert history[0].startswith("life of ") and history[1].split()[:2] == ["stage", "s"]
+    assert history[0].startswith("life of ") and history[1].split()[:2] == ["stage", "s_eff"]
     for path in (tmp_path / "l", tmp_path / "l" / "life.h5"):
         assert main(["table", str(path)]) == 0
         printed = capsys.readouterr().out.splitlines()

@@ -445,8 +445,10 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
 
 
 #: the history as a table, a row per stage (the command's, ``table``'s and the report's): (column, header,
-#: width on the terminal, format); the worn-depth profiles of each stage are the figure's
-HISTORY_TABLE = (("stage", "stage", 5, "d"), ("pocket_clearance_mm", "s [mm]", 8, ".4f"),
+#: width on the terminal, format); the worn-depth profiles of each stage are the figure's. s_eff: the effective
+#: pocket clearance the stage ran at (the worst pocket's s plus its front and rear mean worn depth), not the
+#: scenario's s, which the shape mapping keeps
+HISTORY_TABLE = (("stage", "stage", 5, "d"), ("pocket_clearance_mm", "s_eff [mm]", 10, ".4f"),
                  ("stage_rotations", "rotations", 11, ".4g"), ("hours_end", "h at end", 9, ".4g"),
                  ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
                  ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))

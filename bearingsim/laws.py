@@ -154,6 +154,13 @@ def cage_bar_width(pitch_diameter, roller_diameter, pocket_clearance, roller_cou
     return pitch_diameter * math.sin(math.pi / roller_count) - roller_diameter - pocket_clearance
 
 
+def palmgren_approach(load: float, roller_length: float) -> float:
+    """Approach [m] of one roller pressed on one raceway with ``load`` [N]: Palmgren's line contact
+    ``Q = K delta^(10/9)`` (:func:`palmgren_stiffness`; Harris & Kotzalas Eq. 6.40 writes the same law as
+    delta = 3.84e-5 Q^0.9 / l^0.8 in mm); 0 for no load."""
+    return (max(load, 0.0) / palmgren_stiffness(roller_length)) ** 0.9
+
+
 def palmgren_stiffness(roller_length: float) -> float:
     """Palmgren line-contact constant K of Q = K delta^(10/9), in SI (N / m^(10/9)).
 

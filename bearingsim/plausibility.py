@@ -63,7 +63,7 @@ def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
     """Approach [m] of one roller pressed on one raceway with ``load_N`` [N]: Palmgren's line contact
     ``Q = K delta^(10/9)`` (:func:`bearingsim.laws.palmgren_stiffness`; Harris & Kotzalas Eq. 6.40 writes
     the same law as delta = 3.84e-5 Q^0.9 / l^0.8 in mm)."""
-    return (max(load_N, 0.0) / laws.palmgren_stiffness(roller_length_m)) ** 0.9
+    return laws.palmgren_approach(load_N, roller_length_m)
 
 
 def max_ring_displacement_m(p) -> float:

@@ -205,15 +205,14 @@ def raceway_approach_limit(p) -> float:
     approach is ~50 um per race there.)"""
     g, op = p.bearing, p.operating
     q = op.radial_load + g.roller_mass * g.pitch_radius * op.omega_c**2
-    return max(lp.DELTA_LIMIT_M, RACEWAY_APPROACH_FACTOR * (q / laws.palmgren_stiffness(g.roller_length)) ** 0.9)
+    return max(lp.DELTA_LIMIT_M, RACEWAY_APPROACH_FACTOR * laws.palmgren_approach(q, g.roller_length))
 
 
 def stability_limit(p) -> float:
     """Explicit stability limit 2/omega_n [s] of a roller between two linearised Palmgren contacts."""
     g = p.bearing
-    K = laws.palmgren_stiffness(g.roller_length)
     q = max_roller_load(p)
-    delta = (q / K) ** 0.9
+    delta = laws.palmgren_approach(q, g.roller_length)
     k_lin = 10.0 / 9.0 * q / delta
     omega_n = math.sqrt(2.0 * k_lin / g.roller_mass)
     return 2.0 / omega_n
@@ -508,8 +507,8 @@ def roller_start_radius(p) -> float:
         return rigid_radius(p)
     g = p.bearing
     pd = 0.0 if paper_assumptions(p.multibody.scene) else g.radial_clearance
-    return g.outer_race_radius + 0.25 * pd - g.roller_radius - (
-        centrifugal_load(p) / laws.palmgren_stiffness(g.roller_length)) ** 0.9
+    return g.outer_race_radius + 0.25 * pd - g.roller_radius - laws.palmgren_approach(centrifugal_load(p),
+                                                                                      g.roller_length)
 
 
 #: directions from the pocket centre at which :func:`assembly_overlap` measures a face's distance
@@ -559,7 +558,7 @@ def pinch(p) -> float:
     pocket, whose impulses are those of the rollers' raceway loads, not of a roller free in its pocket."""
     if paper_assumptions(p.multibody.scene):  # rollers held on the pitch circle: no raceway presses them out
         return 0.0
-    approach = 0.0 if rigid(p) else (max_roller_load(p) / laws.palmgren_stiffness(p.bearing.roller_length)) ** 0.9
+    approach = 0.0 if rigid(p) else laws.palmgren_approach(max_roller_load(p), p.bearing.roller_length)
     return assembly_overlap(p, approach)
 
 
@@ -666,7 +665,8 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(op.omega_c), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=_sample_every(p, h),
         max_steps=int(3 * steps_est + 1000), **rk.motion_limits(p))
-    hold = lp.HoldRule(active=reduced_eq, phi=float(phi), radius=r_c if is_rigid else rp - (n_centrifugal / K) ** 0.9,
+    hold = lp.HoldRule(active=reduced_eq, phi=float(phi),
+                       radius=r_c if is_rigid else rp - laws.palmgren_approach(n_centrifugal, geo.roller_length),
                        front_offset=0.5 * s, omega_cage=float(op.sign * op.omega_c))
     return MultibodySetup(
         p=p, scene=scene_kind, reduced_eq=reduced_eq, kinematic=scene_kind in KINEMATIC_CAGE_SCENES, rigid=is_rigid,

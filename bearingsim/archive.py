@@ -302,7 +302,8 @@ def _fill(f, result, in_memory: bool = False) -> None:
         if grp.description:
             w.attr(g, "description", grp.description)
         _write_group_attrs(w, g, grp.attrs, grp.units)
-    _write_group_attrs(w, w.gid("provenance"), _provenance(result), {})
+    prov = _provenance(result)
+    _write_group_attrs(w, w.gid("provenance"), prov, _provenance_units(prov))
     if not in_memory:
         w.attr(w.gid("bearingsim"), "complete", True, replace=True)
 
@@ -590,6 +591,13 @@ def _provenance(result) -> dict[str, Any]:
         if k not in prov:
             prov[k] = v
     return prov
+
+
+def _provenance_units(prov: dict) -> dict[str, str]:
+    """Units of the provenance's numbers that have one: the times and steps in seconds (``dt_s``,
+    ``wall_time_s``, ``solver_wall_s``, ``pymunk_step_s``: the ``_s`` suffix)."""
+    return {k: "s" for k, v in prov.items() if k.endswith("_s") and isinstance(v, (int, float))
+            and not isinstance(v, bool)}
 
 
 #: the HDF5 format signature: at the start of the superblock, at byte 0 or 512, 1024, 2048, ... of a file

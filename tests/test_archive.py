@@ -107,6 +107,19 @@ def test_foreign_truncated_and_incomplete_files_are_refused(tmp_path, base_reduc
         open_archive(tmp_path / "missing.h5")
 
 
+def test_the_provenance_carries_the_units_of_its_times(tmp_path, base_reduced):
+    """docs/archive.md: an attribute group stores units_json for the values that have a unit; /provenance
+    had none, so a reader of dt_s or wall_time_s with h5py alone got no unit. Its times are in seconds."""
+    import bearingsim
+
+    path = bearingsim.run(resolve(base_reduced)).save(tmp_path / "r.h5")
+    with h5py.File(path, "r") as f:
+        values, units = archive.group_attrs(f["provenance"])
+    timed = [k for k, v in values.items() if k.endswith("_s") and isinstance(v, float)]
+    assert "wall_time_s" in timed and {k: units.get(k) for k in timed} == {k: "s" for k in timed}
+    assert "bearingsim_version" not in units and "git_commit" not in units
+
+
 def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(tmp_path, base_reduced):
     """Result.save as its docstring says: missing folders are made; a bearingsim archive at the path is
     replaced (by this result's); a file that is not one is refused with one line and left as it was."""

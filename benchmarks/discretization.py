@@ -1,0 +1,152 @@
+"""Discretization errors of published whole-bearing numbers that no other benchmark measures.
+
+    python -m benchmarks.discretization psi     # wear profile: 16 / 32 / 64 / 128 bins of psi (wear-test scene)
+    python -m benchmarks.discretization theta   # load-zone contact extent, F_dec onset: 180 / 360 / 720 / 1440 bins of theta
+    python -m benchmarks.discretization dt      # I_dec at the automatic step and at half of it, 1 warm-up + 40 rotations
+    python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
+
+``--bins=32,64`` chooses the bin counts, ``--set=KEY=VALUE`` (repeatable) overrides a scenario key, e.g.
+``--set=numerics.dt_s=2e-6`` or ``--set=numerics.warmup_rotations=41`` (the next 40 rotations).
+
+The bins are recording only: the trajectory, and every summary number that is not binned, is the same bit
+for bit at every bin count (each table prints I_dec to show it), so a difference between rows is the
+binning error alone. The bin counts are the model's constants (``multibody.recorder.FACE_BINS`` = 32,
+``multibody.core.THETA_BINS`` = 360); this script changes them for its own runs only.
+
+``psi``: ``scenarios/wear_test_6000rpm.toml`` (Hertz raceways, 1 warm-up + 40 rotations, 922 N) worn for
+1.6e5 inner-ring rotations at k = 6e-4, H = 1.5 GPa, the numbers docs/wear.md quotes (Fig. 13, Fig. 14,
+Table 3). ``theta``: ``scenarios/multibody_3000rpm.toml`` with the fixtures' settings of
+``benchmarks/whole_bearing.py checks`` (1 warm-up + 20 rotations, phi = 23.5 deg), the numbers
+docs/multibody.md's check table quotes.
+"""
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
+
+
+def _run(name, sets):
+    import bearingsim
+    from bearingsim.scenario import load_scenario
+
+    return bearingsim.run(load_scenario(SCENARIOS / f"{name}.toml", list(sets)))
+
+
+def dt(rpms=(1000, 3000, 6000), sets=(), raceways=("hertz", "rigid"), rotations=40):
+    """The time step's error of the mean I_dec over 1 warm-up + ``rotations``: the automatic step against
+    half of it, each with its batch-means standard error (``bearingsim.stats``). The full scene is chaotic:
+    the two runs are two trajectories, so their difference is the dt error plus statistical scatter, judged
+    against the combined standard error."""
+    import math
+
+    from bearingsim.stats import batch_sem, pocket_means
+
+    print("| rpm | raceways | dt [us] | I_dec [mN s] ± s.e. | dt / 2: I_dec ± s.e. | difference | in combined s.e. |")
+    print("|---|---|---|---|---|---|---|")
+    for raceway in raceways:
+        for rpm in rpms:
+            base = ["numerics.warmup_rotations=1", f"numerics.rotations={rotations}",
+                    f"multibody.raceway_contact={raceway}", *sets]
+            a = _run(f"multibody_{rpm}rpm", base)
+            step = a.provenance["dt_s"]
+            b = _run(f"multibody_{rpm}rpm", [*base, f"numerics.dt_s={step / 2!r}"])
+            ia, ib = a.summary["I_dec_mean_Ns"], b.summary["I_dec_mean_Ns"]
+            sa, sb = (batch_sem(pocket_means(r.per_rotation["I_dec"])) for r in (a, b))
+            diff = (ia - ib) / ib
+            print(f"| {rpm} | {raceway} | {step * 1e6:.1f} | {ia * 1e3:.3f} ± {sa * 1e3:.3f} | {ib * 1e3:.3f} ± "
+                  f"{sb * 1e3:.3f} | {diff:+.2%} | {(ia - ib) / math.hypot(sa, sb):+.2f} |", flush=True)
+
+
+def rig(rpms=(2000, 3000, 4000), sets=()):
+    """docs/validation.md's rig table: pocket 0's mean I_dec over the reduced model's, with the batch-means
+    standard error of pocket 0's per-rotation series, at the automatic step and at half of it
+    (``scenarios/rig_<rpm>rpm.toml``, 1 warm-up + 20 rotations, as ``bearingsim validate``)."""
+    from bearingsim.stats import batch_sem
+
+    print("| rpm | reduced [mN s] | dt [us] | pocket 0 [mN s] ± s.e. | ratio ± s.e. | dt / 2: pocket 0 ± s.e. | ratio ± s.e. |")
+    print("|---|---|---|---|---|---|---|")
+    for rpm in rpms:
+        red = _run(f"paper_{rpm}rpm", sets).summary["I_dec_mean_Ns"]
+        a = _run(f"rig_{rpm}rpm", sets)
+        step = a.provenance["dt_s"]
+        b = _run(f"rig_{rpm}rpm", [*sets, f"numerics.dt_s={step / 2!r}"])
+        cells = []
+        for r in (a, b):
+            x = r.per_rotation["I_dec"][:, 0]
+            m, se = float(x.mean()), batch_sem(x)
+            cells.append(f"{m * 1e3:.2f} ± {se * 1e3:.2f} | {m / red:.3f} ± {se / red:.3f}")
+        print(f"| {rpm} | {red * 1e3:.2f} | {step * 1e6:.1f} | {cells[0]} | {cells[1]} |", flush=True)
+
+
+def psi(bins=(16, 32, 64, 128), sets=()):
+    from bearingsim import wear
+    from bearingsim.multibody import recorder
+
+    defaults = recorder.accumulators.__defaults__
+    print("| bins of psi | bin width [deg] | I_dec [mN s] | front bore / middle / rim [um] | rear bore / middle / rim [um] "
+          "| deepest [um] | mean depth front + rear, worst pocket [mm] | front/rear volume | CV front / rear |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    try:
+        for nb in bins:
+            recorder.accumulators.__defaults__ = (nb,)
+            r = _run("wear_test_6000rpm", ["wear.wear_coefficient=6e-4", "wear.hardness_Pa=1.5e9", *sets])
+            rep = wear.wear_report(r, rotations=1.6e5)
+            ends = {f: wear.shape_of(rep.psi_deg, (rep.depth_front if f == "front" else rep.depth_rear).mean(axis=1))
+                    for f in ("front", "rear")}
+            width = (rep.psi_deg[1] - rep.psi_deg[0])
+            play = (rep.mean_depth("front") + rep.mean_depth("rear")).max()
+            ratio = rep.volume_front / rep.volume_rear
+            e = {f: " / ".join(f"{ends[f][k] * 1e6:.0f}" for k in ("bore", "middle", "rim")) for f in ends}
+            print(f"| {nb} | {width:.2f} | {r.summary['I_dec_mean_Ns'] * 1e3:.4f} | {e['front']} | {e['rear']} | "
+                  f"{rep.max_depth * 1e6:.0f} | {play * 1e3:.4f} | {ratio.min():.2f}–{ratio.max():.2f} "
+                  f"(mean {ratio.mean():.3f}) | {rep.cov('front'):.3f} / {rep.cov('rear'):.3f} |", flush=True)
+    finally:
+        recorder.accumulators.__defaults__ = defaults
+
+
+def theta(bins=(180, 360, 720, 1440), sets=()):
+    import bearingsim.multibody as mb
+    from bearingsim.multibody import core
+
+    saved = core.THETA_BINS, mb.THETA_BINS
+    print("| bins of theta | I_dec [mN s] | half angle from ring displacement [deg] | contact extent [deg] | F_dec onset [deg] "
+          "| drive within phi + 15 deg |")
+    print("|---|---|---|---|---|---|")
+    try:
+        for nb in bins:
+            core.THETA_BINS = mb.THETA_BINS = nb
+            r = _run("multibody_3000rpm", ["reduced.load_zone_half_angle_deg=23.5", "numerics.warmup_rotations=1",
+                                           "numerics.rotations=20", *sets])
+            s = r.summary
+            th = r.get("theta_deg")
+            phi = s["load_zone_half_angle_deg"]
+            net = (r.get("force_vs_theta_acc") - r.get("force_vs_theta_dec")).mean(axis=1)
+            pos = np.clip(net, 0, None)
+            lz = (th <= phi + 15) | (th >= 360 - phi - 15)
+            fdec = r.get("force_vs_theta_dec").mean(axis=1)
+            nl = (th > phi) & (th < 180)
+            onset = th[nl][np.argmax(fdec[nl] > 0.1 * fdec[nl].max())]
+            print(f"| {nb} | {s['I_dec_mean_Ns'] * 1e3:.4f} | {phi:.2f} | {s['load_zone_contact_half_angle_deg']:.2f} | "
+                  f"{onset:.2f} | {pos[lz].sum() / pos.sum():.1%} |", flush=True)
+    finally:
+        core.THETA_BINS, mb.THETA_BINS = saved
+
+
+if __name__ == "__main__":
+    what = sys.argv[1] if len(sys.argv) > 1 else ""
+    sets = [a.split("=", 1)[1] for a in sys.argv[2:] if a.startswith("--set=")]
+    given = [tuple(int(b) for b in a.split("=", 1)[1].split(",")) for a in sys.argv[2:] if a.startswith("--bins=")]
+    if what == "psi":
+        psi(*given, sets=sets)
+    elif what == "theta":
+        theta(*given, sets=sets)
+    elif what == "rig":
+        rig(*given, sets=sets)
+    elif what == "dt":
+        dt(*given, sets=sets)
+    else:
+        sys.exit(__doc__)

@@ -4,6 +4,7 @@
     python -m benchmarks.discretization theta   # load-zone contact extent, F_dec onset: 180 / 360 / 720 / 1440 bins of theta
     python -m benchmarks.discretization dt      # I_dec at the automatic step and at half of it, 1 warm-up + 40 rotations
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
+    python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
 
 ``--bins=32,64`` chooses the bin counts, ``--set=KEY=VALUE`` (repeatable) overrides a scenario key, e.g.
 ``--set=numerics.dt_s=2e-6`` or ``--set=numerics.warmup_rotations=41`` (the next 40 rotations).
@@ -84,6 +85,24 @@ def rig(rpms=(2000, 2500, 3000, 3500, 4000), sets=()):
         print(f"| {rpm} | {red * 1e3:.2f} | {step * 1e6:.1f} | {cells[0]} | {cells[1]} |", flush=True)
 
 
+def whatif(rpms=(3000, 6000), sets=()):
+    """docs/whatif.md's whole-bearing rows (1 warm-up + 20 rotations, Hertz raceways): mean I_dec with its
+    batch-means standard error, the mean without the first recorded rotation (the warm-up's trace,
+    docs/statistics.md), and the mean at half the step with its standard error."""
+    from bearingsim.stats import batch_sem, pocket_means
+
+    print("| rpm | cage | I_dec ± s.e. [mN s] | without rotation 1 | dt / 2: I_dec ± s.e. |")
+    print("|---|---|---|---|---|")
+    for rpm in rpms:
+        for guidance in ("rollers", "outer_land", "inner_land"):
+            base = ["numerics.rotations=20", f"bearing.cage_guidance={guidance}", *sets]
+            a = _run(f"multibody_{rpm}rpm", base)
+            b = _run(f"multibody_{rpm}rpm", [*base, f"numerics.dt_s={a.provenance['dt_s'] / 2!r}"])
+            xa, xb = (pocket_means(r.per_rotation["I_dec"]) for r in (a, b))
+            print(f"| {rpm} | {guidance} | {xa.mean() * 1e3:.2f} ± {batch_sem(xa) * 1e3:.2f} | {xa[1:].mean() * 1e3:.2f} | "
+                  f"{xb.mean() * 1e3:.2f} ± {batch_sem(xb) * 1e3:.2f} |", flush=True)
+
+
 def psi(bins=(16, 32, 64, 128), sets=()):
     from bearingsim import wear
     from bearingsim.multibody import recorder
@@ -146,6 +165,8 @@ if __name__ == "__main__":
         psi(*given, sets=sets)
     elif what == "theta":
         theta(*given, sets=sets)
+    elif what == "whatif":
+        whatif(*given, sets=sets)
     elif what == "rig":
         rig(*given, sets=sets)
     elif what == "dt":

@@ -4,7 +4,8 @@ Writes to the output folder:
 
 * ``bench.csv``: one row per solver setting with at least ``model, method, scene, dt_s, wall_s,
   rel_error`` (wall time of one no-load pass for the reduced model, of one cage rotation for the
-  multibody model; ``rel_error`` = error of the mean I_dec against the converged reference);
+  multibody model; ``rel_error`` = error of the mean I_dec against the row's reference, and for the
+  multibody model's chaotic full scene ``ref_sem_rel`` = that reference run's standard error, relative);
 * ``bench.png``: wall time against error, log-log;
 * ``bench_meta.json``: machine, package versions, date, command, and the long-run check;
 * ``bench.md``: the same table as markdown (what docs/bench.md shows).
@@ -184,8 +185,12 @@ def _fmt(v):
 
 def _markdown(rows: list[dict]) -> str:
     """The table printed and written to ``bench.md``; ``notes`` says why a row has no numbers (a run stopped
-    at too long a step) or what a row measures."""
-    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "pymunk_step_s", "rel_error", "unit_of_work", "notes")
+    at too long a step) or what a row measures; ``ref_sem_rel`` beside ``rel_error`` is the standard error of
+    the multibody reference run's mean I_dec (batch means, relative): a full-scene error below about twice it
+    is chaotic scatter, not resolved (empty where the reference is exact: the reduced model and the
+    reduced-equivalent scene)."""
+    cols = ("model", "method", "scene", "rpm", "dt_s", "wall_s", "pymunk_step_s", "rel_error", "ref_sem_rel", "unit_of_work",
+            "notes")
     out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
         out.append("| " + " | ".join(_fmt(r.get(c, "")).replace("|", "/") for c in cols) + " |")

@@ -98,3 +98,32 @@ def test_a_row_stopped_at_too_long_a_step_says_why():
     lines = goal_lines([stopped, ran])
     assert "6000 rpm full scene, dt = 6.0e-06 s: stopped: roller 4 overlaps the cage by 0.2 mm | step too long" in lines
     assert not any("nan" in line for line in lines)
+
+
+def test_the_table_gives_the_reference_runs_standard_error_beside_the_error():
+    """A full-scene row's rel_error is against a run at dt = 1 us over the same few rotations of a chaotic scene:
+    the table printed and written to bench.md gives that reference's standard error (batch means over its
+    rotations, the estimator of bearingsim.stats) beside it, so an error within the scatter reads as such; the
+    reduced model's rows, whose reference is exact, leave the cell empty."""
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from bearingsim.stats import batch_sem, pocket_means
+    from benchmarks.bench import _markdown
+    from benchmarks.multibody_bench import ref_sem_rel
+
+    per_rot = np.array([[1.0, 1.2], [1.4, 1.0], [0.9, 1.1], [1.3, 1.5], [1.0, 0.8], [1.2, 1.2]]) * 1e-2
+    ref = SimpleNamespace(summary={"I_dec_mean_Ns": float(per_rot.mean())}, per_rotation={"I_dec": per_rot})
+    sem = ref_sem_rel(ref)
+    assert sem == batch_sem(pocket_means(per_rot)) / per_rot.mean() and sem > 0
+    full = dict(model="multibody", method="pymunk", scene="full", rpm=3000, dt_s=4e-6, wall_s=0.2, pymunk_step_s=0.08,
+                rel_error=0.0133, ref_sem_rel=sem, unit_of_work="cage rotation")
+    reduced = dict(model="reduced", method="euler", scene="single_pocket", rpm=500, dt_s=1e-4, wall_s=1e-4,
+                   rel_error=2.7e-4, unit_of_work="no-load pass")
+    table = _markdown([full, reduced]).splitlines()
+    head = [c.strip() for c in table[0].strip("|").split("|")]
+    col = head.index("ref_sem_rel")
+    assert col == head.index("rel_error") + 1
+    cells = [[c.strip() for c in line.strip("|").split("|")] for line in table[2:]]
+    assert cells[0][col] == f"{sem:.3g}" and cells[1][col] == ""

@@ -13,6 +13,9 @@ pymunk_step_s`` is the rest of the step (force kernel, recording, batched copies
 * ``scene = full_rigid_raceways``: the full scene with ``multibody.raceway_contact = "rigid"`` at its
   automatic step, error against the same Hertz reference (so it holds the chaotic scatter too;
   ``bearingsim bench --fast-scene`` compares the two scenes over 40 rotations with standard errors);
+* ``scene = full_dynamic_ring``: the full scene with ``multibody.inner_ring = "dynamic"`` (the ring
+  integrated with the rotor's mass, what ``auto`` chooses where fewer than two rollers would carry the
+  load) at its automatic step, error against the same reference (quasi-static ring);
 * ``scene = reduced_equivalent``: deterministic, at 3000 rpm over dt; ``rel_error`` against the exact
   event solution of the reduced model, whose assumptions this scene makes;
 * ``scene = full_polyline_N``: the geometric error. The full scene at 3000 rpm at its automatic step with
@@ -41,7 +44,8 @@ GOAL_ERROR = 0.01
 
 
 def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "full", load: float = 970.0,
-                       phi="auto", source: str = "<bench>", raceway_contact: str = "hertz", pocket_face_segments: int = 0):
+                       phi="auto", source: str = "<bench>", raceway_contact: str = "hertz", pocket_face_segments: int = 0,
+                       inner_ring: str = "auto"):
     """The reference bearing (NU214) in the multibody model at one speed and load; ``phi`` is the
     reduced-equivalent scene's load-zone half angle [deg] or "auto"."""
     doc = {
@@ -50,7 +54,8 @@ def reference_scenario(rpm: float, rotations: int, warmup: int, scene: str = "fu
         "model": "multibody",
         "bearing": {"preset": "NU214-Suzuki2023"},
         "operating": {"inner_ring_speed_rpm": float(rpm), "radial_load_N": float(load)},
-        "multibody": {"scene": scene, "raceway_contact": raceway_contact, "pocket_face_segments": pocket_face_segments},
+        "multibody": {"scene": scene, "raceway_contact": raceway_contact, "pocket_face_segments": pocket_face_segments,
+                      "inner_ring": inner_ring},
         "numerics": {"rotations": rotations, "warmup_rotations": warmup},
         "reduced": {"load_zone_half_angle_deg": phi},
     }
@@ -90,6 +95,14 @@ def _failed_row(scene, rpm, dt, total_rot, why) -> dict:
             "notes": f"stopped: {why}"}
 
 
+#: The full scene's other solvers, each a row per speed at its automatic step against the full scene's
+#: dt = 1 us reference (Hertz raceways; at 970 N and 16 rollers ``inner_ring = "auto"`` is the quasi-static
+#: ring): rigid raceways (docs/fast_scene.md) and the dynamic inner ring (docs/stability.md), which
+#: ``auto`` chooses with few rollers or light loads.
+FULL_VARIANTS = (("full_rigid_raceways", {"raceway_contact": "rigid"}),
+                 ("full_dynamic_ring", {"inner_ring": "dynamic"}))
+
+
 def bench_cases(quick: bool) -> list[dict]:
     """Run the benchmark and return one dict per (scene, rpm, dt) row (see module docstring)."""
     from bearingsim.reduced.core import PassInputs
@@ -123,11 +136,13 @@ def bench_cases(quick: bool) -> list[dict]:
             rows.append({**_row("full", rpm, dt, runs, total_rot, ref_idec, f"full scene at dt = {dt_ref:g} s"),
                          "ref_sem_rel": ref_sem})
         rows.append({**_row("full", rpm, dt_ref, [ref], total_rot, ref_idec, "itself"), "ref_sem_rel": ref_sem})
-        # rigid raceways at their automatic step, against the same Hertz reference
-        rig = Parameters.from_scenario(reference_scenario(rpm, nrot, 1, raceway_contact="rigid"))
-        runs = [simulate(rig) for _ in range(repeats)]
-        rows.append({**_row("full_rigid_raceways", rpm, runs[0].provenance["dt_s"], runs, total_rot, ref_idec,
-                            f"full scene (Hertz raceways) at dt = {dt_ref:g} s"), "ref_sem_rel": ref_sem})
+        # the other solvers of the full scene at their automatic step, against the same reference
+        for scene, options in FULL_VARIANTS:
+            var = Parameters.from_scenario(reference_scenario(rpm, nrot, 1, **options))
+            runs = [simulate(var) for _ in range(repeats)]
+            rows.append({**_row(scene, rpm, runs[0].provenance["dt_s"], runs, total_rot, ref_idec,
+                                f"full scene (Hertz raceways, quasi-static ring) at dt = {dt_ref:g} s"),
+                         "ref_sem_rel": ref_sem})
     # deterministic scene against the exact reduced solution
     sc = Parameters.from_scenario(reference_scenario(3000, 1, 1, scene="reduced_equivalent", phi=23.5))
     exact = solve_event(PassInputs.from_parameters(sc)).I_dec

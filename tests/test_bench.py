@@ -127,3 +127,20 @@ def test_the_table_gives_the_reference_runs_standard_error_beside_the_error():
     assert col == head.index("rel_error") + 1
     cells = [[c.strip() for c in line.strip("|").split("|")] for line in table[2:]]
     assert cells[0][col] == f"{sem:.3g}" and cells[1][col] == ""
+
+
+def test_every_solver_of_the_full_scene_has_a_bench_row():
+    """Each raceway contact law and each inner-ring model the scenario offers is a solver of its own; the bench
+    times it against the full scene's reference. The dynamic inner ring (what 'auto' chooses with few rollers or
+    light loads) had no row; the default row is Hertz raceways with the quasi-static ring at 970 N."""
+    import typing
+
+    from bearingsim.scenario import MultibodySection
+    from benchmarks.multibody_bench import FULL_VARIANTS
+
+    covered = {("raceway_contact", "hertz"), ("inner_ring", "quasi_static")}  # the 'full' rows
+    covered |= {item for _, options in FULL_VARIANTS for item in options.items()}
+    for key in ("raceway_contact", "inner_ring"):
+        offered = set(typing.get_args(MultibodySection.model_fields[key].annotation)) - {"auto"}
+        assert offered <= {v for k, v in covered if k == key}, key
+    assert len({scene for scene, _ in FULL_VARIANTS}) == len(FULL_VARIANTS)

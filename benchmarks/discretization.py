@@ -5,6 +5,7 @@
     python -m benchmarks.discretization dt      # I_dec at the automatic step and at half of it, 1 warm-up + 40 rotations
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
     python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
+    python -m benchmarks.discretization life    # the life study to depth = 0.1 mm (fast scene) with 16 / 32 / 64 bins of psi
 
 ``--bins=32,64`` chooses the bin counts, ``--set=KEY=VALUE`` (repeatable) overrides a scenario key, e.g.
 ``--set=numerics.dt_s=2e-6`` or ``--set=numerics.warmup_rotations=41`` (the next 40 rotations).
@@ -103,6 +104,34 @@ def whatif(rpms=(3000, 6000), sets=()):
                   f"{xb.mean() * 1e3:.2f} ± {batch_sem(xb) * 1e3:.2f} |", flush=True)
 
 
+def life(bins=(16, 32, 64), sets=()):
+    """docs/wear.md's life study to the deepest point's limit, ``depth=0.1mm``, with the worn shape fed back (the
+    default), on the fast scene (``--set multibody.raceway_contact=rigid``, k = 6e-4, 10 stages of 1 warm-up +
+    10 rotations), its wear profile recorded and fed back in other bin counts. The stages run in a worker
+    process forked from this one, which carries the changed bin count."""
+    import tempfile
+
+    from bearingsim.multibody import recorder
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies.life import parse_limit, run_life
+
+    saved = recorder.accumulators.__defaults__, recorder.FACE_BINS
+    print("| bins of psi | rotations to the limit | hours | deepest point's rate, first / last stage [mm/h] | I_dec, first / last stage [mN s] |")
+    print("|---|---|---|---|---|")
+    try:
+        for nb in bins:
+            recorder.accumulators.__defaults__, recorder.FACE_BINS = (nb,), nb
+            sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
+                               ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
+            with tempfile.TemporaryDirectory() as d:
+                c = run_life(sc, d, parse_limit("depth=0.1mm"), stages=10, rotations=10)
+            rate = c["max_depth_rate_um_per_h"]
+            print(f"| {nb} | {c['rotations_end'][-1]:.0f} | {c['hours_end'][-1]:.4g} | {rate[0] / 1e3:.2f} / {rate[-1] / 1e3:.2f} | "
+                  f"{c['I_dec_mean_mNs'][0]:.2f} / {c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
+    finally:
+        recorder.accumulators.__defaults__, recorder.FACE_BINS = saved
+
+
 def psi(bins=(16, 32, 64, 128), sets=()):
     from bearingsim import wear
     from bearingsim.multibody import recorder
@@ -165,6 +194,8 @@ if __name__ == "__main__":
         psi(*given, sets=sets)
     elif what == "theta":
         theta(*given, sets=sets)
+    elif what == "life":
+        life(*given, sets=sets)
     elif what == "whatif":
         whatif(*given, sets=sets)
     elif what == "rig":

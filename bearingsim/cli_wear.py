@@ -49,6 +49,9 @@ def _cmd_life(args) -> int:
     code = report_study(outcome, "life")
     if code:
         return code
+    note = life.depth_limit_note(scenario, limit)  # how to read the history below
+    if note and not args.quiet:
+        print(f"bearingsim: note: {note}", file=sys.stderr)
     print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}"))
     for path in outcome.written:
         print(f"wrote {path}")
@@ -68,7 +71,8 @@ def add_commands(sub) -> None:
     w.set_defaults(func=_cmd_wear)
     li = sub.add_parser("life", help="stages of simulate / wear the pockets / simulate again until a wear limit")
     li.add_argument("scenario", help="multibody scenario TOML file")
-    li.add_argument("--limit", required=True, help="depth=<x>mm (deepest worn point), clearance=<x>mm (pocket "
+    li.add_argument("--limit", required=True, help="depth=<x>mm (deepest worn point: an end bin's, which depends "
+                                                   "on the bins of psi, docs/wear.md), clearance=<x>mm (pocket "
                                                    "clearance), or volume=<x>mm3 (worn volume of one face)")
     li.add_argument("--stages", type=int, default=10, help="stages (default 10)")
     li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")

@@ -147,8 +147,20 @@ def format_report(rep: WearReport) -> str:
         ends = shape_of(rep.psi_deg, d)
         lines.append(f"{f}: mean depth over pockets at the bore end {ends['bore'] * 1e6:.4g} um, middle "
                      f"{ends['middle'] * 1e6:.4g} um, rim end {ends['rim'] * 1e6:.4g} um")
-    lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um")
+    lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um" + edge_caveat(rep))
     return "\n".join(lines)
+
+
+def edge_caveat(rep: WearReport) -> str:
+    """`` (an end bin's ...)`` when the deepest point lies in a bin at an end of a face's extent: the wear
+    there is that of the face's edge, a line, so its depth is the edge's volume over one bin's area and
+    doubles each time the bins halve (docs/wear.md, *Discretization errors*); '' otherwise."""
+    ends = [d[[0, -1]].max() for d in (rep.depth_front, rep.depth_rear)]
+    if max(ends) < rep.max_depth:
+        return ""
+    width = float(np.diff(rep.psi_deg).mean()) if len(rep.psi_deg) > 1 else float("nan")
+    return (f" (an end bin's, {width:.3g} deg of psi wide: the wear at a face's edge is a line, whose depth "
+            "doubles each time the bins halve; the volumes and mean depths do not depend on the bins)")
 
 
 def shape_of(psi_deg, depth) -> dict[str, float]:

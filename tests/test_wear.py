@@ -786,3 +786,29 @@ def test_wear_cli_says_what_is_wrong_with_its_input(tmp_path, capsys, make, word
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
     assert err.startswith(f"bearingsim: error: {path}: {words}"), err
+
+
+def test_a_deepest_point_at_a_faces_edge_says_it_depends_on_the_bins():
+    """docs/wear.md, Discretization errors: the wear at a face's edge is a line, so an end bin's depth is its
+    volume over one bin's area and doubles with each halving of the bins (1374 / 2735 / 5459 / 10911 um at
+    16 / 32 / 64 / 128 bins on the wear test). The report's deepest point says so when it lies in an end bin,
+    and not when it lies inside the face; a depth limit of the life study says so, the other limits not."""
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies.life import depth_limit_note, parse_limit
+    from bearingsim.wear import WearReport, edge_caveat
+
+    psi = np.linspace(-30.0, 25.0, 32)
+
+    def report(depth):
+        z = np.zeros((32, 2))
+        return WearReport(psi, depth, z, z[0], z[0], 1.0, 1.0, 1.0, 1e-5, 1e9, 1e-8)
+
+    edge, inside = np.zeros((32, 2)), np.zeros((32, 2))
+    edge[0, 1], edge[5, 0] = 2e-3, 1e-3
+    inside[0, 1], inside[5, 0] = 1e-3, 2e-3
+    assert "doubles each time the bins halve" in edge_caveat(report(edge))
+    assert "1.77 deg of psi wide" in edge_caveat(report(edge))  # 55 deg over 31 bin steps
+    assert edge_caveat(report(inside)) == ""
+    sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml")
+    assert "1.85 deg of psi wide" in depth_limit_note(sc, parse_limit("depth=0.1mm"))
+    assert depth_limit_note(sc, parse_limit("clearance=0.4mm")) is None

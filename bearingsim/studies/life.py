@@ -65,6 +65,22 @@ MAPPINGS = {
 }
 
 
+def depth_limit_note(scenario, limit: Limit) -> str | None:
+    """For a ``depth`` limit: the deepest point is an end bin's, and the wear at a face's edge is a line,
+    whose depth doubles each time the bins of psi halve (docs/wear.md, *Discretization errors*), so the
+    rotations to a depth limit are those of the recorder's bin width; None for the other limits, which
+    read volumes."""
+    if limit.kind != "depth":
+        return None
+    from bearingsim.multibody.recorder import FACE_BINS
+
+    lo, hi = scenario.parameters.multibody.pocket_face_extent
+    return (f"--limit {limit.text} reads the deepest worn point, in the runs measured a face's edge, an end bin "
+            f"({math.degrees(hi - lo) / FACE_BINS:.3g} deg of psi wide): the wear at a face's edge is a line, whose "
+            "depth doubles each time the bins halve, so the rotations to a depth limit are those of this bin "
+            "width (docs/wear.md); clearance= and volume= limits read volumes, which do not depend on it")
+
+
 def parse_limit(text: str) -> Limit:
     """``depth=0.1mm``, ``clearance=0.5mm`` or ``volume=2mm3`` (also ``um`` for lengths)."""
     m = re.fullmatch(r"\s*(\w+)\s*=\s*([0-9.eE+-]+)\s*(\w+)\s*", text or "")

@@ -39,6 +39,16 @@ def test_readme_is_a_users_page():
     assert len(text.splitlines()) < 150
 
 
+def test_the_pages_carry_no_development_references():
+    """The README and docs/ are the users' pages: no issue numbers of the development log (docs/reliability.md's
+    heading, written by tests/test_reliability.py's ``write_doc``, ended "(issue 14)")."""
+    pattern = re.compile(r"\bissue \d+|\(issue\b", re.I)
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    offenders = [f"{p.relative_to(ROOT)}:{i + 1}" for p in pages
+                 for i, line in enumerate(p.read_text().splitlines()) if pattern.search(line)]
+    assert not offenders, offenders
+
+
 def test_help_texts_and_scenarios_carry_no_development_references():
     """Users read the help texts, module docstrings and scenario files: no issue numbers, no pointers
     into a README section that is not there."""

@@ -926,7 +926,7 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
         return "bearingsim " + " ".join(a)
 
     lines = [
-        "# Bad input, faults and interruptions: what bearingsim does (issue 14)",
+        "# Bad input, faults and interruptions: what bearingsim does",
         "",
         "Generated from `tests/test_reliability.py` (the cases are data there) by",
         "`PYTHONPATH=. python3 -m tests.test_reliability --write-doc`; do not edit by hand.",

@@ -27,7 +27,7 @@ interval is a little narrow). Beside them, a scatter that one odd replica does n
 replica's own ``se``. And the start's transient that one warm-up rotation leaves in the recorded ones:
 ``rotation 1`` and ``rotations 1-5``, the mean I_dec of the first recorded rotation and of the first
 five against that of rotations 9 to N, relative, averaged over the replicas (± its standard error over
-them); 5 is the default ``numerics.rotations``.
+them); 5 is the default ``numerics.rotations``. With N below 9 these two columns are ``-``.
 """
 from __future__ import annotations
 
@@ -121,6 +121,8 @@ def main(argv=None) -> int:
             robust = 1.4826 * statistics.median(abs(m - med) for m in means)
             worst = max(abs(m - med) / e for m, e in zip(means, ses))
             def start(k):  # the first k recorded rotations against rotations 9..N, % (mean, its standard error)
+                if args.rotations < 9:  # no rotation 9..N to compare with
+                    return "-"
                 d = [100.0 * (o[2][:k].mean() / o[2][8:].mean() - 1.0) for o in out]
                 return f"{statistics.fmean(d):+.2f} ± {statistics.stdev(d) / math.sqrt(len(d)):.2f}"
 

@@ -144,3 +144,40 @@ def test_every_solver_of_the_full_scene_has_a_bench_row():
         offered = set(typing.get_args(MultibodySection.model_fields[key].annotation)) - {"auto"}
         assert offered <= {v for k, v in covered if k == key}, key
     assert len({scene for scene, _ in FULL_VARIANTS}) == len(FULL_VARIANTS)
+
+
+def test_replica_scatter_runs_with_fewer_rotations_than_its_start_window(monkeypatch, capsys):
+    """``python -m benchmarks.replica_scatter --rotations N`` takes any N: the columns "rotation 1" and
+    "rotations 1-5" compare with rotations 9..N, so below 9 rotations they have nothing to compare with and
+    say so ("-"). With --rotations 5 the script ended in a traceback (statistics.stdev of NaN) after the
+    runs. The replicas here are stand-ins (no simulation), run in this process."""
+    import numpy as np
+
+    import benchmarks.replica_scatter as rs
+
+    class Serial:
+        def __init__(self, workers):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def map(self, f, jobs):
+            return map(f, jobs)
+
+    def replica(job):
+        raceway, rpm, rotations, load, dt = job
+        series = 0.014 + 1e-4 * np.sin(np.arange(rotations) + load)
+        return float(series.mean()), 1e-5, series, False
+
+    monkeypatch.setattr(rs, "ProcessPoolExecutor", Serial)
+    monkeypatch.setattr(rs, "_replica", replica)
+    assert rs.main(["--replicas", "3", "--rotations", "5", "--case", "rigid:3000", "--jobs", "1"]) == 0
+    row = capsys.readouterr().out.splitlines()[-1].split(" | ")
+    assert row[0] == "| rigid" and row[9] == "-" and row[10] == "-", row
+    assert rs.main(["--replicas", "3", "--rotations", "12", "--case", "rigid:3000", "--jobs", "1"]) == 0
+    row = capsys.readouterr().out.splitlines()[-1].split(" | ")
+    assert "±" in row[9] and "±" in row[10], row

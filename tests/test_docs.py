@@ -355,3 +355,33 @@ def test_every_file_an_example_reads_is_one_an_example_writes():
     unwritten = [f"{page}: {path}" for page, path in reads
                  if not any(path == w or path.startswith(w + "/") for w in written)]
     assert len(reads) > 20 and not unwritten, unwritten
+
+
+def test_every_command_and_option_the_pages_name_exists():
+    """Each ``bearingsim <command> ...`` in the code of the README and docs/ (a command line or an inline
+    span; ``run|sweep`` names two) names a subcommand of the parser, and each option it gives (``--set``,
+    ``-j``, ``[--mapping uniform]``) is one that subcommand accepts."""
+    import argparse
+
+    from bearingsim.cli import build_parser
+
+    options = {}
+    for action in build_parser()._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            options = {name: set(sub._option_string_actions) for name, sub in action.choices.items()}
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    bad, seen = [], 0
+    for page in pages:
+        for span in _code_spans(page):
+            for m in re.finditer(r"\bbearingsim ((?:[a-z]+\|)*[a-z]+)\b((?: +[^ ]+)*)", span):
+                for command in m.group(1).split("|"):
+                    seen += 1
+                    if command not in options:
+                        bad.append(f"{page.name}: bearingsim {command}: no such command")
+                        continue
+                    for token in m.group(2).split():
+                        for flag in re.split(r"[|\[\]]", token):
+                            flag = flag.split("=")[0]
+                            if re.match(r"--?[A-Za-z]", flag) and flag not in options[command]:
+                                bad.append(f"{page.name}: bearingsim {command} {flag}: no such option")
+    assert seen > 100 and not bad, bad

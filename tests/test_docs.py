@@ -385,3 +385,11 @@ def test_every_command_and_option_the_pages_name_exists():
                             if re.match(r"--?[A-Za-z]", flag) and flag not in options[command]:
                                 bad.append(f"{page.name}: bearingsim {command} {flag}: no such option")
     assert seen > 100 and not bad, bad
+
+
+def test_architecture_names_every_benchmark_script():
+    """docs/architecture.md says what each script of benchmarks/ is for; a script it does not name is one a
+    reader of the layout cannot find (nine were missing)."""
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    scripts = sorted(p.name for p in (ROOT / "benchmarks").glob("*.py") if p.name != "__init__.py")
+    assert scripts and [s for s in scripts if f"`{s}`" not in text] == []

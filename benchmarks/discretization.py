@@ -26,7 +26,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
 
 SCENARIOS = Path(__file__).resolve().parents[1] / "scenarios"
 
@@ -167,6 +166,8 @@ def theta(bins=(180, 360, 720, 1440), sets=()):
     import bearingsim.multibody as mb
     from bearingsim.multibody import core
 
+    from benchmarks.whole_bearing import where_forces_act
+
     saved = core.THETA_BINS, mb.THETA_BINS
     print("| bins of theta | I_dec [mN s] | half angle from ring displacement [deg] | contact extent [deg] | F_dec onset [deg] "
           "| drive within phi + 15 deg |")
@@ -177,16 +178,9 @@ def theta(bins=(180, 360, 720, 1440), sets=()):
             r = _run("multibody_3000rpm", ["reduced.load_zone_half_angle_deg=23.5", "numerics.warmup_rotations=1",
                                            "numerics.rotations=20", *sets])
             s = r.summary
-            th = r.get("theta_deg")
-            phi = s["load_zone_half_angle_deg"]
-            net = (r.get("force_vs_theta_acc") - r.get("force_vs_theta_dec")).mean(axis=1)
-            pos = np.clip(net, 0, None)
-            lz = (th <= phi + 15) | (th >= 360 - phi - 15)
-            fdec = r.get("force_vs_theta_dec").mean(axis=1)
-            nl = (th > phi) & (th < 180)
-            onset = th[nl][np.argmax(fdec[nl] > 0.1 * fdec[nl].max())]
-            print(f"| {nb} | {s['I_dec_mean_Ns'] * 1e3:.4f} | {phi:.2f} | {s['load_zone_contact_half_angle_deg']:.2f} | "
-                  f"{onset:.2f} | {pos[lz].sum() / pos.sum():.1%} |", flush=True)
+            drive, onset, _, _ = where_forces_act(r)
+            print(f"| {nb} | {s['I_dec_mean_Ns'] * 1e3:.4f} | {s['load_zone_half_angle_deg']:.2f} | "
+                  f"{s['load_zone_contact_half_angle_deg']:.2f} | {onset:.2f} | {drive:.1%} |", flush=True)
     finally:
         core.THETA_BINS, mb.THETA_BINS = saved
 

@@ -105,6 +105,21 @@ def extent():
               f"{om * 1e6:.0f} / {ox * 1e6:.0f} | {_whirl(r):+.3f} | {r.summary['cage_slip'] * 100:.3f} % |", flush=True)
 
 
+def where_forces_act(r):
+    """Where the forces act (paper Sec. 3.1, Fig. 5): (the share of the net drive F_acc - F_dec within
+    phi + 15 deg of the load-zone centre, the F_dec onset after the load zone [deg], theta [deg], the mean
+    F_dec over pockets per bin of theta) of a run, phi its load-zone half angle."""
+    th = r.get("theta_deg")
+    phi = r.summary["load_zone_half_angle_deg"]
+    net = (r.get("force_vs_theta_acc") - r.get("force_vs_theta_dec")).mean(axis=1)
+    pos = np.clip(net, 0, None)
+    lz = (th <= phi + 15) | (th >= 360 - phi - 15)
+    fdec = r.get("force_vs_theta_dec").mean(axis=1)
+    nl = (th > phi) & (th < 180)
+    onset = th[nl][np.argmax(fdec[nl] > 0.1 * fdec[nl].max())]
+    return pos[lz].sum() / pos.sum(), onset, th, fdec
+
+
 def checks():
     base = ["reduced.load_zone_half_angle_deg=23.5", "numerics.warmup_rotations=1"]
     fwd = _run("multibody_3000rpm", [*base, "numerics.rotations=20"])
@@ -117,17 +132,10 @@ def checks():
           f"{rev.summary['I_dec_mean_Ns'] / s['I_dec_mean_Ns']:.4f}; load-zone half angle "
           f"{s['load_zone_half_angle_deg']:.2f} deg, contact extent {s['load_zone_contact_half_angle_deg']:.2f} deg; "
           f"I_dec {s['I_dec_mean_Ns'] * 1e3:.2f} ± {s['I_dec_std_Ns'] * 1e3:.2f} mN s, slip {s['cage_slip']:.3%}")
-    # where the forces act (paper Sec. 3.1, Fig. 5): share of the drive within phi + 15 deg, F_dec onset
-    th = fwd.get("theta_deg")
     phi = s["load_zone_half_angle_deg"]
-    net = (fwd.get("force_vs_theta_acc") - fwd.get("force_vs_theta_dec")).mean(axis=1)
-    pos = np.clip(net, 0, None)
-    lz = (th <= phi + 15) | (th >= 360 - phi - 15)
-    fdec = fwd.get("force_vs_theta_dec").mean(axis=1)
-    nl = (th > phi) & (th < 180)
-    onset = th[nl][np.argmax(fdec[nl] > 0.1 * fdec[nl].max())]
+    drive, onset, th, fdec = where_forces_act(fwd)
     band = (th >= 240) & (th <= 300)
-    print(f"drive within phi + 15 deg {pos[lz].sum() / pos.sum():.1%}; F_dec onset {onset:.1f} deg (phi {phi:.2f}); "
+    print(f"drive within phi + 15 deg {drive:.1%}; F_dec onset {onset:.1f} deg (phi {phi:.2f}); "
           f"share of F_dec at 240-300 deg {fdec[band].sum() / fdec.sum():.2f}")
     # the reduced-equivalent scene against the event model, and its dt convergence
     from bearingsim.multibody.core import choose_dt

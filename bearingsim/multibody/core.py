@@ -130,7 +130,7 @@ def inner_ring_model(p):
     """(mass [kg], description) of the inner ring: mass 0 is quasi-static (massless).
 
     ``multibody.inner_ring = "auto"`` keeps the quasi-static ring while the load is always shared by at
-    least two rollers (:func:`bearingsim.kinematics.loaded_rollers_with_one_at_centre` >= 2) or there
+    least two rollers (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre` >= 2) or there
     is no load, and otherwise makes it dynamic: a ring resting on a single roller has no stable
     sideways equilibrium, so the rotor's inertia decides where it goes. The dynamic ring's mass is
     ``multibody.inner_ring_mass_kg``; "auto" takes the radial load as the weight of the rotor the

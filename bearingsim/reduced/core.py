@@ -150,7 +150,7 @@ class PassInputs:
         return (self.theta_end - self.theta_start) / self.omega_c
 
     def drag_force(self, theta):
-        """F_o(θ) [N] through :func:`bearingsim.kinematics.oil_film_drag` (vectorised; reference)."""
+        """F_o(θ) [N] through :func:`bearingsim.laws.oil_film_drag` (vectorised; reference)."""
         n = laws.outer_race_normal_load(self.mass, self.pitch_radius, self.omega_c, theta, self.gravity)
         return laws.oil_film_drag(self.drag_coefficient, n, self.rolling_velocity)
 

@@ -381,7 +381,10 @@ class _Drawing:
         e_t = self.sign * np.column_stack([-e_r[:, 1], e_r[:, 0]])
         centred = self.rp * e_r  # pocket centres of a cage on the axis
         pockets = k * cage + centred
-        rollers = centred + k * (m.rollers_xy[j] * 1e3 - cage - centred)
+        # every body at its place on the axis plus K times its offset from there: a roller's offset from its
+        # pocket's centre (cage + centred) is then drawn K times from the drawn pocket's (K cage + centred), and
+        # its offsets from the raceways K times from the drawn raceways
+        rollers = centred + k * (m.rollers_xy[j] * 1e3 - centred)
         self.pockets.set_offsets(pockets)
         self.rollers.set_offsets(rollers)
         self.cage.set_transform(self._shift(k * cage))

@@ -168,6 +168,46 @@ def test_the_cage_is_drawn_where_the_archive_says(runs, tmp_path):
     assert max(errors) < 2.0, (errors, shifts)
 
 
+def test_the_rollers_are_drawn_in_their_pockets_and_on_the_raceways(runs):
+    """Every clearance is drawn K times: a roller's offset from its pocket's centre (the cage centre plus the
+    pitch radius along the pocket's direction) must be drawn K times from the drawn pocket's centre, and its
+    distance from the axis and from the inner ring's centre K times its offset from the pitch circle. The
+    cage rides ~0.2 mm off the axis here: a roller drawn about its pocket's place on a centred cage instead
+    is off by K times that (2 mm at K = 10), through the pocket faces (drawn play K s / 2 = 1 mm) and into a
+    raceway. The drawn offsets are read from the frame's own artists (the collections the frame draws)."""
+    res, path = runs[0], runs[1]
+    p, g = res.parameters, res.parameters.bearing
+    motion = animation._Motion(res)
+    k = animation._exaggeration(p, None)
+    rows = np.arange(0, len(motion.time), 6)
+    drawing = animation._Drawing(res, motion, k, rows)
+    rp, rr = g.pitch_radius * 1e3, g.roller_radius * 1e3
+    play = drawing.R - rr
+    excess_face, excess_outer, excess_inner, cage_off = [], [], [], []
+    for f, j in enumerate(rows):
+        drawing.draw(f)
+        rollers = np.asarray(drawing.rollers.get_offsets())
+        pockets = np.asarray(drawing.pockets.get_offsets())
+        cage = motion.cage_xy[j] * 1e3
+        a = motion.cage_angle[j] + pocket_angles(g.roller_count, p.operating.sign)
+        e_r = np.column_stack([np.cos(a), np.sin(a)])
+        e_t = p.operating.sign * np.column_stack([-e_r[:, 1], e_r[:, 0]])
+        offset = motion.rollers_xy[j] * 1e3 - cage - rp * e_r  # the roller in its pocket [mm]
+        np.testing.assert_allclose(rollers - pockets, k * offset, atol=1e-9)
+        excess_face.append(np.abs(((rollers - pockets) * e_t).sum(1)).max() - play)
+        pd = g.radial_clearance * 1e3
+        excess_outer.append((np.hypot(*rollers.T) + rr - (rp + 0.25 * k * pd + rr)).max())
+        ring = k * motion.ring_xy[j] * 1e3
+        excess_inner.append(((rp - 0.25 * k * pd) - np.hypot(*(rollers - ring).T)).max())
+        cage_off.append(np.hypot(*cage))
+    assert min(cage_off) > 0.1  # the case this test is about: a cage well off the axis [mm]
+    # along the circumference within the drawn play (1 % of it: the overlap the model allows); radially the
+    # raceways' contact approach (a few um, drawn K times) and the second-order growth of the radius of a
+    # roller drawn K times off its place along the circumference (K^2 offset^2 / 2 r_p) on the raceways
+    assert max(excess_face) <= 0.01 * play
+    assert max(excess_outer) < 0.15 and max(excess_inner) < 0.15, (max(excess_outer), max(excess_inner))
+
+
 def test_an_archive_without_motion_is_refused_in_one_line(runs, tmp_path, capsys):
     """No motion: exit 2, one line naming the archive and the key to set, no traceback, no file left."""
     out = tmp_path / "x.mp4"

@@ -471,5 +471,13 @@ def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
                                                           dither=Image.Dither.NONE))
             if progress is not None:
                 progress(i + 1, total)
-        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:], duration=1000.0 / fps,
-                       loop=0, optimize=False, disposal=1)
+        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
+                       duration=gif_durations_ms(len(images), fps), loop=0, optimize=False, disposal=1)
+
+
+def gif_durations_ms(frames: int, fps: float) -> list[int]:
+    """Each frame's delay [ms] in a GIF, which stores delays in hundredths of a second: frame ``i`` ends at
+    ``round((i + 1) x 100 / fps)`` cs, so that ``frames`` frames last ``frames / fps`` s to 10 ms (one delay of
+    1000 / fps ms, which Pillow truncates to whole hundredths, played 15 fps as 60 ms frames: 10 % fast)."""
+    ends = [round((i + 1) * 100.0 / fps) for i in range(frames)]
+    return [10 * (e - s) for s, e in zip([0, *ends[:-1]], ends)]

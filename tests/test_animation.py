@@ -95,6 +95,22 @@ def test_gif_has_the_frames_of_its_window_and_fps(runs, tmp_path):
     assert len(_gif_frames(out)) == round(0.25 * animation.SECONDS_PER_ROTATION * 12)
 
 
+@pytest.mark.parametrize("fps", [12, 15, 30])
+def test_a_gif_plays_for_the_time_its_frames_and_fps_say(runs, tmp_path, fps):
+    """A GIF stores each frame's delay in hundredths of a second: a window of 0.25 rotations must play
+    0.25 x SECONDS_PER_ROTATION = 1 s at any fps (to one hundredth), not 12 x 80 ms, 15 x 60 ms or
+    30 x 30 ms (a delay of 1000 / fps ms truncated to whole hundredths: up to 10 % fast, as the
+    report's 15 fps clip of half a rotation played in 1.8 s instead of 2 s)."""
+    from PIL import Image, ImageSequence
+
+    out = runs[0].animate(tmp_path / "t.gif", rotations=(0.25, 0.5), fps=fps)
+    with Image.open(out) as im:
+        delays = [f.info["duration"] for f in ImageSequence.Iterator(im)]
+    assert len(delays) == round(0.25 * animation.SECONDS_PER_ROTATION * fps)
+    assert abs(sum(delays) - 1000.0 * 0.25 * animation.SECONDS_PER_ROTATION) <= 10.0, delays
+    assert min(delays) >= 20  # browsers show shorter delays as 100 ms
+
+
 def test_mp4_through_the_command_line(runs, tmp_path, capsys):
     """``bearingsim animate ... --rotations a:b --fps F``: decoded back to raw RGB by the same packaged
     ffmpeg, the MP4 has round((b - a) x 4 x F) frames of the frame's size, and the command says what it

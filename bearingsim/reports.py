@@ -494,10 +494,15 @@ def _life_sections(table: Path):
 
     cols, attrs = life.read_life(table)
     head = [h for _, h, _, _ in life.HISTORY_TABLE]
-    blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; {attrs.get('mapping', '')}."},
-              table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); the "
-                          "worn depth over each face at each stage's end is the figure's", head,
-                          life.history_rows(cols), [True] * len(head))]
+    mapping = str(attrs.get("mapping", ""))
+    blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"
+                                       + (f": {life.MAPPINGS[mapping]}." if mapping in life.MAPPINGS else ".")}]
+    note = _life_limit_note(attrs)
+    if note:
+        blocks.append({"kind": "text", "text": f"Note: {note}."})
+    blocks.append(table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); "
+                              "the worn depth over each face at each stage's end is the figure's", head,
+                              life.history_rows(cols), [True] * len(head)))
     figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "
                                                          "running time, stage by stage")]
     import tomllib
@@ -506,6 +511,26 @@ def _life_sections(table: Path):
     name = tomllib.loads(toml).get("name", "?") if toml else "?"
     sections = [Section("table", "Life", blocks), Section("figures", "Figures", figures)]
     return f"Life of {name} to {attrs.get('limit', '?')}", sections, toml
+
+
+def _life_limit_note(attrs: dict) -> str | None:
+    """What ``bearingsim life`` notes under its history for a ``depth`` limit (the deepest point is an end
+    bin's, so the rotations to it are those of the bin width: :func:`bearingsim.studies.life.depth_limit_note`),
+    from the folder's limit and scenario; None for the other limits or a folder that does not say."""
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import parse_toml_text, resolve
+    from bearingsim.studies import life
+
+    toml, text = attrs.get("scenario"), attrs.get("limit")
+    if not toml or not text:
+        return None
+    try:
+        limit = life.parse_limit(str(text))
+        if limit.kind != "depth":
+            return None
+        return life.depth_limit_note(resolve(parse_toml_text(str(toml), "life.h5"), "life.h5"), limit)
+    except UserError:
+        return None
 
 
 def _folder_sections(folder: Path, toml) -> list[Section]:

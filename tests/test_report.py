@@ -232,7 +232,7 @@ def _crosscheck_table(folder: Path) -> None:
     cc.write_table(folder, cc.add_changes(rows), bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
 
 
-def _life_table(folder: Path) -> None:
+def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "test rows") -> None:
     from bearingsim import archive
     from bearingsim.studies import life
 
@@ -245,8 +245,8 @@ def _life_table(folder: Path) -> None:
             "I_dec_mean_mNs": [14.0] * n, "reused": [0] * n, "psi_deg": [np.linspace(-30.0, 25.0, 32)] * n,
             "worn_depth_front_um": np.full((n, 32, 16), 1.25), "worn_depth_rear_um": np.full((n, 32, 16), 2.5)}
     archive.write_table_file(folder / "life.h5", {k: np.asarray(v) for k, v in cols.items()}, life.LIFE_UNITS, {
-        "format": life.LIFE_FORMAT, "limit": "clearance=0.23mm", "stages": n,
-        "scenario": bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml").to_toml(), "mapping": "test rows"})
+        "format": life.LIFE_FORMAT, "limit": limit, "stages": n,
+        "scenario": bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml").to_toml(), "mapping": mapping})
 
 
 @pytest.mark.slow
@@ -469,6 +469,23 @@ def test_the_life_history_of_a_report_is_the_table_the_command_prints(folders, t
     cols, _ = life.read_life(folders / "life" / "life.h5")
     for row in life.history_rows(cols):
         assert "".join(f"<td class=\"num\">{c}</td>" for c in row) in re.sub(r"\s+<", "<", table)
+
+
+def test_a_life_page_to_a_depth_limit_says_what_the_command_notes(tmp_path):
+    """`bearingsim life --limit depth=...` notes under its history that the deepest point is an end bin's,
+    so the rotations to that limit are those of the bin width (docs/wear.md): the page, which a reader takes
+    instead of the command's output, must say it too, and what its mapping means; a clearance limit (read
+    from volumes) gets no such note."""
+    from bearingsim.studies import life
+
+    _life_table(tmp_path / "depth", limit="depth=0.1mm", mapping="shape")
+    html = bearingsim.report(tmp_path / "depth", tmp_path / "d.html").read_text()
+    text = re.sub(r"\s+", " ", re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1))
+    assert "reads the deepest worn point" in text and "1.85 deg of psi wide" in text
+    assert life.MAPPINGS["shape"] in text
+    _life_table(tmp_path / "clearance", mapping="shape")
+    html = bearingsim.report(tmp_path / "clearance", tmp_path / "c.html").read_text()
+    assert "reads the deepest worn point" not in html
 
 
 @pytest.mark.slow

@@ -213,10 +213,12 @@ def _pinched_note(result) -> str | None:
             f"{s_mm + 2e3 * depth:.4g} (now {s_mm:.4g}) frees them")
 
 
-def checks_made(result) -> list[tuple[str, str, bool]]:
+def checks_made(result) -> list[tuple[str, str, bool | None]]:
     """What :func:`check` verifies of ``result``, for a report: one ``(check, what was measured against
     its limit, passed)`` per check, with the limits :func:`check` uses (a report shows them beside the
-    notes and the verdict of :func:`check` itself, which stays the one that refuses a run)."""
+    notes and the verdict of :func:`check` itself, which stays the one that refuses a run). ``passed`` is
+    None for a check that could not be made of this result (too few recorded rotations; a cage-speed
+    drift, whose start and end speeds only a fresh run holds): the row says why, and is not a pass."""
     p = result.parameters
     summary = dict(result.summary)
     bad = _nonfinite(summary)
@@ -245,6 +247,24 @@ def checks_made(result) -> list[tuple[str, str, bool]]:
                     f"the {n} later ones, {sds:.1f} of their standard deviations, against at most "
                     f"{START_TRANSIENT_SD:g} or {START_TRANSIENT_MIN_REL:.0%}",
                     abs(rel) <= START_TRANSIENT_MIN_REL or sds <= START_TRANSIENT_SD))
+    else:
+        rotations = np.shape(result.per_rotation.get("I_dec", np.zeros(0)))[0] if np.ndim(
+            result.per_rotation.get("I_dec", np.zeros(0))) else 0
+        out.append(("warm-up reached a steady state", f"not evaluated: {counted(rotations, 'recorded rotation')}, "
+                    f"at least {START_TRANSIENT_MIN_ROTATIONS} needed (the later ones give the scatter to judge "
+                    "the first by)", None))
+    raw = getattr(result, "raw", None)
+    if raw is None or raw.cage_w_start is None:
+        out.append(("cage speed steady (no drift over the recorded rotations)", "not evaluated: the cage speeds at "
+                    "the start and the end of the recording are a fresh run's, not stored in an archive "
+                    f"(at most {MAX_CAGE_SPEED_DRIFT:.0%} of the mean; 'bearingsim run' notes a drift)", None))
+    else:
+        note = cage_speed_drift(result)
+        ws, we = float(raw.cage_w_start), float(raw.cage_w_end)
+        mean = abs(float(summary.get("cage_speed_mean_rad_s", float("nan"))))
+        out.append(("cage speed steady (no drift over the recorded rotations)",
+                    f"{ws:.4g} to {we:.4g} rad/s ({(we - ws) / mean:+.1%} of the mean) against at most "
+                    f"{MAX_CAGE_SPEED_DRIFT:.0%}", note is None))
     fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
     steps = int(summary.get("steps", 0) or 0)
     if steps:

@@ -272,8 +272,11 @@ def _checks_blocks(result) -> list[dict]:
     blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok} for n, m, ok in rows]}]
     try:
         notes = plausibility.check(result)
-        verdict = ("Every check passed: 'bearingsim run' writes an archive only for a run that passes them "
-                   "(docs/reliability.md); checked again from this archive.")
+        skipped = [n for n, _, ok in rows if ok is None]
+        verdict = (("Every check passed" if not skipped else "Every check that could be made passed")
+                   + ": 'bearingsim run' writes an archive only for a run that passes them (docs/reliability.md); "
+                   "checked again from this archive."
+                   + (f" Not evaluated here, and no pass: {'; '.join(skipped)} (the table says why)." if skipped else ""))
     except SimulationUnstable as exc:
         notes, verdict = [], f"This archive does NOT pass the checks: {exc}"
     blocks.append({"kind": "text", "text": verdict})

@@ -38,6 +38,9 @@ FLASH_ALPHA = (1.0, 0.55, 0.25)
 AUTO_PLAY_FRACTION = 0.3
 MAX_EXAGGERATION = 1000.0
 MAX_FPS = 120.0
+#: highest frame rate of a GIF: it stores each frame's delay in hundredths of a second, and browsers show a
+#: delay under 2 of them (20 ms) as 100 ms, so a GIF above 50 fps would play several times too slowly
+MAX_GIF_FPS = 50.0
 #: the frame: pixels (multiples of 16, as H.264's macro blocks) and the bearing's square view in it
 WIDTH_PX, HEIGHT_PX, DPI = 1024, 768, 100
 VIEW_RECT = (0.0, 0.0, HEIGHT_PX / WIDTH_PX, 1.0)  # figure fraction: the left 768 x 768 px
@@ -76,6 +79,9 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
     if MOTION not in result.series:
         raise _no_motion(result, where)
     fps = check_number(fps, "fps", 1.0, MAX_FPS)
+    if out.suffix.lower() == ".gif" and fps > MAX_GIF_FPS:
+        raise UserError(f"fps {fps:g}: a GIF plays at most {MAX_GIF_FPS:g} frames per second (browsers show a frame "
+                        f"shorter than 20 ms for 100 ms); give a lower fps, or write an .mp4")
     if last is not None and not _as_number(last, "last") > 0:  # NaN too
         raise UserError(f"last: {last!r} is not a positive number of cage rotations")
     motion = _Motion(result)

@@ -43,7 +43,7 @@ def _cmd_animate(args) -> int:
             bar.update(done - bar.n)
 
     try:
-        with options_named("rotations"):
+        with options_named("rotations", "fps"):
             out = render(args.archive, args.output, rotations=rotations, exaggerate=args.exaggerate, fps=args.fps,
                          progress=progress)
     finally:

@@ -247,6 +247,24 @@ def test_bad_rotations_are_refused_in_one_line(runs, tmp_path, capsys, window, w
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_gif_faster_than_browsers_play_is_refused_and_an_mp4_is_not(runs, tmp_path, capsys):
+    """A GIF's delays are whole hundredths of a second and browsers show one under 20 ms as 100 ms: at
+    --fps 60 some frames got 10 ms, at 120 every frame 0 ms, a clip playing several times too slowly.
+    Above MAX_GIF_FPS = 50 a GIF is refused in one line naming the option (the API: its keyword), nothing
+    written; at 50 every frame is 20 ms; an MP4 takes up to MAX_FPS."""
+    from PIL import Image, ImageSequence
+
+    with pytest.raises(UserError, match=r"^fps 60: a GIF plays at most 50 frames per second"):
+        runs[0].animate(tmp_path / "a.gif", rotations=(0.25, 0.3), fps=60)
+    assert main(["animate", str(runs[1]), "-o", str(tmp_path / "b.gif"), "--fps", "120"]) == 2
+    assert capsys.readouterr().err.startswith("bearingsim: error: --fps 120: a GIF plays at most 50")
+    assert list(tmp_path.iterdir()) == []
+    out = runs[0].animate(tmp_path / "c.gif", rotations=(0.25, 0.3), fps=50)
+    with Image.open(out) as im:
+        assert {f.info["duration"] for f in ImageSequence.Iterator(im)} == {20}
+    assert runs[0].animate(tmp_path / "d.mp4", rotations=(0.25, 0.3), fps=120).stat().st_size > 0
+
+
 def test_bad_output_and_options_are_refused(runs, tmp_path):
     """Only .mp4 and .gif; a user's file of another kind at the output path is kept; K and fps in range."""
     with pytest.raises(UserError, match=r"\.mp4 or \.gif"):

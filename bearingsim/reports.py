@@ -546,7 +546,7 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
     checks: list[dict] = []
     first = None
     if archive.is_table_file(index, INDEX_FORMAT):
-        cols, _ = read_index(index)
+        cols, meta = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
         failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]
@@ -556,7 +556,11 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
                                                (":" if failed else ". No case failed.")})
         if failed:
             checks.append(table_block("Failed cases", ["case", "error"], failed))
-        first = next((folder / a for a in cols["archive"] if a and (folder / a).is_file()), None)
+        row = next((i for i, a in enumerate(cols["archive"]) if a and (folder / a).is_file()), None)
+        first = folder / cols["archive"][row] if row is not None else None
+        # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)
+        label = ", ".join(f"{k} = {_plain_cell(cols[k][row])}" for k in meta.get("axes", ()) if k in cols) \
+            if row is not None else ""
     scenario = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
     sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario", scenario)]
     if first is not None:
@@ -564,6 +568,14 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
 
         prov = load(first, only=("results/summary",)).provenance
         sections.append(Section("provenance", "Provenance", [
-            _provenance_table(prov, f"How the first case was made ({first.relative_to(folder)}; every case ran with "
-                                    "the same code unless the index's model_version column says otherwise)")]))
+            _provenance_table(prov, f"How the first case was made ({label + ': ' if label else ''}"
+                                    f"{first.relative_to(folder)}; every case ran with the same code unless the "
+                                    "index's model_version column says otherwise)")]))
     return sections
+
+
+def _plain_cell(v) -> str:
+    """An index cell as the page shows it: text as it is, a number in its shortest form."""
+    if isinstance(v, bytes):
+        v = v.decode()
+    return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)

@@ -251,7 +251,9 @@ def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "t
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name, kind, words", [
-    ("sweep", "sweep", ["inner_ring_speed_rpm", "2 cases: done 2", "I_dec_mean [mN s]"]),
+    ("sweep", "sweep", ["inner_ring_speed_rpm", "2 cases: done 2", "I_dec_mean [mN s]",
+                        # the provenance's case named by what it varies, not by its hash alone
+                        "How the first case was made (operating.inner_ring_speed_rpm = 1000: cases/"]),
     ("sens", "sensitivity", ["contact.restitution", "lubrication.drag_coefficient", "d ln y / d ln x"]),
     ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
     ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),

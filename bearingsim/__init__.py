@@ -33,10 +33,19 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
 
 
 def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None):
-    """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result."""
+    """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result.
+
+    A run that is plausible but not clean returns its result with its one-line notes in ``result.notes``,
+    each also issued as a :class:`bearingsim.errors.PlausibilityWarning`."""
+    import warnings
+
+    from bearingsim.errors import PlausibilityWarning
     from bearingsim.simulation import run as _run
 
-    return _run(scenario, progress=progress, sink=sink, dt=dt)
+    result = _run(scenario, progress=progress, sink=sink, dt=dt)
+    for note in result.notes:
+        warnings.warn(note, PlausibilityWarning, stacklevel=2)
+    return result
 
 
 def load(path):

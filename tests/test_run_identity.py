@@ -105,3 +105,24 @@ def test_the_library_prints_nothing_its_notes_are_log_records(tmp_path, monkeypa
     assert out.result.notes == [NOTE]
     assert capsys.readouterr().err == ""
     assert [r.getMessage() for r in caplog.records if r.name.startswith("bearingsim")] == [NOTE]
+
+
+def test_the_api_warns_of_a_plausible_run_that_is_not_clean(monkeypatch):
+    """``bearingsim.run`` returns a plausible but not clean result with its notes in ``result.notes`` and
+    each issued once as a :class:`bearingsim.errors.PlausibilityWarning` pointing at the caller's line."""
+    import warnings
+
+    import bearingsim as api
+    from bearingsim.errors import PlausibilityWarning
+
+    monkeypatch.setattr(plausibility, "check", lambda result: [NOTE])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = api.run(load_scenario(BASE))
+    assert r.notes == [NOTE]
+    assert [(w.category, str(w.message)) for w in caught] == [(PlausibilityWarning, NOTE)]
+    assert caught[0].filename == __file__
+    monkeypatch.setattr(plausibility, "check", lambda result: [])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert api.run(load_scenario(BASE)).notes == []

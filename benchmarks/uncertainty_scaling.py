@@ -51,7 +51,7 @@ def main(argv=None) -> None:
         for n in (1, 2):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")  # dask's start-up notices
-                with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
                                   host="127.0.0.1") as cluster:
                     eng = DaskEngine(cluster=cluster)
                     eng.start()

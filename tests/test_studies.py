@@ -213,7 +213,8 @@ def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
 
     scenario = load_scenario(REFERENCE)
     local, _ = cc.run_crosscheck(scenario, tmp_path / "local", (RPM,), 1, jobs=1, progress=False)
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0",
+                      host="127.0.0.1") as cluster:
         remote, outcome = cc.run_crosscheck(scenario, tmp_path / "dask", (RPM,), 1,
                                             engine=DaskEngine(cluster=cluster), progress=False)
     assert outcome.count("done") == 5

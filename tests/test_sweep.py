@@ -416,7 +416,7 @@ def test_local_cluster_runs_the_same_cases(tmp_path):
         # dask's own start-up and shut-down notices (a port in use, comms closing) are recorded, not
         # raised; none may come from bearingsim itself
         warnings.simplefilter("always")
-        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+        with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0",
                           host="127.0.0.1") as cluster:
             out = run_sweep(spec, tmp_path / "dask", engine=DaskEngine(cluster=cluster), figures=False,
                             progress=False, archives="all")

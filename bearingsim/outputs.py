@@ -107,18 +107,24 @@ def write_atomic_bytes(path: Path, data: bytes) -> None:
         fh.write(data)
 
 
-def write_csv(path: str | Path, header, rows) -> Path:
-    """Write a CSV table (``header``, then ``rows`` of already formatted cells) through
-    :func:`atomic_file`, so a reader never sees half a table; return the path."""
+def csv_bytes(header, rows) -> bytes:
+    """A CSV table (``header``, then ``rows`` of already formatted cells) as UTF-8 bytes, in the one dialect
+    of every table bearingsim writes: Python's csv default, RFC 4180 (``\r\n`` line ends), as ``sweep.csv``."""
     import csv
     import io
 
-    path = Path(path)
     buf = io.StringIO(newline="")
     w = csv.writer(buf)
     w.writerow(header)
     w.writerows(rows)
-    write_atomic_bytes(path, buf.getvalue().encode("utf-8"))
+    return buf.getvalue().encode("utf-8")
+
+
+def write_csv(path: str | Path, header, rows) -> Path:
+    """Write a CSV table (:func:`csv_bytes`) through :func:`atomic_file`, so a reader never sees half a
+    table; return the path."""
+    path = Path(path)
+    write_atomic_bytes(path, csv_bytes(header, rows))
     return path
 
 

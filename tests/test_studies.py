@@ -277,3 +277,23 @@ def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path,
     capsys.readouterr()
     assert main(["table", str(tmp_path)]) == 0
     assert "3000" in capsys.readouterr().out
+
+
+def test_every_table_is_written_in_one_csv_dialect(tmp_path):
+    """The studies' tables (crosscheck, sensitivity, uncertainty: engine.table_csv), validate's (Fig. 9 and
+    rig: outputs.write_csv) and the sweep's index sweep.csv are written by one writer in one dialect,
+    RFC 4180 line ends; the studies' tables ended their lines in '\\n', the others in '\\r\\n'."""
+    import math
+
+    from bearingsim import outputs
+    from bearingsim.studies.engine import table_csv
+    from bearingsim.sweeps.index import write_index
+
+    study = table_csv([{"key": "x", "n": 2, "v": 1.5, "e": math.nan}], ["key", "n", "v", "e"])
+    assert study == outputs.csv_bytes(["key", "n", "v", "e"], [["x", "2", "1.5", ""]]) == b"key,n,v,e\r\nx,2,1.5,\r\n"
+    validate = outputs.write_csv(tmp_path / "t.csv", ["rpm"], [["500"]]).read_bytes()
+    assert validate == b"rpm\r\n500\r\n"
+    write_index(tmp_path, [{"case": "c", "status": "done", "error": "", "archive": "", "wall_s": 1.0,
+                            "model_version": 1, "summary": {}}], [], {})
+    lines = (tmp_path / "sweep.csv").read_bytes().split(b"\n")
+    assert all(line.endswith(b"\r") for line in lines[:-1]) and lines[-1] == b""

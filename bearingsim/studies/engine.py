@@ -25,13 +25,14 @@ from bearingsim.sweeps.spec import Case, case_hash
 
 
 def table_csv(rows: list[dict], columns) -> bytes:
-    """A study's table as CSV text (UTF-8): the header, then each row's ``columns``: text as it is, an
-    integer as an integer, a float by ``repr`` (every digit), NaN as an empty field."""
-    import csv
-    import io
+    """A study's table as CSV (:func:`bearingsim.outputs.csv_bytes`): the header, then each row's
+    ``columns``: text as it is, an integer as an integer, a float by ``repr`` (every digit), NaN as an empty
+    field."""
     import math
 
     import numpy as np
+
+    from bearingsim.outputs import csv_bytes
 
     def cell(v) -> str:
         if isinstance(v, str):
@@ -40,12 +41,7 @@ def table_csv(rows: list[dict], columns) -> bytes:
             return str(int(v))
         return "" if math.isnan(v) else repr(float(v))
 
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(columns)
-    for r in rows:
-        w.writerow([cell(r[c]) for c in columns])
-    return buf.getvalue().encode("utf-8")
+    return csv_bytes(columns, ([cell(r[c]) for c in columns] for r in rows))
 
 
 def table_columns(rows: list[dict], columns) -> dict:

@@ -164,10 +164,6 @@ class TimeSeries:
         self._buffered = 0
 
 
-def _tmp_name(path: Path) -> Path:
-    return path.with_name(f".{path.name}.tmp-{os.getpid()}")
-
-
 def _prepare_target(path) -> Path:
     """Check that an archive can be written at ``path`` (one-line UserError if not); return it."""
     path = Path(path)
@@ -179,7 +175,7 @@ def _prepare_target(path) -> Path:
     if path.is_dir():
         raise UserError(f"{path}: output path is a directory")
     outputs.check_target(path, (), is_archive, figures=False)  # .h5 name; never replaces a non-archive
-    tmp = _tmp_name(path)
+    tmp = outputs.temporary_name(path)
     try:
         tmp.touch()
     except OSError as exc:
@@ -198,7 +194,7 @@ class Spool:
 
     def __init__(self, path):
         self.path = _prepare_target(path)
-        self.tmp = _tmp_name(self.path)
+        self.tmp = outputs.temporary_name(self.path)
         self._series: list[TimeSeries] = []
         self.f = None
 
@@ -819,7 +815,7 @@ def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str]
     ``sweep.h5``. String columns are stored as variable-length UTF-8."""
     h5py = _lazy_h5py()
     path = Path(path)
-    tmp = _tmp_name(path)
+    tmp = outputs.temporary_name(path)
     try:
         with h5py.File(tmp, "w") as f:
             for k, v in attrs.items():
@@ -877,7 +873,7 @@ def write_grid_file(path, axes: list[tuple[str, np.ndarray, dict[str, str]]],
     """
     h5py = _lazy_h5py()
     path = Path(path)
-    tmp = _tmp_name(path)
+    tmp = outputs.temporary_name(path)
 
     def create(f, name, arr):
         arr = np.asarray(arr)

@@ -42,7 +42,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)
     if jobs < 1:
         raise UserError(f"--jobs: must be at least 1 (got {jobs})")
-    engine = DaskEngine(scheduler) if scheduler else LocalEngine(jobs)
+    engine = DaskEngine(scheduler) if scheduler is not None else LocalEngine(jobs)
     out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force, archives=archives,
                     progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))
     n = len(out.rows)

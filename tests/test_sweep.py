@@ -448,6 +448,18 @@ def test_unreachable_scheduler_is_a_user_error():
             DaskEngine("tcp://127.0.0.1:9", timeout_s=1).start()
 
 
+@pytest.mark.parametrize("address", ["foo", "tcp://127.0.0.1:notaport", "inproc://x", ""])
+def test_a_scheduler_address_no_client_can_use_is_one_line(tmp_path, address):
+    """A malformed, in-process or empty --scheduler address is refused in one line (exit 2), nothing
+    written: the client made with it raised in its constructor and, collected, printed a traceback after
+    the error (and held the command 20 s); an empty one ran the sweep on the local pool instead."""
+    pytest.importorskip("distributed")
+    res = bearingsim("sweep", str(BASE), "--param", f"{SPEED}=1000,2000", "--scheduler", address,
+                     "-o", str(tmp_path / "sw"), "--no-plots", "-q")
+    assert_user_error(res, "--scheduler", "not a dask scheduler address")
+    assert not (tmp_path / "sw").exists()
+
+
 @pytest.mark.slow
 def test_figures_from_the_index(tmp_path):
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 3000])], sets=["numerics.rotations=2"])

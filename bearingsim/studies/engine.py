@@ -140,7 +140,7 @@ def make_engine(jobs: int | None = None, scheduler: str | None = None, option: s
     """The engine of a command's ``-j N`` / ``--scheduler ADDRESS`` (a one-line UserError for ``-j 0``)."""
     from bearingsim.sweeps.engines import DaskEngine, LocalEngine
 
-    if scheduler:
+    if scheduler is not None:
         return DaskEngine(scheduler)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)
     if jobs < 1:

@@ -232,6 +232,8 @@ class DaskEngine:
         except ImportError:
             raise UserError("--scheduler: dask.distributed is not installed; it is the optional extra 'cluster': "
                             "pip install 'bearingsim[cluster]'") from None
+        if self.cluster is None:
+            self._check_address()
         target = self.cluster if self.cluster is not None else self.address
         try:
             self.client = Client(target, timeout=f"{self.timeout_s}s", set_as_default=False)
@@ -239,6 +241,33 @@ class DaskEngine:
             raise UserError(f"--scheduler {self.address}: cannot reach a dask scheduler ({exc.__class__.__name__}: "
                             f"{' '.join(str(exc).split())[:200]})") from None
         self.workers = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
+
+    def _check_address(self) -> None:
+        """Refuse an address no client can connect to before a ``Client`` is made: one made with a
+        malformed address ('foo', 'tcp://host:notaport'), an in-process one ('inproc://') or a TLS one
+        with no TLS configured raised in its constructor, and the half-made client, closed as it was
+        collected, printed a traceback after the one-line error and held the command for 20 s."""
+        from distributed.comm import parse_address, resolve_address
+
+        address = self.address or ""
+        where = f"--scheduler {address!r}" if not address.strip() else f"--scheduler {address}"
+        try:
+            scheme = parse_address(address)[0] if address.strip() else ""
+            if not scheme:
+                raise ValueError("no address")
+            if scheme == "inproc":
+                raise ValueError("an in-process address; a sweep needs a scheduler it can connect to, "
+                                 "e.g. tcp://127.0.0.1:8786")
+            resolve_address(address)
+            if scheme in ("tls", "wss"):
+                from distributed.security import Security
+
+                if Security().get_connection_args("client").get("ssl_context") is None:
+                    raise ValueError(f"{scheme}:// needs TLS configured for the client "
+                                     "(dask's distributed.comm.tls settings)")
+        except Exception as exc:  # noqa: BLE001 - any reason the address is unusable, said in one line
+            raise UserError(f"{where}: not a dask scheduler address ({exc.__class__.__name__}: "
+                            f"{' '.join(str(exc).split())[:200]})") from None
 
     def run(self, batches: list[list[tuple[str, str]]], cases_dir: str,
             archives: str = "all") -> Iterator[list[dict]]:

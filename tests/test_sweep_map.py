@@ -189,6 +189,19 @@ def test_a_user_file_named_map_h5_is_not_replaced(tmp_path):
     assert (tmp_path / "map.h5").read_text() == "mine" and not (tmp_path / "sweep.csv").exists()
 
 
+def test_a_sweep_without_a_map_removes_the_map_an_earlier_sweep_left(tmp_path):
+    """A product sweep, then a zip sweep with the same cases and one more into the same folder (it resumes:
+    nothing of the first is missing from it): the first's map.h5 was left, of two cases, beside the new
+    index of three, and read as the folder's map; a sweep that writes no map leaves none."""
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert (tmp_path / "map.h5").exists()
+    spec = SweepSpec(scenario=BASE, mode="zip", axes=[(SPEED, [1000, 2000])], extra=[{SPEED: 6000}])
+    out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert out.map is None and [r["status"] for r in out.rows] == ["cached", "cached", "done"]
+    assert not (tmp_path / "map.h5").exists()
+
+
 def test_zipped_axes_and_extra_cases_are_not_a_map(tmp_path):
     spec = SweepSpec(scenario=BASE, mode="zip", axes=[(SPEED, [1000, 2000]), ("lubrication.drag_coefficient", [0.01, 0.02])])
     out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)

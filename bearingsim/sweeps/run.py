@@ -334,6 +334,11 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
         engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
         outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None)
+        if grid is None:
+            # no map of its own (zipped axes, no axes, a study's cases): one an earlier product sweep of some
+            # of these cases left (check_sweep_outputs let through only bearingsim's) is not this sweep's
+            # and would be read as it; a zip sweep that added cases left the product's map of two cases
+            (outdir / MAP_NAME).unlink(missing_ok=True)
     except BaseException:
         engine.stop()
         raise

@@ -222,6 +222,13 @@ class DaskEngine:
         self.client = None
         self._futures: list = []
         self.workers = 0
+        self.lost = False  #: the client lost its scheduler mid-sweep (run)
+
+    def _scheduler_lost(self, exc) -> bool:
+        """Whether ``exc``, from a batch's future, says the client lost the scheduler (it ended, or the
+        network went): dask then cancels every future of the client."""
+        return (getattr(exc, "reason", None) == "scheduler-connection-lost"
+                or getattr(self.client, "status", "running") in ("connecting", "closing", "closed"))
 
     def start(self, cases: int | None = None) -> None:
         """Connect to the cluster (``cases``: the sweep's, unused: the cluster's workers are the user's)."""
@@ -291,6 +298,13 @@ class DaskEngine:
             except Exception as exc:  # noqa: BLE001 - a lost worker or a task the cluster gave up on
                 from bearingsim.sweeps.worker import one_line_error
 
+                if self._scheduler_lost(exc):
+                    # every queued batch was cancelled with it: not a failure of its cases, which stay
+                    # pending (each was recorded failed, a line apiece: 8800 lines for the 100 x 100 map)
+                    self.lost = True
+                    raise UserError(f"--scheduler {self.address or 'cluster'}: lost the connection to the dask "
+                                    f"scheduler; the finished cases are kept in the sweep's index, the others not "
+                                    f"run: run the same command again to resume") from None
                 i = self._futures.index(fut)
                 yield [{"hash": h, "status": "failed", "error": f"dask: {one_line_error(exc)}", "wall_s": float("nan"),
                         "summary": {}} for h, _ in batches[i]]
@@ -299,10 +313,20 @@ class DaskEngine:
         """Cancel every queued batch and disconnect (the cluster itself is the user's and stays up)."""
         if self.client is None:
             return
+        import logging
+
+        lost = self.lost or getattr(self.client, "status", "running") in ("connecting", "closing", "closed")
+        log = logging.getLogger("distributed.client")
+        level = log.level
         try:
-            if self._futures:
+            if self._futures and not lost:  # a lost scheduler has no queue left to cancel
                 self.client.cancel(self._futures, force=True)
         finally:
             self._futures = []
-            self.client.close(timeout=5)
-            self.client = None
+            if lost:  # closing ends the client's attempt to reconnect, which dask logs with a traceback
+                log.setLevel(logging.CRITICAL)
+            try:
+                self.client.close(timeout=5)
+            finally:
+                log.setLevel(level)
+                self.client = None

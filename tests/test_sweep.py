@@ -533,6 +533,26 @@ def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
     assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1
 
 
+def test_a_users_file_in_cases_is_not_another_sweeps_case(tmp_path):
+    """A file of the user's in DIR/cases/ (notes.h5, not an archive named by a case's hash) was counted as a
+    case of another sweep: the same sweep's resume was refused, and --force removed the file. Now it is
+    neither; another sweep's archive there still refuses a sweep without --force and goes with it."""
+    from bearingsim.errors import UserError
+
+    first = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    run_sweep(first, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    (tmp_path / "cases" / "notes.h5").write_bytes(b"mine")
+    again = run_sweep(first, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert again.count("cached") == 2
+    other = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 3000])])
+    with pytest.raises(UserError, match="holds another sweep"):
+        run_sweep(other, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    run_sweep(other, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all", force=True)
+    assert (tmp_path / "cases" / "notes.h5").read_bytes() == b"mine"
+    assert sorted(p.name for p in (tmp_path / "cases").iterdir()) == sorted(
+        ["notes.h5"] + [str(a).split("/")[-1] for a in read_index(tmp_path / "sweep.h5")[0]["archive"]])
+
+
 def test_figure_kind_follows_the_grid(tmp_path):
     from bearingsim.sweeps.index import write_index
 

@@ -14,6 +14,7 @@ import contextlib
 import json
 import logging
 import math
+import re
 import signal
 import sys
 import threading
@@ -23,7 +24,8 @@ from pathlib import Path
 
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
-from bearingsim.outputs import FolderLock, remove_folder_files, write_atomic_bytes
+from bearingsim.outputs import (_HDF5_SIGNATURE, FolderLock, _remove_if_it_starts, remove_folder_files,
+                                write_atomic_bytes)
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
 
@@ -38,6 +40,7 @@ INDEX_EVERY_S = 1.0
 INDEX_TIME_SHARE = 0.02
 
 _log = logging.getLogger(__name__)  # a failed case, when no progress bar shows it
+_CASE_NAME = re.compile(r"[0-9a-f]{16}")  # a case archive's name: its hash (spec.case_hash)
 
 
 @dataclass(frozen=True)
@@ -208,7 +211,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
                     if not (k < len(status) and status[k] == "failed")}
     cases_dir = outdir / "cases"
     if cases_dir.is_dir() and not cases_dir.is_symlink():
-        old |= {p.stem for p in cases_dir.glob("*.h5")}
+        old |= _case_archives(cases_dir)
     other = old - new
     if not other:
         return
@@ -217,8 +220,21 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
                         f"this one); not mixed in: give another -o folder, or add --force to replace it (the same "
                         f"command as before resumes it)")
     for h in other:
-        (cases_dir / f"{h}.h5").unlink(missing_ok=True)
+        _remove_if_it_starts(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
+
+
+def _case_archives(cases_dir: Path) -> set[str]:
+    """The hashes of the case archives in ``cases_dir``: regular files named ``<16 hex digits>.h5`` that
+    start as an HDF5 file. A user's file there (``notes.h5``) was taken for a case of another sweep: the
+    same sweep's resume was refused, and ``--force`` removed the file."""
+    found = set()
+    for p in cases_dir.glob("*.h5"):
+        if _CASE_NAME.fullmatch(p.stem) and not p.is_symlink() and p.is_file():
+            with contextlib.suppress(OSError), open(p, "rb") as fh:
+                if fh.read(len(_HDF5_SIGNATURE)) == _HDF5_SIGNATURE:
+                    found.add(p.stem)
+    return found
 
 
 def _clean_temporaries(cases_dir: Path) -> None:

@@ -553,6 +553,24 @@ def test_a_users_file_in_cases_is_not_another_sweeps_case(tmp_path):
         ["notes.h5"] + [str(a).split("/")[-1] for a in read_index(tmp_path / "sweep.h5")[0]["archive"]])
 
 
+def test_temporary_files_a_killed_sweep_left_are_removed_by_the_next(tmp_path):
+    """A sweep killed by SIGKILL while it wrote its index leaves '.sweep.h5.tmp-<pid>' (seen after
+    'kill -9' of the 100 x 100 map): the next sweep into the folder, which removed its workers' ones in
+    cases/, left it for ever. Now it goes (and the CSV's); a live writer's and another program's stay."""
+    from .test_reliability import _dead_pid
+
+    dead = _dead_pid()
+    (tmp_path / f".sweep.h5.tmp-{dead}").write_bytes(b"\x89HDF\r\n\x1a\n half an index")
+    (tmp_path / f".sweep.csv.tmp-{dead}").write_bytes(b"case,operating")
+    kept = {f".sweep.h5.tmp-{os.getppid()}": b"\x89HDF\r\n\x1a\n a live writer's",
+            f".notes.txt.tmp-{dead}": b"mine", f".map.h5.tmp-{dead}": b"not HDF5"}
+    for name, data in kept.items():
+        (tmp_path / name).write_bytes(data)
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert {p.name for p in tmp_path.iterdir() if ".tmp-" in p.name} == set(kept)
+
+
 def test_figure_kind_follows_the_grid(tmp_path):
     from bearingsim.sweeps.index import write_index
 

@@ -14,6 +14,7 @@ import contextlib
 import json
 import logging
 import math
+import os
 import re
 import signal
 import sys
@@ -237,6 +238,29 @@ def _case_archives(cases_dir: Path) -> set[str]:
     return found
 
 
+def _clean_folder_temporaries(outdir: Path) -> None:
+    """Remove the temporary files ``.<name>.tmp-<pid>`` of the folder's index, map, figures and study
+    tables (:data:`bearingsim.outputs.FOLDER_FILES`) that a sweep or study killed by SIGKILL left while
+    writing one: only those whose process is gone and that are empty or start as bearingsim writes that
+    file. They stayed beside the sweep for ever (``.sweep.h5.tmp-<pid>``), as the workers' ones in
+    ``cases/`` did not."""
+    from bearingsim.outputs import FOLDER_FILES, _pid_alive
+
+    with contextlib.suppress(OSError):
+        for entry in outdir.iterdir():
+            m = re.fullmatch(r"\.(.+)\.tmp-(\d+)", entry.name)
+            if not m or m.group(1) not in FOLDER_FILES or entry.is_symlink() or not entry.is_file():
+                continue
+            pid = int(m.group(2))
+            if pid == os.getpid() or _pid_alive(pid):
+                continue
+            with contextlib.suppress(OSError):
+                with open(entry, "rb") as fh:
+                    head = fh.read(len(FOLDER_FILES[m.group(1)]))
+                if not head or head == FOLDER_FILES[m.group(1)]:
+                    entry.unlink()
+
+
 def _clean_temporaries(cases_dir: Path) -> None:
     """Remove temporary archives left by workers ended mid-write (this sweep holds the folder's lock)."""
     for p in cases_dir.glob(".*.h5.tmp-*"):
@@ -350,6 +374,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
         engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
         outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None)
+        _clean_folder_temporaries(outdir)
         if grid is None:
             # no map of its own (zipped axes, no axes, a study's cases): one an earlier product sweep of some
             # of these cases left (check_sweep_outputs let through only bearingsim's) is not this sweep's

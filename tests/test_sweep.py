@@ -571,6 +571,26 @@ def test_temporary_files_a_killed_sweep_left_are_removed_by_the_next(tmp_path):
     assert {p.name for p in tmp_path.iterdir() if ".tmp-" in p.name} == set(kept)
 
 
+def test_an_interrupted_sweep_run_again_with_fewer_values_is_not_refused_for_cases_it_never_ran(tmp_path):
+    """A sweep interrupted before some cases ran leaves them 'pending' in its index (set here as SIGINT
+    leaves them); the same sweep with those values dropped was refused ('holds another sweep or study (2 of
+    its 4 cases are not in this one)') though they left no result, as a failed case, exempt, leaves none."""
+    from bearingsim.errors import UserError
+
+    run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000, 4000])]), tmp_path, engine=LocalEngine(1),
+              figures=False, progress=False)
+    with h5py.File(tmp_path / "sweep.h5", "r+") as f:
+        status = f["index/status"][()]
+        status[2:] = "pending"
+        f["index/status"][...] = status
+    out = run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])]), tmp_path, engine=LocalEngine(1),
+                    figures=False, progress=False)
+    assert [r["status"] for r in out.rows] == ["cached", "cached"]
+    with pytest.raises(UserError, match="holds another sweep"):  # a case with a result still refuses
+        run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [1000])]), tmp_path, engine=LocalEngine(1),
+                  figures=False, progress=False)
+
+
 def test_figure_kind_follows_the_grid(tmp_path):
     from bearingsim.sweeps.index import write_index
 

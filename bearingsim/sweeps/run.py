@@ -192,8 +192,8 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
 
 
 def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> None:
-    """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``; failed ones,
-    which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same
+    """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``; failed and
+    pending ones, which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same
     sweep (or one that only adds cases) passes. With ``force`` the other sweep's or study's case archives,
     index, map, figures and tables are removed instead (:func:`bearingsim.outputs.remove_folder_files`), so
     that nothing of it is mixed into the new one or read as its."""
@@ -207,9 +207,11 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
         with contextlib.suppress(UserError, OSError, KeyError, ValueError):
             cols = read_index(index)[0]
             status = [str(x) for x in cols.get("status", [])]
-            # a failed case left no result to mix in: the same study run again with it mended resumes
+            # a failed case left no result to mix in: the same study run again with it mended resumes; nor
+            # did a pending one (its sweep was interrupted before it ran): a sweep interrupted and run again
+            # with fewer values was refused for the cases it never ran
             old |= {str(h) for k, h in enumerate(cols.get("case", []))
-                    if not (k < len(status) and status[k] == "failed")}
+                    if not (k < len(status) and status[k] in ("failed", "pending"))}
     cases_dir = outdir / "cases"
     if cases_dir.is_dir() and not cases_dir.is_symlink():
         old |= _case_archives(cases_dir)

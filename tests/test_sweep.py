@@ -591,6 +591,37 @@ def test_an_interrupted_sweep_run_again_with_fewer_values_is_not_refused_for_cas
                   figures=False, progress=False)
 
 
+def test_a_pool_worker_that_dies_mid_batch_fails_its_cases_and_the_sweep_ends(tmp_path, monkeypatch):
+    """A local worker killed while it runs a batch (SIGKILL: by hand, the out-of-memory killer): the pool
+    starts another worker but never says the batch was lost, and the sweep waited for it for ever. Now its
+    cases fail, saying so, and the sweep ends (the same command runs them again)."""
+    import threading
+
+    from bearingsim.sweeps import worker
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    doomed = resolve_cases(spec)[1].hash
+    real = worker.run_case
+
+    def run_case(h, *args):  # in the forked worker: the doomed case kills it
+        if h == doomed:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(h, *args)
+
+    monkeypatch.setattr(worker, "run_case", run_case)
+    engine, out = LocalEngine(1), {}
+    thread = threading.Thread(target=lambda: out.update(sweep=run_sweep(spec, tmp_path, engine=engine, figures=False,
+                                                                        progress=False)), daemon=True)
+    thread.start()
+    thread.join(120)  # a guard only: the sweep ends in about a second
+    if thread.is_alive():
+        engine.stop()
+        pytest.fail("the sweep waited for ever for the batch of its dead worker")
+    rows = out["sweep"].rows
+    assert [r["status"] for r in rows] == ["done", "failed"], rows
+    assert "the worker process running it ended (signal 9)" in rows[1]["error"]
+
+
 def test_figure_kind_follows_the_grid(tmp_path):
     from bearingsim.sweeps.index import write_index
 

@@ -7,6 +7,7 @@ interruption, and on Linux the kernel kills them if the sweep process itself die
 """
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
@@ -74,6 +75,21 @@ def _pool_worker_init() -> None:
         pass
 
 
+def _failed(batch, error: str) -> list[dict]:
+    """The records of a batch none of whose cases came back: each failed with ``error``."""
+    return [{"hash": h, "status": "failed", "error": error, "wall_s": float("nan"), "summary": {}} for h, *_ in batch]
+
+
+def _run_marked(started_fd: int, token: int, batch, cases_dir, archives):
+    """A pool worker's task: say on the engine's pipe which batch (``token``) this process (its pid) has
+    started, then run it. A 16-byte write to a pipe is atomic (POSIX: below PIPE_BUF), so no lock is held
+    that a worker killed here could leave taken."""
+    import struct
+
+    os.write(started_fd, struct.pack("qq", token, os.getpid()))
+    return _worker.run_batch(batch, cases_dir, archives)
+
+
 class LocalEngine:
     """A pool of ``jobs`` worker processes on this machine; archives are written in place.
 
@@ -94,6 +110,8 @@ class LocalEngine:
         self.jobs = jobs  #: the worker processes asked for
         self.workers = jobs  #: the pool's (at most one per case of the sweep it runs: start)
         self._pool = None
+        self._started = None  # (read fd, write fd) of the pipe on which a worker says which batch it started
+        self._tokens = iter(range(1, 2**62))  # batch tokens, unique over the engine's runs
 
     def start(self, cases: int | None = None) -> None:
         """Start the pool: ``jobs`` worker processes, or as many as the sweep has ``cases`` when that is
@@ -109,6 +127,9 @@ class LocalEngine:
             # sweep's handler, which raised SweepInterrupted in the worker, with a traceback)
             blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _STOP_SIGNALS)
             try:
+                if self._started is None:  # before the fork: every worker, and each one started later, has it
+                    self._started = os.pipe()
+                    os.set_blocking(self._started[0], False)
                 self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
             finally:
                 signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
@@ -137,25 +158,64 @@ class LocalEngine:
         cases get an archive (:func:`bearingsim.sweeps.worker.keeps_archive`)."""
         import queue
 
-        from bearingsim.sweeps.worker import one_line_error, run_batch
+        from bearingsim.sweeps.worker import one_line_error
 
         self.start()
         done: queue.Queue = queue.Queue()
+        tokens = {}  # token -> batch, until its records are taken
         for b in batches:
-            def lost(exc, b=b):  # the batch itself failed (a worker died): every case of it failed
-                done.put([{"hash": h, "status": "failed", "error": one_line_error(exc), "wall_s": float("nan"),
-                           "summary": {}} for h, *_ in b])
-            self._pool.apply_async(run_batch, (b, cases_dir, archives), callback=done.put, error_callback=lost)
+            token = next(self._tokens)
+            tokens[token] = b
+
+            def lost(exc, b=b, token=token):  # the batch itself failed: every case of it failed
+                done.put((token, _failed(b, one_line_error(exc))))
+            self._pool.apply_async(_run_marked, (self._started[1], token, b, cases_dir, archives),
+                                   callback=lambda records, token=token: done.put((token, records)),
+                                   error_callback=lost)
+        running: dict[int, int] = {}  # token -> pid of the worker that started it
+        procs: dict = {}  # pid -> the pool's Process, as seen while the batches run
         for _ in batches:
             while True:
                 try:  # short waits: a signal handler runs between them
-                    records = done.get(timeout=0.25)
+                    token, records = done.get(timeout=0.25)
+                    if tokens.pop(token, None) is None:
+                        continue  # its worker was found dead, its cases already said failed
+                    running.pop(token, None)
+                    self._lost_batches(tokens, running, procs, done)  # the pipe read as the batches come
                     break
                 except queue.Empty:
                     if self.should_stop():  # a signal whose exception was swallowed (raised in a callback)
                         return
+                    self._lost_batches(tokens, running, procs, done)
                     continue
             yield records
+
+    def _lost_batches(self, tokens: dict, running: dict, procs: dict, done) -> None:
+        """Fail the batches whose worker process ended while it ran them (killed, say by the kernel's
+        out-of-memory killer or by hand): the pool starts another worker but never runs the batch again nor
+        says it was lost, and the sweep waited for it for ever."""
+        import struct
+
+        from bearingsim.outputs import _pid_alive
+
+        with contextlib.suppress(BlockingIOError, InterruptedError):
+            data = os.read(self._started[0], 16 * 4096)
+            for k in range(0, len(data) - len(data) % 16, 16):
+                token, pid = struct.unpack_from("qq", data, k)
+                if token in tokens:
+                    running[token] = pid
+        pool = self._pool
+        if pool is not None:
+            procs.update({p.pid: p for p in list(pool._pool)})
+        for token, pid in list(running.items()):
+            p = procs.get(pid)
+            code = p.exitcode if p is not None else (None if _pid_alive(pid) else "gone")
+            if code is None:
+                continue
+            how = (f"signal {-code}" if code < 0 else f"exit status {code}") if isinstance(code, int) else "gone"
+            del running[token]
+            done.put((token, _failed(tokens[token], f"the worker process running it ended ({how}); "
+                                                    f"run the same command again to run it")))
 
     def stop(self) -> None:
         """End every worker process now (queued batches are dropped) and wait for them to exit.
@@ -169,6 +229,10 @@ class LocalEngine:
         import threading
 
         pool, self._pool = self._pool, None
+        started, self._started = self._started, None
+        for fd in started or ():
+            with contextlib.suppress(OSError):
+                os.close(fd)
         if pool is None:
             return
         workers = list(pool._pool)  # the worker processes (multiprocessing.pool.Pool keeps them here)

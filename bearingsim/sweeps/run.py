@@ -376,17 +376,11 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
         engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
         outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None)
-        _clean_folder_temporaries(outdir)
-        if grid is None:
-            # no map of its own (zipped axes, no axes, a study's cases): one an earlier product sweep of some
-            # of these cases left (check_sweep_outputs let through only bearingsim's) is not this sweep's
-            # and would be read as it; a zip sweep that added cases left the product's map of two cases
-            (outdir / MAP_NAME).unlink(missing_ok=True)
+        _tidy_folder(outdir, grid is not None)
     except BaseException:
         engine.stop()
         raise
-    if progress is None:
-        progress = sys.stderr.isatty()
+    progress = sys.stderr.isatty() if progress is None else progress
     rows = [{"case": c.hash, "values": c.values, "ran_at": c.ran_at, "status": "pending", "error": "", "archive": "",
              "wall_s": math.nan, "model_version": None, "summary": {}} for c in cases]
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
@@ -407,6 +401,18 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
                                f"('bearingsim plot {outcome.h5}' draws them)")
             raise
     return outcome
+
+
+def _tidy_folder(outdir: Path, has_map: bool) -> None:
+    """Before the cases run: the temporary files of dead sweeps (:func:`_clean_folder_temporaries`) and,
+    for a sweep with no map of its own (zipped axes, no axes, a study's cases), the map an earlier product
+    sweep of some of these cases left (``check_sweep_outputs`` let through only bearingsim's): it is not
+    this sweep's and would be read as it (a zip sweep that added cases left the product's map of two)."""
+    from bearingsim.sweeps.grid import MAP_NAME
+
+    _clean_folder_temporaries(outdir)
+    if not has_map:
+        (outdir / MAP_NAME).unlink(missing_ok=True)
 
 
 def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map,

@@ -38,6 +38,7 @@ ARCHIVE_SUFFIXES = (".h5", ".hdf5")
 # ArchiveWriter's temporary name, ".<name>.h5.tmp-<pid>"; only such files that are empty or start with
 # the HDF5 signature are removed, so another program's temporary file is never touched.
 _TMP_RE = re.compile(r"^\..+\.(?:h5|hdf5)\.tmp-(\d+)$")
+_FOLDER_TMP_RE = re.compile(r"^\.(.+)\.tmp-(\d+)$")  # the temporary of any file: (its name, the pid)
 _HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 
@@ -381,7 +382,7 @@ def dying(status: str) -> bool:
     return False
 
 
-def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
+def clean_stale_temporaries(folder: str | Path, report=None, names: dict[str, bytes] | None = None) -> list[Path]:
     """Remove ``.<name>.tmp-<pid>`` files in ``folder`` whose process no longer exists.
 
     Parameters
@@ -389,6 +390,9 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
     folder : output folder
     report : callable taking one line (default: a note of the ``bearingsim.outputs`` logger, which the
         command line prints on stderr)
+    names : the files whose temporaries to remove, each with the first bytes bearingsim writes it with
+        (a sweep's or a study's :data:`FOLDER_FILES`); default: any archive (``.h5``, ``.hdf5``, HDF5's
+        signature). A temporary that is not empty and does not start so is not bearingsim's: kept.
 
     Returns
     -------
@@ -401,18 +405,19 @@ def clean_stale_temporaries(folder: str | Path, report=None) -> list[Path]:
     if not folder.is_dir():
         return removed
     for entry in folder.iterdir():
-        m = _TMP_RE.match(entry.name)
-        if not m or not entry.is_file():
+        m = _TMP_RE.match(entry.name) if names is None else _FOLDER_TMP_RE.match(entry.name)
+        if not m or not entry.is_file() or (names is not None and (m.group(1) not in names or entry.is_symlink())):
             continue
-        pid = int(m.group(1))
+        pid = int(m.group(m.lastindex))
         if pid == os.getpid() or _pid_alive(pid):
             continue
+        head_wanted = _HDF5_SIGNATURE if names is None else names[m.group(1)]
         try:
             with open(entry, "rb") as fh:
-                head = fh.read(len(_HDF5_SIGNATURE))
+                head = fh.read(len(head_wanted))
         except OSError:
             continue
-        if head and head != _HDF5_SIGNATURE:
+        if head and head != head_wanted:
             continue
         try:
             entry.unlink()

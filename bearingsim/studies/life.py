@@ -208,12 +208,10 @@ def _start_value(scenario, limit: Limit, s0: float, start) -> float:
         return s0 if limit.kind == "clearance" else 0.0
     from bearingsim.wear import face_area
 
-    if limit.kind == "depth":
-        return float(start.max())
+    st = _State(s0, start)
+    st.area = face_area(scenario.parameters)
     volume = start.sum(axis=1) * face_area(scenario.parameters, start.shape[1])  # (2, pockets)
-    if limit.kind == "volume":
-        return float(volume.max())
-    return float(s0 + volume.sum(axis=0).max() / face_area(scenario.parameters))
+    return float(st.quantity(limit.kind, start, volume).max())
 
 
 def _limit_text(kind: str, value: float) -> str:

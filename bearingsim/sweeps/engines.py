@@ -369,9 +369,7 @@ class DaskEngine:
                     raise UserError(f"--scheduler {self.address or 'cluster'}: lost the connection to the dask "
                                     f"scheduler; the finished cases are kept in the sweep's index, the others not "
                                     f"run: run the same command again to resume") from None
-                i = self._futures.index(fut)
-                yield [{"hash": h, "status": "failed", "error": f"dask: {one_line_error(exc)}", "wall_s": float("nan"),
-                        "summary": {}} for h, _ in batches[i]]
+                yield _failed(batches[self._futures.index(fut)], f"dask: {one_line_error(exc)}")
 
     def stop(self) -> None:
         """Cancel every queued batch and disconnect (the cluster itself is the user's and stays up)."""

@@ -14,7 +14,6 @@ import contextlib
 import json
 import logging
 import math
-import os
 import re
 import signal
 import sys
@@ -240,29 +239,6 @@ def _case_archives(cases_dir: Path) -> set[str]:
     return found
 
 
-def _clean_folder_temporaries(outdir: Path) -> None:
-    """Remove the temporary files ``.<name>.tmp-<pid>`` of the folder's index, map, figures and study
-    tables (:data:`bearingsim.outputs.FOLDER_FILES`) that a sweep or study killed by SIGKILL left while
-    writing one: only those whose process is gone and that are empty or start as bearingsim writes that
-    file. They stayed beside the sweep for ever (``.sweep.h5.tmp-<pid>``), as the workers' ones in
-    ``cases/`` did not."""
-    from bearingsim.outputs import FOLDER_FILES, _pid_alive
-
-    with contextlib.suppress(OSError):
-        for entry in outdir.iterdir():
-            m = re.fullmatch(r"\.(.+)\.tmp-(\d+)", entry.name)
-            if not m or m.group(1) not in FOLDER_FILES or entry.is_symlink() or not entry.is_file():
-                continue
-            pid = int(m.group(2))
-            if pid == os.getpid() or _pid_alive(pid):
-                continue
-            with contextlib.suppress(OSError):
-                with open(entry, "rb") as fh:
-                    head = fh.read(len(FOLDER_FILES[m.group(1)]))
-                if not head or head == FOLDER_FILES[m.group(1)]:
-                    entry.unlink()
-
-
 def _clean_temporaries(cases_dir: Path) -> None:
     """Remove temporary archives left by workers ended mid-write (this sweep holds the folder's lock)."""
     for p in cases_dir.glob(".*.h5.tmp-*"):
@@ -404,13 +380,16 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
 
 
 def _tidy_folder(outdir: Path, has_map: bool) -> None:
-    """Before the cases run: the temporary files of dead sweeps (:func:`_clean_folder_temporaries`) and,
-    for a sweep with no map of its own (zipped axes, no axes, a study's cases), the map an earlier product
-    sweep of some of these cases left (``check_sweep_outputs`` let through only bearingsim's): it is not
-    this sweep's and would be read as it (a zip sweep that added cases left the product's map of two)."""
+    """Before the cases run, remove quietly the temporary files of the folder's index, map, figures and
+    tables that a sweep or study killed by SIGKILL left while writing one
+    (:func:`bearingsim.outputs.clean_stale_temporaries` of :data:`bearingsim.outputs.FOLDER_FILES`) and, for
+    a sweep with no map of its own (zipped axes, no axes, a study's cases), the map an earlier product sweep
+    of some of these cases left (``check_sweep_outputs`` let through only bearingsim's): it is not this
+    sweep's and would be read as it (a zip sweep that added cases left the product's map of two)."""
+    from bearingsim.outputs import FOLDER_FILES, clean_stale_temporaries
     from bearingsim.sweeps.grid import MAP_NAME
 
-    _clean_folder_temporaries(outdir)
+    clean_stale_temporaries(outdir, report=lambda line: None, names=FOLDER_FILES)
     if not has_map:
         (outdir / MAP_NAME).unlink(missing_ok=True)
 

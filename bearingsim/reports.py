@@ -541,6 +541,7 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
     or the Scenario section's blocks) and the provenance of a folder's first case archive."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
+    from bearingsim.tables import cell_text
 
     index = folder / "sweep.h5"
     checks: list[dict] = []
@@ -559,7 +560,7 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         row = next((i for i, a in enumerate(cols["archive"]) if a and (folder / a).is_file()), None)
         first = folder / cols["archive"][row] if row is not None else None
         # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)
-        label = ", ".join(f"{k} = {_plain_cell(cols[k][row])}" for k in meta.get("axes", ()) if k in cols) \
+        label = ", ".join(f"{k} = {cell_text(cols[k][row])}" for k in meta.get("axes", ()) if k in cols) \
             if row is not None else ""
     scenario = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
     sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario", scenario)]
@@ -573,9 +574,3 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
                                     "index's model_version column says otherwise)")]))
     return sections
 
-
-def _plain_cell(v) -> str:
-    """An index cell as the page shows it: text as it is, a number in its shortest form."""
-    if isinstance(v, bytes):
-        v = v.decode()
-    return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)

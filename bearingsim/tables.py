@@ -60,7 +60,8 @@ def significant(x: float, se: float, x0: float, se0: float) -> bool | None:
     return abs(x - x0) > SIGNIFICANCE_SE * math.hypot(se, se0)
 
 
-def _text(v) -> str:
+def cell_text(v) -> str:
+    """A label cell as the tables (and the report's pages) show it: a number in its shortest form, text as it is."""
     if isinstance(v, (float, np.floating)):
         return f"{float(v):g}"
     return str(v)
@@ -76,7 +77,7 @@ def table_of_index(path) -> Table:
     axes = [k for k in meta["axes"] if k in cols]
     status = [str(s) for s in cols["status"]]
     names = list(axes)
-    labels = {k: [_text(v) for v in cols[k]] for k in axes}
+    labels = {k: [cell_text(v) for v in cols[k]] for k in axes}
     if any(s not in ("done", "cached") for s in status):
         names.append("status")
         labels["status"] = status
@@ -105,7 +106,7 @@ def table_of_archives(paths) -> Table:
     names = ["archive", *shown]
     labels = {"archive": distinguishing_labels(paths)}
     for k in shown:
-        labels[k] = [_text(f.get(k, "(unset)")) for f in flat]
+        labels[k] = [cell_text(f.get(k, "(unset)")) for f in flat]
     keys = list(dict.fromkeys(k for r in results for k, v in r.summary.items() if _is_number(v)))
     numbers, units = {}, {}
     for k in keys:

@@ -12,6 +12,7 @@ file's, and the decorator's options live in this one, which numba's check of the
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import sys
 from pathlib import Path
@@ -40,3 +41,33 @@ def drop_stale_caches(module_name: str, dependencies, dispatchers=None) -> None:
         stamp.write_text(digest)
     except (OSError, AttributeError):  # read-only install, or a numba without these internals
         pass
+
+
+@contextlib.contextmanager
+def on_first_compile(call, package: str = "bearingsim"):
+    """While the block runs, ``call(module)`` once, as numba starts to compile the first function of
+    ``package`` (``module``: that function's module) because it found no copy of it in its cache for this
+    machine; loading a cached copy calls nothing. numba's event API ("numba:compile" fires after a cache
+    miss only); numba is imported here, not before."""
+    from numba.core import event
+
+    class _First(event.Listener):
+        told = False
+
+        def on_start(self, ev):
+            if self.told:
+                return
+            module = getattr(getattr(ev.data.get("dispatcher"), "py_func", None), "__module__", None) or ""
+            if module == package or module.startswith(package + "."):
+                self.told = True
+                call(module)
+
+        def on_end(self, ev):
+            pass
+
+    listener = _First()
+    event.register("numba:compile", listener)
+    try:
+        yield listener
+    finally:
+        event.unregister("numba:compile", listener)

@@ -772,6 +772,29 @@ def _notes_on_stderr():
         log.propagate = before[1]
 
 
+#: the commands that run a model, whose first run on a machine compiles its kernels
+_MODEL_COMMANDS = ("run", "rerun", "sweep", "crosscheck", "validate", "bench", "sensitivity", "uncertainty", "life")
+
+
+def _compile_note(args):
+    """Where a progress bar would be shown (a terminal, no -q) and the command runs a model: one line
+    as numba starts to compile a kernel it has no cached copy of, so that the first run's tens of
+    seconds of compiling are not silent."""
+    if args.command not in _MODEL_COMMANDS or getattr(args, "dry_run", False) or not progress_wanted(args):
+        return contextlib.nullcontext()
+    from bearingsim import _jit
+
+    return _jit.on_first_compile(_say_compiling)
+
+
+def _say_compiling(module: str) -> None:
+    model = next((m for m in ("multibody", "reduced") if f".{m}." in f"{module}."), None)
+    what = f"the {model} model's kernels" if model else "bearingsim's compiled kernels"
+    # \r and erase-to-end: the line replaces a progress bar already drawn, which draws itself again below
+    print(f"\rbearingsim: note: compiling {what} for this machine, once: tens of seconds (later runs load "
+          f"them from numba's cache)\033[K", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
@@ -794,7 +817,8 @@ def main(argv: list[str] | None = None) -> int:
             errors[name] = stream.errors
             stream.reconfigure(errors="backslashreplace")
     try:
-        with _interrupts_redelivered() as swallowed, outputs.command_line_owns_stderr(), _notes_on_stderr():
+        with (_interrupts_redelivered() as swallowed, outputs.command_line_owns_stderr(), _notes_on_stderr(),
+              _compile_note(args)):
             return _run_command(args, swallowed)
     except (OSError, UserError, SimulationUnstable, KeyboardInterrupt, MemoryError) as exc:
         return _failed(exc, args)

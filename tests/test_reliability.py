@@ -384,6 +384,9 @@ CASES: list[Case] = [
          ("bearing.roller_count", "at least 3")),
     Case("geometry-0-rollers-reduced", "geometry", run(*S("bearing.roller_count=0")), 2,
          ("bearing.roller_count", "0 is too few", "at least 3")),
+    # pockets that do not fit name the count that the bar check accepts too
+    Case("geometry-24-pockets-do-not-fit", "geometry", run(*S("bearing.roller_count=24")), 2,
+         ("bearing.roller_count", "do not fit", "at most 21 rollers")),
     Case("geometry-23-pockets-0.08-mm-bars", "geometry", run(*S("bearing.roller_count=23")), 2,
          ("bearing.roller_count", "cage bars of 0.0762 mm", "at most 21 rollers")),
     Case("geometry-22-pockets-multibody", "geometry", run(*S("bearing.roller_count=22"), scenario=MB), 2,

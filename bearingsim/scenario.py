@@ -1205,17 +1205,18 @@ def _check_cage_bars(b: "BearingSection", source: str) -> None:
     keys = "bearing.roller_diameter_mm + bearing.pocket_clearance_mm"
     least = MIN_CAGE_BAR_TO_ROLLER * b.roller_diameter_mm
     most = _most_pockets(pocket + least, b.pitch_diameter_mm)  # the most either check accepts
+    advice = (f"at most {most} rollers" if most >= MIN_ROLLER_COUNT else
+              f"not even {MIN_ROLLER_COUNT} rollers leave such bars: the pockets are too wide for this pitch circle")
     if pocket >= chord:
         raise UserError(
             f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) do not fit "
-            f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart); at most "
-            f"{most} rollers, with cage bars of at least {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter")
+            f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart); with cage bars "
+            f"of at least {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter, {advice}")
     if chord - pocket < least:
         raise UserError(
             f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) on a "
             f"{b.pitch_diameter_mm} mm pitch circle leave cage bars of {chord - pocket:.3g} mm between them, less "
-            f"than {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter ({least:.3g} mm): not a rigid cage; at most "
-            f"{most} rollers")
+            f"than {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter ({least:.3g} mm): not a rigid cage; {advice}")
 
 
 def _check_cage_wall(m: ScenarioModel, source: str) -> None:

@@ -123,7 +123,7 @@ def test_overlapping_pockets_name_both_keys():
     with pytest.raises(UserError) as err:
         load_scenario(SCENARIOS / "paper_3000rpm.toml", ["bearing.roller_diameter_mm=80"])
     msg = str(err.value)
-    assert ": bearing.roller_count:" in msg and "bearing.roller_diameter_mm" in msg and "at most 3 fit" in msg, msg
+    assert ": bearing.roller_count:" in msg and "bearing.roller_diameter_mm" in msg and "not even 3 rollers leave such bars" in msg, msg
 
 
 def test_missing_geometry_without_preset_names_the_key(base_reduced):

@@ -951,17 +951,6 @@ def _solve(par, K, A, tol, min_width, nroots_n, root_n0, root_n1, nodes, cosmat,
     return status, npan, n_imp, n_pc, totals, impacts[:n_imp].copy(), pieces[:n_pc].copy(), roots, tab
 
 
-@njit(cache=True)
-def _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, n):
-    """Evaluate the closed form of one flight at n angles spread over [th0, th1] (for
-    the benchmark's cost floor); returns the sum of l so that nothing is optimised away."""
-    acc = 0.0
-    for i in range(n):
-        l, _, _, _, _ = _flight(tab, npan, omega, g, fs, th0 + (th1 - th0) * (i + 0.5) / n)
-        acc += l
-    return acc
-
-
 # ---- Python wrapper ----------------------------------------------------------------------------
 @dataclass
 class PassSolution:
@@ -1098,22 +1087,6 @@ def solve_event(
         lr, vr, ir = _trace(par, tab, npan, pieces, n_pc, th_all, left)
         sol.trace = dict(theta=th_all, l_r=lr, dl_r_dt=vr, I_dec_cumulative=ir)
     return sol
-
-
-def closed_form_evaluator(inp: PassInputs):
-    """``evaluate(n)``: the closed form of one flight of this pass (its own drag table) evaluated at n
-    angles in one compiled call; ``evaluate(0)`` is a bare call into compiled code. For the benchmark's
-    cost floor (``benchmarks.bench.reduced_rows`` of a source checkout)."""
-    tab, npan = drag_table(inp)
-    par = pass_constants(inp, DEFAULT_ZENO_HEIGHT, DEFAULT_ZENO_FLOOR)
-    omega, g, th0, th1 = par.omega_c, par.gravity, par.theta_start, par.theta_end
-    fs = _flight_start(tab, npan, omega, th0, par.clearance, 0.0)
-
-    def evaluate(n: int) -> float:
-        return _flight_cost_loop(tab, npan, omega, g, fs, th0, th1, n)
-
-    evaluate(1)  # compile / load the cache outside any timing
-    return evaluate
 
 
 drop_stale_caches(__name__, (_core, laws))  # the kernels here compile in those of reduced/core.py and laws.py

@@ -591,10 +591,15 @@ def test_an_interrupted_sweep_run_again_with_fewer_values_is_not_refused_for_cas
                   figures=False, progress=False)
 
 
-def test_a_pool_worker_that_dies_mid_batch_fails_its_cases_and_the_sweep_ends(tmp_path, monkeypatch):
+@pytest.mark.parametrize("reaped_first", [False, True], ids=["seen-alive", "reaped-before-seen"])
+def test_a_pool_worker_that_dies_mid_batch_fails_its_cases_and_the_sweep_ends(tmp_path, monkeypatch, reaped_first):
     """A local worker killed while it runs a batch (SIGKILL: by hand, the out-of-memory killer): the pool
     starts another worker but never says the batch was lost, and the sweep waited for it for ever. Now its
-    cases fail, saying so, and the sweep ends (the same command runs them again)."""
+    cases fail, saying so, and the sweep ends (the same command runs them again). ``reaped-before-seen``: the
+    sweep process first looks for dead workers only once the pool has reaped and replaced the killed one (a
+    loaded machine's scheduling: the worker runs its first batch and dies on the second while the sweep
+    process waits for the CPU); its status went with the pool's record of it, and the case said the worker
+    ended "(gone)"."""
     import threading
 
     from bearingsim.sweeps import worker
@@ -610,6 +615,19 @@ def test_a_pool_worker_that_dies_mid_batch_fails_its_cases_and_the_sweep_ends(tm
 
     monkeypatch.setattr(worker, "run_case", run_case)
     engine, out = LocalEngine(1), {}
+    if reaped_first:
+        engine.start(1)  # run_sweep keeps this pool
+        (first,) = engine._pool._pool
+        look = engine._lost_batches
+
+        def look_once_the_pool_has_replaced_it(*args):
+            deadline = time.monotonic() + 60  # a guard only: the worker dies about a second in
+            while any(p is first for p in engine._pool._pool) and time.monotonic() < deadline:
+                time.sleep(0.01)
+            monkeypatch.setattr(engine, "_lost_batches", look)
+            return look(*args)
+
+        monkeypatch.setattr(engine, "_lost_batches", look_once_the_pool_has_replaced_it)
     thread = threading.Thread(target=lambda: out.update(sweep=run_sweep(spec, tmp_path, engine=engine, figures=False,
                                                                         progress=False)), daemon=True)
     thread.start()

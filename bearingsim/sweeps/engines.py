@@ -80,6 +80,21 @@ def _failed(batch, error: str) -> list[dict]:
     return [{"hash": h, "status": "failed", "error": error, "wall_s": float("nan"), "summary": {}} for h, *_ in batch]
 
 
+def _recording_pool(context, processes: int, procs: list):
+    """A process pool of ``context`` whose worker processes, each one it starts (in place of a dead one
+    too), are appended to ``procs``."""
+    from multiprocessing.pool import Pool
+
+    class RecordingPool(Pool):
+        @staticmethod
+        def Process(ctx, *args, **kwds):  # noqa: N802 - multiprocessing's name
+            proc = ctx.Process(*args, **kwds)
+            procs.append(proc)
+            return proc
+
+    return RecordingPool(processes, initializer=_pool_worker_init, context=context)
+
+
 def _run_marked(started_fd: int, token: int, batch, cases_dir, archives):
     """A pool worker's task: say on the engine's pipe which batch (``token``) this process (its pid) has
     started, then run it. A 16-byte write to a pipe is atomic (POSIX: below PIPE_BUF), so no lock is held
@@ -110,6 +125,7 @@ class LocalEngine:
         self.jobs = jobs  #: the worker processes asked for
         self.workers = jobs  #: the pool's (at most one per case of the sweep it runs: start)
         self._pool = None
+        self._procs = []  # every worker process the pool has started, the ones it has replaced too
         self._started = None  # (read fd, write fd) of the pipe on which a worker says which batch it started
         self._tokens = iter(range(1, 2**62))  # batch tokens, unique over the engine's runs
 
@@ -130,7 +146,8 @@ class LocalEngine:
                 if self._started is None:  # before the fork: every worker, and each one started later, has it
                     self._started = os.pipe()
                     os.set_blocking(self._started[0], False)
-                self._pool = mp.get_context("fork").Pool(self.workers, initializer=_pool_worker_init)
+                self._procs = []
+                self._pool = _recording_pool(mp.get_context("fork"), self.workers, self._procs)
             finally:
                 signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
@@ -172,50 +189,53 @@ class LocalEngine:
             self._pool.apply_async(_run_marked, (self._started[1], token, b, cases_dir, archives),
                                    callback=lambda records, token=token: done.put((token, records)),
                                    error_callback=lost)
-        running: dict[int, int] = {}  # token -> pid of the worker that started it
-        procs: dict = {}  # pid -> the pool's Process, as seen while the batches run
+        running: dict[int, int] = {}  # pid -> token of the batch that worker started last, until its records come
         for _ in batches:
             while True:
                 try:  # short waits: a signal handler runs between them
                     token, records = done.get(timeout=0.25)
                     if tokens.pop(token, None) is None:
                         continue  # its worker was found dead, its cases already said failed
-                    running.pop(token, None)
-                    self._lost_batches(tokens, running, procs, done)  # the pipe read as the batches come
+                    self._lost_batches(tokens, running, done)  # the pipe read as the batches come
                     break
                 except queue.Empty:
                     if self.should_stop():  # a signal whose exception was swallowed (raised in a callback)
                         return
-                    self._lost_batches(tokens, running, procs, done)
+                    self._lost_batches(tokens, running, done)
                     continue
             yield records
 
-    def _lost_batches(self, tokens: dict, running: dict, procs: dict, done) -> None:
+    def _lost_batches(self, tokens: dict, running: dict, done) -> None:
         """Fail the batches whose worker process ended while it ran them (killed, say by the kernel's
         out-of-memory killer or by hand): the pool starts another worker but never runs the batch again nor
-        says it was lost, and the sweep waited for it for ever."""
+        says it was lost, and the sweep waited for it for ever.
+
+        A worker runs one batch at a time, so the batch it started last is the one it was running: a batch
+        it started before has ended and its records are on their way (failing it too recorded a finished
+        case as failed). The workers found ended are taken before the pipe is read, so every batch they
+        started is on it. Their exit status is that of the pool's own record of the process, kept from its
+        start (:func:`_recording_pool`): the pool forgets a worker it has reaped and replaced, which it can
+        do before this looks, and the batch then said the worker ended "(gone)" instead of its signal."""
         import struct
 
-        from bearingsim.outputs import _pid_alive
-
+        ended = {p.pid: p.exitcode for p in list(self._procs) if p.pid is not None}  # a pid reused: the latest
+        ended = {pid: code for pid, code in ended.items() if code is not None}
+        data = b""
         with contextlib.suppress(BlockingIOError, InterruptedError):
-            data = os.read(self._started[0], 16 * 4096)
-            for k in range(0, len(data) - len(data) % 16, 16):
-                token, pid = struct.unpack_from("qq", data, k)
-                if token in tokens:
-                    running[token] = pid
-        pool = self._pool
-        if pool is not None:
-            procs.update({p.pid: p for p in list(pool._pool)})
-        for token, pid in list(running.items()):
-            p = procs.get(pid)
-            code = p.exitcode if p is not None else (None if _pid_alive(pid) else "gone")
-            if code is None:
-                continue
-            how = (f"signal {-code}" if code < 0 else f"exit status {code}") if isinstance(code, int) else "gone"
-            del running[token]
-            done.put((token, _failed(tokens[token], f"the worker process running it ended ({how}); "
-                                                    f"run the same command again to run it")))
+            while chunk := os.read(self._started[0], 16 * 4096):
+                data += chunk
+        for k in range(0, len(data) - len(data) % 16, 16):
+            token, pid = struct.unpack_from("qq", data, k)
+            running[pid] = token
+        for pid, token in list(running.items()):
+            if token not in tokens:  # its records came
+                del running[pid]
+            elif pid in ended:
+                del running[pid]
+                code = ended[pid]
+                how = f"signal {-code}" if code < 0 else f"exit status {code}"
+                done.put((token, _failed(tokens[token], f"the worker process running it ended ({how}); "
+                                                        f"run the same command again to run it")))
 
     def stop(self) -> None:
         """End every worker process now (queued batches are dropped) and wait for them to exit.
@@ -229,6 +249,7 @@ class LocalEngine:
         import threading
 
         pool, self._pool = self._pool, None
+        self._procs = []
         started, self._started = self._started, None
         for fd in started or ():
             with contextlib.suppress(OSError):

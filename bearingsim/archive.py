@@ -748,7 +748,7 @@ def _read_scenario(f, path):
 def check_layout(f, path, result_class, scenario) -> None:
     """Refuse, with a one-line UserError naming ``path`` and what is wrong, an archive whose structure is
     not what ``result_class`` reads and draws: ``/results/summary`` a group holding the model's summary
-    numbers (:attr:`Result.SUMMARY_NUMBERS`), every array of :attr:`Result.LAYOUT` a numeric (or text)
+    numbers (:attr:`Result.SUMMARY_NUMBERS`, and :attr:`Result.SUMMARY_OPTIONAL` where present), every array of :attr:`Result.LAYOUT` a numeric (or text)
     dataset of its declared dimensions, consistent with each other and with the scenario
     (:meth:`Result.archive_dims`), ``/observables`` groups of ``step``, ``time`` and ``value`` datasets of
     one length. Only metadata is read (shapes and types): nothing is decompressed."""
@@ -763,7 +763,7 @@ def check_layout(f, path, result_class, scenario) -> None:
     if "provenance" in f and not isinstance(f["provenance"], h5py.Group):
         raise _damaged(path, "/provenance is not a group")
     summary = group_attrs(f["results/summary"])[0]
-    for key in result_class.SUMMARY_NUMBERS:
+    for key in (*result_class.SUMMARY_NUMBERS, *(k for k in result_class.SUMMARY_OPTIONAL if k in summary)):
         v = summary.get(key)
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise _damaged(path, f"/results/summary: {key} is {outputs.printable(repr(v))[:40]}, not a number")

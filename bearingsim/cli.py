@@ -559,7 +559,8 @@ def _add_run_commands(sub) -> None:
                          "or run archives")
     tb.add_argument("--columns", metavar="KEY,...",
                     help="summary keys to show (default: I_dec_mean_Ns, I_acc_mean_Ns, first_impact_speed_m_s, "
-                         "cage_slip, load_zone_half_angle_deg, those present); not for a study's own table")
+                         "cage_slip, cage_rest_angle_deg, load_zone_half_angle_deg, those present); not for a "
+                         "study's own table")
     tb.set_defaults(func=_cmd_table)
 
     ks = sub.add_parser("keys", help="every scenario key with its unit, type and bounds, default and source")

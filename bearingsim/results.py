@@ -54,6 +54,8 @@ class Result:
     FIGURE_DATA: tuple[str, ...] = ()
     #: the keys of ``/results/summary`` that must be numbers (the figures and the CLI print them)
     SUMMARY_NUMBERS: tuple[str, ...] = ()
+    #: keys of ``/results/summary`` that are numbers where present (added after archives were written without)
+    SUMMARY_OPTIONAL: tuple[str, ...] = ()
 
     @classmethod
     def archive_dims(cls, scenario) -> dict[str, int]:

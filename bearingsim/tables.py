@@ -29,7 +29,8 @@ SIGNIFICANCE_SE = 2.0
 RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2), x_ref the first row with a number (SE: batch means over "
         "rotations, docs/statistics.md); no mark: within that, or no SE to judge by")
 #: number columns shown by default, those present
-DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "load_zone_half_angle_deg")
+DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
+                   "load_zone_half_angle_deg")
 #: summary keys with a standard error (the key of the error)
 SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns"}
 #: display scale and unit of units that read better scaled

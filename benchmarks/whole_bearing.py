@@ -71,15 +71,6 @@ def _whirl(r):
     return float(rate / (r.parameters.operating.sign * r.parameters.operating.omega_c))
 
 
-def _rests_at(r):
-    """Where the cage centre rests: the angle of its mean position over the kept samples from the bottom
-    (the load's direction), counted in the direction of rotation [deg]."""
-    o = np.asarray(r.get("cage_orbit"))
-    o = o[np.isfinite(o[:, 1])]
-    x, y = o[:, 1].mean(), o[:, 2].mean()
-    return float(np.degrees(np.arctan2(r.parameters.operating.sign * x, -y)))
-
-
 def orbit():
     print("| rpm | pocket clearance s [mm] | orbit mean / max [µm] | max / s | whirl rate / cage speed | rests at [deg] "
           "| I_dec [mN s] | cage slip |")
@@ -91,7 +82,8 @@ def orbit():
                                         f"bearing.pocket_clearance_mm={s}"])
         om, ox = _orbit(r)
         print(f"| {rpm} | {s} | {om * 1e6:.0f} / {ox * 1e6:.0f} | {ox / (s * 1e-3):.2f} | {_whirl(r):+.3f} | "
-              f"{_rests_at(r):.0f} | {r.summary['I_dec_mean_Ns'] * 1e3:.2f} | {r.summary['cage_slip'] * 100:.3f} % |",
+              f"{r.summary['cage_rest_angle_deg']:.0f} | {r.summary['I_dec_mean_Ns'] * 1e3:.2f} | "
+              f"{r.summary['cage_slip'] * 100:.3f} % |",
               flush=True)
 
 

@@ -324,3 +324,36 @@ def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
     assert stdout.startswith(f"refused: {out}: cannot write archive (File too large)"), stdout
     assert stderr == ""
     assert list((tmp_path / "out").iterdir()) == []
+
+
+def test_a_multibody_archive_of_the_version_before_where_the_cage_rests_still_reads(tmp_path, capsys):
+    """Multibody model version 6 added ``cage_rest_offset_m`` and ``cage_rest_angle_deg`` to the summary
+    (bearingsim.multibody.SUMMARY_SINCE). An archive without them (one of version 5) reads, and the archive
+    tools show the angle as missing ('-'), not the archive as damaged; one whose value is not a number is
+    damaged."""
+    import bearingsim
+    from bearingsim.cli import main
+    from bearingsim.multibody import SUMMARY_SINCE
+
+    from .conftest import SCENARIOS
+
+    r = bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 1}))
+    assert set(SUMMARY_SINCE) <= set(r.summary) and r.summary["cage_rest_offset_m"] > 0
+    group = r.groups["results/summary"]
+    for key in SUMMARY_SINCE:
+        del group.attrs[key], group.units[key]
+    old = r.save(tmp_path / "v5.h5")
+    back = bearingsim.load(old)
+    assert not set(SUMMARY_SINCE) & set(back.summary) and back.summary["I_dec_mean_Ns"] == r.summary["I_dec_mean_Ns"]
+    now = bearingsim.run(r.scenario).save(tmp_path / "v6.h5")
+    capsys.readouterr()
+    assert main(["table", str(now), str(old)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    lines = lines[next(i for i, line in enumerate(lines) if line.startswith("archive ")):]  # the table's header on
+    assert "cage_rest_angle [deg]" in lines[0], lines[0]
+    assert lines[1].split()[0] == "v6.h5" and lines[2].split()[0] == "v5.h5", lines
+    assert lines[2].split()[-2] == "-" and lines[1].split()[-2] != "-", lines  # its angle, before the load zone's
+    with h5py.File(old, "r+") as f:
+        f["results/summary"].attrs["cage_rest_angle_deg"] = "west"
+    with pytest.raises(UserError, match="cage_rest_angle_deg is 'west', not a number"):
+        bearingsim.load(old)

@@ -136,6 +136,25 @@ def test_forward_reverse_same_I_dec(full_3000, full_3000_reverse):
     assert b == pytest.approx(a, rel=0.05), (a, b)
 
 
+@pytest.mark.slow
+def test_where_the_cage_rests_is_its_orbit_mean_and_mirrors_with_the_rotation(full_3000, full_3000_reverse):
+    """The summary's cage_rest_offset_m / cage_rest_angle_deg are the mean of the result's own
+    /results/cage_orbit (1e-12), and mirror symmetry (paper Fig. 7): reversed, the cage rests at the
+    mirror image, so its angle counted in the direction of rotation is the same (forward x > 0, reverse
+    x < 0). Tolerance 10 deg: the two runs' resting angles are means over their last 4096 samples of a
+    chaotic motion (59-60 deg at 3000 rpm in 20- and 40-rotation runs: docs/geometry.md, Cage motion)."""
+    for r in (full_3000, full_3000_reverse):
+        o = np.asarray(r.get("cage_orbit"))
+        x, y = o[:, 1].mean(), o[:, 2].mean()
+        assert r.summary["cage_rest_offset_m"] == pytest.approx(math.hypot(x, y), rel=1e-12)
+        sign = r.parameters.operating.sign
+        assert r.summary["cage_rest_angle_deg"] == pytest.approx(math.degrees(math.atan2(sign * x, -y)), abs=1e-9)
+    fwd, rev = (np.asarray(r.get("cage_orbit"))[:, 1].mean() for r in (full_3000, full_3000_reverse))
+    assert fwd > 0 > rev, (fwd, rev)
+    assert full_3000_reverse.summary["cage_rest_angle_deg"] == pytest.approx(
+        full_3000.summary["cage_rest_angle_deg"], abs=10.0)
+
+
 def test_load_zone_half_angle(full_3000):
     """Paper Sec. 2.3: the load zone at 970 N has a half angle of 23.5 deg. That number is the classical
     half angle psi_l = arccos(P_d / (2 delta_r)) (Harris & Kotzalas Sec. 7.2) of the ring displacement

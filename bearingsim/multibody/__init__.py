@@ -84,9 +84,14 @@ SUMMARY_UNITS = {
     "first_impact_speed_m_s": "m/s", "first_impact_energy_J": "J", "cage_speed_mean_rad_s": "rad/s",
     "cage_slip": "1", "load_zone_half_angle_deg": "deg",
     "load_zone_contact_half_angle_deg": "deg", "inner_ring_displacement_m": "m", "torque_balance_residual": "1",
-    "max_penetration_m": "m", "max_penetration_all_m": "m", "cage_orbit_max_m": "m", "dt_s": "s", "steps": "1",
+    "max_penetration_m": "m", "max_penetration_all_m": "m", "cage_orbit_max_m": "m", "cage_rest_offset_m": "m",
+    "cage_rest_angle_deg": "deg", "dt_s": "s", "steps": "1",
 }
 
+
+#: summary numbers added after archives were written without them, and the model version that added
+#: each: an archive of an earlier version reads without them (where the cage rests: :func:`_cage_rest`)
+SUMMARY_SINCE = {"cage_rest_offset_m": 6, "cage_rest_angle_deg": 6}
 
 RIGID_SUMMARY_UNITS = {"roller_lift_max_m": "m", "roller_beyond_race_max_m": "m"}
 
@@ -203,6 +208,16 @@ def _load_zone_half_angle(q_bin, tq_bin):
     return 0.5 * width
 
 
+def _cage_rest(orbit, sign: int) -> dict:
+    """Where the cage centre rests over the kept samples of its orbit (rows t, x, y; y up, the load along
+    -y): the distance of its mean position from the axis [m], and that position's angle from the bottom,
+    counted in the direction of rotation [deg] (a whirling or centred cage's mean lies near the axis,
+    where the angle says little: read it beside the distance)."""
+    o = orbit[np.isfinite(orbit[:, 0])]
+    x, y = (float(o[:, 1].mean()), float(o[:, 2].mean())) if len(o) else (math.nan, math.nan)
+    return {"cage_rest_offset_m": math.hypot(x, y), "cage_rest_angle_deg": math.degrees(math.atan2(sign * x, -y))}
+
+
 def _summary(p, raw, per) -> tuple[dict, dict]:
     """The headline numbers of a run and their units."""
     geo, op = p.bearing, p.operating
@@ -247,6 +262,7 @@ def _summary(p, raw, per) -> tuple[dict, dict]:
         "max_penetration_m": float(max(g["maxpen_front"], g["maxpen_rear"])),
         "max_penetration_all_m": float(g["maxpen_all"]),
         "cage_orbit_max_m": float(raw.orbit_max),
+        **_cage_rest(raw.orbit, op.sign),
         "dt_s": float(raw.setup.dt),
         "steps": int(raw.steps),
     }
@@ -406,7 +422,9 @@ class MultibodyResult(Result):
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
                 PROFILE_PATHS)  # archives written before the wear profile
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
-    SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m")  # no ring: absent
+    SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m"  # no ring: absent
+                            and k not in SUMMARY_SINCE)
+    SUMMARY_OPTIONAL = tuple(SUMMARY_SINCE)
     FIGURE_DATA = ("results/theta_deg", "results/force_vs_theta_acc", "results/force_vs_theta_dec",
                    "results/per_rotation/I_acc", "results/per_rotation/I_dec", "results/cage_orbit", "results/wear")
 

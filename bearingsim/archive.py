@@ -748,10 +748,10 @@ def _read_scenario(f, path):
 def check_layout(f, path, result_class, scenario) -> None:
     """Refuse, with a one-line UserError naming ``path`` and what is wrong, an archive whose structure is
     not what ``result_class`` reads and draws: ``/results/summary`` a group holding the model's summary
-    numbers (:attr:`Result.SUMMARY_NUMBERS`, and :attr:`Result.SUMMARY_OPTIONAL` where present), every array of :attr:`Result.LAYOUT` a numeric (or text)
-    dataset of its declared dimensions, consistent with each other and with the scenario
-    (:meth:`Result.archive_dims`), ``/observables`` groups of ``step``, ``time`` and ``value`` datasets of
-    one length. Only metadata is read (shapes and types): nothing is decompressed."""
+    numbers (:attr:`Result.SUMMARY_NUMBERS`, and :attr:`Result.SUMMARY_OPTIONAL` where present), every
+    array of :attr:`Result.LAYOUT` a numeric (or text) dataset of its declared dimensions, consistent with
+    each other and with the scenario (:meth:`Result.archive_dims`), ``/observables`` groups of ``step``,
+    ``time`` and ``value`` datasets of one length. Only metadata is read (shapes and types): nothing is decompressed."""
     h5py = _lazy_h5py()
     scenario_model = scenario.model
     if scenario_model != result_class.model:

@@ -74,10 +74,13 @@ def result_dataframe(result, what: str = "per_rotation", units_in_names: bool = 
     pd = need("pandas", "Result.to_dataframe")
     if what == "per_rotation":
         arrays = _under(result, "results/per_rotation")
-        first = next(iter(arrays.values())).data
+        first = next(a.data for a in arrays.values() if np.ndim(a.data) == 2)
         rot, pocket = np.indices(first.shape[:2])
         index = pd.MultiIndex.from_arrays([rot.ravel(), pocket.ravel()], names=["rotation", "pocket"])
-        frame = pd.DataFrame({k: np.asarray(a.data).reshape(-1) for k, a in arrays.items()}, index=index)
+        # a number per rotation (the cage's: where it rests, a land's impulses) stands in each of its pockets' rows
+        frame = pd.DataFrame({k: (np.asarray(a.data).reshape(-1) if np.ndim(a.data) == 2 else
+                                  np.repeat(np.asarray(a.data), first.shape[1])) for k, a in arrays.items()},
+                             index=index)
         units = {k: a.unit for k, a in arrays.items()}
     elif what == "impacts":
         arrays = _under(result, "results/impacts")
@@ -102,7 +105,8 @@ def result_xarray(result):
     xr = need("xarray", "Result.to_xarray")
     data_vars = {}
     for name, a in _under(result, "results/per_rotation").items():
-        data_vars[name] = (("rotation", "pocket"), np.asarray(a.data), {"units": a.unit, "description": a.description})
+        dims = ("rotation", "pocket") if np.ndim(a.data) == 2 else ("rotation",)  # the cage's, per rotation
+        data_vars[name] = (dims, np.asarray(a.data), {"units": a.unit, "description": a.description})
     for name, a in _under(result, "results/impacts").items():
         values = np.asarray(a.data)
         if values.dtype.kind == "U":

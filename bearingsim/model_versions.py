@@ -26,8 +26,9 @@ This module imports nothing, so a sweep's resume check does not load the models.
 
 # multibody 2: exact arc pocket faces over the cage wall; 3: the rigid scene's automatic step at 80 % of the
 # overlap bound; 4: a worn face's contact at the nearest point of its material (its edges); 5: the automatic
-# step's impact speed across the play worn faces leave (core.worn_play); 6: where the cage rests in the
-# summary (cage_rest_offset_m, cage_rest_angle_deg: numbers an archive of 5 lacks; no number of 5 moved)
+# step's impact speed across the play worn faces leave (core.worn_play); 6: where the cage rests, in the
+# summary (cage_rest_offset_m, cage_rest_angle_deg) and per rotation (numbers an archive of 5 lacks; no
+# number of 5 moved)
 #: version of each model's numbers (bumped when a change moves numbers; see the module docstring)
 MODEL_VERSIONS = {"reduced": 1, "multibody": 6}
 

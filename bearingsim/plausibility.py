@@ -53,6 +53,19 @@ MAX_CAGE_SPEED_DRIFT = 0.03
 START_TRANSIENT_SD = 3.0
 START_TRANSIENT_MIN_REL = 0.01
 START_TRANSIENT_MIN_ROTATIONS = 4
+
+# Where the cage rests (its centre's mean position in each recorded rotation, as an angle from the bottom:
+# /results/per_rotation/cage_rest_angle) stays within a few degrees in a steady run: at most 8.3 deg over
+# the runs measured (3000 and 6000 rpm for 20 rotations, 500 and 1000 rpm, both land guidances, rigid
+# raceways, pocket clearances 0.1 and 0.4 mm, the rig, and the scenarios/hard multibody cases, of which
+# restitution 0.99 spans 11.8 deg over 4 rotations). Under load a roller-guided cage can take a second
+# resting place (docs/whatif.md, Radial load): a 14 kN run at 3000 rpm that changes place among its recorded
+# rotations spans 51 deg, the 20000 rpm and 3-roller hard cases 94 and 32 deg. A span beyond
+# CAGE_REST_SPAN_DEG gets a note: the run's means mix the places it rested in. Not judged where the cage's
+# mean position lies within CAGE_REST_MIN_OFFSET of the pocket clearance of the axis in some rotation (a
+# centred or kinematic cage, a whirling one: the angle of a point at the axis says nothing).
+CAGE_REST_SPAN_DEG = 20.0
+CAGE_REST_MIN_OFFSET = 0.25
 # A mean cage speed above this multiple of the epicyclic speed (Eq. 11; a roller-guided cage slips
 # behind it, never ahead by much) is a cage driven by something other than rolling: the advice for too
 # few samples then names the traction and drag keys, not the output rate.
@@ -145,7 +158,7 @@ def check(result) -> list[str]:
         samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
         if samples < MIN_ORBIT_SAMPLES:
             raise SimulationUnstable(f"{counted(samples, 'time-series sample')} recorded; {_few_samples_advice(result)}")
-        for note in (cage_speed_drift(result), start_transient(result)):
+        for note in (cage_speed_drift(result), start_transient(result), cage_rest_change(result)):
             if note is not None:
                 notes.append(note)
         fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
@@ -253,6 +266,12 @@ def checks_made(result) -> list[tuple[str, str, bool | None]]:
         out.append(("warm-up reached a steady state", f"not evaluated: {counted(rotations, 'recorded rotation')}, "
                     f"at least {START_TRANSIENT_MIN_ROTATIONS} needed (the later ones give the scatter to judge "
                     "the first by)", None))
+    rest = _rest_span(result)
+    out.append(("cage rests in one place", (f"its resting angle spanned {rest[0]:.1f} deg over the recorded rotations "
+                                            f"against at most {CAGE_REST_SPAN_DEG:g}") if rest is not None else
+                "not evaluated: no per-rotation resting place (an archive of multibody model version 5 or "
+                "before, one recorded rotation, or a cage at the axis)",
+                None if rest is None else rest[0] <= CAGE_REST_SPAN_DEG))
     raw = getattr(result, "raw", None)
     if raw is None or raw.cage_w_start is None:
         out.append(("cage speed steady (no drift over the recorded rotations)", "not evaluated: the cage speeds at "
@@ -305,6 +324,38 @@ def start_transient(result) -> str | None:
             f"ones ({sds:.1f} of their standard deviations): the warm-up did not reach a steady state, and the "
             f"mean I_dec holds {rel / (n + 1):+.2%} of it; set more numerics.warmup_rotations (now "
             f"{result.parameters.numerics.warmup_rotations}) or more numerics.rotations (docs/statistics.md)")
+
+
+def _rest_span(result) -> tuple[float, float, float] | None:
+    """(span [deg], least and largest angle [deg]) of where a multibody result's cage rested over its
+    recorded rotations (/results/per_rotation/cage_rest_angle, taken round the circle from the first
+    rotation's), or None: an archive without them, fewer than 2 rotations, or a cage at the axis
+    (:data:`CAGE_REST_MIN_OFFSET`)."""
+    pr = result.per_rotation
+    if result.parameters.model != "multibody" or "cage_rest_angle" not in pr:
+        return None
+    a = np.asarray(pr["cage_rest_angle"], dtype=float)
+    o = np.asarray(pr["cage_rest_offset"], dtype=float)
+    ok = np.isfinite(a) & np.isfinite(o)
+    a, o = a[ok], o[ok]
+    if a.size < 2 or o.min() < CAGE_REST_MIN_OFFSET * result.parameters.bearing.pocket_clearance:
+        return None
+    d = (a - a[0] + 180.0) % 360.0 - 180.0
+    return float(d.max() - d.min()), float(a[0] + d.min()), float(a[0] + d.max())
+
+
+def cage_rest_change(result) -> str | None:
+    """A note when a multibody run's cage did not rest in one place over its recorded rotations (a span of
+    its resting angle beyond :data:`CAGE_REST_SPAN_DEG`), else None."""
+    got = _rest_span(result)
+    if got is None or got[0] <= CAGE_REST_SPAN_DEG:
+        return None
+    span, lo, hi = got
+    return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
+            f"the bottom spanned {span:.0f} deg over the recorded rotations ({lo:.0f} to {hi:.0f} deg, "
+            f"/results/per_rotation/cage_rest_angle; a steady run's stays within {CAGE_REST_SPAN_DEG:g} deg), so the "
+            f"run's means mix the places it rested in (under load a roller-guided cage can rest in two: "
+            f"docs/whatif.md, Radial load)")
 
 
 def cage_speed_drift(result) -> str | None:

@@ -115,7 +115,8 @@ class Result:
         """A pandas DataFrame of ``what`` (needs the extra ``bearingsim[frames]``):
 
         * ``"per_rotation"``: one row per (rotation, pocket) (a MultiIndex), one column per
-          per-rotation array (``I_dec``, ``I_acc``, ...);
+          per-rotation array (``I_dec``, ``I_acc``, ...; a number per rotation, such as where the cage
+          rests, in each of its pockets' rows);
         * ``"impacts"``: one row per roller-cage impact (``time_s``, ``theta_deg``, ``face`` ...);
         * ``"observables"``: the time series, indexed by ``time_s`` (vectors split into ``_x``, ``_y``);
         * ``"summary"``: one row of the summary numbers.

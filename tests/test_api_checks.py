@@ -217,3 +217,39 @@ def test_a_classical_half_angle_of_zero_under_load_is_noted_as_no_result():
     assert len(found) == 1 and "load_zone_contact_half_angle_deg" in found[0], three.notes
     assert notes(MULTIBODY, *RIGID)[1] == []
     assert notes(MULTIBODY, *RIGID, "operating.radial_load_N=0")[1] == []
+
+
+def test_a_cage_that_changes_where_it_rests_is_noted():
+    """docs/whatif.md, Radial load: under load a roller-guided cage can rest in two places, and a run that
+    changes place among its recorded rotations mixes them in its means. A steady run's resting angle per
+    rotation (/results/per_rotation/cage_rest_angle) spans a few degrees (3000 rpm, rigid raceways, 8
+    rotations: below 10 deg; the measurements behind plausibility.CAGE_REST_SPAN_DEG give at most 8.3 deg
+    over 20 rotations), so it gets no note and passes the report's check. The same run's arrays with the
+    cage moved from 60 to 130 deg halfway get the note and fail the check; the span is taken round the
+    circle (170 and -170 deg are 20 apart, not 340); a cage at the axis is not judged."""
+    import numpy as np
+
+    from bearingsim import plausibility
+    from bearingsim.datatypes import NamedArray
+
+    r = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={"multibody.raceway_contact": "rigid",
+                                                                "numerics.rotations": 8}))
+    angle = np.asarray(r.per_rotation["cage_rest_angle"])
+    assert angle.shape == (8,) and np.ptp(angle) < 10.0, angle
+    assert not [n for n in r.notes if "did not rest in one place" in n], r.notes
+    row = next(c for c in plausibility.checks_made(r) if c[0] == "cage rests in one place")
+    assert row[2] is True, row
+
+    def with_angles(values, offset=None):
+        r.data["results/per_rotation/cage_rest_angle"] = NamedArray(np.asarray(values, float), "deg")
+        if offset is not None:
+            r.data["results/per_rotation/cage_rest_offset"] = NamedArray(np.full(len(values), offset), "m")
+        return plausibility.cage_rest_change(r)
+
+    note = with_angles([60.0] * 4 + [130.0] * 4)
+    assert note is not None and "spanned 70 deg" in note and "60 to 130 deg" in note, note
+    row = next(c for c in plausibility.checks_made(r) if c[0] == "cage rests in one place")
+    assert row[2] is False and "70.0 deg" in row[1], row
+    assert with_angles([170.0, -170.0] * 4) is None  # 20 deg apart round the circle: not beyond the bound
+    assert with_angles([170.0, -150.0] * 4) is not None  # 40 deg apart
+    assert with_angles([60.0] * 4 + [130.0] * 4, offset=1e-6) is None  # a cage at the axis: no angle to judge

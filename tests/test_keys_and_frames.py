@@ -280,6 +280,24 @@ def test_per_rotation_and_impacts_frames_hold_the_arrays_with_units(multibody_re
     assert "I_dec [N s]" in named.columns
 
 
+def test_a_number_per_rotation_stands_in_each_pocket_row_and_is_a_rotation_variable():
+    """The per-rotation arrays of the cage, one number per rotation (where it rests; a land-guided cage's
+    land impulses), beside the [rotation, pocket] ones: the DataFrame repeats a rotation's number in each of
+    its pockets' rows, and the Dataset gives it the dimension rotation alone. Before, a land-guided result's
+    frames failed ("Length of values (2) does not match length of index (32)")."""
+    r = bearingsim.run(load_scenario(SCENARIOS / "multibody_3000rpm.toml", [
+        "bearing.cage_guidance=outer_land", "multibody.raceway_contact=rigid", "numerics.rotations=2"]))
+    per = r.to_dataframe("per_rotation")
+    land = np.asarray(r.per_rotation["land_normal"])
+    assert land.shape == (2,) and per.shape[0] == 2 * 16
+    assert (per.loc[1, "land_normal"].to_numpy() == land[1]).all()
+    assert per.loc[(0, 7), "I_dec"] == r.per_rotation["I_dec"][0, 7]
+    assert (per.loc[0, "cage_rest_angle"].to_numpy() == r.per_rotation["cage_rest_angle"][0]).all()
+    ds = r.to_xarray()
+    assert ds["land_normal"].dims == ("rotation",) and ds["cage_rest_angle"].dims == ("rotation",)
+    assert ds["I_dec"].dims == ("rotation", "pocket") and ds["cage_rest_angle"].attrs["units"] == "deg"
+
+
 def test_every_summary_number_has_the_unit_the_archive_page_gives(multibody_result, tmp_path):
     """`bearingsim inspect` showed the summary number `pockets` without a unit (and `to_dataframe("summary")`
     had none for it), where docs/archive.md gives `1` as for `steps`: every number carries its unit,

@@ -493,9 +493,10 @@ def test_a_life_page_to_a_depth_limit_says_what_the_command_notes(tmp_path):
 @pytest.mark.slow
 def test_checks_an_archive_cannot_make_are_not_evaluated_not_passed(whole, tmp_path):
     """bearingsim run judges the warm-up from at least 4 recorded rotations and the cage-speed drift from the
-    speeds at the start and end of the recording, which only a fresh run holds. Read back from a 1-rotation
-    archive neither can be made: the page must list both as not evaluated, and its verdict must not say
-    that every check passed (it said so, listing neither)."""
+    speeds at the start and end of the recording, which only a fresh run holds, and where the cage rests
+    from at least 2 recorded rotations. Read back from a 1-rotation archive none can be made: the page must
+    list all three as not evaluated, and its verdict must not say that every check passed (it said so,
+    listing neither of the first two)."""
     from bearingsim.reports import _checks_blocks
 
     blocks = _checks_blocks(bearingsim.load(whole))
@@ -503,10 +504,11 @@ def test_checks_an_archive_cannot_make_are_not_evaluated_not_passed(whole, tmp_p
     assert rows["warm-up reached a steady state"]["passed"] is None
     assert "1 recorded rotation" in rows["warm-up reached a steady state"]["measured"]
     assert rows["cage speed steady (no drift over the recorded rotations)"]["passed"] is None
+    assert rows["cage rests in one place"]["passed"] is None
     assert [r["passed"] for r in blocks[0]["rows"] if r["passed"] is not None] == [True] * 5
     assert not blocks[1]["text"].startswith("Every check passed") and "Not evaluated here" in blocks[1]["text"]
     html = bearingsim.report(whole, tmp_path / "c.html", animation=None).read_text()
-    assert html.count('<td class="skip">not evaluated</td>') == 2
+    assert html.count('<td class="skip">not evaluated</td>') == 3
 
 
 @pytest.mark.slow

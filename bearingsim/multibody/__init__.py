@@ -288,6 +288,22 @@ def _summary(p, raw, per) -> tuple[dict, dict]:
 _PER_ROTATION_DESC = "per cage rotation (rows; see bearingsim.multibody docstring) and pocket (columns)"
 
 
+def _rest_per_rotation(rest_win, sign: int) -> dict:
+    """Where the cage rests in each recorded rotation (``rest_win``: sums of the sampled centre's x, y and
+    their count per rotation): ``/results/per_rotation/cage_rest_offset`` and ``cage_rest_angle``, as
+    :func:`_cage_rest` gives them for the whole record (NaN: a rotation without a sample)."""
+    count = rest_win[:, 2]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x, y = rest_win[:, 0] / count, rest_win[:, 1] / count
+    desc = "per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start)"
+    pr = "results/per_rotation"
+    return {f"{pr}/cage_rest_offset": NamedArray(np.hypot(x, y), "m", "distance of the cage centre's mean "
+                                                 "position from the bearing axis, " + desc),
+            f"{pr}/cage_rest_angle": NamedArray(np.degrees(np.arctan2(sign * x, -y)), "deg",
+                                                "that position's angle from the bottom (the load's direction), "
+                                                "counted in the direction of rotation, " + desc)}
+
+
 def _per_rotation_arrays(per, first_imp, land) -> dict:
     """``/results/per_rotation``: the impulses, sliding work and first impact speed [rotation, pocket],
     and a land-guided cage's land impulses [rotation]."""
@@ -403,10 +419,11 @@ class MultibodyResult(Result):
     _PER_ROTATION = ("I_acc", "I_dec", "Jn_front", "Jn_rear", "Jf_front", "Jf_rear", "slide_work_front",
                      "slide_work_rear", "first_impact_speed")
     _LAND = ("land_normal", "land_friction", "land_torque")
+    _REST = ("cage_rest_offset", "cage_rest_angle")  # where the cage rests (model version 6)
     _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation")
     LAYOUT = {
         **{f"results/per_rotation/{c}": ("rotations", "pockets") for c in _PER_ROTATION},
-        **{f"results/per_rotation/{c}": ("rotations",) for c in _LAND},
+        **{f"results/per_rotation/{c}": ("rotations",) for c in _LAND + _REST},
         "results/theta_deg": ("theta bins",),
         **{f"results/{c}": ("theta bins", "pockets") for c in ("force_vs_theta", "force_vs_theta_acc",
                                                                 "force_vs_theta_dec")},
@@ -420,7 +437,8 @@ class MultibodyResult(Result):
     }
     OPTIONAL = (frozenset(f"results/per_rotation/{c}" for c in _LAND),  # a land-guided cage
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
-                PROFILE_PATHS)  # archives written before the wear profile
+                PROFILE_PATHS,  # archives written before the wear profile
+                frozenset(f"results/per_rotation/{c}" for c in _REST))  # archives of model version 5 and before
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m"  # no ring: absent
                             and k not in SUMMARY_SINCE)
@@ -446,7 +464,8 @@ class MultibodyResult(Result):
             ("Jf_front", "Jf_front"), ("Jf_rear", "Jf_rear"), ("slide_work_front", "work_front"),
             ("slide_work_rear", "work_rear"))}
         summary, units = _summary(p, raw, per)
-        data = {**_per_rotation_arrays(per, raw.first_imp, raw.land), **_theta_arrays(raw),
+        data = {**_per_rotation_arrays(per, raw.first_imp, raw.land),
+                **_rest_per_rotation(raw.rest_win, p.operating.sign), **_theta_arrays(raw),
                 **_impact_arrays(raw.impacts), **_wear_arrays(p, per),
                 **_profile_arrays(raw.prof, p.multibody.pocket_face_extent)}
         orbit = raw.orbit

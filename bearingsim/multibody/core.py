@@ -775,7 +775,8 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
         e_set=np.full(n, e), e_want=np.full(n, e), touched=np.zeros(n, dtype=np.bool_),
         n_extra=np.zeros(n),
         arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
-        arc_todo=np.zeros((n, 2), dtype=np.bool_), mot=rk.motion_block(n))
+        arc_todo=np.zeros((n, 2), dtype=np.bool_), rest_win=np.zeros((p.numerics.rotations, 3)),
+        mot=rk.motion_block(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
@@ -844,6 +845,7 @@ class MultibodyRaw(NamedTuple):
     beyond_vr: float | None  #: rigid raceways: the radial speed with it [m/s]
     beyond_before: float | None  #: rigid raceways: the move beyond the race before the joint acted [m]
     land: dict | None  #: land-guided cage: per-rotation impulses, torque, overlap, stiffness, half clearance
+    rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
 
 
 def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
@@ -1017,4 +1019,5 @@ def _raw(su: MultibodySetup, pl: _Placed, acc, st, loop_s: float, t_wall0: float
         beyond_before=float(st["beyond_before"]) if rigid_ else None,
         land=(dict(win=wk.land_win.copy(), tau=float(st["land_tau"]), overlap_max=float(st["land_overlap_max"]),
                    stiffness=land.stiffness, half_clearance=land.half_clearance) if land.active else None),
+        rest_win=wk.rest_win.copy(),
     )

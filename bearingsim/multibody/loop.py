@@ -414,6 +414,7 @@ class StepWork(NamedTuple):
     n_extra: np.ndarray  #: (n,) rigid raceways: the outer race's force of :func:`~bearingsim.multibody.forces.race_orbit` in the step [N]
     arc_ends: np.ndarray  #: (n, 2, 4) exact faces: each pocket's (front, rear) segment as placed (ax, ay, bx, by), cage frame [m]
     arc_todo: np.ndarray  #: (n, 2) bool, exact faces: the segments :func:`arc_faces` moved for the coming step
+    rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
     #: (rows, columns) motion poses (:func:`bearingsim.multibody.recorder.record_motion`)
     mot: np.ndarray = np.zeros((1, 1))
 
@@ -679,6 +680,12 @@ def after_step(st0, st1, arb_f, arb_i, n_arb, inp, wk, acc, ls):
             orbit[k, 2] = now[n, 1]
             s.n_orbit += 1
             s.orbit_max = max(s.orbit_max, math.hypot(now[n, 0], now[n, 1]))
+            # where the cage rests, per cage rotation (rotation k: cage travel in [2 pi (W + k), 2 pi (W + k + 1)))
+            kr = int(math.floor(sign * now[n, 2] / (2.0 * math.pi) - inp.cfg.warmup_rotations))
+            if 0 <= kr < wk.rest_win.shape[0]:
+                wk.rest_win[kr, 0] += now[n, 0]
+                wk.rest_win[kr, 1] += now[n, 1]
+                wk.rest_win[kr, 2] += 1.0
         k = s.n_samples
         r = wk.smp[k]
         r.step = s.step

@@ -353,9 +353,9 @@ def cage_rest_change(result) -> str | None:
     span, lo, hi = got
     return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
             f"the bottom spanned {span:.0f} deg over the recorded rotations ({lo:.0f} to {hi:.0f} deg, "
-            f"/results/per_rotation/cage_rest_angle; a steady run's stays within {CAGE_REST_SPAN_DEG:g} deg), so the "
-            f"run's means mix the places it rested in (under load a roller-guided cage can rest in two: "
-            f"docs/whatif.md, Radial load)")
+            f"/results/per_rotation/cage_rest_angle; a steady run's stays within a few, the bound is "
+            f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in (under load a roller-guided "
+            f"cage can rest in two: docs/whatif.md, Radial load)")
 
 
 def cage_speed_drift(result) -> str | None:

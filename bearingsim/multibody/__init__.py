@@ -208,14 +208,20 @@ def _load_zone_half_angle(q_bin, tq_bin):
     return 0.5 * width
 
 
+def _rest_place(x, y, sign: int):
+    """(distance from the axis [m], angle from the bottom counted in the direction of rotation [deg]) of
+    the cage centre's mean position (x, y) (y up, the load along -y): where the cage rests. A whirling or
+    centred cage's mean lies near the axis, where the angle says little: read it beside the distance."""
+    return np.hypot(x, y), np.degrees(np.arctan2(sign * x, -y))
+
+
 def _cage_rest(orbit, sign: int) -> dict:
-    """Where the cage centre rests over the kept samples of its orbit (rows t, x, y; y up, the load along
-    -y): the distance of its mean position from the axis [m], and that position's angle from the bottom,
-    counted in the direction of rotation [deg] (a whirling or centred cage's mean lies near the axis,
-    where the angle says little: read it beside the distance)."""
+    """The summary's :func:`_rest_place` of the mean over the kept samples of the cage's orbit (rows t, x,
+    y: the end of the recording)."""
     o = orbit[np.isfinite(orbit[:, 0])]
-    x, y = (float(o[:, 1].mean()), float(o[:, 2].mean())) if len(o) else (math.nan, math.nan)
-    return {"cage_rest_offset_m": math.hypot(x, y), "cage_rest_angle_deg": math.degrees(math.atan2(sign * x, -y))}
+    x, y = (o[:, 1].mean(), o[:, 2].mean()) if len(o) else (math.nan, math.nan)
+    offset, angle = _rest_place(x, y, sign)
+    return {"cage_rest_offset_m": float(offset), "cage_rest_angle_deg": float(angle)}
 
 
 def _summary(p, raw, per) -> tuple[dict, dict]:
@@ -289,17 +295,17 @@ _PER_ROTATION_DESC = "per cage rotation (rows; see bearingsim.multibody docstrin
 
 
 def _rest_per_rotation(rest_win, sign: int) -> dict:
-    """Where the cage rests in each recorded rotation (``rest_win``: sums of the sampled centre's x, y and
-    their count per rotation): ``/results/per_rotation/cage_rest_offset`` and ``cage_rest_angle``, as
-    :func:`_cage_rest` gives them for the whole record (NaN: a rotation without a sample)."""
+    """:func:`_rest_place` in each recorded rotation (``rest_win``: sums of the sampled centre's x, y and
+    their count per rotation): ``/results/per_rotation/cage_rest_offset`` and ``cage_rest_angle`` (NaN: a
+    rotation without a sample)."""
     count = rest_win[:, 2]
     with np.errstate(invalid="ignore", divide="ignore"):
-        x, y = rest_win[:, 0] / count, rest_win[:, 1] / count
+        offset, angle = _rest_place(rest_win[:, 0] / count, rest_win[:, 1] / count, sign)
     desc = "per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start)"
     pr = "results/per_rotation"
-    return {f"{pr}/cage_rest_offset": NamedArray(np.hypot(x, y), "m", "distance of the cage centre's mean "
+    return {f"{pr}/cage_rest_offset": NamedArray(offset, "m", "distance of the cage centre's mean "
                                                  "position from the bearing axis, " + desc),
-            f"{pr}/cage_rest_angle": NamedArray(np.degrees(np.arctan2(sign * x, -y)), "deg",
+            f"{pr}/cage_rest_angle": NamedArray(angle, "deg",
                                                 "that position's angle from the bottom (the load's direction), "
                                                 "counted in the direction of rotation, " + desc)}
 

@@ -328,25 +328,25 @@ def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
 
 def test_a_multibody_archive_of_the_version_before_where_the_cage_rests_still_reads(tmp_path, capsys):
     """Multibody model version 6 added ``cage_rest_offset_m`` and ``cage_rest_angle_deg`` to the summary
-    (bearingsim.multibody.SUMMARY_SINCE) and their per-rotation arrays. An archive without them (one of
+    (bearingsim.multibody.SUMMARY_ADDED) and their per-rotation arrays. An archive without them (one of
     version 5) reads, the archive tools show the angle as missing ('-'), not the archive as damaged, and a
     report's check of where the cage rests is 'not evaluated'; a value that is not a number is damaged."""
     import bearingsim
     from bearingsim.cli import main
-    from bearingsim.multibody import SUMMARY_SINCE
+    from bearingsim.multibody import SUMMARY_ADDED
 
     from .conftest import SCENARIOS
 
     r = bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 1}))
-    assert set(SUMMARY_SINCE) <= set(r.summary) and r.summary["cage_rest_offset_m"] > 0
+    assert set(SUMMARY_ADDED) <= set(r.summary) and r.summary["cage_rest_offset_m"] > 0
     group = r.groups["results/summary"]
-    for key in SUMMARY_SINCE:
+    for key in SUMMARY_ADDED:
         del group.attrs[key], group.units[key]
     for name in ("cage_rest_angle", "cage_rest_offset"):  # and its per-rotation arrays
         del r.data[f"results/per_rotation/{name}"]
     old = r.save(tmp_path / "v5.h5")
     back = bearingsim.load(old)
-    assert not set(SUMMARY_SINCE) & set(back.summary) and back.summary["I_dec_mean_Ns"] == r.summary["I_dec_mean_Ns"]
+    assert not set(SUMMARY_ADDED) & set(back.summary) and back.summary["I_dec_mean_Ns"] == r.summary["I_dec_mean_Ns"]
     assert "cage_rest_angle" not in back.per_rotation
     from bearingsim.plausibility import checks_made
 

@@ -89,9 +89,9 @@ SUMMARY_UNITS = {
 }
 
 
-#: summary numbers added after archives were written without them, and the model version that added
-#: each: an archive of an earlier version reads without them (where the cage rests: :func:`_cage_rest`)
-SUMMARY_SINCE = {"cage_rest_offset_m": 6, "cage_rest_angle_deg": 6}
+#: summary numbers added after archives were written without them (model version 6: where the cage rests,
+#: :func:`_cage_rest`): an archive of an earlier version reads without them
+SUMMARY_ADDED = ("cage_rest_offset_m", "cage_rest_angle_deg")
 
 RIGID_SUMMARY_UNITS = {"roller_lift_max_m": "m", "roller_beyond_race_max_m": "m"}
 
@@ -447,8 +447,8 @@ class MultibodyResult(Result):
                 frozenset(f"results/per_rotation/{c}" for c in _REST))  # archives of model version 5 and before
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m"  # no ring: absent
-                            and k not in SUMMARY_SINCE)
-    SUMMARY_OPTIONAL = tuple(SUMMARY_SINCE)
+                            and k not in SUMMARY_ADDED)
+    SUMMARY_OPTIONAL = SUMMARY_ADDED
     FIGURE_DATA = ("results/theta_deg", "results/force_vs_theta_acc", "results/force_vs_theta_dec",
                    "results/per_rotation/I_acc", "results/per_rotation/I_dec", "results/cage_orbit", "results/wear")
 

@@ -48,19 +48,23 @@ def on_first_compile(call, package: str = "bearingsim"):
     """While the block runs, ``call(module)`` once, as numba starts to compile the first function of
     ``package`` (``module``: that function's module) because it found no copy of it in its cache for this
     machine; loading a cached copy calls nothing. numba's event API ("numba:compile" fires after a cache
-    miss only); numba is imported here, not before."""
+    miss only); numba is imported here, not before. Once in all: the processes a sweep forks inside the
+    block (they compile, not the sweep process) share one flag (shared memory), so the first of them to
+    compile calls and the others do not."""
     from numba.core import event
 
-    class _First(event.Listener):
-        told = False
+    told = _shared_flag()
 
+    class _First(event.Listener):
         def on_start(self, ev):
-            if self.told:
+            if told.value:
                 return
             module = getattr(getattr(ev.data.get("dispatcher"), "py_func", None), "__module__", None) or ""
             if module == package or module.startswith(package + "."):
-                self.told = True
-                call(module)
+                with told.get_lock():
+                    first, told.value = not told.value, True
+                if first:
+                    call(module)
 
         def on_end(self, ev):
             pass
@@ -71,3 +75,22 @@ def on_first_compile(call, package: str = "bearingsim"):
         yield listener
     finally:
         event.unregister("numba:compile", listener)
+
+
+def _shared_flag():
+    """A boolean flag (``.value``, ``.get_lock()``) in memory that processes forked after it share; where
+    the platform has no shared semaphores (some sandboxes), a flag of this process only."""
+    import multiprocessing
+    import threading
+
+    try:
+        return multiprocessing.Value("b", False)
+    except (OSError, ImportError):  # no /dev/shm, no sem_open
+        class _Local:
+            value = False
+            _lock = threading.Lock()
+
+            def get_lock(self):
+                return self._lock
+
+        return _Local()

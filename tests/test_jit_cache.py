@@ -152,3 +152,22 @@ def test_a_first_run_on_a_terminal_says_it_compiles_and_the_next_run_does_not(tm
     code, second = _on_a_terminal(cmd, env, tmp_path)
     assert code == 0, second
     assert "compiling" not in second, second
+
+
+@pytest.mark.slow
+def test_a_sweeps_workers_say_once_between_them_that_they_compile(tmp_path):
+    """From an empty numba cache, `bearingsim sweep -j 2` on a terminal: its two forked workers each compile
+    the reduced model's kernels (the sweep process runs no model), and the note is said once, by the first
+    of them to start (each worker said it, one line per worker, before the flag was shared)."""
+    import os
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    cmd = [sys.executable, "-m", "bearingsim", "sweep", str(root / "scenarios" / "paper_3000rpm.toml"),
+           "--param", "operating.inner_ring_speed_rpm=1000,2000,3000,4000", "-j", "2", "--no-plots",
+           "-o", str(tmp_path / "sw")]
+    code, said = _on_a_terminal(cmd, env, tmp_path)
+    assert code == 0, said
+    assert said.count("compiling the reduced model's kernels for this machine") == 1, said
+    assert len(list((tmp_path / "cache").rglob("*.nbi"))) > 0  # the workers did compile into the empty cache

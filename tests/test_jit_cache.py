@@ -171,3 +171,26 @@ def test_a_sweeps_workers_say_once_between_them_that_they_compile(tmp_path):
     assert code == 0, said
     assert said.count("compiling the reduced model's kernels for this machine") == 1, said
     assert len(list((tmp_path / "cache").rglob("*.nbi"))) > 0  # the workers did compile into the empty cache
+
+
+def test_without_shared_semaphores_the_note_flag_is_the_process_own(monkeypatch):
+    """Where multiprocessing cannot make a shared value (no /dev/shm: OSError), the flag of
+    on_first_compile is a flag of this process: the note is still said once in it."""
+    import multiprocessing
+
+    import numba
+
+    from bearingsim import _jit, laws
+
+    def no_shm(*a, **kw):
+        raise OSError("sem_open: function not implemented")
+
+    monkeypatch.setattr(multiprocessing, "Value", no_shm)
+    flag = _jit._shared_flag()
+    with flag.get_lock():
+        assert flag.value is False
+    seen = []
+    with _jit.on_first_compile(seen.append):
+        numba.njit(laws.palmgren_load)(3.0e9, 1e-5)
+        numba.njit(laws.oil_film_drag_scalar)(1e-3, 100.0, 5.0)
+    assert seen == ["bearingsim.laws"]

@@ -447,19 +447,19 @@ def _cmd_crosscheck(args) -> int:
     from bearingsim.studies import make_engine
 
     speeds = cc.parse_speeds(args.speeds)
-    if args.rotations < 1:
-        raise UserError(f"--rotations {args.rotations}: give at least 1 recorded rotation")
     engine = make_engine(args.jobs, args.scheduler)
     scenario = load_scenario(args.scenario, args.set)
-    cc.rung_scenarios(scenario, speeds[0], args.rotations)  # refuse a wrong scenario before any run
+    rotations = _crosscheck_rotations(args, scenario)
+    cc.rung_scenarios(scenario, speeds[0], rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
-    rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, args.rotations, engine=engine,
+    rows, outcome = cc.run_crosscheck(scenario, Path(args.output), speeds, rotations, engine=engine,
                                       force=args.force, progress=progress_wanted(args))
     wall = time.perf_counter() - t0
     if outcome.interrupted is None and not args.quiet:
         where = f"dask scheduler {args.scheduler}" if args.scheduler else counted(args.jobs, "process", "processes")
-        print(f"cross-check of {args.scenario}: {counted(len(speeds), 'speed')} x {len(cc.RUNGS)} rungs, 1 warm-up + "
-              f"{counted(args.rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
+        warmup = counted(scenario.numerics.warmup_rotations, "warm-up")
+        print(f"cross-check of {args.scenario}: {counted(len(speeds), 'speed')} x {len(cc.RUNGS)} rungs, {warmup} + "
+              f"{counted(rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
               f"rotation, mean over all pockets ± batch-means standard error")
         print(cc.format_table(rows))
         for line in cc.verdicts(rows):
@@ -468,6 +468,24 @@ def _cmd_crosscheck(args) -> int:
             print(f"wrote {Path(args.output) / name}")
         print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
     return report_study(outcome, "cross-check")
+
+
+def _crosscheck_rotations(args, scenario) -> int:
+    """The rungs' recorded rotations: ``--rotations``, else a ``--set numerics.rotations`` (the scenario
+    file's own count is for its single run), else :data:`~bearingsim.studies.crosscheck.DEFAULT_ROTATIONS`;
+    both given and different is refused."""
+    from bearingsim.scenario import parse_override
+    from bearingsim.studies.crosscheck import DEFAULT_ROTATIONS
+
+    given = "numerics.rotations" in [parse_override(o)[0] for o in args.set]
+    if args.rotations is not None and given and args.rotations != scenario.numerics.rotations:
+        raise UserError(f"--rotations {args.rotations} and --set numerics.rotations={scenario.numerics.rotations}: "
+                        "the rungs' recorded rotations given twice; give one")
+    rotations = args.rotations if args.rotations is not None else (
+        scenario.numerics.rotations if given else DEFAULT_ROTATIONS)
+    if rotations < 1:
+        raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation")
+    return rotations
 
 
 def _cmd_report(args) -> int:
@@ -607,7 +625,9 @@ def _add_study_commands(sub) -> None:
                                            "(docs/crosscheck.md; run again to resume)")
     cc.add_argument("scenario", help="multibody scenario TOML, full scene")
     cc.add_argument("--speeds", default="1000,3000,6000", help="inner-ring speeds in rpm (default 1000,3000,6000)")
-    cc.add_argument("--rotations", type=int, default=10, help="recorded cage rotations of every rung (default 10)")
+    cc.add_argument("--rotations", type=int, default=None,
+                    help="recorded cage rotations of every rung (default 10, or a --set numerics.rotations), after "
+                         "the scenario's warm-up rotations")
     cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario key (repeatable)")
     cc.add_argument("-o", "--output", default="outputs/crosscheck", help="output folder")

@@ -1,6 +1,6 @@
 """The cross-check ladder (issue 13): ``bearingsim crosscheck`` and the scenes it climbs through.
 
-One command run (3000 rpm, 1 warm-up + 4 rotations, 2 processes, ~10 s once compiled) feeds the tests;
+One command run (3000 rpm, 2 warm-up + 4 rotations, 2 processes, ~10 s once compiled) feeds the tests;
 each rung's archive is read back to check that its scene holds what it claims.
 """
 from __future__ import annotations
@@ -18,12 +18,13 @@ import bearingsim
 from bearingsim.studies import crosscheck as cc
 from bearingsim.cli import main
 from bearingsim.compare import compare_results
-from bearingsim.scenario import load_scenario
+from bearingsim.scenario import load_scenario, parse_toml_text
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 REFERENCE = SCENARIOS / "multibody_3000rpm.toml"
 RPM = 3000.0
 ROTATIONS = 4
+WARMUP = 2  # not the scenario file's 1: the header says the warm-up the rungs ran
 
 
 @pytest.fixture(scope="module")
@@ -35,7 +36,8 @@ def ladder(tmp_path_factory):
     out = tmp_path_factory.mktemp("crosscheck")
     buf = io.StringIO()
     with contextlib.redirect_stdout(buf):
-        rc = main(["crosscheck", str(REFERENCE), "--speeds", f"{RPM:g}", "--rotations", str(ROTATIONS), "-o", str(out)])
+        rc = main(["crosscheck", str(REFERENCE), "--speeds", f"{RPM:g}", "--set", f"numerics.rotations={ROTATIONS}",
+                   "--set", f"numerics.warmup_rotations={WARMUP}", "-o", str(out)])
     return out, rc, buf.getvalue().splitlines()
 
 
@@ -61,6 +63,9 @@ def test_command_succeeds_and_reports(ladder):
     significance."""
     out, rc, lines = ladder
     assert rc == 0
+    # the header says what the rungs ran: the scenario's warm-up (it said "1 warm-up" whatever it was) and
+    # the recorded rotations of `--set numerics.rotations` (which the default --rotations 10 overrode)
+    assert f"{WARMUP} warm-ups + {ROTATIONS} rotations each" in lines[0], lines[0]
     sentence = [ln for ln in lines if ln.startswith(f"{RPM:g} rpm: the largest change of I_dec is at rung")]
     assert len(sentence) == 1
     assert sentence[0].count("significant") == 4  # one verdict per change (rungs 2..5)
@@ -128,7 +133,8 @@ def test_rung4_cage_centre_held_and_momentum_balanced(ladder):
 def test_rung5_is_bearingsim_run_of_the_scenario(ladder):
     """The full rung is ``bearingsim run`` of the scenario at that speed and rotation count, bit for bit
     (every summary number and per-rotation array); its cage momentum balances too."""
-    sc = load_scenario(REFERENCE).replace(**{"operating.inner_ring_speed_rpm": RPM, "numerics.rotations": ROTATIONS})
+    sc = load_scenario(REFERENCE).replace(**{"operating.inner_ring_speed_rpm": RPM, "numerics.rotations": ROTATIONS,
+                                             "numerics.warmup_rotations": WARMUP})
     fresh = bearingsim.run(sc)
     stored = _rung(ladder[0], 5)
     c = compare_results(stored, fresh)
@@ -143,6 +149,8 @@ def test_index_and_plot(ladder, tmp_path):
     out = ladder[0]
     rows, meta = cc.read_table(out / "crosscheck.h5")
     assert [r["rung"] for r in rows] == [1, 2, 3, 4, 5]
+    stored = parse_toml_text(meta["scenario"], "crosscheck.h5")  # what `bearingsim show crosscheck.h5` prints
+    assert stored["numerics"]["rotations"] == ROTATIONS and stored["numerics"]["warmup_rotations"] == WARMUP
     assert {r["status"] for r in rows} == {"done"} and {r["error"] for r in rows} == {""}
     for r in rows:
         res = bearingsim.load(out / r["archive"])
@@ -165,6 +173,8 @@ def test_rung_scenarios():
     expect["operating"]["inner_ring_speed_rpm"] = 1000.0
     expect["numerics"]["rotations"] = 7
     assert full.raw == expect
+    # the table's stored scenario (`bearingsim show crosscheck.h5`) has the rungs' count, not the file's 4
+    assert cc.CrossCheck(sc, speeds=(1000,), rotations=7).scenario.numerics.rotations == 7
 
 
 @pytest.mark.parametrize("contact, named", [("hertz", "(Hertz;"), ("rigid", "(rigid raceways;")])
@@ -183,6 +193,8 @@ def test_each_rung_says_the_raceway_contacts_its_scenario_has(contact, named):
     (["crosscheck", str(REFERENCE), "--set", "multibody.scene=reduced_equivalent"], "multibody.scene"),
     (["crosscheck", str(REFERENCE), "--speeds", "1000,fast"], "--speeds"),
     (["crosscheck", str(REFERENCE), "--rotations", "0"], "--rotations"),
+    (["crosscheck", str(REFERENCE), "--set", "numerics.rotations=0"], "numerics.rotations"),
+    (["crosscheck", str(REFERENCE), "--rotations", "3", "--set", "numerics.rotations=5"], "given twice"),
     (["crosscheck", str(REFERENCE), "-j", "0"], "-j 0"),
 ])
 def test_refusals(argv, words, capsys, tmp_path):

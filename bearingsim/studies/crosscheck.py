@@ -170,7 +170,8 @@ class CrossCheck(Study):
         from bearingsim import archive
         from bearingsim.outputs import PNG_SIGNATURE
 
-        self.scenario = scenario
+        # the table keeps the scenario with the rungs' recorded rotations ('bearingsim show crosscheck.h5')
+        self.scenario = scenario if rotations is None else scenario.replace(**{"numerics.rotations": int(rotations)})
         self.rungs = {}  # case hash -> (rpm, rung, scene, relaxed)
         cases = []
         for rpm in speeds:

@@ -71,6 +71,10 @@ def _observables(result) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, s
 
 def result_dataframe(result, what: str = "per_rotation", units_in_names: bool = False):
     """The DataFrame of ``what`` (:data:`FRAMES`) of ``result``; see :meth:`Result.to_dataframe`."""
+    if not isinstance(what, str) or what not in FRAMES:
+        from bearingsim.errors import UserError
+
+        raise UserError(f"to_dataframe({what!r}): give one of {', '.join(FRAMES)}")
     pd = need("pandas", "Result.to_dataframe")
     if what == "per_rotation":
         arrays = _under(result, "results/per_rotation")
@@ -95,8 +99,6 @@ def result_dataframe(result, what: str = "per_rotation", units_in_names: bool = 
         summary = result.summary
         frame = pd.DataFrame({k: [v] for k, v in summary.items()}, index=pd.Index([result.scenario.name], name="run"))
         units = {k: result.summary_units.get(k, "1") for k in summary}
-    else:
-        raise ValueError(f"to_dataframe({what!r}): give one of {', '.join(FRAMES)}")
     return _named(frame, units, units_in_names)
 
 

@@ -323,8 +323,6 @@ def test_observables_frame_and_dataset(multibody_result):
     assert ds.attrs["I_dec_mean_Ns"] == r.summary["I_dec_mean_Ns"] and ds.attrs["units_I_dec_mean_Ns"] == "N s"
     assert load_scenario_text(ds.attrs["scenario_toml"]) == r.scenario.to_toml()
     assert r.to_dataframe("summary").loc[r.scenario.name, "cage_slip"] == r.summary["cage_slip"]
-    with pytest.raises(ValueError, match="per_rotation, impacts, observables, summary"):
-        r.to_dataframe("everything")
 
 
 def load_scenario_text(text):
@@ -357,3 +355,13 @@ def test_without_pandas_a_one_line_hint_names_the_extra(monkeypatch, multibody_r
         multibody_result.to_dataframe()
     with pytest.raises(MissingExtra, match=r"needs xarray.*bearingsim\[frames\]"):
         multibody_result.to_xarray()
+
+
+@pytest.mark.parametrize("what", ["everything", 3, None])
+def test_a_frame_that_is_not_there_is_a_user_error(multibody_result, what):
+    """A bad argument from the caller is a bearingsim.UserError (docs/usage.md), naming what to give: an unknown
+    frame raised a plain ValueError."""
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match=r"give one of per_rotation, impacts, observables, summary"):
+        multibody_result.to_dataframe(what)

@@ -379,6 +379,12 @@ def _cmd_validate(args) -> int:
 
 
 def _print_validate(args, studies, outcome) -> None:
+    """The Fig. 9 table and its files, then the rig table and its files (what ``bearingsim table`` of the
+    folder prints: :func:`bearingsim.studies.validate.format_tables`), then the cases' counts."""
+    if outcome.interrupted is None:
+        from bearingsim.studies.fig9 import format_table
+
+        print(format_table(studies[0].table))
     for p in outcome.written[:2]:
         print(f"wrote {p}")
     if args.rig_rotations > 0 and outcome.interrupted is None:

@@ -213,6 +213,10 @@ def test_table_of_a_validate_folder_prints_its_fig9_and_rig_tables(tmp_path):
         first = next(csv.DictReader(fh))
     assert printed[k + 2].split() == ["500", *(f"{float(first[c]) * 1e3:.3f}" for c in list(first)[1:])]
     assert len(printed[k + 2:j]) >= 9  # the 9 speeds (then a blank line or a note before the rig table)
+    # validate itself printed the same Fig. 9 table (it printed only the rig table, though docs/validation.md
+    # gives the Fig. 9 numbers as printed by it)
+    f = lines.index(printed[k])
+    assert lines[f:f + 11] == printed[k:k + 11]  # the heading, the column names and the 9 speeds
     index = cli("table", out / "sweep.h5")
     assert index.returncode == 0 and index.stdout.splitlines()[1].split()[:4] == ["study", "rpm", "drag", "variant"]
 

@@ -30,13 +30,12 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
 
     spec = spec_from_args(target, params, sets)
     if not quiet:  # keys that change nothing in the base scenario's model (unless the model is swept too)
-        from bearingsim.scenario import UNREAD_SETTINGS, given_keys, load_scenario, unread_note
+        from bearingsim.scenario import given_keys, load_scenario, unread_note
 
         keys = given_keys(spec.scenario, spec.sets) + spec.keys
         base = load_scenario(spec.scenario, spec.sets)
         method = None if "reduced.method" in spec.keys else base.reduced.method  # swept: some cases use the step
-        settings = not any(k in spec.keys for k in UNREAD_SETTINGS)  # swept: some cases read the keys
-        note = None if "model" in spec.keys else unread_note(base, keys, method, settings)
+        note = None if "model" in spec.keys else unread_note(base, keys, method, varied=spec.keys)
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)

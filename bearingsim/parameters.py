@@ -291,6 +291,30 @@ def paper_assumptions(scene: str) -> bool:
     return scene == "reduced_equivalent"
 
 
+def inner_ring_mode(p) -> tuple[str, str]:
+    """What the multibody model makes of its inner ring: ``("none", why)`` in the scene of the paper's
+    assumptions (:func:`paper_assumptions`), else ``("quasi_static" | "dynamic", why)``.
+
+    ``multibody.inner_ring = "auto"`` keeps the quasi-static ring while the load is always shared by at
+    least two rollers (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre` >= 2) or there is no
+    load, and otherwise makes it dynamic: a ring resting on a single roller has no stable sideways
+    equilibrium, so the rotor's inertia decides where it goes. ``why`` says how "auto" chose ("" when
+    the mode is given)."""
+    mb = p.multibody
+    if paper_assumptions(mb.scene):
+        return "none", "reduced-equivalent scene"
+    if mb.inner_ring != "auto":
+        return mb.inner_ring, ""
+    load = p.operating.radial_load
+    if load <= 0.0:
+        return "quasi_static", "auto: no radial load"
+    geo = p.bearing
+    k = laws.loaded_rollers_with_one_at_centre(load, geo.roller_count, geo.roller_length, geo.radial_clearance)
+    return ("quasi_static" if k >= 2 else "dynamic",
+            f"auto: {k} roller(s) loaded with one at the load-zone centre "
+            f"({'>= 2: quasi-static' if k >= 2 else 'the ring would rest on one roller: dynamic'})")
+
+
 def pocket_angles(roller_count: int, sign: int) -> np.ndarray:
     """Cage-frame angles [rad] of the pocket centres at cage angle 0.
 

@@ -743,18 +743,34 @@ LOAD_ZONE_KEYS = ("operating.radial_load_N", "bearing.roller_count", "bearing.ro
                   "bearing.radial_clearance_mm")
 
 
-def _unread_by_setting(scenario, key: str) -> str | None:
-    """Why a key the model uses is not read with this scenario's settings, or None."""
-    if key in LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers":
+#: the keys whose values decide whether a dynamic ring's mass is read (:func:`bearingsim.parameters.inner_ring_mode`)
+RING_MODE_KEYS = ("multibody.inner_ring", "multibody.scene", *LOAD_ZONE_KEYS)
+
+
+def _unread_by_setting(scenario, key: str, varied=()) -> str | None:
+    """Why a key the model uses is not read with this scenario's settings, or None. A rule whose deciding
+    setting is among ``varied`` (the keys a sweep varies: some of its cases may read the key) says nothing."""
+    varied = set(varied)
+    if (key in LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers"
+            and "bearing.cage_guidance" not in varied):
         return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
     if (key in LOAD_ZONE_KEYS and scenario.model == "reduced"
-            and scenario.reduced.load_zone_half_angle_deg != "auto"):
+            and scenario.reduced.load_zone_half_angle_deg != "auto" and "reduced.load_zone_half_angle_deg" not in varied):
         return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
                 "load zone only when 'auto')")
     if (key == "reduced.load_zone_half_angle_deg" and scenario.model == "multibody"
-            and scenario.multibody.scene != "reduced_equivalent"):
+            and scenario.multibody.scene != "reduced_equivalent" and "multibody.scene" not in varied):
         return (f"not used by the multibody model's {scenario.multibody.scene!r} scene (its load zone comes out of "
                 f"the raceway contacts; only multibody.scene = 'reduced_equivalent' reads it)")
+    if key == "multibody.inner_ring_mass_kg" and scenario.model == "multibody" and not varied & set(RING_MODE_KEYS):
+        from bearingsim.parameters import inner_ring_mode
+
+        mode, why = inner_ring_mode(scenario.parameters)
+        if mode == "none":
+            return "not used by the multibody model's 'reduced_equivalent' scene (it has no inner ring)"
+        if mode == "quasi_static":
+            return (f"not used with a quasi-static (massless) inner ring ({why or 'multibody.inner_ring'}; only "
+                    f"multibody.inner_ring = 'dynamic' gives it a mass)")
     return None
 
 
@@ -768,22 +784,18 @@ def unread_because(scenario, key: str) -> str | None:
     return _unread_by_setting(scenario, key)
 
 
-#: the settings that decide whether a key the model uses is read (:func:`_unread_by_setting`)
-UNREAD_SETTINGS = ("bearing.cage_guidance", "reduced.load_zone_half_angle_deg", "multibody.scene")
-
-
-def unread_note(scenario, keys, method: str | None = "", settings: bool = True) -> str | None:
+def unread_note(scenario, keys, method: str | None = "", varied=()) -> str | None:
     """One line saying which of ``keys`` the resolved scenario's run does not read: :func:`unused_note` of
     its model and method, and the keys its settings leave unread (:func:`unread_because`); None if it
     reads them all. ``method``: the reduced model's method to judge by (default: the scenario's; None: none,
-    as for a sweep that varies it); ``settings=False`` leaves out the keys unread by a setting (a sweep
-    that varies one of :data:`UNREAD_SETTINGS`)."""
+    as for a sweep that varies it); ``varied``: the keys a sweep varies (a key left unread by a setting
+    among them is not noted: some cases read it)."""
     method = scenario.reduced.method if method == "" else method
     note = unused_note(scenario.model, keys, method)
     unused = unused_keys(scenario.model, keys, method)
     by_setting: dict[str, list[str]] = {}
-    for k in dict.fromkeys(keys) if settings else ():
-        why = None if k in unused else _unread_by_setting(scenario, k)
+    for k in dict.fromkeys(keys):
+        why = None if k in unused else _unread_by_setting(scenario, k, varied)
         if why is not None:
             by_setting.setdefault(why, []).append(k)
     parts = ([note] if note else []) + [f"{', '.join(ks)}: {why}; no effect on the run" for why, ks in by_setting.items()]

@@ -361,3 +361,38 @@ def test_a_missing_key_is_told_to_name_a_preset_only_where_a_preset_gives_it():
         resolve({"schema_version": 1, "name": "x", "model": "reduced", "bearing": {"roller_count": 16},
                  "operating": {"inner_ring_speed_rpm": 3000.0, "radial_load_N": 970.0}}, "<test>")
     assert "bearing." in str(err.value) and "missing (set it in the scenario or name a [bearing] preset)" in str(err.value)
+
+
+def test_a_ring_mass_the_ring_does_not_have_is_noted():
+    """multibody.inner_ring_mass_kg is read by a dynamic inner ring only: with a quasi-static ring (given, or
+    chosen by inner_ring = "auto" where two or more rollers share the load: 970 N) a run with another mass
+    gave the same numbers bit for bit and no note. It is noted now, with how the ring was chosen; a dynamic
+    ring (given, or chosen by "auto" at 200 N, where one roller would carry the ring) reads it; a sweep
+    varying a key that decides the ring's model notes nothing (some of its cases may read the mass)."""
+    from bearingsim.scenario import unread_note
+
+    mb = SCENARIOS / "multibody_3000rpm.toml"
+    keys = ["multibody.inner_ring_mass_kg"]
+    given = load_scenario(mb, ["multibody.inner_ring=quasi_static", "multibody.inner_ring_mass_kg=5"])
+    assert unread_note(given, keys) == (
+        "multibody.inner_ring_mass_kg: not used with a quasi-static (massless) inner ring (multibody.inner_ring; "
+        "only multibody.inner_ring = 'dynamic' gives it a mass); no effect on the run")
+    auto = load_scenario(mb, ["multibody.inner_ring_mass_kg=5"])
+    assert "(auto: 3 roller(s) loaded with one at the load-zone centre (>= 2: quasi-static);" in unread_note(auto, keys)
+    for varied in (["operating.radial_load_N"], ["multibody.inner_ring"]):
+        assert unread_note(auto, keys, varied=varied) is None
+    for sets in (["multibody.inner_ring=dynamic"], ["operating.radial_load_N=200"]):
+        assert unread_note(load_scenario(mb, [*sets, "multibody.inner_ring_mass_kg=5"]), keys) is None
+    equivalent = load_scenario(SCENARIOS / "multibody_reduced_equivalent_3000rpm.toml", ["multibody.inner_ring_mass_kg=5"])
+    assert "it has no inner ring" in unread_note(equivalent, keys)
+
+
+def test_a_sweep_of_one_setting_keeps_the_notes_other_settings_decide(tmp_path):
+    """A land key with a roller-guided cage is noted in a sweep that varies the load (a setting that decides
+    another key's note, the ring mass's): sweeping any deciding setting dropped every such note."""
+    from bearingsim.scenario import unread_note
+
+    rollers = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["contact.land_friction=0.2"])
+    note = unread_note(rollers, ["contact.land_friction"], varied=["operating.radial_load_N"])
+    assert note is not None and "bearing.cage_guidance = 'rollers'" in note
+    assert unread_note(rollers, ["contact.land_friction"], varied=["bearing.cage_guidance"]) is None

@@ -31,6 +31,7 @@ from bearingsim.multibody import chipmunk
 from bearingsim.multibody import loop as lp
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
+from bearingsim.parameters import inner_ring_mode
 from bearingsim.parameters import paper_assumptions  # noqa: F401 - re-exported: the scene of the paper's assumptions
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
@@ -127,33 +128,18 @@ class PenetrationExceeded(Exception):
 
 
 def inner_ring_model(p):
-    """(mass [kg], description) of the inner ring: mass 0 is quasi-static (massless).
-
-    ``multibody.inner_ring = "auto"`` keeps the quasi-static ring while the load is always shared by at
-    least two rollers (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre` >= 2) or there
-    is no load, and otherwise makes it dynamic: a ring resting on a single roller has no stable
-    sideways equilibrium, so the rotor's inertia decides where it goes. The dynamic ring's mass is
+    """(mass [kg], description) of the inner ring: mass 0 is quasi-static (massless), as
+    :func:`bearingsim.parameters.inner_ring_mode` decides. The dynamic ring's mass is
     ``multibody.inner_ring_mass_kg``; "auto" takes the radial load as the weight of the rotor the
     bearing carries (the paper's rig), ``M = W / g_n``.
     """
-    mb = p.multibody
-    if paper_assumptions(mb.scene):
+    mode, why = inner_ring_mode(p)
+    if mode == "none":
         return 0.0, "none (reduced-equivalent scene)"
-    geo = p.bearing
-    load = p.operating.radial_load
-    mode = mb.inner_ring
-    why = ""
-    if mode == "auto":
-        if load <= 0.0:
-            mode, why = "quasi_static", "auto: no radial load"
-        else:
-            k = laws.loaded_rollers_with_one_at_centre(load, geo.roller_count, geo.roller_length,
-                                                      geo.radial_clearance)
-            mode = "quasi_static" if k >= 2 else "dynamic"
-            why = (f"auto: {k} roller(s) loaded with one at the load-zone centre "
-                   f"({'>= 2: quasi-static' if k >= 2 else 'the ring would rest on one roller: dynamic'})")
     if mode == "quasi_static":
         return 0.0, "quasi-static (massless)" + (f"; {why}" if why else "")
+    mb = p.multibody
+    load = p.operating.radial_load
     if mb.inner_ring_mass is None:
         if load <= 0.0:
             raise UserError("multibody.inner_ring_mass_kg: a dynamic inner ring without radial load needs its "

@@ -33,7 +33,7 @@ SUFFIXES = (".html", ".htm")
 MAX_ROWS = 200
 #: the formats of the embedded animation and how the page shows them
 ANIMATIONS = {"gif": ("image/gif", "img"), "mp4": ("video/mp4", "video")}
-KINDS = ("run", "sweep", "crosscheck", "validate", "sensitivity", "uncertainty", "life")
+KINDS = ("run", "sweep", "crosscheck", "validate", "sensitivity", "uncertainty", "life", "studies")
 
 
 @dataclass
@@ -79,6 +79,7 @@ def report(path, out=None, *, animation: str | None = "gif") -> Path:
     of an archive's embedded animation, ``"gif"`` (an image: every browser, printed as its frame) or
     ``"mp4"`` (a video, smaller), None for none. One-line UserError for a PATH that is none of these and
     for an output that cannot be written."""
+    from bearingsim import tables
     from bearingsim.outputs import atomic_file
 
     if animation is not None and animation not in ANIMATIONS:
@@ -88,7 +89,12 @@ def report(path, out=None, *, animation: str | None = "gif") -> Path:
         check_path(out, "out", "the report (.html)")
     out = check_output(default_output(path) if out is None else out, path)
     kind, file = kind_of(path)
-    title, sections = _sections(kind, file, animation)
+    found = tables.studies_of(path) if kind != "run" else []
+    if len(found) > 1:  # a folder of several studies (run_studies of a cross-check and Fig. 9): every one
+        kind = "studies"
+        title, sections = _studies_sections(found)
+    else:
+        title, sections = _sections(kind, file, animation)
     html = render(title, str(path), kind, sections)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -140,11 +146,37 @@ def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
 def _sections(kind: str, file: Path, animation) -> tuple[str, list[Section]]:
     if kind == "run":
         return _run_sections(file, animation)
-    builders = {"sweep": _sweep_sections, "crosscheck": _crosscheck_sections, "validate": _validate_sections,
-                "sensitivity": _sensitivity_sections, "uncertainty": _uncertainty_sections, "life": _life_sections}
-    title, sections, scenario = builders[kind](file)  # scenario: the folder's scenario as TOML, or its blocks
+    title, sections, scenario = _builders()[kind](file)  # scenario: the folder's scenario as TOML, or its blocks
     sections += _folder_sections(file.parent, scenario)
     return title, sections
+
+
+def _builders() -> dict:
+    return {"sweep": _sweep_sections, "crosscheck": _crosscheck_sections, "validate": _validate_sections,
+            "sensitivity": _sensitivity_sections, "uncertainty": _uncertainty_sections, "life": _life_sections}
+
+
+def _studies_sections(found) -> tuple[str, list[Section]]:
+    """A folder holding several studies' tables (``found``: :func:`bearingsim.tables.studies_of`): each
+    study's sections in that order (anchors and figure titles named after the study), then the folder's
+    cases and checks, each study's scenario and the provenance of its first case."""
+    from bearingsim.tables import STUDY_NAMES
+
+    folder = found[0][1].parent
+    titles, sections, scenarios = [], [], []
+    for kind, file in found:
+        title, own, scenario = _builders()[kind](file)
+        titles.append(title)
+        for s in own:
+            s.id = f"{kind}-{s.id}"
+            s.title = s.title if s.id != f"{kind}-figures" else f"Figures: {own[0].title}"
+        sections += own
+        blocks = scenario if isinstance(scenario, list) else _scenario_blocks(scenario, file)
+        scenarios.append(Section(f"{kind}-scenario", f"Scenario: {own[0].title}", blocks))
+    intro = {"kind": "text", "text": f"{folder} holds {len(found)} studies' tables, each shown here: "
+                                     + ", ".join(f"{STUDY_NAMES[k]} ({f.name})" for k, f in found) + "."}
+    sections[0].blocks.insert(0, intro)
+    return "; ".join(titles), sections + _folder_sections(folder, None, scenarios=scenarios)
 
 
 # --- blocks -------------------------------------------------------------------------------------
@@ -430,13 +462,15 @@ def _rig_block(rows: list[dict], rotations: int) -> dict:
 
 def _validate_scenario(folder: Path) -> list[dict]:
     """The Scenario section's blocks of a validate folder: every case has its own scenario; shown is the
-    first finished rig case's (else the first finished case's), as its archive stores it."""
+    first finished rig case's (else the first finished Fig. 9 case's, else the first finished case's: a
+    folder may hold another study's cases too), as its archive stores it."""
     from bearingsim import archive
     from bearingsim.sweeps.index import read_index
 
     cols, _ = read_index(folder / "sweep.h5")
     done = [i for i, s in enumerate(cols["status"]) if str(s) in ("done", "cached", "stale") and cols["archive"][i]]
-    pick = next((i for i in done if str(cols["study"][i]) == "rig"), done[0] if done else None)
+    pick = next((i for study in ("rig", "fig9") for i in done if str(cols["study"][i]) == study),
+                done[0] if done else None)
     got = archive.peek(folder / str(cols["archive"][pick])) if pick is not None else None
     if got is None:
         return _scenario_blocks(None, folder)
@@ -536,9 +570,10 @@ def _life_limit_note(attrs: dict) -> str | None:
         return None
 
 
-def _folder_sections(folder: Path, toml) -> list[Section]:
+def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None) -> list[Section]:
     """The cases (status counts, failures), the scenario (``toml``: the folder's scenario as TOML text,
-    or the Scenario section's blocks) and the provenance of a folder's first case archive."""
+    or the Scenario section's blocks; ``scenarios``: sections given instead) and the provenance of a
+    folder's first case archive."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
     from bearingsim.tables import cell_text
@@ -562,8 +597,10 @@ def _folder_sections(folder: Path, toml) -> list[Section]:
         # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)
         label = ", ".join(f"{k} = {cell_text(cols[k][row])}" for k in meta.get("axes", ()) if k in cols) \
             if row is not None else ""
-    scenario = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
-    sections = [Section("checks", "Cases and checks", checks), Section("scenario", "Scenario", scenario)]
+    if scenarios is None:
+        blocks = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
+        scenarios = [Section("scenario", "Scenario", blocks)]
+    sections = [Section("checks", "Cases and checks", checks), *scenarios]
     if first is not None:
         from bearingsim.simulation import load
 

@@ -168,18 +168,23 @@ def _is_study_table(kind: str, path: Path) -> bool:
     return archive.is_table_file(path, fmt)
 
 
-def study_of(path) -> tuple[str, Path] | None:
-    """``(kind, table file)`` of a study folder (life, cross-check, sensitivity, uncertainty or validate:
-    :data:`STUDY_TABLES`) or of its table file; None for anything else (a sweep folder, a case index, an
-    archive)."""
+def studies_of(path) -> list[tuple[str, Path]]:
+    """``(kind, table file)`` of every study whose table a folder holds (life, cross-check, sensitivity,
+    uncertainty, validate), in the order of :data:`STUDY_TABLES` (one folder may hold several:
+    :func:`bearingsim.studies.run_studies` of a cross-check and the Fig. 9 study), or of a table file
+    itself; empty for anything else (a sweep folder, a case index, an archive)."""
     p = Path(path)
     if not p.exists():
-        return None
+        return []
     folder = p if p.is_dir() else p.parent
-    for kind, name in STUDY_TABLES:
-        if (p.is_dir() or p.name == name) and _is_study_table(kind, folder / name):
-            return kind, folder / name
-    return None
+    return [(kind, folder / name) for kind, name in STUDY_TABLES
+            if (p.is_dir() or p.name == name) and _is_study_table(kind, folder / name)]
+
+
+def study_of(path) -> tuple[str, Path] | None:
+    """The first of :func:`studies_of` (the most specific study table of a folder), or None."""
+    found = studies_of(path)
+    return found[0] if found else None
 
 
 def study_text(kind: str, file: Path) -> str:
@@ -223,17 +228,29 @@ def study_text(kind: str, file: Path) -> str:
 
 def format_paths(paths, columns=None) -> str:
     """What ``bearingsim table PATHS`` prints: for a study folder or its table file, the study's own table
-    (:func:`study_text`; ``columns`` refused: its columns are its own); else the summary table of a
-    sweep folder or index, or of run archives (:func:`table_of`, :func:`format_table`)."""
+    (:func:`study_text`; ``columns`` refused: its columns are its own), of a folder holding several studies'
+    tables each of them, in the order of :func:`studies_of`, under a line naming them; else the summary
+    table of a sweep folder or index, or of run archives (:func:`table_of`, :func:`format_table`)."""
     paths = [Path(paths)] if isinstance(paths, (str, Path)) else [Path(p) for p in paths]
-    found = study_of(paths[0]) if len(paths) == 1 else None
-    if found is None:
+    found = studies_of(paths[0]) if len(paths) == 1 else []
+    if not found:
         return format_table(table_of(paths), columns=columns)
-    kind, file = found
+    folder = found[0][1].parent
     if columns:
-        raise UserError(f"--columns: {file} is a {STUDY_NAMES[kind]}'s table, whose columns are its own; give "
-                        f"{file.parent / 'sweep.h5'} for its cases' summary numbers")
-    return study_text(kind, file)
+        what = (f"{found[0][1]} is a {STUDY_NAMES[found[0][0]]}'s table, whose columns are its own" if len(found) == 1
+                else f"{folder} holds {len(found)} studies' tables, whose columns are their own: {_named(found)}")
+        raise UserError(f"--columns: {what}; give {folder / 'sweep.h5'} for its cases' summary numbers")
+    texts = [study_text(kind, file) for kind, file in found]
+    if len(found) == 1:
+        return texts[0]
+    head = (f"{folder}: {len(found)} studies' tables, each below: {_named(found)}; "
+            f"'bearingsim table {folder / 'FILE'}' prints one")
+    return "\n\n".join([head, *texts])
+
+
+def _named(found) -> str:
+    """``cross-check (crosscheck.h5), validate (fig9_idec_vs_speed.csv)``"""
+    return ", ".join(f"{STUDY_NAMES[kind]} ({file.name})" for kind, file in found)
 
 
 def table_of(paths) -> Table:

@@ -224,7 +224,7 @@ def folders(tmp_path_factory):
 def _crosscheck_table(folder: Path) -> None:
     from bearingsim.studies import crosscheck as cc
 
-    folder.mkdir()
+    folder.mkdir(exist_ok=True)
     rows = [{"rpm": 3000.0, "rung": k, "scene": scene, "relaxed": what, "I_dec_mean_Ns": 5e-3 * k,
              "I_dec_sem_Ns": 2e-4, "I_acc_mean_Ns": 3e-3, "I_acc_sem_Ns": 1e-4, "first_impact_speed_m_s": 0.1,
              "cage_slip": 0.01, "archive": "", "wall_s": 1.0, "status": "done", "error": ""}
@@ -271,6 +271,37 @@ def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name
     assert_renders(seen, ["table", "figures", "checks", "scenario"])
     for w in words:
         assert w in seen["text"], w
+
+
+@pytest.mark.slow
+def test_a_folder_of_two_studies_shows_both_in_table_and_report(tmp_path):
+    """`run_studies([CrossCheck(...), Fig9()], DIR)` (docs/sweeps.md) leaves two study tables in one folder;
+    `table DIR` and `report DIR` showed the cross-check alone (the first table found), not the Fig. 9 one.
+    Both show every study's table, in the order of tables.STUDY_TABLES, under a line naming them; a table
+    file given alone is still that study alone. The cross-check's table is written by its own writer."""
+    from bearingsim import tables
+    from bearingsim.studies import fig9, make_engine, run_studies
+
+    folder = tmp_path / "two"
+    run_studies([fig9.Fig9(speeds=(3000,), drags=(0.02,))], folder, engine=make_engine(jobs=1))
+    _crosscheck_table(folder)
+    assert [k for k, _ in tables.studies_of(folder)] == ["crosscheck", "validate"]
+    res = cli("table", folder)
+    assert res.returncode == 0, res.stderr
+    out = res.stdout
+    assert out.splitlines()[0].startswith(f"{folder}: 2 studies' tables, each below: cross-check (crosscheck.h5), "
+                                          f"validate ({fig9.CSV_NAME});")
+    assert 0 < out.index(f"{folder / 'crosscheck.h5'}: cross-check") < out.index("Fig. 9 analog")
+    value = fig9.read_fig9(folder / fig9.CSV_NAME)["I_dec_c0.02_Ns"][0]
+    assert f"{value * 1e3:.3f}" in out and "largest change of I_dec" in out
+    alone = cli("table", folder / fig9.CSV_NAME)
+    assert alone.returncode == 0 and "Fig. 9 analog" in alone.stdout and "cross-check" not in alone.stdout
+    assert_user_error(cli("table", folder, "--columns", "I_dec_mean_Ns"), "2 studies' tables", "sweep.h5")
+    html = bearingsim.report(folder, tmp_path / "two.html").read_text()
+    ids = re.findall(r'<section id="([^"]+)"', html)
+    assert len(ids) == len(set(ids)), ids
+    assert ids[:4] == ["crosscheck-table", "crosscheck-figures", "validate-table", "validate-figures"], ids
+    assert "Fig. 9 analog" in html and "largest change of I_dec" in html and "centred_cage" in html
 
 
 @pytest.mark.slow

@@ -5,7 +5,6 @@ Used by ``bearingsim compare A.h5 B.h5`` and ``bearingsim rerun ARCHIVE``.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -38,12 +37,21 @@ class Comparison:
                 cells = [f"{'(none)':>14s}" if self.absent[k] == side else f"{v:14.7g}" for side, v in (("A", a), ("B", b))]
                 rows.append(f"{k:34s} {cells[0]} {cells[1]} {'':>11s} {'':>11s}{mark}")
                 continue
-            d = b - a
-            rel = d / abs(a) if a not in (0.0,) and math.isfinite(a) else float("nan")
-            rows.append(f"{k:34s} {a:14.7g} {b:14.7g} {d:11.3g} {rel:11.3g}{mark}")
+            rows.append(f"{k:34s} {a:14.7g} {b:14.7g} {b - a:11.3g} {relative_change(a, b):>11s}{mark}")
         if self.summary_differs:
             rows.append(f"* : not bit-identical, however small the difference; {SIGNIFICANCE_HINT}")
         return "\n".join(rows)
+
+
+def relative_change(a: float, b: float) -> str:
+    """The ``(B - A)/|A|`` cell: ``0`` for equal numbers (0 and 0 too), ``from 0`` where A is 0 and B is not
+    (a change from zero has no relative size: the ``B - A`` cell says how large it is), else the ratio
+    (``nan`` where a number is NaN)."""
+    if a == b:
+        return "0"
+    if a == 0.0:
+        return "from 0"
+    return f"{(b - a) / abs(a):.3g}"
 
 
 #: where a difference is judged against the runs' scatter (the marks of this module are bit-for-bit)

@@ -314,6 +314,27 @@ def test_compare_of_two_says_what_its_mark_means():
     assert same.identical and not any("*" in line for line in same.summary_table().splitlines())
 
 
+def test_compare_of_a_zero_shows_no_change_or_a_change_from_zero_not_nan():
+    """`compare A B` of a reduced run at 3000 rpm (event) and one at 500 rpm (euler) printed
+    `I_dec_std_Ns 0 0 0 nan` and `I_acc_mean_Ns 0 0.00874 0.00874 nan *`: the relative change divided by
+    |A| = 0. Two zeros are no change (0, as for any two equal numbers); a change from zero says so, its size
+    in the B - A column."""
+    from bearingsim.compare import compare_results
+
+    def result(summary):
+        return SimpleNamespace(scenario=SimpleNamespace(raw={"model": "reduced"}), summary=summary,
+                               data={}, groups={}, provenance={})
+
+    c = compare_results(result({"I_dec_std_Ns": 0.0, "I_acc_mean_Ns": 0.0, "I_dec_mean_Ns": 0.00528}),
+                        result({"I_dec_std_Ns": 0.0, "I_acc_mean_Ns": 0.00874, "I_dec_mean_Ns": 0.01288}))
+    table = c.summary_table()
+    rows = {line.split()[0]: line.split() for line in table.splitlines()[1:]}
+    assert "nan" not in table and "inf" not in table, table
+    assert rows["I_dec_std_Ns"] == ["I_dec_std_Ns", "0", "0", "0", "0"]
+    assert rows["I_acc_mean_Ns"] == ["I_acc_mean_Ns", "0", "0.00874", "0.00874", "from", "0", "*"]
+    assert rows["I_dec_mean_Ns"][4:] == [f"{(0.01288 - 0.00528) / 0.00528:.3g}", "*"]
+
+
 def test_a_folder_of_nothing_names_every_folder_table_reads(tmp_path):
     """`bearingsim table EMPTY_DIR` said "give the folder of a sweep, cross-check or validate run, or archives",
     leaving out the sensitivity, uncertainty and life folders whose tables it prints as well."""

@@ -313,16 +313,24 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
     return head, cells
 
 
+def column_keys(table: Table) -> list[str]:
+    """The number columns ``columns`` of :func:`format_table` (``--columns``) may name, in the table's order:
+    every summary number of its runs, the standard errors (``I_dec_sem_Ns``, ``I_acc_sem_Ns``) included;
+    the one list its refusal of another name prints."""
+    return list(table.numbers)
+
+
 def format_table(table: Table, columns=None, max_rows: int | None = None) -> str:
     """The table as aligned text: label columns left-aligned, number columns right-aligned, the rule
     of the marks below it when a column has standard errors. ``columns``: summary keys to show
     (default: :data:`DEFAULT_COLUMNS` present); ``max_rows``: at most this many rows (then a line
     saying how many are left out)."""
     if columns:
-        missing = [k for k in columns if k not in table.numbers]
+        accepted = column_keys(table)
+        missing = [k for k in columns if k not in accepted]
         if missing:
             raise UserError(f"--columns: {', '.join(missing)}: not a number of these runs (they have: "
-                            f"{', '.join(k for k in table.numbers if not k.endswith('_sem_Ns'))})")
+                            f"{', '.join(accepted)})")
     keys = list(columns) if columns else [k for k in DEFAULT_COLUMNS if k in table.numbers]
     n = len(table)
     heads = [*table.label_names]

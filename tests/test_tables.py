@@ -152,6 +152,26 @@ def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
     assert_user_error(cli("table", d / "nope.h5"), "nope.h5")
 
 
+def test_the_columns_a_refusal_lists_are_the_columns_accepted(reduced_runs):
+    """`table A B --columns X` with an unknown X listed the runs' numbers but left out I_dec_sem_Ns and
+    I_acc_sem_Ns, which --columns accepts. The refusal lists tables.column_keys: every name it lists is
+    accepted, and every number of the table (what --columns accepts) is listed."""
+    from bearingsim.errors import UserError
+
+    table = tables.table_of_archives([reduced_runs / "a.h5", reduced_runs / "c.h5"])
+    with pytest.raises(UserError) as err:
+        tables.format_table(table, columns=["I_dec_mean_Ns", "nope"])
+    message = str(err.value)
+    assert message.startswith("--columns: nope: not a number of these runs (they have: ") and message.endswith(")")
+    listed = message.split("(they have: ", 1)[1][:-1].split(", ")
+    assert "I_dec_sem_Ns" in listed and "I_acc_sem_Ns" in listed
+    assert sorted(listed) == sorted(table.numbers) == sorted(tables.column_keys(table))
+    for key in listed:  # each accepted alone: a header and one cell per run
+        lines = tables.format_table(table, columns=[key]).splitlines()
+        i = next(i for i, line in enumerate(lines) if line.startswith("archive"))
+        assert tables._bare(key) in lines[i] and lines[i + 1].startswith("a.h5 ") and lines[i + 2].startswith("c.h5 ")
+
+
 @pytest.mark.slow
 def test_table_labels_archives_of_one_name_in_different_folders_apart(reduced_runs, tmp_path):
     """Two sweeps' ``cases/<hash>.h5`` (one file name in two folders) were both labelled ``<hash>.h5``:

@@ -273,21 +273,55 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     assert [r["status"] for r in third.rows] == ["cached"] * 3
 
 
-@pytest.mark.alone  # bounds a wall time
+class _FakeTime:
+    """A stand-in for the ``time`` module of :mod:`bearingsim.sweeps.run`: its clocks (``perf_counter``,
+    ``monotonic``) read ``now``, which moves only when the test moves it; anything else is the real module's."""
+
+    def __init__(self):
+        self.now = 1000.0
+
+    def perf_counter(self) -> float:
+        return self.now
+
+    monotonic = perf_counter
+
+    def __getattr__(self, name):
+        return getattr(time, name)
+
+
 def test_sweep_wall_time_covers_its_cases(tmp_path, monkeypatch):
-    """``SweepOutcome.wall_s`` is the sweep's wall time from call to return (80 %: the call's own
-    set-up and return are outside it), and on one worker at least the sum of the cases' own times (a
-    timer reused for the index rewrites once made it the time since the last rewrite; the index is
-    rewritten after every batch here)."""
+    """``SweepOutcome.wall_s`` is the sweep's wall time from call to return: on a clock of the test's that
+    moves only by the set-up's time (resolving the cases, SETUP_S) and, as each batch's records come in, by
+    the cases' own times (measured in the worker), it is all the time that passed in the call, so on one
+    worker at least the sum of the cases' own times (a timer reused for the index rewrites once made it the
+    time since the last rewrite; the index is rewritten after every batch here). No real-time bound."""
     import bearingsim.sweeps.run as sweep_run
 
+    setup_s = 7.0
+    clock = _FakeTime()
+    resolve = sweep_run._resolve
+
+    def slow_resolve(*args, **kwargs):  # the call's own set-up, inside its wall time
+        clock.now += setup_s
+        return resolve(*args, **kwargs)
+
+    class CaseTimedEngine(LocalEngine):
+        def run(self, *args, **kwargs):
+            for records in super().run(*args, **kwargs):
+                clock.now += sum(r["wall_s"] for r in records)
+                yield records
+
+    monkeypatch.setattr(sweep_run, "time", clock)
+    monkeypatch.setattr(sweep_run, "_resolve", slow_resolve)
     monkeypatch.setattr(sweep_run, "INDEX_EVERY_S", 0.0)
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000])])
-    t0 = time.perf_counter()
-    out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
-    outside = time.perf_counter() - t0
-    assert 0.8 * outside <= out.wall_s <= outside
-    assert out.wall_s >= sum(r["wall_s"] for r in out.rows) > 0.0
+    before = clock.now
+    out = run_sweep(spec, tmp_path, engine=CaseTimedEngine(1), figures=False, progress=False)
+    cases_s = sum(r["wall_s"] for r in out.rows)
+    assert [r["status"] for r in out.rows] == ["done"] * 3 and cases_s > 0.0
+    assert clock.now - before == pytest.approx(setup_s + cases_s, rel=1e-12)  # the clock moved as meant
+    assert out.wall_s == pytest.approx(clock.now - before, rel=1e-12)  # all of the call's time
+    assert out.wall_s >= cases_s
 
 
 @pytest.mark.slow

@@ -206,13 +206,17 @@ def test_refusals(argv, words, capsys, tmp_path):
     assert not (tmp_path / "cc" / "cases").exists()
 
 
-@pytest.mark.alone  # bounds a wall time
 @pytest.mark.slow
 @pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
 def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_path, signum, code):
     """Issue 30, item 4: ``crosscheck -j 2`` took 7-15 s to stop after SIGINT/SIGTERM and wrote rung
-    archives after the signal. On the sweep engine: stopped within a generous bound, its worker
-    processes ended, no archive written after the signal, no table, exit 128 + signal."""
+    archives after the signal. On the sweep engine the signal stops it at once: the rungs running when it
+    comes are not finished (no archive, no row done; a worker let finish its rung wrote it), its worker
+    processes ended before it exits, no table, no temporary file, one line on how to resume, exit 128 +
+    signal. No wall-time bound: the signal comes when the first two rungs (5 full and 4 centred_cage,
+    started together) have their archives, and the two then running (3 and 2) started when those ended
+    and take as long as a rung of the whole bearing, so they are far from their end on a machine of any
+    speed."""
     import os
     import subprocess
     import sys
@@ -221,31 +225,33 @@ def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_p
     import psutil
 
     from .conftest import ROOT, started
+    from .test_sweep import _rows, _running
 
     out = tmp_path / "cc"
-    cmd = [sys.executable, "-m", "bearingsim", "crosscheck", REFERENCE, "--speeds", f"{RPM:g}", "--rotations", "2",
-           "-j", "2", "-o", out]
+    cmd = [sys.executable, "-m", "bearingsim", "crosscheck", REFERENCE, "--speeds", f"{RPM:g}", "--rotations",
+           str(ROTATIONS), "-j", "2", "-o", out]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env) as proc:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and proc.poll() is None:  # a rung finished, others running
-            if list((out / "cases").glob("[!.]*.h5")):
-                break
+        deadline = time.monotonic() + 300  # a hang guard only
+        finished = set()
+        while time.monotonic() < deadline and proc.poll() is None and len(finished) < 2:
             time.sleep(0.02)
+            finished = {p.name for p in (out / "cases").glob("[!.]*.h5")}
         children = psutil.Process(proc.pid).children(recursive=True)
         assert proc.poll() is None and len(children) >= 2, "the cross-check ended before the signal"
-        t_signal = time.time()
         os.kill(proc.pid, signum)
-        _, err = proc.communicate(timeout=30)
-        took = time.time() - t_signal
+        _, err = proc.communicate(timeout=300)  # a hang guard only
     assert proc.returncode == code, err
-    assert took < 5.0, took  # about a second; generous for a loaded machine
-    assert "Traceback" not in err and "interrupted" in err and "resume" in err
-    _, alive = psutil.wait_procs(children, timeout=5)
-    assert alive == []
-    late = [p.name for p in (out / "cases").iterdir() if p.stat().st_mtime > t_signal + 0.5]
-    assert late == []  # no rung archive written after the signal (0.5 s: one rename already under way)
-    assert not list((out / "cases").glob(".*")) and not (out / "crosscheck.csv").exists()
+    assert _running(children) == []  # ended (and reaped) before the cross-check exited
+    assert {p.name for p in (out / "cases").iterdir()} == finished  # nothing written after the signal
+    rows = _rows(out)
+    assert len(rows) == 5 and len(finished) == 2
+    for r in rows:  # a finished rung is done or (its record not yet in at the signal) pending; the others pending
+        running = f"{r['case']}.h5" not in finished
+        assert r["status"] == "pending" if running else r["status"] in ("done", "pending"), r
+    assert not (out / "crosscheck.csv").exists() and not (out / "crosscheck.h5").exists()
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert "cross-check interrupted" in err and err.rstrip().endswith("run the same command again to resume")
 
 
 def test_one_rotation_prints_no_nan_standard_error():

@@ -1,12 +1,10 @@
 """Shared test helpers. Paths are absolute so tests run from any folder.
 
 The suite runs on pytest-xdist (``-n auto --dist loadfile`` in pyproject.toml): each test file on one
-worker, so a module's fixtures are computed once. Tests marked ``alone`` bound a wall time (a signal
-answered within so many seconds): under xdist they run while no other test runs, as they did in one
-process.
+worker, so a module's fixtures are computed once. No test bounds a wall time (a busy machine makes
+every run slower), so tests need no turns of their own.
 """
 import contextlib
-import fcntl
 import os
 import subprocess
 from pathlib import Path
@@ -94,35 +92,3 @@ def pytest_xdist_auto_num_workers(config):
         return None  # xdist's own hook reads it
     n = min(len(os.sched_getaffinity(0)), MAX_WORKERS)
     return n if n > 1 else 0
-
-
-@pytest.hookimpl(wrapper=True)
-def pytest_runtest_protocol(item, nextitem):
-    """Under xdist, each test (set-up, call, tear-down) holds a shared lock that an ``alone`` test takes
-    exclusively: it starts once the other workers' running tests have ended, and none starts until it
-    has ended. The lock files are in the run's base temporary folder, which xdist shares with every
-    worker of this run only."""
-    if "PYTEST_XDIST_WORKER" not in os.environ:  # one process: every test runs alone
-        return (yield)
-    folder = Path(item.config.option.basetemp).parent  # the controller's basetemp; each worker's is inside
-    with _turn(folder, alone=item.get_closest_marker("alone") is not None):
-        return (yield)
-
-
-@contextlib.contextmanager
-def _turn(folder: Path, alone: bool):
-    """A readers-writer lock of two ``flock`` files: ``gate`` keeps new tests out while an ``alone`` test
-    waits (so it cannot be starved), ``room`` is held shared by running tests and exclusively by it."""
-    gate = os.open(folder / "alone.gate", os.O_RDWR | os.O_CREAT, 0o600)
-    room = os.open(folder / "alone.room", os.O_RDWR | os.O_CREAT, 0o600)
-    try:
-        fcntl.flock(gate, fcntl.LOCK_EX)
-        if alone:
-            fcntl.flock(room, fcntl.LOCK_EX)  # the gate stays closed until this test has ended
-        else:
-            fcntl.flock(room, fcntl.LOCK_SH)
-            fcntl.flock(gate, fcntl.LOCK_UN)
-        yield
-    finally:
-        os.close(room)  # closing a file releases its locks
-        os.close(gate)

@@ -14,10 +14,11 @@ import os
 import stat
 import math
 import tomllib
+import types
 import unicodedata
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, Union, get_args, get_origin
 
 import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
@@ -973,6 +974,23 @@ def known_keys() -> list[str]:
         else:
             out.append(name)
     return out
+
+
+def is_integer_key(key: str) -> bool:
+    """Whether the schema types dotted ``key`` as an integer, with no float it may also be
+    (``bearing.roller_count``, ``numerics.rotations``; not ``bearing.cage_land_clearance_mm``, nor an unknown key):
+    a strict ``int`` field refuses ``10.0``, so a sweep's evenly spaced values of it must be ints."""
+    section, _, name = key.partition(".")
+    field = ScenarioModel.model_fields.get(section)
+    if field is not None and name:
+        sub = field.annotation
+        fields = sub.model_fields if isinstance(sub, type) and issubclass(sub, BaseModel) else {}
+        field = fields.get(name)
+    if field is None:
+        return False
+    ann = field.annotation  # int, or a union such as int | None (not list[int]: a list is no number)
+    kinds = get_args(ann) if get_origin(ann) in (Union, types.UnionType) else (ann,)
+    return int in kinds and float not in kinds
 
 
 def did_you_mean(key: str) -> str:

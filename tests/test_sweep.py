@@ -1012,6 +1012,46 @@ def test_a_range_of_one_value_between_two_ends_is_refused_and_one_at_one_end_run
         load_sweep_file(f)
 
 
+def test_evenly_spaced_values_of_an_integer_key_are_ints(tmp_path):
+    """START:STOP:NUM and { start, stop, num } gave floats for any key, and an integer key refuses 10.0
+    ('bearing.roller_count: must be a valid integer (got 10.0)'): values that are whole numbers are ints
+    for a key the schema types as an integer, so the sweep resolves; a float key keeps floats."""
+    from bearingsim.sweeps.spec import parse_param, spec_from_args
+
+    for item, values in (("bearing.roller_count=10:20:3", [10, 15, 20]), ("numerics.rotations=1:3:3", [1, 2, 3]),
+                         ("multibody.pocket_face_segments=0:0:1", [0])):
+        got = parse_param(item)[1]
+        assert got == values and all(type(v) is int for v in got), (item, got)
+    assert parse_param("bearing.pocket_clearance_mm=0.1:0.3:3")[1] == [0.1, 0.2, 0.3]
+    assert all(type(v) is float for v in parse_param(f"{SPEED}=1000:6000:2")[1])
+    f = tmp_path / "s.toml"
+    f.write_text(f'scenario = "{BASE}"\n[set]\n"reduced.load_zone_half_angle_deg" = "auto"\n'
+                 '[axes]\n"bearing.roller_count" = { start = 10, stop = 20, num = 3 }\n')
+    cases = resolve_cases(load_sweep_file(f))
+    assert [scenario_from_toml(c.toml).bearing.roller_count for c in cases] == [10, 15, 20]
+    cases = resolve_cases(spec_from_args(BASE, ["numerics.rotations=1:3:3"], []))
+    assert [c.values for c in cases] == [{"numerics.rotations": n} for n in (1, 2, 3)]
+
+
+def test_evenly_spaced_values_of_an_integer_key_that_are_not_whole_are_refused(tmp_path):
+    """10:20:4 of an integer key is 10, 13.33, 16.67, 20: refused before any case runs, in one line naming
+    the key and the axis and saying what to give instead (a list, or a NUM that lands on whole numbers);
+    exit 2 and no output folder."""
+    from bearingsim.errors import UserError
+
+    res = bearingsim("sweep", BASE, "--param", "bearing.roller_count=10:20:4", "-o", tmp_path / "out")
+    assert_user_error(res, "--param 'bearing.roller_count=10:20:4': bearing.roller_count is an integer, and "
+                      "10:20:4 gives 13.33, 16.67, not whole numbers; give a list (bearing.roller_count=10,13,17,20) "
+                      "or a NUM that lands on whole numbers (3 or 6)")
+    assert not (tmp_path / "out").exists()
+    f = tmp_path / "s.toml"
+    f.write_text(f'scenario = "{BASE}"\n[axes]\n"numerics.rotations" = {{ start = 1.5, stop = 3, num = 4 }}\n')
+    with pytest.raises(UserError) as err:
+        load_sweep_file(f)
+    assert str(err.value) == (f"{f}: axes: numerics.rotations: an integer, and {{ start = 1.5, stop = 3, num = 4 }} "
+                              "gives 1.5, 2.5, not whole numbers; give a list ([2, 3]), or a whole start and stop")
+
+
 def test_a_sweep_files_base_scenario_is_named_without_a_detour(monkeypatch):
     """A sweep file names its base scenario relative to itself ("../paper_3000rpm.toml"); the sweep's index
     showed it as "scenarios/sweeps/../paper_3000rpm.toml". It is the same file, named the short way."""

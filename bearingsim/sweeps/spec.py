@@ -36,7 +36,8 @@ from pathlib import Path
 from typing import Any
 
 from bearingsim.errors import UserError
-from bearingsim.scenario import check_run_request, load_scenario, parse_override, read_toml_file
+from bearingsim.scenario import (check_run_request, is_integer_key, load_scenario, parse_override,
+                                 read_toml_file)
 
 SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
 # Most cases in one sweep: ten times the 100 x 100 map of scenarios/sweeps/. Each case is resolved and
@@ -147,8 +148,8 @@ def _split_top_level(text: str) -> list[str]:
     return parts
 
 
-def _range_values(item: str, text: str) -> list[float] | None:
-    """``START:STOP:NUM`` as :class:`_Range` values; None if ``text`` is not of that form."""
+def _range_values(item: str, key: str, text: str) -> list[float] | list[int] | None:
+    """``START:STOP:NUM`` as :class:`_Range` values of ``key``; None if ``text`` is not of that form."""
     parts = text.split(":")
     if len(parts) != 3 or any(c in text for c in "[]{}\"'"):
         return None
@@ -160,7 +161,7 @@ def _range_values(item: str, text: str) -> list[float] | None:
         num = int(parts[2])
     except ValueError:
         raise UserError(f"--param {item!r}: START:STOP:NUM needs an integer NUM >= 1") from None
-    return _Range({"start": start, "stop": stop, "num": num}).values(f"--param {item!r}")
+    return _Range({"start": start, "stop": stop, "num": num}).values(f"--param {item!r}", key, text)
 
 
 def parse_param(item: str) -> tuple[str, list]:
@@ -171,7 +172,7 @@ def parse_param(item: str) -> tuple[str, list]:
         raise UserError(f"--param {item!r}: expected {PARAM_HELP}")
     key, text = item.split("=", 1)
     key = key.strip()
-    values = _range_values(item, text.strip())
+    values = _range_values(item, key, text.strip())
     if values is None:
         values = [parse_override(f"{key}={v}")[1] for v in _split_top_level(text) if v.strip()]
     if not key or not values:
@@ -208,7 +209,9 @@ class _Range:
     def __init__(self, table: dict):
         self.table = table
 
-    def values(self, where: str) -> list[float]:
+    def values(self, where: str, key: str = "", given: str = "") -> list[float] | list[int]:
+        """The values, ints for a key the schema types as an integer (:func:`_whole`); ``given``: the
+        command line's ``START:STOP:NUM`` (a sweep file's range otherwise), as a refusal quotes it."""
         import numpy as np
 
         start, stop, num = self.table["start"], self.table["stop"], self.table["num"]
@@ -224,7 +227,41 @@ class _Range:
                             "are included from num = 2 (one value: start = stop, or a list)")
         # to 15 significant digits, as the ends are written: 0.05:0.5:10 gives 0.15, not 0.15000000000000002
         # (a value a reader of the map selects by, xarray's .sel(0.15), and that names the case)
-        return [float(f"{x:.15g}") for x in np.linspace(float(start), float(stop), num)]
+        values = [float(f"{x:.15g}") for x in np.linspace(float(start), float(stop), num)]
+        return _whole(values, key, where, given) if key and is_integer_key(key) else values
+
+
+def _whole(values: list[float], key: str, where: str, given: str) -> list[int]:
+    """Evenly spaced ``values`` of integer ``key`` as ints (10:20:3 -> 10, 15, 20: a strict integer key
+    refuses 15.0); values that are not whole (10:20:4 -> 13.33) are refused, saying what to give instead."""
+    bad = [v for v in values if not v.is_integer()]
+    if not bad:
+        return [int(v) for v in values]
+    start, stop, num = values[0], values[-1], len(values)
+    axis = given or f"{{ start = {start:g}, stop = {stop:g}, num = {num} }}"
+    nums = _whole_nums(start, stop, num)
+    rounded = list(dict.fromkeys(math.floor(v + 0.5) for v in values))
+    if given:
+        instead = f"a list ({key}={','.join(map(str, rounded))})" if num <= 10 else "a list of integers"
+        instead += f" or a NUM that lands on whole numbers ({nums})" if nums else ", or a whole START and STOP"
+    else:
+        instead = f"a list ({rounded})" if num <= 10 else "a list of integers"
+        instead += f" or a num that lands on whole numbers ({nums})" if nums else ", or a whole start and stop"
+    shown = ", ".join(f"{v:.4g}" for v in bad[:3]) + (", ..." if len(bad) > 3 else "")
+    what = f"{key} is an integer" if given else "an integer"  # a sweep file's ``where`` ends with the key
+    raise UserError(f"{where}: {what}, and {axis} gives {shown}, not whole numbers; give {instead}")
+
+
+def _whole_nums(start: float, stop: float, num: int) -> str:
+    """The counts nearest ``num`` (one below, one above) whose evenly spaced values from whole ``start``
+    to ``stop`` are whole numbers: a divisor of the span, plus one ("3 or 6" for 10 to 20, num 4); "" when
+    an end is not whole."""
+    if not (start.is_integer() and stop.is_integer()):
+        return ""
+    span = abs(int(stop) - int(start))
+    below = next((c for c in range(num - 1, 1, -1) if span % (c - 1) == 0), None)
+    above = next((c for c in range(num + 1, min(span + 1, MAX_SWEEP_CASES) + 1) if span % (c - 1) == 0), None)
+    return " or ".join(str(c) for c in (below, above) if c is not None)
 
 
 def _check_unique(keys: list[str], where: str) -> None:
@@ -292,7 +329,7 @@ def load_sweep_file(path: str | Path) -> SweepSpec:
             raise UserError(f"{path}: axes: {parent}: {{ start, stop, num }} needs exactly these three keys (got {got})")
     for k, v in axes.items():
         if _is_range(v):
-            axes[k] = _Range(v).values(f"{path}: axes: {k}")
+            axes[k] = _Range(v).values(f"{path}: axes: {k}", k)
         elif not isinstance(v, list) or not v:
             raise UserError(f"{path}: axes: {k}: must be a non-empty list of values or {{ start, stop, num }}")
     extra = [_flatten(c, f"{path}: cases[{i}]") for i, c in enumerate(cases)]

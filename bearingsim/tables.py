@@ -9,7 +9,8 @@ numbers). ``I_dec_mean_Ns`` and ``I_acc_mean_Ns`` carry their standard error, th
 
     ``*`` when |x - x_ref| > 2 sqrt(SE² + SE_ref²), x_ref the first row with a number
 
-(two standard errors of the difference of two independent means, about 95 % for normal errors); no mark
+(two standard errors of the difference of two independent means, about 95 % for normal errors), and
+more than round-off, 1e-9 of the larger (:func:`bearingsim.stats.significant`, the one rule); no mark
 where the difference is within that, and none where a standard error is missing (fewer than 2
 rotations: NaN) so the difference cannot be judged. Impulses are shown in mN s; every other column in
 the unit its key names.
@@ -23,11 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.stats import ROUND_OFF_REL, SIGNIFICANCE_SE, significant
 
-#: a difference is marked when it exceeds this many standard errors of the difference
-SIGNIFICANCE_SE = 2.0
-RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2), x_ref the first row with a number (SE: batch means over "
-        "rotations, docs/statistics.md); no mark: within that, or no SE to judge by")
+#: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
+RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) "
+        "(round-off), x_ref the first row with a number (SE: batch means over rotations, docs/statistics.md); "
+        "no mark: within that, or no SE to judge by")
 #: number columns shown by default, those present
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
                    "load_zone_half_angle_deg")
@@ -50,15 +52,6 @@ class Table:
 
     def __len__(self) -> int:
         return len(next(iter(self.labels.values()))) if self.labels else 0
-
-
-def significant(x: float, se: float, x0: float, se0: float) -> bool | None:
-    """True/False: whether ``x - x0`` exceeds :data:`SIGNIFICANCE_SE` standard errors of the difference;
-    None when it cannot be judged (a number or a standard error missing)."""
-    vals = (x, se, x0, se0)
-    if any(v is None or not math.isfinite(v) for v in vals):
-        return None
-    return abs(x - x0) > SIGNIFICANCE_SE * math.hypot(se, se0)
 
 
 def cell_text(v) -> str:

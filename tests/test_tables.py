@@ -122,6 +122,27 @@ def test_marks_only_where_the_difference_exceeds_two_standard_errors():
     assert lines[-1] == tables.RULE
 
 
+def test_a_deterministic_models_round_off_is_not_marked_and_its_real_differences_are():
+    """The reduced model's standard error is 0, so every difference was marked, also the last bits a pocket
+    clearance leaves in I_dec through the flight's round-off (a sweep's 1000 rpm rows, 0.16/0.20/0.24 mm:
+    '7.833 ± 0 *'). Differences within 1e-9 of the value are round-off, unmarked; 1000 against 6000 rpm
+    (20 %) and one of 1e-6 are marked. The cross-check's verdicts use the same rule."""
+    from bearingsim.studies import crosscheck as cc
+
+    i_dec = [0.007832783677204172, 0.006223442, 0.007832783677204178, 0.007832783677204176,
+             0.007832783677204172 * (1 + 1e-6)]
+    t = tables.Table(["row"], {"row": ["ref", "6000rpm", "last-bits", "last-bits2", "1e-6"]},
+                     {"I_dec_mean_Ns": np.array(i_dec), "I_dec_sem_Ns": np.zeros(5)}, {"I_dec_mean_Ns": "N s"})
+    rows = {ln.split()[0]: ln for ln in tables.format_table(t).splitlines()[1:6]}
+    assert rows["6000rpm"].endswith("*") and rows["1e-6"].endswith("*"), rows
+    assert not rows["last-bits"].endswith("*") and not rows["last-bits2"].endswith("*"), rows
+    rungs = [dict(rpm=1000.0, rung=k, scene=f"s{k}", I_dec_mean_Ns=m, I_dec_sem_Ns=0.0, change_from_previous=c)
+             for k, m, c in ((1, i_dec[0], math.nan), (2, i_dec[2], i_dec[2] - i_dec[0]),
+                             (3, i_dec[1], i_dec[1] - i_dec[2]))]
+    (verdict,) = cc.verdicts(rungs)
+    assert "rung 2 s2 +0.00 mN s (not significant" in verdict and "rung 3 s3 -1.61 mN s (significant" in verdict
+
+
 # --- the commands -------------------------------------------------------------------------------------
 
 @pytest.mark.slow

@@ -38,6 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.stats import SIGNIFICANCE_SE, significant
 from bearingsim.studies.engine import Study, case_of, load_result
 
 INDEX_FORMAT = "bearingsim crosscheck index 1"
@@ -307,7 +308,8 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
 
 def verdicts(rows: list[dict]) -> list[str]:
     """One sentence per speed: the rung whose I_dec change is largest, and each change against two
-    standard errors of the difference, sqrt(sem_a^2 + sem_b^2). A change next to a failed rung (NaN)
+    standard errors of the difference, sqrt(sem_a^2 + sem_b^2), by the tables' rule
+    (:func:`bearingsim.stats.significant`: round-off is no change). A change next to a failed rung (NaN)
     is not judged; the failed rungs are named."""
     out = []
     for rpm in sorted({r["rpm"] for r in rows}):
@@ -318,10 +320,12 @@ def verdicts(rows: list[dict]) -> list[str]:
             if math.isnan(d):
                 continue
             se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
-            if math.isnan(se):  # a rung of fewer than 2 recorded rotations has no batch-means error
+            mark = significant(b["I_dec_mean_Ns"], b["I_dec_sem_Ns"], a["I_dec_mean_Ns"], a["I_dec_sem_Ns"])
+            if mark is None:  # a rung of fewer than 2 recorded rotations has no batch-means error
                 sig = "not judged: no standard error from fewer than 2 rotations"
             else:
-                sig = ("significant" if abs(d) > 2.0 * se else "not significant") + f": 2 SE = {2 * se * 1e3:.2g}"
+                sig = ("significant" if mark else "not significant") + f": {SIGNIFICANCE_SE:g} SE = " \
+                      f"{SIGNIFICANCE_SE * se * 1e3:.2g}"
             parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig})")
         failed = [f"{r['rung']} {r['scene']}" for r in rs if r.get("status", "done") == "failed"]
         changes = [r for r in rs[1:] if not math.isnan(r["change_from_previous"])]

@@ -196,7 +196,8 @@ def test_a_one_rotation_rig_row_shows_no_scatter_rather_than_zero(capsys):
     assert two["pocket0_I_dec_std_Ns"] == pytest.approx(0.01)
     args = SimpleNamespace(rig_rotations=1, output="v")
     outcome = SimpleNamespace(written=[], interrupted=None, sweep=SimpleNamespace(rows=[]), counts=lambda: "")
-    _print_validate(args, [None, SimpleNamespace(rows=[one, two])], outcome)
+    fig9 = SimpleNamespace(table={"speed_rpm": np.array([500.0]), "I_dec_c0.02_Ns": np.array([0.0129])})
+    _print_validate(args, [fig9, SimpleNamespace(rows=[one, two])], outcome)
     lines = [ln for ln in capsys.readouterr().out.splitlines() if ln.strip().startswith("3000")]
     assert "± 0.00" not in lines[0] and "±   n/a (std)" in lines[0], lines
     assert "± 10.00 (std)" in lines[1], lines

@@ -76,7 +76,7 @@ def started(cmd, **kw):
         proc.wait()
 
 
-# --- pytest-xdist: how many workers, and the tests that run alone ------------------------------------
+# --- pytest-xdist: how many workers ---------------------------------------------------------------------
 #: most workers ``-n auto`` starts: each worker loads numba's compiled kernels (and compiles them on a
 #: fresh checkout) and has its own server of forked command lines (tests/forked_cli.py), and many tests
 #: start process pools of their own, so more workers add memory and start-up rather than speed

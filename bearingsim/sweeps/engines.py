@@ -29,6 +29,8 @@ _STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
 
 def _exit_worker(signum, frame):
+    if _worker.warming:  # nothing of the sweep's held: end now, nothing unwound (worker.warming)
+        os._exit(128 + signum)
     _worker.ending = True  # a worker's: SIGTERM came, the worker is ending
     raise _worker.WorkerStop(128 + signum)
 

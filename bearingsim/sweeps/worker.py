@@ -76,6 +76,12 @@ def _run_in_memory(scenario, notes: bool = True, archive: bool = True):
 #: compiled code, while it calls back into Python: "SystemError: CPUDispatcher(...) returned a result with
 #: an exception set"), which a case would record as its failure before the worker went on to wait for a task
 ending = False
+#: True in a worker while it warms up (:func:`warm_up`): it holds nothing of the sweep's (no task queue lock,
+#: no file), so SIGTERM then ends it at once (:mod:`bearingsim.sweeps.engines`) rather than by an exception
+#: raised inside numba's loading of its compiled kernels, whose objects, left half made, could be freed twice
+#: (a worker of a sweep refused while its cases were resolved wrote glibc's "free(): double free detected" on
+#: the sweep's stderr)
+warming = False
 
 
 class WorkerStop(SystemExit):
@@ -160,12 +166,16 @@ def warm_up(toml_text: str, archive: bool = True) -> None:
     """Run a reduced-model scenario once and, with ``archive``, build its archive in memory, discarding
     both: the first case of a process loads the compiled model (~0.3 s). Errors are ignored (the cases
     report theirs)."""
+    global warming
     from bearingsim.sweeps.spec import scenario_from_toml
 
+    warming = True
     try:
         _run_in_memory(scenario_from_toml(toml_text), notes=False, archive=archive)
     except Exception:  # noqa: BLE001
         pass
+    finally:
+        warming = False
 
 
 def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archives: str = "all") -> list[dict]:

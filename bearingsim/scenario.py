@@ -517,6 +517,8 @@ def _plain(value: Any) -> Any:
 
 
 def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
+    """Set dotted ``key`` of ``raw`` to ``value``; a table given for a section (``operating={...}``) sets the
+    keys it holds and keeps the section's others, as its keys given one by one would."""
     value = _plain(value)
     parts = key.split(".")
     node = raw
@@ -525,7 +527,8 @@ def _set_dotted(raw: dict, key: str, value: Any, origin: str) -> None:
         if not isinstance(child, dict):
             raise UserError(f"{origin}: {key}: {p!r} is a value, not a section")
         node = child
-    node[parts[-1]] = value
+    old = node.get(parts[-1])
+    node[parts[-1]] = _merge(old, value) if isinstance(old, dict) and isinstance(value, dict) else value
 
 
 def _merge(base: dict, top: dict) -> dict:
@@ -833,7 +836,11 @@ def given_keys(path, overrides=()) -> list[str]:
     in_file = flatten(read_toml_file(path))
     if in_file.get("reduced.load_zone_half_angle_deg", "auto") != "auto":
         in_file = {k: v for k, v in in_file.items() if k not in LOAD_ZONE_KEYS}
-    return list(in_file) + [parse_override(o)[0] for o in overrides]
+    given = []
+    for o in overrides:
+        key, value = parse_override(o)  # a table for a section gives the keys it holds
+        given += [f"{key}.{k}" for k in flatten(value)] if isinstance(value, dict) and value else [key]
+    return list(in_file) + given
 
 
 # compact wording of the differences most often made (others: ``key = value`` by the key's last part)

@@ -3,8 +3,9 @@ import math
 
 import pytest
 
+import bearingsim
 from bearingsim.errors import UserError
-from bearingsim.scenario import load_preset, load_scenario, parse_override, resolve
+from bearingsim.scenario import given_keys, load_preset, load_scenario, parse_override, resolve
 
 from .conftest import SCENARIOS, si
 
@@ -352,10 +353,10 @@ def test_a_cage_mass_without_its_inertia_is_refused_with_the_inertia_a_ring_of_i
 
 def test_a_missing_key_is_told_to_name_a_preset_only_where_a_preset_gives_it():
     """A preset gives the bearing's keys only: a missing operating key was told "set it in the scenario or
-    name a [bearing] preset", which cannot give it (`--set 'operating={radial_load_N=3}'` replaces the
-    file's [operating] table, the speed with it)."""
+    name a [bearing] preset", which cannot give it."""
     with pytest.raises(UserError) as err:
-        load_scenario(SCENARIOS / "paper_3000rpm.toml", ["operating={radial_load_N=3}"])
+        resolve({"schema_version": 1, "name": "x", "model": "reduced", "bearing": {"preset": "NU214-Suzuki2023"},
+                 "operating": {"radial_load_N": 3.0}}, "<test>")
     assert str(err.value).endswith("operating.inner_ring_speed_rpm: missing (set it in the scenario)")
     with pytest.raises(UserError) as err:
         resolve({"schema_version": 1, "name": "x", "model": "reduced", "bearing": {"roller_count": 16},
@@ -396,3 +397,21 @@ def test_a_sweep_of_one_setting_keeps_the_notes_other_settings_decide(tmp_path):
     note = unread_note(rollers, ["contact.land_friction"], varied=["operating.radial_load_N"])
     assert note is not None and "bearing.cage_guidance = 'rollers'" in note
     assert unread_note(rollers, ["contact.land_friction"], varied=["bearing.cage_guidance"]) is None
+
+
+def test_a_table_given_for_a_section_sets_its_keys_and_keeps_the_others(tmp_path):
+    """`--set 'operating={inner_ring_speed_rpm=500}'` replaced the file's whole [operating] section: its
+    2000 N and reverse direction were lost for the preset's 970 N, forward, without a word; replace() with
+    the same table was refused for a missing key the scenario had. A table sets the keys it holds, as
+    they given one by one would; the section's other keys are kept."""
+    f = tmp_path / "custom.toml"
+    f.write_text('schema_version = 1\nname = "custom"\nmodel = "reduced"\n[bearing]\npreset = "NU214-Suzuki2023"\n'
+                 '[operating]\nradial_load_N = 2000.0\ndirection = "reverse"\ninner_ring_speed_rpm = 3000\n')
+    one_by_one = load_scenario(f, ["operating.inner_ring_speed_rpm=500"])
+    for sc in (load_scenario(f, ["operating={inner_ring_speed_rpm=500}"]),
+               bearingsim.load_scenario(f, set={"operating": {"inner_ring_speed_rpm": 500}}),
+               load_scenario(f).replace(**{"operating": {"inner_ring_speed_rpm": 500}})):
+        assert sc.raw == one_by_one.raw
+        assert (sc.operating.radial_load_N, sc.operating.direction) == (2000.0, "reverse")
+    # the keys such a table gives are noted as the same keys given one by one
+    assert given_keys(f, ["multibody={inner_ring_mass_kg=5}"])[-1] == "multibody.inner_ring_mass_kg"

@@ -489,8 +489,13 @@ def _sensitivity_sections(table: Path):
     def num(v, digits):
         return _cell(v, digits=digits) if math.isfinite(float(v)) else "n/a"
 
-    cells = [[r["key"], r["quantity"], r["measure"], f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}",
-              num(r["over_range"], 3), sens.missing_note(r)] for r in rows]
+    def slope(r):  # S ± SE, and S at half the step where the study ran it (a deterministic model)
+        half = float(r.get("sensitivity_half_step", math.nan))
+        return (f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}"
+                + (f" (half step: {num(half, 3)})" if math.isfinite(half) else ""))
+
+    cells = [[r["key"], r["quantity"], r["measure"], slope(r), num(r["over_range"], 3), sens.missing_note(r)]
+             for r in rows]
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {meta.get('step', 0):.0%})); log: d ln y / d ln x, "
                           "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False])]

@@ -41,6 +41,14 @@ def test_reduced_sensitivities_are_the_event_solvers_central_difference(tmp_path
         expected = (math.log(ip) - math.log(im)) / (math.log(xp) - math.log(xm))
         assert r["sensitivity"] == pytest.approx(expected, rel=1e-6, abs=1e-12)
         assert r["sensitivity_se"] == 0.0
+        # no standard error shows what the step does: the slope at half the step beside it, x (1 -+ 5 %)
+        i2 = [simulate(Parameters.from_scenario(sc.replace(**{r["key"]: x * f}))).summary["I_dec_mean_Ns"]
+              for f in (0.95, 1.05)]
+        half = (math.log(i2[1]) - math.log(i2[0])) / (math.log(1.05) - math.log(0.95))
+        assert r["sensitivity_half_step"] == pytest.approx(half, rel=1e-6, abs=1e-12)
+    # the restitution's at 6000 rpm is no local slope: +0.50 at 10 %, -0.48 at 5 % (I_dec is piecewise smooth,
+    # with jumps where the number of impacts of a pass changes)
+    assert rows[1]["sensitivity"] > 0.3 and rows[1]["sensitivity_half_step"] < -0.3
     # the drag brakes the roller in the no-load zone: more drag, larger rear-face impulse
     assert rows[0]["sensitivity"] > 0
     assert (tmp_path / "sensitivity.png").stat().st_size > 0 and (tmp_path / "sensitivity.csv").is_file()
@@ -98,13 +106,13 @@ def test_a_rarely_nonzero_output_has_finite_intervals():
 def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
     """The + run of the drag coefficient given the explicit Euler method at a 5 ms step fails
     (unstable): its key's rows have NaN numbers, status failed and the error; the other key's rows are
-    complete. Run again without the fault: the three finished runs come from their archives."""
+    complete. Run again without the fault: the seven finished runs come from their archives."""
     sc = load_scenario(REDUCED)
     real = sens.perturbed_scenarios
 
     def broken(scenario, keys, step):
         return [(k, side, v, x.replace(**{"reduced.method": "euler", "numerics.dt_s": 0.005})
-                 if (k, side) == (KEYS[0], "+") else x) for k, side, v, x in real(scenario, keys, step)]
+                 if (k, side, step) == (KEYS[0], "+", 0.1) else x) for k, side, v, x in real(scenario, keys, step)]
 
     monkeypatch.setattr(sens, "perturbed_scenarios", broken)
     res = sens.run_sensitivity(sc, tmp_path, KEYS, 0.1)
@@ -117,7 +125,7 @@ def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch
     assert [r["status"] for r in stored if r["quantity"] == "I_dec"] == ["failed", "done"]
     monkeypatch.setattr(sens, "perturbed_scenarios", real)
     again = sens.run_sensitivity(sc, tmp_path, KEYS, 0.1)
-    assert again.outcome.count("cached") == 3 and again.outcome.count("done") == 1
+    assert again.outcome.count("cached") == 7 and again.outcome.count("done") == 1  # 4 runs a key: +-step, +-step/2
     assert {(r["key"], r["quantity"]): r["sensitivity"] for r in again.table}[(KEYS[1], "I_dec")] == \
         by[(KEYS[1], "I_dec")]["sensitivity"]
 

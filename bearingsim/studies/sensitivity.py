@@ -18,7 +18,9 @@ independent (a chaotic scene forgets its start within the warm-up), so
 SE(S) = sqrt(SE(ln y+)^2 + SE(ln y-)^2) / |ln x+ - ln x-|.
 
 The reduced model repeats one no-load pass every rotation: its sensitivities have no scatter (SE 0)
-and it has neither cage slip nor eccentricity (only ``I_dec`` and ``I_acc`` rows).
+and it has neither cage slip nor eccentricity (only ``I_dec`` and ``I_acc`` rows). Its I_dec jumps where the
+number of impacts of a pass changes, so a difference across a step may be no local slope: each key also
+runs at half the step, and ``sensitivity_half_step`` is S from those runs (NaN for the whole bearing).
 
 Outputs in ``DIR``: ``sensitivity.csv`` (:data:`COLUMNS`), ``sensitivity.h5`` (the same table as an
 index, with each run's archive, status and error), ``sensitivity.png`` (tornado chart), ``cases/``
@@ -45,9 +47,13 @@ QUANTITIES = (("I_dec", "N s", "log"), ("I_acc", "N s", "log"), ("cage_slip", "1
 REDUCED_QUANTITIES = ("I_dec", "I_acc")
 
 COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y_minus_se", "y_plus", "y_plus_se",
-           "sensitivity", "sensitivity_se", "over_range")
+           "sensitivity", "sensitivity_se", "over_range", "sensitivity_half_step")
 UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
-         "over_range": "as sensitivity"}
+         "over_range": "as sensitivity", "sensitivity_half_step": "as sensitivity"}
+#: the paired runs' sides: at the step, and, for a deterministic model (the reduced one: no standard error
+#: to show what the step does), at half of it: S there beside S says whether the difference is a local slope
+SIDES = ("-", "+")
+HALF_SIDES = ("-/2", "+/2")
 
 def parse_step(text) -> float:
     """``"10%"`` or ``"0.1"`` -> 0.1; a one-line UserError naming ``--step`` unless 0 < step < 1."""
@@ -266,11 +272,14 @@ class Sensitivity(Study):
         self.left_out: list[tuple[str, str]] = []  # default keys at 0, which a relative step cannot move
         self.keys = check_keys(scenario, keys, left_out=self.left_out)
         self.runs = {}  # (key, side) -> (value, case)
+        self.half = scenario.model == "reduced"  # deterministic: S at half the step too (HALF_SIDES)
         cases = []
-        for k, side, v, sc in perturbed_scenarios(scenario, self.keys, self.step):
-            c = case_of(sc, {"key": k, "side": side, "value": v})
-            self.runs[(k, side)] = (v, c)
-            cases.append(c)
+        for frac, sides in ((1.0, SIDES), (0.5, HALF_SIDES)) if self.half else ((1.0, SIDES),):
+            for k, side, v, sc in perturbed_scenarios(scenario, self.keys, self.step * frac):
+                side = sides[SIDES.index(side)]
+                c = case_of(sc, {"key": k, "side": side, "value": v})
+                self.runs[(k, side)] = (v, c)
+                cases.append(c)
         self.cases = cases
         self.outputs = [("sensitivity.csv", ",".join(COLUMNS).encode(), "sensitivity table"),
                         ("sensitivity.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sensitivity table"),
@@ -287,26 +296,39 @@ class Sensitivity(Study):
         rows = []
         for k in self.keys:
             lo, hi, _ = ranges[k]
-            (xm, cm), (xp, cp) = self.runs[(k, "-")], self.runs[(k, "+")]
-            rm, rp = records[cm.hash], records[cp.hash]
-            res_m, res_p = load_result(outdir, rm), load_result(outdir, rp)
-            hm = headline_numbers(res_m) if res_m is not None else {}
-            hp = headline_numbers(res_p) if res_p is not None else {}
-            failed = [r for r in (rm, rp) if r["status"] == "failed"]
+            (xm, xp), (hm, hp), (rm, rp) = self._pair(outdir, records, k, SIDES)
+            half = self._pair(outdir, records, k, HALF_SIDES) if self.half else None
+            failed = [r for r in (rm, rp, *(half[2] if half else ())) if r["status"] == "failed"]
             for q, _, measure in quantities:
                 ym, sm = hm.get(q, (math.nan, math.nan))
                 yp, sp = hp.get(q, (math.nan, math.nan))
                 s, se = sensitivity_of(measure, xm, xp, ym, sm, yp, sp)
+                s_half = math.nan
+                if half:
+                    (xm2, xp2), (hm2, hp2), _ = half
+                    y2 = [h.get(q, (math.nan, math.nan)) for h in (hm2, hp2)]
+                    s_half = sensitivity_of(measure, xm2, xp2, y2[0][0], y2[0][1], y2[1][0], y2[1][1])[0]
                 rows.append({"key": k, "quantity": q, "measure": measure, "x": float(value_of(self.scenario, k)),
                              "x_minus": xm, "x_plus": xp, "y_minus": ym, "y_minus_se": sm, "y_plus": yp,
                              "y_plus_se": sp, "sensitivity": s, "sensitivity_se": se,
                              "over_range": s * math.log(hi / lo) if lo > 0 else math.nan,
+                             "sensitivity_half_step": s_half,
                              "archive_minus": rm["archive"], "archive_plus": rp["archive"],
                              "status": "failed" if failed else "done",
                              "error": "; ".join(r["error"] for r in failed)})
         self.rows = rows
         paths = write_table(outdir, rows, self.scenario, self.step, self.left_out)
         return [*paths, *plot_sensitivity(outdir / "sensitivity.h5", outdir)]
+
+    def _pair(self, outdir, records, key, sides):
+        """((x-, x+), (headline numbers -, +), (records -, +)) of ``key``'s runs at ``sides``."""
+        (xm, cm), (xp, cp) = self.runs[(key, sides[0])], self.runs[(key, sides[1])]
+        rm, rp = records[cm.hash], records[cp.hash]
+        heads = []
+        for rec in (rm, rp):
+            res = load_result(outdir, rec)
+            heads.append(headline_numbers(res) if res is not None else {})
+        return (xm, xp), tuple(heads), (rm, rp)
 
 
 def write_table(outdir, rows, scenario, step, left_out=()) -> tuple[Path, Path]:
@@ -339,12 +361,18 @@ def _num(v, spec: str) -> str:
 def format_table(rows: list[dict]) -> str:
     """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
     quantity, S ± its standard error and the change over the key's range (n/a and why where missing)."""
-    lines = [f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}"]
+    half = any(math.isfinite(float(r.get("sensitivity_half_step", math.nan))) for r in rows)
+    lines = [f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}"
+             + (f" {'S, half step':>12s}" if half else "")]
     for r in rows:
         note = missing_note(r)
         lines.append(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
                      f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
+                     + (f" {_num(float(r.get('sensitivity_half_step', math.nan)), '+12.3f')}" if half else "")
                      + (f"  ({note})" if note else ""))
+    if half:
+        lines.append("S, half step: the same slope from runs at half the step (a deterministic model has no "
+                     "standard error; where the two differ, the difference is not a local slope)")
     return "\n".join(lines)
 
 

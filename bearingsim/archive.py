@@ -673,6 +673,7 @@ def read(path, result_class, only=None):
         data: dict[str, NamedArray] = {}
         groups: dict[str, AttrGroup] = {}
         tables: dict[str, str] = {}
+        columns: dict[str, list[str]] = {}  # each table's column order, as its @columns stores it
 
         def visit(name, obj):
             if name.startswith("results"):
@@ -685,12 +686,14 @@ def read(path, result_class, only=None):
                     data[name] = NamedArray(v, str(obj.attrs.get("unit", "1")), str(obj.attrs.get("description", "")))
                 elif "columns" in obj.attrs:
                     tables[name] = str(obj.attrs.get("description", ""))
+                    columns[name] = _column_names(obj.attrs["columns"])
                 else:
                     attrs, units = group_attrs(obj)
                     if attrs:
                         groups[name] = AttrGroup(attrs, units, str(_plain(obj.attrs.get("description", ""))))
 
         f.visititems(visit)
+        data = _in_result_order(data, columns, result_class.LAYOUT)
         series = {}
         for name, g in (f["observables"].items() if "observables" in f and _wanted("observables", only) else ()):
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
@@ -703,6 +706,31 @@ def read(path, result_class, only=None):
     finally:
         f.close()
     return result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
+
+
+def _column_names(value) -> list[str]:
+    """A table's ``@columns`` as a list of names (empty for a value that is not a list of names)."""
+    names = [v.decode("utf-8", "replace") if isinstance(v, bytes) else v for v in np.atleast_1d(value).tolist()]
+    return names if all(isinstance(v, str) for v in names) else []
+
+
+def _in_result_order(data: dict, columns: dict[str, list[str]], layout) -> dict:
+    """``data`` (read in the order HDF5 lists a group's members: by name) in the order of the result that
+    was written: a table's columns in the order its ``@columns`` stores, every other array in the order
+    of the model's :attr:`~bearingsim.results.Result.LAYOUT`, arrays it does not declare after them in
+    the order read."""
+    declared = {k: i for i, k in enumerate(layout)}
+    start = {t: min((i for k, i in declared.items() if k.startswith(t + "/")), default=len(declared))
+             for t in columns}
+
+    def rank(item):
+        i, name = item
+        table, _, column = name.rpartition("/")
+        if column in columns.get(table, ()):
+            return start[table], columns[table].index(column), i
+        return declared.get(name, len(declared)), 0, i
+
+    return {name: data[name] for _, name in sorted(enumerate(data), key=rank)}
 
 
 def _damaged(path, what: str) -> UserError:

@@ -47,8 +47,9 @@ def _observables(result) -> tuple[np.ndarray, dict[str, np.ndarray], dict[str, s
     """(time [s], columns, units) of the result's time series sampled at the same instants; a vector
     series gives one column per component (``cage_centre_x``, ``cage_centre_y``). The motion series
     (``motion_*``, poses for animations, sampled per cage travel: docs/archive.md) are not among them:
-    read them from ``Result.series``."""
-    series = {k: s for k, s in result.series.items() if not k.startswith("motion_")}
+    read them from ``Result.series``. By name, the order an archive lists them in: a fresh result's frame
+    and its archive's have the same columns in the same order."""
+    series = {k: s for k, s in sorted(result.series.items()) if not k.startswith("motion_")}
     if not series:
         return np.array([]), {}, {}
     times = {name: s.time for name, s in series.items()}

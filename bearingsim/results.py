@@ -44,7 +44,8 @@ class Result:
 
     #: what an archive of this model holds, checked on read (:func:`bearingsim.archive.check_layout`):
     #: archive path -> its dimensions, each a length or a name; arrays sharing a name share its length,
-    #: and :meth:`archive_dims` fixes some names from the scenario
+    #: and :meth:`archive_dims` fixes some names from the scenario; in the order the model lays its arrays
+    #: out, which a result read back keeps (a table's columns: the order its ``@columns`` stores)
     LAYOUT: dict[str, tuple] = {}
     #: sets of arrays of :attr:`LAYOUT` that are optional: all of a set or none
     OPTIONAL: tuple[frozenset, ...] = ()
@@ -84,14 +85,16 @@ class Result:
 
     @property
     def summary(self) -> dict[str, float]:
-        """The headline numbers in SI (names carry their unit), as floats."""
+        """The headline numbers in SI (names carry their unit), as floats, by name (the order the archive
+        stores them in: a result read back lists them as the run's result did)."""
         attrs = self.groups[SUMMARY].attrs
-        return {k: float(v) for k, v in attrs.items()
+        return {k: float(v) for k, v in sorted(attrs.items())
                 if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)}
 
     @property
     def summary_units(self) -> dict[str, str]:
-        return dict(self.groups[SUMMARY].units)
+        """The unit of each summary value, by name."""
+        return dict(sorted(self.groups[SUMMARY].units.items()))
 
     @property
     def per_rotation(self) -> dict[str, np.ndarray]:

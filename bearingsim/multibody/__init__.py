@@ -434,13 +434,13 @@ class MultibodyResult(Result):
         **{f"results/{c}": ("theta bins", "pockets") for c in ("force_vs_theta", "force_vs_theta_acc",
                                                                 "force_vs_theta_dec")},
         "results/raceway_load_inner": ("theta bins",), "results/raceway_load_outer": ("theta bins",),
+        **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
         **{f"results/wear/{c}": ("pockets",) for c in ("paper_index_front", "paper_index_rear",
                                                        "sliding_work_front", "sliding_work_rear")},
         "results/wear/profile_psi_deg": ("face bins",),
         **{f"results/wear/profile_{q}_{f}": ("face bins", "pockets") for q in PROFILE_QUANTITIES for f in ("front", "rear")},
         "results/cage_orbit": ("orbit samples", 3),
-        **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
-    }
+    }  # in the order a run lays its arrays out (MultibodyResult.from_raw), which a result read back keeps
     OPTIONAL = (frozenset(f"results/per_rotation/{c}" for c in _LAND),  # a land-guided cage
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
                 PROFILE_PATHS,  # archives written before the wear profile

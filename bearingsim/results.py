@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
+from bearingsim.errors import check_path
 
 PER_ROTATION = "results/per_rotation"
 IMPACTS = "results/impacts"
@@ -166,15 +167,21 @@ class Result:
         return {name: getattr(self, f"plot_{name}")() for name in self.FIGURES}
 
     def save_figures(self, stem) -> list[Path]:
-        """Write every figure as ``<stem>_<name>.png``; return the paths. Every path is checked before
-        any figure is drawn: one that is not a PNG file (a link, a folder, a user's file) is refused
-        with a one-line error and nothing is written (:func:`bearingsim.outputs.check_replaceable`)."""
-        from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
+        """Write every figure as ``<stem>_<name>.png``; return the paths. Missing folders are created, as
+        :meth:`save` does. Every path is checked before any figure is drawn: a folder that cannot be made
+        or written in, or a path that is not a PNG file (a link, a folder, a user's file), is refused with a
+        one-line :class:`bearingsim.UserError` and nothing is written
+        (:func:`bearingsim.outputs.check_replaceable`)."""
+        from bearingsim.archive import check_writable_dir
+        from bearingsim.outputs import PNG_SIGNATURE, check_folder_path, check_replaceable, figure_path
         from bearingsim.plotting import save_figure
 
+        stem = check_path(stem, "stem", "the figures' stem (<stem>_<name>.png)")
         paths = {name: figure_path(stem, name) for name in self.FIGURES}
+        folder = check_folder_path(Path(stem).parent)  # a file in the way: refused, nothing created
         for path in paths.values():
             check_replaceable(path, PNG_SIGNATURE, "figure")
+        check_writable_dir(folder)
         return [save_figure(getattr(self, f"plot_{name}")(), path) for name, path in paths.items()]
 
     #: at most this many differences from the preset are named in a title (then "+N more")

@@ -104,3 +104,19 @@ def test_figures_leave_the_users_matplotlib_backend_alone(tmp_path):
     assert res.returncode == 0, res.stderr
     assert res.stdout.split() == ["svg", "False", "True"], res.stdout
     assert all(p.read_bytes().startswith(b"\x89PNG") for p in tmp_path.glob("r_*.png"))
+
+
+def test_save_figures_makes_missing_folders_as_save_does(tmp_path):
+    """``save_figures`` into a folder that did not exist failed with a raw FileNotFoundError naming its
+    temporary file (``.stem_pass.png.tmp-<pid>``), where ``save`` makes the folders: it makes them too, and a
+    folder that cannot be made (a file in the way) is one ``bearingsim.UserError`` naming it, nothing written."""
+    r = bearingsim.run(_short_scenarios()[0])
+    written = r.save_figures(tmp_path / "new" / "deeper" / "run")
+    assert written == [tmp_path / "new" / "deeper" / f"run_{name}.png" for name in r.FIGURES]
+    assert all(p.read_bytes().startswith(b"\x89PNG") for p in written)
+    (tmp_path / "file").write_text("mine\n")
+    with pytest.raises(bearingsim.UserError) as err:
+        r.save_figures(tmp_path / "file" / "sub" / "run")
+    folder, file = tmp_path / "file" / "sub", tmp_path / "file"
+    assert str(err.value) == f"{folder}: cannot create the output folder ({file} is not a folder)"
+    assert sorted(p.name for p in tmp_path.rglob("*")) == sorted(["new", "deeper", "file", *(p.name for p in written)])

@@ -217,6 +217,22 @@ def test_dynamic_inner_ring_agrees_with_quasi_static_where_both_apply(full_3000)
     assert r.per_rotation["I_dec"].mean() == pytest.approx(full_3000.per_rotation["I_dec"].mean(), rel=0.10)
 
 
+@pytest.mark.parametrize("extra, ring", [
+    ([], "quasi-static"),  # auto at 970 N: 3 rollers loaded
+    (["multibody.inner_ring=dynamic"], "dynamic"),
+    (["operating.radial_load_N=200"], "dynamic"),  # auto: one roller loaded
+])
+def test_the_inner_ring_series_says_which_ring_it_is(tmp_path, extra, ring):
+    """/observables/inner_ring_centre@description said "quasi-static inner-ring centre (x, y)" for every run,
+    a dynamic ring (given, or chosen by "auto") too, against the provenance's `inner_ring`: it names the ring
+    the run had, in the result and in its archive."""
+    r = simulate(_scenario(rotations=1, extra=extra))
+    assert r.provenance["inner_ring"].startswith(ring)
+    assert r.series["inner_ring_centre"].description == f"{ring} inner-ring centre (x, y)"
+    with h5py.File(r.save(tmp_path / "r.h5"), "r") as f:
+        assert f["observables/inner_ring_centre"].attrs["description"] == f"{ring} inner-ring centre (x, y)"
+
+
 def test_inner_ring_auto_choice():
     """A ring resting on a single roller has no stable sideways equilibrium: "auto" keeps the massless
     quasi-static ring only when >= 2 rollers carry the load with one roller at the centre (16 rollers at

@@ -779,8 +779,9 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     return _Placed(sc, io, why, inp, wk)
 
 
-def _series(sink, reduced_eq: bool):
-    """The time series a run streams to ``sink``: (appender, sample fields) pairs (None: no sink)."""
+def _series(sink, su: MultibodySetup):
+    """The time series a run streams to ``sink``: (appender, sample fields) pairs (None: no sink). The
+    inner ring's says which ring it is: dynamic (a mass, :func:`inner_ring_model`) or quasi-static."""
     if sink is None:
         return None
     series = [
@@ -790,8 +791,9 @@ def _series(sink, reduced_eq: bool):
         (sink.timeseries("cage_centre", (2,), "m", "cage centre (x, y); y up, radial load along -y"),
          ("cage_x", "cage_y")),
     ]
-    if not reduced_eq:
-        series.append((sink.timeseries("inner_ring_centre", (2,), "m", "quasi-static inner-ring centre (x, y)"),
+    if not su.reduced_eq:
+        ring = "dynamic" if su.prm.ring_mass > 0.0 else "quasi-static"
+        series.append((sink.timeseries("inner_ring_centre", (2,), "m", f"{ring} inner-ring centre (x, y)"),
                        ("ring_x", "ring_y")))
     return series
 
@@ -851,7 +853,7 @@ def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIM
     t_loop0 = time.perf_counter()
     motion = (rk.MotionSeries(sink, p.bearing.roller_count, not su.reduced_eq)
               if sink is not None and p.numerics.motion_rotations > 0 else None)
-    _drive(su, pl, acc, ls, _series(sink, su.reduced_eq), motion, progress)
+    _drive(su, pl, acc, ls, _series(sink, su), motion, progress)
     loop_s = time.perf_counter() - t_loop0
     return _raw(su, pl, acc, ls[0], loop_s, t_wall0)
 

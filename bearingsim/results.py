@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
-from bearingsim.errors import check_path
+from bearingsim.errors import UserError, check_path
 
 PER_ROTATION = "results/per_rotation"
 IMPACTS = "results/impacts"
@@ -108,8 +108,31 @@ class Result:
         return self._under(IMPACTS)
 
     def get(self, name: str) -> np.ndarray:
-        """The array stored at ``results/<name>`` (e.g. ``"theta_deg"``, ``"wear/paper_index_rear"``)."""
-        return self.data[f"results/{name}"].data
+        """The array stored at ``results/<name>`` (e.g. ``"theta_deg"``, ``"wear/paper_index_rear"``). A name
+        this result holds no array under is a one-line :class:`bearingsim.UserError` naming the names it has."""
+        arr = self.data.get(f"results/{name}") if isinstance(name, str) else None
+        if arr is None:
+            raise UserError(self._unknown_array(name))
+        return arr.data
+
+    def _unknown_array(self, name) -> str:
+        """The message of :meth:`get` for ``name``: the closest names (if any) and every name there is, those
+        of a group together (``per_rotation/{I_dec, I_acc}``)."""
+        import difflib
+
+        if not isinstance(name, str):
+            return f"get({name!r}): expected the name of an array under results/ (a str), got {type(name).__name__}"
+        names = [k.removeprefix("results/") for k in self.data if k.startswith("results/")]
+        folders: dict[str, list[str]] = {}
+        for n in names:
+            folder, _, leaf = n.rpartition("/")
+            folders.setdefault(folder, []).append(leaf)
+        listed = [", ".join(leaves) if not folder else f"{folder}/{{{', '.join(leaves)}}}"
+                  for folder, leaves in folders.items()]
+        close = difflib.get_close_matches(name, names, n=3)
+        hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+        return f"get({name!r}): no array results/{name} in this {self.model} result{hint}; its arrays: " + (
+            ", ".join(listed) or "none")
 
     def _under(self, prefix: str) -> dict[str, np.ndarray]:
         p = prefix + "/"

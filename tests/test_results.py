@@ -120,3 +120,18 @@ def test_save_figures_makes_missing_folders_as_save_does(tmp_path):
     folder, file = tmp_path / "file" / "sub", tmp_path / "file"
     assert str(err.value) == f"{folder}: cannot create the output folder ({file} is not a folder)"
     assert sorted(p.name for p in tmp_path.rglob("*")) == sorted(["new", "deeper", "file", *(p.name for p in written)])
+
+
+def test_get_of_a_name_the_result_lacks_is_one_user_error_naming_what_it_has():
+    """``r.get("nope")`` raised a bare ``KeyError: 'results/nope'``; a name of the caller's that is not there is
+    one ``bearingsim.UserError`` line (docs/usage.md) naming it, the closest names and every array there is."""
+    r = bearingsim.run(_short_scenarios()[0])
+    assert r.get("trace/theta_deg") is r.data["results/trace/theta_deg"].data
+    for name, words in (("nope", ["get('nope'): no array results/nope in this reduced result; its arrays: "
+                                  "per_rotation/{I_dec, I_acc}, impacts/{time_s, "]),
+                        ("trace/theta", ["(did you mean trace/theta_deg "]),
+                        (3, ["get(3): expected the name of an array under results/ (a str), got int"])):
+        with pytest.raises(bearingsim.UserError) as err:
+            r.get(name)
+        text = str(err.value)
+        assert "\n" not in text and all(w in text for w in words), text

@@ -87,7 +87,8 @@ class Result:
     @property
     def summary(self) -> dict[str, float]:
         """The headline numbers in SI (names carry their unit), as floats, by name (the order the archive
-        stores them in: a result read back lists them as the run's result did)."""
+        stores them in: a result read back lists them as the run's result did). A text value of the summary
+        (a multibody run's ``scene``) is not among them: ``groups["results/summary"].attrs["scene"]``."""
         attrs = self.groups[SUMMARY].attrs
         return {k: float(v) for k, v in sorted(attrs.items())
                 if isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)}

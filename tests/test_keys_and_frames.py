@@ -311,6 +311,21 @@ def test_every_summary_number_has_the_unit_the_archive_page_gives(multibody_resu
         assert {k: r.summary_units.get(k) for k in numbers} == {k: documented[k] for k in numbers}
 
 
+def test_the_archive_page_says_where_the_summary_text_scene_is(multibody_result, tmp_path):
+    """docs/archive.md lists `scene` (text) among the summary attributes, and it is one, in the archive's
+    `/results/summary` and in the result's group of it; but `'scene' in r.summary` is False, fresh or read
+    back: `Result.summary` is the numbers (its docstring, SUMMARY_NUMBERS, the frames). The page said
+    nothing of it; it says where the text is, and what it says holds."""
+    from .conftest import archive_summary_table
+
+    table, units = archive_summary_table()
+    assert [k for k, u in units.items() if u == "text"] == ["scene"]
+    assert '`r.summary` holds the numbers' in table and 'r.groups["results/summary"].attrs["scene"]' in table
+    for r in (multibody_result, bearingsim.load(multibody_result.save(tmp_path / "m.h5"))):
+        assert "scene" not in r.summary and all(isinstance(v, float) for v in r.summary.values())
+        assert r.groups["results/summary"].attrs["scene"] == r.scenario.multibody.scene == "full"
+
+
 def test_observables_frame_and_dataset(multibody_result):
     r = multibody_result
     obs = r.to_dataframe("observables")

@@ -199,16 +199,17 @@ def _cmd_plot(args) -> int:
 
     from bearingsim.studies import crosscheck
 
+    say = _say(args)
     if archive.is_table_file(path, crosscheck.INDEX_FORMAT):  # a cross-check's index: its figure
         folder = check_writable_dir(args.output) if args.output else path.parent
         for png in crosscheck.plot_crosscheck(path, folder):
-            print(f"wrote {png}")
+            say(f"wrote {png}")
         return 0
     drawer = _study_table_drawer(path)
     if drawer is not None:  # sensitivity.h5, uncertainty.h5, life.h5: the study's figure from its table alone
         folder = check_writable_dir(args.output) if args.output else path.parent
         for png in drawer(path, folder):
-            print(f"wrote {png}")
+            say(f"wrote {png}")
         return 0
     from bearingsim.sweeps.grid import MAP_FORMAT
 
@@ -222,19 +223,26 @@ def _cmd_plot(args) -> int:
         notes: list[str] = []
         written = plot_sweep_index(path, folder, notes=notes)
         for png in written:
-            print(f"wrote {png}")
+            say(f"wrote {png}")
         if not written:  # nothing drawn: say why, in one line, and fail
             raise UserError(f"{path}: no figure written: " + "; ".join(notes))
         for line in notes:
-            print(f"bearingsim: note: {line}", file=sys.stderr)
+            say(f"bearingsim: note: {line}", file=sys.stderr)
         return 0
     from bearingsim.simulation import model_module
 
     result = read(path, only=model_module(archive.model_of(path)).RESULT.FIGURE_DATA)
     folder = check_writable_dir(args.output) if args.output else path.parent
     for png in result.save_figures(folder / path.stem):
-        print(f"wrote {png}")
+        say(f"wrote {png}")
     return 0
+
+
+def _say(args):
+    """``print``, or with ``-q`` (``args.quiet``) a function that prints nothing: what a command says on success."""
+    if getattr(args, "quiet", False):
+        return lambda *a, **kw: None
+    return print
 
 
 def _study_table_drawer(path):
@@ -262,7 +270,7 @@ def _cmd_rerun(args) -> int:
     from bearingsim.simulation import COMPARED, run, run_scenario
 
     old = read(args.archive, only=COMPARED)
-    progress = sys.stderr.isatty()
+    progress = not args.quiet and sys.stderr.isatty()
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
         new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
                            force=args.force).result
@@ -274,11 +282,11 @@ def _cmd_rerun(args) -> int:
     new.provenance.update({f"version_{k}": v for k, v in package_versions().items()}, bearingsim_version=version)
     c = compare_results(old, new)
     args.status = 0 if c.identical else 1  # the verdict, kept if the reader of stdout goes early (main)
-    if args.output:
+    if args.output and not args.quiet:
         print(f"wrote {args.output}")
     if c.identical:
-        print(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
-              f"{len(compared_arrays(old))} arrays, {len(other_numbers(old))} other numbers)")
+        _say(args)(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
+                   f"{len(compared_arrays(old))} arrays, {len(other_numbers(old))} other numbers)")
         return 0
     print(f"{args.archive}: rerun differs")
     print(c.summary_table())
@@ -559,6 +567,7 @@ def _add_run_commands(sub) -> None:
                                      "crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 alone")
     pl.add_argument("archive", help="a run archive, sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5")
     pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the file)")
+    pl.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     pl.set_defaults(func=_cmd_plot)
 
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
@@ -566,6 +575,9 @@ def _add_run_commands(sub) -> None:
     rr.add_argument("-o", "--output", help="also write the new run's archive here")
     rr.add_argument("--force", action="store_true",
                     help="with -o: replace an archive of a different scenario there (default: refused)")
+    rr.add_argument("-q", "--quiet", action="store_true",
+                    help="no progress bar and nothing printed when the rerun is bit-identical (exit 0); what "
+                         "differs is printed as without it (exit 1)")
     rr.set_defaults(func=_cmd_rerun)
 
     cp = sub.add_parser("compare", help="scenario keys and summary numbers of two or more archives side by side "

@@ -28,9 +28,10 @@ def _cmd_wear(args) -> int:
         folder = check_writable_dir(args.output) if args.output else path.parent
         pngs = {name: check_replaceable(figure_path(folder / path.stem, name), PNG_SIGNATURE, "figure")
                 for name in figures}
-    print(f"{path}: " + wear.format_report(rep))
+    say = (lambda line: None) if args.quiet else print
+    say(f"{path}: " + wear.format_report(rep))
     for name, png in pngs.items():
-        print(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
+        say(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
     return 0
 
 
@@ -68,6 +69,7 @@ def add_commands(sub) -> None:
     t.add_argument("--rotations", type=float, help="running time as inner-ring (shaft) rotations")
     w.add_argument("-o", "--output", help="folder for the figures (default: the archive's)")
     w.add_argument("--no-plots", action="store_true", help="print only")
+    w.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (the figures only)")
     w.set_defaults(func=_cmd_wear)
     li = sub.add_parser("life", help="stages of simulate / wear the pockets / simulate again until a wear limit")
     li.add_argument("scenario", help="multibody scenario TOML file")

@@ -98,6 +98,36 @@ FOLDER_WRITERS = {
 }
 
 
+#: commands of FOLDER_WRITERS without -q: bench (a source checkout's tool, its printed tables are what it is for)
+NOT_QUIET = ("bench-map", "bench-fast-scene")
+
+
+def test_every_command_that_writes_files_takes_quiet():
+    """`plot ARCHIVE -o DIR -q` failed with "unrecognized arguments: -q" (so did `rerun` and `wear`), while
+    run, report, animate, sweep and the studies take it: every command that writes files takes -q."""
+    from bearingsim.cli import build_parser
+
+    parser = build_parser()
+    for command, args in FOLDER_WRITERS.items():
+        if command not in NOT_QUIET:
+            assert parser.parse_args([str(a) for a in args] + ["-q"]).quiet is True, command
+
+
+@pytest.mark.parametrize("command", [
+    ["plot", "{R}", "-o", "{out}"],
+    ["wear", "{M}", "--hours", "1", "-o", "{out}"],
+    ["rerun", "{R}", "-o", "{out}/again.h5"],
+])
+def test_quiet_prints_nothing_on_success_and_writes_the_files(tmp_path, archives_to_write_from, command):
+    """-q as on `run`: the files written, nothing printed (`rerun`: bit-identical, exit 0)."""
+    out = tmp_path / "out"
+    res = bearingsim(*[str(a).format(out=out, **archives_to_write_from) for a in command], "-q")
+    assert res.returncode == 0 and res.stdout == "" and res.stderr == "", (res.stdout, res.stderr)
+    written = sorted(p.name for p in out.iterdir())
+    assert written == {"plot": ["r_pass.png"], "wear": ["m_wear_profile.png", "m_wear_volume.png"],
+                       "rerun": ["again.h5"]}[command[0]]
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("below", [False, True], ids=["file-is-the-folder", "file-above-the-folder"])
 @pytest.mark.parametrize("command", list(FOLDER_WRITERS))

@@ -196,6 +196,14 @@ def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
      "--keys bearing.roller_count: not a continuous number (a count or a choice): it has no range or derivative; "
      "sweep its values instead (bearingsim sweep --param bearing.roller_count=A,B,...)"),
     ("multibody_3000rpm", [], "bearing.cage_guidance", "--keys bearing.cage_guidance: not a continuous number"),
+    # Archard's k and H: read, but they only scale the wear outputs (was: a ranged k ran both runs, bit-identical
+    # I_dec, and printed S +0.000 with a standard error; the uncertainty study spent its runs and printed n/a)
+    ("multibody_6000rpm", ["multibody.raceway_contact=rigid", "numerics.rotations=2"], "wear.wear_coefficient",
+     "--keys wear.wear_coefficient: Archard's wear coefficient k only scales the wear outputs (worn volumes and "
+     "depths are proportional to k and 1/H), so varying it changes no I_dec, I_acc, cage slip or eccentricity, "
+     "the numbers the study measures; leave it out"),
+    ("paper_3000rpm", [], "wear.wear_coefficient", "proportional to k and 1/H"),
+    ("paper_3000rpm", [], "wear.hardness_Pa", "--keys wear.hardness_Pa: the cage's hardness H only scales the wear"),
 ])
 def test_a_key_that_is_not_one_or_not_read_is_refused_naming_it(tmp_path, capsys, command, scenario, sets, key,
                                                                  words):
@@ -221,9 +229,12 @@ def test_the_default_keys_are_those_the_model_reads():
     assert not {"bearing.cage_land_clearance_mm", "contact.land_friction"} & set(keys)
     land = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["bearing.cage_guidance=outer_land"])
     assert {"bearing.cage_land_clearance_mm", "contact.land_friction"} <= set(sens.default_keys(land))
+    from bearingsim.ranges import ranged_keys
     from bearingsim.scenario import unread_because
 
     assert all(unread_because(sc, k) is None for sc in (reduced, multibody, land) for k in sens.default_keys(sc))
+    assert all(sens.unmeasured_because(sc, k) is None for sc in (reduced, multibody, land) for k in sens.default_keys(sc))
+    assert "wear.wear_coefficient" in ranged_keys(multibody) and "wear.wear_coefficient" not in keys
 
 
 def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys):

@@ -68,15 +68,33 @@ def parse_step(text) -> float:
     return step
 
 
+#: keys every run reads that move none of the headline numbers (:data:`QUANTITIES`): Archard's k and H scale
+#: the wear outputs alone (worn volumes and depths k W / H of the sliding work W, which they do not change)
+WEAR_SCALE_KEYS = {"wear.wear_coefficient": "Archard's wear coefficient k", "wear.hardness_Pa": "the cage's hardness H"}
+
+
+def unmeasured_because(scenario, key: str) -> str | None:
+    """Why varying ``key`` moves none of the numbers the sensitivity and uncertainty studies measure, or
+    None: the scenario's run does not read it (:func:`bearingsim.scenario.unread_because`), or it only
+    scales the wear outputs (:data:`WEAR_SCALE_KEYS`). The phrase names the scenario where its settings decide."""
+    why = unread_because(scenario, key)
+    if why is not None:
+        return f"{scenario.source}: {why}, so varying it changes no run"
+    if key in WEAR_SCALE_KEYS:
+        return (f"{WEAR_SCALE_KEYS[key]} only scales the wear outputs (worn volumes and depths are proportional to "
+                f"k and 1/H), so varying it changes no I_dec, I_acc, cage slip or eccentricity, the numbers the "
+                f"study measures")
+    return None
+
+
 def default_keys(scenario) -> list[str]:
     """Every ranged key the scenario's model reads for its headline numbers (not the wear keys, which only
-    scale the wear outputs): the land keys only with a land-guided cage, the
+    scale the wear outputs: :func:`unmeasured_because`): the land keys only with a land-guided cage, the
     reduced model without the cage's mass, inertia, diameters, frictions and the multibody keys, and
     without the radial clearance when its load zone is given."""
     from bearingsim.ranges import ranged_keys
 
-    return [k for k in ranged_keys(scenario) if not k.startswith("wear.")  # Archard's k and H: wear outputs only
-            and unread_because(scenario, k) is None]
+    return [k for k in ranged_keys(scenario) if unmeasured_because(scenario, k) is None]
 
 
 def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:
@@ -116,7 +134,7 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
 
 def _check_given_key(scenario, key: str) -> None:
     """A one-line UserError naming ``key`` (given to ``--keys``) when no scenario has it (with the closest
-    accepted key) or the scenario's run does not read it (:func:`bearingsim.scenario.unread_because`)."""
+    accepted key) or varying it moves no number the study measures (:func:`unmeasured_because`)."""
     from bearingsim.scenario import did_you_mean, known_keys
 
     known = known_keys()
@@ -124,9 +142,9 @@ def _check_given_key(scenario, key: str) -> None:
         raise UserError(f"--keys {key}: unknown key{did_you_mean(key)}")
     if any(k.startswith(key + ".") for k in known):
         raise UserError(f"--keys {key}: a section, not a key (give its keys, e.g. {key}.<key>)")
-    why = unread_because(scenario, key)
+    why = unmeasured_because(scenario, key)
     if why is not None:
-        raise UserError(f"--keys {key}: {scenario.source}: {why}, so varying it changes no run; leave it out")
+        raise UserError(f"--keys {key}: {why}; leave it out")
     from bearingsim.ranges import is_continuous
 
     if not is_continuous(scenario, key):

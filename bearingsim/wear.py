@@ -15,6 +15,7 @@ Results only: a result read from an archive is enough (every number here is draw
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -73,6 +74,28 @@ def has_profile(result) -> bool:
     return "results/wear/profile_work_front" in result.data
 
 
+def _is_number(value) -> bool:
+    """A real number (numpy's too), not a bool."""
+    return isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+
+
+def archard_values(wear_coefficient, hardness) -> tuple[float, float]:
+    """(k, H) given to :func:`wear_report` checked as the scenario checks ``[wear]``: a one-line UserError
+    naming the argument unless 0 < k <= :data:`bearingsim.scenario.MAX_WEAR_COEFFICIENT` and H within
+    :data:`bearingsim.scenario.HARDNESS_RANGE_PA` (a negative k wore -0.0 m deep, H = 0 gave NaN). A k of 0,
+    which a scenario takes (nothing wears), is refused here: a report of no wear has no spread or ratio."""
+    from bearingsim.scenario import HARDNESS_RANGE_PA, MAX_WEAR_COEFFICIENT
+
+    k_ok = _is_number(wear_coefficient) and 0.0 < wear_coefficient <= MAX_WEAR_COEFFICIENT
+    if not k_ok:
+        raise UserError(f"wear_coefficient {wear_coefficient!r}: must be an Archard wear coefficient above 0 and at "
+                        f"most {MAX_WEAR_COEFFICIENT:g} (dimensionless; measured values are 1e-9..1e-2)")
+    lo, hi = HARDNESS_RANGE_PA
+    if not (_is_number(hardness) and lo <= hardness <= hi):
+        raise UserError(f"hardness {hardness!r}: must be a hardness in Pa within that of solids ({lo:g}..{hi:g} Pa)")
+    return float(wear_coefficient), float(hardness)
+
+
 def running_time(result, *, hours: float | None = None, rotations: float | None = None) -> tuple[float, float, float]:
     """(shaft rotations, hours, cage rotations) of a running time given as ``hours`` or inner-ring
     ``rotations`` (exactly one); the cage rotations at the run's measured mean cage speed. A refusal starts
@@ -80,7 +103,7 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     if (hours is None) == (rotations is None):
         raise UserError("give the running time as hours or as inner-ring rotations (exactly one)")
     value, name = (hours, "hours") if hours is not None else (rotations, "rotations")
-    if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+    if not (_is_number(value) and math.isfinite(value) and value > 0):
         raise UserError(f"{name} {value!r}: must be a positive number")
     op = result.parameters.operating
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
@@ -112,8 +135,9 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
         raise UserError("this archive has no wear profile (written before bearingsim recorded one, or not a "
                         "multibody run): run its scenario again ('bearingsim rerun' or 'bearingsim run')")
     p = result.parameters
-    k = p.wear.wear_coefficient if wear_coefficient is None else wear_coefficient
-    h = p.wear.hardness if hardness is None else hardness
+    k, h = p.wear.wear_coefficient, p.wear.hardness  # checked with the scenario (its k may be 0: no wear)
+    if wear_coefficient is not None or hardness is not None:
+        k, h = archard_values(k if wear_coefficient is None else wear_coefficient, h if hardness is None else hardness)
     shaft, hrs, cage_rot = running_time(result, hours=hours, rotations=rotations)
     recorded = result.per_rotation["I_dec"].shape[0]
     scale = cage_rot / recorded

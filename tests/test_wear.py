@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import signal
 import sys
 import time
@@ -196,6 +197,39 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
         res.wear_report(hours="x")
     with pytest.raises(UserError, match="^give the running time as hours or as inner-ring rotations"):
         res.wear_report()
+
+
+def test_wear_report_takes_numpy_numbers_and_refuses_what_a_scenario_refuses(fast_run):
+    """`wear_report(rotations=np.int64(100000))` was refused as "must be a positive number" (np.float64 was
+    taken); `wear_coefficient=-1` gave a max depth of -0.0 and `hardness=0` NaN with a divide-by-zero warning.
+    Numpy numbers are taken; k and H outside the scenario's bounds are refused in one line naming the argument."""
+    import warnings
+
+    from bearingsim.scenario import HARDNESS_RANGE_PA, MAX_WEAR_COEFFICIENT
+    from bearingsim.wear import wear_report
+
+    res = fast_run[0]
+    base = res.wear_report(rotations=1e5)
+    for kw in ({"rotations": np.int64(100000)}, {"rotations": np.float32(1e5)}, {"hours": np.int32(1)}):
+        rep = res.wear_report(**kw)
+        assert math.isfinite(rep.max_depth) and rep.max_depth > 0.0, kw
+    assert res.wear_report(rotations=np.int64(100000)).max_depth == base.max_depth
+    k, h = res.parameters.wear.wear_coefficient, res.parameters.wear.hardness
+    rep = wear_report(res, rotations=1e5, wear_coefficient=np.float64(2 * k), hardness=np.int64(int(h)))
+    assert rep.max_depth == pytest.approx(2 * base.max_depth, rel=1e-12)
+    lo, hi = HARDNESS_RANGE_PA
+    bad = [("wear_coefficient", -1), ("wear_coefficient", 0.0), ("wear_coefficient", 2 * MAX_WEAR_COEFFICIENT),
+           ("wear_coefficient", float("nan")), ("wear_coefficient", "1e-6"), ("wear_coefficient", True),
+           ("hardness", 0), ("hardness", -1.5e9), ("hardness", lo / 2), ("hardness", hi * 2), ("hardness", np.inf)]
+    for name, value in bad:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # no RuntimeWarning on the way to the refusal
+            with pytest.raises(UserError, match=f"^{name} {re.escape(repr(value))}: must be ") as err:
+                wear_report(res, rotations=1e5, **{name: value})
+        assert "\n" not in str(err.value)
+    for value in (True, np.bool_(True)):
+        with pytest.raises(UserError, match="^rotations .*: must be a positive number$"):
+            res.wear_report(rotations=value)
 
 
 @pytest.mark.parametrize("option, value", [("--rotations", "1e300"), ("--hours", "1e300"), ("--hours", "2e6")])

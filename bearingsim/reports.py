@@ -496,7 +496,7 @@ def _sensitivity_sections(table: Path):
 
     cells = [[r["key"], r["quantity"], r["measure"], slope(r), num(r["over_range"], 3), sens.missing_note(r)]
              for r in rows]
-    blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {meta.get('step', 0):.0%})); log: d ln y / d ln x, "
+    blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: d ln y / d ln x, "
                           "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False])]
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))

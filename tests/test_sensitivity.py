@@ -448,3 +448,22 @@ def test_the_tornado_draws_the_change_across_each_range_it_is_ordered_by():
 
     plt.close(fig)
 
+
+
+@pytest.mark.parametrize("step, shown", [("0.1%", "0.1%"), ("12.5%", "12.5%"), ("0.1", "10%")])
+def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown):
+    """`--step=0.1%` printed "at x (1 ± 0%)" and `--step=12.5%` "(1 ± 12%)" (a whole percent): the command's
+    line, `bearingsim table`, the report's table and the tornado's title show the step as given."""
+    from bearingsim import reports
+
+    titles = []
+    drawn = sens.plot_tornado
+    monkeypatch.setattr(sens, "plot_tornado", lambda rows, title="": titles.append(title) or drawn(rows, title))
+    code = main(["sensitivity", str(REDUCED), "--keys", KEYS[0], f"--step={step}", "-o", str(tmp_path), "-j", "1"])
+    out = capsys.readouterr().out
+    assert code == 0 and f"2 runs at x (1 ± {shown}) within each key's range" in out.splitlines()[0], out
+    assert titles and all(f"x (1 ± {shown}) within each key's range" in t for t in titles), titles
+    assert main(["table", str(tmp_path)]) == 0
+    assert f"2 runs at x (1 ± {shown}) within each key's range" in capsys.readouterr().out.splitlines()[0]
+    _, sections, _ = reports._sensitivity_sections(tmp_path / "sensitivity.h5")
+    assert f"(runs at x (1 ± {shown}))" in sections[0].blocks[0]["caption"], sections[0].blocks[0]["caption"]

@@ -68,6 +68,12 @@ def parse_step(text) -> float:
     return step
 
 
+def step_text(step) -> str:
+    """The relative step as a percentage, as given (0.1 -> "10%", 0.001 -> "0.1%", 0.125 -> "12.5%"): a whole
+    percent would show 0.1 % as "0%"."""
+    return f"{float(step) * 100.0:g}%"
+
+
 #: keys every run reads that move none of the headline numbers (:data:`QUANTITIES`): Archard's k and H scale
 #: the wear outputs alone (worn volumes and depths k W / H of the sliding work W, which they do not change)
 WEAR_SCALE_KEYS = {"wear.wear_coefficient": "Archard's wear coefficient k", "wear.hardness_Pa": "the cage's hardness H"}
@@ -444,7 +450,7 @@ def plot_sensitivity(index_path, outdir) -> list[Path]:
     from bearingsim.plotting import save_figure
 
     rows, meta = read_table(index_path)
-    fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {meta['step']:.0%}) within each key's "
+    fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {step_text(meta['step'])}) within each key's "
                              "range; bars: S ln(high / low), the change across the key's plausible range if linear, "
                              "± 1 standard error (batch means over rotations)")
     return [save_figure(fig, Path(outdir) / "sensitivity.png")]
@@ -461,7 +467,7 @@ class SensitivityResult:
 
     def plot_tornado(self):
         """The tornado chart (a matplotlib figure)."""
-        return plot_tornado(self.table, f"Sensitivity of {self.scenario.name}: x (1 ± {self.step:.0%}) within each "
+        return plot_tornado(self.table, f"Sensitivity of {self.scenario.name}: x (1 ± {step_text(self.step)}) within each "
                                        "key's range")
 
     def __repr__(self) -> str:

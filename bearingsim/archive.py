@@ -1048,13 +1048,37 @@ def _check_regular(p: Path) -> None:
 
 def _directory_error(p: Path) -> UserError:
     """The refusal of a folder given where an archive is read; a sweep's or a study's folder (its index
-    ``sweep.h5``) is named as one, with the commands that read it."""
+    ``sweep.h5``) is named as one, with the commands that read it and the file ``bearingsim plot`` draws its
+    figures from: a study's own table (:func:`_study_tables`), else the sweep's index (of a study, that draws
+    only the cases' overview)."""
     if (p / "sweep.h5").is_file():
         cases = (f"its cases' archives are in {p / 'cases'}" if (p / "cases").is_dir()
                  else "its cases kept no archives (sweep --archives all keeps them)")
+        tables = _study_tables(p)
+        drawn = (", ".join(f"'bearingsim plot {t}' draws the study's figure" for t in tables) if tables
+                 else f"'bearingsim plot {p / 'sweep.h5'}' draws its figures")
         return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}' and 'bearingsim "
-                         f"report {p}' read it, 'bearingsim plot {p / 'sweep.h5'}' draws its figures; {cases}")
+                         f"report {p}' read it, {drawn}; {cases}")
     return UserError(f"{p}: is a directory, not an archive")
+
+
+def _study_tables(folder: Path) -> list[Path]:
+    """The studies' tables in ``folder`` (``life.h5``, ``sensitivity.h5``, ...: its regular ``*.h5`` files whose
+    root ``format`` is one of :data:`STUDY_TABLE_FORMATS`), by name; what :func:`bearingsim.tables.studies_of`
+    finds of them, told by the format alone (this layer does not import the studies)."""
+    h5py = _lazy_h5py()
+    found = []
+    for f in sorted(folder.glob("*.h5")):
+        if f.name == "sweep.h5" or not f.is_file():
+            continue
+        try:
+            with h5py.File(f, "r") as h:
+                fmt = _plain(h.attrs.get("format"))
+        except (OSError, ValueError):
+            continue
+        if isinstance(fmt, str) and fmt.rstrip("0123456789. ") in STUDY_TABLE_FORMATS:
+            found.append(f)
+    return found
 
 
 def is_scenario_file(path) -> bool:
@@ -1092,6 +1116,9 @@ OWN_FILES = {"bearingsim sweep index": "a sweep's index", "bearingsim sweep map"
              "bearingsim crosscheck index": "a cross-check's table",
              "bearingsim sensitivity index": "a sensitivity study's table",
              "bearingsim uncertainty index": "an uncertainty study's table", "bearingsim life": "a life study's table"}
+#: the studies' tables among them ('bearingsim plot' draws each study's figure from its table)
+STUDY_TABLE_FORMATS = ("bearingsim crosscheck index", "bearingsim sensitivity index", "bearingsim uncertainty index",
+                       "bearingsim life")
 
 
 def _own_file_error(p: Path, fmt) -> UserError | None:

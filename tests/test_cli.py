@@ -477,3 +477,47 @@ def test_stdout_on_a_full_device_after_the_archive_is_not_exit_2(tmp_path):
     assert proc.returncode == 0 and len(lines) == 1, err
     assert "standard output" in lines[0] and f"the archive {out} is complete" in lines[0]
     assert out.is_file()
+
+
+@pytest.mark.slow
+def test_a_study_folder_given_to_plot_names_the_studys_own_table(tmp_path):
+    """`bearingsim plot DIR` of a sensitivity, uncertainty or life folder said "'bearingsim plot DIR/sweep.h5'
+    draws its figures", which draws only the cases' overview (sweep_cases.png): the tornado, the Sobol figure and
+    life.png come from sensitivity.h5, uncertainty.h5 and life.h5. The line names the study's table, which
+    draws its figure; a sweep folder's still names its sweep.h5."""
+    import numpy as np
+
+    from bearingsim import archive
+    from bearingsim.studies import crosscheck, sensitivity, uncertainty
+    from bearingsim.studies import life as life_study
+    from bearingsim.tables import STUDY_TABLES, studies_of
+
+    paper = SCENARIOS / "paper_6000rpm.toml"
+    runs = {"sensitivity": ["sensitivity", paper, "--keys", "contact.restitution"],
+            "uncertainty": ["uncertainty", paper, "--keys", "contact.restitution", "--samples", "2"],
+            "sweep": ["sweep", paper, "--param", "contact.restitution=0.7,0.8", "--archives", "all"]}
+    for kind, argv in runs.items():
+        folder = tmp_path / kind
+        res = bearingsim(*argv, "-q", "-j", "1", "-o", folder)
+        assert res.returncode == 0, res.stderr
+        table = folder / ("sweep.h5" if kind == "sweep" else f"{kind}.h5")
+        said = f"'bearingsim plot {table}' draws " + ("its figures" if kind == "sweep" else "the study's figure")
+        assert_user_error(bearingsim("plot", folder), f"{folder}: is a sweep or study folder, not an archive", said,
+                          f"its cases' archives are in {folder / 'cases'}")
+        if kind != "sweep":
+            assert "sweep.h5" not in bearingsim("plot", folder).stderr
+            res = bearingsim("plot", table, "-o", tmp_path / "again")
+            assert res.returncode == 0 and res.stdout == f"wrote {tmp_path / 'again' / f'{kind}.png'}\n", res
+    life = tmp_path / "life"  # a life study's table (its stages are multibody runs: not run here)
+    life.mkdir()
+    (life / "sweep.h5").write_bytes(b"")
+    archive.write_table_file(life / "life.h5", {"stage": np.arange(2)}, {}, {"format": life_study.LIFE_FORMAT})
+    res = bearingsim("inspect", life)
+    assert_user_error(res, f"'bearingsim plot {life / 'life.h5'}' draws the study's figure")
+    assert "sweep.h5" not in res.stderr
+    # the archive finds the tables by their format (it does not import the studies): as bearingsim.tables does
+    formats = (life_study.LIFE_FORMAT, crosscheck.INDEX_FORMAT, sensitivity.INDEX_FORMAT, uncertainty.INDEX_FORMAT)
+    assert sorted(archive.STUDY_TABLE_FORMATS) == sorted(f.rstrip("0123456789. ") for f in formats)
+    assert len(STUDY_TABLES) == len(formats) + 1  # and validate's table, a CSV: its folder names its sweep.h5
+    for folder in (*(tmp_path / kind for kind in runs), life):
+        assert archive._study_tables(folder) == [t for _, t in studies_of(folder)], folder

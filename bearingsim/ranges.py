@@ -49,22 +49,36 @@ def preset_ranges(preset: dict[str, Any]) -> dict[str, Any]:
 
 def _field_kind(section_model, key: str) -> str | None:
     """"float" for a key whose values are real numbers (possibly also a word such as "auto" or unset),
-    "other" for any other key of the section, None for no such key."""
+    "list" for a list (of numbers: ``wear.worn_depth_front_um``, possibly unset), "other" for any other key
+    of the section (a count or a choice), None for no such key."""
+    import types
+    import typing
+
     field = type(section_model).model_fields.get(key)
     if field is None:
         return None
-    text = str(field.annotation)
-    if "float" in text:
+    annotation = field.annotation
+    kinds = (typing.get_args(annotation) if typing.get_origin(annotation) in (typing.Union, types.UnionType)
+             else (annotation,))
+    if float in kinds:
         return "float"
+    if any(typing.get_origin(k) is list for k in kinds):
+        return "list"
     return "other"
 
 
 def is_continuous(scenario, dotted: str) -> bool:
     """Whether ``section.key`` of a resolved scenario takes real numbers (what a range, a relative step and
-    a sensitivity need), not a count or a choice."""
+    a sensitivity need), not a count, a choice or a list."""
+    return key_kind(scenario, dotted) == "float"
+
+
+def key_kind(scenario, dotted: str) -> str | None:
+    """What ``section.key`` of a resolved scenario takes: "float" (a real number), "list" (a list of numbers),
+    "other" (a count or a choice); None for no such key."""
     section, key = dotted.split(".", 1)
     sec = getattr(scenario.model_, section, None)
-    return sec is not None and hasattr(type(sec), "model_fields") and _field_kind(sec, key) == "float"
+    return _field_kind(sec, key) if sec is not None and hasattr(type(sec), "model_fields") else None
 
 
 _BOUND_ERRORS: dict[tuple, str | None] = {}

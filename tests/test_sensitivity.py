@@ -196,6 +196,11 @@ def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
      "--keys bearing.roller_count: not a continuous number (a count or a choice): it has no range or derivative; "
      "sweep its values instead (bearingsim sweep --param bearing.roller_count=A,B,...)"),
     ("multibody_3000rpm", [], "bearing.cage_guidance", "--keys bearing.cage_guidance: not a continuous number"),
+    # a list of numbers (was: "give [ranges.wear.worn_depth_front_um] range = ...", a range then refused as
+    # "must be a valid list")
+    ("paper_3000rpm", [], "wear.worn_depth_front_um",
+     "--keys wear.worn_depth_front_um: not a continuous number (a list of numbers): it has no range or derivative"),
+    ("multibody_3000rpm", [], "wear.worn_depth_rear_um", "--keys wear.worn_depth_rear_um: not a continuous number"),
     # Archard's k and H: read, but they only scale the wear outputs (was: a ranged k ran both runs, bit-identical
     # I_dec, and printed S +0.000 with a standard error; the uncertainty study spent its runs and printed n/a)
     ("multibody_6000rpm", ["multibody.raceway_contact=rigid", "numerics.rotations=2"], "wear.wear_coefficient",
@@ -244,6 +249,25 @@ def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys
     err = capsys.readouterr().err
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "ranges.contact.restitution" in err and "1.2" in err and "less than or equal to 1" in err
+
+
+def test_a_range_of_a_list_key_is_refused_as_not_a_continuous_number(tmp_path, capsys):
+    """A range given to a list key (wear.worn_depth_front_um, list[list[float]]) was refused as "must be a
+    valid list" (the key was taken for a continuous number because its type names float)."""
+    sc = tmp_path / "mine.toml"
+    sc.write_text(REDUCED.read_text() + '\n[ranges.wear.worn_depth_front_um]\nrange = [1, 2]\nreason = "mine"\n')
+    code = main(["sensitivity", str(sc), "-o", str(tmp_path / "o")])
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1, err
+    assert (f"{sc}: ranges.wear.worn_depth_front_um: wear.worn_depth_front_um is not a continuous number; only such "
+            f"keys take a range") in err, err
+    from bearingsim.ranges import is_continuous, key_kind
+
+    multibody = load_scenario(SCENARIOS / "multibody_3000rpm.toml")
+    assert [key_kind(multibody, k) for k in ("wear.worn_depth_rear_um", "bearing.cage_land_clearance_mm",
+                                             "multibody.inner_ring_mass_kg", "bearing.roller_count")] == \
+        ["list", "float", "float", "other"]
+    assert not is_continuous(multibody, "wear.worn_depth_rear_um")
 
 
 @pytest.mark.slow

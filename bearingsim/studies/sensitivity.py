@@ -151,10 +151,12 @@ def _check_given_key(scenario, key: str) -> None:
     why = unmeasured_because(scenario, key)
     if why is not None:
         raise UserError(f"--keys {key}: {why}; leave it out")
-    from bearingsim.ranges import is_continuous
+    from bearingsim.ranges import key_kind
 
-    if not is_continuous(scenario, key):
-        raise UserError(f"--keys {key}: not a continuous number (a count or a choice): it has no range or derivative; "
+    kind = key_kind(scenario, key)
+    if kind != "float":
+        what = "a list of numbers" if kind == "list" else "a count or a choice"
+        raise UserError(f"--keys {key}: not a continuous number ({what}): it has no range or derivative; "
                         f"sweep its values instead (bearingsim sweep --param {key}=A,B,...)")
 
 

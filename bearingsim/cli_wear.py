@@ -53,7 +53,8 @@ def _cmd_life(args) -> int:
     note = life.depth_limit_note(scenario, limit)  # how to read the history below
     if note and not args.quiet:
         print(f"bearingsim: note: {note}", file=sys.stderr)
-    print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}"))
+    # the limit reached, or the cage bar worn through first (the end of the life all the same: exit 0)
+    print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}", study.attrs()))
     for path in outcome.written:
         print(f"wrote {path}")
     return 0

@@ -539,6 +539,10 @@ def _life_sections(table: Path):
     mapping = str(attrs.get("mapping", ""))
     blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"
                                        + (f": {life.MAPPINGS[mapping]}." if mapping in life.MAPPINGS else ".")}]
+    if attrs.get("worn_through"):
+        blocks.append({"kind": "text", "text": f"The cage bar wears through before the limit, after "
+                                               f"{float(cols['hours_end'][-1]):.4g} h in stage "
+                                               f"{int(cols['stage'][-1])}: {attrs['worn_through']}."})
     note = _life_limit_note(attrs)
     if note:
         blocks.append({"kind": "text", "text": f"Note: {note}."})

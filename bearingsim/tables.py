@@ -216,7 +216,7 @@ def study_text(kind: str, file: Path) -> str:
                 + uncertainty.format_table(spreads, rows))
     cols, attrs = life.read_life(file)
     name = tomllib.loads(attrs["scenario"]).get("name", "?") if attrs.get("scenario") else "?"
-    return life.format_history(cols, f"{file}: life of {name} to {attrs.get('limit', '?')}")
+    return life.format_history(cols, f"{file}: life of {name} to {attrs.get('limit', '?')}", attrs)
 
 
 def format_paths(paths, columns=None) -> str:

@@ -113,7 +113,7 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
     from bearingsim.errors import UserError
     from bearingsim.multibody import recorder
     from bearingsim.scenario import load_scenario
-    from bearingsim.studies.life import parse_limit, run_life
+    from bearingsim.studies.life import parse_limit, read_life, run_life
 
     saved = recorder.accumulators.__defaults__, recorder.FACE_BINS
     print("| bins of psi | rotations to the limit | hours | deepest point's rate, first / last stage [mm/h] | I_dec, first / last stage [mN s] |")
@@ -126,12 +126,14 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
             with tempfile.TemporaryDirectory() as d:
                 try:
                     c = run_life(sc, d, parse_limit(limit), stages=10, rotations=10)
-                except UserError as exc:  # e.g. the cage bar wears through before the limit: a finding
+                except UserError as exc:  # a stage that failed: a finding
                     print(f"| {nb} | {exc} | | | |", flush=True)
                     continue
+                worn = read_life(f"{d}/life.h5")[1].get("worn_through")  # the cage bar before the limit
             rate = c["max_depth_rate_um_per_h"]
-            print(f"| {nb} | {c['rotations_end'][-1]:.0f} | {c['hours_end'][-1]:.4g} | {rate[0] / 1e3:.2f} / {rate[-1] / 1e3:.2f} | "
-                  f"{c['I_dec_mean_mNs'][0]:.2f} / {c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
+            end = f"not reached: the cage bar wears through first, in stage {c['stage'][-1]} ({worn}); " if worn else ""
+            print(f"| {nb} | {end}{c['rotations_end'][-1]:.0f} | {c['hours_end'][-1]:.4g} | {rate[0] / 1e3:.2f} / "
+                  f"{rate[-1] / 1e3:.2f} | {c['I_dec_mean_mNs'][0]:.2f} / {c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
     finally:
         recorder.accumulators.__defaults__, recorder.FACE_BINS = saved
 

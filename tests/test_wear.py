@@ -513,25 +513,47 @@ def test_the_pages_cage_bar_width_is_the_wear_test_bearings():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("limit, stages", [("volume=30mm3", 2), ("depth=5.8mm", 1), ("depth=5.8mm", 2)])
-def test_life_ends_in_one_line_when_the_cage_bar_wears_through_before_the_limit(tmp_path, capsys, limit, stages):
+def test_life_ends_where_the_cage_bar_wears_through_before_the_limit_its_stages_kept(tmp_path, capsys, limit, stages):
     """A limit whose mean depth fits the bar but whose worn edges do not (the roller-guided cage wears its
     faces' ends two orders of magnitude more per area than their middle, docs/wear.md), or a depth just
-    short of the bar's width: the study ends in one line saying the bar wears through first, when (within
-    the stage that does it, the last one included) and naming --limit. It named wear.worn_depth_front_um
-    of the scenario file, and with the wear-through in the last stage it reported the limit reached (exit
-    0 for --stages 1 and 2, exit 2 for 4)."""
+    short of the bar's width: the bar wearing through is the end of the life, the study's answer. It exits
+    0 as a study that reaches its limit does, its history's first line saying the bar wears through first
+    and when (within the stage that does it, the last one included), the stages run kept in life.h5 (the
+    last one ending at that time), life.png and the table. It was a usage error (exit 2, "give a smaller
+    limit") with no history: the stage run was lost. The same call again reuses the stages and ends there."""
     import re
 
     from bearingsim.cli import main
+    from bearingsim.studies.life import parse_limit, read_life, run_life
 
-    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", limit, "--stages", str(stages),
-                 "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)])
-    err = capsys.readouterr().err.strip().splitlines()
-    assert code == 2 and len(err) == 1, err
-    assert re.fullmatch(rf"bearingsim: error: --limit {limit}: the cage bar wears through first, after about "
-                        r"[0-9.]+ h \(in stage [0-9]+\): the deepest front and rear worn depths reach the 5\.821 mm "
-                        r"of the bar between two pockets; give a smaller limit", err[0]), err[0]
-    assert not (tmp_path / "life.h5").exists()
+    scenario = str(SCENARIOS / "wear_test_6000rpm.toml")
+    code = main(["life", scenario, "--limit", limit, "--stages", str(stages), "--rotations", "1", "-q",
+                 "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)])
+    out, err = capsys.readouterr()
+    assert code == 0 and err == "", (code, err)
+    lines = out.splitlines()
+    m = re.fullmatch(rf"life of {re.escape(scenario)} to {limit}: not reached, the cage bar wears through first, "
+                     rf"after ([0-9.e+-]+) h = ([0-9.e+-]+) inner-ring rotations, in stage ([0-9]+) \(of {stages}\): "
+                     r".*5\.821 mm.*", lines[0])
+    assert m, lines[0]
+    cols, attrs = read_life(tmp_path / "life.h5")
+    last = int(m.group(3))
+    assert cols["stage"].tolist() == list(range(last + 1)) and "worn_through" in attrs
+    assert float(m.group(1)) == pytest.approx(cols["hours_end"][-1], rel=1e-3)
+    assert float(m.group(2)) == pytest.approx(cols["rotations_end"][-1], rel=1e-3)
+    assert np.all(cols["stage_rotations"] > 0)
+    if limit.startswith("depth"):
+        assert cols["max_depth_um"][-1] < 5800.0  # short of the limit: the bar ends the life first
+    assert (tmp_path / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert [ln for ln in lines if ln.startswith("wrote ")] == [f"wrote {tmp_path / n}" for n in ("life.h5", "life.png")]
+    assert main(["table", str(tmp_path)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed == [f"{tmp_path / 'life.h5'}: " + lines[0].replace(scenario, "wear_test_6000rpm"),
+                       *lines[1:len(cols["stage"]) + 2]]
+    sc = load_scenario(scenario, ["multibody.raceway_contact=rigid"])
+    again = run_life(sc, tmp_path, parse_limit(limit), stages=stages, rotations=1)
+    assert again["reused"].tolist() == [1] * (last + 1)
+    np.testing.assert_array_equal(again["hours_end"], cols["hours_end"])
 
 
 @pytest.mark.slow

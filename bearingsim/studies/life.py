@@ -262,6 +262,8 @@ class LifeStudy(Study):
         self.rotations, self.mapping, self.progress = rotations, mapping, progress
         self.state = _State(s0, start)
         self.rows: list[dict] = []
+        #: why the life ended before the limit, when a pocket's faces wore through the cage bar (None: it did not)
+        self.worn_through: str | None = None
         self.stage_cases = [self._case(0)]
         self.cases = list(self.stage_cases)
         self.outputs = [("life.h5", lambda p: archive.is_table_file(p, LIFE_FORMAT), "life history"),
@@ -273,12 +275,11 @@ class LifeStudy(Study):
               else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.grown_clearance()))
         return case_of(sc, {"stage": j})
 
-    def _check_bar(self, j: int, d_rate, n_stage: float, hours_per_rotation: float) -> None:
-        """End the study when stage ``j``'s wear (``d_rate`` per inner-ring rotation for ``n_stage`` rotations,
-        on the depth the stages before it left) wears a pocket's faces through the cage bar (the deepest
-        front plus the deepest rear depth, as a worn scenario is checked), the last stage's included: the bar
-        ends the life before the limit does. The time it does so is found within the stage (the depths grow
-        linearly in it; bisection to 1e-9 of the stage)."""
+    def _bar_reached(self, d_rate, n_stage: float) -> float | None:
+        """The inner-ring rotations into the present stage (``d_rate`` per rotation on the depth the stages
+        before it left, for at most ``n_stage``) at which a pocket's faces wear through the cage bar (the
+        deepest front plus the deepest rear depth reach its width, as a worn scenario is checked), or None
+        when they do not within the stage. The depths grow linearly in it: bisection to 1e-9 of the stage."""
         bar = _bar(self.scenario)
         depth = self.state.depth
 
@@ -287,15 +288,14 @@ class LifeStudy(Study):
             return float(d[0].max() + d[1].max())
 
         if worn(n_stage) < bar:
-            return
+            return None
         lo, hi = 0.0, n_stage
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             lo, hi = (mid, hi) if worn(mid) < bar else (lo, mid)
-        hours = self.state.hours + hi * hours_per_rotation
-        raise UserError(f"--limit {self.limit.text}: the cage bar wears through first, after about {hours:.4g} h (in "
-                        f"stage {j}): the deepest front and rear worn depths reach the {bar * 1e3:.4g} mm of the bar "
-                        f"between two pockets; give a smaller limit")
+        self.worn_through = (f"the deepest front and rear worn depths reach the {bar * 1e3:.4g} mm of the bar between "
+                             f"two pockets")
+        return hi
 
     def next_cases(self, outdir: Path, records: dict[str, dict]) -> list:
         """The wear of the last stage run (its archive's wear rate, for as many rotations as bring the
@@ -320,7 +320,8 @@ class LifeStudy(Study):
         q_now = st.quantity(self.limit.kind, st.depth, st.volume)
         q_rate = st.quantity(self.limit.kind, d_rate, v_rate) - (st.s0 if self.limit.kind == "clearance" else 0.0)
         n_stage = _stage_length(q_now, q_rate, goal)
-        self._check_bar(j, d_rate, n_stage, rate.hours)
+        n_bar = self._bar_reached(d_rate, n_stage)  # the bar wears through first: the life ends there
+        n_stage = n_stage if n_bar is None else n_bar
         st.depth = st.depth + d_rate * n_stage
         st.volume = st.volume + v_rate * n_stage
         st.shaft += n_stage
@@ -329,14 +330,18 @@ class LifeStudy(Study):
         if self.progress:
             self.progress(f"stage {j:02d} of {self.planned}: {'reused' if self.rows[-1]['reused'] else 'run'}, "
                           f"I_dec {res.summary['I_dec_mean_Ns'] * 1e3:.4g} mN s; worn on for {n_stage:.4g} rotations, "
-                          f"deepest worn point {st.depth.max() * 1e6:.4g} um")
-        if j + 1 == self.planned:
+                          f"deepest worn point {st.depth.max() * 1e6:.4g} um"
+                          + ("; the cage bar wears through: the life ends here" if self.worn_through else ""))
+        if j + 1 == self.planned or self.worn_through:
             return []
         self.stage_cases.append(self._case(j + 1))
         return [self.stage_cases[-1]]
 
     def cases_to_come(self, known: set[str]) -> int:
-        """The stages not among ``known`` (each is made from the one before it)."""
+        """The stages not among ``known`` (each is made from the one before it); none after the stage in which
+        the cage bar wore through."""
+        if self.worn_through:
+            return 0
         return self.planned - sum(c.hash in known for c in self.stage_cases)
 
     def columns(self) -> dict:
@@ -344,19 +349,26 @@ class LifeStudy(Study):
         return {k: np.array([r[k] for r in self.rows]) for k in self.rows[0]}
 
     def finish(self, outdir: Path, records: dict[str, dict]) -> list[Path]:
-        """``life.h5`` (written atomically) and ``life.png``, once every stage has run (after a failed stage:
-        nothing, the failure is the engine's to tell)."""
+        """``life.h5`` (written atomically) and ``life.png``, once every stage has run or a stage has worn the
+        cage bar through (after a failed stage: nothing, the failure is the engine's to tell)."""
         from bearingsim import archive
         from bearingsim.plotting import save_figure
 
-        if len(self.rows) < self.planned:
+        if len(self.rows) < self.planned and not self.worn_through:
             return []
-        cols = self.columns()
+        cols, attrs = self.columns(), self.attrs()
+        archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
+        return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
+
+    def attrs(self) -> dict:
+        """The history's attributes (``life.h5``): the study, and ``worn_through`` when the cage bar wore
+        through before the limit (what reached its width; the time is the last stage's end)."""
         attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned,
                  "rotations": self.stage_rotations, "scenario": self.scenario.to_toml(), "mapping": self.mapping,
                  "mapping_text": MAPPINGS[self.mapping]}
-        archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
-        return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
+        if self.worn_through:
+            attrs["worn_through"] = self.worn_through
+        return attrs
 
     def _differs(self, attrs: dict) -> str:
         """What of a ``life.h5``'s study (its attributes) is not this one's: "" when the same, else what
@@ -420,8 +432,10 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
              force: bool = False, progress=None, mapping: str = "shape", engine=None) -> dict:
     """Run a life study (module docstring, :class:`LifeStudy`) into ``folder`` on the study engine (default:
     one local worker process); return the history's columns (also written as ``folder/life.h5``, with
-    ``life.png``). A stage that fails raises :class:`bearingsim.errors.UserError` with its one-line error
-    (the stages before it are kept); SIGINT/SIGTERM raise KeyboardInterrupt (the same call resumes)."""
+    ``life.png``). When a pocket's faces wear through the cage bar before the limit, the life ends there: the
+    history ends at that time, and ``life.h5``'s attribute ``worn_through`` says what reached the bar's
+    width. A stage that fails raises :class:`bearingsim.errors.UserError` with its one-line error (the stages
+    before it are kept); SIGINT/SIGTERM raise KeyboardInterrupt (the same call resumes)."""
     import signal
 
     from bearingsim.studies.engine import run_studies
@@ -474,14 +488,21 @@ def history_rows(cols: dict) -> list[list[str]]:
             for i in range(len(cols["stage"]))]
 
 
-def format_history(cols: dict, title: str) -> str:
+def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     """The history for the terminal, as ``bearingsim life`` prints it: ``title`` (``life of X to LIMIT``)
-    with the life reached, then one row per stage."""
+    with the life reached, or where the cage bar wore through first (``attrs``' ``worn_through``), then one
+    row per stage."""
     from bearingsim.wording import counted
 
-    lines = [f"{title}: {cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations in "
-             f"{counted(len(cols['stage']), 'stage')}",
-             " ".join(f"{head:>{width}}" for _, head, width, _ in HISTORY_TABLE)]
+    attrs = attrs or {}
+    n = len(cols["stage"])
+    when = f"{cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations"
+    if attrs.get("worn_through"):
+        first = (f"{title}: not reached, the cage bar wears through first, after {when}, in stage "
+                 f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
+    else:
+        first = f"{title}: {when} in {counted(n, 'stage')}"
+    lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in HISTORY_TABLE)]
     lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, HISTORY_TABLE))
               for row in history_rows(cols)]
     return "\n".join(lines)
@@ -513,8 +534,9 @@ def plot_life(cols: dict, attrs: dict):
     for ax in axes[:3]:
         ax.set_xlabel("running time [h]")
     _plot_worn_faces(axes[3], cols)
-    fig.suptitle(f"life to {attrs.get('limit', '?')}: {h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} inner-ring "
-                 f"rotations, {counted(len(h_end), 'stage')}", fontsize=9)
+    end = "the cage bar worn through first, after " if attrs.get("worn_through") else ""
+    fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} "
+                 f"inner-ring rotations, {counted(len(h_end), 'stage')}", fontsize=9)
     fig.tight_layout()
     return fig
 

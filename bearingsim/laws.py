@@ -150,8 +150,22 @@ def pocket_face_extent(pitch_radius, pocket_radius, wall_inner_radius, wall_oute
 def cage_bar_width(pitch_diameter, roller_diameter, pocket_clearance, roller_count):
     """Width of the cage bar between two neighbouring pockets at the pitch circle: the chord between their
     centres, ``d_p sin(pi / Z)``, less one pocket's width ``D + s`` (any length unit in, the same out).
-    What the front and rear faces of a pocket can wear together before the bar is worn through."""
+    What the two faces on a bar (:func:`worn_bar_depth`) can wear together before it is worn through."""
     return pitch_diameter * math.sin(math.pi / roller_count) - roller_diameter - pocket_clearance
+
+
+def worn_bar_depth(front, rear):
+    """The worn depth each cage bar carries, per bin of psi: ``front[..., i]`` plus ``rear[..., i - 1]``
+    (pockets mod Z), from the worn depths ``front``, ``rear`` (..., pockets) of the pockets' front and rear
+    faces in the same bins of psi. Bar ``i`` is the one between pocket ``i`` and pocket ``i - 1``: pocket
+    ``i`` trails pocket 0 by ``i`` pitches (:func:`bearingsim.parameters.pocket_angles`), so pocket ``i - 1``
+    lies ahead of it in the direction of rotation, and a pocket's front face is its side towards ``e_t``, the
+    direction of rotation (the rear face the other), in either direction of rotation. So a bar carries one
+    pocket's front face and its neighbour's rear face, not the front and rear faces of one pocket, which lie
+    on the two bars either side of it. Psi counts from each face's middle towards the cage's rim on both
+    faces, and the two faces' points at the same psi lie at the same distance from the cage's axis: their
+    bins of the same index face each other across the bar."""
+    return np.asarray(front) + np.roll(np.asarray(rear), 1, axis=-1)
 
 
 def palmgren_approach(load: float, roller_length: float) -> float:

@@ -1195,7 +1195,8 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
 def _check_worn(m: ScenarioModel, source: str) -> None:
     """A worn-depth profile (``wear.worn_depth_front_um``, ``_rear_um``): the multibody model with exact arc
     faces, one row per pocket, rows of equal length (the bins of psi), depths >= 0, and a cage bar that
-    is not worn through (the deepest front plus the deepest rear depth below the bar's width)."""
+    is not worn through (the depths of the two faces on each bar, one pocket's front face and its neighbour's
+    rear face, in each bin of psi, below the bar's width: :func:`bearingsim.laws.worn_bar_depth`)."""
     w = m.wear
     given = [(k, v) for k, v in (("worn_depth_front_um", w.worn_depth_front_um),
                                  ("worn_depth_rear_um", w.worn_depth_rear_um)) if v is not None]
@@ -1219,13 +1220,19 @@ def _check_worn(m: ScenarioModel, source: str) -> None:
     for k, v in given:
         if min(min(row) for row in v) < 0.0:
             raise UserError(f"{source}: wear.{k}: a worn depth is negative; wear only removes material")
-    deepest = sum(max(max(row) for row in v) for _, v in given) * 1e-3
-    from bearingsim.laws import cage_bar_width
+    import numpy as np
 
+    from bearingsim.laws import cage_bar_width, worn_bar_depth
+
+    faces = {k: np.array(v, dtype=np.float64).T for k, v in given}  # (bins, pockets) [um]
+    zero = np.zeros_like(next(iter(faces.values())))
+    on_bar = worn_bar_depth(faces.get("worn_depth_front_um", zero), faces.get("worn_depth_rear_um", zero)) * 1e-3
     bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count)
-    if deepest >= bar:
-        raise UserError(f"{source}: {key}: the deepest front and rear worn depths ({deepest:.4g} mm together) "
-                        f"reach the cage bar's width ({bar:.4g} mm): the bar would be worn through")
+    if on_bar.max() >= bar:
+        i = int(np.unravel_index(np.argmax(on_bar), on_bar.shape)[1])
+        raise UserError(f"{source}: {key}: pocket {i}'s front face and pocket {(i - 1) % b.roller_count}'s rear face, "
+                        f"either side of the cage bar between them, are worn {on_bar.max():.4g} mm deep together in a "
+                        f"bin of psi, the bar's width ({bar:.4g} mm) or more: the bar would be worn through")
 
 
 def _most_pockets(width_mm: float, pitch_mm: float) -> int:

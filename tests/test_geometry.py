@@ -193,6 +193,36 @@ def _worn(n, face, i, row):
     return w
 
 
+@pytest.mark.parametrize("sign", [1, -1])
+def test_a_cage_bar_carries_one_pockets_front_face_and_its_neighbours_rear_face(sign):
+    """The bar between pockets i - 1 and i carries pocket i's front face and pocket i - 1's rear face, in
+    either direction of rotation: the pocket centre nearest to the middle of pocket i's front face (as the
+    scene builds it) is pocket i - 1's, to its rear face pocket i + 1's; the two faces' points at the same
+    psi lie at the same distance from the cage's axis (their bins of one index face each other across the
+    bar); and laws.worn_bar_depth sums exactly those. The cage-bar checks summed the deepest front and the
+    deepest rear depth of any pockets and bins, as if a pocket's two faces lay on one bar."""
+    p, sc = _scene(sign=sign)
+    n = p.bearing.roller_count
+    af = arc_faces(sc, p.bearing.roller_radius, p.operating.sign)
+    centres = np.asarray(sc.pocket_centres)
+    for i in range(n):
+        for f, neighbour in ((0, (i - 1) % n), (1, (i + 1) % n)):
+            seg = sc.arc_shapes[i][f]
+            middle = 0.5 * (np.array(seg.a) + np.array(seg.b))
+            others = [k for k in range(n) if k != i]
+            assert min(others, key=lambda k: np.linalg.norm(centres[k] - middle)) == neighbour, (i, f)
+        j = (i - 1) % n
+        for psi in np.radians([-32.0, -10.0, 0.0, 12.0, 26.0]):
+            front = centres[i] + af.radius * (math.cos(psi) * af.e_t[i] + math.sin(psi) * af.e_r[i])
+            rear = centres[j] + af.radius * (-math.cos(psi) * af.e_t[j] + math.sin(psi) * af.e_r[j])
+            assert np.linalg.norm(front) == pytest.approx(np.linalg.norm(rear), rel=1e-12)
+    bins = 4
+    front, rear = np.zeros((bins, n)), np.zeros((bins, n))
+    front[1, 5], rear[1, 4], rear[2, 5] = 2.0, 3.0, 7.0
+    on_bar = laws.worn_bar_depth(front, rear)
+    assert on_bar[1, 5] == 5.0 and on_bar[2, 6] == 7.0 and on_bar.sum() == 12.0
+
+
 @pytest.mark.parametrize("face", [0, 1])
 @pytest.mark.parametrize("psi_deg", [0.0, 15.0, -25.0])
 def test_a_uniformly_worn_face_moves_the_contact_outwards_by_w(face, psi_deg):

@@ -473,16 +473,20 @@ def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario,
 @pytest.mark.parametrize("extra, words", [
     (["--limit", "depth=6mm"], "--limit depth=6mm: the cage bar between two pockets is 5.821 mm wide"),
     (["--limit", "depth=10000mm"], "--limit depth=10000mm: the cage bar"),
-    (["--limit", "clearance=6.1mm"], "--limit clearance=6.1mm: the cage bar"),
+    (["--limit", "clearance=11.9mm"], "--limit clearance=11.9mm: the cage bar between two pockets is 5.821 mm wide: "
+                                      "a pocket worn 11.7 mm wider, at least twice the bar's width"),
     (["--limit", "volume=1000mm3"], "--limit volume=1000mm3: the cage bar"),
     (["--limit", "depth=0.1mm", "--set", "wear.wear_coefficient=0"], "wear.wear_coefficient = 0: nothing wears"),
-], ids=["depth-beyond-bar", "depth-absurd", "clearance-beyond-bar", "volume-beyond-bar", "no-wear"])
+], ids=["depth-beyond-bar", "depth-absurd", "clearance-beyond-two-bars", "volume-beyond-bar", "no-wear"])
 def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, monkeypatch, capsys, extra, words):
-    """A limit beyond the cage bar between two pockets (the wear-test bearing: 97.5 mm pitch, 16 rollers of
-    13 mm, s = 0.2 mm: 97.5 sin(pi/16) - 13.2 = 5.821 mm, which the front and rear faces wear through
-    together), or a wear coefficient of 0, is refused in one line before any stage runs, and nothing is
-    created (a stage ran, then the next stage's scenario was refused naming wear.worn_depth_front_um, or
-    'no wear at this stage'; depth=6mm even ran to the end)."""
+    """A limit that a face reaches only through the cage bar between two pockets, on its face (the
+    wear-test bearing: 97.5 mm pitch, 16 rollers of 13 mm, s = 0.2 mm: 97.5 sin(pi/16) - 13.2 = 5.821 mm):
+    a depth, or a face's mean depth (volume), at that width or beyond, a clearance whose pocket has grown by
+    twice that (its front and rear faces lie on the two bars either side of it: one face alone through its
+    bar), or a wear coefficient of 0, is refused in one line before any stage runs, and nothing is created
+    (a stage ran, then the next stage's scenario was refused naming wear.worn_depth_front_um, or 'no wear at
+    this stage'; depth=6mm even ran to the end). A limit short of that runs, and may end where a bar wears
+    through (the test above)."""
     from bearingsim.cli import main
 
     monkeypatch.chdir(tmp_path)
@@ -512,11 +516,16 @@ def test_the_pages_cage_bar_width_is_the_wear_test_bearings():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("limit, stages", [("volume=30mm3", 2), ("depth=5.8mm", 1), ("depth=5.8mm", 2)])
+@pytest.mark.parametrize("limit, stages", [("volume=30mm3", 2), ("depth=5.8mm", 1), ("depth=5.8mm", 2),
+                                           ("clearance=6.1mm", 2)])
 def test_life_ends_where_the_cage_bar_wears_through_before_the_limit_its_stages_kept(tmp_path, capsys, limit, stages):
     """A limit whose mean depth fits the bar but whose worn edges do not (the roller-guided cage wears its
-    faces' ends two orders of magnitude more per area than their middle, docs/wear.md), or a depth just
-    short of the bar's width: the bar wearing through is the end of the life, the study's answer. It exits
+    faces' ends two orders of magnitude more per area than their middle, docs/wear.md), a depth just short
+    of the bar's width, or a clearance a pocket reaches with its two faces on two bars (it was refused before
+    any stage, as if they lay on one): the bar wearing through is the end of the life, the study's answer,
+    when the two faces on one bar (pocket i's front face, pocket i - 1's rear face) reach its 5.821 mm
+    together in one bin of psi (laws.worn_bar_depth: the check summed the deepest front and rear depths of
+    any pockets and bins, which reached the bar's width sooner). It exits
     0 as a study that reaches its limit does, its history's first line saying the bar wears through first
     and when (within the stage that does it, the last one included), the stages run kept in life.h5 (the
     last one ending at that time), life.png and the table. It was a usage error (exit 2, "give a smaller
@@ -544,6 +553,11 @@ def test_life_ends_where_the_cage_bar_wears_through_before_the_limit_its_stages_
     assert np.all(cols["stage_rotations"] > 0)
     if limit.startswith("depth"):
         assert cols["max_depth_um"][-1] < 5800.0  # short of the limit: the bar ends the life first
+    on_bar = laws.worn_bar_depth(cols["worn_depth_front_um"][-1], cols["worn_depth_rear_um"][-1])  # [bin, bar]
+    bar = laws.cage_bar_width(97.5, 13.0, 0.2, 16) * 1e3
+    assert on_bar.max() == pytest.approx(bar, rel=1e-6)  # the bar's width, reached at the stage's end
+    i = int(np.unravel_index(np.argmax(on_bar), on_bar.shape)[1])
+    assert f"pocket {i}'s front face and pocket {(i - 1) % 16}'s rear face" in lines[0]
     assert (tmp_path / "life.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert [ln for ln in lines if ln.startswith("wrote ")] == [f"wrote {tmp_path / n}" for n in ("life.h5", "life.png")]
     assert main(["table", str(tmp_path)]) == 0
@@ -816,12 +830,60 @@ def test_life_keeps_a_users_file_in_its_folder(tmp_path, capsys, name):
 ])
 def test_bad_worn_depth_is_refused_naming_the_key(over, words):
     """A worn-depth profile that does not fit the bearing is refused in one line naming the key: a row per
-    pocket (16), equal rows, no negative depth, a cage bar (5.821 mm) not worn through by its front and
-    rear faces together, exact arc faces, the multibody model."""
+    pocket (16), equal rows, no negative depth, no cage bar (5.821 mm) worn through by the two faces on it,
+    exact arc faces, the multibody model."""
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"))
     with pytest.raises(UserError, match=r"wear\.worn_depth_(front|rear)_um") as exc:
         sc.replace(**over)
     assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_worn_scenarios_cage_bar_carries_one_pockets_front_face_and_its_neighbours_rear_face():
+    """The cage-bar check of worn faces sums, per bar and bin of psi, pocket i's front face and pocket
+    i - 1's rear face (laws.worn_bar_depth; tests/test_geometry.py shows they face each other across the bar,
+    bins of one index opposite). It summed the deepest front and the deepest rear depth of any pockets and
+    bins: pocket 0's own faces, 3 mm deep each at the bore end (they lie on the two bars either side of it),
+    were refused as a bar worn through, and so was pocket 1's front face with pocket 0's rear face deep at
+    opposite ends of the bar (bore and rim)."""
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"))
+
+    def worn(front, rear):
+        rows = {f: [[0.0] * 32 for _ in range(16)] for f in ("front", "rear")}
+        for f, (pocket, b) in (("front", front), ("rear", rear)):
+            rows[f][pocket][b] = 3000.0
+        return {f"wear.worn_depth_{f}_um": rows[f] for f in rows}
+
+    for front, rear in (((0, 0), (0, 0)), ((1, 0), (0, 31)), ((0, 0), (1, 0))):
+        assert sc.replace(**worn(front, rear)).wear.worn_depth_front_um[front[0]][front[1]] == 3000.0
+    with pytest.raises(UserError, match=r"wear\.worn_depth_front_um: pocket 1's front face and pocket 0's rear face, "
+                                        r"either side of the cage bar between them, are worn 6 mm deep together"):
+        sc.replace(**worn((1, 5), (0, 5)))
+    with pytest.raises(UserError, match="pocket 0's front face and pocket 15's rear face"):
+        sc.replace(**worn((0, 0), (15, 0)))
+
+
+@pytest.mark.slow
+def test_life_from_a_pocket_worn_deep_on_both_faces_runs_to_its_limit(tmp_path, capsys):
+    """A life study from a scenario whose pocket 0 is worn 3 mm deep at the bore end of both its faces (on
+    the two bars either side of it, each carrying one of them) runs to depth=3.05mm and reaches it: no bar
+    is worn through. The scenario was refused (3 + 3 mm: 'the bar would be worn through')."""
+    from bearingsim.cli import main
+    from bearingsim.studies.life import read_life
+
+    deep = [[3000.0] + [0.0] * 31] + [[0.0] * 32 for _ in range(15)]
+    scenario = tmp_path / "deep.toml"
+    text = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"]).replace(
+        **{"wear.worn_depth_front_um": deep, "wear.worn_depth_rear_um": deep}).to_toml()
+    scenario.write_text(text)
+    code = main(["life", str(scenario), "--limit", "depth=3.05mm", "--stages", "1", "--rotations", "1", "-q",
+                 "-o", str(tmp_path / "life")])
+    out, err = capsys.readouterr()
+    assert code == 0 and err == "", (code, err)
+    cols, attrs = read_life(tmp_path / "life" / "life.h5")
+    assert "worn_through" not in attrs and "not reached" not in out
+    assert cols["max_depth_um"][-1] == pytest.approx(3050.0, rel=1e-9)
+    on_bar = laws.worn_bar_depth(cols["worn_depth_front_um"][-1], cols["worn_depth_rear_um"][-1])
+    assert 3050.0 <= on_bar.max() < laws.cage_bar_width(97.5, 13.0, 0.2, 16) * 1e3
 
 
 @pytest.mark.parametrize("make, words", [

@@ -178,10 +178,13 @@ def _bar(scenario) -> float:
 
 
 def _check_reachable(scenario, limit: Limit) -> None:
-    """Refuse a limit that no wear can reach: with no wear (a wear coefficient of 0), or beyond the cage bar
-    between two pockets, which the front and rear faces of a pocket wear through together (the deepest
-    point of one face, the mean worn depth of both over a face's area, or one face's volume over its
-    area reaching the bar's width: worn through before the limit)."""
+    """Refuse a limit that no wear can reach: with no wear (a wear coefficient of 0), or one that a face
+    reaches only through a cage bar on its face: the deepest point of one face, or one face's volume over
+    its area (its mean depth), at the bar's width or beyond; for a clearance, the mean worn depth of a
+    pocket's front and rear faces at twice the bar's width or beyond, the two faces lying on the two bars
+    either side of the pocket (:func:`bearingsim.laws.worn_bar_depth`), so that one of them alone is through
+    its bar. A limit short of that may still come after a bar has worn through, which the stages find (the
+    end of the life, not a refusal: :meth:`LifeStudy._bar_reached`)."""
     from bearingsim.wear import face_area
 
     if scenario.wear.wear_coefficient <= 0.0:
@@ -190,14 +193,18 @@ def _check_reachable(scenario, limit: Limit) -> None:
     b = scenario.bearing
     bar = _bar(scenario)
     if limit.kind == "depth":
-        depth = limit.value
-    elif limit.kind == "clearance":
-        depth = limit.value - b.pocket_clearance_mm * 1e-3  # front + rear, mean over the faces
+        depth, what = limit.value, "a face worn that deep is through its bar on its own"
+    elif limit.kind == "clearance":  # front + rear mean depth of one pocket, whose faces lie on two bars
+        grown = limit.value - b.pocket_clearance_mm * 1e-3
+        depth = 0.5 * grown
+        what = (f"a pocket worn {grown * 1e3:.4g} mm wider, at least twice the bar's width (its front and rear "
+                f"faces lie on the two bars either side of it), has a face through its bar on its own")
     else:
         depth = limit.value / face_area(scenario.parameters)
+        what = f"a face worn that much ({depth * 1e3:.4g} mm deep on the mean) is through its bar on its own"
     if depth >= bar:
-        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide and would "
-                        f"be worn through before that; give a smaller limit")
+        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide: {what}; "
+                        f"give a smaller limit")
 
 
 def _start_value(scenario, limit: Limit, s0: float, start) -> float:
@@ -275,26 +282,32 @@ class LifeStudy(Study):
               else stage_scenario(self.scenario, None, j, self.rotations, clearance=st.grown_clearance()))
         return case_of(sc, {"stage": j})
 
-    def _bar_reached(self, d_rate, n_stage: float) -> float | None:
+    def _bar_reached(self, d_rate, n_stage: float, psi_deg) -> float | None:
         """The inner-ring rotations into the present stage (``d_rate`` per rotation on the depth the stages
-        before it left, for at most ``n_stage``) at which a pocket's faces wear through the cage bar (the
-        deepest front plus the deepest rear depth reach its width, as a worn scenario is checked), or None
-        when they do not within the stage. The depths grow linearly in it: bisection to 1e-9 of the stage."""
+        before it left, for at most ``n_stage``) at which a cage bar wears through: the two faces on it, one
+        pocket's front face and its neighbour's rear face, worn as deep together in a bin of psi (``psi_deg``,
+        the bins' centres) as the bar is wide (:func:`bearingsim.laws.worn_bar_depth`, as a worn scenario is
+        checked); None when none does within the stage. The depths grow linearly in it: bisection to 1e-9 of
+        the stage."""
+        from bearingsim.laws import worn_bar_depth
+
         bar = _bar(self.scenario)
         depth = self.state.depth
 
-        def worn(n):
+        def on_bar(n):
             d = depth + d_rate * n
-            return float(d[0].max() + d[1].max())
+            return worn_bar_depth(d[0], d[1])  # (bins, bars)
 
-        if worn(n_stage) < bar:
+        if on_bar(n_stage).max() < bar:
             return None
         lo, hi = 0.0, n_stage
         for _ in range(60):
             mid = 0.5 * (lo + hi)
-            lo, hi = (mid, hi) if worn(mid) < bar else (lo, mid)
-        self.worn_through = (f"the deepest front and rear worn depths reach the {bar * 1e3:.4g} mm of the bar between "
-                             f"two pockets")
+            lo, hi = (mid, hi) if on_bar(mid).max() < bar else (lo, mid)
+        k, i = np.unravel_index(np.argmax(on_bar(hi)), depth.shape[1:])
+        self.worn_through = (f"pocket {i}'s front face and pocket {(i - 1) % depth.shape[2]}'s rear face, either "
+                             f"side of the bar between them, reach its {bar * 1e3:.4g} mm together at psi = "
+                             f"{float(psi_deg[k]):.3g} deg")
         return hi
 
     def next_cases(self, outdir: Path, records: dict[str, dict]) -> list:
@@ -320,7 +333,7 @@ class LifeStudy(Study):
         q_now = st.quantity(self.limit.kind, st.depth, st.volume)
         q_rate = st.quantity(self.limit.kind, d_rate, v_rate) - (st.s0 if self.limit.kind == "clearance" else 0.0)
         n_stage = _stage_length(q_now, q_rate, goal)
-        n_bar = self._bar_reached(d_rate, n_stage)  # the bar wears through first: the life ends there
+        n_bar = self._bar_reached(d_rate, n_stage, rate.psi_deg)  # the bar wears through first: the life ends there
         n_stage = n_stage if n_bar is None else n_bar
         st.depth = st.depth + d_rate * n_stage
         st.volume = st.volume + v_rate * n_stage

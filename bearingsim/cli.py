@@ -111,8 +111,25 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
                 name = tomllib.loads(meta["scenario"]).get("name")
             lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
             lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "rotations", "left_out") if k in meta]
+            if fmt == life.LIFE_FORMAT:
+                lines += _life_lines(meta)
             return archive.describe_table(path, what, cols, columns, lines, noun=noun), meta.get("scenario")
     return None
+
+
+def _life_lines(meta: dict) -> list[str]:
+    """What a life history's attributes say beside its limit and counts: the wear mapping its stages ran
+    with (the one a resume must give; a history without one is a uniform study's) and, when the cage bar
+    wore through before the limit, that."""
+    from bearingsim.studies import life
+
+    mapping = meta.get("mapping")
+    text = (f"mapping: {mapping} ({life.MAPPINGS[mapping]})" if mapping in life.MAPPINGS else
+            f"mapping: {mapping}" if mapping else "mapping: uniform (none recorded: written before the shape mapping)")
+    lines = [text]
+    if meta.get("worn_through"):
+        lines.append(f"ended before the limit, the cage bar worn through: {meta['worn_through']}")
+    return lines
 
 
 def _cmd_inspect(args) -> int:

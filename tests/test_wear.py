@@ -314,7 +314,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
     lim = parse_limit("clearance=0.203mm")
     cols = run_life(sc, tmp_path, lim, stages=3, rotations=1, mapping=mapping)
-    assert np.all(np.diff(cols["pocket_clearance_mm"]) > 0) and np.all(np.diff(cols["hours_end"]) > 0)
+    assert np.all(np.diff(cols["clearance_start_mm"]) > 0) and np.all(np.diff(cols["hours_end"]) > 0)
     assert np.all(cols["stage_rotations"] > 0)
     assert cols["clearance_end_mm"][-1] == pytest.approx(0.203, rel=1e-9)
     assert np.all(cols["reused"] == 0)
@@ -331,8 +331,8 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
             assert stage.bearing.pocket_clearance_mm == sc.bearing.pocket_clearance_mm
             # the history's clearance is the effective one, which its header says (it was "s [mm]", read
             # as the scenario's s, which these stages keep at 0.2 mm)
-            assert cols["pocket_clearance_mm"][j] > stage.bearing.pocket_clearance_mm
-            assert ("pocket_clearance_mm", "s_eff [mm]") in [c[:2] for c in HISTORY_TABLE]
+            assert cols["clearance_start_mm"][j] > stage.bearing.pocket_clearance_mm
+            assert ("clearance_start_mm", "s_eff [mm]") in [c[:2] for c in HISTORY_TABLE]
             for f in ("front", "rear"):
                 np.testing.assert_allclose(np.array(getattr(stage.wear, f"worn_depth_{f}_um")).T,
                                            cols[f"worn_depth_{f}_um"][j - 1], rtol=0, atol=5e-7)
@@ -376,7 +376,7 @@ def test_life_uniform_mapping_counts_a_worn_start_once(tmp_path):
     assert stage1.bearing.pocket_clearance_mm == pytest.approx(sc.bearing.pocket_clearance_mm + grown * 1e-3, abs=2e-9)
     # the history's effective clearance holds the start's depth once
     start_mean = sum(start[f].mean(axis=0) for f in ("front", "rear")).max()
-    assert cols["pocket_clearance_mm"][0] == pytest.approx(sc.bearing.pocket_clearance_mm + start_mean * 1e-3, abs=1e-9)
+    assert cols["clearance_start_mm"][0] == pytest.approx(sc.bearing.pocket_clearance_mm + start_mean * 1e-3, abs=1e-9)
 
 
 @pytest.mark.slow
@@ -590,6 +590,50 @@ def test_life_folder_of_other_stages_or_rotations_is_refused_and_a_limit_in_othe
         assert len(err) == 1 and words in err[0] and "--force" in err[0], err
     assert main([*base, "--limit", "depth=100um", "--stages", "2", "--rotations", "1"]) == 0
     assert read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
+
+
+@pytest.mark.slow
+def test_life_history_names_the_effective_clearance_and_keeps_the_scenario_its_stages_ran(tmp_path, capsys):
+    """life.h5 of `--rotations 1` (the scenario file says 40): the effective clearance at each stage's start
+    is the column clearance_start_mm (it was pocket_clearance_mm, the name of the scenario's key, which the
+    shape mapping keeps at 0.2 mm while the column grows); its scenario ('bearingsim show life.h5') says
+    rotations = 1, so that TOML run again without --rotations resumes the study (it said rotations = 40 and
+    was refused: "another number of rotations per stage (1; this one: --rotations 40)"); `inspect` lists
+    the wear mapping a resume depends on. A history written before (the old column name, the scenario as
+    given) still reads and resumes."""
+    from bearingsim import archive
+    from bearingsim.cli import main
+    from bearingsim.studies.life import LIFE_FORMAT, LIFE_UNITS, read_life
+
+    scenario = str(SCENARIOS / "wear_test_6000rpm.toml")
+    cmd = ["life", scenario, "--limit", "clearance=0.203mm", "--stages", "2", "--rotations", "1", "-q",
+           "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path / "l")]
+    assert main(cmd) == 0
+    capsys.readouterr()
+    history = tmp_path / "l" / "life.h5"
+    raw, attrs = archive.read_table_file(history, LIFE_FORMAT)
+    assert "clearance_start_mm" in raw and "pocket_clearance_mm" not in raw
+    assert raw["clearance_start_mm"][0] == pytest.approx(0.2, abs=1e-12) and raw["clearance_start_mm"][1] > 0.2
+    assert _stage(tmp_path / "l", 1).scenario.bearing.pocket_clearance_mm == 0.2
+    assert main(["show", str(history)]) == 0
+    saved = tmp_path / "saved.toml"
+    saved.write_text(capsys.readouterr().out)
+    assert load_scenario(str(saved)).numerics.rotations == 1
+    again = ["life", str(saved), "--limit", "clearance=0.203mm", "--stages", "2", "-q", "-o", str(tmp_path / "l")]
+    assert main(again) == 0, capsys.readouterr().err
+    assert read_life(history)[0]["reused"].tolist() == [1, 1]
+    capsys.readouterr()
+    assert main(["inspect", str(history)]) == 0
+    assert "\nmapping: shape (the worn depth added to each face where it wore" in capsys.readouterr().out
+    # a history written before: the old column name, the scenario as given (its file's 40 rotations)
+    old = {("pocket_clearance_mm" if k == "clearance_start_mm" else k): v for k, v in raw.items()}
+    given = load_scenario(scenario, ["multibody.raceway_contact=rigid"]).to_toml()
+    archive.write_table_file(history, old, LIFE_UNITS, {**attrs, "scenario": given})
+    cols, _ = read_life(history)
+    np.testing.assert_array_equal(cols["clearance_start_mm"], raw["clearance_start_mm"])
+    assert main(["table", str(tmp_path / "l")]) == 0 and "s_eff [mm]" in capsys.readouterr().out
+    assert main(cmd) == 0, capsys.readouterr().err
+    assert read_life(history)[0]["reused"].tolist() == [1, 1]
 
 
 #: case hash -> the signal its worker sends the study before it runs the case

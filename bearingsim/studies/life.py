@@ -265,6 +265,11 @@ class LifeStudy(Study):
         if self.start_value >= limit.value:
             raise UserError(f"--limit {limit.text}: {scenario.source}'s own worn faces ([wear] worn_depth_*_um) are "
                             f"there already ({_limit_text(limit.kind, self.start_value)}); give a larger limit")
+        # the history keeps the scenario with the stages' recorded rotations ('bearingsim show life.h5' gives
+        # what the stages ran); a history written before it did kept the scenario as given
+        self.given_toml = scenario.to_toml()
+        if rotations is not None:
+            scenario = scenario.replace(**{"numerics.rotations": int(rotations)})
         self.scenario, self.limit, self.planned = scenario, limit, stages
         self.rotations, self.mapping, self.progress = rotations, mapping, progress
         self.state = _State(s0, start)
@@ -386,14 +391,18 @@ class LifeStudy(Study):
     def _differs(self, attrs: dict) -> str:
         """What of a ``life.h5``'s study (its attributes) is not this one's: "" when the same, else what
         differs (the scenario or the limit, the number of stages, the rotations per stage; a limit is the
-        same in other units: depth=100um is depth=0.1mm)."""
+        same in other units: depth=100um is depth=0.1mm). The scenario is the one with the stages' rotations,
+        or, in a history written before it held that, the one given with ``--rotations``."""
         try:
             held = parse_limit(attrs.get("limit", ""))
         except UserError:
             held = None
         same_limit = (held is not None and held.kind == self.limit.kind
                       and math.isclose(held.value, self.limit.value, rel_tol=1e-12))
-        if attrs.get("scenario") != self.scenario.to_toml() or not same_limit:
+        ours = {self.scenario.to_toml(), self.given_toml}
+        if "rotations" in attrs and int(attrs["rotations"]) != self.stage_rotations:  # told below, not as a scenario
+            ours.add(self.scenario.replace(**{"numerics.rotations": int(attrs["rotations"])}).to_toml())
+        if attrs.get("scenario") not in ours or not same_limit:
             return "scenario or limit"
         if int(attrs.get("stages", self.planned)) != self.planned:
             return f"number of stages ({attrs['stages']}; this one: --stages {self.planned})"
@@ -463,18 +472,26 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int
     return study.columns()
 
 
-LIFE_UNITS = {"stage": "1", "pocket_clearance_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
+LIFE_UNITS = {"stage": "1", "clearance_start_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
               "hours_end": "h", "max_depth_rate_um_per_h": "um/h", "max_volume_rate_mm3_per_h": "mm^3/h",
               "max_depth_um": "um", "max_volume_mm3": "mm^3", "clearance_end_mm": "mm", "I_dec_mean_mNs": "mN s",
               "reused": "1", "psi_deg": "deg", "worn_depth_front_um": "um", "worn_depth_rear_um": "um"}
 
 
+#: the history's column of the effective pocket clearance at a stage's start, under the name it had before
+#: (``pocket_clearance_mm``, the name of the scenario's key ``bearing.pocket_clearance_mm``, which the shape
+#: mapping keeps as given): :func:`read_life` reads it under its present name
+OLD_COLUMNS = {"pocket_clearance_mm": "clearance_start_mm"}
+
+
 def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
-    """One stage's history row; ``clearance``: the effective pocket clearance it ran at [m]. The worn
-    depth at the stage's end is ``worn_depth_*_um`` [bin, pocket], at the bins ``psi_deg``."""
+    """One stage's history row; ``clearance``: the effective pocket clearance it ran at [m] (the worst
+    pocket's ``s`` plus its front and rear mean worn depth at the stage's start: ``clearance_start_mm``, not
+    the scenario's ``s``, which the shape mapping keeps). The worn depth at the stage's end is
+    ``worn_depth_*_um`` [bin, pocket], at the bins ``psi_deg``."""
     per_hour = 1.0 / rate.hours  # rate report is for one rotation
     return {
-        "stage": j, "pocket_clearance_mm": clearance * 1e3, "stage_rotations": n_stage,
+        "stage": j, "clearance_start_mm": clearance * 1e3, "stage_rotations": n_stage,
         "rotations_end": st.shaft, "hours_end": st.hours,
         "max_depth_rate_um_per_h": rate.max_depth * per_hour * 1e6,
         "max_volume_rate_mm3_per_h": float(max(rate.volume_front.max(), rate.volume_rear.max())) * per_hour * 1e9,
@@ -489,7 +506,7 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
 #: width on the terminal, format); the worn-depth profiles of each stage are the figure's. s_eff: the effective
 #: pocket clearance the stage ran at (the worst pocket's s plus its front and rear mean worn depth), not the
 #: scenario's s, which the shape mapping keeps
-HISTORY_TABLE = (("stage", "stage", 5, "d"), ("pocket_clearance_mm", "s_eff [mm]", 10, ".4f"),
+HISTORY_TABLE = (("stage", "stage", 5, "d"), ("clearance_start_mm", "s_eff [mm]", 10, ".4f"),
                  ("stage_rotations", "rotations", 11, ".4g"), ("hours_end", "h at end", 9, ".4g"),
                  ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
                  ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
@@ -522,10 +539,12 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
 
 
 def read_life(path) -> tuple[dict, dict]:
-    """The history's columns and attributes of a ``life.h5``."""
+    """The history's columns and attributes of a ``life.h5``; a column of an older history under its
+    present name (:data:`OLD_COLUMNS`)."""
     from bearingsim import archive
 
-    return archive.read_table_file(path, LIFE_FORMAT)
+    cols, attrs = archive.read_table_file(path, LIFE_FORMAT)
+    return {OLD_COLUMNS.get(k, k): v for k, v in cols.items()}, attrs
 
 
 def plot_life(cols: dict, attrs: dict):
@@ -538,7 +557,7 @@ def plot_life(cols: dict, attrs: dict):
     fig, axes = subplots(1, 4, figsize=(16, 3.8))
     axes[0].plot(np.concatenate([[0.0], h_end]), np.concatenate([[0.0], cols["max_depth_um"]]), "o-")
     axes[0].set_ylabel("deepest worn point [µm]")
-    axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["pocket_clearance_mm"][0]],
+    axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["clearance_start_mm"][0]],
                                                                    cols["clearance_end_mm"]]), "o-", color="C2")
     axes[1].set_ylabel("effective pocket clearance [mm]\n(worst pocket: s + mean worn depth)")
     axes[2].hlines(cols["max_depth_rate_um_per_h"], h_start, h_end, color="C3")

@@ -477,9 +477,9 @@ def _cmd_crosscheck(args) -> int:
     from bearingsim.studies import crosscheck as cc
     from bearingsim.studies import make_engine
 
-    speeds = cc.parse_speeds(args.speeds)
     engine = make_engine(args.jobs, args.scheduler)
     scenario = load_scenario(args.scenario, args.set)
+    speeds = _crosscheck_speeds(args, scenario)
     rotations = _crosscheck_rotations(args, scenario)
     cc.rung_scenarios(scenario, speeds[0], rotations)  # refuse a wrong scenario before any run
     t0 = time.perf_counter()
@@ -499,6 +499,24 @@ def _cmd_crosscheck(args) -> int:
             print(f"wrote {Path(args.output) / name}")
         print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
     return report_study(outcome, "cross-check")
+
+
+def _crosscheck_speeds(args, scenario) -> tuple[float, ...]:
+    """The rungs' speeds: ``--speeds``, else a ``--set operating.inner_ring_speed_rpm`` (as one speed), else
+    :data:`~bearingsim.studies.crosscheck.DEFAULT_SPEEDS_RPM`; both given and different is refused (the
+    --set was silently replaced by --speeds, and stored as the table's scenario)."""
+    from bearingsim.scenario import parse_override
+    from bearingsim.studies import crosscheck as cc
+
+    key = "operating.inner_ring_speed_rpm"
+    given = key in [parse_override(o)[0] for o in args.set]
+    if args.speeds is None:
+        return (float(scenario.operating.inner_ring_speed_rpm),) if given else cc.DEFAULT_SPEEDS_RPM
+    speeds = cc.parse_speeds(args.speeds)
+    if given and speeds != (scenario.operating.inner_ring_speed_rpm,):
+        raise UserError(f"--speeds {args.speeds} and --set {key}={scenario.operating.inner_ring_speed_rpm:g}: "
+                        "the rungs' inner-ring speed given twice; give one")
+    return speeds
 
 
 def _crosscheck_rotations(args, scenario) -> int:
@@ -659,7 +677,8 @@ def _add_study_commands(sub) -> None:
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
                                            "(docs/crosscheck.md; run again to resume)")
     cc.add_argument("scenario", help="multibody scenario TOML, full scene")
-    cc.add_argument("--speeds", default="1000,3000,6000", help="inner-ring speeds in rpm (default 1000,3000,6000)")
+    cc.add_argument("--speeds", help="inner-ring speeds in rpm (default 1000,3000,6000, or a --set "
+                                     "operating.inner_ring_speed_rpm)")
     cc.add_argument("--rotations", type=int, default=None,
                     help="recorded cage rotations of every rung (default 10, or a --set numerics.rotations), after "
                          "the scenario's warm-up rotations")

@@ -196,6 +196,7 @@ def test_each_rung_says_the_raceway_contacts_its_scenario_has(contact, named):
     (["crosscheck", str(REFERENCE), "--set", "numerics.rotations=0"], "numerics.rotations"),
     (["crosscheck", str(REFERENCE), "--rotations", "3", "--set", "numerics.rotations=5"], "given twice"),
     (["crosscheck", str(REFERENCE), "-j", "0"], "-j 0"),
+    (["crosscheck", str(REFERENCE), "--speeds", "3000", "--set", "operating.inner_ring_speed_rpm=1000"], "given twice"),
 ])
 def test_refusals(argv, words, capsys, tmp_path):
     """A reduced-model scenario, a non-full scene and bad options: one line on stderr, exit 2, nothing run."""
@@ -204,6 +205,30 @@ def test_refusals(argv, words, capsys, tmp_path):
     assert rc == 2
     assert err.count("\n") == 1 and words in err
     assert not (tmp_path / "cc" / "cases").exists()
+
+
+@pytest.mark.parametrize("argv, speeds", [
+    (["--set", "operating.inner_ring_speed_rpm=2000"], (2000.0,)),
+    (["--set", "operating.inner_ring_speed_rpm=2000", "--speeds", "2000"], (2000.0,)),
+    ([], cc.DEFAULT_SPEEDS_RPM),
+])
+def test_a_set_speed_is_the_speed_the_rungs_run_at(argv, speeds, monkeypatch, tmp_path):
+    """``crosscheck --speeds 3000 --set operating.inner_ring_speed_rpm=1000`` ran the rungs at 3000 rpm and
+    stored 1000 rpm as the table's scenario (the --set silently overridden). As for the rotations, a --set of
+    the speed without --speeds is taken as --speeds N (and both given differently are refused, above)."""
+    seen = []
+
+    class Ran(BaseException):
+        pass
+
+    def run_crosscheck(scenario, outdir, speeds, rotations, **kw):
+        seen.append(tuple(speeds))
+        raise Ran
+
+    monkeypatch.setattr(cc, "run_crosscheck", run_crosscheck)
+    with pytest.raises(Ran):
+        main(["crosscheck", str(REFERENCE), *argv, "-o", str(tmp_path / "cc")])
+    assert seen == [speeds]
 
 
 @pytest.mark.slow

@@ -1134,6 +1134,23 @@ def _own_file_error(p: Path, fmt) -> UserError | None:
                      f"it holds, 'bearingsim table {p.parent}' prints its folder's table")
 
 
+def _own_table_error(p: Path) -> UserError | None:
+    """The one-line refusal of a CSV table a sweep or study wrote (``sweep.csv``, ``crosscheck.csv``, ...:
+    :data:`bearingsim.outputs.FOLDER_FILES`, told by its name and first bytes) given where an archive is
+    read, naming the command that reads its folder; None for any other file."""
+    head = outputs.FOLDER_FILES.get(p.name)
+    if head is None or not p.name.endswith(".csv"):
+        return None
+    try:
+        with open(p, "rb") as f:
+            if f.read(len(head)) != head:
+                return None
+    except OSError:
+        return None
+    return UserError(f"{p}: a table bearingsim wrote (CSV), not an archive; 'bearingsim table {p.parent}' prints "
+                     "its folder's tables")
+
+
 def open_archive(path: str | Path):
     """Open a complete bearingsim archive read-only, or raise a one-line :class:`UserError`."""
     h5py = _lazy_h5py()
@@ -1148,7 +1165,8 @@ def open_archive(path: str | Path):
     except OSError:
         ok = False
     if not ok:
-        raise scenario_file_error(p) or UserError(f"{p}: not an HDF5 file (truncated, or not a bearingsim archive)")
+        raise scenario_file_error(p) or _own_table_error(p) or UserError(
+            f"{p}: not an HDF5 file (truncated, or not a bearingsim archive)")
     try:
         f = h5py.File(p, "r")
     except OSError as exc:

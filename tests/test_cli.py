@@ -279,6 +279,22 @@ def test_a_scenario_file_given_for_an_archive_names_the_commands_that_read_it(tm
         assert_user_error(bearingsim("inspect", other), "notes.txt: not an HDF5 file")
 
 
+@pytest.mark.parametrize("name, head", [("sweep.csv", "case,operating.inner_ring_speed_rpm,status\n"),
+                                        ("crosscheck.csv", "rpm,rung,scene,relaxed\n"),
+                                        ("rig_idec_vs_speed.csv", "rpm,rotations,pocket0\n")])
+@pytest.mark.parametrize("command", ["table", "inspect", "plot", "show", "rerun"])
+def test_a_csv_table_given_for_an_archive_names_its_folder(tmp_path, name, head, command):
+    """``bearingsim table DIR/sweep.csv`` (or inspect, plot, show, rerun of a study's CSV table) said "not an
+    HDF5 file (truncated, or not a bearingsim archive)" of a table bearingsim wrote; it says what it is and
+    which command reads its folder. A CSV of that name that bearingsim did not write keeps the old line."""
+    table = tmp_path / name
+    table.write_text(head)
+    assert_user_error(bearingsim(command, table), f"{table}: a table bearingsim wrote (CSV), not an archive",
+                      f"'bearingsim table {tmp_path}' prints")
+    table.write_text("x,y\n")
+    assert_user_error(bearingsim(command, table), f"{table}: not an HDF5 file")
+
+
 @pytest.mark.slow
 def test_a_sweep_file_given_for_an_archive_says_what_it_is(tmp_path):
     """A sweep's sweep.h5 or map.h5 given to a command that reads a run's archive (rerun, compare, wear,

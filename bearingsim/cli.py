@@ -391,11 +391,16 @@ def _cmd_validate(args) -> int:
     from bearingsim.studies import make_engine, run_studies
     from bearingsim.studies.fig9 import Fig9
 
-    studies = [Fig9()]
-    if args.rig_rotations > 0:
+    studies, n = [Fig9()], args.rig_rotations
+    if n < 0:
+        raise UserError(f"--rig-rotations {n}: give 0 (no rig) or more recorded rotations")
+    if n > 0:
         from bearingsim.studies.rig import Rig
 
-        studies.append(Rig(rotations=args.rig_rotations))
+        try:
+            studies.append(Rig(rotations=n))
+        except UserError as exc:  # named after the option, not the module that builds the rig's scenarios
+            raise UserError(f"--rig-rotations {n}: {str(exc).removeprefix('bearingsim.studies.rig: ')}") from None
     engine = make_engine(args.jobs, args.scheduler)
     outcome = run_studies(studies, Path(args.output), engine=engine, force=args.force, progress=progress_wanted(args))
     if not args.quiet:

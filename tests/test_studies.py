@@ -203,6 +203,20 @@ def test_a_one_rotation_rig_row_shows_no_scatter_rather_than_zero(capsys):
     assert "± 10.00 (std)" in lines[1], lines
 
 
+@pytest.mark.parametrize("n, words", [("-1", "--rig-rotations -1: give 0 (no rig) or more"),
+                                      ("100000", "--rig-rotations 100000: numerics.rotations: 100001 rotations")])
+def test_validate_refuses_a_rig_rotations_it_cannot_run(n, words, tmp_path, capsys):
+    """``validate --rig-rotations -1`` ran the Fig. 9 cases and no rig (exit 0), as 0 does; a count beyond the
+    limit was refused as "bearingsim.studies.rig: numerics.rotations: ...", naming a module, not the option.
+    Both are refused naming --rig-rotations, before anything is written."""
+    from bearingsim.cli import main
+
+    rc = main(["validate", "--rig-rotations", n, "-o", str(tmp_path / "v")])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.count("\n") == 1 and words in err, err
+    assert not (tmp_path / "v").exists()
+
+
 @pytest.mark.slow
 def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
     """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come

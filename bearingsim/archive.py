@@ -1134,10 +1134,11 @@ def _own_file_error(p: Path, fmt) -> UserError | None:
                      f"it holds, 'bearingsim table {p.parent}' prints its folder's table")
 
 
-def _own_table_error(p: Path) -> UserError | None:
+def own_table_error(p: Path, command: str = "table") -> UserError | None:
     """The one-line refusal of a CSV table a sweep or study wrote (``sweep.csv``, ``crosscheck.csv``, ...:
     :data:`bearingsim.outputs.FOLDER_FILES`, told by its name and first bytes) given where an archive is
-    read, naming the command that reads its folder; None for any other file."""
+    read, naming the command that reads its folder (``table``, or ``report``); None for any other file."""
+    p = Path(p)
     head = outputs.FOLDER_FILES.get(p.name)
     if head is None or not p.name.endswith(".csv"):
         return None
@@ -1147,8 +1148,8 @@ def _own_table_error(p: Path) -> UserError | None:
                 return None
     except OSError:
         return None
-    return UserError(f"{p}: a table bearingsim wrote (CSV), not an archive; 'bearingsim table {p.parent}' prints "
-                     "its folder's tables")
+    does = "reports on its folder" if command == "report" else "prints its folder's tables"
+    return UserError(f"{p}: a table bearingsim wrote (CSV), not an archive; 'bearingsim {command} {p.parent}' {does}")
 
 
 def open_archive(path: str | Path):
@@ -1165,7 +1166,7 @@ def open_archive(path: str | Path):
     except OSError:
         ok = False
     if not ok:
-        raise scenario_file_error(p) or _own_table_error(p) or UserError(
+        raise scenario_file_error(p) or own_table_error(p) or UserError(
             f"{p}: not an HDF5 file (truncated, or not a bearingsim archive)")
     try:
         f = h5py.File(p, "r")

@@ -67,7 +67,7 @@ def kind_of(path) -> tuple[str, Path]:
     index = p / "sweep.h5" if p.is_dir() else p
     if index.name == "sweep.h5" and index.is_file() and archive.is_table_file(index, INDEX_FORMAT):
         return "sweep", index
-    raise archive.scenario_file_error(p) or UserError(
+    raise archive.scenario_file_error(p) or archive.own_table_error(p, "report") or UserError(
         f"{p}: not a bearingsim archive, nor a sweep, cross-check, validate, sensitivity, uncertainty or life folder "
         f"(no sweep.h5, crosscheck.h5, fig9_idec_vs_speed.csv, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
 

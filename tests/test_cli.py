@@ -282,17 +282,18 @@ def test_a_scenario_file_given_for_an_archive_names_the_commands_that_read_it(tm
 @pytest.mark.parametrize("name, head", [("sweep.csv", "case,operating.inner_ring_speed_rpm,status\n"),
                                         ("crosscheck.csv", "rpm,rung,scene,relaxed\n"),
                                         ("rig_idec_vs_speed.csv", "rpm,rotations,pocket0\n")])
-@pytest.mark.parametrize("command", ["table", "inspect", "plot", "show", "rerun"])
+@pytest.mark.parametrize("command", ["table", "inspect", "plot", "show", "rerun", "report"])
 def test_a_csv_table_given_for_an_archive_names_its_folder(tmp_path, name, head, command):
     """``bearingsim table DIR/sweep.csv`` (or inspect, plot, show, rerun of a study's CSV table) said "not an
     HDF5 file (truncated, or not a bearingsim archive)" of a table bearingsim wrote; it says what it is and
     which command reads its folder. A CSV of that name that bearingsim did not write keeps the old line."""
     table = tmp_path / name
     table.write_text(head)
+    reader = "report" if command == "report" else "table"  # report: "(no sweep.h5, ... in it)" of a file
     assert_user_error(bearingsim(command, table), f"{table}: a table bearingsim wrote (CSV), not an archive",
-                      f"'bearingsim table {tmp_path}' prints")
+                      f"'bearingsim {reader} {tmp_path}' ")
     table.write_text("x,y\n")
-    assert_user_error(bearingsim(command, table), f"{table}: not an HDF5 file")
+    assert_user_error(bearingsim(command, table), f"{table}: not a" if reader == "report" else f"{table}: not an HDF5")
 
 
 @pytest.mark.slow

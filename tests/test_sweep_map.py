@@ -212,3 +212,18 @@ def test_zipped_axes_and_extra_cases_are_not_a_map(tmp_path):
     m = read_map(tmp_path / "grid")
     assert m.shape == (2,) and len(out.rows) == 3
     _same(m["I_dec_mean_Ns"], [r["summary"]["I_dec_mean_Ns"] for r in out.rows[:2]])
+
+
+def test_every_summary_number_gets_its_unit_and_name_from_its_suffix():
+    """A sweep over land-guided cages wrote ``land_stiffness_N_m`` into map.h5 with units "m" and long_name
+    "land stiffness N", and ``land_torque_impulse_Nms`` with units "1" (the index's table headed them
+    "land_stiffness_N [m]" and "land_torque_impulse_Nms"): the suffix rule knew neither "_N_m" nor "_Nms".
+    Every summary number of either model reads, by its suffix, the unit its model declares."""
+    from bearingsim import multibody, reduced
+    from bearingsim.sweeps.index import name_of, unit_of
+
+    declared = {**reduced.SUMMARY_UNITS, **multibody.SUMMARY_UNITS, **multibody.RIGID_SUMMARY_UNITS,
+                **multibody.LAND_SUMMARY_UNITS}
+    assert {k: unit_of(k) for k in declared} == declared
+    assert name_of("land_stiffness_N_m") == "land stiffness"
+    assert name_of("land_torque_impulse_Nms") == "land torque impulse"

@@ -442,10 +442,27 @@ def _benchmarks_root() -> Path:
     return root
 
 
+def _check_bench_options(args) -> None:
+    """One bench at a time, and --rotations only where it is read (a --rotations of 0 is not the default)."""
+    modes = [flag for flag, on in (("--map", args.map), ("--sweep", args.sweep), ("--geometry", args.geometry),
+                                   ("--fast-scene", args.fast_scene)) if on]
+    if len(modes) > 1 or (modes and args.quick):
+        given = modes + (["--quick"] if args.quick else [])
+        raise UserError(f"bench: {' and '.join(given)}: give one of --quick, --sweep, --fast-scene, --geometry "
+                        "and --map (each is a bench of its own)")
+    if args.rotations is None:
+        return
+    if not (args.geometry or args.fast_scene):
+        raise UserError(f"bench: --rotations {args.rotations}: read only by --fast-scene and --geometry")
+    if args.rotations < 1:
+        raise UserError(f"bench: --rotations {args.rotations}: give at least 1 recorded rotation")
+
+
 def _cmd_bench(args) -> int:
     from bearingsim.outputs import check_folder_path
 
     _benchmarks_root()
+    _check_bench_options(args)
     check_folder_path(args.output)  # a file in the way: refused in the words of every other command
     if args.map:
         from benchmarks.sweep_bench import run_map_bench

@@ -181,3 +181,24 @@ def test_replica_scatter_runs_with_fewer_rotations_than_its_start_window(monkeyp
     assert rs.main(["--replicas", "3", "--rotations", "12", "--case", "rigid:3000", "--jobs", "1"]) == 0
     row = capsys.readouterr().out.splitlines()[-1].split(" | ")
     assert "±" in row[9] and "±" in row[10], row
+
+
+def test_bench_refuses_options_it_would_not_read(tmp_path, monkeypatch, capsys):
+    """`bench --rotations` only with --fast-scene or --geometry, at least 1 (0 ran the default 30 or 40);
+    one bench at a time (--map --sweep ran the map alone, --quick --geometry ignored --quick). Refused in
+    one line before any bench runs."""
+    from bearingsim import cli
+    from benchmarks import bench, multibody_bench
+
+    ran = []
+    monkeypatch.setattr(bench, "run_bench", lambda *a, **k: ran.append("bench"))
+    monkeypatch.setattr(multibody_bench, "run_geometry_bench", lambda *a, **k: ran.append("geometry"))
+    out = str(tmp_path / "b")
+    for argv in (["--quick", "--rotations", "5"], ["--geometry", "--rotations", "0"],
+                 ["--geometry", "--rotations", "-3"], ["--map", "--sweep"], ["--quick", "--geometry"]):
+        assert cli.main(["bench", *argv, "-o", out]) == 2, argv
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "bench: " in err, (argv, err)
+    assert ran == [] and not (tmp_path / "b").exists()
+    assert cli.main(["bench", "--geometry", "--rotations", "2", "-o", out]) == 0
+    assert ran == ["geometry"]

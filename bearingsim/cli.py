@@ -159,16 +159,17 @@ def _write_toml(text: str) -> None:
     buffer.write(text.encode("utf-8"))
 
 
-def _resolved_text(scenario, out=None) -> str:
+def _resolved_text(scenario, out=None, figures=True) -> str:
     """The resolved scenario as TOML, with what differs from its preset (and the archive a run would
-    write) as comments above it."""
+    write, with its figures unless ``--no-plots``) as comments above it."""
     from bearingsim.scenario import differences_from_preset
 
     head = [f"# resolved from {scenario.source}: every key, defaults < preset < file < --set"]
     diffs = differences_from_preset(scenario)
     head.append("# differs from the preset: " + (", ".join(diffs) if diffs else "nothing"))
     if out is not None:
-        head.append(f"# 'bearingsim run' would write {out} (and its figures beside it); nothing was run")
+        also = "and its figures beside it" if figures else "no figures: --no-plots"
+        head.append(f"# 'bearingsim run' would write {out} ({also}); nothing was run")
     return "\n".join(head) + "\n" + scenario.to_toml()
 
 
@@ -182,7 +183,7 @@ def _dry_run(scenario, args) -> int:
     note = None if args.quiet else out_of_range_note(scenario)  # the run's note of it, given before any step
     if note:
         print(note, file=sys.stderr)
-    _write_toml(_resolved_text(scenario, out))
+    _write_toml(_resolved_text(scenario, out, figures=not args.no_plots))
     return 0
 
 

@@ -37,6 +37,17 @@ def test_unknown_key_in_set_gets_the_closest_key(tmp_path, setting, hint):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_dry_run_with_no_plots_does_not_promise_figures(tmp_path):
+    """`run --dry-run --no-plots` said the run would write the archive 'and its figures beside it'."""
+    res = cli("run", PAPER, "--dry-run", "--no-plots", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "would write outputs/paper_3000rpm.h5 (no figures: --no-plots)" in res.stdout
+    assert "and its figures" not in res.stdout
+    res = cli("run", PAPER, "--dry-run", cwd=tmp_path)
+    assert "would write outputs/paper_3000rpm.h5 (and its figures beside it)" in res.stdout
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_unknown_key_in_a_file_gets_the_closest_key_and_nonsense_gets_none(tmp_path):
     from bearingsim.errors import UserError
 

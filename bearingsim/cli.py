@@ -668,7 +668,7 @@ def _add_study_commands(sub) -> None:
     """Many-case studies that are not sweeps: validate, bench, crosscheck."""
     v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
                                         "(pocket 0 flat) against it (tables and PNGs; run again to resume)")
-    v.add_argument("-o", "--output", default="outputs/validate", help="output folder")
+    v.add_argument("-o", "--output", default="outputs/validate", help="output folder (default outputs/validate)")
     v.add_argument("--rig-rotations", type=int, default=20,
                    help="recorded rotations of each rig run (after 1 warm-up); 0 skips the rig (default 20)")
     v.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
@@ -694,7 +694,7 @@ def _add_study_commands(sub) -> None:
     b.add_argument("--map", action="store_true",
                    help="the 100 x 100 reduced-model sweep map (2 workers), map only and with --archives all: "
                         "wall time, resume, files and sizes")
-    b.add_argument("-o", "--output", default="outputs/bench", help="output folder")
+    b.add_argument("-o", "--output", default="outputs/bench", help="output folder (default outputs/bench)")
     b.set_defaults(func=_cmd_bench)
 
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
@@ -707,7 +707,8 @@ def _add_study_commands(sub) -> None:
                          "the scenario's warm-up rotations")
     cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario key (repeatable)")
-    cc.add_argument("-o", "--output", default="outputs/crosscheck", help="output folder")
+    cc.add_argument("-o", "--output", default="outputs/crosscheck",
+                    help="output folder (default outputs/crosscheck)")
     cc.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
     cc.add_argument("--scheduler", metavar="ADDRESS",
                     help="run the rungs on an existing dask.distributed cluster, e.g. tcp://127.0.0.1:8786")

@@ -76,7 +76,7 @@ def _common(p, default_out):
     p.add_argument("scenario", help="scenario TOML (either model) whose keys carry ranges (its preset's or its own)")
     p.add_argument("--keys", metavar="K1,K2,...", help="dotted keys to vary (default: every ranged key the model reads)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key (repeatable)")
-    p.add_argument("-o", "--output", default=default_out, help="output folder")
+    p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
     p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core; at most one per case)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table (failures still said)")
@@ -89,7 +89,8 @@ def add_parsers(sub) -> None:
     s = sub.add_parser("sensitivity", help="d ln y / d ln x of I_dec, I_acc, cage slip and eccentricity for every "
                                            "ranged key (docs/sensitivity.md; run again to resume)")
     _common(s, "outputs/sensitivity")
-    s.add_argument("--step", default="10%", help="relative step, e.g. 10%% or 0.1 (held within each key's range)")
+    s.add_argument("--step", default="10%",
+                   help="relative step, e.g. 10%% or 0.1 (default 10%%; held within each key's range)")
     s.set_defaults(func=_cmd_sensitivity)
     u = sub.add_parser("uncertainty", help="every ranged key sampled over its range: median, 5-95 %% interval and "
                                            "Sobol indices (docs/sensitivity.md; run again to resume)")

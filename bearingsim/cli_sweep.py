@@ -92,7 +92,8 @@ def add_commands(sub) -> None:
                         "is the product)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key in every case (repeatable)")
-    s.add_argument("-o", "--output", default="outputs/sweep", help="sweep folder (index, map, cases/, figures)")
+    s.add_argument("-o", "--output", default="outputs/sweep",
+                   help="sweep folder (index, map, cases/, figures; default outputs/sweep)")
     s.add_argument("--archives", choices=("none", "all"), default=None,
                    help="per-case archives in DIR/cases/: 'all' or 'none' (default: the multibody cases only; "
                         "every case's numbers are in the index sweep.h5 and, for a product grid, map.h5)")

@@ -151,6 +151,21 @@ def test_a_file_where_the_output_folder_should_be_is_named_alike_by_every_comman
     assert (tmp_path / "blocker").read_text() == "my notes\n"
 
 
+def test_help_names_the_default_of_every_folder_command_and_of_the_sensitivity_step():
+    """``-o`` of validate, bench, crosscheck, sweep, sensitivity and uncertainty said "output folder" and
+    not which (run, plot, wear, life and report name theirs); ``sensitivity --step`` did not say 10 %."""
+    import argparse
+
+    from bearingsim.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    for command in ("validate", "bench", "crosscheck", "sweep", "sensitivity", "uncertainty"):
+        out = next(a for a in sub.choices[command]._actions if a.dest == "output")
+        assert f"default {out.default}" in out.help, (command, out.help)
+    step = next(a for a in sub.choices["sensitivity"]._actions if a.dest == "step")
+    assert f"default {step.default}%" in step.help, step.help
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("command", ["inspect", "show"])
 def test_help_of_inspect_and_show_names_every_file_they_read(command):

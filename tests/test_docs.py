@@ -396,3 +396,18 @@ def test_architecture_names_every_benchmark_script():
     text = (ROOT / "docs" / "architecture.md").read_text()
     scripts = sorted(p.name for p in (ROOT / "benchmarks").glob("*.py") if p.name != "__init__.py")
     assert scripts and [s for s in scripts if f"`{s}`" not in text] == []
+
+
+def test_commands_page_names_every_default_column_of_table():
+    """`bearingsim table`'s columns as commands.md gives them: it left out cage_rest_angle_deg, which the
+    table prints by default (tables.DEFAULT_COLUMNS, `table --help`)."""
+    from bearingsim.tables import DEFAULT_COLUMNS
+
+    text = " ".join((ROOT / "docs" / "commands.md").read_text().split())
+    sentence = text[text.index("Columns: "):]
+    sentence = sentence[:sentence.index("those present")]
+    words = {"I_dec_mean_Ns": "`I_dec_mean`", "I_acc_mean_Ns": "`I_acc_mean`",
+             "first_impact_speed_m_s": "first impact speed", "cage_slip": "cage slip",
+             "cage_rest_angle_deg": "`cage_rest_angle` [deg]", "load_zone_half_angle_deg": "load-zone half angle"}
+    assert set(words) == set(DEFAULT_COLUMNS)
+    assert [k for k, w in words.items() if w not in sentence] == [], sentence

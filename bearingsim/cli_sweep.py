@@ -39,8 +39,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
         if note:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     jobs = jobs if jobs is not None else (os.cpu_count() or 1)
-    if jobs < 1:
-        raise UserError(f"--jobs: must be at least 1 (got {jobs})")
+    if jobs < 1:  # in the words of every other command's -j (studies.make_engine)
+        raise UserError(f"-j {jobs}: give at least 1 worker process")
     engine = DaskEngine(scheduler) if scheduler is not None else LocalEngine(jobs)
     out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force, archives=archives,
                     progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))

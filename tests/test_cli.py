@@ -553,3 +553,17 @@ def test_a_study_folder_given_to_plot_names_the_studys_own_table(tmp_path):
     assert len(STUDY_TABLES) == len(formats) + 1  # and validate's table, a CSV: its folder names its sweep.h5
     for folder in (*(tmp_path / kind for kind in runs), life):
         assert archive._study_tables(folder) == [t for _, t in studies_of(folder)], folder
+
+
+def test_minus_j_0_is_refused_in_the_same_words_by_every_command_that_takes_it(tmp_path, capsys):
+    """sweep said "--jobs: must be at least 1 (got 0)", crosscheck, validate, sensitivity and uncertainty
+    "-j 0: give at least 1 worker process"."""
+    from bearingsim import cli
+
+    paper, multibody = str(SCENARIOS / "paper_3000rpm.toml"), str(SCENARIOS / "multibody_3000rpm.toml")
+    for argv in (["sweep", paper, "--param", "operating.inner_ring_speed_rpm=1000"], ["crosscheck", multibody],
+                 ["validate"], ["sensitivity", paper], ["uncertainty", paper, "--samples", "2"]):
+        assert cli.main([*argv, "-j", "0", "-o", str(tmp_path / "o")]) == 2, argv
+        err = capsys.readouterr().err
+        assert err.endswith("error: -j 0: give at least 1 worker process\n"), (argv, err)
+    assert list(tmp_path.iterdir()) == []

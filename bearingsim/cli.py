@@ -287,6 +287,9 @@ def _cmd_rerun(args) -> int:
     from bearingsim.compare import compare_results, compared_arrays, other_numbers
     from bearingsim.simulation import COMPARED, run, run_scenario
 
+    if args.force and not args.output:  # it was accepted and did nothing: a rerun without -o writes nothing
+        raise UserError(f"rerun {args.archive}: --force applies with -o (it replaces an archive of another "
+                        "scenario there); without -o the rerun writes nothing")
     old = read(args.archive, only=COMPARED)
     progress = not args.quiet and sys.stderr.isatty()
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned

@@ -567,3 +567,19 @@ def test_minus_j_0_is_refused_in_the_same_words_by_every_command_that_takes_it(t
         err = capsys.readouterr().err
         assert err.endswith("error: -j 0: give at least 1 worker process\n"), (argv, err)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_rerun_force_without_output_is_refused(tmp_path, base_reduced, capsys):
+    """`rerun --force` ("with -o: replace an archive of a different scenario there") was accepted without -o
+    and did nothing; it is refused in one line before the archive is read or run."""
+    import bearingsim
+    from bearingsim import cli
+    from bearingsim.scenario import resolve
+
+    archive = tmp_path / "a.h5"
+    bearingsim.run(resolve(base_reduced)).save(archive)
+    before = archive.read_bytes()
+    assert cli.main(["rerun", str(archive), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--force applies with -o" in err, err
+    assert archive.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]

@@ -35,6 +35,17 @@ def _cmd_wear(args) -> int:
     return 0
 
 
+def _check_rotations_given_once(args, scenario) -> None:
+    """``--rotations`` and a different ``--set numerics.rotations`` refused, as ``crosscheck`` refuses them
+    (the --set was dropped without a word)."""
+    from bearingsim.scenario import parse_override
+
+    given = "numerics.rotations" in [parse_override(o)[0] for o in args.set]
+    if args.rotations is not None and given and args.rotations != scenario.numerics.rotations:
+        raise UserError(f"--rotations {args.rotations} and --set numerics.rotations={scenario.numerics.rotations}: "
+                        "the stages' recorded rotations given twice; give one")
+
+
 def _cmd_life(args) -> int:
     from bearingsim.cli_common import progress_wanted, report_study
     from bearingsim.scenario import load_scenario
@@ -42,6 +53,7 @@ def _cmd_life(args) -> int:
 
     limit = life.parse_limit(args.limit)
     scenario = load_scenario(args.scenario, args.set)
+    _check_rotations_given_once(args, scenario)
     study = life.LifeStudy(scenario, limit, stages=args.stages, rotations=args.rotations, mapping=args.mapping,
                            progress=None if args.quiet else (lambda line: print(line, file=sys.stderr)))
     engine = make_engine(1, args.scheduler, "--scheduler")

@@ -583,3 +583,16 @@ def test_rerun_force_without_output_is_refused(tmp_path, base_reduced, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--force applies with -o" in err, err
     assert archive.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]
+
+
+def test_life_refuses_its_rotations_given_twice_as_crosscheck_does(tmp_path, capsys):
+    """`life --rotations 1 --set numerics.rotations=2` ran 1 rotation per stage and dropped the --set without
+    a word; crosscheck refused the same pair. Refused in one line before any stage runs."""
+    from bearingsim import cli
+
+    mb = str(SCENARIOS / "multibody_3000rpm.toml")
+    argv = ["life", mb, "--limit", "depth=1mm", "--stages", "1", "--rotations", "1", "-o", str(tmp_path / "li")]
+    assert cli.main([*argv, "--set", "numerics.rotations=2"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--rotations 1 and --set numerics.rotations=2" in err, err
+    assert list(tmp_path.iterdir()) == []

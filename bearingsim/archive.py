@@ -1106,8 +1106,23 @@ def scenario_file_error(path) -> UserError | None:
     commands that read it; None for any other path."""
     if not is_scenario_file(path):
         return None
+    if _is_sweep_toml(path):  # 'run' and 'show' refuse it: send to the command that reads it
+        return UserError(f"{path}: is a sweep file, not an archive; 'bearingsim sweep {path}' runs it "
+                         "(docs/sweeps.md)")
     return UserError(f"{path}: is a scenario file, not an archive; 'bearingsim run {path}' runs it and writes an "
                      f"archive, 'bearingsim show {path}' prints it resolved")
+
+
+def _is_sweep_toml(path) -> bool:
+    """A TOML file with a sweep file's mark (``scenario``, no ``schema_version``: sweeps.spec.is_sweep_file)."""
+    import tomllib
+
+    try:
+        with open(path, "rb") as f:
+            raw = tomllib.loads(f.read(1 << 20).decode("utf-8"))
+    except (OSError, ValueError):
+        return False
+    return "schema_version" not in raw and "scenario" in raw
 
 
 #: what each of bearingsim's own files that is not a run archive is, by its root ``format`` attribute less

@@ -626,6 +626,9 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     if overrides is not None and (isinstance(overrides, (str, bytes)) or not isinstance(overrides, (list, tuple))):
         raise UserError(f"overrides: expected a list of 'KEY=VALUE' strings (got {type(overrides).__name__})")
     raw = read_toml_file(path)
+    if "schema_version" not in raw and "scenario" in raw:  # a sweep file's mark (sweeps.spec.is_sweep_file)
+        raise UserError(f"{path}: is a sweep file (its base scenario and axes), not a scenario file; "
+                        f"'bearingsim sweep {path}' runs it (docs/sweeps.md)")
     if not isinstance(raw.get("name", ""), str):
         raise UserError(f"{path}: name: must be a string")
     given = {}  # key -> the override that set it, as the user wrote it

@@ -596,3 +596,13 @@ def test_life_refuses_its_rotations_given_twice_as_crosscheck_does(tmp_path, cap
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "--rotations 1 and --set numerics.rotations=2" in err, err
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_sweep_file_given_for_a_scenario_or_an_archive_says_what_it_is(tmp_path):
+    """A sweep file given to run, show or crosscheck was "schema_version: missing"; given to inspect or rerun,
+    "is a scenario file ... 'bearingsim run FILE' runs it", which run then refused. Each names the sweep."""
+    f = SCENARIOS / "sweeps" / "speed_zip_and_extras.toml"
+    for args in (["run", f, "-o", tmp_path / "a.h5"], ["show", f], ["crosscheck", f, "-o", tmp_path / "cc"],
+                 ["inspect", f], ["rerun", f]):
+        assert_user_error(bearingsim(*args), f"{f}: is a sweep file", f"'bearingsim sweep {f}' runs it")
+    assert list(tmp_path.iterdir()) == []

@@ -38,14 +38,14 @@ def _run(study, args):
 
 def _cmd_sensitivity(args) -> int:
     from bearingsim.cli_common import report_study
-    from bearingsim.studies.sensitivity import Sensitivity, format_table, parse_step, step_text
+    from bearingsim.studies.sensitivity import Sensitivity, format_table, parse_step, runs_text
 
     step = parse_step(args.step)
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x 2 runs at x (1 ± {step_text(step)}) within each "
-              f"key's range, {wall:.1f} s")
+        print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x {runs_text(step, study.half)} "
+              f"within each key's range, {wall:.1f} s")
         for k, why in study.left_out:
             print(f"left out: {k}: {why}; give it a nonzero value to vary it")
         print(format_table(study.rows))

@@ -203,8 +203,9 @@ def study_text(kind: str, file: Path) -> str:
     if kind == "sensitivity":
         rows, meta = sensitivity.read_table(file)
         keys = len(dict.fromkeys(r["key"] for r in rows))
-        head = [f"{file}: sensitivity of {meta.get('scenario_name', '?')}: {counted(keys, 'key')} x 2 runs at x "
-                f"(1 ± {sensitivity.step_text(meta.get('step', 0))}) within each key's range"]
+        half = any(math.isfinite(float(r.get("sensitivity_half_step", math.nan))) for r in rows)
+        head = [f"{file}: sensitivity of {meta.get('scenario_name', '?')}: {counted(keys, 'key')} x "
+                f"{sensitivity.runs_text(meta.get('step', 0), half)} within each key's range"]
         if meta.get("left_out"):
             head.append(f"left out: {meta['left_out']}")
         return "\n".join([*head, sensitivity.format_table(rows)])

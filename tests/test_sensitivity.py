@@ -474,10 +474,12 @@ def test_the_tornado_draws_the_change_across_each_range_it_is_ordered_by():
 
 
 
-@pytest.mark.parametrize("step, shown", [("0.1%", "0.1%"), ("12.5%", "12.5%"), ("0.1", "10%")])
-def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown):
+@pytest.mark.parametrize("step, shown, half", [("0.1%", "0.1%", "0.05%"), ("12.5%", "12.5%", "6.25%"),
+                                              ("0.1", "10%", "5%")])
+def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown, half):
     """`--step=0.1%` printed "at x (1 ± 0%)" and `--step=12.5%` "(1 ± 12%)" (a whole percent): the command's
-    line, `bearingsim table`, the report's table and the tornado's title show the step as given."""
+    line, `bearingsim table`, the report's table and the tornado's title show the step as given. The reduced
+    model runs each key at half the step too, and the lines say so (they said "2 runs" after it did)."""
     from bearingsim import reports
 
     titles = []
@@ -485,9 +487,10 @@ def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown):
     monkeypatch.setattr(sens, "plot_tornado", lambda rows, title="": titles.append(title) or drawn(rows, title))
     code = main(["sensitivity", str(REDUCED), "--keys", KEYS[0], f"--step={step}", "-o", str(tmp_path), "-j", "1"])
     out = capsys.readouterr().out
-    assert code == 0 and f"2 runs at x (1 ± {shown}) within each key's range" in out.splitlines()[0], out
+    runs = f"4 runs at x (1 ± {shown}) and x (1 ± {half}) within each key's range"
+    assert code == 0 and runs in out.splitlines()[0], out
     assert titles and all(f"x (1 ± {shown}) within each key's range" in t for t in titles), titles
     assert main(["table", str(tmp_path)]) == 0
-    assert f"2 runs at x (1 ± {shown}) within each key's range" in capsys.readouterr().out.splitlines()[0]
+    assert runs in capsys.readouterr().out.splitlines()[0]
     _, sections, _ = reports._sensitivity_sections(tmp_path / "sensitivity.h5")
     assert f"(runs at x (1 ± {shown}))" in sections[0].blocks[0]["caption"], sections[0].blocks[0]["caption"]

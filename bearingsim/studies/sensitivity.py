@@ -74,6 +74,13 @@ def step_text(step) -> str:
     return f"{float(step) * 100.0:g}%"
 
 
+def runs_text(step, half: bool) -> str:
+    """The paired runs of a key, as the headers say them: "2 runs at x (1 ± 10%)", and for a study that ran
+    half steps too (the reduced model) "4 runs at x (1 ± 10%) and x (1 ± 5%)"."""
+    text = f"x (1 ± {step_text(step)})"
+    return f"4 runs at {text} and x (1 ± {step_text(float(step) / 2)})" if half else f"2 runs at {text}"
+
+
 #: keys every run reads that move none of the headline numbers (:data:`QUANTITIES`): Archard's k and H scale
 #: the wear outputs alone (worn volumes and depths k W / H of the sliding work W, which they do not change)
 WEAR_SCALE_KEYS = {"wear.wear_coefficient": "Archard's wear coefficient k", "wear.hardness_Pa": "the cage's hardness H"}

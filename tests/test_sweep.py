@@ -1094,3 +1094,19 @@ def test_a_worker_stopped_while_it_warms_up_ends_at_once_unwinding_nothing():
         _, err = proc.communicate(timeout=300)  # a hang guard only
     assert proc.returncode == 143, err
     assert "unwound" not in err and "Traceback" not in err, err
+
+
+def test_a_range_of_no_values_is_refused_in_the_form_given(tmp_path):
+    """`--param KEY=500:6000:0` was refused as "{ start, stop, num } needs numbers and an integer num >= 1",
+    the sweep file's form, not the one typed; each form's refusal names its own."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.spec import parse_param
+
+    with pytest.raises(UserError) as err:
+        parse_param("operating.inner_ring_speed_rpm=500:6000:0")
+    assert str(err.value) == ("--param 'operating.inner_ring_speed_rpm=500:6000:0': START:STOP:NUM needs an "
+                              "integer NUM >= 1")
+    f = tmp_path / "s.toml"
+    f.write_text(f'scenario = "{BASE}"\n[axes]\n"bearing.pocket_clearance_mm" = {{ start = 0.1, stop = 0.3, num = 0 }}\n')
+    with pytest.raises(UserError, match=r"pocket_clearance_mm: \{ start, stop, num \} needs numbers and an integer num"):
+        load_sweep_file(f)

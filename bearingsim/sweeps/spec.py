@@ -217,8 +217,10 @@ class _Range:
         start, stop, num = self.table["start"], self.table["stop"], self.table["num"]
         num_ok = isinstance(num, int) and not isinstance(num, bool) and num >= 1
         ends_ok = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in (start, stop))
-        if not (num_ok and ends_ok):
-            raise UserError(f"{where}: {{ start, stop, num }} needs numbers and an integer num >= 1")
+        if not (num_ok and ends_ok):  # in the form given: START:STOP:NUM on the command line
+            form = "START:STOP:NUM needs an integer NUM >= 1" if given else ("{ start, stop, num } needs numbers "
+                                                                            "and an integer num >= 1")
+            raise UserError(f"{where}: {form}")
         if num > MAX_SWEEP_CASES:
             raise UserError(f"{where}: num = {num} is more than the {MAX_SWEEP_CASES} cases a sweep may have; "
                             "split it into several sweeps")

@@ -761,8 +761,8 @@ def _unread_by_setting(scenario, key: str, varied=()) -> str | None:
     if (key in LAND_KEYS and scenario.model == "multibody" and scenario.bearing.cage_guidance == "rollers"
             and "bearing.cage_guidance" not in varied):
         return "not used with bearing.cage_guidance = 'rollers' (no land to run on)"
-    if (key in LOAD_ZONE_KEYS and scenario.model == "reduced"
-            and scenario.reduced.load_zone_half_angle_deg != "auto" and "reduced.load_zone_half_angle_deg" not in varied):
+    if (key in LOAD_ZONE_KEYS and scenario.model == "reduced" and scenario.reduced.load_zone_half_angle_deg != "auto"
+            and "reduced.load_zone_half_angle_deg" not in varied):
         return ("not used by the reduced model when reduced.load_zone_half_angle_deg is given (it sets the "
                 "load zone only when 'auto')")
     if (key == "reduced.load_zone_half_angle_deg" and scenario.model == "multibody"

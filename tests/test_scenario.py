@@ -384,7 +384,8 @@ def test_a_ring_mass_the_ring_does_not_have_is_noted():
         assert unread_note(auto, keys, varied=varied) is None
     for sets in (["multibody.inner_ring=dynamic"], ["operating.radial_load_N=200"]):
         assert unread_note(load_scenario(mb, [*sets, "multibody.inner_ring_mass_kg=5"]), keys) is None
-    equivalent = load_scenario(SCENARIOS / "multibody_reduced_equivalent_3000rpm.toml", ["multibody.inner_ring_mass_kg=5"])
+    equivalent = load_scenario(SCENARIOS / "multibody_reduced_equivalent_3000rpm.toml",
+                               ["multibody.inner_ring_mass_kg=5"])
     assert "it has no inner ring" in unread_note(equivalent, keys)
 
 

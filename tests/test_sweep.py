@@ -1107,6 +1107,7 @@ def test_a_range_of_no_values_is_refused_in_the_form_given(tmp_path):
     assert str(err.value) == ("--param 'operating.inner_ring_speed_rpm=500:6000:0': START:STOP:NUM needs an "
                               "integer NUM >= 1")
     f = tmp_path / "s.toml"
-    f.write_text(f'scenario = "{BASE}"\n[axes]\n"bearing.pocket_clearance_mm" = {{ start = 0.1, stop = 0.3, num = 0 }}\n')
-    with pytest.raises(UserError, match=r"pocket_clearance_mm: \{ start, stop, num \} needs numbers and an integer num"):
+    f.write_text(f'scenario = "{BASE}"\n[axes]\n'
+                 '"bearing.pocket_clearance_mm" = { start = 0.1, stop = 0.3, num = 0 }\n')
+    with pytest.raises(UserError, match=r"clearance_mm: \{ start, stop, num \} needs numbers and an integer num"):
         load_sweep_file(f)

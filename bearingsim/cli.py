@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import progress_wanted, report_study
+from bearingsim.cli_common import given_once, progress_wanted, report_study, say
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.wording import counted
 
@@ -217,17 +217,17 @@ def _cmd_plot(args) -> int:
 
     from bearingsim.studies import crosscheck
 
-    say = _say(args)
+    tell = say(args)
     if archive.is_table_file(path, crosscheck.INDEX_FORMAT):  # a cross-check's index: its figure
         folder = check_writable_dir(args.output) if args.output else path.parent
         for png in crosscheck.plot_crosscheck(path, folder):
-            say(f"wrote {png}")
+            tell(f"wrote {png}")
         return 0
     drawer = _study_table_drawer(path)
     if drawer is not None:  # sensitivity.h5, uncertainty.h5, life.h5: the study's figure from its table alone
         folder = check_writable_dir(args.output) if args.output else path.parent
         for png in drawer(path, folder):
-            say(f"wrote {png}")
+            tell(f"wrote {png}")
         return 0
     from bearingsim.sweeps.grid import MAP_FORMAT
 
@@ -241,26 +241,19 @@ def _cmd_plot(args) -> int:
         notes: list[str] = []
         written = plot_sweep_index(path, folder, notes=notes)
         for png in written:
-            say(f"wrote {png}")
+            tell(f"wrote {png}")
         if not written:  # nothing drawn: say why, in one line, and fail
             raise UserError(f"{path}: no figure written: " + "; ".join(notes))
         for line in notes:
-            say(f"bearingsim: note: {line}", file=sys.stderr)
+            tell(f"bearingsim: note: {line}", file=sys.stderr)
         return 0
     from bearingsim.simulation import model_module
 
     result = read(path, only=model_module(archive.model_of(path)).RESULT.FIGURE_DATA)
     folder = check_writable_dir(args.output) if args.output else path.parent
     for png in result.save_figures(folder / path.stem):
-        say(f"wrote {png}")
+        tell(f"wrote {png}")
     return 0
-
-
-def _say(args):
-    """``print``, or with ``-q`` (``args.quiet``) a function that prints nothing: what a command says on success."""
-    if getattr(args, "quiet", False):
-        return lambda *a, **kw: None
-    return print
 
 
 def _study_table_drawer(path):
@@ -306,7 +299,7 @@ def _cmd_rerun(args) -> int:
     if args.output and not args.quiet:
         print(f"wrote {args.output}")
     if c.identical:
-        _say(args)(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
+        say(args)(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
                    f"{len(compared_arrays(old))} arrays, {len(other_numbers(old))} other numbers)")
         return 0
     print(f"{args.archive}: rerun differs")
@@ -529,35 +522,24 @@ def _cmd_crosscheck(args) -> int:
 
 def _crosscheck_speeds(args, scenario) -> tuple[float, ...]:
     """The rungs' speeds: ``--speeds``, else a ``--set operating.inner_ring_speed_rpm`` (as one speed), else
-    :data:`~bearingsim.studies.crosscheck.DEFAULT_SPEEDS_RPM`; both given and different is refused (the
-    --set was silently replaced by --speeds, and stored as the table's scenario)."""
-    from bearingsim.scenario import parse_override
+    :data:`~bearingsim.studies.crosscheck.DEFAULT_SPEEDS_RPM` (:func:`~bearingsim.cli_common.given_once`)."""
     from bearingsim.studies import crosscheck as cc
 
-    key = "operating.inner_ring_speed_rpm"
-    given = key in [parse_override(o)[0] for o in args.set]
-    if args.speeds is None:
-        return (float(scenario.operating.inner_ring_speed_rpm),) if given else cc.DEFAULT_SPEEDS_RPM
-    speeds = cc.parse_speeds(args.speeds)
-    if given and speeds != (scenario.operating.inner_ring_speed_rpm,):
-        raise UserError(f"--speeds {args.speeds} and --set {key}={scenario.operating.inner_ring_speed_rpm:g}: "
-                        "the rungs' inner-ring speed given twice; give one")
-    return speeds
+    speeds = cc.parse_speeds(args.speeds) if args.speeds is not None else None
+    speeds = given_once(args.set, "operating.inner_ring_speed_rpm", f"--speeds {args.speeds}", speeds,
+                        (float(scenario.operating.inner_ring_speed_rpm),), "the rungs' inner-ring speed")
+    return speeds if speeds is not None else cc.DEFAULT_SPEEDS_RPM
 
 
 def _crosscheck_rotations(args, scenario) -> int:
     """The rungs' recorded rotations: ``--rotations``, else a ``--set numerics.rotations`` (the scenario
-    file's own count is for its single run), else :data:`~bearingsim.studies.crosscheck.DEFAULT_ROTATIONS`;
-    both given and different is refused."""
-    from bearingsim.scenario import parse_override
+    file's own count is for its single run), else :data:`~bearingsim.studies.crosscheck.DEFAULT_ROTATIONS`
+    (:func:`~bearingsim.cli_common.given_once`)."""
     from bearingsim.studies.crosscheck import DEFAULT_ROTATIONS
 
-    given = "numerics.rotations" in [parse_override(o)[0] for o in args.set]
-    if args.rotations is not None and given and args.rotations != scenario.numerics.rotations:
-        raise UserError(f"--rotations {args.rotations} and --set numerics.rotations={scenario.numerics.rotations}: "
-                        "the rungs' recorded rotations given twice; give one")
-    rotations = args.rotations if args.rotations is not None else (
-        scenario.numerics.rotations if given else DEFAULT_ROTATIONS)
+    rotations = given_once(args.set, "numerics.rotations", f"--rotations {args.rotations}", args.rotations,
+                           scenario.numerics.rotations, "the rungs' recorded rotations")
+    rotations = DEFAULT_ROTATIONS if rotations is None else rotations
     if rotations < 1:
         raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation")
     return rotations

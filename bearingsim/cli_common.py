@@ -48,3 +48,25 @@ def report_study(outcome, command: str) -> int:
 def progress_wanted(args) -> bool:
     """A progress bar on stderr: only on a terminal, and not with -q."""
     return not getattr(args, "quiet", False) and sys.stderr.isatty()
+
+
+def say(args):
+    """``print``, or with ``-q`` (``args.quiet``) a function that prints nothing: what a command says on success."""
+    if getattr(args, "quiet", False):
+        return lambda *a, **kw: None
+    return print
+
+
+def given_once(sets, key: str, option: str, value, from_set, what: str):
+    """A study's option that a ``--set KEY`` of its scenario may give instead (``crosscheck --speeds`` and
+    ``--rotations``, ``life --rotations``): ``value`` (the option's, None when not given), else ``from_set``
+    (the scenario's value, when one of ``sets``, the command line's overrides, sets ``key``), else None (the
+    study's default). Both given and different is one line naming both (``option``: the option as given;
+    ``what``: what is given twice): a ``--set`` the option silently replaced ran, and was stored, unread."""
+    from bearingsim.scenario import parse_override
+
+    in_set = key in [parse_override(o)[0] for o in sets]
+    if value is not None and in_set and value != from_set:
+        shown = from_set[0] if isinstance(from_set, tuple) and len(from_set) == 1 else from_set
+        raise UserError(f"{option} and --set {key}={shown:g}: {what} given twice; give one")
+    return value if value is not None else (from_set if in_set else None)

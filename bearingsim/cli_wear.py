@@ -11,7 +11,7 @@ from bearingsim.errors import UserError
 def _cmd_wear(args) -> int:
     from bearingsim import wear
     from bearingsim.archive import check_writable_dir
-    from bearingsim.cli_common import options_named
+    from bearingsim.cli_common import options_named, say
     from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
     from bearingsim.plotting import save_figure
     from bearingsim.simulation import load
@@ -28,32 +28,22 @@ def _cmd_wear(args) -> int:
         folder = check_writable_dir(args.output) if args.output else path.parent
         pngs = {name: check_replaceable(figure_path(folder / path.stem, name), PNG_SIGNATURE, "figure")
                 for name in figures}
-    say = (lambda line: None) if args.quiet else print
-    say(f"{path}: " + wear.format_report(rep))
+    tell = say(args)
+    tell(f"{path}: " + wear.format_report(rep))
     for name, png in pngs.items():
-        say(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
+        tell(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
     return 0
 
 
-def _check_rotations_given_once(args, scenario) -> None:
-    """``--rotations`` and a different ``--set numerics.rotations`` refused, as ``crosscheck`` refuses them
-    (the --set was dropped without a word)."""
-    from bearingsim.scenario import parse_override
-
-    given = "numerics.rotations" in [parse_override(o)[0] for o in args.set]
-    if args.rotations is not None and given and args.rotations != scenario.numerics.rotations:
-        raise UserError(f"--rotations {args.rotations} and --set numerics.rotations={scenario.numerics.rotations}: "
-                        "the stages' recorded rotations given twice; give one")
-
-
 def _cmd_life(args) -> int:
-    from bearingsim.cli_common import progress_wanted, report_study
+    from bearingsim.cli_common import given_once, progress_wanted, report_study
     from bearingsim.scenario import load_scenario
     from bearingsim.studies import life, make_engine, run_studies
 
     limit = life.parse_limit(args.limit)
     scenario = load_scenario(args.scenario, args.set)
-    _check_rotations_given_once(args, scenario)
+    given_once(args.set, "numerics.rotations", f"--rotations {args.rotations}", args.rotations,
+               scenario.numerics.rotations, "the stages' recorded rotations")
     study = life.LifeStudy(scenario, limit, stages=args.stages, rotations=args.rotations, mapping=args.mapping,
                            progress=None if args.quiet else (lambda line: print(line, file=sys.stderr)))
     engine = make_engine(1, args.scheduler, "--scheduler")

@@ -291,6 +291,18 @@ def test_one_rotation_prints_no_nan_standard_error():
     assert "not judged" in text and "n/a" in text
 
 
+def test_terminal_table_gives_cage_slip_in_per_cent_as_the_docs_do():
+    """The cage slip (a fraction in crosscheck.h5/.csv) printed as 1e-2 numbers ("-4.10e-03") under a
+    header without a unit, while docs/crosscheck.md quotes it in per cent; the terminal table gives it
+    in per cent, in a column headed so."""
+    row = dict(rpm=3000.0, rung=5, scene="full", I_dec_mean_Ns=1.4563e-2, I_dec_sem_Ns=1.53e-4,
+               I_acc_mean_Ns=1.5121e-2, I_acc_sem_Ns=3.56e-4, first_impact_speed_m_s=0.0349, cage_slip=-0.0041,
+               change_from_previous=8.76e-3, status="done")
+    head, line = cc.format_table([row]).splitlines()
+    assert "slip [%]" in head
+    assert line.split()[-2:] == ["-0.41", "+8.760"], line
+
+
 def test_crosscheck_index_and_table_give_each_rung_one_standard_error(ladder):
     """Issue 28, item 5: the cross-check's table, the engine's case index in the same folder and
     ``bearingsim table`` of a rung's archive report the same standard error, bit for bit."""

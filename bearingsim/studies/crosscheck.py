@@ -344,9 +344,9 @@ def verdicts(rows: list[dict]) -> list[str]:
 
 
 def format_table(rows: list[dict]) -> str:
-    """The table for the terminal (impulses in mN s)."""
+    """The table for the terminal (impulses in mN s, cage slip in per cent as in docs/crosscheck.md)."""
     head = (f"{'rpm':>6s} {'rung':>4s} {'scene':18s} {'I_dec [mN s]':>16s} {'I_acc [mN s]':>16s} "
-            f"{'v1 [m/s]':>9s} {'cage slip':>10s} {'change [mN s]':>13s}")
+            f"{'v1 [m/s]':>9s} {'slip [%]':>9s} {'change [mN s]':>13s}")
     lines = [head]
     for r in rows:
         ch = "" if math.isnan(r["change_from_previous"]) else f"{r['change_from_previous'] * 1e3:+.3f}"
@@ -356,5 +356,5 @@ def format_table(rows: list[dict]) -> str:
         lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
                      f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_dec_sem_Ns'])} "
                      f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_acc_sem_Ns'])} "
-                     f"{r['first_impact_speed_m_s']:9.4f} {r['cage_slip']:10.2e} {ch:>13s}")
+                     f"{r['first_impact_speed_m_s']:9.4f} {r['cage_slip'] * 100:+9.2f} {ch:>13s}")
     return "\n".join(lines)

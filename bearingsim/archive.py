@@ -165,21 +165,24 @@ class TimeSeries:
 
 
 def _prepare_target(path) -> Path:
-    """Check that an archive can be written at ``path`` (one-line UserError if not); return it."""
+    """Check that an archive can be written at ``path`` (one-line UserError if not); return it. Its folder
+    is made here; the folders made are removed again when the check refuses the path."""
     path = Path(path)
-    outputs.check_folder_can_be_made(path, "archive")
+    outputs.check_target(path, (), is_archive, figures=False)  # .h5 name; never replaces a non-archive
+    made = outputs.missing_folders(path.parent)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = outputs.temporary_name(path)
+        try:
+            tmp.touch()
+        except OSError as exc:
+            raise UserError(f"{path}: output is not writable ({exc.strerror})") from None
     except OSError as exc:
+        outputs.remove_empty(made)
         raise UserError(f"{path}: cannot create output folder ({exc.strerror})") from None
-    if path.is_dir():
-        raise UserError(f"{path}: output path is a directory")
-    outputs.check_target(path, (), is_archive, figures=False)  # .h5 name; never replaces a non-archive
-    tmp = outputs.temporary_name(path)
-    try:
-        tmp.touch()
-    except OSError as exc:
-        raise UserError(f"{path}: output is not writable ({exc.strerror})") from None
+    except UserError:
+        outputs.remove_empty(made)
+        raise
     tmp.unlink()
     return path
 

@@ -1,4 +1,6 @@
 """Archive format: atomic write, units on physical datasets, provenance, and clear errors on bad files."""
+import os
+
 import h5py
 import numpy as np
 import pytest
@@ -137,6 +139,27 @@ def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(t
         r.save(mine)
     assert mine.read_text() == "my notes\n"
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["a", "b", "mine.h5", "r.h5"]
+
+
+def test_a_refused_save_leaves_no_folder_behind(tmp_path, base_reduced):
+    """Result.save made the missing folders of its path before checking the path's name, so a refused
+    ``a/b/x.txt`` left ``a/b`` behind; a refusal writes nothing (as the command line's does)."""
+    import bearingsim
+
+    r = bearingsim.run(resolve(base_reduced))
+    for target in (tmp_path / "a" / "b" / "x.txt", tmp_path / "c" / "deep" / "x"):
+        with pytest.raises(UserError, match="archive path must end in .h5 or .hdf5"):
+            r.save(target)
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        if not os.access(locked, os.W_OK):  # root writes anywhere: the check needs a user the mode binds
+            with pytest.raises(UserError, match="cannot create output folder"):
+                r.save(locked / "new" / "x.h5")
+    finally:
+        locked.chmod(0o700)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["locked"]
 
 
 @pytest.mark.slow

@@ -21,12 +21,16 @@ class MissingExtra(ImportError):
 
 
 def need(module: str, what: str):
-    """Import ``module`` (``"pandas"``/``"xarray"``) for ``what``, or raise :class:`MissingExtra`."""
+    """Import ``module`` (``"pandas"``/``"xarray"``) for ``what``, or raise :class:`MissingExtra` when it is
+    not installed; any other failure of its import (a module of the user's shadowing one it imports, a
+    broken install) is raised as it is, so that its message says what failed."""
     import importlib
 
     try:
         return importlib.import_module(module)
-    except ImportError:
+    except ModuleNotFoundError as exc:
+        if exc.name != module:
+            raise
         raise MissingExtra(f"{what} needs {module}, which is not installed: {EXTRA_HINT}") from None
 
 

@@ -408,6 +408,25 @@ def test_without_pandas_a_one_line_hint_names_the_extra(monkeypatch, multibody_r
         multibody_result.to_xarray()
 
 
+def test_an_installed_extra_that_fails_to_import_is_not_called_missing(monkeypatch):
+    """A module of the user's named like one xarray imports (a ``glob.py`` beside the script) made
+    ``to_xarray`` say "xarray, which is not installed" and dropped the real error; only a missing module
+    is a missing extra, any other failure of its import is raised as it is."""
+    import importlib
+
+    from bearingsim import frames
+
+    def broken(name, *a, **k):
+        if name == "xarray":
+            raise ModuleNotFoundError("No module named 'glob.escape'; 'glob' is not a package", name="glob.escape")
+        return importlib.import_module(name, *a, **k)
+
+    monkeypatch.setattr(importlib, "import_module", broken)
+    with pytest.raises(ModuleNotFoundError, match="glob") as caught:
+        frames.need("xarray", "Result.to_xarray")
+    assert not isinstance(caught.value, frames.MissingExtra)
+
+
 @pytest.mark.parametrize("what", ["everything", 3, None])
 def test_a_frame_that_is_not_there_is_a_user_error(multibody_result, what):
     """A bad argument from the caller is a bearingsim.UserError (docs/usage.md), naming what to give: an unknown

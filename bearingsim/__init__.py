@@ -26,6 +26,9 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     path : scenario TOML file.
     set : ``{"dotted.key": value}`` overrides with Python values (``{"numerics.rotations": 10}``).
     overrides : ``["dotted.key=VALUE", ...]`` overrides as on the command line (VALUE read as TOML).
+
+    ``overrides`` are applied in their order, then ``set``: a key given twice takes the value given last
+    (as a repeated ``--set``), so ``set`` wins over ``overrides``.
     """
     from bearingsim import scenario
 

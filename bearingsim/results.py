@@ -100,7 +100,9 @@ class Result:
 
     @property
     def per_rotation(self) -> dict[str, np.ndarray]:
-        """Per cage rotation and pocket arrays ``[rotations, pockets]``: ``I_dec``, ``I_acc``, ..."""
+        """Per cage rotation arrays: ``[rotations, pockets]`` for the pockets' (``I_dec``, ``I_acc``, ...),
+        ``[rotations]`` for the cage's own (a multibody run's ``cage_rest_offset``, ``cage_rest_angle``);
+        ``docs/archive.md`` lists them."""
         return self._under(PER_ROTATION)
 
     @property

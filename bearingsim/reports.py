@@ -304,17 +304,30 @@ def _checks_blocks(result) -> list[dict]:
     blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok} for n, m, ok in rows]}]
     try:
         notes = plausibility.check(result)
-        skipped = [n for n, _, ok in rows if ok is None]
-        verdict = (("Every check passed" if not skipped else "Every check that could be made passed")
-                   + ": 'bearingsim run' writes an archive only for a run that passes them (docs/reliability.md); "
-                   "checked again from this archive."
-                   + (f" Not evaluated here, and no pass: {'; '.join(skipped)} (the table says why)." if skipped else ""))
+        verdict = _checks_verdict(rows)
     except SimulationUnstable as exc:
         notes, verdict = [], f"This archive does NOT pass the checks: {exc}"
     blocks.append({"kind": "text", "text": verdict})
     if notes:
         blocks.append({"kind": "list", "items": [n.removeprefix("bearingsim: note: ") for n in notes]})
     return blocks
+
+
+def _checks_verdict(rows) -> str:
+    """The sentence under the checks' table of an archive that :func:`bearingsim.plausibility.check` does not
+    refuse: every check passed, or which did not (they give the notes below it, the run is kept), and which
+    could not be made."""
+    skipped = [n for n, _, ok in rows if ok is None]
+    failed = [n for n, _, ok in rows if ok is False]
+    if failed:
+        verdict = (f"Did not pass: {'; '.join(failed)}. No check that refuses a run failed, so 'bearingsim run' "
+                   "kept it (docs/reliability.md); read its numbers with the notes below. Checked again from this "
+                   "archive.")
+    else:
+        verdict = (("Every check passed" if not skipped else "Every check that could be made passed")
+                   + ": 'bearingsim run' writes an archive only for a run that passes the checks that refuse a run "
+                   "(docs/reliability.md); checked again from this archive.")
+    return verdict + (f" Not evaluated here, and no pass: {'; '.join(skipped)} (the table says why)." if skipped else "")
 
 
 def _scenario_blocks(toml: str | None, where) -> list[dict]:

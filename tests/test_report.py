@@ -486,6 +486,24 @@ def test_a_check_that_fails_is_shown_as_failed(runs):
     assert blocks[1]["text"].startswith("This archive does NOT pass the checks: non-finite I_dec per rotation")
 
 
+def test_a_check_that_gives_a_note_is_not_called_passed(runs, monkeypatch):
+    """A kept run whose warm-up and resting-place checks failed (they give notes; only the others refuse a
+    run) read "Every check that could be made passed" under the rows marked FAILED: the verdict names the
+    checks that did not pass and points to the notes."""
+    from bearingsim import plausibility
+    from bearingsim.reports import _checks_blocks
+
+    rows = [("summary numbers finite", "8 numbers", True), ("warm-up reached a steady state", "+34.4 %", False),
+            ("cage rests in one place", "31.5 deg", False), ("cage speed steady", "not evaluated", None)]
+    monkeypatch.setattr(plausibility, "checks_made", lambda result: rows)
+    monkeypatch.setattr(plausibility, "check", lambda result: ["bearingsim: note: the first recorded rotation ..."])
+    blocks = _checks_blocks(bearingsim.load(runs / "r.h5"))
+    verdict = blocks[1]["text"]
+    assert verdict.startswith("Did not pass: warm-up reached a steady state; cage rests in one place."), verdict
+    assert "Every check" not in verdict and "Not evaluated here, and no pass: cage speed steady" in verdict
+    assert blocks[2]["items"] == ["the first recorded rotation ..."]
+
+
 @pytest.mark.slow
 def test_the_life_history_of_a_report_is_the_table_the_command_prints(folders, tmp_path):
     """The report of a life folder put every column of life.h5 into its table, the worn-depth profiles

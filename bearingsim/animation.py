@@ -16,7 +16,8 @@ archive alone:
 
 Frames are drawn by matplotlib's Agg canvas (the user's backend is never touched), MP4 written by the
 ffmpeg binary that ``imageio-ffmpeg`` packages (H.264), GIF by Pillow; the file appears complete or not at
-all (:func:`bearingsim.outputs.atomic_file`).
+all (:func:`bearingsim.outputs.atomic_file`) and carries bearingsim's mark (:data:`bearingsim.outputs.MARK`):
+only a file with it is replaced.
 """
 from __future__ import annotations
 
@@ -112,7 +113,8 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
 def check_output(out) -> Path:
     """``out`` as a Path, refused in one line unless it ends in .mp4 or .gif, its folder is a folder or
     can be made one (a missing folder is created when the animation is written, as a run's is) and it is
-    not a file bearingsim did not write."""
+    not a file bearingsim did not write (one without its mark, :data:`bearingsim.outputs.MARK`: a user's
+    GIF or MP4 is kept)."""
     from bearingsim import outputs
     from bearingsim.errors import check_path
 
@@ -122,15 +124,10 @@ def check_output(out) -> Path:
         raise UserError(f"{out}: animation path must end in .mp4 or .gif (got {out.suffix or 'no suffix'!r})")
     outputs.check_folder_can_be_made(out, "animation")
     if suffix == ".gif":
-        outputs.check_replaceable(out, b"GIF8", "GIF animation")
+        outputs.check_replaceable(out, outputs.is_own_gif, "GIF animation")
     else:
-        outputs.check_replaceable(out, _is_mp4, "MP4 animation")
+        outputs.check_replaceable(out, outputs.is_own_mp4, "MP4 animation")
     return out
-
-
-def _is_mp4(path) -> bool:
-    with open(path, "rb") as fh:
-        return fh.read(8)[4:8] == b"ftyp"
 
 
 def check_number(value, name, lo, hi) -> float:
@@ -445,15 +442,17 @@ class _Drawing:
 
 # --- writers -------------------------------------------------------------------------------------------
 def _write_mp4(out: Path, frames, fps: float, total: int, progress) -> None:
-    """H.264 MP4 through the ffmpeg binary of ``imageio-ffmpeg``, into a temporary file renamed at the end."""
+    """H.264 MP4 through the ffmpeg binary of ``imageio-ffmpeg``, with the comment tag
+    :data:`bearingsim.outputs.MARK`, into a temporary file renamed at the end."""
     import imageio_ffmpeg
 
-    from bearingsim.outputs import atomic_file, temporary_name
+    from bearingsim.outputs import MARK, atomic_file, temporary_name
 
     with atomic_file(out):  # ffmpeg writes the temporary file by its name; renamed when complete
         writer = imageio_ffmpeg.write_frames(
             str(temporary_name(out)), (WIDTH_PX, HEIGHT_PX), fps=fps, codec="libx264", quality=7,
-            macro_block_size=16, output_params=["-preset", "veryfast", "-f", "mp4"], ffmpeg_log_level="error")
+            macro_block_size=16, output_params=["-preset", "veryfast", "-metadata", f"comment={MARK}", "-f", "mp4"],
+            ffmpeg_log_level="error")
         writer.send(None)
         try:
             for i, frame in enumerate(frames):
@@ -465,10 +464,11 @@ def _write_mp4(out: Path, frames, fps: float, total: int, progress) -> None:
 
 
 def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
-    """GIF through Pillow (each frame on an adaptive palette), written atomically."""
+    """GIF through Pillow (each frame on an adaptive palette) with the comment :data:`bearingsim.outputs.MARK`,
+    written atomically."""
     from PIL import Image
 
-    from bearingsim.outputs import atomic_file
+    from bearingsim.outputs import MARK, atomic_file
 
     with atomic_file(out) as fh:  # the temporary file first: an unwritable folder is told before any frame
         images = []
@@ -478,7 +478,8 @@ def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:
             if progress is not None:
                 progress(i + 1, total)
         images[0].save(fh, format="GIF", save_all=True, append_images=images[1:],
-                       duration=gif_durations_ms(len(images), fps), loop=0, optimize=False, disposal=1)
+                       duration=gif_durations_ms(len(images), fps), loop=0, optimize=False, disposal=1,
+                       comment=MARK)
 
 
 def gif_durations_ms(frames: int, fps: float) -> list[int]:

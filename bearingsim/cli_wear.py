@@ -12,7 +12,7 @@ def _cmd_wear(args) -> int:
     from bearingsim import wear
     from bearingsim.archive import check_writable_dir
     from bearingsim.cli_common import options_named, say
-    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable, figure_path
+    from bearingsim.outputs import check_replaceable, figure_path, is_own_png
     from bearingsim.plotting import save_figure
     from bearingsim.simulation import load
 
@@ -26,7 +26,7 @@ def _cmd_wear(args) -> int:
     pngs = {}
     if not args.no_plots:  # the figures' folder and paths checked before anything is printed
         folder = check_writable_dir(args.output) if args.output else path.parent
-        pngs = {name: check_replaceable(figure_path(folder / path.stem, name), PNG_SIGNATURE, "figure")
+        pngs = {name: check_replaceable(figure_path(folder / path.stem, name), is_own_png, "figure")
                 for name in figures}
     tell = say(args)
     tell(f"{path}: " + wear.format_report(rep))

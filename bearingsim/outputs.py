@@ -6,11 +6,14 @@ Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any 
 * an archive path ends in ``.h5`` / ``.hdf5`` (so ``-o my.toml`` or ``-o notes.txt`` is refused);
 * the target is never the input scenario file;
 * an existing target that is not a bearingsim archive is not replaced;
-* a figure path of the run (``<stem>_<name>.png``) that is a symbolic link, a directory or not a PNG
-  file is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
+* every PNG, GIF and MP4 bearingsim writes carries its mark (:data:`MARK`: a PNG's ``Software`` text,
+  a GIF's comment, an MP4's comment tag), and only a file with the mark is replaced: a figure path of the
+  run (``<stem>_<name>.png``) that is a symbolic link, a directory or a file without the mark (a user's
+  picture) is refused before the run (:func:`check_replaceable`); figures, tables and archives are written
   to a temporary name and renamed over the target (:func:`atomic_file`), never through a link;
 * once a run's archive is written, the figures at its stem of any model that the run does not draw
-  (:func:`remove_figures`: only regular PNG files so named) are removed, being the replaced archive's;
+  (:func:`remove_figures`: only regular PNG files so named that carry the mark) are removed, being the
+  replaced archive's;
 * one writer per target: an exclusive ``fcntl`` lock on ``.<name>.lock`` beside the target (an empty
   regular file, opened with ``O_NOFOLLOW``: a link or a user's file there is refused), held from
   the start of the run until its archive and figures are written, then removed; a second run to the
@@ -130,19 +133,107 @@ def write_csv(path: str | Path, header, rows) -> Path:
 
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
+#: the mark of every PNG, GIF and MP4 bearingsim writes (no time, no host: the same figure is the same bytes):
+#: a PNG's ``Software`` text chunk (:data:`PNG_METADATA`), a GIF's comment, an MP4's ``comment`` tag. Only a
+#: file that carries it is replaced or removed (:func:`is_own_png`, :func:`is_own_gif`, :func:`is_own_mp4`).
+MARK = "bearingsim"
+#: what ``savefig(metadata=...)`` writes into every PNG bearingsim draws
+PNG_METADATA = {"Software": MARK}
+_MARK_BYTES = MARK.encode("ascii")
+#: the MP4 atom ffmpeg writes for ``-metadata comment=MARK`` (``moov/udta/meta/ilst/\xa9cmt``, its ``data``: UTF-8)
+_MP4_COMMENT = ((24 + len(_MARK_BYTES)).to_bytes(4, "big") + b"\xa9cmt" + (16 + len(_MARK_BYTES)).to_bytes(4, "big")
+                + b"data" + b"\x00\x00\x00\x01" + b"\x00\x00\x00\x00" + _MARK_BYTES)
+#: most bytes of an MP4's ``moov`` box read to find the mark (a long animation's is well under 1 MB)
+_MAX_MOOV = 64 << 20
+
+
+def _open_regular(path):
+    """``path`` opened for reading, never through a symbolic link nor blocking on a FIFO."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
+    return open(fd, "rb")
+
+
+def is_own_png(path) -> bool:
+    """True when ``path`` is a PNG file bearingsim drew: a ``tEXt`` chunk ``Software`` = :data:`MARK` before
+    its image data. False for any other file, or one that cannot be read."""
+    try:
+        with _open_regular(path) as fh:
+            if fh.read(8) != PNG_SIGNATURE:
+                return False
+            while True:
+                head = fh.read(8)
+                if len(head) < 8 or head[4:] in (b"IDAT", b"IEND"):
+                    return False
+                size = int.from_bytes(head[:4], "big")
+                if head[4:] == b"tEXt" and size == len(b"Software\x00") + len(_MARK_BYTES):
+                    if fh.read(size) == b"Software\x00" + _MARK_BYTES:
+                        return True
+                    fh.seek(4, os.SEEK_CUR)
+                else:
+                    fh.seek(size + 4, os.SEEK_CUR)
+    except OSError:
+        return False
+
+
+def is_own_gif(path) -> bool:
+    """True when ``path`` is a GIF file bearingsim wrote: a comment extension :data:`MARK` before its first
+    image. False for any other file, or one that cannot be read."""
+    try:
+        with _open_regular(path) as fh:
+            head = fh.read(13)
+            if len(head) < 13 or head[:4] != b"GIF8":
+                return False
+            if head[10] & 0x80:  # the global colour table
+                fh.seek(3 << ((head[10] & 7) + 1), os.SEEK_CUR)
+            while (block := fh.read(2))[:1] == b"\x21":  # extensions, up to the first image (0x2c)
+                data = b""
+                while size := fh.read(1):
+                    if size == b"\x00":
+                        break
+                    data += fh.read(size[0])
+                if block[1:] == b"\xfe" and data == _MARK_BYTES:
+                    return True
+            return False
+    except (OSError, IndexError):
+        return False
+
+
+def is_own_mp4(path) -> bool:
+    """True when ``path`` is an MP4 file bearingsim wrote: it starts with an ``ftyp`` box and its ``moov`` box
+    holds the comment :data:`MARK`. False for any other file, or one that cannot be read."""
+    try:
+        with _open_regular(path) as fh:
+            first = True
+            while len(head := fh.read(8)) == 8:
+                size, kind = int.from_bytes(head[:4], "big"), head[4:]
+                if first and kind != b"ftyp":
+                    return False
+                first = False
+                body = 8
+                if size == 1:  # a 64-bit size follows
+                    size, body = int.from_bytes(fh.read(8), "big"), 16
+                if kind == b"moov":
+                    return size <= _MAX_MOOV and _MP4_COMMENT in fh.read(size - body)
+                if size < body:  # 0: to the end of the file; or not an MP4
+                    return False
+                fh.seek(size - body, os.SEEK_CUR)
+            return False
+    except OSError:
+        return False
 
 
 def check_replaceable(path: str | Path, signature, what: str) -> Path:
     """Refuse (one-line :class:`UserError`) to replace ``path`` unless it is absent or a regular file
-    bearingsim could have written there (a PNG for a figure, its own index for ``sweep.csv``). A
-    symbolic link, a directory, a FIFO or a file of another kind is the user's: not replaced, not
-    followed. Returns ``path``.
+    bearingsim wrote there (a PNG with its :data:`MARK` for a figure, its own index for ``sweep.csv``). A
+    symbolic link, a directory, a FIFO or any other file (a user's picture, a figure without the mark) is
+    the user's: not replaced, not followed. Returns ``path``.
 
     Parameters
     ----------
     path : file bearingsim is about to write
     signature : bytes the files it writes there start with, or ``signature(path) -> bool`` for a
-        regular file (e.g. :func:`bearingsim.archive.is_table_file` of the right format)
+        regular file (:func:`is_own_png`, :func:`is_own_gif`, :func:`is_own_mp4`, or e.g.
+        :func:`bearingsim.archive.is_table_file` of the right format)
     what : what the file is, for the message ("figure", "sweep index")
     """
     p = Path(path)
@@ -158,23 +249,16 @@ def check_replaceable(path: str | Path, signature, what: str) -> Path:
         kind = "a directory"
     elif not stat.S_ISREG(st.st_mode):
         kind = "not a regular file"
-    elif callable(signature):
-        if signature(p):
-            return p
-        kind = f"a file that is not a {what} bearingsim wrote"
     else:
         try:
-            fd = os.open(p, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0))
-            try:
-                head = os.read(fd, len(signature))
-            finally:
-                os.close(fd)
+            with _open_regular(p) as fh:
+                head = b"" if callable(signature) else fh.read(len(signature))
         except OSError as exc:
             raise UserError(f"{p}: cannot read the existing {what} ({exc.strerror or exc}); not replaced") from None
-        if head == signature:
+        if signature(p) if callable(signature) else head == signature:
             return p
-        kind = f"a file that is not a {what} bearingsim wrote"
-    raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another output)")
+        kind = "a file not written by bearingsim"
+    raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another -o)")
 
 
 def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True) -> Path:
@@ -187,7 +271,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     is_archive : ``is_archive(path) -> bool``, what may be replaced (:func:`bearingsim.archive.is_archive`);
         None: the file signature of HDF5
     figures : names of the figures the run also writes beside the archive (``<stem>_<name>.png``): each
-        must be absent or a PNG file (:func:`check_replaceable`); True: only check that no
+        must be absent or a figure bearingsim drew (:func:`check_replaceable`, :func:`is_own_png`); True: only check that no
         ``<stem>_*.png`` is a folder; False or empty: no figures
 
     Returns
@@ -219,7 +303,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
                 raise UserError(f"{fig}: figure path is a directory")
     elif figures:
         for name in figures:
-            check_replaceable(figure_path(stem, name), PNG_SIGNATURE, "figure")
+            check_replaceable(figure_path(stem, name), is_own_png, "figure")
     return p
 
 
@@ -245,8 +329,8 @@ def check_folder_can_be_made(out: Path, what: str) -> None:
 
 #: every file a sweep or a study writes into its folder beside ``cases/`` (the sweep's index, map and figures;
 #: each study's table and figures: tests/test_studies.py checks that every study's outputs are listed), with
-#: the first bytes bearingsim writes it with (a CSV's header, a PNG's or HDF5's signature): what ``--force``
-#: removes of another sweep or study in the folder (:func:`remove_folder_files`)
+#: the first bytes bearingsim writes it with (a CSV's header, a PNG's or HDF5's signature; a PNG also carries
+#: :data:`MARK`): what ``--force`` removes of another sweep or study in the folder (:func:`remove_folder_files`)
 FOLDER_FILES = {
     "sweep.csv": b"case,", "sweep.h5": _HDF5_SIGNATURE, "map.h5": _HDF5_SIGNATURE,
     "sweep_I.png": PNG_SIGNATURE, "sweep_map.png": PNG_SIGNATURE, "sweep_cases.png": PNG_SIGNATURE,
@@ -263,11 +347,11 @@ FOLDER_FILES = {
 
 def remove_folder_files(folder: str | Path) -> list[Path]:
     """Remove from ``folder`` the files a sweep or study writes there (:data:`FOLDER_FILES`) that start as
-    bearingsim writes them (never a link, a folder or a file of another content): what
-    ``--force`` does to the sweep or study it replaces, so that no table or figure of it is left to be read
-    as the new one's. Returns the files removed."""
+    bearingsim writes them, a figure only with its :data:`MARK` (never a link, a folder, a user's picture or
+    a file of another content): what ``--force`` does to the sweep or study it replaces, so that no table or
+    figure of it is left to be read as the new one's. Returns the files removed."""
     return [Path(folder) / name for name, head in FOLDER_FILES.items()
-            if _remove_if_it_starts(Path(folder) / name, head)]
+            if _remove_if_own(Path(folder) / name, is_own_png if head == PNG_SIGNATURE else head)]
 
 
 def check_writable(path: str | Path) -> None:
@@ -315,22 +399,23 @@ def figure_path(stem: str | Path, name: str) -> Path:
 
 
 def remove_figures(stem: str | Path, names) -> list[Path]:
-    """Remove the figures ``<stem>_<name>.png`` of ``names`` that are regular PNG files (what
-    :func:`check_replaceable` would let bearingsim replace); a link, a folder or any other file is left
-    alone, and so is a file that cannot be removed. Returns the paths removed."""
+    """Remove the figures ``<stem>_<name>.png`` of ``names`` that are regular PNG files with bearingsim's
+    :data:`MARK` (what :func:`check_replaceable` would let bearingsim replace); a link, a folder or any
+    other file (a user's picture) is left alone, and so is a file that cannot be removed. Returns the paths
+    removed."""
     paths = [figure_path(stem, name) for name in names]
-    return [p for p in paths if _remove_if_it_starts(p, PNG_SIGNATURE)]
+    return [p for p in paths if _remove_if_own(p, is_own_png)]
 
 
-def _remove_if_it_starts(path: Path, head: bytes) -> bool:
-    """Remove ``path`` if it is a regular file (not a link: never followed) whose first bytes are ``head``,
-    as bearingsim writes it; anything else, or a file that cannot be removed, is left. True if removed."""
+def _remove_if_own(path: Path, own) -> bool:
+    """Remove ``path`` if it is a regular file (not a link: never followed) as bearingsim writes it: its
+    first bytes are ``own`` (bytes), or ``own(path)`` is true (:func:`is_own_png`); anything else, or a
+    file that cannot be removed, is left. True if removed."""
     try:
         if not stat.S_ISREG(os.lstat(path).st_mode):
             return False
-        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
-        with open(fd, "rb") as fh:
-            if fh.read(len(head)) != head:
+        with _open_regular(path) as fh:
+            if not (own(path) if callable(own) else fh.read(len(own)) == own):
                 return False
         path.unlink()
     except OSError:

@@ -40,15 +40,16 @@ def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
     """Lay out and write one report figure; return its path. (The figure is in no pyplot list: there
     is nothing to close; its memory goes with its last reference.)
 
-    Written atomically (:func:`bearingsim.outputs.atomic_file`); an existing ``path`` that is not a PNG
-    file (a symbolic link, a directory, a user's file) is refused with a one-line error and kept
+    Written atomically (:func:`bearingsim.outputs.atomic_file`), marked as bearingsim's
+    (:data:`bearingsim.outputs.MARK`); an existing ``path`` that is not a figure bearingsim drew (a
+    symbolic link, a directory, a user's picture) is refused with a one-line error and kept
     (:func:`bearingsim.outputs.check_replaceable`). ``tight``: ``tight_layout`` and a bounding box
     that keeps a legend placed outside the axes.
     """
-    from bearingsim.outputs import PNG_SIGNATURE, atomic_file, check_replaceable
+    from bearingsim.outputs import atomic_file, check_replaceable, is_own_png
 
     path = Path(path)
-    check_replaceable(path, PNG_SIGNATURE, "figure")
+    check_replaceable(path, is_own_png, "figure")
     data = figure_png(fig, dpi=dpi, tight=tight)  # drawn whole before anything is written
     with atomic_file(path) as fh:
         fh.write(data)
@@ -56,14 +57,18 @@ def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
 
 
 def figure_png(fig, *, dpi: int = 120, tight: bool = True) -> bytes:
-    """The PNG bytes :func:`save_figure` would write for ``fig`` (a report embeds them)."""
+    """The PNG bytes :func:`save_figure` would write for ``fig`` (a report embeds them), with the ``Software``
+    text :data:`bearingsim.outputs.MARK` (what tells bearingsim's figures from a user's pictures)."""
     import io
+
+    from bearingsim.outputs import PNG_METADATA
 
     buf = io.BytesIO()
     with _missing_glyphs_quiet():
         if tight:
             fig.tight_layout()
-        fig.savefig(buf, format="png", dpi=dpi, **({"bbox_inches": "tight"} if tight else {}))
+        fig.savefig(buf, format="png", dpi=dpi, metadata=PNG_METADATA,
+                    **({"bbox_inches": "tight"} if tight else {}))
     return buf.getvalue()
 
 

@@ -195,18 +195,18 @@ class Result:
     def save_figures(self, stem) -> list[Path]:
         """Write every figure as ``<stem>_<name>.png``; return the paths. Missing folders are created, as
         :meth:`save` does. Every path is checked before any figure is drawn: a folder that cannot be made
-        or written in, or a path that is not a PNG file (a link, a folder, a user's file), is refused with a
-        one-line :class:`bearingsim.UserError` and nothing is written
+        or written in, or a path that holds anything but a figure bearingsim drew (a link, a folder, a user's
+        picture), is refused with a one-line :class:`bearingsim.UserError` and nothing is written
         (:func:`bearingsim.outputs.check_replaceable`)."""
         from bearingsim.archive import check_writable_dir
-        from bearingsim.outputs import PNG_SIGNATURE, check_folder_path, check_replaceable, figure_path
+        from bearingsim.outputs import check_folder_path, check_replaceable, figure_path, is_own_png
         from bearingsim.plotting import save_figure
 
         stem = check_path(stem, "stem", "the figures' stem (<stem>_<name>.png)")
         paths = {name: figure_path(stem, name) for name in self.FIGURES}
         folder = check_folder_path(Path(stem).parent)  # a file in the way: refused, nothing created
         for path in paths.values():
-            check_replaceable(path, PNG_SIGNATURE, "figure")
+            check_replaceable(path, is_own_png, "figure")
         check_writable_dir(folder)
         return [save_figure(getattr(self, f"plot_{name}")(), path) for name, path in paths.items()]
 

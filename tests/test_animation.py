@@ -280,6 +280,48 @@ def test_bad_output_and_options_are_refused(runs, tmp_path):
         bearingsim.animate(runs[1], tmp_path / "b.gif", fps=0)
 
 
+def _users_video(path):
+    """A user's own animation at ``path``: a GIF that Pillow wrote, or an MP4 (H.264) that the packaged
+    ffmpeg wrote, outside bearingsim. Returns its bytes."""
+    from PIL import Image
+
+    frames = [np.full((48, 64, 3), 40 * i, np.uint8) for i in range(4)]
+    if path.suffix == ".gif":
+        images = [Image.fromarray(f) for f in frames]
+        images[0].save(path, format="GIF", save_all=True, append_images=images[1:], duration=100, loop=0)
+    else:
+        import imageio_ffmpeg
+
+        writer = imageio_ffmpeg.write_frames(str(path), (64, 48), fps=8, macro_block_size=16,
+                                             output_params=["-f", "mp4"], ffmpeg_log_level="error")
+        writer.send(None)
+        for f in frames:
+            writer.send(f)
+        writer.close()
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("suffix", [".gif", ".mp4"])
+def test_only_an_animation_bearingsim_wrote_is_replaced(runs, tmp_path, capsys, suffix):
+    """`animate -o user.gif` replaced any GIF (and any MP4, by its 'ftyp'), a user's own picture or video
+    included: bearingsim marks what it writes (a GIF's comment, an MP4's comment tag) and replaces only a
+    file with the mark; a user's file is refused in one line naming it, exit 2, kept, nothing written."""
+    from bearingsim import outputs
+
+    ours, mine = tmp_path / f"ours{suffix}", tmp_path / f"mine{suffix}"
+    data = _users_video(mine)
+    args = ["--rotations", "0:0.05", "--fps", "8", "-q"]
+    for _ in range(2):  # written, then replaced
+        assert main(["animate", str(runs[1]), "-o", str(ours), *args]) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    assert main(["animate", str(runs[1]), "-o", str(mine), *args]) == 2
+    what = "GIF" if suffix == ".gif" else "MP4"
+    assert capsys.readouterr().err == (f"bearingsim: error: {mine}: {what} animation path is a file not written by "
+                                       f"bearingsim; not replaced (remove it or choose another -o)\n")
+    assert mine.read_bytes() == data and sorted(p.name for p in tmp_path.iterdir()) == sorted([ours.name, mine.name])
+    assert (outputs.is_own_gif if suffix == ".gif" else outputs.is_own_mp4)(ours)
+
+
 @pytest.mark.parametrize("last, words", [(-1, "last: -1 is not a positive"), (0, "last: 0 is not a positive"),
                                          (float("nan"), "last: nan is not a positive"), ("x", "last: expected a number")])
 def test_a_bad_last_is_refused_in_one_line(runs, tmp_path, last, words):

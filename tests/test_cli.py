@@ -232,16 +232,22 @@ def test_a_new_run_over_an_archive_removes_the_figures_it_does_not_write(tmp_pat
     """`run -o X.h5 --force` over a multibody run's archive left X_forces.png, X_impulses.png, ... beside
     the reduced run's archive, and a rerun -o (which draws none) left every figure of the run it replaced.
     Once the new archive is written, the figures of any model at that stem that it does not write are
-    removed: only regular PNG files so named, nothing else; a run that fails first leaves them all."""
+    removed: only figures bearingsim drew so named (regular PNG files with its mark), nothing else (a user's
+    picture of such a name included); a run that fails first leaves them all."""
     import shutil
 
-    png = b"\x89PNG\r\n\x1a\n an earlier run's figure"
+    from bearingsim.plotting import figure, figure_png
+
+    png = figure_png(figure())  # an earlier run's figure
+    users = tmp_path / "X_impulses.png"
+    figure().savefig(users, format="png")  # a user's picture: a PNG without bearingsim's mark
     shutil.copy(archives_to_write_from["M"], tmp_path / "X.h5")
-    for name in ("forces", "impulses", "wear"):
+    for name in ("forces", "wear"):
         (tmp_path / f"X_{name}.png").write_bytes(png)
     (tmp_path / "elsewhere.png").write_bytes(png)
     (tmp_path / "X_orbit.png").symlink_to(tmp_path / "elsewhere.png")  # a link: the user's
-    kept = {"X_notes.png": png, "X_wear.png.bak": png, "Y_forces.png": png, "X_pass.txt": b"mine"}
+    kept = {"X_notes.png": png, "X_wear.png.bak": png, "Y_forces.png": png, "X_pass.txt": b"mine",
+            users.name: users.read_bytes()}
     for name, data in kept.items():
         (tmp_path / name).write_bytes(data)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}

@@ -103,6 +103,52 @@ def test_a_figure_is_written_whole_or_not_at_all(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["f.png"]
 
 
+def _users_png(path: Path) -> bytes:
+    """A user's picture at ``path``: a PNG that matplotlib drew outside bearingsim (a PNG's signature, its
+    chunks, a ``Software`` text of matplotlib's own), not one bearingsim wrote. Returns its bytes."""
+    from bearingsim.plotting import figure
+
+    fig = figure()
+    fig.add_subplot().plot([0, 1], [1, 0])
+    fig.savefig(path, format="png")
+    return path.read_bytes()
+
+
+def test_a_users_png_at_a_figure_path_is_refused_in_one_line_and_kept(tmp_path):
+    """A figure path holding a user's PNG (any PNG passed the signature check and was replaced): refused,
+    one line naming the file and saying bearingsim did not write it, kept; a figure bearingsim drew
+    carries its mark and is replaced."""
+    from bearingsim.errors import UserError
+    from bearingsim.outputs import MARK, check_target, is_own_png
+    from bearingsim.plotting import figure, save_figure
+
+    mine = tmp_path / "o_pass.png"
+    data = _users_png(mine)
+    for call in (lambda: save_figure(figure(), mine), lambda: check_target(tmp_path / "o.h5", figures=["pass"])):
+        with pytest.raises(UserError) as err:
+            call()
+        assert str(err.value) == (f"{mine}: figure path is a file not written by bearingsim; not replaced "
+                                  "(remove it or choose another -o)")
+    assert mine.read_bytes() == data and sorted(p.name for p in tmp_path.iterdir()) == ["o_pass.png"]
+    own = save_figure(figure(), tmp_path / "own.png")
+    assert is_own_png(own) and not is_own_png(mine) and f"Software\x00{MARK}".encode() in own.read_bytes()
+    assert save_figure(figure(dpi=50), own) == own and is_own_png(own)  # its own figure: replaced
+
+
+def test_figures_removed_are_only_those_bearingsim_drew(tmp_path):
+    """``remove_figures`` (a new run's archive over another model's) and ``remove_folder_files`` (``--force``
+    over another sweep or study) remove a figure bearingsim drew, never a user's PNG of that name."""
+    from bearingsim.outputs import remove_figures, remove_folder_files
+    from bearingsim.plotting import figure, save_figure
+
+    save_figure(figure(), tmp_path / "X_forces.png")
+    save_figure(figure(), tmp_path / "sweep_I.png")
+    kept = {name: _users_png(tmp_path / name) for name in ("X_wear.png", "life.png", "sweep_map.png")}
+    assert remove_figures(tmp_path / "X", ["forces", "wear"]) == [tmp_path / "X_forces.png"]
+    assert remove_folder_files(tmp_path) == [tmp_path / "sweep_I.png"]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == kept
+
+
 # --- lock files (item 5) -------------------------------------------------------------------------
 @pytest.mark.slow
 def test_run_lock_file_is_never_followed(tmp_path):

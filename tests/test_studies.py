@@ -267,19 +267,23 @@ def test_every_file_a_sweep_or_study_writes_into_its_folder_is_one_force_removes
 def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path, capsys):
     """A sweep run with --force into the folder of another study removes that study's table and figure
     (they were left: `table` and `report` of the folder then showed a life study the sweep had replaced);
-    a user's file in the folder, and a file of a study's name that bearingsim did not write, are kept."""
+    a user's file in the folder, and a file of a study's name that bearingsim did not write (a PNG without
+    bearingsim's mark included), are kept."""
     import numpy as np
 
     from bearingsim import archive
     from bearingsim.cli import main
-    from bearingsim.outputs import PNG_SIGNATURE
+    from bearingsim.plotting import figure, save_figure
     from bearingsim.studies import life
 
     sweep = ["sweep", str(SCENARIOS / "paper_3000rpm.toml"), "-q", "--no-plots", "-o", str(tmp_path)]
     assert main([*sweep, "--param", "operating.inner_ring_speed_rpm=1000,2000"]) == 0
     cols = {"stage": np.arange(1), "I_dec_mean_mNs": np.array([14.0])}
     archive.write_table_file(tmp_path / "life.h5", cols, life.LIFE_UNITS, {"format": life.LIFE_FORMAT, "limit": "x"})
-    (tmp_path / "life.png").write_bytes(PNG_SIGNATURE + b"\0" * 16)
+    save_figure(figure(), tmp_path / "life.png")
+    users = figure()
+    users.savefig(tmp_path / "crosscheck.png", format="png")  # a user's picture of a study's name: kept
+    picture = (tmp_path / "crosscheck.png").read_bytes()
     (tmp_path / "crosscheck.csv").write_bytes(b"\x00\x01 not a table")  # a study's name, not bearingsim's file
     (tmp_path / "notes.txt").write_text("mine")
     capsys.readouterr()
@@ -288,6 +292,7 @@ def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path,
     assert main([*sweep, "--param", "operating.inner_ring_speed_rpm=3000,4000", "--force"]) == 0
     assert not (tmp_path / "life.h5").exists() and not (tmp_path / "life.png").exists()
     assert (tmp_path / "crosscheck.csv").read_bytes() == b"\x00\x01 not a table"
+    assert (tmp_path / "crosscheck.png").read_bytes() == picture
     assert (tmp_path / "notes.txt").read_text() == "mine"
     capsys.readouterr()
     assert main(["table", str(tmp_path)]) == 0

@@ -169,7 +169,7 @@ class CrossCheck(Study):
 
     def __init__(self, scenario, speeds=DEFAULT_SPEEDS_RPM, rotations: int | None = DEFAULT_ROTATIONS):
         from bearingsim import archive
-        from bearingsim.outputs import PNG_SIGNATURE
+        from bearingsim.outputs import is_own_png
 
         # the table keeps the scenario with the rungs' recorded rotations ('bearingsim show crosscheck.h5')
         self.scenario = scenario if rotations is None else scenario.replace(**{"numerics.rotations": int(rotations)})
@@ -185,7 +185,7 @@ class CrossCheck(Study):
         self.cases = cases
         self.outputs = [("crosscheck.csv", ",".join(COLUMNS).encode(), "cross-check table"),
                         ("crosscheck.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "cross-check table"),
-                        ("crosscheck.png", PNG_SIGNATURE, "figure")]
+                        ("crosscheck.png", is_own_png, "figure")]
         self.rows: list[dict] = []
 
     def finish(self, outdir, records) -> list[Path]:

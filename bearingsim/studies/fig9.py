@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.outputs import PNG_SIGNATURE, write_csv
+from bearingsim.outputs import is_own_png, write_csv
 from bearingsim.scenario import resolve
 from bearingsim.studies.engine import FINISHED, Study, case_of
 
@@ -73,7 +73,7 @@ class Fig9(Study):
         self.grid = {(col, i): reference_case(n, c, prev)
                      for c, prev in self.variants for col in [column_name(c, prev)] for i, n in enumerate(self.speeds)}
         self.cases = list(self.grid.values())
-        self.outputs = [(CSV_NAME, CSV_SIGNATURE, "Fig. 9 table"), (PNG_NAME, PNG_SIGNATURE, "figure")]
+        self.outputs = [(CSV_NAME, CSV_SIGNATURE, "Fig. 9 table"), (PNG_NAME, is_own_png, "figure")]
         self.table: dict[str, np.ndarray] = {}
 
     def finish(self, outdir, records) -> list[Path]:

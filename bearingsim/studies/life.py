@@ -244,7 +244,7 @@ class LifeStudy(Study):
     def __init__(self, scenario, limit: Limit, *, stages: int = 10, rotations: int | None = None,
                  mapping: str = "shape", progress=None):
         from bearingsim import archive
-        from bearingsim.outputs import PNG_SIGNATURE
+        from bearingsim.outputs import is_own_png
 
         if scenario.model != "multibody":
             raise UserError(f"{scenario.source}: model = {scenario.model!r}: wear profiles need the whole bearing "
@@ -279,7 +279,7 @@ class LifeStudy(Study):
         self.stage_cases = [self._case(0)]
         self.cases = list(self.stage_cases)
         self.outputs = [("life.h5", lambda p: archive.is_table_file(p, LIFE_FORMAT), "life history"),
-                        ("life.png", PNG_SIGNATURE, "figure")]
+                        ("life.png", is_own_png, "figure")]
 
     def _case(self, j: int):
         st = self.state

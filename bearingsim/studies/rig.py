@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.outputs import PNG_SIGNATURE, write_csv
+from bearingsim.outputs import is_own_png, write_csv
 from bearingsim.scenario import resolve
 from bearingsim.studies.engine import FINISHED, Study, batch_sem, case_of, load_result
 from bearingsim.studies.fig9 import reference_case
@@ -73,7 +73,7 @@ class Rig(Study):
                       for n in self.speeds]
         self.cases = [c for pair in self.pairs for c in pair]
         self.outputs = [(CSV_NAME, CSV_SIGNATURE, "rig table"),
-                        (FIGURE_NAMES[0], PNG_SIGNATURE, "figure"), (FIGURE_NAMES[1], PNG_SIGNATURE, "figure")]
+                        (FIGURE_NAMES[0], is_own_png, "figure"), (FIGURE_NAMES[1], is_own_png, "figure")]
         self.rows: list[dict] = []
         self.missing: list[float] = []
 

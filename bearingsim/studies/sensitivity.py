@@ -297,7 +297,7 @@ class Sensitivity(Study):
 
     def __init__(self, scenario, keys=None, step: float = DEFAULT_STEP):
         from bearingsim import archive
-        from bearingsim.outputs import PNG_SIGNATURE
+        from bearingsim.outputs import is_own_png
 
         if not (isinstance(step, (int, float)) and 0.0 < step < 1.0):
             raise UserError(f"step {step!r}: the relative step must be above 0 and below 1 (0.1 = 10 %)")
@@ -316,7 +316,7 @@ class Sensitivity(Study):
         self.cases = cases
         self.outputs = [("sensitivity.csv", ",".join(COLUMNS).encode(), "sensitivity table"),
                         ("sensitivity.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sensitivity table"),
-                        ("sensitivity.png", PNG_SIGNATURE, "figure")]
+                        ("sensitivity.png", is_own_png, "figure")]
         self.rows: list[dict] = []
 
     def finish(self, outdir, records) -> list[Path]:

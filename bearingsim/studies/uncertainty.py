@@ -127,7 +127,7 @@ class Uncertainty(Study):
 
     def __init__(self, scenario, samples: int, seed: int = 0, keys=None):
         from bearingsim import archive
-        from bearingsim.outputs import PNG_SIGNATURE
+        from bearingsim.outputs import is_own_png
         from bearingsim.ranges import ranged_keys
         from bearingsim.studies.sensitivity import check_keys
 
@@ -154,7 +154,7 @@ class Uncertainty(Study):
         self.outputs = [("uncertainty.csv", ",".join(COLUMNS).encode(), "uncertainty table"),
                         ("uncertainty_spread.csv", ",".join(SPREAD_COLUMNS).encode(), "uncertainty table"),
                         ("uncertainty.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "uncertainty table"),
-                        ("uncertainty.png", PNG_SIGNATURE, "figure")]
+                        ("uncertainty.png", is_own_png, "figure")]
         self.indices: list[dict] = []
         self.spreads: list[dict] = []
 

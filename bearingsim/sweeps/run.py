@@ -24,7 +24,7 @@ from pathlib import Path
 
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
-from bearingsim.outputs import (_HDF5_SIGNATURE, FolderLock, _remove_if_it_starts, remove_folder_files,
+from bearingsim.outputs import (_HDF5_SIGNATURE, FolderLock, _remove_if_own, remove_folder_files,
                                 write_atomic_bytes)
 from bearingsim.sweeps.index import IndexWriter, read_cached
 from bearingsim.sweeps.spec import Case, SweepSpec, resolve_cases
@@ -174,7 +174,7 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
     the sweep did not write (a user's ``sweep.csv``, a link, a folder): one line naming the file, and
     nothing in the folder is replaced (:func:`bearingsim.outputs.check_replaceable`)."""
     from bearingsim import archive
-    from bearingsim.outputs import PNG_SIGNATURE, check_replaceable
+    from bearingsim.outputs import check_replaceable, is_own_png
     from bearingsim.sweeps.grid import MAP_FORMAT, MAP_NAME
     from bearingsim.sweeps.index import CSV_SIGNATURE, INDEX_FORMAT
     from bearingsim.sweeps.plot import FIGURE_NAMES
@@ -183,7 +183,7 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
     check_replaceable(outdir / "sweep.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sweep index")
     check_replaceable(outdir / MAP_NAME, lambda p: archive.is_grid_file(p, MAP_FORMAT), "sweep map")
     for name in FIGURE_NAMES if figures else ():
-        check_replaceable(outdir / name, PNG_SIGNATURE, "figure")
+        check_replaceable(outdir / name, is_own_png, "figure")
     cases = outdir / "cases"
     if cases.is_symlink() or (cases.exists() and not cases.is_dir()):
         raise UserError(f"{cases}: the sweep's folder of case archives is "
@@ -222,7 +222,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
                         f"this one); not mixed in: give another -o folder, or add --force to replace it (the same "
                         f"command as before resumes it)")
     for h in other:
-        _remove_if_it_starts(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
+        _remove_if_own(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
 
 

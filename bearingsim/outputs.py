@@ -271,8 +271,8 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     is_archive : ``is_archive(path) -> bool``, what may be replaced (:func:`bearingsim.archive.is_archive`);
         None: the file signature of HDF5
     figures : names of the figures the run also writes beside the archive (``<stem>_<name>.png``): each
-        must be absent or a figure bearingsim drew (:func:`check_replaceable`, :func:`is_own_png`); True: only check that no
-        ``<stem>_*.png`` is a folder; False or empty: no figures
+        must be absent or a figure bearingsim drew (:func:`check_replaceable`, :func:`is_own_png`); True: only
+        check that no ``<stem>_*.png`` is a folder; False or empty: no figures
 
     Returns
     -------
@@ -311,12 +311,16 @@ def check_folder_path(folder: str | Path, what: str = "output folder") -> Path:
     """Refuse (one-line :class:`UserError`) a ``folder`` to write into that, or the nearest of its
     parents that exists, is not a folder (a file in the way): it could never be made. Every command
     that writes into a folder says it in these words, ``{folder}: cannot create the {what} ({file} is
-    not a folder)``. Nothing is created here; ``what`` names the folder ("output folder", "report's
-    folder"). Returns ``folder`` as a :class:`~pathlib.Path`."""
+    not a folder)``, or ``(it is a file)`` when ``folder`` itself is the file in the way. Nothing is
+    created here; ``what`` names the folder ("output folder", "report's folder"). Returns ``folder`` as a
+    :class:`~pathlib.Path`."""
     folder = Path(folder)
     existing = next((p for p in (folder, *folder.parents) if p.exists()), None)
     if existing is not None and not existing.is_dir():
-        raise UserError(f"{folder}: cannot create the {what} ({existing} is not a folder)")
+        if existing != folder:
+            raise UserError(f"{folder}: cannot create the {what} ({existing} is not a folder)")
+        kind = "a file" if existing.is_file() else "not a folder"
+        raise UserError(f"{folder}: cannot create the {what} (it is {kind})")
     return folder
 
 

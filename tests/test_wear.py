@@ -258,7 +258,7 @@ def test_wear_cli_checks_its_output_before_printing(fast_run, tmp_path, capsys):
     code = main(["wear", str(archive), "--hours", "1", "-o", str(afile)])
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and len(err.strip().splitlines()) == 1, (code, out, err)
-    assert f"afile: cannot create the output folder ({afile} is not a folder)" in err and afile.read_text() == "mine"
+    assert f"{afile}: cannot create the output folder (it is a file)\n" in err and afile.read_text() == "mine"
     figs = tmp_path / "figs"
     (figs / f"{archive.stem}_wear_volume.png").mkdir(parents=True)
     code = main(["wear", str(archive), "--hours", "1", "-o", str(figs)])

@@ -6,6 +6,7 @@ Layout (format documented in ``docs/archive.md``)::
 
     /h5md                      attrs version; /h5md/creator attrs name, version
     /bearingsim                attrs format_version, model, scenario_name, complete
+    /bearingsim/notes          the run's notes, one text per note (dataset)
     /scenario                  resolved scenario as TOML text (dataset)
     /provenance                attrs_json: package versions, git commit, created_utc, wall_time_s, ...
     /results/per_rotation/*    [rotations, pockets] arrays
@@ -303,6 +304,7 @@ def _fill(f, result, in_memory: bool = False) -> None:
         _write_group_attrs(w, g, grp.attrs, grp.units)
     prov = _provenance(result)
     _write_group_attrs(w, w.gid("provenance"), prov, _provenance_units(prov))
+    _write_notes(w, result.notes)
     if not in_memory:
         w.attr(w.gid("bearingsim"), "complete", True, replace=True)
 
@@ -484,6 +486,30 @@ def _write_header(w: _Writer, result, complete: bool = False) -> None:
     ds = w.dataset("scenario", sc.to_toml())
     w.attr(ds, "format", "TOML (resolved: defaults, preset and overrides applied)")
     w.attr(ds, "source", str(sc.source))
+
+
+NOTES = "bearingsim/notes"
+
+
+def _write_notes(w: _Writer, notes) -> None:
+    """The run's notes (:func:`bearingsim.plausibility.check`) as ``/bearingsim/notes``: a 1-D text
+    dataset, one note per element, in the order the run made them (empty: a run without a note)."""
+    h5py = _lazy_h5py()
+    data = np.array([str(n) for n in notes], dtype=object).reshape(-1)
+    w.group("bearingsim").create_dataset("notes", data=data, dtype=h5py.string_dtype())
+
+
+def read_notes(f, path) -> list[str] | None:
+    """The notes stored in the open archive ``f`` (:func:`_write_notes`), or None for an archive that
+    stores none (no ``/bearingsim/notes``); a one-line UserError for one that is not a 1-D text dataset."""
+    h5py = _lazy_h5py()
+    if NOTES not in f:
+        return None
+    ds = f[NOTES]
+    if not isinstance(ds, h5py.Dataset) or ds.ndim != 1 or ds.dtype.kind not in "OS" or (
+            ds.dtype.kind == "O" and h5py.check_string_dtype(ds.dtype) is None):
+        raise _damaged(path, f"/{NOTES} is not a list of texts")
+    return [v.decode("utf-8", "replace") if isinstance(v, bytes) else str(v) for v in ds[()].tolist()]
 
 
 def _json_scalar(v):
@@ -702,13 +728,16 @@ def read(path, result_class, only=None):
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
         provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}
+        notes = read_notes(f, path) or []
     except UserError:
         raise
     except (KeyError, ValueError, TypeError, OSError) as exc:
         raise UserError(f"{path}: damaged archive ({exc.__class__.__name__}: {exc})") from None
     finally:
         f.close()
-    return result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
+    result = result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
+    result.notes = notes
+    return result
 
 
 def _column_names(value) -> list[str]:
@@ -1212,6 +1241,17 @@ def open_archive(path: str | Path):
     return f
 
 
+def _notes_lines(notes: list[str] | None) -> list[str]:
+    """The "notes:" part of :func:`describe`: each stored note on a line of its own, ``notes: none`` for a
+    run without a note, and what an archive that stores no notes is."""
+    if notes is None:
+        return ["notes: not stored in this archive (no /bearingsim/notes; 'bearingsim report' checks the "
+                "archive again)"]
+    if not notes:
+        return ["notes: none"]
+    return ["notes:", *(f"  {n.removeprefix('bearingsim: note: ')}" for n in notes)]
+
+
 def describe(path: str | Path) -> str:
     """Human-readable listing of an archive: header, provenance, summary, then every dataset."""
     f = open_archive(path)
@@ -1235,10 +1275,11 @@ def describe(path: str | Path) -> str:
                 v = sa[k]
                 vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
                 lines.append(f"  {k:32s} {vs} {unit}")
+        lines += _notes_lines(read_notes(f, path))
         lines.append("datasets:")
 
         def visit(name, obj):
-            if hasattr(obj, "shape") and name != "scenario":
+            if hasattr(obj, "shape") and name not in ("scenario", NOTES):
                 unit = obj.attrs.get("unit", "")
                 lines.append(f"  /{name:52s} {str(obj.shape):14s} {obj.dtype!s:8s} {unit}")
 

@@ -276,7 +276,8 @@ def checks_made(result) -> list[tuple[str, str, bool | None]]:
     if raw is None or raw.cage_w_start is None:
         out.append(("cage speed steady (no drift over the recorded rotations)", "not evaluated: the cage speeds at "
                     "the start and the end of the recording are a fresh run's, not stored in an archive "
-                    f"(at most {MAX_CAGE_SPEED_DRIFT:.0%} of the mean; 'bearingsim run' notes a drift)", None))
+                    f"(at most {MAX_CAGE_SPEED_DRIFT:.0%} of the mean; 'bearingsim run' notes a drift, and its archive "
+                    "stores the run's notes)", None))
     else:
         note = cage_speed_drift(result)
         ws, we = float(raw.cage_w_start), float(raw.cage_w_end)

@@ -303,11 +303,12 @@ def _checks_blocks(result) -> list[dict]:
     rows = plausibility.checks_made(result)
     blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok} for n, m, ok in rows]}]
     try:
-        notes = plausibility.check(result)
+        again = plausibility.check(result)
         verdict = _checks_verdict(rows)
     except SimulationUnstable as exc:
-        notes, verdict = [], f"This archive does NOT pass the checks: {exc}"
+        again, verdict = [], f"This archive does NOT pass the checks: {exc}"
     blocks.append({"kind": "text", "text": verdict})
+    notes = list(dict.fromkeys([*result.notes, *again]))  # the run's stored notes, then those made again
     if notes:
         blocks.append({"kind": "list", "items": [n.removeprefix("bearingsim: note: ") for n in notes]})
     return blocks

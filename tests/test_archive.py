@@ -387,3 +387,45 @@ def test_a_multibody_archive_of_the_version_before_where_the_cage_rests_still_re
         f["results/summary"].attrs["cage_rest_angle_deg"] = "west"
     with pytest.raises(UserError, match="cage_rest_angle_deg is 'west', not a number"):
         bearingsim.load(old)
+
+
+def test_a_runs_notes_are_stored_and_read_inspected_and_reported_back(tmp_path):
+    """A run's notes (plausibility.check of a kept run that is not clean) were printed by `run` and lost: the
+    archive did not hold them, so `inspect`, `bearingsim.load` and `run -q` (which prints nothing) never
+    showed them. They are stored as /bearingsim/notes, read back into result.notes, listed by inspect
+    ("notes: none" for a run without one) and once each in a report; an archive without them reads as
+    before (no notes), and inspect says it stores none."""
+    import bearingsim
+    from bearingsim.reports import _checks_blocks
+
+    from .conftest import SCENARIOS
+    from .test_cli import bearingsim as cli
+
+    out = tmp_path / "z3.h5"  # 3 rollers: three notes (no load-zone angle, the warm-up, where the cage rests)
+    res = cli("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "bearing.roller_count=3", "--set",
+              "numerics.rotations=4", "--no-plots", "-q", "-o", out)
+    assert res.returncode == 0 and res.stdout == "" and res.stderr == "", res.stderr
+    with pytest.warns(bearingsim.errors.PlausibilityWarning):
+        fresh = bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+            "bearing.roller_count": 3, "numerics.rotations": 4}))
+    back = bearingsim.load(out)
+    assert back.notes == fresh.notes and len(back.notes) == 3, back.notes
+    for words in ("load_zone_half_angle_deg = 0 is no result", "the first recorded rotation's I_dec",
+                  "the cage did not rest in one place"):
+        assert sum(words in n for n in back.notes) == 1, words
+    with h5py.File(out, "r") as f:
+        assert [v.decode() for v in f["bearingsim/notes"][()]] == back.notes
+    text = describe(out)
+    part = text[text.index("\nnotes:\n"):text.index("\ndatasets:")].splitlines()[2:]
+    assert part == [f"  {n.removeprefix('bearingsim: note: ')}" for n in back.notes], part
+    items = _checks_blocks(back)[2]["items"]
+    assert items == [n.removeprefix("bearingsim: note: ") for n in back.notes], items  # none twice
+    back.notes = []  # stored notes the checks cannot make again (a drift) are listed too, once
+    stored = bearingsim.load(back.save(tmp_path / "none.h5"))
+    assert stored.notes == [] and "\nnotes: none\n" in describe(tmp_path / "none.h5")
+    stored.notes = ["bearingsim: note: not statistically steady: ..."]
+    items = _checks_blocks(bearingsim.load(stored.save(tmp_path / "drift.h5")))[2]["items"]
+    assert items[0] == "not statistically steady: ..." and len(items) == 4, items
+    with h5py.File(out, "r+") as f:  # an archive that stores no notes
+        del f["bearingsim/notes"]
+    assert bearingsim.load(out).notes == [] and "\nnotes: not stored in this archive" in describe(out)

@@ -136,6 +136,33 @@ def test_a_first_rotation_still_in_the_start_transient_gets_a_note():
     assert abs(rel) < plausibility.START_TRANSIENT_MIN_REL and sds < plausibility.START_TRANSIENT_SD
 
 
+def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
+    """The start-transient check needs START_TRANSIENT_MIN_ROTATIONS (4) recorded rotations; a whole-bearing
+    run of fewer printed its numbers with no word of it, though the README says a short run reads high at
+    3000 rpm and a run says so in a note. Such a run gets one note: the warm-up could not be judged, what the
+    check needs, and how large the transient is (docs/statistics.md); a run of 4 rotations, whose warm-up is
+    judged, and a reduced-model run get none."""
+    from bearingsim import plausibility
+
+    assert plausibility.START_TRANSIENT_MIN_ROTATIONS == 4
+    res = cli("run", MULTIBODY, "--set", "numerics.rotations=3", "--no-plots", "-o", tmp_path / "r3.h5")
+    assert res.returncode == 0, res.stderr
+    lines = [line for line in res.stderr.splitlines() if "warm-up could not be judged" in line]
+    assert len(lines) == 1, res.stderr
+    assert lines[0].startswith("bearingsim: note: the warm-up could not be judged: 3 recorded rotations, and the "
+                               "check of the start's transient needs at least 4"), lines[0]
+    for words in ("9 to 10 % high at 3000 rpm", "about +3.3 % in the mean of 3 rotations", "docs/statistics.md",
+                  "numerics.rotations to 4 or more (now 3)", "numerics.warmup_rotations (now 1)"):
+        assert words in lines[0], words
+    assert bearingsim.load(tmp_path / "r3.h5").notes.count(lines[0]) == 1  # stored with the run's others
+    with pytest.warns(bearingsim.errors.PlausibilityWarning, match="warm-up could not be judged: 1 recorded rotation,"):
+        one = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={"numerics.rotations": 1}))
+    assert len([n for n in one.notes if "warm-up could not be judged" in n]) == 1, one.notes
+    judged = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={"numerics.rotations": 4}))
+    assert not [n for n in judged.notes if "warm-up could not be judged" in n], judged.notes
+    assert not [n for n in bearingsim.run(bearingsim.load_scenario(PAPER)).notes if "warm-up" in n]
+
+
 @pytest.mark.slow
 def test_without_radial_load_the_inner_ring_displacement_is_noted_as_no_result():
     """The radial load W is the only force on the inner ring (forces.py: quasi-static, sum Q N = (0, -W);

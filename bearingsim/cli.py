@@ -27,15 +27,16 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import given_keys, load_scenario, unread_note
+    from bearingsim.scenario import given_keys, load_scenario, motion_window_note, unread_note
     from bearingsim.simulation import check_run, run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
     check_run(scenario)  # what the run would refuse before its first step: the dry run refuses it too
-    if not args.quiet:  # the keys given that have no effect on the run, noted by the dry run too
-        note = unread_note(scenario, given_keys(args.scenario, args.set))
-        if note:
-            print(f"bearingsim: note: {note}", file=sys.stderr)
+    if not args.quiet:  # the keys given that have no effect on the run, or not the one asked, noted by the dry run too
+        keys = given_keys(args.scenario, args.set)
+        for note in (unread_note(scenario, keys), motion_window_note(scenario, keys)):
+            if note:
+                print(f"bearingsim: note: {note}", file=sys.stderr)
     if args.dry_run:
         return _dry_run(scenario, args)
     progress = not args.quiet and sys.stderr.isatty()

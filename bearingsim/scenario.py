@@ -1138,6 +1138,20 @@ def _check_motion(m: ScenarioModel, source: str) -> None:
                         f"window or fewer output.motion_samples_per_rotation")
 
 
+def motion_window_note(scenario, keys) -> str | None:
+    """One line when ``output.motion_rotations``, among the keys given (:func:`given_keys`), asks a multibody
+    run for a window longer than its recorded rotations: with ``motion_start_rotation = "last"`` such a window
+    is the whole run, which the archive stores instead (a given start is refused: :func:`_check_motion`);
+    None otherwise."""
+    out, rotations = scenario.output, scenario.numerics.rotations
+    if (scenario.model != "multibody" or "output.motion_rotations" not in keys or out.motion_start_rotation != "last"
+            or out.motion_rotations <= rotations):
+        return None
+    return (f"output.motion_rotations = {out.motion_rotations:g} is longer than the run's {rotations} recorded "
+            f"rotations (numerics.rotations): the archive stores the motion of those {rotations}, the whole "
+            f"recorded run (docs/archive.md, Motion)")
+
+
 def _check_cage_inertia(b: "BearingSection", source: str) -> None:
     """The cage is a ring between the raceways (or between its given diameters): the moment of inertia of
     a ring of mass m between radii r_in and r_out lies between m r_in^2 and m r_out^2."""

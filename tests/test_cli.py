@@ -614,3 +614,27 @@ def test_a_sweep_file_given_for_a_scenario_or_an_archive_says_what_it_is(tmp_pat
                  ["inspect", f], ["rerun", f]):
         assert_user_error(bearingsim(*args), f"{f}: is a sweep file", f"'bearingsim sweep {f}' runs it")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_motion_window_longer_than_the_run_is_noted_before_it(tmp_path):
+    """`--set output.motion_rotations=50` with `numerics.rotations=3` ran silently and stored 3 rotations of
+    motion: the run (and its dry run) says so in one note before it starts; a window the run holds, a run
+    that did not give the key (the default 2 rotations of a 1-rotation run) and -q give none."""
+    import h5py
+
+    scenario = SCENARIOS / "multibody_3000rpm.toml"
+    long = ("--set", "output.motion_rotations=50", "--set", "numerics.rotations=3")
+    dry = bearingsim("run", scenario, *long, "--dry-run", "-o", tmp_path / "m.h5")
+    real = bearingsim("run", scenario, *long, "--no-plots", "-o", tmp_path / "m.h5")
+    for res in (dry, real):
+        assert res.returncode == 0, res.stderr
+        lines = [line for line in res.stderr.splitlines() if "motion_rotations" in line]
+        assert lines == ["bearingsim: note: output.motion_rotations = 50 is longer than the run's 3 recorded rotations "
+                         "(numerics.rotations): the archive stores the motion of those 3, the whole recorded run "
+                         "(docs/archive.md, Motion)"], res.stderr
+    with h5py.File(tmp_path / "m.h5", "r") as f:  # the whole run: 3 rotations of 240 poses and the last pose
+        assert f["observables/motion_cage_angle/value"].shape[0] == 3 * 240 + 1
+    for sets in (("--set", "output.motion_rotations=3", "--set", "numerics.rotations=3"),
+                 ("--set", "numerics.rotations=1"), (*long, "-q")):
+        res = bearingsim("run", scenario, *sets, "--dry-run", "-o", tmp_path / "n.h5")
+        assert res.returncode == 0 and "motion_rotations" not in res.stderr, (sets, res.stderr)

@@ -339,12 +339,14 @@ def warmup_not_judged(result) -> str | None:
     if n >= START_TRANSIENT_MIN_ROTATIONS:
         return None
     warmup = result.parameters.numerics.warmup_rotations
+    first = 10.0 if warmup < 2 else 1.0  # [%] the first recorded rotation's excess, docs/statistics.md
     return (f"bearingsim: note: the warm-up could not be judged: {counted(n, 'recorded rotation')}, and the check "
             f"of the start's transient needs at least {START_TRANSIENT_MIN_ROTATIONS} (the later ones give the "
             f"scatter to judge the first by); on the reference bearing the first recorded rotation after one "
-            f"warm-up rotation reads 9 to 10 % high at 3000 rpm (about +{10 / n:.2g} % in the mean of "
-            f"{counted(n, 'rotation')}), after two within about 1 % (docs/statistics.md); set numerics.rotations to "
-            f"{START_TRANSIENT_MIN_ROTATIONS} or more (now {n}), or more numerics.warmup_rotations (now {warmup})")
+            f"warm-up rotation reads 9 to 10 % high at 3000 rpm, after two within about 1 % (docs/statistics.md), "
+            f"so up to about +{first / n:.2g} % in the mean of {counted(n, 'rotation')} after {warmup}; set "
+            f"numerics.rotations to {START_TRANSIENT_MIN_ROTATIONS} or more (now {n}), or more "
+            f"numerics.warmup_rotations")
 
 
 def _rest_span(result) -> tuple[float, float, float] | None:

@@ -15,7 +15,7 @@ Every module and subpackage is an attribute of the package on first use (``beari
 (PEP 562), so ``import bearingsim`` stays light.
 """
 from bearingsim._version import __version__  # noqa: E402
-from bearingsim.errors import SimulationUnstable, UserError  # noqa: E402
+from bearingsim.errors import SimulationUnstable, UnreadKeyWarning, UserError  # noqa: E402
 
 
 def load_scenario(path, set: dict | None = None, overrides: list[str] | None = None):
@@ -29,23 +29,39 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
 
     ``overrides`` are applied in their order, then ``set``: a key given twice takes the value given last
     (as a repeated ``--set``), so ``set`` wins over ``overrides``.
-    """
-    from bearingsim import scenario
 
-    return scenario.load_scenario(path, overrides, values=set)
+    Keys the file, ``overrides`` or ``set`` give that the run does not read (``numerics.dt_s`` with the
+    reduced model's event method, a multibody key in a reduced scenario) are named in one
+    :class:`bearingsim.UnreadKeyWarning`, the note ``bearingsim run`` prints.
+    """
+    import warnings
+
+    from bearingsim import scenario
+    from bearingsim.errors import UnreadKeyWarning
+
+    sc = scenario.load_scenario(path, overrides, values=set)
+    note = scenario.unread_note(sc, scenario.given_keys(path, overrides, set))
+    if note:
+        warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
+    return sc
 
 
 def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None):
     """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result.
 
     A run that is plausible but not clean returns its result with its one-line notes in ``result.notes``,
-    each also issued as a :class:`bearingsim.errors.PlausibilityWarning`."""
+    each also issued as a :class:`bearingsim.errors.PlausibilityWarning`. A ``dt`` the run does not read
+    (the reduced model's event method has no time step) is named in a :class:`bearingsim.UnreadKeyWarning`."""
     import warnings
 
-    from bearingsim.errors import PlausibilityWarning
+    from bearingsim.errors import PlausibilityWarning, UnreadKeyWarning
+    from bearingsim.scenario import unread_note
     from bearingsim.simulation import run as _run
 
     result = _run(scenario, progress=progress, sink=sink, dt=dt)
+    note = unread_note(result.scenario, ["numerics.dt_s"]) if dt is not None else None
+    if note:
+        warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
     for note in result.notes:
         warnings.warn(note, PlausibilityWarning, stacklevel=2)
     return result
@@ -105,5 +121,5 @@ def __dir__():
     return sorted(set(globals()) | set(submodule_names(__path__)))
 
 
-__all__ = ["UserError", "SimulationUnstable", "__version__", "load_scenario", "run", "load", "sensitivity",
-           "uncertainty", "report", "animate"]
+__all__ = ["UserError", "SimulationUnstable", "UnreadKeyWarning", "__version__", "load_scenario", "run", "load",
+           "sensitivity", "uncertainty", "report", "animate"]

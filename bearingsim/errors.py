@@ -28,6 +28,12 @@ class PlausibilityWarning(UserWarning):
     archive stand, and the message says what to know about them."""
 
 
+class UnreadKeyWarning(UserWarning):
+    """A key the caller gave that the run does not read (:func:`bearingsim.scenario.unread_note`: a key its
+    model or method does not use, or one its settings leave unread): a run with another value of it gives
+    the same numbers. The message is the line ``bearingsim run`` prints as its note."""
+
+
 class SlowLoopWarning(UserWarning):
     """The multibody model's compiled step loop cannot run with the installed pymunk: the plain loop
     runs instead (the same numbers, several times slower). Issued once per process."""

@@ -831,17 +831,17 @@ def out_of_range_note(scenario) -> str | None:
             f"('bearingsim keys KEY --why' says where it comes from); the run is of another bearing")
 
 
-def given_keys(path, overrides=()) -> list[str]:
-    """Every dotted key a scenario file and its ``KEY=VALUE`` overrides set (not its preset's or the
-    defaults': those are the model's own), the keys whose effect a run notes. A file that gives the reduced
-    model's load zone itself states the load it is of beside it (the paper scenarios: 970 N, 23.5°), so its
-    own :data:`LOAD_ZONE_KEYS` are left out; an override of them is kept."""
+def given_keys(path, overrides=(), values=None) -> list[str]:
+    """Every dotted key a scenario file, its ``KEY=VALUE`` overrides and its ``{KEY: value}`` values set (not
+    its preset's or the defaults': those are the model's own), the keys whose effect a run notes. A file that
+    gives the reduced model's load zone itself states the load it is of beside it (the paper scenarios: 970 N,
+    23.5°), so its own :data:`LOAD_ZONE_KEYS` are left out; an override of them is kept."""
     in_file = flatten(read_toml_file(path))
     if in_file.get("reduced.load_zone_half_angle_deg", "auto") != "auto":
         in_file = {k: v for k, v in in_file.items() if k not in LOAD_ZONE_KEYS}
     given = []
-    for o in overrides:
-        key, value = parse_override(o)  # a table for a section gives the keys it holds
+    pairs = [parse_override(o) for o in overrides or ()] + list((values or {}).items())
+    for key, value in pairs:  # a table for a section gives the keys it holds
         given += [f"{key}.{k}" for k in flatten(value)] if isinstance(value, dict) and value else [key]
     return list(in_file) + given
 

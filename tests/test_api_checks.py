@@ -42,6 +42,33 @@ def test_run_with_dt_stores_it_in_the_scenario():
     assert same.summary == r.summary
 
 
+def test_the_api_notes_keys_the_run_does_not_read_as_the_cli_does(tmp_path):
+    """``load_scenario(..., set={"numerics.dt_s": 5.0})`` of the event method and ``run(sc, dt=...)`` were
+    silent where ``bearingsim run --set numerics.dt_s=5`` notes the key: one UnreadKeyWarning, the CLI's line;
+    keys that are read give none."""
+    import warnings
+
+    res = cli("run", PAPER, "--set", "numerics.dt_s=5", "--dry-run")
+    said = [line for line in res.stderr.splitlines() if "note:" in line]
+    assert res.returncode == 0 and len(said) == 1, res.stderr
+    for load in (lambda: bearingsim.load_scenario(PAPER, set={"numerics.dt_s": 5.0}),
+                 lambda: bearingsim.load_scenario(PAPER, overrides=["numerics.dt_s=5"])):
+        with pytest.warns(bearingsim.UnreadKeyWarning) as got:
+            load()
+        assert [str(w.message) for w in got] == said
+    with pytest.warns(bearingsim.UnreadKeyWarning, match="numerics.dt_s: not used by reduced.method = 'event'"):
+        bearingsim.load_scenario(PAPER, set={"numerics": {"dt_s": 5.0}})
+    with pytest.warns(bearingsim.UnreadKeyWarning, match="multibody.scene: not used by the reduced model"):
+        bearingsim.load_scenario(PAPER, set={"multibody.scene": "full"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sc = bearingsim.load_scenario(PAPER, set={"operating.inner_ring_speed_rpm": 500.0})
+        bearingsim.run(bearingsim.load_scenario(PAPER, set={"reduced.method": "euler"}), dt=2e-6)
+    with pytest.warns(bearingsim.UnreadKeyWarning, match="numerics.dt_s: not used by reduced.method = 'event'"):
+        r = bearingsim.run(sc, dt=1e-2)
+    assert r.summary == bearingsim.run(sc).summary
+
+
 @pytest.mark.slow
 def test_an_implausible_run_is_refused_by_the_api_as_by_the_cli(tmp_path):
     """Rigid raceways at dt = 10 s: was I_dec = 0 from the API while the CLI exits 3."""

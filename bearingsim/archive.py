@@ -8,7 +8,8 @@ Layout (format documented in ``docs/archive.md``)::
     /bearingsim                attrs format_version, model, scenario_name, complete
     /bearingsim/notes          the run's notes, one text per note (dataset)
     /scenario                  resolved scenario as TOML text (dataset)
-    /provenance                attrs_json: package versions, git commit, created_utc, wall_time_s, ...
+    /provenance                attrs_json: the result's (package versions, git commit, wall_time_s, ...),
+                               and created_utc, the time the archive was written
     /results/per_rotation/*    [rotations, pockets] arrays
     /results/impacts/*         impact table, one column dataset each
     /results/summary           attrs_json, units_json (one JSON object each)
@@ -597,21 +598,29 @@ def _write_array(w: _Writer, path: str, arr) -> None:
     # RuntimeError from h5py; the ids go with the file, whose flush and close report an OSError
 
 
+def run_facts() -> dict[str, Any]:
+    """The facts of the code and the machine that compute a run, in every fresh result's provenance
+    (:func:`bearingsim.simulation.run`): ``bearingsim_version``, ``git_commit``, ``platform``, ``command``
+    and ``version_<package>`` of python and the packages its numbers depend on."""
+    facts = {"bearingsim_version": __version__, "git_commit": git_commit(), "platform": platform.platform(),
+             "command": " ".join(sys.argv)}
+    facts.update((f"version_{k}", v) for k, v in package_versions().items())
+    return facts
+
+
 def _provenance(result) -> dict[str, Any]:
-    """Provenance, written in this one place: the package, its versions, the machine and the run.
+    """Provenance, written in this one place: the result's own (a fresh result's holds the facts of the code
+    that computed it, :func:`run_facts`) and ``created_utc``, the time the archive is written.
 
     A result read back from an archive keeps the provenance of the run that made it (the code, the
-    machine, the command and the time it was computed): re-saving it elsewhere does not restamp it
-    with the machine that saves it."""
+    machine, the command and the time it was first written): re-saving it elsewhere does not restamp it
+    with the machine that saves it. A result made otherwise (no run facts) gets those of this process."""
     own = result.provenance
-    here = {"bearingsim_version": __version__, "git_commit": git_commit(),
-            "created_utc": _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"),
-            "platform": platform.platform(), "command": " ".join(sys.argv)}
-    prov = {k: own.get(k, v) for k, v in here.items()}
+    here = run_facts()
+    prov = {k: own.get(k, v) for k, v in here.items() if not k.startswith("version_")}
+    prov["created_utc"] = own.get("created_utc", _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds"))
     versions = {k: v for k, v in own.items() if k.startswith("version_")}
-    if not versions:
-        versions = {f"version_{k}": v for k, v in package_versions().items()}
-    prov.update(versions)
+    prov.update(versions or {k: v for k, v in here.items() if k.startswith("version_")})
     for k, v in own.items():
         if k not in prov:
             prov[k] = v

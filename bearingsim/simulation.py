@@ -90,7 +90,7 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     :class:`bearingsim.errors.SimulationUnstable`; the one-line notes of a plausible run that is not
     clean are in ``result.notes`` (the command line prints them).
     """
-    from bearingsim import plausibility
+    from bearingsim import archive, plausibility
 
     if not isinstance(scenario, Scenario):
         from bearingsim.errors import UserError
@@ -104,6 +104,7 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
+    result.provenance = {**archive.run_facts(), **result.provenance}  # the code that computed it
     result.provenance["wall_time_s"] = time.perf_counter() - t0
     result.notes = plausibility.check(result)
     return result

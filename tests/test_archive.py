@@ -122,6 +122,23 @@ def test_the_provenance_carries_the_units_of_its_times(tmp_path, base_reduced):
     assert "bearingsim_version" not in units and "git_commit" not in units
 
 
+def test_a_fresh_result_has_the_provenance_it_reads_back_with_but_the_time_written(tmp_path, base_reduced):
+    """docs/architecture.md: a fresh result and one read back have the same content. The versions, commit,
+    platform and command were added only when the archive was written (13 keys missing from a fresh
+    result); only ``created_utc``, the time the archive was written, is the archive's. A second save keeps
+    the facts and the time of the first."""
+    import bearingsim
+
+    r = bearingsim.run(resolve(base_reduced))
+    back = bearingsim.load(r.save(tmp_path / "r.h5"))
+    assert set(back.provenance) - set(r.provenance) == {"created_utc"} and set(r.provenance) <= set(back.provenance)
+    assert repr({k: back.provenance[k] for k in r.provenance}) == repr(r.provenance)  # dt_s is nan here
+    for key in ("bearingsim_version", "git_commit", "platform", "command", "version_numpy", "model_version"):
+        assert key in r.provenance, key
+    again = bearingsim.load(back.save(tmp_path / "again.h5"))
+    assert repr(again.provenance) == repr(back.provenance)
+
+
 def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(tmp_path, base_reduced):
     """Result.save as its docstring says: missing folders are made; a bearingsim archive at the path is
     replaced (by this result's); a file that is not one is refused with one line and left as it was."""

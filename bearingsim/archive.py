@@ -4,7 +4,8 @@ gives it back as the same class.
 
 Layout (format documented in ``docs/archive.md``)::
 
-    /h5md                      attrs version; /h5md/creator attrs name, version
+    /h5md                      attrs version; /h5md/creator attrs name, version; /h5md/author attr name
+                               ($BEARINGSIM_AUTHOR, else "unknown": never the host's login name)
     /bearingsim                attrs format_version, model, scenario_name, complete
     /bearingsim/notes          the run's notes, one text per note (dataset)
     /scenario                  resolved scenario as TOML text (dataset)
@@ -472,6 +473,18 @@ class _IdHolder:
         self.id = oid
 
 
+#: the environment variable naming the author an archive's ``/h5md/author`` records
+AUTHOR_VARIABLE = "BEARINGSIM_AUTHOR"
+
+
+def author() -> str:
+    """The name ``/h5md/author@name`` records (H5MD 1.1 requires it): ``$BEARINGSIM_AUTHOR`` if set and not
+    blank, else ``"unknown"``; never read from the host (no login name), so the same run writes the same
+    header on any machine."""
+    name = os.environ.get(AUTHOR_VARIABLE, "").strip()
+    return name or "unknown"
+
+
 def _write_header(w: _Writer, result, complete: bool = False) -> None:
     sc = result.scenario
     w.attr(w.gid(""), "title", f"bearingsim archive: {sc.name}")
@@ -479,6 +492,7 @@ def _write_header(w: _Writer, result, complete: bool = False) -> None:
     creator = w.gid("h5md/creator")
     w.attr(creator, "name", "bearingsim")
     w.attr(creator, "version", __version__)
+    w.attr(w.gid("h5md/author"), "name", author())
     g = w.gid("bearingsim")
     w.attr(g, "format_version", FORMAT_VERSION)
     w.attr(g, "model", result.model)

@@ -65,6 +65,24 @@ def test_complete_archive_has_header_scenario_provenance_units(tmp_path, base_re
     assert "I_dec_mean_Ns" in text and "/results/per_rotation/I_dec" in text
 
 
+def test_the_h5md_header_names_an_author_from_the_environment_only(tmp_path, base_reduced, monkeypatch):
+    """H5MD 1.1 requires /h5md/author with a name beside /h5md/creator; the header claimed 1.1 without it.
+    The name is $BEARINGSIM_AUTHOR, else "unknown" (never the host's login name)."""
+    sc = resolve(base_reduced)
+    monkeypatch.delenv("BEARINGSIM_AUTHOR", raising=False)
+    archive.write(_result(sc), tmp_path / "a.h5")
+    monkeypatch.setenv("BEARINGSIM_AUTHOR", "  ")
+    archive.write(_result(sc), tmp_path / "b.h5")
+    monkeypatch.setenv("BEARINGSIM_AUTHOR", "A. Tester")
+    archive.write(_result(sc), tmp_path / "c.h5")
+    names = []
+    for name in ("a.h5", "b.h5", "c.h5"):
+        with open_archive(tmp_path / name) as f:
+            assert list(f["h5md"].attrs["version"]) == [1, 1] and f["h5md/creator"].attrs["name"] == "bearingsim"
+            names.append(f["h5md/author"].attrs["name"])
+    assert names == ["unknown", "unknown", "A. Tester"]
+
+
 def test_crash_leaves_no_archive_and_keeps_previous_file(tmp_path, base_reduced):
     sc = resolve(base_reduced)
     path = tmp_path / "a.h5"

@@ -5,7 +5,8 @@ Rules, each a one-line :class:`bearingsim.errors.UserError` (exit 2) before any 
 * a default output name (``outputs/<name>.h5``) never leaves the output folder;
 * an archive path ends in ``.h5`` / ``.hdf5`` (so ``-o my.toml`` or ``-o notes.txt`` is refused);
 * the target is never the input scenario file;
-* an existing target that is not a bearingsim archive is not replaced;
+* an existing target that is not a bearingsim archive is not replaced, nor a symbolic link at the
+  archive path, whatever it points to (a link is the user's, as at a figure path);
 * every PNG, GIF and MP4 bearingsim writes carries its mark (:data:`MARK`: a PNG's ``Software`` text,
   a GIF's comment, an MP4's comment tag), and only a file with the mark is replaced: a figure path of the
   run (``<stem>_<name>.png``) that is a symbolic link, a directory or a file without the mark (a user's
@@ -282,6 +283,8 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     p = Path(path)
     if "\x00" in str(p):
         raise UserError(f"{str(p)!r}: output path contains a NUL byte")
+    if p.is_symlink():  # the user's, as a linked figure is (check_replaceable): neither replaced nor followed
+        raise UserError(f"{p}: archive path is a symbolic link; not replaced (remove it or choose another output)")
     for src in inputs:
         if src and _same_file(p, Path(src)):
             raise UserError(f"{p}: output path is the input scenario file; choose another -o")

@@ -178,8 +178,8 @@ class Result:
     def save(self, path) -> Path:
         """Write this result as an archive at ``path`` (``.h5`` or ``.hdf5``; atomically: a temporary file
         renamed when complete) and return the path. Missing folders are created; a bearingsim archive at
-        ``path`` is replaced, any other file there is refused (:class:`bearingsim.UserError`, nothing
-        written)."""
+        ``path`` is replaced, any other file there, and a symbolic link (even to an archive: a link is the
+        user's, as at a figure path), is refused (:class:`bearingsim.UserError`, nothing written)."""
         from bearingsim import archive
 
         return archive.write(self, path)

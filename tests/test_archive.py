@@ -176,6 +176,26 @@ def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(t
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["a", "b", "mine.h5", "r.h5"]
 
 
+def test_save_refuses_a_symbolic_link_as_figures_do(tmp_path, base_reduced):
+    """``Result.save("link.h5")``, a link to an archive, replaced the link with a regular file, where a
+    figure path that is a link is refused: a link at the archive path (to an archive, or to nothing) is
+    refused in one line naming it, and the link and its target are left as they were."""
+    import bearingsim
+
+    r = bearingsim.run(resolve(base_reduced))
+    real = r.save(tmp_path / "real.h5")
+    before = real.read_bytes()
+    link, dangling = tmp_path / "link.h5", tmp_path / "dangling.h5"
+    link.symlink_to(real)
+    dangling.symlink_to(tmp_path / "nowhere.h5")
+    for target in (link, dangling):
+        with pytest.raises(UserError, match="archive path is a symbolic link; not replaced") as err:
+            r.save(target)
+        assert str(err.value).startswith(f"{target}: ") and "\n" not in str(err.value) and target.is_symlink()
+    assert real.read_bytes() == before and not (tmp_path / "nowhere.h5").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling.h5", "link.h5", "real.h5"]
+
+
 def test_a_refused_save_leaves_no_folder_behind(tmp_path, base_reduced):
     """Result.save made the missing folders of its path before checking the path's name, so a refused
     ``a/b/x.txt`` left ``a/b`` behind; a refusal writes nothing (as the command line's does)."""

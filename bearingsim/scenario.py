@@ -353,6 +353,14 @@ class Scenario:
             raise AttributeError(f"{type(self).__name__!r} object has no attribute {item!r}")
         return getattr(model, item)
 
+    def __repr__(self) -> str:
+        """``<Scenario 'paper_3000rpm': reduced model, from 'scenarios/paper_3000rpm.toml'>``: its name, model
+        and where it came from."""
+        model = self.__dict__.get("model_")
+        if model is None:  # not filled in yet (unpickling)
+            return f"<{type(self).__name__} (empty)>"
+        return f"<{type(self).__name__} {model.name!r}: {model.model} model, from {self.source!r}>"
+
     def __eq__(self, other) -> bool:
         """Two scenarios are equal when they resolve to the same values (wherever they came from)."""
         if not isinstance(other, Scenario):

@@ -416,3 +416,15 @@ def test_a_table_given_for_a_section_sets_its_keys_and_keeps_the_others(tmp_path
         assert (sc.operating.radial_load_N, sc.operating.direction) == (2000.0, "reverse")
     # the keys such a table gives are noted as the same keys given one by one
     assert given_keys(f, ["multibody={inner_ring_mass_kg=5}"])[-1] == "multibody.inner_ring_mass_kg"
+
+
+def test_a_scenario_has_a_short_repr_naming_it_its_model_and_its_file(base_reduced):
+    """``repr(Scenario)`` was the default ``<bearingsim.scenario.Scenario object at 0x...>``."""
+    import pickle
+
+    path = SCENARIOS / "multibody_3000rpm.toml"
+    sc = load_scenario(path)
+    assert repr(sc) == f"<Scenario 'multibody_3000rpm': multibody model, from {str(path)!r}>"
+    assert repr(sc.replace(name="x")) == f"<Scenario 'x': multibody model, from {str(path)!r}>"
+    assert repr(resolve(base_reduced)) == "<Scenario 't': reduced model, from '<dict>'>"
+    assert repr(pickle.loads(pickle.dumps(sc))) == repr(sc) and "\n" not in repr(sc)

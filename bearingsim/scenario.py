@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import copy
 import os
+import re
 import stat
 import math
 import tomllib
@@ -656,15 +657,44 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
         raise _with_override(exc, str(path), given) from None
 
 
+#: a dotted scenario key as a message names it (``bearing.pocket_clearance_mm``)
+_KEY_IN_TEXT = re.compile(r"\b[a-z][a-z0-9_]*(?:\.[a-z0-9_]+)+\b")
+
+
 def _with_override(exc: UserError, source: str, given: dict[str, str]) -> UserError:
-    """``exc`` of the scenario file ``source`` ("FILE: KEY: why"), saying the override that gave KEY its value
-    when one did ("FILE with KEY=VALUE: KEY: why"): the file does not hold that value."""
+    """``exc`` of the scenario file ``source`` ("FILE: KEY: why"), saying the overrides that gave the values
+    it is about when some did ("FILE with KEY=VALUE: KEY: why"; several: "with A=1 and B=2"), the file does
+    not hold those values: every override of KEY, of a key the message names, or of a key the violated
+    check reads (``exc.involves``, :func:`_involving`); an override of a table or of a key in it counts
+    for both (an unknown section ``operatin`` is the override ``operatin.inner_ring_speed_rpm``)."""
     text = str(exc)
     head = f"{source}: "
-    key = text[len(head):].split(":", 1)[0] if text.startswith(head) else None
-    if key not in given:
+    if not text.startswith(head):
         return exc
-    return type(exc)(f"{source} with {given[key]}: {text[len(head):]}")
+    body = text[len(head):]
+    named = {body.split(":", 1)[0], *_KEY_IN_TEXT.findall(body), *getattr(exc, "involves", ())}
+
+    def about(key: str) -> bool:
+        return any(key == k or k.startswith(f"{key}.") or key.startswith(f"{k}.") for k in named)
+
+    which = [given[k] for k in given if about(k)]
+    if not which:
+        return exc
+    return type(exc)(f"{source} with {' and '.join(which)}: {body}")
+
+
+def _involving(exc: UserError, *keys: str) -> UserError:
+    """``exc``, a check's refusal, marked with the other keys the check reads (``exc.involves``): an override
+    of any of them is named in the message too (:func:`_with_override`)."""
+    exc.involves = keys
+    return exc
+
+
+#: the keys that place the raceways (the pitch circle and the rollers on it), read by the checks of the cage
+_RACEWAY_KEYS = ("bearing.pitch_diameter_mm", "bearing.roller_diameter_mm")
+#: and the pockets' width, D + s
+_POCKET_KEYS = (*_RACEWAY_KEYS, "bearing.pocket_clearance_mm")
+_CAGE_DIAMETER_KEYS = ("bearing.cage_inner_diameter_mm", "bearing.cage_outer_diameter_mm")
 
 
 def resolve(raw: dict[str, Any], source: str = "<dict>") -> Scenario:
@@ -1080,26 +1110,30 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
     total = n.rotations + n.warmup_rotations
     if total > MAX_ROTATIONS:
         key = "numerics.rotations" if n.rotations > n.warmup_rotations else "numerics.warmup_rotations"
-        raise UserError(f"{source}: {key}: {total} rotations in all exceed {MAX_ROTATIONS} (memory and run "
+        exc = UserError(f"{source}: {key}: {total} rotations in all exceed {MAX_ROTATIONS} (memory and run "
                         "time grow with rotations); run fewer")
+        raise _involving(exc, "numerics.rotations", "numerics.warmup_rotations")
     dmn = o.inner_ring_speed_rpm * b.pitch_diameter_mm
     if dmn > MAX_DM_N_MM_RPM:
-        raise UserError(f"{source}: operating.inner_ring_speed_rpm: {o.inner_ring_speed_rpm:g} rpm gives "
+        exc = UserError(f"{source}: operating.inner_ring_speed_rpm: {o.inner_ring_speed_rpm:g} rpm gives "
                         f"dm*n = {dmn:.3g} mm rpm, beyond any rolling bearing (limit {MAX_DM_N_MM_RPM:.0e})")
+        raise _involving(exc, "bearing.pitch_diameter_mm")
     rho = b.roller_mass_kg / (math.pi / 4 * (b.roller_diameter_mm * 1e-3) ** 2 * b.roller_length_mm * 1e-3)
     lo, hi = ROLLER_DENSITY_RANGE_KG_M3
     if not lo <= rho <= hi:
-        raise UserError(f"{source}: bearing.roller_mass_kg: {b.roller_mass_kg:g} kg gives a roller density of "
+        exc = UserError(f"{source}: bearing.roller_mass_kg: {b.roller_mass_kg:g} kg gives a roller density of "
                         f"{rho:.3g} kg/m^3, outside any roller material ({lo:g}..{hi:g} kg/m^3)")
+        raise _involving(exc, "bearing.roller_diameter_mm", "bearing.roller_length_mm")
     if m.wear.wear_coefficient > MAX_WEAR_COEFFICIENT:
         raise UserError(f"{source}: wear.wear_coefficient: {m.wear.wear_coefficient:g} is not an Archard wear "
                         f"coefficient (dimensionless, a probability per asperity contact; measured values are "
                         f"1e-9..1e-2, at most {MAX_WEAR_COEFFICIENT:g} accepted)")
     limit = MAX_RADIAL_CLEARANCE_TO_ROLLER * b.roller_diameter_mm
     if b.radial_clearance_mm > limit:
-        raise UserError(f"{source}: bearing.radial_clearance_mm: {b.radial_clearance_mm:g} mm is more than "
+        exc = UserError(f"{source}: bearing.radial_clearance_mm: {b.radial_clearance_mm:g} mm is more than "
                         f"{MAX_RADIAL_CLEARANCE_TO_ROLLER:.0%} of the roller diameter ({limit:.3g} mm); the largest "
                         f"standard clearance (ISO 5753-1 C5) is 1..2 % of it")
+        raise _involving(exc, "bearing.roller_diameter_mm")
     _check_cage_inertia(b, source)
     lo, hi = HARDNESS_RANGE_PA
     if not lo <= m.wear.hardness_Pa <= hi:
@@ -1113,22 +1147,26 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
     if n_free > 0:
         drag = float(laws.oil_film_drag(m.lubrication.drag_coefficient, n_free, op.rolling_velocity))
         if drag > MAX_DRAG_TO_LOAD * n_free:
-            raise UserError(f"{source}: lubrication.drag_coefficient: {m.lubrication.drag_coefficient:g} gives an "
+            exc = UserError(f"{source}: lubrication.drag_coefficient: {m.lubrication.drag_coefficient:g} gives an "
                             f"oil-film drag of {drag:.3g} N against a roller load of {n_free:.3g} N (Eq. 2); "
                             f"rolling resistance is a small fraction of the load")
+            raise _involving(exc, "bearing.roller_mass_kg", *_RACEWAY_KEYS, "operating.inner_ring_speed_rpm",
+                             "operating.gravity")
     c0 = ISO76_C0_FACTOR * (1 - b.roller_diameter_mm / b.pitch_diameter_mm) * b.roller_count * \
         b.roller_length_mm * b.roller_diameter_mm
     if o.radial_load_N > c0:
-        raise UserError(f"{source}: operating.radial_load_N: {o.radial_load_N:g} N exceeds the static load rating "
+        exc = UserError(f"{source}: operating.radial_load_N: {o.radial_load_N:g} N exceeds the static load rating "
                         f"C0r = {c0:.4g} N of this bearing (ISO 76); the raceways would yield")
+        raise _involving(exc, "bearing.roller_count", "bearing.roller_length_mm", *_RACEWAY_KEYS)
     if m.model == "multibody":
         period = 2 * math.pi / op.omega_c
         per_rotation = n.output_rate_hz * period
         need = 2 * b.roller_count  # Nyquist for the roller-pass frequency in the cage orbit
         if per_rotation < need:
-            raise UserError(f"{source}: numerics.output_rate_hz: {n.output_rate_hz:g} Hz gives {per_rotation:.3g} "
+            exc = UserError(f"{source}: numerics.output_rate_hz: {n.output_rate_hz:g} Hz gives {per_rotation:.3g} "
                             f"samples per cage rotation; at least {need} (2 per roller pass) are needed, use "
                             f">= {need / period:.3g} Hz")
+            raise _involving(exc, "operating.inner_ring_speed_rpm", *_RACEWAY_KEYS, "bearing.roller_count")
 
 
 def _check_motion(m: ScenarioModel, source: str) -> None:
@@ -1136,14 +1174,16 @@ def _check_motion(m: ScenarioModel, source: str) -> None:
     :data:`MAX_MOTION_SAMPLES` poses. With start "last" a window longer than the run is the whole run."""
     out, rotations = m.output, m.numerics.rotations
     if out.motion_start_rotation != "last" and out.motion_start_rotation + out.motion_rotations > rotations:
-        raise UserError(f"{source}: output.motion_start_rotation: the window {out.motion_start_rotation:g} .. "
+        exc = UserError(f"{source}: output.motion_start_rotation: the window {out.motion_start_rotation:g} .. "
                         f"{out.motion_start_rotation + out.motion_rotations:g} ends after the "
                         f"{rotations} recorded rotations (numerics.rotations); start it earlier or set 'last'")
+        raise _involving(exc, "output.motion_rotations")
     length = min(out.motion_rotations, rotations)
     if length * out.motion_samples_per_rotation > MAX_MOTION_SAMPLES:
-        raise UserError(f"{source}: output.motion_rotations: {length:g} rotations x {out.motion_samples_per_rotation} "
+        exc = UserError(f"{source}: output.motion_rotations: {length:g} rotations x {out.motion_samples_per_rotation} "
                         f"samples per rotation is more than {MAX_MOTION_SAMPLES} motion samples; store a shorter "
                         f"window or fewer output.motion_samples_per_rotation")
+        raise _involving(exc, "numerics.rotations")
 
 
 def motion_window_note(scenario, keys) -> str | None:
@@ -1167,30 +1207,33 @@ def _check_cage_inertia(b: "BearingSection", source: str) -> None:
     r_in = 0.5e-3 * (b.cage_inner_diameter_mm or b.pitch_diameter_mm - b.roller_diameter_mm)
     lo, hi = b.cage_mass_kg * r_in**2, b.cage_mass_kg * r_out**2
     if not lo <= b.cage_inertia_kgm2 <= hi:
-        raise UserError(f"{source}: bearing.cage_inertia_kgm2: {b.cage_inertia_kgm2:g} kg m^2 is impossible for a "
+        exc = UserError(f"{source}: bearing.cage_inertia_kgm2: {b.cage_inertia_kgm2:g} kg m^2 is impossible for a "
                         f"{b.cage_mass_kg:g} kg cage ring between radii {r_in * 1e3:.4g} and {r_out * 1e3:.4g} mm "
                         f"(m r_in^2 = {lo:.3g} .. m r_out^2 = {hi:.3g} kg m^2); the cage's mass and inertia go "
                         f"together: a uniform ring of this mass has m (r_in^2 + r_out^2) / 2 = "
                         f"{0.5 * (lo + hi):.4g} kg m^2")
+        raise _involving(exc, "bearing.cage_mass_kg", *_CAGE_DIAMETER_KEYS, *_RACEWAY_KEYS)
 
 
 def _check_geometry(m: ScenarioModel, source: str) -> None:
     b = m.bearing
     if b.roller_diameter_mm >= b.pitch_diameter_mm:
-        raise UserError(
+        exc = UserError(
             f"{source}: bearing.roller_diameter_mm: {b.roller_diameter_mm} mm must be smaller than "
             f"the pitch diameter {b.pitch_diameter_mm} mm"
         )
+        raise _involving(exc, "bearing.pitch_diameter_mm")
     if b.roller_count < MIN_ROLLER_COUNT:
         raise UserError(
             f"{source}: bearing.roller_count: {b.roller_count} is too few; a bearing needs at least "
             f"{MIN_ROLLER_COUNT} rollers to hold its inner ring and its cage (both models describe a whole bearing)"
         )
     if b.pocket_clearance_mm >= b.roller_diameter_mm:
-        raise UserError(
+        exc = UserError(
             f"{source}: bearing.pocket_clearance_mm: {b.pocket_clearance_mm} mm is not smaller than the "
             f"roller diameter {b.roller_diameter_mm} mm"
         )
+        raise _involving(exc, "bearing.roller_diameter_mm")
     _check_cage_bars(b, source)
     flat = m.multibody.flat_pockets
     bad = [i for i in flat if not 0 <= i < b.roller_count]
@@ -1229,8 +1272,9 @@ def _check_worn(m: ScenarioModel, source: str) -> None:
         return
     key = f"wear.{given[0][0]}"
     if m.model != "multibody":
-        raise UserError(f"{source}: {key}: worn pocket faces need the whole bearing (model = \"multibody\"); the "
+        exc = UserError(f"{source}: {key}: worn pocket faces need the whole bearing (model = \"multibody\"); the "
                         f"reduced model has no shape of the pocket faces")
+        raise _involving(exc, "model")
     if m.multibody.pocket_face_segments != 0:
         raise UserError(f"{source}: {key}: worn faces need the exact arc faces (multibody.pocket_face_segments = 0)")
     b = m.bearing
@@ -1255,9 +1299,10 @@ def _check_worn(m: ScenarioModel, source: str) -> None:
     bar = cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count)
     if on_bar.max() >= bar:
         i = int(np.unravel_index(np.argmax(on_bar), on_bar.shape)[1])
-        raise UserError(f"{source}: {key}: pocket {i}'s front face and pocket {(i - 1) % b.roller_count}'s rear face, "
+        exc = UserError(f"{source}: {key}: pocket {i}'s front face and pocket {(i - 1) % b.roller_count}'s rear face, "
                         f"either side of the cage bar between them, are worn {on_bar.max():.4g} mm deep together in a "
                         f"bin of psi, the bar's width ({bar:.4g} mm) or more: the bar would be worn through")
+        raise _involving(exc, *_POCKET_KEYS, "bearing.roller_count")
 
 
 def _most_pockets(width_mm: float, pitch_mm: float) -> int:
@@ -1277,15 +1322,17 @@ def _check_cage_bars(b: "BearingSection", source: str) -> None:
     advice = (f"at most {most} rollers" if most >= MIN_ROLLER_COUNT else
               f"not even {MIN_ROLLER_COUNT} rollers leave such bars: the pockets are too wide for this pitch circle")
     if pocket >= chord:
-        raise UserError(
+        exc = UserError(
             f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) do not fit "
             f"on a {b.pitch_diameter_mm} mm pitch circle (adjacent pockets {chord:.4g} mm apart); with cage bars "
             f"of at least {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter, {advice}")
+        raise _involving(exc, *_POCKET_KEYS)
     if chord - pocket < least:
-        raise UserError(
+        exc = UserError(
             f"{source}: bearing.roller_count: {b.roller_count} pockets of {pocket:.4g} mm ({keys}) on a "
             f"{b.pitch_diameter_mm} mm pitch circle leave cage bars of {chord - pocket:.3g} mm between them, less "
             f"than {MIN_CAGE_BAR_TO_ROLLER:.0%} of the roller diameter ({least:.3g} mm): not a rigid cage; {advice}")
+        raise _involving(exc, *_POCKET_KEYS)
 
 
 def _check_cage_wall(m: ScenarioModel, source: str) -> None:
@@ -1302,11 +1349,13 @@ def _check_cage_wall(m: ScenarioModel, source: str) -> None:
     pitch, d = b.pitch_diameter_mm, b.roller_diameter_mm
     wall = "(the cage wall holds the pockets around the pitch circle, between the raceways)"
     if bore is not None and not pitch - d < bore < pitch:
-        raise UserError(f"{source}: bearing.cage_inner_diameter_mm: the cage bore {bore:g} mm must lie between the inner raceway "
+        exc = UserError(f"{source}: bearing.cage_inner_diameter_mm: the cage bore {bore:g} mm must lie between the inner raceway "
                         f"diameter {pitch - d:g} mm and the pitch diameter {pitch:g} mm {wall}")
+        raise _involving(exc, *_RACEWAY_KEYS)
     if rim is not None and not pitch < rim < pitch + d:
-        raise UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage's outside diameter {rim:g} mm must lie between the pitch diameter "
+        exc = UserError(f"{source}: bearing.cage_outer_diameter_mm: the cage's outside diameter {rim:g} mm must lie between the pitch diameter "
                         f"{pitch:g} mm and the outer raceway diameter {pitch + d:g} mm {wall}")
+        raise _involving(exc, *_RACEWAY_KEYS)
 
 
 def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
@@ -1328,10 +1377,11 @@ def _check_pocket_faces(m: ScenarioModel, source: str) -> None:
                                      0.5e-3 * wall[0], 0.5e-3 * wall[1])
     a = mb.pocket_face_half_angle_deg
     if a != "auto" and a > min(-lo, hi) * 180.0 / math.pi * (1.0 + 1e-12):
-        raise UserError(f"{source}: multibody.pocket_face_half_angle_deg: {a:g} deg is wider than the cage wall "
+        exc = UserError(f"{source}: multibody.pocket_face_half_angle_deg: {a:g} deg is wider than the cage wall "
                         f"allows ({lo * 180.0 / math.pi:.1f} to +{hi * 180.0 / math.pi:.1f} deg from the pocket's "
                         f"centre line between bearing.cage_inner_diameter_mm and cage_outer_diameter_mm); use "
                         f"'auto' or at most {min(-lo, hi) * 180.0 / math.pi:.1f}")
+        raise _involving(exc, *_POCKET_KEYS, *_CAGE_DIAMETER_KEYS)
 
 
 def _check_land(m: ScenarioModel, source: str) -> None:
@@ -1345,10 +1395,12 @@ def _check_land(m: ScenarioModel, source: str) -> None:
                             f"(set it in the scenario or name a [bearing] preset that has it)")
     od, idia, c = b.cage_outer_diameter_mm, b.cage_inner_diameter_mm, b.cage_land_clearance_mm
     if b.cage_guidance == "outer_land" and od + c >= b.pitch_diameter_mm + b.roller_diameter_mm:
-        raise UserError(f"{source}: bearing.cage_land_clearance_mm: the outer land bore, cage OD + c_L = "
+        exc = UserError(f"{source}: bearing.cage_land_clearance_mm: the outer land bore, cage OD + c_L = "
                         f"{od + c:g} mm, must be smaller than the outer raceway diameter "
                         f"{b.pitch_diameter_mm + b.roller_diameter_mm:g} mm")
+        raise _involving(exc, "bearing.cage_outer_diameter_mm", "bearing.cage_guidance", *_RACEWAY_KEYS)
     if b.cage_guidance == "inner_land" and idia - c <= b.pitch_diameter_mm - b.roller_diameter_mm:
-        raise UserError(f"{source}: bearing.cage_land_clearance_mm: the inner land, cage ID - c_L = "
+        exc = UserError(f"{source}: bearing.cage_land_clearance_mm: the inner land, cage ID - c_L = "
                         f"{idia - c:g} mm, must be larger than the inner raceway diameter "
                         f"{b.pitch_diameter_mm - b.roller_diameter_mm:g} mm")
+        raise _involving(exc, "bearing.cage_inner_diameter_mm", "bearing.cage_guidance", *_RACEWAY_KEYS)

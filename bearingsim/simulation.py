@@ -82,7 +82,8 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     progress : show a progress bar on stderr (multibody runs).
     sink : where time series are streamed (default: kept in memory with the result).
     dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice; it becomes the scenario's
-        ``numerics.dt_s`` (validated as that key, and stored with the result, so its archive reruns it).
+        ``numerics.dt_s`` (validated as that key, a refusal naming the argument: "run(): dt: ...", and
+        stored with the result, so its archive reruns it).
 
     The checks are those of ``bearingsim run``: the step is validated as a scenario key, the run request
     too (:func:`bearingsim.scenario.check_run_request`: a multibody run needs a warm-up rotation), and a finished
@@ -92,15 +93,18 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     """
     from bearingsim import archive, plausibility
 
-    if not isinstance(scenario, Scenario):
-        from bearingsim.errors import UserError
+    from bearingsim.errors import UserError
 
+    if not isinstance(scenario, Scenario):
         raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
                         f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
     t0 = time.perf_counter()
-    if dt is not None:
-        scenario = scenario.replace(**{"numerics.dt_s": dt})
-    check_run(scenario, dt)  # what `bearingsim run` refuses beyond the schema, refused on every path
+    try:
+        if dt is not None:
+            scenario = scenario.replace(**{"numerics.dt_s": dt})
+        check_run(scenario, dt)  # what `bearingsim run` refuses beyond the schema, refused on every path
+    except UserError as exc:
+        raise _of_argument(exc, scenario.source) if dt is not None else exc from None
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
@@ -108,6 +112,15 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     result.provenance["wall_time_s"] = time.perf_counter() - t0
     result.notes = plausibility.check(result)
     return result
+
+
+def _of_argument(exc, source: str):
+    """``exc``, a refusal of the scenario ``source``'s ``numerics.dt_s`` that :func:`run`'s argument ``dt`` gave,
+    said of the argument ("run(): dt: why"): the scenario file does not hold that value. Any other refusal
+    is ``exc`` itself."""
+    head = f"{source}: numerics.dt_s: "
+    text = str(exc)
+    return type(exc)(f"run(): dt: {text[len(head):]}") if text.startswith(head) else exc
 
 
 def check_run(scenario: Scenario, dt: float | None = None) -> None:

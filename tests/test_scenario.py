@@ -272,6 +272,43 @@ def test_a_bad_override_is_named_as_the_override_not_as_the_file(sets, words):
         load_scenario(SCENARIOS / "paper_3000rpm.toml", values={"contact.restitution": 1.5})
 
 
+@pytest.mark.parametrize("scenario, sets, head", [
+    # a check across keys leads with another key than the one set (the pockets no longer fit: roller_count)
+    ("multibody_3000rpm", {"bearing.pocket_clearance_mm": 5},
+     "with bearing.pocket_clearance_mm=5: bearing.roller_count:"),
+    ("multibody_3000rpm", {"bearing.pitch_diameter_mm": 60},
+     "with bearing.pitch_diameter_mm=60: bearing.roller_count:"),
+    ("multibody_6000rpm", {"bearing.cage_outer_diameter_mm": 80.0},
+     "with bearing.cage_outer_diameter_mm=80.0: bearing.cage_inner_diameter_mm: the cage bore 91 mm"),
+    ("multibody_3000rpm",
+     {"bearing.pitch_diameter_mm": 60, "bearing.pocket_clearance_mm": 5, "contact.restitution": 0.5},
+     "with bearing.pitch_diameter_mm=60 and bearing.pocket_clearance_mm=5: bearing.roller_count:"),
+    # an unknown section or key: the override that named it
+    ("paper_3000rpm", {"operatin.inner_ring_speed_rpm": 500},
+     "with operatin.inner_ring_speed_rpm=500: operatin: unknown"),
+    ("paper_3000rpm", {"bearing.roller_diametre_mm": 13.0},
+     "with bearing.roller_diametre_mm=13.0: bearing.roller_diametre"),
+    ("paper_3000rpm", {"operating": {"speed": 1}}, "with operating={'speed': 1}: operating.speed: unknown key"),
+])
+def test_a_refusal_names_every_override_it_is_about(scenario, sets, head):
+    """A refusal of a check across keys, or of an unknown section, dropped the override that caused it
+    ("multibody_3000rpm.toml: bearing.roller_count: 16 pockets ... at most 15 rollers" for --set
+    bearing.pocket_clearance_mm=5; "paper_3000rpm.toml: operatin: unknown key" for operatin.inner_ring_speed_rpm):
+    the line names every override of a key it names or its check reads, as --set and as set= alike."""
+    path = SCENARIOS / f"{scenario}.toml"
+    with pytest.raises(UserError) as got:
+        load_scenario(path, values=sets)
+    assert str(got.value).startswith(f"{path} {head}"), str(got.value)
+    assert "\n" not in str(got.value)
+    if not any(isinstance(v, dict) for v in sets.values()):
+        with pytest.raises(UserError) as cli:
+            load_scenario(path, [f"{k}={v}" for k, v in sets.items()])
+        assert str(cli.value) == str(got.value)
+    with pytest.raises(UserError) as plain:
+        load_scenario(SCENARIOS / "paper_3000rpm.toml", ["foo.bar=1"])
+    assert str(plain.value).endswith("paper_3000rpm.toml with foo.bar=1: foo: unknown key")
+
+
 def test_a_key_the_settings_leave_unread_is_noted_as_unused_not_as_out_of_range():
     """A land key with a roller-guided cage (the preset's) changes nothing: `run` notes it as unused, and the
     plausible-range note leaves it out (it said the run "is of another bearing" and nothing of its being

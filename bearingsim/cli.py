@@ -27,11 +27,15 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.scenario import given_keys, load_scenario, motion_window_note, unread_note
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import given_keys, load_scenario, motion_window_note, unread_note, with_overrides
     from bearingsim.simulation import check_run, run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
-    check_run(scenario)  # what the run would refuse before its first step: the dry run refuses it too
+    try:
+        check_run(scenario)  # what the run would refuse before its first step: the dry run refuses it too
+    except UserError as exc:  # a value a --set gave is not the file's
+        raise with_overrides(exc, scenario.source, args.set) from None
     if not args.quiet:  # the keys given that have no effect on the run, or not the one asked, noted by the dry run too
         keys = given_keys(args.scenario, args.set)
         for note in (unread_note(scenario, keys), motion_window_note(scenario, keys)):

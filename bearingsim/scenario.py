@@ -683,6 +683,16 @@ def _with_override(exc: UserError, source: str, given: dict[str, str]) -> UserEr
     return type(exc)(f"{source} with {' and '.join(which)}: {body}")
 
 
+def with_overrides(exc: UserError, path, overrides=()) -> UserError:
+    """``exc``, a refusal of the run that the scenario file ``path`` with the ``KEY=VALUE`` ``overrides``
+    asks for (:func:`bearingsim.simulation.check_run`), naming the overrides it is about as a refusal of
+    :func:`load_scenario` does (:func:`_with_override`)."""
+    given = {}
+    for item in overrides or ():
+        given[parse_override(item)[0]] = item.strip()
+    return _with_override(exc, str(path), given)
+
+
 def _involving(exc: UserError, *keys: str) -> UserError:
     """``exc``, a check's refusal, marked with the other keys the check reads (``exc.involves``): an override
     of any of them is named in the message too (:func:`_with_override`)."""

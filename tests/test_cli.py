@@ -42,6 +42,23 @@ def test_bad_override_exits_2_naming_key_and_writes_nothing(tmp_path, setting, k
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("scenario, sets, head", [
+    ("paper_3000rpm", ["reduced.method=euler", "numerics.dt_s=1e-10"],
+     "with reduced.method=euler and numerics.dt_s=1e-10: numerics.dt_s: 1e-10 s needs"),
+    ("multibody_3000rpm", ["numerics.warmup_rotations=0", "contact.restitution=0.5"],
+     "with numerics.warmup_rotations=0: numerics.warmup_rotations: 0 with the multibody model"),
+])
+def test_a_refused_run_names_the_overrides_it_is_about(tmp_path, scenario, sets, head):
+    """What the run refuses before its first step (the model's step, the warm-up) blamed the file
+    ("paper_3000rpm.toml: numerics.dt_s: 1e-10 s needs ...") for values --set gave: the line names them, as
+    a refusal of the scenario's values does; the dry run refuses the same."""
+    path = SCENARIOS / f"{scenario}.toml"
+    for extra in (["--dry-run"], ["-o", tmp_path / "r.h5"]):
+        res = bearingsim("run", path, *extra, *[a for s in sets for a in ("--set", s)])
+        assert_user_error(res, f"{path} {head}")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_wrong_type_in_file_names_key(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text((SCENARIOS / "paper_3000rpm.toml").read_text().replace("rotations = 1", 'rotations = "one"'))

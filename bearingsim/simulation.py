@@ -92,7 +92,6 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     clean are in ``result.notes`` (the command line prints them).
     """
     from bearingsim import archive, plausibility
-
     from bearingsim.errors import UserError
 
     if not isinstance(scenario, Scenario):
@@ -104,7 +103,9 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
             scenario = scenario.replace(**{"numerics.dt_s": dt})
         check_run(scenario, dt)  # what `bearingsim run` refuses beyond the schema, refused on every path
     except UserError as exc:
-        raise _of_argument(exc, scenario.source) if dt is not None else exc from None
+        if dt is None:
+            raise
+        raise _of_argument(exc, scenario.source) from None
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario

@@ -294,14 +294,15 @@ def test_dt_far_too_large_is_user_error():
 @pytest.mark.parametrize("scenario, sets", [("multibody_3000rpm.toml", ["numerics.dt_s=1"]),
                                            ("paper_3000rpm.toml", ["reduced.method=euler", "numerics.dt_s=1"])])
 def test_a_time_step_refused_before_the_run_names_the_scenario_file(capsys, scenario, sets):
-    """The run's refusal of a step far above the stable one names the file, as the scenario's own refusals
-    do (it named the key alone): one line, exit 2, nothing written."""
+    """The run's refusal of a step far above the stable one names the file and the --set that gave the
+    step, as the scenario's own refusals do: one line, exit 2, nothing written."""
     from bearingsim.cli import main
 
     args = ["run", str(SCENARIOS / scenario), "--dry-run", "-q"] + [a for s in sets for a in ("--set", s)]
     assert main(args) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and err[0].startswith(f"bearingsim: error: {SCENARIOS / scenario}: numerics.dt_s")
+    assert len(err) == 1, err
+    assert err[0].startswith(f"bearingsim: error: {SCENARIOS / scenario} with numerics.dt_s=1: numerics.dt_s"), err
 
 
 @pytest.mark.slow

@@ -333,6 +333,21 @@ def test_report_of_a_validate_folder_is_its_own_kind(folders, tmp_path):
     assert "41 cases: done 41" in html
 
 
+def test_a_users_picture_in_a_validate_folder_is_not_shown_as_its_figure(folders, tmp_path):
+    """A validate folder's figures were picked by the PNG signature alone, so a user's picture saved under
+    a figure's name was shown as the study's; only a PNG bearingsim drew (its mark) is."""
+    import shutil
+
+    from bearingsim.studies import fig9, rig, validate
+
+    folder = tmp_path / "val"
+    shutil.copytree(folders / "val", folder)
+    assert validate.read_validate(folder).figures == [folder / n for n in (fig9.PNG_NAME, *rig.FIGURE_NAMES)]
+    mine = folder / rig.FIGURE_NAMES[0]
+    mine.write_bytes(b"\x89PNG\r\n\x1a\n" + b"\x00" * 64)  # a PNG signature, no mark of bearingsim's
+    assert validate.read_validate(folder).figures == [folder / fig9.PNG_NAME, folder / rig.FIGURE_NAMES[1]]
+
+
 def test_the_per_pocket_table_of_one_rotation_shows_no_standard_deviation(tmp_path):
     """A run of one recorded rotation was reported "mean and standard deviation over 1 recorded rotations"
     with a standard deviation of 0 in every pocket, a spread that one rotation cannot show; it says

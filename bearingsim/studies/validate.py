@@ -64,15 +64,16 @@ def is_validate_table(path) -> bool:
 
 def read_validate(folder) -> ValidateTables:
     """The tables and figures of validate folder ``folder`` (:func:`is_validate_table` of its Fig. 9
-    table is the caller's to check)."""
-    from bearingsim.outputs import PNG_SIGNATURE
+    table is the caller's to check); its figures are those bearingsim drew there (:func:`bearingsim.outputs.is_own_png`:
+    a user's picture of that name is not shown as the study's)."""
+    from bearingsim.outputs import is_own_png
 
     folder = Path(folder)
     rig_csv = folder / rig.CSV_NAME
     has_rig = "rig" in studies_in(folder) and _starts_with(rig_csv, rig.CSV_SIGNATURE)
     rows = rig.read_rig(rig_csv) if has_rig else None
     names = [fig9.PNG_NAME, *(rig.FIGURE_NAMES if has_rig else ())]
-    figures = [folder / n for n in names if _starts_with(folder / n, PNG_SIGNATURE)]
+    figures = [folder / n for n in names if is_own_png(folder / n)]
     return ValidateTables(folder, fig9.read_fig9(folder / fig9.CSV_NAME), rows,
                           int(rows[0]["rotations"]) if rows else 0, figures)
 

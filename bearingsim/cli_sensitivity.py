@@ -44,8 +44,8 @@ def _cmd_sensitivity(args) -> int:
     study = Sensitivity(_scenario(args), _keys(args.keys), step)  # bad keys refused before any run
     outcome, wall = _run(study, args)
     if outcome.interrupted is None and not args.quiet:
-        print(f"sensitivity of {args.scenario}: {counted(len(study.keys), 'key')} x {runs_text(step, study.half)} "
-              f"within each key's range, {wall:.1f} s")
+        print(f"sensitivity of {args.scenario}: {runs_text(step, study.half, len(study.keys), study.run_count)}, "
+              f"{wall:.1f} s")
         for k, why in study.left_out:
             print(f"left out: {k}: {why}; give it a nonzero value to vary it")
         print(format_table(study.rows))

@@ -498,7 +498,7 @@ def _sensitivity_sections(table: Path):
     from bearingsim.studies import sensitivity as sens
 
     rows, meta = sens.read_table(table)
-    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range", "n/a: why"]
+    head = ["key", "quantity", "measure", "sensitivity", "change over the key's range", "notes (n/a: why)"]
 
     def num(v, digits):
         return _cell(v, digits=digits) if math.isfinite(float(v)) else "n/a"
@@ -508,7 +508,7 @@ def _sensitivity_sections(table: Path):
         return (f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}"
                 + (f" (half step: {num(half, 3)})" if math.isfinite(half) else ""))
 
-    cells = [[r["key"], r["quantity"], r["measure"], slope(r), num(r["over_range"], 3), sens.missing_note(r)]
+    cells = [[r["key"], r["quantity"], r["measure"], slope(r), num(r["over_range"], 3), sens.row_note(r)]
              for r in rows]
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: d ln y / d ln x, "
                           "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,

@@ -203,9 +203,8 @@ def study_text(kind: str, file: Path) -> str:
     if kind == "sensitivity":
         rows, meta = sensitivity.read_table(file)
         keys = len(dict.fromkeys(r["key"] for r in rows))
-        half = any(math.isfinite(float(r.get("sensitivity_half_step", math.nan))) for r in rows)
-        head = [f"{file}: sensitivity of {meta.get('scenario_name', '?')}: {counted(keys, 'key')} x "
-                f"{sensitivity.runs_text(meta.get('step', 0), half)} within each key's range"]
+        runs = sensitivity.runs_text(meta.get("step", 0), sensitivity.ran_half_steps(rows), keys, meta.get("runs"))
+        head = [f"{file}: sensitivity of {meta.get('scenario_name', '?')}: {runs}"]
         if meta.get("left_out"):
             head.append(f"left out: {meta['left_out']}")
         return "\n".join([*head, sensitivity.format_table(rows)])

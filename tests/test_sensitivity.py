@@ -494,3 +494,32 @@ def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown, 
     assert runs in capsys.readouterr().out.splitlines()[0]
     _, sections, _ = reports._sensitivity_sections(tmp_path / "sensitivity.h5")
     assert f"(runs at x (1 ± {shown}))" in sections[0].blocks[0]["caption"], sections[0].blocks[0]["caption"]
+
+
+def test_a_half_step_clipped_onto_the_full_step_is_no_agreement(tmp_path, capsys):
+    """At 3000 rpm the roller diameter (13 mm, the top of its range [12.7, 13]) and the pitch diameter (97.5 mm,
+    range +-0.5 mm) are clipped to their ranges at 10 % and at 5 % alike: the half step's runs are the full
+    step's. Their "S, half step" said the same as S, which reads as "the slope is local", and the header
+    counted 4 runs a key (5 x 4) where 16 ran. Now the half step is n/a with why, the roller diameter's
+    one-sided difference is said, the count is the runs that ran, and the drag coefficient keeps its half step."""
+    keys = ["bearing.roller_diameter_mm", "bearing.pitch_diameter_mm", "lubrication.drag_coefficient"]
+    code = main(["sensitivity", str(SCENARIOS / "paper_3000rpm.toml"), "--keys", ",".join(keys), "-o", str(tmp_path),
+                 "-j", "1"])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "3 keys, 8 runs at x (1 ± 10%) and x (1 ± 5%) within each key's range (not 4 a key" in out.splitlines()[0]
+    assert "runs: 8 done, 0 cached, 0 failed" in out
+    rows, meta = sens.read_table(tmp_path / "sensitivity.h5")
+    by = {r["key"]: r for r in rows if r["quantity"] == "I_dec"}
+    clipped = "half step n/a: clipped to the key's range onto the full step's values"
+    for k in keys[:2]:
+        assert math.isnan(by[k]["sensitivity_half_step"]) and math.isfinite(by[k]["sensitivity"]), by[k]
+        assert clipped in sens.row_note(by[k])
+    assert sens.step_notes(by[keys[0]])[0] == "one-sided: x+ is x, the top of the key's range"
+    assert sens.step_notes(by[keys[1]]) == [clipped]
+    assert math.isfinite(by[keys[2]]["sensitivity_half_step"]) and sens.step_notes(by[keys[2]]) == []
+    line = next(x for x in out.splitlines() if x.startswith(keys[0]))
+    assert line.split()[5] == "n/a" and clipped in line, line
+    assert meta["runs"] == 8
+    assert main(["table", str(tmp_path)]) == 0
+    assert "3 keys, 8 runs" in capsys.readouterr().out.splitlines()[0]

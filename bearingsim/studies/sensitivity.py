@@ -20,7 +20,8 @@ SE(S) = sqrt(SE(ln y+)^2 + SE(ln y-)^2) / |ln x+ - ln x-|.
 The reduced model repeats one no-load pass every rotation: its sensitivities have no scatter (SE 0)
 and it has neither cage slip nor eccentricity (only ``I_dec`` and ``I_acc`` rows). Its I_dec jumps where the
 number of impacts of a pass changes, so a difference across a step may be no local slope: each key also
-runs at half the step, and ``sensitivity_half_step`` is S from those runs (NaN for the whole bearing).
+runs at half the step, and ``sensitivity_half_step`` is S from those runs (NaN for the whole bearing, and
+where the key's range clips the half step onto the full step's values: :func:`step_notes`).
 
 Outputs in ``DIR``: ``sensitivity.csv`` (:data:`COLUMNS`), ``sensitivity.h5`` (the same table as an
 index, with each run's archive, status and error), ``sensitivity.png`` (tornado chart), ``cases/``
@@ -74,11 +75,20 @@ def step_text(step) -> str:
     return f"{float(step) * 100.0:g}%"
 
 
-def runs_text(step, half: bool) -> str:
-    """The paired runs of a key, as the headers say them: "2 runs at x (1 ± 10%)", and for a study that ran
-    half steps too (the reduced model) "4 runs at x (1 ± 10%) and x (1 ± 5%)"."""
-    text = f"x (1 ± {step_text(step)})"
-    return f"4 runs at {text} and x (1 ± {step_text(float(step) / 2)})" if half else f"2 runs at {text}"
+def runs_text(step, half: bool, keys: int, runs: int | None = None) -> str:
+    """The keys and their runs, as the headers say them: "5 keys x 2 runs at x (1 ± 10%) within each key's
+    range", for a study that ran half steps too (the reduced model) "5 keys x 4 runs at x (1 ± 10%) and
+    x (1 ± 5%) within ...". ``runs``, the study's distinct runs, when fewer (a half step clipped to its key's
+    range onto the full step's values runs nothing new): "5 keys, 16 runs at ... (not 4 a key: ...)"."""
+    from bearingsim.wording import counted
+
+    per = 4 if half else 2
+    at = (f"at x (1 ± {step_text(step)})" + (f" and x (1 ± {step_text(float(step) / 2)})" if half else "")
+          + " within each key's range")
+    if runs is None or int(runs) == keys * per:
+        return f"{counted(keys, 'key')} x {per} runs {at}"
+    return (f"{counted(keys, 'key')}, {counted(int(runs), 'run')} {at} (not {per} a key: a half step the range "
+            f"clips onto the full step's values is no new run)")
 
 
 #: keys every run reads that move none of the headline numbers (:data:`QUANTITIES`): Archard's k and H scale
@@ -282,6 +292,28 @@ def missing_note(row) -> str:
     return "; ".join(notes)
 
 
+def step_notes(row) -> list[str]:
+    """What a row's differences are, where not the central ones they are taken for: one-sided (x+ or x- is
+    x itself, the key's value at an end of its range) and a half step clipped to the key's range onto the
+    full step's values (``x_minus_half``, ``x_plus_half`` of the study's index): no second slope, so its
+    ``sensitivity_half_step`` is NaN rather than the full step's S shown as agreement."""
+    x, xm, xp = (float(row[k]) for k in ("x", "x_minus", "x_plus"))
+    notes = []
+    if xp == x:
+        notes.append("one-sided: x+ is x, the top of the key's range")
+    elif xm == x:
+        notes.append("one-sided: x- is x, the bottom of the key's range")
+    hm, hp = (float(row.get(k, math.nan)) for k in ("x_minus_half", "x_plus_half"))
+    if (hm, hp) == (xm, xp):
+        notes.append("half step n/a: clipped to the key's range onto the full step's values")
+    return notes
+
+
+def row_note(row) -> str:
+    """A row's notes in one line: why a number is missing (:func:`missing_note`) and :func:`step_notes`."""
+    return "; ".join(n for n in (missing_note(row), *step_notes(row)) if n)
+
+
 class Sensitivity(Study):
     """Paired runs of every key (:func:`perturbed_scenarios`); table ``sensitivity.{csv,h5}``, figure
     ``sensitivity.png``.
@@ -304,20 +336,32 @@ class Sensitivity(Study):
         self.scenario, self.step = scenario, float(step)
         self.left_out: list[tuple[str, str]] = []  # default keys at 0, which a relative step cannot move
         self.keys = check_keys(scenario, keys, left_out=self.left_out)
-        self.runs = {}  # (key, side) -> (value, case)
+        self.runs = {}  # (key, side) -> (value, case); no half sides where they are the full step's values
+        self.half_values = {}  # key -> (x-, x+) of the half step, clipped to the key's range
         self.half = scenario.model == "reduced"  # deterministic: S at half the step too (HALF_SIDES)
+        full = perturbed_scenarios(scenario, self.keys, self.step)
+        half = perturbed_scenarios(scenario, self.keys, self.step / 2) if self.half else []
+        for k, side, v, _ in half:
+            self.half_values.setdefault(k, [None, None])[SIDES.index(side)] = v
+        same = {k for k, (hm, hp) in self.half_values.items() if (hm, hp) == self._full_values(full, k)}
         cases = []
-        for frac, sides in ((1.0, SIDES), (0.5, HALF_SIDES)) if self.half else ((1.0, SIDES),):
-            for k, side, v, sc in perturbed_scenarios(scenario, self.keys, self.step * frac):
+        for pairs, sides in ((full, SIDES), ([h for h in half if h[0] not in same], HALF_SIDES)):
+            for k, side, v, sc in pairs:
                 side = sides[SIDES.index(side)]
                 c = case_of(sc, {"key": k, "side": side, "value": v})
                 self.runs[(k, side)] = (v, c)
                 cases.append(c)
         self.cases = cases
+        self.run_count = len({c.hash for c in cases})  # a half side at the full step's value is the same run
         self.outputs = [("sensitivity.csv", ",".join(COLUMNS).encode(), "sensitivity table"),
                         ("sensitivity.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sensitivity table"),
                         ("sensitivity.png", is_own_png, "figure")]
         self.rows: list[dict] = []
+
+    @staticmethod
+    def _full_values(full, key) -> tuple:
+        """(x-, x+) of ``key`` in :func:`perturbed_scenarios`' list ``full``."""
+        return tuple(v for k, _, v, _ in full if k == key)
 
     def finish(self, outdir, records) -> list[Path]:
         from bearingsim.ranges import value_of
@@ -330,7 +374,8 @@ class Sensitivity(Study):
         for k in self.keys:
             lo, hi, _ = ranges[k]
             (xm, xp), (hm, hp), (rm, rp) = self._pair(outdir, records, k, SIDES)
-            half = self._pair(outdir, records, k, HALF_SIDES) if self.half else None
+            half = self._pair(outdir, records, k, HALF_SIDES) if (k, HALF_SIDES[0]) in self.runs else None
+            hx = self.half_values.get(k, (math.nan, math.nan))
             failed = [r for r in (rm, rp, *(half[2] if half else ())) if r["status"] == "failed"]
             for q, _, measure in quantities:
                 ym, sm = hm.get(q, (math.nan, math.nan))
@@ -345,12 +390,12 @@ class Sensitivity(Study):
                              "x_minus": xm, "x_plus": xp, "y_minus": ym, "y_minus_se": sm, "y_plus": yp,
                              "y_plus_se": sp, "sensitivity": s, "sensitivity_se": se,
                              "over_range": s * math.log(hi / lo) if lo > 0 else math.nan,
-                             "sensitivity_half_step": s_half,
+                             "sensitivity_half_step": s_half, "x_minus_half": hx[0], "x_plus_half": hx[1],
                              "archive_minus": rm["archive"], "archive_plus": rp["archive"],
                              "status": "failed" if failed else "done",
                              "error": "; ".join(r["error"] for r in failed)})
         self.rows = rows
-        paths = write_table(outdir, rows, self.scenario, self.step, self.left_out)
+        paths = write_table(outdir, rows, self.scenario, self.step, self.left_out, self.run_count)
         return [*paths, *plot_sensitivity(outdir / "sensitivity.h5", outdir)]
 
     def _pair(self, outdir, records, key, sides):
@@ -364,10 +409,11 @@ class Sensitivity(Study):
         return (xm, xp), tuple(heads), (rm, rp)
 
 
-def write_table(outdir, rows, scenario, step, left_out=()) -> tuple[Path, Path]:
+def write_table(outdir, rows, scenario, step, left_out=(), runs=None) -> tuple[Path, Path]:
     """``sensitivity.csv`` (exactly :data:`COLUMNS`, a failed pair's numbers empty) and
-    ``sensitivity.h5`` (those columns and each pair's archives, status and error; ``left_out``, the
-    default keys not varied and why, in its ``left_out`` attribute) atomically."""
+    ``sensitivity.h5`` (those columns, the half step's values ``x_minus_half``, ``x_plus_half`` and each
+    pair's archives, status and error; ``left_out``, the default keys not varied and why, in its
+    ``left_out`` attribute; ``runs``, the study's distinct runs, in its ``runs`` attribute) atomically."""
     from bearingsim import archive
     from bearingsim.outputs import write_atomic_bytes
     from bearingsim.studies.engine import table_columns, table_csv
@@ -375,10 +421,12 @@ def write_table(outdir, rows, scenario, step, left_out=()) -> tuple[Path, Path]:
     outdir = Path(outdir)
     csv_path = outdir / "sensitivity.csv"
     write_atomic_bytes(csv_path, table_csv(rows, COLUMNS))
-    columns = (*COLUMNS, "archive_minus", "archive_plus", "status", "error")
+    columns = (*COLUMNS, "x_minus_half", "x_plus_half", "archive_minus", "archive_plus", "status", "error")
     cols = table_columns(rows, columns)
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
              "scenario_name": scenario.name, "step": float(step)}
+    if runs is not None:
+        attrs["runs"] = int(runs)
     if left_out:
         attrs["left_out"] = "; ".join(f"{k} ({why})" for k, why in left_out)
     h5_path = archive.write_table_file(outdir / "sensitivity.h5", cols, UNITS, attrs)
@@ -391,21 +439,28 @@ def _num(v, spec: str) -> str:
     return format(v, spec) if math.isfinite(v) else "n/a".rjust(width)
 
 
+def ran_half_steps(rows) -> bool:
+    """Whether the study of ``rows`` ran half steps (the reduced model): a half step's value or slope is a number."""
+    return any(math.isfinite(float(r.get(k, math.nan))) for r in rows
+               for k in ("sensitivity_half_step", "x_minus_half"))
+
+
 def format_table(rows: list[dict]) -> str:
     """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
     quantity, S ± its standard error and the change over the key's range (n/a and why where missing)."""
-    half = any(math.isfinite(float(r.get("sensitivity_half_step", math.nan))) for r in rows)
+    half = ran_half_steps(rows)
     lines = [f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}"
              + (f" {'S, half step':>12s}" if half else "")]
     for r in rows:
-        note = missing_note(r)
+        note = row_note(r)
         lines.append(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
                      f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
                      + (f" {_num(float(r.get('sensitivity_half_step', math.nan)), '+12.3f')}" if half else "")
                      + (f"  ({note})" if note else ""))
     if half:
         lines.append("S, half step: the same slope from runs at half the step (a deterministic model has no "
-                     "standard error; where the two differ, the difference is not a local slope)")
+                     "standard error; where the two differ, the difference is not a local slope; n/a where the "
+                     "key's range clips the half step onto the full step's values: no second slope to compare)")
     return "\n".join(lines)
 
 

@@ -72,8 +72,11 @@ def _describe_index(path) -> tuple[str, str | None] | None:
                  f"grid of {', '.join(meta['grid']) or '(no axes)'}: {counted(n, 'case')}; extra cases: {total - n}",
                  "each case's archive: the 'archive' column (relative to this folder; empty for a case run "
                  "without one); 'bearingsim show' of a case archive gives its scenario"]
+        toml = meta.get("scenario_toml") or None
+        if toml:
+            lines.append(f"the base scenario resolved, with the sweep's --set: 'bearingsim show {path}'")
         return archive.describe_table(path, "bearingsim sweep index (one row per case)", cols,
-                                      meta["columns"], lines, noun="case"), None
+                                      meta["columns"], lines, noun="case"), toml
     from bearingsim.sweeps.grid import MAP_FORMAT, describe_map, read_map
 
     if archive.is_grid_file(path, MAP_FORMAT):

@@ -389,7 +389,9 @@ def _sweep_sections(index: Path):
     head = {"kind": "text", "text": f"Base scenario {meta.get('scenario') or '(cases only)'}; swept keys: {keys}; "
                                     f"mode {meta.get('mode', '?')}."}
     map_path = index.parent / MAP_NAME
-    toml = read_map(map_path).attrs.get("scenario") if archive.is_grid_file(map_path, MAP_FORMAT) else None
+    toml = meta.get("scenario_toml") or None  # the base scenario resolved (a sweep of a scenario stores it)
+    if toml is None and archive.is_grid_file(map_path, MAP_FORMAT):
+        toml = read_map(map_path).attrs.get("scenario")
     sections = [Section("table", "Cases", [head, _summary_table_block(tables.table_of_index(index),
                                                                       "Summary numbers of every case")]),
                 Section("figures", "Figures", figures)]

@@ -1111,3 +1111,23 @@ def test_a_range_of_no_values_is_refused_in_the_form_given(tmp_path):
                  '"bearing.pocket_clearance_mm" = { start = 0.1, stop = 0.3, num = 0 }\n')
     with pytest.raises(UserError, match=r"clearance_mm: \{ start, stop, num \} needs numbers and an integer num"):
         load_sweep_file(f)
+
+
+def test_a_zip_sweep_without_archives_keeps_its_resolved_scenario(tmp_path, capsys):
+    """A zip sweep of reduced cases keeps no case archive and no map: its sweep.h5 held only the scenario's
+    path, so `show` of it gave a description and the folder's report said "stores no scenario". The index
+    now holds the base scenario resolved with the sweep's --set (rotations 2, the file's [set] says 1)."""
+    from bearingsim import reports
+    from bearingsim.cli import main
+
+    target = ROOT / "scenarios" / "sweeps" / "speed_zip_and_extras.toml"
+    out = tmp_path / "zip"
+    assert run_sweep_cli(target, [], ["numerics.rotations=2"], out, jobs=1, figures=False, quiet=True) == 0
+    assert not (out / "cases").exists() and not (out / "map.h5").exists()
+    want = load_scenario(BASE, ["numerics.rotations=2"]).to_toml()
+    assert read_index(out / "sweep.h5")[1]["scenario_toml"] == want
+    capsys.readouterr()
+    assert main(["show", str(out / "sweep.h5")]) == 0
+    assert capsys.readouterr().out == want
+    _, _, toml = reports._sweep_sections(out / "sweep.h5")
+    assert toml == want

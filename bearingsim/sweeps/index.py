@@ -15,7 +15,9 @@ plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.stats.impulse_st
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
 NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every
 swept key in ``axes``, the grid's axes in ``grid`` (JSON lists), the sweep ``mode`` (``product`` or
-``zip``) and ``grid_rows`` (the grid's cases come first; explicit extra cases follow). Both files are written to a temporary name and renamed.
+``zip``), ``grid_rows`` (the grid's cases come first; explicit extra cases follow) and, for a sweep of a
+scenario, ``scenario_toml``: its base scenario resolved, with the sweep's ``--set`` applied (``scenario``
+is the scenario file's path). Both files are written to a temporary name and renamed.
 """
 from __future__ import annotations
 

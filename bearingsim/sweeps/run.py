@@ -511,9 +511,10 @@ def _resolve(spec, engine, archives: str, grid) -> tuple[list[Case], list[str], 
     cases = resolve_cases(spec)
     from bearingsim.scenario import load_scenario, sweep_context
 
+    base = load_scenario(spec.scenario, spec.sets)
     meta = {"scenario": str(spec.scenario), "mode": spec.mode, "origin": spec.origin,
             "grid": json.dumps([k for k, _ in spec.axes]), "grid_rows": len(cases) - len(spec.extra),
-            "context": sweep_context(load_scenario(spec.scenario, spec.sets), spec.keys)}
+            "context": sweep_context(base, spec.keys), "scenario_toml": base.to_toml()}
     return cases, spec.keys, meta, (_map_attrs(spec) if grid else {})
 
 

@@ -66,7 +66,10 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
             from bearingsim import tables
 
             print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
-            print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s)")
+            noted = sum(bool(r.get("notes")) for r in out.rows)
+            notes = (f"; {counted(noted, 'case')} with notes (the table's notes column; 'bearingsim table "
+                     f"{out.outdir}' lists them)" if noted else "")
+            print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s){notes}")
     except KeyboardInterrupt as exc:  # the cases, index and figures are written: the command line says so
         exc.resume_note = (f"{counted(n, 'case')} indexed in {out.h5}, the table not all printed "
                            f"('bearingsim table {out.outdir}' prints it)")

@@ -595,6 +595,23 @@ def _life_limit_note(attrs: dict) -> str | None:
         return None
 
 
+def _run_notes_blocks(cols, meta) -> list[dict]:
+    """The index's run notes (its ``notes`` column: a run that is plausible but not clean,
+    :func:`bearingsim.plausibility.check`): a line saying how many cases have them and a table of them."""
+    from bearingsim.sweeps.index import notes_of
+    from bearingsim.tables import cell_text
+
+    axes = [k for k in meta.get("axes", ()) if k in cols]
+    rows = [[str(c), ", ".join(f"{k} = {cell_text(cols[k][i])}" for k in axes), note]
+            for i, (c, cell) in enumerate(zip(cols["case"], cols.get("notes", ()))) for note in notes_of(cell)]
+    if not rows:
+        return []
+    cases = len({r[0] for r in rows})
+    return [{"kind": "text", "text": f"{counted(cases, 'case')} kept with notes (a run that is plausible but not "
+                                     "clean; docs/reliability.md):"},
+            table_block("Notes of the cases' runs", ["case", "values", "note"], rows)]
+
+
 def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None) -> list[Section]:
     """The cases (status counts, failures), the scenario (``toml``: the folder's scenario as TOML text,
     or the Scenario section's blocks; ``scenarios``: sections given instead) and the provenance of a
@@ -617,6 +634,7 @@ def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None)
                                                (":" if failed else ". No case failed.")})
         if failed:
             checks.append(table_block("Failed cases", ["case", "error"], failed))
+        checks += _run_notes_blocks(cols, meta)
         row = next((i for i, a in enumerate(cols["archive"]) if a and (folder / a).is_file()), None)
         first = folder / cols["archive"][row] if row is not None else None
         # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)

@@ -42,13 +42,15 @@ SCALED = {"N s": (1e3, "mN s")}
 @dataclass
 class Table:
     """Rows of runs: ``labels[name]`` (text per row), ``numbers[key]`` (float per row, SI),
-    ``units[key]``; ``notes`` are lines printed above the table."""
+    ``units[key]``; ``notes`` are lines printed above the table; ``footnotes`` (row -> text) are printed
+    under it for the rows shown, each marked in the row's label column ``notes`` (``[1]``, ``[2]``, ...)."""
 
     label_names: list[str]
     labels: dict[str, list[str]]
     numbers: dict[str, np.ndarray]
     units: dict[str, str]
     notes: list[str] = field(default_factory=list)
+    footnotes: dict[int, str] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(next(iter(self.labels.values()))) if self.labels else 0
@@ -82,7 +84,23 @@ def table_of_index(path) -> Table:
     from bearingsim.wording import counted
 
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
-    return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes)
+    footnotes = _run_notes(cols, names, labels)
+    return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes)
+
+
+def _run_notes(cols, names: list[str], labels: dict) -> dict[int, str]:
+    """The index's run notes (its ``notes`` column) as footnotes by row, each row with notes marked
+    ``[k]`` in a label column ``notes`` added to ``names`` and ``labels`` (none when no case has notes)."""
+    from bearingsim.sweeps.index import notes_of
+
+    n = len(cols["case"])
+    found = {i: notes_of(c) for i, c in enumerate(cols.get("notes", [""] * n)) if notes_of(c)}
+    if not found:
+        return {}
+    marks = {i: f"[{k}]" for k, i in enumerate(sorted(found), 1)}
+    names.append("notes")
+    labels["notes"] = [marks.get(i, "") for i in range(n)]
+    return {i: f"{marks[i]} " + "; ".join(found[i]) for i in sorted(found)}
 
 
 def table_of_archives(paths) -> Table:
@@ -345,4 +363,8 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
         out.append(f"... {n - shown} more rows ('bearingsim table' prints them all)")
     if any(k in SEM_OF for k in keys):
         out.append(RULE)
+    noted = [text for i, text in sorted(table.footnotes.items()) if i < shown]
+    if noted:
+        out.append("notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):")
+        out += noted
     return "\n".join(out)

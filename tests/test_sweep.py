@@ -1131,3 +1131,32 @@ def test_a_zip_sweep_without_archives_keeps_its_resolved_scenario(tmp_path, caps
     assert capsys.readouterr().out == want
     _, _, toml = reports._sweep_sections(out / "sweep.h5")
     assert toml == want
+
+
+@pytest.mark.parametrize("archives", ["auto", "all"])
+def test_a_runs_notes_are_kept_in_the_sweeps_index_table_and_report(tmp_path, capsys, archives):
+    """A case run alone prints its plausibility notes; in a sweep they were dropped: no notes column, no
+    word in the closing line or the table, and the report said "No case failed" alone. A pocket clearance of
+    0.3 mm (plausible 0.16 to 0.24) gets a note; 0.2 mm none. The notes stay when the sweep is run again
+    (cached: from the previous index, whether or not the case keeps an archive)."""
+    from bearingsim import reports, tables
+
+    out = tmp_path / "s"
+    for again in (False, True):
+        assert run_sweep_cli(BASE, ["bearing.pocket_clearance_mm=0.2,0.3"], [], out, jobs=1, figures=False,
+                             archives=archives) == 0
+        printed = capsys.readouterr().out
+        cols, _ = read_index(out / "sweep.h5")
+        assert list(cols["status"]) == ["cached" if again else "done"] * 2
+        assert cols["notes"][0] == "" and "bearing.pocket_clearance_mm = 0.3" in cols["notes"][1], cols["notes"]
+        assert "outside the plausible range" in cols["notes"][1] and "bearingsim: note:" not in cols["notes"][1]
+        assert printed.rstrip().splitlines()[-1].endswith(f"1 case with notes (the table's notes column; "
+                                                          f"'bearingsim table {out}' lists them)"), printed
+        assert _rows(out)[1]["notes"] == cols["notes"][1]
+    text = tables.format_table(tables.table_of_index(out / "sweep.h5"))
+    head, first, second = text.splitlines()[1:4]
+    assert "notes" in head.split() and "[1]" not in first and "[1]" in second
+    assert any(line.startswith("[1] bearing.pocket_clearance_mm = 0.3") for line in text.splitlines()), text
+    checks = reports._folder_sections(out, None)[0].blocks
+    assert "1 case kept with notes" in checks[1]["text"]
+    assert [r[2] for r in checks[2]["rows"]] == [cols["notes"][1]]

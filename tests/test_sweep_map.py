@@ -43,7 +43,7 @@ def test_map_holds_the_index_numbers_over_the_axes(tmp_path):
     _same(m.coords[SPEED], [1000.0, 2000.0, 3000.0])
     _same(m.coords[DT], [1e-6, 0.01])
     cols, meta = read_index(tmp_path / "sweep.h5")
-    summary = [c for c in meta["columns"] if c not in ("case", SPEED, DT, "status", "error", "archive")]
+    summary = [c for c in meta["columns"] if c not in ("case", SPEED, DT, "status", "error", "archive", "notes")]
     assert {"I_dec_mean_Ns", "I_acc_mean_Ns", "I_dec_sem_Ns", "first_impact_speed_m_s", "wall_s",
             "model_version"} <= set(summary)
     for k in summary:

@@ -227,7 +227,7 @@ def _new_cases(cases: list[Case], more) -> list[Case]:
 
 
 #: what a round of a staged study hands on of each case's row to the next (sweeps.run_sweep's ``earlier``)
-_ROW_KEYS = ("status", "error", "archive", "wall_s", "model_version", "summary")
+_ROW_KEYS = ("status", "error", "archive", "wall_s", "model_version", "summary", "notes")
 
 
 def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options: dict):

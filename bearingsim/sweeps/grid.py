@@ -37,7 +37,7 @@ MAP_FORMAT = "bearingsim sweep map 1"
 MAP_NAME = "map.h5"
 #: index columns that are not variables of the map: the axes are its coordinates, the rest is text
 #: about single cases (``error``, ``archive``) that the index keeps
-NOT_MAPPED = ("error", "archive")
+NOT_MAPPED = ("error", "archive", "notes")
 LONG_NAMES = {"status": "status of the case (done, cached, stale, failed, pending)",
               "case": "content hash of the case's resolved scenario",
               "model_version": "version of the model that computed the case",

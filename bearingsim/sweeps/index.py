@@ -9,7 +9,9 @@ archive of the same scenario there was computed by another version of the model,
 that stored none; ``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
 ``archive`` (path relative to the sweep folder; empty for a case run without one), ``wall_s`` (seconds
 the case took; for a cached case the stored run's own wall time), ``model_version`` (the version of the
-model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown) and the summary numbers (SI, as in the archives' ``/results/summary``,
+model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown), ``notes`` (the run's
+plausibility notes, :func:`bearingsim.plausibility.check`, one a line without the ``bearingsim: note:``
+prefix; empty for a clean run) and the summary numbers (SI, as in the archives' ``/results/summary``,
 plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.stats.impulse_standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
@@ -34,7 +36,7 @@ from bearingsim.outputs import write_atomic_bytes
 
 INDEX_FORMAT = "bearingsim sweep index 1"
 CSV_SIGNATURE = b"case,"  # the first bytes of every sweep.csv bearingsim writes (its header)
-FIXED = ("status", "error", "archive", "wall_s", "model_version")
+FIXED = ("status", "error", "archive", "wall_s", "model_version", "notes")
 # summary numbers shown first when present; any others follow in name order
 PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
              "first_impact_speed_m_s", "first_impact_energy_J", "cage_slip", "cage_rest_angle_deg",
@@ -101,7 +103,7 @@ class IndexWriter:
             else:
                 cols[k] = np.array(["" if v is None else str(v) for v in vals], dtype=object)
             units[k] = unit_of(k)
-        for col in ("status", "error", "archive"):
+        for col in ("status", "error", "archive", "notes"):
             cols[col] = np.empty(n, dtype=object)
         cols["wall_s"] = np.full(n, math.nan)
         units["wall_s"] = "s"
@@ -125,12 +127,13 @@ class IndexWriter:
             buf.truncate()
             w.writerow([r["case"], *[_cell(_value(r, k)) for k in keys], r["status"], r.get("error", ""),
                         r.get("archive", ""), _fmt(r.get("wall_s")), _version_text(r.get("model_version")),
-                        *[_fmt(s.get(k)) for k in summ]])
+                        notes_text(r.get("notes")), *[_fmt(s.get(k)) for k in summ]])
             self._lines[i] = buf.getvalue()
             for col in ("status", "error", "archive"):
                 cols[col][i] = r.get(col, "")
             cols["wall_s"][i] = _float(r.get("wall_s"))
             cols["model_version"][i] = _float(r.get("model_version"))
+            cols["notes"][i] = notes_text(r.get("notes"))
             for k in summ:
                 cols[k][i] = _float(s.get(k))
         self._dirty = set()
@@ -150,6 +153,16 @@ class IndexWriter:
     def columns(self) -> dict[str, np.ndarray]:
         """The index's columns as last written (one array per column, in column order)."""
         return {c: self._cols[c] for c in ["case", *self.keys, *FIXED, *(self._summ or [])]}
+
+
+def notes_text(notes) -> str:
+    """A row's notes (a list of lines) as its ``notes`` cell: one a line, "" for none."""
+    return "\n".join(notes or ())
+
+
+def notes_of(cell) -> list[str]:
+    """The notes of a ``notes`` cell (:func:`notes_text`) as a list; [] for an empty cell or none."""
+    return [line for line in str(cell or "").split("\n") if line]
 
 
 def _value(row: dict, key: str):
@@ -234,7 +247,8 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     """The record of a case whose archive is complete and stores exactly ``toml_text``, else None.
 
     Only a file at the final name is considered (temporary files are never trusted); an unreadable,
-    incomplete or different archive gives None and the case runs again. An archive of the case's
+    incomplete or different archive gives None and the case runs again. The record has ``notes`` when
+    the archive stores its run's notes (else the caller takes the previous index row's). An archive of the case's
     scenario computed by another version of its model than this one (``model_version`` in its
     provenance against :data:`bearingsim.model_versions.MODEL_VERSIONS`; none stored counts as
     another) gives ``{"status": "stale"}`` without its numbers: the case runs again too.
@@ -250,8 +264,12 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
     summary.update(standard_errors(got["I_dec"], got["I_acc"], got["model"]))
     wall = got["wall_time_s"]
-    return {"status": "cached", "error": "", "wall_s": wall, "summary": summary,
-            "model_version": got["model_version"]}
+    rec = {"status": "cached", "error": "", "wall_s": wall, "summary": summary, "model_version": got["model_version"]}
+    if got.get("notes") is not None:  # an archive that stores its run's notes
+        from bearingsim.sweeps.worker import run_notes
+
+        rec["notes"] = run_notes([got["notes"]] if isinstance(got["notes"], str) else got["notes"])
+    return rec
 
 
 #: statuses of an index row whose numbers a resumed sweep may take (when its model version matches)
@@ -260,8 +278,8 @@ HAS_NUMBERS = ("done", "cached", "stale")
 
 def read_rows(path: Path) -> dict[str, dict]:
     """The rows of an existing ``sweep.h5`` by case hash, each ``status``, ``model_version`` (None if
-    the index has none), ``wall_s`` and ``summary`` (every summary column, NaN included); ``{}`` when
-    ``path`` is missing or not a sweep index."""
+    the index has none), ``wall_s``, ``notes`` (a list; [] where the index has no notes column) and
+    ``summary`` (every summary column, NaN included); ``{}`` when ``path`` is missing or not a sweep index."""
     from bearingsim.errors import UserError
 
     try:
@@ -271,12 +289,14 @@ def read_rows(path: Path) -> dict[str, dict]:
     summ = [c for c in meta["columns"] if c != "case" and c not in meta["axes"] and c not in FIXED]
     n = len(cols["case"])
     versions = cols.get("model_version", np.full(n, math.nan))
+    notes = cols.get("notes", [""] * n)
     out = {}
     for i in range(n):
         v = float(versions[i])
         out[str(cols["case"][i])] = {
             "status": str(cols["status"][i]), "model_version": int(v) if math.isfinite(v) else None,
-            "wall_s": float(cols["wall_s"][i]), "summary": {k: float(cols[k][i]) for k in summ}}
+            "wall_s": float(cols["wall_s"][i]), "notes": notes_of(notes[i]),
+            "summary": {k: float(cols[k][i]) for k in summ}}
     return out
 
 
@@ -294,4 +314,4 @@ def trusted_row(row: dict | None, model: str) -> dict | None:
     if row["model_version"] is None or row["model_version"] != MODEL_VERSIONS.get(model):
         return {"status": "stale"}
     return {"status": "cached", "error": "", "wall_s": row["wall_s"], "summary": dict(row["summary"]),
-            "model_version": row["model_version"]}
+            "model_version": row["model_version"], "notes": list(row.get("notes", ()))}

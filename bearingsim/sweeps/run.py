@@ -269,12 +269,13 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
     scenario computed by the current model version (:func:`~bearingsim.sweeps.index.read_cached`);
     a case that keeps no archive under ``archives`` is also taken from its row of the previous index
     (:func:`~bearingsim.sweeps.index.trusted_row`: same content hash, same model version). A stale
-    archive or row, or none, means the case runs again; a stale archive is removed first."""
+    archive or row, or none, means the case runs again; a stale archive is removed first. A cached case
+    keeps the notes of its run: its archive's when it stores them, else its row's in the previous index."""
     from bearingsim.sweeps.index import read_rows, trusted_row
     from bearingsim.sweeps.worker import keeps_archive
 
     cases_dir = outdir / "cases"
-    old = read_rows(outdir / "sweep.h5") if any(not keeps_archive(c.model, archives) for c in cases) else {}
+    old = read_rows(outdir / "sweep.h5")  # numbers of cases without an archive; notes of every case
     todo, stale = [], set()
     for c, row in zip(cases, rows):
         if earlier and c.hash in earlier:
@@ -294,6 +295,8 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
                 stale.add(c.hash)
         else:
             row.update(rec, archive=where)
+            if "notes" not in rec:  # an archive that stores no notes: its row's in the previous index
+                row["notes"] = list(old.get(c.hash, {}).get("notes", ()))
     return todo, stale
 
 
@@ -358,7 +361,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         raise
     progress = sys.stderr.isatty() if progress is None else progress
     rows = [{"case": c.hash, "values": c.values, "ran_at": c.ran_at, "status": "pending", "error": "", "archive": "",
-             "wall_s": math.nan, "model_version": None, "summary": {}} for c in cases]
+             "wall_s": math.nan, "model_version": None, "summary": {}, "notes": []} for c in cases]
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
                            map=outdir / MAP_NAME if grid else None)
     index = IndexWriter(outdir, rows, keys, meta)
@@ -478,7 +481,7 @@ def _collect(engine, todo, cases, rows, stale, counts, index, bar, say, signals,
                 write_atomic_bytes(cases_dir / f"{rec['hash']}.h5", data)
             status = "stale" if rec["status"] == "done" and rec["hash"] in stale else rec["status"]
             kept = rec["status"] == "done" and keeps_archive(cases[i].model, archives)
-            row.update(status=status, error=rec["error"], wall_s=rec["wall_s"],
+            row.update(status=status, error=rec["error"], wall_s=rec["wall_s"], notes=rec.get("notes", []),
                        summary=rec["summary"], model_version=rec.get("model_version"),
                        archive=f"cases/{rec['hash']}.h5" if kept else "")
             index.changed(i)

@@ -43,6 +43,15 @@ def _numbers(summary: dict) -> dict[str, float]:
     return out
 
 
+NOTE_PREFIX = "bearingsim: note: "
+
+
+def run_notes(notes) -> list[str]:
+    """A run's notes (:func:`bearingsim.plausibility.check`, ``result.notes``) as a sweep's index keeps
+    them: one line each, without the command line's ``bearingsim: note:`` prefix."""
+    return [str(n)[len(NOTE_PREFIX):] if str(n).startswith(NOTE_PREFIX) else str(n) for n in notes or ()]
+
+
 def _per_rotation(res):
     """(I_dec, I_acc) per rotation [rotations, pockets] of a result."""
     return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
@@ -103,8 +112,8 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
     validated it), else the text is resolved again here.
 
     Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s``,
-    ``model_version`` (of the model that computed it) and the summary numbers with the standard
-    errors of :func:`standard_errors`.
+    ``model_version`` (of the model that computed it), ``notes`` (the run's plausibility notes,
+    :func:`run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`.
     """
     from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml
@@ -134,7 +143,8 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res), scenario.model))
         rec = {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
-               "summary": summary, "model_version": res.provenance.get("model_version")}
+               "summary": summary, "model_version": res.provenance.get("model_version"),
+               "notes": run_notes(res.notes)}
         if data is not None:
             rec["archive"] = data
         return rec

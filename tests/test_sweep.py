@@ -1160,3 +1160,17 @@ def test_a_runs_notes_are_kept_in_the_sweeps_index_table_and_report(tmp_path, ca
     checks = reports._folder_sections(out, None)[0].blocks
     assert "1 case kept with notes" in checks[1]["text"]
     assert [r[2] for r in checks[2]["rows"]] == [cols["notes"][1]]
+
+
+def test_a_case_has_one_wall_time_done_or_cached(tmp_path):
+    """A case's wall_s was the worker's time around the run and its archive's writing when done (1.5367 s)
+    and the archive's own run time when cached (1.4349 s): now the run's own time, as its archive stores it."""
+    from bearingsim import archive
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    done = run_sweep(spec, tmp_path, figures=False, progress=False, archives="all")
+    cached = run_sweep(spec, tmp_path, figures=False, progress=False, archives="all")
+    assert [r["status"] for r in done.rows] == ["done"] * 2 and [r["status"] for r in cached.rows] == ["cached"] * 2
+    for a, b in zip(done.rows, cached.rows):
+        assert a["wall_s"] == b["wall_s"] == archive.peek(tmp_path / a["archive"])["wall_time_s"]
+    assert [float(x) for x in read_index(tmp_path / "sweep.h5")[0]["wall_s"]] == [r["wall_s"] for r in done.rows]

@@ -7,8 +7,9 @@ its resolved scenario; empty only where that has none), ``status``
 of its model (:mod:`bearingsim.model_versions`), was already there; ``stale``: run now because the
 archive of the same scenario there was computed by another version of the model, or by a bearingsim
 that stored none; ``failed``; ``pending``: not run because the sweep was interrupted), ``error`` (one line),
-``archive`` (path relative to the sweep folder; empty for a case run without one), ``wall_s`` (seconds
-the case took; for a cached case the stored run's own wall time), ``model_version`` (the version of the
+``archive`` (path relative to the sweep folder; empty for a case run without one), ``wall_s`` (the
+run's own wall time, ``wall_time_s`` of its provenance, which its archive stores: one number whether the
+case is done or cached; of a failed case, the time to its failure), ``model_version`` (the version of the
 model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown), ``notes`` (the run's
 plausibility notes, :func:`bearingsim.plausibility.check`, one a line without the ``bearingsim: note:``
 prefix; empty for a clean run) and the summary numbers (SI, as in the archives' ``/results/summary``,

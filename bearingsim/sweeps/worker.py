@@ -111,7 +111,9 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
     validated scenario model the client wrote ``toml_text`` from (a forked local worker: the same code
     validated it), else the text is resolved again here.
 
-    Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s``,
+    Returns a record: ``hash``, ``status`` (``done``/``failed``), ``error``, ``wall_s`` (the run's own
+    wall time, ``wall_time_s`` of its provenance, which its archive stores; of a failed case, the time to
+    its failure),
     ``model_version`` (of the model that computed it), ``notes`` (the run's plausibility notes,
     :func:`run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`.
     """
@@ -142,7 +144,10 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
                 data = path.read_bytes()
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res), scenario.model))
-        rec = {"hash": case_hash, "status": "done", "error": "", "wall_s": time.perf_counter() - t0,
+        # the run's own wall time, the one its archive stores: the same number when the case is cached later
+        wall = res.provenance.get("wall_time_s")
+        rec = {"hash": case_hash, "status": "done", "error": "",
+               "wall_s": float(wall) if wall is not None else time.perf_counter() - t0,
                "summary": summary, "model_version": res.provenance.get("model_version"),
                "notes": run_notes(res.notes)}
         if data is not None:

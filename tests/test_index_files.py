@@ -164,3 +164,26 @@ def test_every_summary_key_is_documented_with_its_unit():
     wrong = {k: (rows[k], u) for k, u in units.items() if k in rows and rows[k] != u}
     assert wrong == {}
     assert "total over all recorded steps" in table  # land_torque_impulse_Nms is a run total, unlike the others
+
+
+@pytest.mark.parametrize("item, message", [
+    ("=1,2", "--param '=1,2': empty key; expected KEY=V1,V2,..."),  # it said "--set '=1': empty key"
+    (".k=1", "--param '.k=1': empty key"),
+    (f"{SPEED}=1000:2000", f"--param '{SPEED}=1000:2000': expected START:STOP:NUM (NUM evenly spaced numbers, both "
+                           f"ends included), e.g. {SPEED}=1000:2000:3"),  # it said "must be a valid number"
+    (f"{SPEED}=1000:2000:3:4", "expected START:STOP:NUM"),
+])
+def test_a_bad_param_is_named_as_the_param_it_is(item, message):
+    with pytest.raises(UserError) as exc:
+        parse_param(item)
+    assert message in str(exc.value) and "--set" not in str(exc.value), str(exc.value)
+
+
+def test_crosscheck_speeds_given_as_a_range_say_the_form_they_take():
+    from bearingsim.studies.crosscheck import parse_speeds
+
+    with pytest.raises(UserError) as exc:
+        parse_speeds("1000:3000:3")
+    assert str(exc.value) == ("--speeds '1000:3000:3': --speeds takes a list, not a range START:STOP:NUM as --param "
+                              "does: give inner-ring speeds in rpm separated by commas, e.g. 1000,3000,6000")
+    assert parse_speeds("1000,3000") == (1000.0, 3000.0)

@@ -68,11 +68,14 @@ UNITS = {"rpm": "rpm", "rung": "1", "I_dec_mean_Ns": "N s", "I_dec_sem_Ns": "N s
 
 
 def parse_speeds(text: str) -> tuple[float, ...]:
-    """``"1000,3000,6000"`` -> speeds [rpm]; a one-line UserError naming ``--speeds`` otherwise."""
+    """``"1000,3000,6000"`` -> speeds [rpm]; a one-line UserError naming ``--speeds`` and its form otherwise
+    (a sweep's range START:STOP:NUM is not one: the refusal says so)."""
     try:
         speeds = tuple(float(v) for v in text.split(","))
     except ValueError:
-        raise UserError(f"--speeds {text!r}: give inner-ring speeds in rpm separated by commas, e.g. 1000,3000,6000") from None
+        form = ("--speeds takes a list, not a range START:STOP:NUM as --param does: " if ":" in text else "")
+        raise UserError(f"--speeds {text!r}: {form}give inner-ring speeds in rpm separated by commas, e.g. "
+                        f"1000,3000,6000") from None
     if not speeds or not all(math.isfinite(v) and v > 0 for v in speeds):
         raise UserError(f"--speeds {text!r}: every speed must be a positive number of rpm")
     if len(set(speeds)) != len(speeds):

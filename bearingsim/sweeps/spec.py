@@ -151,12 +151,15 @@ def _split_top_level(text: str) -> list[str]:
 def _range_values(item: str, key: str, text: str) -> list[float] | list[int] | None:
     """``START:STOP:NUM`` as :class:`_Range` values of ``key``; None if ``text`` is not of that form."""
     parts = text.split(":")
-    if len(parts) != 3 or any(c in text for c in "[]{}\"'"):
+    if len(parts) < 2 or any(c in text for c in "[]{}\"'"):
         return None
     try:
         start, stop = float(parts[0]), float(parts[1])
     except ValueError:
         return None
+    if len(parts) != 3:  # numbers between colons: a range with a part missing or too many
+        raise UserError(f"--param {item!r}: expected START:STOP:NUM (NUM evenly spaced numbers, both ends "
+                        f"included), e.g. {key}={parts[0]}:{parts[1]}:3")
     try:
         num = int(parts[2])
     except ValueError:
@@ -172,9 +175,14 @@ def parse_param(item: str) -> tuple[str, list]:
         raise UserError(f"--param {item!r}: expected {PARAM_HELP}")
     key, text = item.split("=", 1)
     key = key.strip()
+    if not key or any(not part for part in key.split(".")):
+        raise UserError(f"--param {item!r}: empty key; expected {PARAM_HELP}")
     values = _range_values(item, key, text.strip())
     if values is None:
-        values = [parse_override(f"{key}={v}")[1] for v in _split_top_level(text) if v.strip()]
+        try:
+            values = [parse_override(f"{key}={v}")[1] for v in _split_top_level(text) if v.strip()]
+        except UserError as exc:  # a value refused as --set would be: named as the --param it is
+            raise UserError(str(exc).replace("--set", "--param", 1)) from None
     if not key or not values:
         raise UserError(f"--param {item!r}: expected {PARAM_HELP}, with at least one value")
     return key, values

@@ -1174,3 +1174,17 @@ def test_a_case_has_one_wall_time_done_or_cached(tmp_path):
     for a, b in zip(done.rows, cached.rows):
         assert a["wall_s"] == b["wall_s"] == archive.peek(tmp_path / a["archive"])["wall_time_s"]
     assert [float(x) for x in read_index(tmp_path / "sweep.h5")[0]["wall_s"]] == [r["wall_s"] for r in done.rows]
+
+
+def test_the_sweeps_page_says_a_zip_sweep_refuses_param_as_it_does(tmp_path):
+    """docs/sweeps.md said "--param and --set add to a sweep file" with no exception; a zip sweep refuses
+    --param: the page quotes the refusal the command gives."""
+    import re
+
+    target = ROOT / "scenarios" / "sweeps" / "speed_zip_and_extras.toml"
+    res = bearingsim("sweep", target, "--param", "contact.restitution=0.6,0.7", "-o", tmp_path / "z")
+    assert_user_error(res, 'mode: --param adds a product axis; not allowed with mode = "zip"')
+    page = " ".join((ROOT / "docs" / "sweeps.md").read_text().split())
+    said = re.search(r"`--param` and `--set` add to a sweep file[^.]*\.[^.]*\.", page).group(0)
+    assert 'a sweep file of `mode = "zip"` refuses it (`mode: --param adds a product axis; not allowed with mode = ' \
+           '"zip"`)' in page and "exception" in said, said

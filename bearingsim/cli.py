@@ -980,7 +980,11 @@ def _failed(exc: BaseException, args) -> int:
 
 #: what an interrupted command has not written, by command ("no archive written" for the others)
 _NOT_WRITTEN = {"animate": "no animation written", "report": "no report written",
-                "plot": "its figures not all written", "wear": "its figures not all written", "life": "no stage run"}
+                "plot": "its figures not all written", "wear": "its figures not all written", "life": "no stage run",
+                "sweep": "before any case of the sweep ran (cases an earlier run kept are kept; the same command "
+                         "runs it)"}
+_NOT_WRITTEN.update({c: f"before any case of the {c} study ran (cases an earlier run kept are kept; the same command "
+                        f"runs it)" for c in ("sensitivity", "uncertainty", "crosscheck", "validate")})
 
 
 def _interrupted(exc: KeyboardInterrupt, args) -> int:

@@ -1188,3 +1188,24 @@ def test_the_sweeps_page_says_a_zip_sweep_refuses_param_as_it_does(tmp_path):
     said = re.search(r"`--param` and `--set` add to a sweep file[^.]*\.[^.]*\.", page).group(0)
     assert 'a sweep file of `mode = "zip"` refuses it (`mode: --param adds a product axis; not allowed with mode = ' \
            '"zip"`)' in page and "exception" in said, said
+
+
+@pytest.mark.parametrize("command", ["sweep", "sensitivity"])
+def test_a_signal_before_any_case_ran_is_said_in_a_sweeps_words(tmp_path, monkeypatch, capsys, command):
+    """SIGINT while a sweep or study resolved its cases said the run command's "interrupted, no archive
+    written"; a sweep writes no archive of its own: it says no case of it ran and that the command runs it."""
+    from bearingsim.cli import main
+    from bearingsim.studies import sensitivity
+    from bearingsim.sweeps import spec
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(spec, "spec_from_args", interrupted)
+    monkeypatch.setattr(sensitivity, "parse_step", interrupted)
+    args = ["--param", f"{SPEED}=1000,2000"] if command == "sweep" else []
+    assert main([command, str(BASE), *args, "-o", str(tmp_path / "o"), "-j", "1"]) == 130
+    err = capsys.readouterr().err.strip().splitlines()
+    what = "the sweep" if command == "sweep" else "the sensitivity study"
+    assert err == [f"bearingsim: interrupted, before any case of {what} ran (cases an earlier run kept are kept; the "
+                   f"same command runs it)"], err

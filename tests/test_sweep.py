@@ -1209,3 +1209,13 @@ def test_a_signal_before_any_case_ran_is_said_in_a_sweeps_words(tmp_path, monkey
     what = "the sweep" if command == "sweep" else "the sensitivity study"
     assert err == [f"bearingsim: interrupted, before any case of {what} ran (cases an earlier run kept are kept; the "
                    f"same command runs it)"], err
+
+
+def test_another_sweeps_cases_are_counted_in_good_grammar(tmp_path):
+    """The refusal said "1 of its 1 case are not in this one"."""
+    from bearingsim.errors import UserError
+
+    run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [1000])]), tmp_path, figures=False, progress=False)
+    with pytest.raises(UserError) as exc:
+        run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [2000])]), tmp_path, figures=False, progress=False)
+    assert "(1 case of its 1 is not in this one)" in str(exc.value), str(exc.value)

@@ -218,9 +218,10 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
     if not other:
         return
     if not force:
-        raise UserError(f"{outdir}: holds another sweep or study ({len(other)} of its {counted(len(old), 'case')} are not in "
-                        f"this one); not mixed in: give another -o folder, or add --force to replace it (the same "
-                        f"command as before resumes it)")
+        verb = "is" if len(other) == 1 else "are"
+        raise UserError(f"{outdir}: holds another sweep or study ({counted(len(other), 'case')} of its {len(old)} "
+                        f"{verb} not in this one); not mixed in: give another -o folder, or add --force to replace it "
+                        f"(the same command as before resumes it)")
     for h in other:
         _remove_if_own(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's

@@ -523,3 +523,16 @@ def test_a_half_step_clipped_onto_the_full_step_is_no_agreement(tmp_path, capsys
     assert meta["runs"] == 8
     assert main(["table", str(tmp_path)]) == 0
     assert "3 keys, 8 runs" in capsys.readouterr().out.splitlines()[0]
+
+
+def test_inspect_gives_every_number_column_of_the_table_a_unit(tmp_path, capsys):
+    """`inspect sensitivity.h5` listed x, x_minus, y_minus ... without units."""
+    row = {c: 1.0 for c in sens.COLUMNS}
+    row.update(key="contact.restitution", quantity="I_dec", measure="log", x_minus_half=0.76, x_plus_half=0.84,
+               archive_minus="", archive_plus="", status="done", error="")
+    _, h5 = sens.write_table(tmp_path, [row], load_scenario(REDUCED), 0.1)
+    assert main(["inspect", str(h5)]) == 0
+    lines = {line.split()[0]: line for line in capsys.readouterr().out.splitlines() if line.startswith("  ")}
+    for c in ("x", "x_minus", "x_plus", "x_minus_half", "x_plus_half", "y_minus", "y_minus_se", "y_plus", "y_plus_se"):
+        assert "number [" in lines[c], lines[c]
+    assert "[the key's unit]" in lines["x"] and "N s" in lines["y_minus"]

@@ -50,7 +50,10 @@ REDUCED_QUANTITIES = ("I_dec", "I_acc")
 COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y_minus_se", "y_plus", "y_plus_se",
            "sensitivity", "sensitivity_se", "over_range", "sensitivity_half_step")
 UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
-         "over_range": "as sensitivity", "sensitivity_half_step": "as sensitivity"}
+         "over_range": "as sensitivity", "sensitivity_half_step": "as sensitivity",
+         **{c: "the key's unit" for c in ("x", "x_minus", "x_plus", "x_minus_half", "x_plus_half")},
+         **{c: "the quantity's SI unit (I_dec, I_acc: N s; cage_slip: 1; cage_eccentricity: m)"
+            for c in ("y_minus", "y_minus_se", "y_plus", "y_plus_se")}}
 #: the paired runs' sides: at the step, and, for a deterministic model (the reduced one: no standard error
 #: to show what the step does), at half of it: S there beside S says whether the difference is a local slope
 SIDES = ("-", "+")

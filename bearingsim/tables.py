@@ -361,10 +361,10 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
     out += [line([col[i] for col in cols]) for i in range(shown)]
     if shown < n:
         out.append(f"... {n - shown} more rows ('bearingsim table' prints them all)")
-    if any(k in SEM_OF for k in keys):
-        out.append(RULE)
     noted = [text for i, text in sorted(table.footnotes.items()) if i < shown]
     if noted:
         out.append("notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):")
         out += noted
+    if any(k in SEM_OF for k in keys):
+        out.append(RULE)
     return "\n".join(out)

@@ -1055,8 +1055,9 @@ def is_table_file(path, fmt: str) -> bool:
 def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
     (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
-    stores none), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``. None
-    for a missing, unreadable or incomplete file (never trusted)."""
+    stores none), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``, ``notes``
+    (the run's stored notes, :func:`read_notes`; None if it stores none). None for a missing, unreadable,
+    damaged or incomplete file (never trusted)."""
     h5py = _lazy_h5py()
     path = Path(path)
     if not path.is_file():
@@ -1079,8 +1080,9 @@ def peek(path) -> dict[str, Any] | None:
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
                 "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
+                "notes": read_notes(f, path),
             }
-    except (OSError, KeyError, ValueError, TypeError):
+    except (OSError, KeyError, ValueError, TypeError, UserError):
         return None
 
 

@@ -1162,6 +1162,22 @@ def test_a_runs_notes_are_kept_in_the_sweeps_index_table_and_report(tmp_path, ca
     assert [r[2] for r in checks[2]["rows"]] == [cols["notes"][1]]
 
 
+def test_a_cached_case_takes_its_notes_from_its_archive(tmp_path, capsys):
+    """A case taken from its archive, with no index row to take its notes from (the index removed), keeps
+    the notes its run stored in the archive (/bearingsim/notes, read by archive.peek)."""
+    out = tmp_path / "s"
+    args = (BASE, ["bearing.pocket_clearance_mm=0.2,0.3"], [], out)
+    assert run_sweep_cli(*args, jobs=1, figures=False, archives="all") == 0
+    first, _ = read_index(out / "sweep.h5")
+    for name in ("sweep.h5", "sweep.csv"):
+        (out / name).unlink()
+    assert run_sweep_cli(*args, jobs=1, figures=False, archives="all") == 0
+    capsys.readouterr()
+    cols, _ = read_index(out / "sweep.h5")
+    assert list(cols["status"]) == ["cached", "cached"]
+    assert list(cols["notes"]) == list(first["notes"]) and "bearing.pocket_clearance_mm = 0.3" in cols["notes"][1]
+
+
 def test_a_case_has_one_wall_time_done_or_cached(tmp_path):
     """A case's wall_s was the worker's time around the run and its archive's writing when done (1.5367 s)
     and the archive's own run time when cached (1.4349 s): now the run's own time, as its archive stores it."""

@@ -457,10 +457,13 @@ def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     ("wear_test_6000rpm.toml", ["--limit", "clearance=0.1mm"], "--limit clearance=0.1mm"),
     ("wear_test_6000rpm.toml", ["--limit", "depth=0.1mm", "--stages", "0"], "--stages 0"),
     ("wear_test_6000rpm.toml", ["--limit", "depth=0.1mm", "--rotations", "0"], "--rotations 0"),
-], ids=["reduced-model", "clearance-below-s", "no-stages", "no-rotations"])
+    ("wear_test_6000rpm.toml", ["--limit", "depth=0.1mm", "--set", "multibody.pocket_face_segments=8"],
+     "multibody.pocket_face_segments = 8: --mapping shape (the default) feeds the worn depths back"),
+], ids=["reduced-model", "clearance-below-s", "no-stages", "no-rotations", "shape-on-polylines"])
 def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario, extra, words):
     """A life study refused for its scenario or arguments exits 2 in one line and creates nothing (it left an
-    empty outputs/<name>_life/)."""
+    empty outputs/<name>_life/; the shape mapping on polyline faces ran stage 0, then refused stage 1's
+    worn faces)."""
     from bearingsim.cli import main
 
     monkeypatch.chdir(tmp_path)
@@ -468,6 +471,17 @@ def test_refused_life_creates_no_folder(tmp_path, monkeypatch, capsys, scenario,
     err = capsys.readouterr().err
     assert code == 2 and words in err and len(err.strip().splitlines()) == 1, (code, err)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_life_uniform_mapping_takes_polyline_faces():
+    """Polyline pocket faces (multibody.pocket_face_segments >= 1) are refused with the shape mapping only:
+    the uniform one grows the clearance and never gives the faces a worn depth."""
+    from bearingsim.studies.life import LifeStudy, parse_limit
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.pocket_face_segments=8"])
+    with pytest.raises(UserError, match="--mapping uniform"):
+        LifeStudy(sc, parse_limit("depth=0.1mm"))
+    assert LifeStudy(sc, parse_limit("depth=0.1mm"), mapping="uniform").mapping == "uniform"
 
 
 @pytest.mark.parametrize("extra, words", [

@@ -234,7 +234,8 @@ class LifeStudy(Study):
     """A life study (module docstring) as a staged study: stage ``j + 1``'s case is made from stage ``j``'s
     archive (:meth:`next_cases`), each run by the study engine (:func:`bearingsim.studies.run_studies`);
     :meth:`finish` writes ``life.h5`` and ``life.png``. Refused here, before anything is created: a
-    scenario of the reduced model, an unknown ``mapping``, ``stages`` outside 1..100, ``rotations`` below
+    scenario of the reduced model, an unknown ``mapping``, the ``shape`` mapping with polyline pocket faces
+    (``multibody.pocket_face_segments`` not 0), ``stages`` outside 1..100, ``rotations`` below
     1, a clearance limit at or below the pocket clearance, a worn depth of the wrong bins. ``progress``: a
     callable given one line per stage when its wear is known (the command line prints them)."""
 
@@ -251,6 +252,12 @@ class LifeStudy(Study):
                             f"(model = \"multibody\")")
         if mapping not in MAPPINGS:
             raise UserError(f"--mapping {mapping}: give one of {', '.join(MAPPINGS)}")
+        segments = scenario.parameters.multibody.pocket_face_segments
+        if mapping == "shape" and segments != 0:
+            raise UserError(f"{scenario.source}: multibody.pocket_face_segments = {segments}: --mapping shape (the "
+                            f"default) feeds the worn depths back into the faces, which needs the exact arc faces "
+                            f"(multibody.pocket_face_segments = 0); give that, or --mapping uniform, which works "
+                            f"with polyline faces")
         if not 1 <= stages <= 100:
             raise UserError(f"--stages {stages}: give 1 to 100 stages")
         if rotations is not None and rotations < 1:

@@ -36,7 +36,8 @@ _OPS = (("gt", ">"), ("ge", ">="), ("lt", "<"), ("le", "<="))
 class KeyInfo:
     """One scenario key: ``key`` (dotted), ``unit``, ``kind`` (type and bounds as text), ``default`` (the
     value a scenario gets when it does not set the key, as TOML text, or ``"(required)"``), ``source``
-    (where that value comes from), ``why`` (the preset's reference or reasoning, may be empty),
+    (where that value comes from), ``why`` (the preset's reference or reasoning, also for a package default
+    that the preset's ``[source.<section>.<key>]`` documents; may be empty),
     ``unused_by`` (models that read nothing of the key), ``plausible`` (the preset's plausible range of
     an uncertain value, ``"lo..hi"``, or empty: :mod:`bearingsim.ranges`)."""
 
@@ -131,25 +132,33 @@ def list_keys(preset: str = "NU214-Suzuki2023") -> list[KeyInfo]:
     return out
 
 
+def _plausible(src: dict) -> str:
+    """The plausible range of a preset's ``[source.<section>.<key>]`` entry, ``"lo..hi"``, or empty."""
+    rng = src.get("range")
+    if isinstance(rng, list) and len(rng) == 2:
+        return f"{rng[0]:g}..{rng[1]:g}"
+    return ""
+
+
 def _info(key, field, section, name, defaults, preset_values, sources, preset, unused) -> KeyInfo:
     kind = (_validated_kind(section, name) if section else "") or _kind(field)
     extra = _bounds_note(section, name) if section else ""
     if extra:
         kind = kind.replace("float", f"float {extra}", 1)
+    src = sources.get(section, {}).get(name, {}) if section and isinstance(sources.get(section), dict) else {}
+    src = src if isinstance(src, dict) else {}
     why = ""
-    plausible = ""
+    plausible = _plausible(src)
     if section and name in preset_values.get(section, {}):
         default = _toml_value(preset_values[section][name])
-        src = sources.get(section, {}).get(name, {}) if isinstance(sources.get(section), dict) else {}
         where = src.get("where") or ""
         short = where if len(where) <= WHERE_CHARS else where[:WHERE_CHARS - 1].rstrip() + "..."
         source = f"preset {preset}: {src.get('kind', 'no source entry')}" + (f" ({short})" if short else "")
         why = src.get("reason", "") or (where if short != where else "")
-        if isinstance(src.get("range"), list) and len(src["range"]) == 2:
-            plausible = f"{src['range'][0]:g}..{src['range'][1]:g}"
     elif section and name in defaults.get(section, {}):
         default = _toml_value(defaults[section][name])
         source = "package default" + (f": {DEFAULT_SOURCES[key]}" if key in DEFAULT_SOURCES else "")
+        why = src.get("reason", "") or src.get("range_reason", "")  # the preset's word on the package's value
     elif key == "schema_version":
         default, source = "1", "the only schema this bearingsim reads (required)"
     elif key == "name":
@@ -168,8 +177,8 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
 
 
 def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
-    """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, each
-    preset value's reasoning on the line below it."""
+    """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, the preset's
+    reasoning for each of its values and each package default it documents on the line below it."""
     rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
     head = ("key", "unit", "type and bounds", "default", "source")
     cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,

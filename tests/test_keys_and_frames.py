@@ -94,6 +94,23 @@ def test_keys_lists_every_key_a_resolved_scenario_has_with_unit_bounds_default_s
     assert keys["multibody.scene"].unused_by == ("reduced",)
 
 
+def test_keys_why_gives_the_presets_reason_and_range_for_a_package_default():
+    """A key whose value is a package default that the preset documents (``[source.wear.wear_coefficient]``,
+    with a reason and a range) shows them: ``keys KEY --why``, to which a run's out-of-range note points,
+    showed the table row alone."""
+    from bearingsim.keys import format_keys, list_keys
+    from bearingsim.scenario import load_preset
+
+    src = load_preset("NU214-Suzuki2023")["source"]
+    keys = {k.key: k for k in list_keys()}
+    k = keys["wear.wear_coefficient"]
+    assert k.source.startswith("package default") and k.plausible == "3e-07..0.0001"
+    assert k.why == src["wear"]["wear_coefficient"]["reason"]
+    assert keys["contact.cage_friction"].why == src["contact"]["cage_friction"]["range_reason"]  # no reason: the range's
+    text = format_keys(list(keys.values()), "wear.wear_coefficient", why=True)
+    assert "plausible 3e-07..0.0001" in text and "Rabinowicz, 'The Wear Coefficient" in text
+
+
 @pytest.mark.parametrize("scenario", ["multibody_3000rpm.toml", "paper_3000rpm.toml"])
 def test_keys_gives_the_lower_bound_of_an_integer_key_that_a_run_enforces(scenario):
     """`bearingsim keys roller_count` said `int >= 1` where 1 and 2 rollers are refused ("at least 3

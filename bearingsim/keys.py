@@ -104,14 +104,45 @@ def _bounds_note(section: str, name: str) -> str:
 
 
 def _validated_kind(section: str, name: str) -> str:
-    """Type and bounds of a key whose validator raises the field's own bound (the field keeps its looser lower
+    """Type and bounds of a key whose validator raises the field's own bound (the field keeps its looser
     bound, so that the validator's message, which says why, is the one a user sees)."""
-    from bearingsim.scenario import MIN_ROLLER_COUNT
+    from bearingsim.scenario import HARDNESS_RANGE_PA, MAX_WEAR_COEFFICIENT, MIN_ROLLER_COUNT
 
     return {
         ("bearing", "roller_count"): f"int >= {MIN_ROLLER_COUNT}",
         ("numerics", "warmup_rotations"): "int >= 0, >= 1 to run the multibody model",  # check_run_request
+        ("wear", "wear_coefficient"): f"float >= 0, <= {MAX_WEAR_COEFFICIENT:g}",
+        ("wear", "hardness_Pa"): f"float >= {HARDNESS_RANGE_PA[0]:g}, <= {HARDNESS_RANGE_PA[1]:g}",
     }.get((section, name), "")
+
+
+def _checked_bounds(section: str, name: str) -> str:
+    """Bounds that a scenario's checks enforce with other keys (:func:`bearingsim.scenario._check_limits`,
+    from its constants), added to the field's own."""
+    from bearingsim import scenario as sc
+
+    lo, hi = sc.ROLLER_DENSITY_RANGE_KG_M3
+    return {
+        ("numerics", "rotations"): f"+ numerics.warmup_rotations <= {sc.MAX_ROTATIONS}",
+        ("numerics", "warmup_rotations"): f"+ numerics.rotations <= {sc.MAX_ROTATIONS}",
+        ("operating", "inner_ring_speed_rpm"): f"x bearing.pitch_diameter_mm (dm*n) <= {sc.MAX_DM_N_MM_RPM:g} mm rpm",
+        ("bearing", "roller_mass_kg"): f"density m / (pi/4 d^2 l) in [{lo:g}, {hi:g}] kg/m^3",
+        ("bearing", "radial_clearance_mm"): f"<= {sc.MAX_RADIAL_CLEARANCE_TO_ROLLER:g} x bearing.roller_diameter_mm",
+        ("bearing", "cage_inertia_kgm2"): "in [m r_in^2, m r_out^2] of the cage ring (m: bearing.cage_mass_kg)",
+        ("lubrication", "drag_coefficient"): f"oil-film drag (Eq. 2) <= {sc.MAX_DRAG_TO_LOAD:g} x the least roller load",
+        ("operating", "radial_load_N"): f"<= C0r = {sc.ISO76_C0_FACTOR:g} (1 - D/d_p) Z l D [N, mm] (ISO 76)",
+        ("numerics", "output_rate_hz"): "multibody: >= 2 x bearing.roller_count samples per cage rotation",
+    }.get((section, name), "")
+
+
+def _with_bound(kind: str, bound: str) -> str:
+    """``kind`` with ``bound`` added to its number's bounds: ``int >= 1`` and ``+ x <= 9``: ``int >= 1, + x <= 9``."""
+    parts = kind.split(" | ")
+    num = next((i for i, p in enumerate(parts) if p.split(" ")[0] in ("int", "float")), None)
+    if num is None:
+        return kind
+    parts[num] += (", " if " " in parts[num] else " ") + bound
+    return " | ".join(parts)
 
 
 def list_keys(preset: str = "NU214-Suzuki2023") -> list[KeyInfo]:
@@ -145,6 +176,9 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
     extra = _bounds_note(section, name) if section else ""
     if extra:
         kind = kind.replace("float", f"float {extra}", 1)
+    checked = _checked_bounds(section, name) if section else ""
+    if checked:
+        kind = _with_bound(kind, checked)
     src = sources.get(section, {}).get(name, {}) if section and isinstance(sources.get(section), dict) else {}
     src = src if isinstance(src, dict) else {}
     why = ""

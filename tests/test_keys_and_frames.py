@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import bearingsim
+from bearingsim.errors import UserError
 from bearingsim.scenario import flatten, load_scenario
 
 from .conftest import SCENARIOS
@@ -109,6 +110,57 @@ def test_keys_why_gives_the_presets_reason_and_range_for_a_package_default():
     assert keys["contact.cage_friction"].why == src["contact"]["cage_friction"]["range_reason"]  # no reason: the range's
     text = format_keys(list(keys.values()), "wear.wear_coefficient", why=True)
     assert "plausible 3e-07..0.0001" in text and "Rabinowicz, 'The Wear Coefficient" in text
+
+
+@pytest.mark.parametrize("key", ["wear.wear_coefficient", "wear.hardness_Pa"])
+def test_keys_gives_the_bounds_a_scenario_enforces_on_a_wear_key(key):
+    """`bearingsim keys wear` said `float >= 0` for the wear coefficient and `float > 0` for the hardness,
+    where a scenario refuses k above scenario.MAX_WEAR_COEFFICIENT and a hardness outside
+    scenario.HARDNESS_RANGE_PA: the bounds keys gives are accepted, values beyond them refused."""
+    import re
+
+    from bearingsim.keys import list_keys
+
+    kind = {k.key: k for k in list_keys()}[key].kind
+    m = re.fullmatch(r"float >= ([0-9.e+-]+), <= ([0-9.e+-]+)", kind)
+    assert m, kind
+    lo, hi = float(m[1]), float(m[2])
+    for value, ok in ((lo, True), (hi, True), (hi * 1.01, False), (lo * 0.99 if lo else -1e-9, False)):
+        try:
+            load_scenario(SCENARIOS / "wear_test_6000rpm.toml", values={key: value})
+        except UserError:
+            assert not ok, (key, value)
+        else:
+            assert ok, (key, value)
+
+
+def test_keys_bounds_come_from_the_scenarios_limits(monkeypatch):
+    """The keys table gives the limits of scenario._check_limits from its constants, those with other keys
+    too (total rotations, dm*n, roller density, radial clearance, drag, static load rating), so a changed
+    limit changes the table."""
+    from bearingsim import scenario
+    from bearingsim.keys import list_keys
+
+    monkeypatch.setattr(scenario, "MAX_WEAR_COEFFICIENT", 0.05)
+    monkeypatch.setattr(scenario, "HARDNESS_RANGE_PA", (2.0e7, 1.0e11))
+    monkeypatch.setattr(scenario, "MAX_ROTATIONS", 777)
+    monkeypatch.setattr(scenario, "MAX_DM_N_MM_RPM", 3.5e6)
+    monkeypatch.setattr(scenario, "ROLLER_DENSITY_RANGE_KG_M3", (600.0, 19_000.0))
+    monkeypatch.setattr(scenario, "MAX_RADIAL_CLEARANCE_TO_ROLLER", 0.04)
+    monkeypatch.setattr(scenario, "MAX_DRAG_TO_LOAD", 0.5)
+    monkeypatch.setattr(scenario, "ISO76_C0_FACTOR", 43.0)
+    kinds = {k.key: k.kind for k in list_keys()}
+    assert kinds["wear.wear_coefficient"] == "float >= 0, <= 0.05"
+    assert kinds["wear.hardness_Pa"] == "float >= 2e+07, <= 1e+11"
+    assert kinds["numerics.rotations"] == "int >= 1, + numerics.warmup_rotations <= 777"
+    assert kinds["numerics.warmup_rotations"].endswith(", + numerics.rotations <= 777")
+    assert "(dm*n) <= 3.5e+06 mm rpm" in kinds["operating.inner_ring_speed_rpm"]
+    assert "in [600, 19000] kg/m^3" in kinds["bearing.roller_mass_kg"]
+    assert kinds["bearing.radial_clearance_mm"] == "float >= 0, <= 0.04 x bearing.roller_diameter_mm"
+    assert "<= 0.5 x the least roller load" in kinds["lubrication.drag_coefficient"]
+    assert "<= C0r = 43 " in kinds["operating.radial_load_N"]
+    assert "bearing.cage_mass_kg" in kinds["bearing.cage_inertia_kgm2"]
+    assert "2 x bearing.roller_count samples per cage rotation" in kinds["numerics.output_rate_hz"]
 
 
 @pytest.mark.parametrize("scenario", ["multibody_3000rpm.toml", "paper_3000rpm.toml"])

@@ -441,6 +441,36 @@ def test_plot_and_table_of_a_life_history_again(tmp_path, capsys):
         assert printed[1:] == history[1:]
 
 
+def test_life_table_shows_a_volume_limits_quantity_and_the_stages_notes(tmp_path, capsys):
+    """The life table of a volume limit gave the deepest point and its rate, not the largest face volume
+    that the limit reads (life.h5 held it), and no table gave the stages' run notes (their archives hold
+    them): the command and `bearingsim table DIR` give the volume and its rate, and under the table each
+    distinct note once with how many stages carry it (1 recorded rotation: the warm-up cannot be judged)."""
+    import bearingsim
+    from bearingsim.cli import main
+
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "volume=0.5mm3", "--stages", "2",
+           "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+    assert main(cmd) == 0
+    printed = capsys.readouterr().out
+    assert main(["table", str(tmp_path)]) == 0
+    table = capsys.readouterr().out
+    from bearingsim.studies.life import read_life
+
+    cols, _ = read_life(tmp_path / "life.h5")
+    for out in (printed, table):
+        lines = out.splitlines()
+        head = next(i for i, ln in enumerate(lines) if ln.lstrip().startswith("stage "))
+        assert "largest volume [mm3]" in lines[head] and "volume rate [mm3/h]" in lines[head]
+        assert "deepest [um]" not in lines[head]
+        assert lines[head + 2].split()[5] == format(float(cols["max_volume_mm3"][1]), ".4g") == "0.5"
+        notes = [ln for ln in lines if ln.startswith("note (")]
+        assert notes and notes[0].startswith("note (2 of 2 stages): the warm-up could not be judged"), out
+        assert len(notes) == len(set(notes))
+    stage_notes = {n for p in (tmp_path / "cases").glob("*.h5") for n in bearingsim.load(p).notes}
+    assert len(notes) == len(stage_notes)
+
+
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     from bearingsim.cli import main
 
@@ -577,7 +607,7 @@ def test_life_ends_where_the_cage_bar_wears_through_before_the_limit_its_stages_
     assert main(["table", str(tmp_path)]) == 0
     printed = capsys.readouterr().out.splitlines()
     assert printed == [f"{tmp_path / 'life.h5'}: " + lines[0].replace(scenario, "wear_test_6000rpm"),
-                       *lines[1:len(cols["stage"]) + 2]]
+                       *[ln for ln in lines[1:] if not ln.startswith("wrote ")]]  # the stages' notes too
     sc = load_scenario(scenario, ["multibody.raceway_contact=rigid"])
     again = run_life(sc, tmp_path, parse_limit(limit), stages=stages, rotations=1)
     assert again["reused"].tolist() == [1] * (last + 1)

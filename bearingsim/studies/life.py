@@ -495,7 +495,10 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
     """One stage's history row; ``clearance``: the effective pocket clearance it ran at [m] (the worst
     pocket's ``s`` plus its front and rear mean worn depth at the stage's start: ``clearance_start_mm``, not
     the scenario's ``s``, which the shape mapping keeps). The worn depth at the stage's end is
-    ``worn_depth_*_um`` [bin, pocket], at the bins ``psi_deg``."""
+    ``worn_depth_*_um`` [bin, pocket], at the bins ``psi_deg``; ``notes``: the stage's run notes, one a
+    line (:func:`bearingsim.sweeps.index.notes_text`)."""
+    from bearingsim.sweeps.index import notes_text
+
     per_hour = 1.0 / rate.hours  # rate report is for one rotation
     return {
         "stage": j, "clearance_start_mm": clearance * 1e3, "stage_rotations": n_stage,
@@ -506,6 +509,7 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
         "clearance_end_mm": st.clearance() * 1e3, "I_dec_mean_mNs": res.summary["I_dec_mean_Ns"] * 1e3,
         "reused": int(reused), "psi_deg": rate.psi_deg,
         "worn_depth_front_um": st.depth[0] * 1e6, "worn_depth_rear_um": st.depth[1] * 1e6,
+        "notes": notes_text(res.notes),
     }
 
 
@@ -517,21 +521,46 @@ HISTORY_TABLE = (("stage", "stage", 5, "d"), ("clearance_start_mm", "s_eff [mm]"
                  ("stage_rotations", "rotations", 11, ".4g"), ("hours_end", "h at end", 9, ".4g"),
                  ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
                  ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
+#: the columns of a volume limit's quantity in place of the deepest point's (:func:`history_table`)
+VOLUME_COLUMNS = {"max_depth_rate_um_per_h": ("max_volume_rate_mm3_per_h", "volume rate [mm3/h]", 19, ".4g"),
+                  "max_depth_um": ("max_volume_mm3", "largest volume [mm3]", 20, ".4g")}
 
 
-def history_rows(cols: dict) -> list[list[str]]:
-    """The cells of :data:`HISTORY_TABLE`, a row per stage."""
-    return [[format(int(cols[c][i]) if f == "d" else float(cols[c][i]), f) for c, _, _, f in HISTORY_TABLE]
+def history_table(limit: str | None = None) -> tuple:
+    """:data:`HISTORY_TABLE` for a study to ``limit`` (its text, ``volume=2mm3``): for a volume limit, the
+    quantity it reads, the largest worn volume of a face, and its rate in place of the deepest point's."""
+    if str(limit or "").split("=")[0].strip() != "volume":
+        return HISTORY_TABLE
+    return tuple(VOLUME_COLUMNS.get(c[0], c) for c in HISTORY_TABLE)
+
+
+def history_rows(cols: dict, table: tuple = HISTORY_TABLE) -> list[list[str]]:
+    """The cells of ``table`` (:func:`history_table`), a row per stage."""
+    return [[format(int(cols[c][i]) if f == "d" else float(cols[c][i]), f) for c, _, _, f in table]
             for i in range(len(cols["stage"]))]
+
+
+def stage_notes(cols: dict) -> list[str]:
+    """The stages' run notes (the history's ``notes`` column; none in a history written before it held
+    them): each distinct note once, with how many stages carry it, in the order they first come."""
+    from bearingsim.sweeps.index import notes_of
+
+    counts: dict[str, int] = {}
+    for cell in cols.get("notes", ()):
+        for note in dict.fromkeys(notes_of(cell)):
+            counts[note] = counts.get(note, 0) + 1
+    n = len(cols["stage"])
+    return [f"note ({k} of {counted(n, 'stage')}): {note.removeprefix('bearingsim: note: ')}"
+            for note, k in counts.items()]
 
 
 def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     """The history for the terminal, as ``bearingsim life`` prints it: ``title`` (``life of X to LIMIT``)
     with the life reached, or where the cage bar wore through first (``attrs``' ``worn_through``), then one
-    row per stage."""
-    from bearingsim.wording import counted
-
+    row per stage (:func:`history_table` of ``attrs``' limit), then the stages' run notes
+    (:func:`stage_notes`)."""
     attrs = attrs or {}
+    table = history_table(attrs.get("limit"))
     n = len(cols["stage"])
     when = f"{cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations"
     if attrs.get("worn_through"):
@@ -539,10 +568,10 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
                  f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
     else:
         first = f"{title}: {when} in {counted(n, 'stage')}"
-    lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in HISTORY_TABLE)]
-    lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, HISTORY_TABLE))
-              for row in history_rows(cols)]
-    return "\n".join(lines)
+    lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
+    lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
+              for row in history_rows(cols, table)]
+    return "\n".join(lines + stage_notes(cols))
 
 
 def read_life(path) -> tuple[dict, dict]:

@@ -471,6 +471,22 @@ def test_life_table_shows_a_volume_limits_quantity_and_the_stages_notes(tmp_path
     assert len(notes) == len(stage_notes)
 
 
+def test_read_life_takes_the_study_folder(tmp_path):
+    """read_life(DIR) on a life study's folder raised a UserError telling to pass DIR/life.h5: it reads
+    DIR/life.h5, as read_life(DIR/life.h5) does; a folder without one is still refused in one line."""
+    from bearingsim.studies.life import parse_limit, read_life, run_life
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
+    run_life(sc, tmp_path / "l", parse_limit("clearance=0.201mm"), stages=1, rotations=1)
+    cols, attrs = read_life(tmp_path / "l")
+    file_cols, file_attrs = read_life(str(tmp_path / "l" / "life.h5"))
+    assert attrs == file_attrs and attrs["limit"] == "clearance=0.201mm"
+    assert cols.keys() == file_cols.keys() and cols["hours_end"].tolist() == file_cols["hours_end"].tolist()
+    assert read_life(str(tmp_path / "l"))[1] == attrs
+    with pytest.raises(UserError, match="life.h5"):
+        read_life(tmp_path / "l" / "cases")
+
+
 def test_life_cli_bad_input_is_one_line(tmp_path, capsys):
     from bearingsim.cli import main
 

@@ -575,11 +575,12 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
 
 
 def read_life(path) -> tuple[dict, dict]:
-    """The history's columns and attributes of a ``life.h5``; a column of an older history under its
-    present name (:data:`OLD_COLUMNS`)."""
+    """The history's columns and attributes of a ``life.h5``, or of a life study's folder (its
+    ``life.h5``); a column of an older history under its present name (:data:`OLD_COLUMNS`)."""
     from bearingsim import archive
 
-    cols, attrs = archive.read_table_file(path, LIFE_FORMAT)
+    path = Path(path)
+    cols, attrs = archive.read_table_file(path / "life.h5" if path.is_dir() else path, LIFE_FORMAT)
     return {OLD_COLUMNS.get(k, k): v for k, v in cols.items()}, attrs
 
 

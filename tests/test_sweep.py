@@ -93,6 +93,25 @@ def test_set_on_the_command_line_overrides_the_sweep_files_set():
         resolve_cases(spec_from_args(path, [], ["numerics.rotations=2", "numerics.rotations=3"]))
 
 
+@pytest.mark.parametrize("params, sets, named", [
+    (["bearing.pocket_clearance_mm=0.2,0.3"], ["numerics.warmup_rotations=0"], "with numerics.warmup_rotations=0: "),
+    (["bearing.pocket_clearance_mm=0.2,5"], [], "with bearing.pocket_clearance_mm=5: "),
+    (["bearing.roller_count=16,17"], ["bearing.pocket_clearance_mm=4.2"],
+     "with bearing.pocket_clearance_mm=4.2 and bearing.roller_count=17: "),
+])
+def test_a_sweeps_refusal_names_the_overrides_and_the_case_value_it_is_about(params, sets, named):
+    """A sweep's refusal of a case names the --set values and the case's --param value it is about as `run --set`
+    does ("FILE with KEY=VALUE: ..."); it blamed the scenario file for them ("FILE: KEY: ...")."""
+    from bearingsim.errors import UserError
+    from bearingsim.sweeps.spec import spec_from_args
+
+    path = SCENARIOS / "multibody_3000rpm.toml"
+    with pytest.raises(UserError) as err:
+        resolve_cases(spec_from_args(path, params, sets))
+    assert str(err.value).startswith(f"{path} {named}"), str(err.value)
+    assert "(sweep case " in str(err.value)
+
+
 @pytest.mark.parametrize("spec_or_cases", ["spec", "cases"])
 def test_the_pool_has_no_more_workers_than_the_sweep_has_cases(tmp_path, spec_or_cases):
     """`-j 1000` for a sweep of two cases started a thousand worker processes (the trial's machine ran out

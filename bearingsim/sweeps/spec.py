@@ -36,8 +36,8 @@ from pathlib import Path
 from typing import Any
 
 from bearingsim.errors import UserError
-from bearingsim.scenario import (check_run_request, is_integer_key, load_scenario, parse_override,
-                                 read_toml_file)
+from bearingsim.scenario import (_with_override, check_run_request, is_integer_key, load_scenario,
+                                 parse_override, read_toml_file)
 
 SWEEP_FILE_KEYS = ("scenario", "mode", "set", "axes", "cases")
 # Most cases in one sweep: ten times the 100 x 100 map of scenarios/sweeps/. Each case is resolved and
@@ -390,6 +390,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         points += [dict(zip(axis_keys, c)) for c in combos]
     points += [dict(c) for c in spec.extra]
     base = load_scenario(spec.scenario, spec.sets)  # the base alone first: its own errors name it
+    given = {parse_override(s)[0]: s.strip() for s in spec.sets}  # the values the scenario file does not hold
     keys = spec.keys
     cases: list[Case] = []
     seen: dict[str, int] = {}
@@ -397,7 +398,8 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         try:
             sc = base.replace(**values)
             check_run_request(sc)  # refused here as `bearingsim run` refuses it, before any case runs
-        except UserError as exc:
+        except UserError as exc:  # "FILE with KEY=VALUE: ..." for the overrides and the case's values it is about
+            exc = _with_override(exc, base.source, {**given, **{k: f"{k}={v}" for k, v in values.items()}})
             raise UserError(f"{exc} (sweep case {_label(values)})") from None
         text = sc.to_toml()
         h = case_hash(text)

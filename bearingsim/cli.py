@@ -294,11 +294,13 @@ def _cmd_rerun(args) -> int:
     old = read(args.archive, only=COMPARED)
     progress = not args.quiet and sys.stderr.isatty()
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
-        new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=False,
+        new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=not args.quiet,
                            force=args.force).result
         args.written = Path(args.output)
     else:
         new = run(old.scenario, progress=progress)
+        for note in new.notes if not args.quiet else ():  # the rerun's notes, as `run` prints them
+            print(note, file=sys.stderr)
     from bearingsim import __version__ as version
 
     new.provenance.update({f"version_{k}": v for k, v in package_versions().items()}, bearingsim_version=version)

@@ -610,6 +610,24 @@ def test_rerun_force_without_output_is_refused(tmp_path, base_reduced, capsys):
     assert archive.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]
 
 
+@pytest.mark.slow
+def test_rerun_prints_the_reruns_notes_as_run_does(tmp_path):
+    """`rerun` printed no note of the run it repeats, though the reliability page said `run` and `rerun` print
+    them: with and without -o it prints the rerun's notes on stderr as `run` does, -q none."""
+    archive = tmp_path / "a.h5"
+    res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "numerics.rotations=3", "-o", archive,
+                     "--no-plots")
+    assert res.returncode == 0, res.stderr
+    notes = [ln for ln in res.stderr.splitlines() if ln.startswith("bearingsim: note: ")]
+    assert any("warm-up could not be judged" in n for n in notes), res.stderr
+    for extra in ([], ["-o", tmp_path / "b.h5"]):
+        res = bearingsim("rerun", archive, *extra)
+        assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
+        assert [ln for ln in res.stderr.splitlines() if ln.startswith("bearingsim: note: ")] == notes, res.stderr
+    res = bearingsim("rerun", "-q", archive, "-o", tmp_path / "b.h5")
+    assert res.returncode == 0 and res.stderr == "", res.stderr
+
+
 def test_life_refuses_its_rotations_given_twice_as_crosscheck_does(tmp_path, capsys):
     """`life --rotations 1 --set numerics.rotations=2` ran 1 rotation per stage and dropped the --set without
     a word; crosscheck refused the same pair. Refused in one line before any stage runs."""

@@ -66,7 +66,7 @@ def cell_text(v) -> str:
 def table_of_index(path) -> Table:
     """The table of a sweep's or study's index (``DIR/sweep.h5`` or the file): one row per case,
     labelled by its swept keys (and its status where it is not done or cached)."""
-    from bearingsim.sweeps.index import FIXED, read_index, unit_of
+    from bearingsim.sweeps.index import FIXED, notes_of, read_index, unit_of
 
     cols, meta = read_index(path)
     n = len(cols["case"])
@@ -84,32 +84,32 @@ def table_of_index(path) -> Table:
     from bearingsim.wording import counted
 
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
-    footnotes = _run_notes(cols, names, labels)
+    footnotes = _run_notes([notes_of(c) for c in cols.get("notes", [""] * n)], names, labels)
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes)
 
 
-def _run_notes(cols, names: list[str], labels: dict) -> dict[int, str]:
-    """The index's run notes (its ``notes`` column) as footnotes by row, each row with notes marked
-    ``[k]`` in a label column ``notes`` added to ``names`` and ``labels`` (none when no case has notes)."""
-    from bearingsim.sweeps.index import notes_of
-
-    n = len(cols["case"])
-    found = {i: notes_of(c) for i, c in enumerate(cols.get("notes", [""] * n)) if notes_of(c)}
-    if not found:
+def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:
+    """The runs' notes (``found``, a list per row: an index's ``notes`` column, an archive's
+    ``/bearingsim/notes``) as footnotes by row, each row with notes marked ``[k]`` in a label column
+    ``notes`` added to ``names`` and ``labels`` (none when no row has notes)."""
+    rows = [i for i, lines in enumerate(found) if lines]
+    if not rows:
         return {}
-    marks = {i: f"[{k}]" for k, i in enumerate(sorted(found), 1)}
+    marks = {i: f"[{k}]" for k, i in enumerate(rows, 1)}
     names.append("notes")
-    labels["notes"] = [marks.get(i, "") for i in range(n)]
-    return {i: f"{marks[i]} " + "; ".join(found[i]) for i in sorted(found)}
+    labels["notes"] = [marks.get(i, "") for i in range(len(found))]
+    return {i: f"{marks[i]} " + "; ".join(found[i]) for i in rows}
 
 
 def table_of_archives(paths) -> Table:
     """The table of run archives, one row each: labelled by the file and the scenario keys that
-    differ between them (at most 4 as columns; the others listed in ``notes``); the standard errors
-    computed from each archive's per-rotation impulses (:func:`bearingsim.stats.result_standard_errors`)."""
+    differ between them (at most 4 as columns; the others listed in ``notes``), and its notes' mark
+    (:func:`_run_notes`); the standard errors computed from each archive's per-rotation impulses
+    (:func:`bearingsim.stats.result_standard_errors`)."""
     from bearingsim.scenario import flatten
     from bearingsim.simulation import COMPARED, load
     from bearingsim.stats import result_standard_errors
+    from bearingsim.sweeps.worker import run_notes
 
     results = [load(p, only=COMPARED) for p in paths]
     flat = [flatten(r.scenario.raw) for r in results]
@@ -134,7 +134,8 @@ def table_of_archives(paths) -> Table:
         notes.append("scenario keys that also differ: " + ", ".join(rest))
     if not differ and len(results) > 1:
         notes.append("scenarios: identical")
-    return Table(names, labels, numbers, units, notes)
+    footnotes = _run_notes([run_notes(r.notes) for r in results], names, labels)  # worded as an index's
+    return Table(names, labels, numbers, units, notes, footnotes)
 
 
 def distinguishing_labels(paths) -> list[str]:

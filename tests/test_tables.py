@@ -173,6 +173,23 @@ def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
     assert_user_error(cli("table", d / "nope.h5"), "nope.h5")
 
 
+def test_a_table_of_archives_marks_and_lists_the_notes_they_store(reduced_runs, tmp_path):
+    """`bearingsim table A.h5 B.h5` ignored the notes the archives store (/bearingsim/notes); it marks the
+    rows with notes [1], [2] ... in a notes column and lists them under the table, as `table DIR` does."""
+    noted = tmp_path / "n.h5"
+    sc = bearingsim.load_scenario(PAPER, set={"bearing.pocket_clearance_mm": 0.3})
+    with pytest.warns(UserWarning, match="outside the plausible range"):  # the run's note
+        bearingsim.run(sc).save(noted)
+    assert bearingsim.load(noted).notes
+    lines = tables.format_table(tables.table_of_archives([reduced_runs / "a.h5", noted])).splitlines()
+    head = next(i for i, line in enumerate(lines) if line.startswith("archive"))
+    assert lines[head].split()[:2] == ["archive", "bearing.pocket_clearance_mm"] and "notes" in lines[head].split()
+    assert "[1]" not in lines[head + 1] and "[1]" in lines[head + 2]
+    assert lines[head + 3].startswith("notes: the runs' plausibility notes")
+    assert lines[head + 4].startswith("[1] bearing.pocket_clearance_mm = 0.3"), lines
+    assert tables.table_of_archives([reduced_runs / "a.h5"]).footnotes == {}
+
+
 def test_the_columns_a_refusal_lists_are_the_columns_accepted(reduced_runs):
     """`table A B --columns X` with an unknown X listed the runs' numbers but left out I_dec_sem_Ns and
     I_acc_sem_Ns, which --columns accepts. The refusal lists tables.column_keys: every name it lists is

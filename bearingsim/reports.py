@@ -240,6 +240,15 @@ def _summary_table_block(table, caption: str) -> dict:
                        " ".join([*table.notes, rule]).strip())
 
 
+def _footnote_blocks(table) -> list[dict]:
+    """The key of a summary table's ``[k]`` marks (its rows' notes) as ``bearingsim table`` prints it, for
+    the rows the report shows (:data:`MAX_ROWS`); none for a table without marks."""
+    from bearingsim import tables
+
+    noted = [text for i, text in sorted(table.footnotes.items()) if i < MAX_ROWS]
+    return [{"kind": "text", "text": tables.NOTES_HEAD}, {"kind": "list", "items": noted}] if noted else []
+
+
 # --- a run archive ------------------------------------------------------------------------------
 def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
     from bearingsim.simulation import load
@@ -392,8 +401,9 @@ def _sweep_sections(index: Path):
     toml = meta.get("scenario_toml") or None  # the base scenario resolved (a sweep of a scenario stores it)
     if toml is None and archive.is_grid_file(map_path, MAP_FORMAT):
         toml = read_map(map_path).attrs.get("scenario")
-    sections = [Section("table", "Cases", [head, _summary_table_block(tables.table_of_index(index),
-                                                                      "Summary numbers of every case")]),
+    table = tables.table_of_index(index)
+    sections = [Section("table", "Cases", [head, _summary_table_block(table, "Summary numbers of every case"),
+                                           *_footnote_blocks(table)]),
                 Section("figures", "Figures", figures)]
     return sweep_title(meta, len(cols["case"])), sections, toml
 

@@ -30,6 +30,8 @@ from bearingsim.stats import ROUND_OFF_REL, SIGNIFICANCE_SE, significant
 RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) "
         "(round-off), x_ref the first row with a number (SE: batch means over rotations, docs/statistics.md); "
         "no mark: within that, or no SE to judge by")
+#: the line above the key of a table's ``[k]`` marks, the runs' notes (:attr:`Table.footnotes`)
+NOTES_HEAD = "notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):"
 #: number columns shown by default, those present
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
                    "load_zone_half_angle_deg")
@@ -364,7 +366,7 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
         out.append(f"... {n - shown} more rows ('bearingsim table' prints them all)")
     noted = [text for i, text in sorted(table.footnotes.items()) if i < shown]
     if noted:
-        out.append("notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):")
+        out.append(NOTES_HEAD)
         out += noted
     if any(k in SEM_OF for k in keys):
         out.append(RULE)

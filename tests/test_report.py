@@ -388,6 +388,22 @@ def test_a_sweep_page_says_when_no_case_failed(tmp_path):
     assert "too large for the euler method" in text
 
 
+def test_a_sweep_pages_notes_marks_have_their_key_under_the_table(tmp_path):
+    """A sweep page's table of cases marked rows [1] in its notes column with no key to them; the key (the
+    case's notes, as `bearingsim table` lists them) follows the table."""
+    import html as html_text
+
+    res = cli("sweep", PAPER, "--param", "bearing.pocket_clearance_mm=0.2,0.3", "-o", tmp_path / "s", "-q",
+              "--no-plots")
+    assert res.returncode == 0, res.stderr
+    html = bearingsim.report(tmp_path / "s", tmp_path / "s.html").read_text()
+    section = re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1)
+    text = html_text.unescape(re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section)))
+    table, after = text.split("notes: the runs' plausibility notes")
+    assert "[1]" in table, text
+    assert "[1] bearing.pocket_clearance_mm = 0.3" in after, text
+
+
 @pytest.mark.slow
 def test_a_table_file_reports_its_folder(folders):
     from bearingsim.reports import kind_of

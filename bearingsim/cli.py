@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import given_once, progress_wanted, report_study, say
+from bearingsim.cli_common import given_once, progress_wanted, report_study, say, with_notes
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.wording import counted
 
@@ -526,7 +526,8 @@ def _cmd_crosscheck(args) -> int:
             print(line)
         for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
             print(f"wrote {Path(args.output) / name}")
-        print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+        notes = with_notes(outcome.sweep.rows, "rung", Path(args.output) / "sweep.h5")
+        print(f"rungs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}{notes}")
     return report_study(outcome, "cross-check")
 
 

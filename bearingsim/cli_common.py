@@ -45,6 +45,15 @@ def report_study(outcome, command: str) -> int:
     return 0
 
 
+def with_notes(rows, what: str, where: str) -> str:
+    """The end of a sweep's or study's closing line counting its ``rows`` (the case index's) with notes,
+    ``"; 1 case with notes (the table's notes column; 'bearingsim table DIR' lists them)"``; "" for none.
+    ``what``: what a row is (case, rung); ``where``: the path whose table lists them."""
+    noted = sum(bool(r.get("notes")) for r in rows)
+    return (f"; {counted(noted, what)} with notes (the table's notes column; 'bearingsim table {where}' "
+            f"lists them)" if noted else "")
+
+
 def progress_wanted(args) -> bool:
     """A progress bar on stderr: only on a terminal, and not with -q."""
     return not getattr(args, "quiet", False) and sys.stderr.isatty()

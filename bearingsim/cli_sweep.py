@@ -24,6 +24,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
     SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
     """
+    from bearingsim.cli_common import with_notes
     from bearingsim.sweeps.engines import DaskEngine, LocalEngine
     from bearingsim.sweeps.run import run_sweep
     from bearingsim.sweeps.spec import spec_from_args
@@ -66,10 +67,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
             from bearingsim import tables
 
             print(tables.format_table(tables.table_of_index(out.h5), max_rows=TABLE_ROWS))
-            noted = sum(bool(r.get("notes")) for r in out.rows)
-            notes = (f"; {counted(noted, 'case')} with notes (the table's notes column; 'bearingsim table "
-                     f"{out.outdir}' lists them)" if noted else "")
-            print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s){notes}")
+            print(f"{counted(n, 'case')}: {counts} ({out.wall_s:.1f} s){with_notes(out.rows, 'case', out.outdir)}")
     except KeyboardInterrupt as exc:  # the cases, index and figures are written: the command line says so
         exc.resume_note = (f"{counted(n, 'case')} indexed in {out.h5}, the table not all printed "
                            f"('bearingsim table {out.outdir}' prints it)")

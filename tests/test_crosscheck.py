@@ -279,6 +279,24 @@ def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_p
     assert "cross-check interrupted" in err and err.rstrip().endswith("run the same command again to resume")
 
 
+@pytest.mark.slow
+def test_the_closing_line_counts_the_rungs_with_notes(tmp_path, capsys):
+    """A sweep's closing line counts its cases with notes; the cross-check's ("rungs: 5 done, 0 cached, 0
+    failed; ...") did not: it counts the rungs with notes and names the table that lists them."""
+    from bearingsim.sweeps import read_index
+    from bearingsim.sweeps.index import notes_of
+
+    out = tmp_path / "cc"
+    assert main(["crosscheck", str(REFERENCE), "--speeds", f"{RPM:g}", "--set", "numerics.rotations=3",
+                 "-o", str(out), "-j", "1"]) == 0  # 3 rotations: the whole-bearing rungs get a note
+    last = capsys.readouterr().out.rstrip().splitlines()[-1]
+    noted = sum(bool(notes_of(c)) for c in read_index(out / "sweep.h5")[0]["notes"])
+    assert noted >= 1
+    assert last.startswith("rungs: 5 done, 0 cached, 0 failed; ") and last.endswith(
+        f"; {noted} rung{'s' if noted > 1 else ''} with notes (the table's notes column; 'bearingsim table "
+        f"{out / 'sweep.h5'}' lists them)"), last
+
+
 def test_one_rotation_prints_no_nan_standard_error():
     """Issue 30, Low: ``crosscheck --rotations 1`` printed "not significant: 2 SE = nan" and "± nan":
     one rotation gives no batch-means error, so the change is not judged and the table says n/a."""

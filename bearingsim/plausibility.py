@@ -331,8 +331,16 @@ def start_transient(result) -> str | None:
 def warmup_not_judged(result) -> str | None:
     """A note when a multibody run recorded fewer rotations than :func:`start_transient` judges the warm-up
     from (:data:`START_TRANSIENT_MIN_ROTATIONS`), else None: its means may hold the start's transient unseen,
-    whose size on the reference bearing docs/statistics.md gives."""
-    if result.parameters.model != "multibody":
+    whose size on the reference bearing docs/statistics.md gives.
+
+    :func:`start_transient` judges every multibody scene, but the ``reduced_equivalent`` scene has no start
+    transient to judge: its cage turns kinematically at the epicyclic speed and the load zone carries every
+    roller at the front of its pocket with zero relative speed, so each pass starts from the same state and
+    its rotations repeat (their standard error about 0); it gets no note. The other scenes, the
+    ``kinematic_cage`` one included (its rollers and inner ring settle from the assembled state), may
+    carry a transient and get it."""
+    p = result.parameters
+    if p.model != "multibody" or p.multibody.scene == "reduced_equivalent":
         return None
     arr = np.asarray(result.per_rotation.get("I_dec", np.zeros(0)))
     n = int(arr.shape[0]) if arr.ndim == 2 else 0

@@ -4,6 +4,8 @@ plausibility checks of a finished run (:mod:`bearingsim.plausibility`) itself; t
 only prints what it raises."""
 from __future__ import annotations
 
+import warnings
+
 import pytest
 
 import bearingsim
@@ -202,6 +204,18 @@ def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
     judged = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={"numerics.rotations": 4}))
     assert not [n for n in judged.notes if "warm-up could not be judged" in n], judged.notes
     assert not [n for n in bearingsim.run(bearingsim.load_scenario(PAPER)).notes if "warm-up" in n]
+
+
+@pytest.mark.parametrize("scene, noted", [("reduced_equivalent", False), ("kinematic_cage", True)])
+def test_a_scene_whose_rotations_repeat_gets_no_warm_up_note(scene, noted):
+    """The warm-up note was given to every short multibody run, the cross-check's reduced_equivalent rung too,
+    whose rotations repeat (each pass starts at the front of its pocket: standard error about 0) and hold no
+    start transient; that scene gets none, the kinematic_cage scene (rollers and inner ring settle) still does."""
+    sc = bearingsim.load_scenario(MULTIBODY, set={"numerics.rotations": 3, "multibody.scene": scene})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", bearingsim.errors.PlausibilityWarning)
+        notes = bearingsim.run(sc).notes
+    assert any("warm-up could not be judged" in n for n in notes) == noted, notes
 
 
 @pytest.mark.slow

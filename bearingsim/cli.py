@@ -206,7 +206,8 @@ def _cmd_show(args) -> int:
     if args.set:
         raise UserError(f"show {args.archive}: --set applies to a scenario file (.toml), not to an archive")
     index = _describe_index(args.archive)
-    if index is not None:  # an index file: its scenario if it stores one, else what it is (as TOML comments)
+    if index is not None:  # an index file: the scenario it stores as runnable TOML (a sweep.h5: its base scenario
+        # with the sweep's --set); of one that stores none (a sweep of given cases), what it is as TOML comments
         idx_text, toml = index
         text = toml if toml else "".join(f"# {line}\n" for line in idx_text.splitlines())
     else:
@@ -608,10 +609,11 @@ def _add_run_commands(sub) -> None:
     i.add_argument("archive", help=_INDEX_KINDS)
     i.set_defaults(func=_cmd_inspect)
 
-    sh = sub.add_parser("show", help="print the scenario stored in an archive, map.h5, crosscheck.h5, sensitivity.h5, "
-                                     "uncertainty.h5 or life.h5 as TOML (a runnable scenario file); for a sweep.h5, "
-                                     "what it holds as TOML comments; for a scenario file (.toml), the resolved "
-                                     "scenario: every key, before any run")
+    sh = sub.add_parser("show", help="print the scenario stored in an archive, sweep.h5, map.h5, crosscheck.h5, "
+                                     "sensitivity.h5, uncertainty.h5 or life.h5 as TOML (a runnable scenario file; of "
+                                     "a sweep.h5, its base scenario with the sweep's --set; of an index that stores "
+                                     "none, a sweep of given cases, what it holds as TOML comments); for a scenario "
+                                     "file (.toml), the resolved scenario: every key, before any run")
     sh.add_argument("archive", help=f"{_INDEX_KINDS}, or a scenario .toml file")
     sh.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="with a scenario file: override a key, as 'run --set' does (repeatable)")

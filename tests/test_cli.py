@@ -184,6 +184,19 @@ def test_help_names_the_default_of_every_folder_command_and_of_the_sensitivity_s
     assert f"default {step.default}%" in step.help, step.help
 
 
+def test_shows_help_says_a_sweep_index_gives_its_base_scenario_as_toml():
+    """`show` of a sweep.h5 prints the base scenario it stores as runnable TOML (docs/commands.md); its help
+    said "for a sweep.h5, what it holds as TOML comments"."""
+    import argparse
+
+    from bearingsim.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    text = " ".join(next(c.help for c in sub._choices_actions if c.dest == "show").split())
+    assert "for a sweep.h5, what it holds as TOML comments" not in text, text
+    assert "of a sweep.h5, its base scenario with the sweep's --set" in text, text
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("command", ["inspect", "show"])
 def test_help_of_inspect_and_show_names_every_file_they_read(command):

@@ -443,8 +443,9 @@ def automatic_dt(p) -> float | None:
 
 
 def _given_step_advice(result) -> str | None:
-    """Advice naming ``numerics.dt_s`` when the run used a step the user gave that is longer than the
-    automatic step (None otherwise: then the step is not the first suspect)."""
+    """Advice naming ``numerics.dt_s``, or the ``dt`` argument of :func:`bearingsim.run` when the step came from
+    it, when the run used a step the user gave that is longer than the automatic step (None otherwise: then
+    the step is not the first suspect)."""
     how = str(result.provenance.get("dt_choice", ""))
     dt = result.provenance.get("dt_s")
     if not how.startswith(("numerics.dt_s", "simulate(dt=")) or dt is None or not math.isfinite(float(dt)):
@@ -455,6 +456,9 @@ def _given_step_advice(result) -> str | None:
         return None
     if auto is None or not float(dt) > auto:
         return None
+    if how.startswith("simulate(dt="):  # the dt argument of bearingsim.run, stored as numerics.dt_s
+        return (f"the given step dt = {float(dt):.3g} s (run()'s dt argument) is {float(dt) / auto:.3g} times the "
+                f"automatic {auto:.3g} s: give a smaller dt, or none")
     return (f"the given step numerics.dt_s = {float(dt):.3g} s is {float(dt) / auto:.3g} times the automatic "
             f"{auto:.3g} s: remove numerics.dt_s or set a smaller one")
 

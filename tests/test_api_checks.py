@@ -10,7 +10,7 @@ import pytest
 
 import bearingsim
 
-from .conftest import SCENARIOS
+from .conftest import ROOT, SCENARIOS
 from .test_cli import bearingsim as cli
 
 PAPER = SCENARIOS / "paper_3000rpm.toml"
@@ -87,14 +87,33 @@ def test_the_api_notes_keys_the_run_does_not_read_as_the_cli_does(tmp_path):
 
 @pytest.mark.slow
 def test_an_implausible_run_is_refused_by_the_api_as_by_the_cli(tmp_path):
-    """Rigid raceways at dt = 10 s: was I_dec = 0 from the API while the CLI exits 3."""
+    """Rigid raceways at dt = 10 s: was I_dec = 0 from the API while the CLI exits 3. The same line, but for
+    where the step came from: the API's `dt=` argument (it said "the given step numerics.dt_s = 10 s"), the
+    CLI's `--set numerics.dt_s`."""
     sc = bearingsim.load_scenario(MULTIBODY, overrides=RIGID)
     with pytest.raises(bearingsim.SimulationUnstable) as api:
         bearingsim.run(sc, dt=10.0)
+    assert "the given step dt = 10 s (run()'s dt argument) is " in str(api.value), str(api.value)
+    assert str(api.value).endswith(": give a smaller dt, or none") and "numerics.dt_s" not in str(api.value)
     res = cli("run", MULTIBODY, *[a for s in RIGID for a in ("--set", s)], "--set", "numerics.dt_s=10",
               "-o", tmp_path / "o.h5", "--no-plots")
-    assert res.returncode == 3 and str(api.value) in res.stderr, res.stderr
+    cli_line = (str(api.value).replace("dt = 10 s (run()'s dt argument)", "numerics.dt_s = 10 s")
+                .replace("give a smaller dt, or none", "remove numerics.dt_s or set a smaller one"))
+    assert res.returncode == 3 and cli_line in res.stderr, res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_reliability_page_quotes_the_apis_step_refusal_as_it_is(base_reduced):
+    """docs/reliability.md said a bad `run(sc, dt=...)` raises a UserError "naming numerics.dt_s"; it names the
+    argument: the page quotes the refusal as the API words it."""
+    from bearingsim.scenario import resolve
+
+    with pytest.raises(bearingsim.UserError) as err:
+        bearingsim.run(resolve(base_reduced), dt=-1.0)
+    (row,) = [ln for ln in (ROOT / "docs" / "reliability.md").read_text().splitlines()
+              if ln.startswith("| API step and plausibility")]
+    assert f'"{err.value}"' in row and "naming `numerics.dt_s`" not in row, row
+    assert "the given step dt = 10 s (run()'s dt argument) is " in row, row
 
 
 def test_numpy_numbers_are_the_numbers_they_hold(base_reduced):

@@ -32,7 +32,9 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
 
     Keys the file, ``overrides`` or ``set`` give that the run does not read (``numerics.dt_s`` with the
     reduced model's event method, a multibody key in a reduced scenario) are named in one
-    :class:`bearingsim.UnreadKeyWarning`, the note ``bearingsim run`` prints.
+    :class:`bearingsim.UnreadKeyWarning`, the note ``bearingsim run`` prints; so is a given
+    ``output.motion_rotations`` longer than the recorded rotations with ``output.motion_start_rotation =
+    "last"``, of which the run reads only the recorded rotations (:func:`bearingsim.scenario.motion_window_note`).
     """
     import warnings
 
@@ -40,9 +42,10 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     from bearingsim.errors import UnreadKeyWarning
 
     sc = scenario.load_scenario(path, overrides, values=set)
-    note = scenario.unread_note(sc, scenario.given_keys(path, overrides, set))
-    if note:
-        warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
+    keys = scenario.given_keys(path, overrides, set)
+    for note in (scenario.unread_note(sc, keys), scenario.motion_window_note(sc, keys)):
+        if note:
+            warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
     return sc
 
 

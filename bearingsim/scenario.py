@@ -1183,10 +1183,16 @@ def _check_motion(m: ScenarioModel, source: str) -> None:
     """The motion window lies in the recorded rotations (a given start) and holds at most
     :data:`MAX_MOTION_SAMPLES` poses. With start "last" a window longer than the run is the whole run."""
     out, rotations = m.output, m.numerics.rotations
-    if out.motion_start_rotation != "last" and out.motion_start_rotation + out.motion_rotations > rotations:
-        exc = UserError(f"{source}: output.motion_start_rotation: the window {out.motion_start_rotation:g} .. "
-                        f"{out.motion_start_rotation + out.motion_rotations:g} ends after the "
-                        f"{rotations} recorded rotations (numerics.rotations); start it earlier or set 'last'")
+    start, length = out.motion_start_rotation, out.motion_rotations
+    if start != "last" and start + length > rotations:
+        ways = []  # what moves the window into the run: an earlier start only where the window fits in it
+        if length <= rotations:
+            ways.append(f"start it at {rotations - length:g} or earlier")
+        if start < rotations:
+            ways.append(f"shorten output.motion_rotations to {rotations - start:g} or less")
+        exc = UserError(f"{source}: output.motion_start_rotation: the window {start:g} .. {start + length:g} ends "
+                        f"after the {rotations} recorded rotations (numerics.rotations); {', '.join(ways)} or set "
+                        f"output.motion_start_rotation = 'last' (the last recorded rotations)")
         raise _involving(exc, "output.motion_rotations")
     length = min(out.motion_rotations, rotations)
     if length * out.motion_samples_per_rotation > MAX_MOTION_SAMPLES:

@@ -175,6 +175,37 @@ def test_pocket_shape_keys_are_validated(override, words):
         assert w in str(e.value)
 
 
+@pytest.mark.parametrize("start, length, advice", [
+    (0, 50, "; shorten output.motion_rotations to 3 or less or set output.motion_start_rotation = 'last'"),
+    (2, 2, "; start it at 1 or earlier, shorten output.motion_rotations to 1 or less or set "
+           "output.motion_start_rotation = 'last'"),
+    (5, 1, "; start it at 2 or earlier or set output.motion_start_rotation = 'last'"),
+])
+def test_a_motion_window_after_the_run_is_refused_with_advice_that_can_be_followed(start, length, advice):
+    """A window from rotation 0 longer than the run was told to "start it earlier", which it cannot: the advice
+    names only what moves the window into the recorded rotations."""
+    with pytest.raises(UserError) as err:
+        load_scenario(SCENARIOS / "multibody_3000rpm.toml", values={
+            "numerics.rotations": 3, "output.motion_start_rotation": start, "output.motion_rotations": length})
+    assert advice in str(err.value) and "earlier or set 'last'" not in str(err.value), str(err.value)
+
+
+def test_the_api_warns_of_a_motion_window_longer_than_the_run_as_the_cli_notes_it():
+    """`bearingsim run` notes a given output.motion_rotations longer than the recorded rotations with the start
+    "last" (the run stores the recorded ones); bearingsim.load_scenario said nothing: it warns as it warns of
+    an unread key, with the same line, and not for a window that fits."""
+    from bearingsim.scenario import motion_window_note
+
+    path = SCENARIOS / "multibody_3000rpm.toml"
+    values = {"numerics.rotations": 3, "output.motion_rotations": 50}
+    with pytest.warns(bearingsim.UnreadKeyWarning) as caught:
+        sc = bearingsim.load_scenario(path, set=values)
+    assert [str(w.message) for w in caught] == [
+        f"bearingsim: note: {motion_window_note(sc, given_keys(path, values=values))}"]
+    assert "output.motion_rotations = 50 is longer than the run's 3 recorded rotations" in str(caught[0].message)
+    bearingsim.load_scenario(path, set={"numerics.rotations": 3, "output.motion_rotations": 3})  # no warning
+
+
 def test_flat_pockets_reach_the_parameters():
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["multibody.flat_pockets=[3, 0]"])
     assert si(sc).multibody.flat_pockets == (0, 3)

@@ -259,7 +259,7 @@ def check_replaceable(path: str | Path, signature, what: str) -> Path:
         if signature(p) if callable(signature) else head == signature:
             return p
         kind = "a file not written by bearingsim"
-    raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another -o)")
+    raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another path)")
 
 
 def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True) -> Path:
@@ -298,7 +298,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
             with open(q, "rb") as fh:
                 return fh.read(8) == _HDF5_SIGNATURE
     if p.exists() and not is_archive(p):
-        raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another -o)")
+        raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another path)")
     stem = p.with_suffix("")
     if figures is True and p.parent.is_dir():
         for fig in p.parent.glob(f"{_glob_escape(stem.name)}_*.png"):

@@ -124,11 +124,16 @@ def test_a_users_png_at_a_figure_path_is_refused_in_one_line_and_kept(tmp_path):
 
     mine = tmp_path / "o_pass.png"
     data = _users_png(mine)
-    for call in (lambda: save_figure(figure(), mine), lambda: check_target(tmp_path / "o.h5", figures=["pass"])):
+    import bearingsim
+
+    result = bearingsim.run(bearingsim.load_scenario(PAPER))
+    calls = (lambda: save_figure(figure(), mine), lambda: check_target(tmp_path / "o.h5", figures=["pass"]),
+             lambda: result.save_figures(tmp_path / "o"))  # the API's too: worded for it and -o alike
+    for call in calls:
         with pytest.raises(UserError) as err:
             call()
         assert str(err.value) == (f"{mine}: figure path is a file not written by bearingsim; not replaced "
-                                  "(remove it or choose another -o)")
+                                  "(remove it or choose another path)")
     assert mine.read_bytes() == data and sorted(p.name for p in tmp_path.iterdir()) == ["o_pass.png"]
     own = save_figure(figure(), tmp_path / "own.png")
     assert is_own_png(own) and not is_own_png(mine) and f"Software\x00{MARK}".encode() in own.read_bytes()

@@ -321,6 +321,17 @@ def test_terminal_table_gives_cage_slip_in_per_cent_as_the_docs_do():
     assert line.split()[-2:] == ["-0.41", "+8.760"], line
 
 
+def test_a_slip_that_rounds_to_zero_is_printed_without_a_sign():
+    """A cage slip of -1.2e-06 (a kinematic cage) printed as "-0.00" in the slip [%] column; it prints 0.00,
+    and a slip that does not round to zero keeps its sign."""
+    row = dict(rpm=3000.0, rung=3, scene="kinematic_cage", I_dec_mean_Ns=1.1486e-2, I_dec_sem_Ns=2.83e-4,
+               I_acc_mean_Ns=0.0, I_acc_sem_Ns=0.0, first_impact_speed_m_s=0.0318, cage_slip=-1.2e-06,
+               change_from_previous=6.218e-3, status="done")
+    slips = [cc.format_table([{**row, "cage_slip": v}]).splitlines()[1].split()[-2]
+             for v in (-1.2e-06, 4e-05, -0.0014, 0.0038)]
+    assert slips == ["0.00", "0.00", "-0.14", "+0.38"], slips
+
+
 def test_crosscheck_index_and_table_give_each_rung_one_standard_error(ladder):
     """Issue 28, item 5: the cross-check's table, the engine's case index in the same folder and
     ``bearingsim table`` of a rung's archive report the same standard error, bit for bit."""

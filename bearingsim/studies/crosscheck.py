@@ -359,5 +359,12 @@ def format_table(rows: list[dict]) -> str:
         lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
                      f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_dec_sem_Ns'])} "
                      f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_acc_sem_Ns'])} "
-                     f"{r['first_impact_speed_m_s']:9.4f} {r['cage_slip'] * 100:+9.2f} {ch:>13s}")
+                     f"{r['first_impact_speed_m_s']:9.4f} {_percent(r['cage_slip']):>9s} {ch:>13s}")
     return "\n".join(lines)
+
+
+def _percent(fraction: float) -> str:
+    """A fraction in per cent with its sign and 2 decimals ("+0.38", "-0.14"); one that rounds to zero is
+    "0.00", with no sign (a slip of -1.2e-06 is not "-0.00")."""
+    text = f"{fraction * 100:+.2f}"
+    return "0.00" if float(text) == 0.0 else text

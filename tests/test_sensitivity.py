@@ -536,3 +536,24 @@ def test_inspect_gives_every_number_column_of_the_table_a_unit(tmp_path, capsys)
     for c in ("x", "x_minus", "x_plus", "x_minus_half", "x_plus_half", "y_minus", "y_minus_se", "y_plus", "y_plus_se"):
         assert "number [" in lines[c], lines[c]
     assert "[the key's unit]" in lines["x"] and "N s" in lines["y_minus"]
+
+
+def test_the_csv_holds_the_half_steps_values_as_the_h5_does(tmp_path):
+    """docs/sensitivity.md calls sensitivity.csv and sensitivity.h5 the same table; the CSV lacked the half
+    step's values x_minus_half, x_plus_half. It has every column of the .h5 but each pair's archives, status
+    and error, with the same numbers."""
+    import csv
+    import json
+
+    from bearingsim import archive
+
+    row = {c: 1.0 for c in sens.COLUMNS}
+    row.update(key="contact.restitution", quantity="I_dec", measure="log", x_minus_half=0.76, x_plus_half=0.84,
+               archive_minus="", archive_plus="", status="done", error="")
+    csv_path, h5 = sens.write_table(tmp_path, [row], load_scenario(REDUCED), 0.1)
+    with open(csv_path, newline="") as fh:
+        (got,) = list(csv.DictReader(fh))
+    _, meta = archive.read_table_file(h5, sens.INDEX_FORMAT)
+    columns = json.loads(meta["columns"])
+    assert list(got) == [c for c in columns if c not in ("archive_minus", "archive_plus", "status", "error")]
+    assert (float(got["x_minus_half"]), float(got["x_plus_half"])) == (0.76, 0.84)

@@ -23,7 +23,7 @@ number of impacts of a pass changes, so a difference across a step may be no loc
 runs at half the step, and ``sensitivity_half_step`` is S from those runs (NaN for the whole bearing, and
 where the key's range clips the half step onto the full step's values: :func:`step_notes`).
 
-Outputs in ``DIR``: ``sensitivity.csv`` (:data:`COLUMNS`), ``sensitivity.h5`` (the same table as an
+Outputs in ``DIR``: ``sensitivity.csv`` (:data:`CSV_COLUMNS`), ``sensitivity.h5`` (the same table as an
 index, with each run's archive, status and error), ``sensitivity.png`` (tornado chart), ``cases/``
 (every run's ordinary archive) and ``sweep.{csv,h5}`` (the engine's index).
 """
@@ -49,6 +49,9 @@ REDUCED_QUANTITIES = ("I_dec", "I_acc")
 
 COLUMNS = ("key", "quantity", "measure", "x", "x_minus", "x_plus", "y_minus", "y_minus_se", "y_plus", "y_plus_se",
            "sensitivity", "sensitivity_se", "over_range", "sensitivity_half_step")
+#: the columns of ``sensitivity.csv``: the table's and the half step's values (``sensitivity.h5`` also has them);
+#: its header starts with :data:`COLUMNS`, which marks the file as the study's
+CSV_COLUMNS = (*COLUMNS, "x_minus_half", "x_plus_half")
 UNITS = {"measure": "", "sensitivity": "1 (log) or y's unit (lin)", "sensitivity_se": "as sensitivity",
          "over_range": "as sensitivity", "sensitivity_half_step": "as sensitivity",
          **{c: "the key's unit" for c in ("x", "x_minus", "x_plus", "x_minus_half", "x_plus_half")},
@@ -413,8 +416,8 @@ class Sensitivity(Study):
 
 
 def write_table(outdir, rows, scenario, step, left_out=(), runs=None) -> tuple[Path, Path]:
-    """``sensitivity.csv`` (exactly :data:`COLUMNS`, a failed pair's numbers empty) and
-    ``sensitivity.h5`` (those columns, the half step's values ``x_minus_half``, ``x_plus_half`` and each
+    """``sensitivity.csv`` (exactly :data:`CSV_COLUMNS`: the table and the half step's values ``x_minus_half``,
+    ``x_plus_half``; a failed pair's numbers empty) and ``sensitivity.h5`` (those columns and each
     pair's archives, status and error; ``left_out``, the default keys not varied and why, in its
     ``left_out`` attribute; ``runs``, the study's distinct runs, in its ``runs`` attribute) atomically."""
     from bearingsim import archive
@@ -423,8 +426,8 @@ def write_table(outdir, rows, scenario, step, left_out=(), runs=None) -> tuple[P
 
     outdir = Path(outdir)
     csv_path = outdir / "sensitivity.csv"
-    write_atomic_bytes(csv_path, table_csv(rows, COLUMNS))
-    columns = (*COLUMNS, "x_minus_half", "x_plus_half", "archive_minus", "archive_plus", "status", "error")
+    write_atomic_bytes(csv_path, table_csv(rows, CSV_COLUMNS))
+    columns = (*CSV_COLUMNS, "archive_minus", "archive_plus", "status", "error")
     cols = table_columns(rows, columns)
     attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "scenario": scenario.to_toml(),
              "scenario_name": scenario.name, "step": float(step)}

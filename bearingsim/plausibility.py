@@ -377,13 +377,14 @@ def _rest_span(result) -> tuple[float, float, float] | None:
 
 def cage_rest_change(result) -> str | None:
     """A note when a multibody run's cage did not rest in one place over its recorded rotations (a span of
-    its resting angle beyond :data:`CAGE_REST_SPAN_DEG`), else None."""
+    its resting angle beyond :data:`CAGE_REST_SPAN_DEG`), else None; the span to 0.1 deg, as the check of
+    :func:`checks_made` gives it."""
     got = _rest_span(result)
     if got is None or got[0] <= CAGE_REST_SPAN_DEG:
         return None
     span, lo, hi = got
     return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
-            f"the bottom spanned {span:.0f} deg over the recorded rotations ({lo:.0f} to {hi:.0f} deg, "
+            f"the bottom spanned {span:.1f} deg over the recorded rotations ({lo:.1f} to {hi:.1f} deg, "
             f"/results/per_rotation/cage_rest_angle; a steady run's stays within a few, the bound is "
             f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in (under load a roller-guided "
             f"cage can rest in two: docs/whatif.md, Radial load)")

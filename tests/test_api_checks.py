@@ -348,9 +348,12 @@ def test_a_cage_that_changes_where_it_rests_is_noted():
         return plausibility.cage_rest_change(r)
 
     note = with_angles([60.0] * 4 + [130.0] * 4)
-    assert note is not None and "spanned 70 deg" in note and "60 to 130 deg" in note, note
+    assert note is not None and "spanned 70.0 deg" in note and "60.0 to 130.0 deg" in note, note
     row = next(c for c in plausibility.checks_made(r) if c[0] == "cage rests in one place")
     assert row[2] is False and "70.0 deg" in row[1], row
+    note = with_angles([60.0] * 4 + [91.5] * 4)  # the note and the check give one span, rounded once
+    row = next(c for c in plausibility.checks_made(r) if c[0] == "cage rests in one place")
+    assert "spanned 31.5 deg" in note and "spanned 31.5 deg" in row[1], (note, row)
     assert with_angles([170.0, -170.0] * 4) is None  # 20 deg apart round the circle: not beyond the bound
     assert with_angles([170.0, -150.0] * 4) is not None  # 40 deg apart
     assert with_angles([60.0] * 4 + [130.0] * 4, offset=1e-6) is None  # a cage at the axis: no angle to judge

@@ -360,12 +360,10 @@ def _compare_many(paths, args) -> int:
     differ = [Path(p).name for p, r in zip(paths[1:], results[1:]) if not compare_results(results[0], r).identical]
     args.status = 1 if differ else 0  # the verdict, kept if the reader of stdout goes early (main)
     keys = differing_keys(*(r.scenario.raw for r in results))
-    if keys:
+    if keys:  # identical scenarios: the table's header says so
         print("scenario keys that differ (archive 1, 2, ...):")
         for k, *values in keys:
             print(f"  {k}: " + ", ".join(map(repr, values)))
-    else:
-        print("scenarios: identical")
     print(tables.format_table(tables.table_of_archives(paths)))
     print("results: identical" if not differ else f"results: differ from {Path(paths[0]).name}: {', '.join(differ)}")
     return args.status

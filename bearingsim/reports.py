@@ -561,7 +561,8 @@ def _life_sections(table: Path):
     from bearingsim.studies import life
 
     cols, attrs = life.read_life(table)
-    head = [h for _, h, _, _ in life.HISTORY_TABLE]
+    history = life.history_table(attrs.get("limit"))  # a volume limit's columns are the volume's
+    head = [h for _, h, _, _ in history]
     mapping = str(attrs.get("mapping", ""))
     blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"
                                        + (f": {life.MAPPINGS[mapping]}." if mapping in life.MAPPINGS else ".")}]
@@ -574,7 +575,10 @@ def _life_sections(table: Path):
         blocks.append({"kind": "text", "text": f"Note: {note}."})
     blocks.append(table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); "
                               "the worn depth over each face at each stage's end is the figure's", head,
-                              life.history_rows(cols), [True] * len(head)))
+                              life.history_rows(cols, history), [True] * len(head)))
+    notes = life.stage_notes(cols)
+    if notes:  # the stages' run notes, each once, as the command prints them under its history
+        blocks.append({"kind": "list", "items": notes})
     figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "
                                                          "running time, stage by stage")]
     import tomllib

@@ -232,13 +232,14 @@ def _crosscheck_table(folder: Path) -> None:
     cc.write_table(folder, cc.add_changes(rows), bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
 
 
-def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "test rows") -> None:
+def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "test rows", notes=None) -> None:
     from bearingsim import archive
     from bearingsim.studies import life
 
     folder.mkdir()
     n = 3
-    cols = {"stage": np.arange(n), "pocket_clearance_mm": [0.2, 0.21, 0.22], "stage_rotations": [1e6] * n,
+    extra = {} if notes is None else {"notes": np.asarray(notes, dtype=object)}
+    cols = {**extra, "stage": np.arange(n), "pocket_clearance_mm": [0.2, 0.21, 0.22], "stage_rotations": [1e6] * n,
             "rotations_end": [1e6, 2e6, 3e6], "hours_end": [10.0, 20.0, 30.0], "max_depth_rate_um_per_h": [1.0] * n,
             "max_volume_rate_mm3_per_h": [1e-3] * n, "max_depth_um": [10.0, 20.0, 30.0],
             "max_volume_mm3": [0.01, 0.02, 0.03], "clearance_end_mm": [0.21, 0.22, 0.23],
@@ -533,6 +534,16 @@ def test_a_check_that_gives_a_note_is_not_called_passed(runs, monkeypatch):
     assert verdict.startswith("Did not pass: warm-up reached a steady state; cage rests in one place."), verdict
     assert "Every check" not in verdict and "Not evaluated here, and no pass: cage speed steady" in verdict
     assert blocks[2]["items"] == ["the first recorded rotation ..."]
+
+
+def test_a_life_page_to_a_volume_limit_shows_the_volume_and_the_stages_notes(tmp_path):
+    """A life study to a volume limit prints the volume it reads and the stages' run notes under its history;
+    its report showed the depth columns and no note."""
+    _life_table(tmp_path / "v", limit="volume=0.03mm3", notes=["", "k is high", "k is high"])
+    html = bearingsim.report(tmp_path / "v", tmp_path / "v.html").read_text()
+    text = re.sub(r"\s+", " ", re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1))
+    assert "largest volume [mm3]" in text and "volume rate [mm3/h]" in text and "deepest [um]" not in text
+    assert "note (2 of 3 stages): k is high" in text
 
 
 @pytest.mark.slow

@@ -92,15 +92,19 @@ def table_of_index(path) -> Table:
 
 def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:
     """The runs' notes (``found``, a list per row: an index's ``notes`` column, an archive's
-    ``/bearingsim/notes``) as footnotes by row, each row with notes marked ``[k]`` in a label column
-    ``notes`` added to ``names`` and ``labels`` (none when no row has notes)."""
+    ``/bearingsim/notes``) as footnotes, each row with notes marked ``[k]`` in a label column ``notes`` added
+    to ``names`` and ``labels`` (none when no row has notes). Rows with the same notes share one mark, whose
+    footnote is keyed by the first of them (a study's stages or cases often carry one note alike)."""
     rows = [i for i, lines in enumerate(found) if lines]
     if not rows:
         return {}
-    marks = {i: f"[{k}]" for k, i in enumerate(rows, 1)}
+    first: dict[str, int] = {}  # the notes' text -> the first row that carries it
+    for i in rows:
+        first.setdefault("; ".join(found[i]), i)
+    number = {text: k for k, text in enumerate(first, 1)}
     names.append("notes")
-    labels["notes"] = [marks.get(i, "") for i in range(len(found))]
-    return {i: f"{marks[i]} " + "; ".join(found[i]) for i in rows}
+    labels["notes"] = [f"[{number['; '.join(lines)]}]" if lines else "" for lines in found]
+    return {i: f"[{number[text]}] {text}" for text, i in first.items()}
 
 
 def table_of_archives(paths) -> Table:

@@ -143,6 +143,18 @@ def test_a_deterministic_models_round_off_is_not_marked_and_its_real_differences
     assert "rung 2 s2 +0.00 mN s (not significant" in verdict and "rung 3 s3 -1.61 mN s (significant" in verdict
 
 
+def test_rows_with_the_same_notes_share_one_mark():
+    """A study whose stages or cases carry one note alike listed it in full once per row ([1] ... [4], the
+    same text); rows with the same notes share a mark and the note is listed once."""
+    from bearingsim.tables import _run_notes
+
+    names, labels = ["case"], {"case": ["a", "b", "c", "d"]}
+    found = [["k is high"], [], ["k is high"], ["k is high", "short run"]]
+    footnotes = _run_notes(found, names, labels)
+    assert names == ["case", "notes"] and labels["notes"] == ["[1]", "", "[1]", "[2]"]
+    assert footnotes == {0: "[1] k is high", 3: "[2] k is high; short run"}
+
+
 # --- the commands -------------------------------------------------------------------------------------
 
 @pytest.mark.slow

@@ -676,7 +676,10 @@ def _add_study_commands(sub) -> None:
     v.set_defaults(func=_cmd_validate)
 
     b = sub.add_parser("bench", help="speed against error of every solver (CSV, table, plot); from a source "
-                                     "checkout (benchmarks/)")
+                                     "checkout (benchmarks/)",
+                       description="Speed against error of every solver (CSV, table, plot). The benchmarks are "
+                                   "not installed with the package: run this from a source checkout of bearingsim "
+                                   "(its benchmarks/ folder); docs/bench.md.")
     b.add_argument("--quick", action="store_true", help="short version (a few minutes)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")

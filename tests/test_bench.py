@@ -1,4 +1,6 @@
 """The benchmark's read-off of issue 2's goal (pure bookkeeping on given rows; no timing here)."""
+import pytest
+
 from benchmarks.bench import reduced_goal
 
 
@@ -59,6 +61,9 @@ def test_bench_is_not_in_the_installed_package_and_runs_from_a_checkout(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "source checkout" in err
     assert not (tmp_path / "b").exists()
+    with pytest.raises(SystemExit):  # its help says so before anyone runs it
+        cli.main(["bench", "--help"])
+    assert "run this from a source checkout" in " ".join(capsys.readouterr().out.split())
 
 
 def test_geometry_and_cost_lines_read_their_own_rows():

@@ -144,6 +144,8 @@ def check(result) -> list[str]:
         arr = np.asarray(result.per_rotation.get(name, np.zeros(0)))
         if arr.size and not np.all(np.isfinite(arr)):
             raise SimulationUnstable(f"non-finite {name} per rotation; {_advice(result)}")
+    if p.model == "reduced":
+        notes += [n for n in (_lift_off_note(p), _no_load_zone_note(p)) if n is not None]
     if p.model == "multibody":
         disp = abs(float(summary.get("inner_ring_displacement_m", 0.0)))
         limit = max_ring_displacement_m(p)
@@ -172,6 +174,33 @@ def check(result) -> list[str]:
                     "multibody.inner_ring=dynamic")
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def _lift_off_note(p) -> str | None:
+    """The reduced model's roller stays on the pitch circle (its Eq. 1). Below the speed where the centrifugal
+    force m r_p omega_c^2 no longer outweighs gravity, N of Eq. 3 turns negative around the top: the roller
+    leaves the outer race there, which the model does not follow (it only drops F_o where N <= 0)."""
+    op, g = p.operating, p.operating.gravity
+    centripetal = p.bearing.pitch_radius * op.omega_c ** 2
+    if g <= 0.0 or centripetal >= g:
+        return None
+    arc = 2.0 * math.degrees(math.pi - math.acos(-centripetal / g))
+    least = op.inner_ring_speed_rpm * math.sqrt(g / centripetal)
+    return (f"bearingsim: note: at {op.inner_ring_speed_rpm:g} rpm the roller's centrifugal acceleration "
+            f"r_p omega_c^2 = {centripetal:.3g} m/s^2 is less than g: over {arc:.0f} deg around the top N <= 0 "
+            "(Eq. 3) and the roller leaves the outer race, which the reduced model does not follow (it keeps the "
+            f"roller on the pitch circle, without drag there); its numbers hold from {least:.0f} rpm up "
+            "(docs/physics.md); model = \"multibody\" follows the roller off the race")
+
+
+def _no_load_zone_note(p) -> str | None:
+    """With the load zone the load gives ("auto") and no radial load there is no load zone: the reduced
+    model still turns its cage at the epicyclic speed (Eq. 11), which nothing drives without load."""
+    if p.reduced.load_zone_half_angle > 0.0:
+        return None
+    return ("bearingsim: note: the load zone is 0 deg (no radial load on it): the reduced model still turns the "
+            "cage at the epicyclic speed (Eq. 11), which no loaded roller drives; the whole bearing "
+            "(model = \"multibody\") shows the cage slowing without load")
 
 
 def _unloaded_ring_note(result) -> str | None:

@@ -357,3 +357,40 @@ def test_a_cage_that_changes_where_it_rests_is_noted():
     assert with_angles([170.0, -170.0] * 4) is None  # 20 deg apart round the circle: not beyond the bound
     assert with_angles([170.0, -150.0] * 4) is not None  # 40 deg apart
     assert with_angles([60.0] * 4 + [130.0] * 4, offset=1e-6) is None  # a cage at the axis: no angle to judge
+
+
+def test_the_reduced_model_notes_where_its_roller_would_leave_the_outer_race():
+    """Eq. 3: N = m r_p omega_c^2 + m g cos(theta) turns negative around the top once r_p omega_c^2 < g, on the
+    reference bearing below 312.55 rpm (omega_c = 0.4333 omega_i, r_p = 48.75 mm). There the roller leaves
+    the outer race, which the reduced model, keeping it on the pitch circle (Eq. 1), does not follow: it ran
+    silently (I_dec 28 mN s at 200 rpm). Such a run is noted, with the arc and the speed from which it holds;
+    a run at 313 rpm is not, nor one without gravity (N > 0 everywhere)."""
+    import math
+
+    def notes(rpm, *extra):
+        sc = bearingsim.load_scenario(PAPER, overrides=[f"operating.inner_ring_speed_rpm={rpm}", *extra])
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", bearingsim.errors.PlausibilityWarning)
+            return [n for n in bearingsim.run(sc).notes if "leaves the outer race" in n]
+
+    (note,) = notes(200)
+    ratio = (200 / 312.55) ** 2  # r_p omega_c^2 / g, omega_c proportional to the speed
+    arc = 2 * math.degrees(math.pi - math.acos(-ratio))  # where cos(theta) < -ratio, around theta = 180 deg
+    assert f"over {arc:.0f} deg around the top" in note and "from 313 rpm up" in note, note
+    assert notes(313) == [] and notes(200, "operating.gravity=false") == []
+
+
+def test_the_reduced_model_notes_a_load_zone_of_zero():
+    """With the load zone the load gives ("auto") and no radial load the half angle is 0: the reduced model
+    still turns its cage at the epicyclic speed (Eq. 11), which nothing drives without load; the whole bearing's
+    cage slows (+23 % slip at 0 N, 3000 rpm). A given half angle, or any load, gives no such note."""
+    def notes(*sets):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", bearingsim.errors.PlausibilityWarning)
+            warnings.simplefilter("ignore", bearingsim.UnreadKeyWarning)  # the load, with a given half angle
+            sc = bearingsim.load_scenario(PAPER, overrides=list(sets))
+            return [n for n in bearingsim.run(sc).notes if "load zone is 0 deg" in n]
+
+    assert len(notes("operating.radial_load_N=0", "reduced.load_zone_half_angle_deg='auto'")) == 1
+    assert notes("operating.radial_load_N=1", "reduced.load_zone_half_angle_deg='auto'") == []
+    assert notes("operating.radial_load_N=0") == []  # the file's 23.5 deg: the load is not read

@@ -225,3 +225,13 @@ def test_roller_leaves_outer_race_without_nan():
     cap = inp.mass * bound + inp.mass * 1.8 * math.sqrt(2 * a_max * inp.pocket_clearance)
     assert 0 < sol.I_dec <= cap and 0 <= sol.I_acc <= cap
     assert np.all((sol.trace["l_r"] >= -1e-12) & (sol.trace["l_r"] <= inp.pocket_clearance + 1e-12))
+
+
+def test_the_reduced_wear_says_it_is_of_the_no_load_pass_alone():
+    """The reduced model's front-face wear is that of the no-load pass's front-face impacts, 0 from 3000 rpm up
+    (I_acc = 0): read alone it said "no front-face wear", where the paper measured front and rear wear alike
+    (Fig. 14). The group's description says what its numbers are of (Eq. 16 on the pass's impulses)."""
+    res = simulate(paper_scenario(6000.0))
+    wear = res.groups["results/wear"]
+    assert wear.attrs["front_per_rotation_m3"] == 0.0 < wear.attrs["rear_per_rotation_m3"]
+    assert "no-load pass" in wear.description and "F_acc" in wear.description and "not part of" in wear.description

@@ -64,6 +64,12 @@ def solve_pass(inp: PassInputs, method: str = "event", dt: float | None = None, 
                        automatic=automatic)
 
 
+#: what the reduced model's wear numbers are of: its no-load pass alone
+WEAR_DESCRIPTION = ("Archard wear of the pocket's faces from the no-load pass's impulses (Eq. 16): rear_* of I_dec, "
+                    "front_* of I_acc, the pass's front-face impacts alone; the load zone's drive F_acc on the front "
+                    "face is not part of this model (the whole bearing's front and rear wear are alike, Fig. 14)")
+
+
 class ReducedResult(Result):
     """One reduced-model run: the solved pass, replicated over ``rotations`` cage rotations.
 
@@ -160,7 +166,8 @@ class ReducedResult(Result):
                 {"omega_c_rad_s": inp.omega_c, "omega_r_rad_s": inp.omega_r, "rolling_velocity_m_s": inp.rolling_velocity},
                 {"omega_c_rad_s": "rad/s", "omega_r_rad_s": "rad/s", "rolling_velocity_m_s": "m/s"}),
             "results/summary": AttrGroup(summary, dict(SUMMARY_UNITS)),
-            "results/wear": AttrGroup(wear, {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in wear}),
+            "results/wear": AttrGroup(wear, {k: ("m^3" if k.endswith("_m3") else "m^3/h") for k in wear},
+                                      WEAR_DESCRIPTION),
         }
         provenance = {"model_version": MODEL_VERSION, "solver": f"reduced/{sol.method}", "solver_wall_s": sol.wall_s,
                       "dt_s": sol.dt if sol.dt is not None else float("nan"), "dt_choice": dt_choice}

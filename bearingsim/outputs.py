@@ -284,7 +284,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     if "\x00" in str(p):
         raise UserError(f"{str(p)!r}: output path contains a NUL byte")
     if p.is_symlink():  # the user's, as a linked figure is (check_replaceable): neither replaced nor followed
-        raise UserError(f"{p}: archive path is a symbolic link; not replaced (remove it or choose another output)")
+        raise UserError(f"{p}: archive path is a symbolic link; not replaced (remove it or choose another path)")
     for src in inputs:
         if src and _same_file(p, Path(src)):
             raise UserError(f"{p}: output path is the input scenario file; choose another -o")

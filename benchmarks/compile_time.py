@@ -6,10 +6,13 @@ runs each scenario (default: ``scenarios/paper_3000rpm.toml`` and ``scenarios/mu
 for one recorded rotation in a fresh process whose numba cache (``NUMBA_CACHE_DIR``) is a new empty
 folder, and prints the first run's wall time and the functions numba compiled, longest first, each
 with its compile time including what it compiled inside it (numba's ``numba:compile`` events). A
-process that finds the kernels in the cache loads them instead (about a second).
+process that finds the kernels in the cache loads them instead (about a second). Each scenario takes
+about half a minute to a minute (docs/crosscheck.md: 22.5 s on 2 quiet cores); the caches are temporary
+folders, removed after each run, and nothing else is written.
 """
 from __future__ import annotations
 
+import argparse
 import os
 import subprocess
 import sys
@@ -38,9 +41,15 @@ for s, name in sorted(spans, reverse=True)[:int(sys.argv[2])]:
 """
 
 
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.compile_time", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("scenarios", nargs="*", metavar="SCENARIO", help="scenario files (default: the two above)")
+    return ap
+
+
 def main(argv=None) -> None:
-    args = sys.argv[1:] if argv is None else argv
-    files = args or ["scenarios/paper_3000rpm.toml", "scenarios/multibody_6000rpm.toml"]
+    files = parser().parse_args(argv).scenarios or ["scenarios/paper_3000rpm.toml", "scenarios/multibody_6000rpm.toml"]
     for f in files:
         with tempfile.TemporaryDirectory(prefix="bearingsim-numba-cache-") as cache:
             print(f"{f} (empty kernel cache):", flush=True)

@@ -20,10 +20,13 @@ binning error alone. The bin counts are the model's constants (``multibody.recor
 Table 3). ``theta``: ``scenarios/multibody_3000rpm.toml`` with the fixtures' settings of
 ``benchmarks/whole_bearing.py checks`` (1 warm-up + 20 rotations, phi = 23.5 deg), the numbers
 docs/multibody.md's check table quotes.
+
+Each study is several whole-bearing runs of 1 warm-up + 10 to 40 rotations, minutes or more; it prints
+markdown tables and writes nothing (``life`` keeps its studies in temporary folders, removed after).
 """
 from __future__ import annotations
 
-import sys
+import argparse
 from pathlib import Path
 
 
@@ -187,22 +190,27 @@ def theta(bins=(180, 360, 720, 1440), sets=()):
         core.THETA_BINS, mb.THETA_BINS = saved
 
 
+def _bins(text: str) -> tuple[int, ...]:
+    return tuple(int(b) for b in text.split(","))
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.discretization", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("study", choices=("psi", "theta", "dt", "rig", "whatif", "life"))
+    ap.add_argument("--bins", type=_bins, help="bin counts, e.g. 32,64 (psi, theta, life); the speeds of dt, rig, "
+                                               "whatif")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario override (repeatable)")
+    ap.add_argument("--limit", help="life only: the life study's limit (default depth=0.1mm)")
+    return ap
+
+
+def main(argv=None) -> None:
+    a = parser().parse_args(argv)
+    given = [a.bins] if a.bins else []
+    study = {"psi": psi, "theta": theta, "life": life, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
+    study(*given, sets=a.set, **({"limit": a.limit} if a.study == "life" and a.limit else {}))
+
+
 if __name__ == "__main__":
-    what = sys.argv[1] if len(sys.argv) > 1 else ""
-    sets = [a.split("=", 1)[1] for a in sys.argv[2:] if a.startswith("--set=")]
-    given = [tuple(int(b) for b in a.split("=", 1)[1].split(",")) for a in sys.argv[2:] if a.startswith("--bins=")]
-    if what == "psi":
-        psi(*given, sets=sets)
-    elif what == "theta":
-        theta(*given, sets=sets)
-    elif what == "life":
-        limits = [a.split("=", 1)[1] for a in sys.argv[2:] if a.startswith("--limit=")]
-        life(*given, sets=sets, **({"limit": limits[0]} if limits else {}))
-    elif what == "whatif":
-        whatif(*given, sets=sets)
-    elif what == "rig":
-        rig(*given, sets=sets)
-    elif what == "dt":
-        dt(*given, sets=sets)
-    else:
-        sys.exit(__doc__)
+    main()

@@ -7,13 +7,14 @@ to the bound (0.01, the rule before multibody model version 3) and to the presen
 the two three times. It prints, per run, the step kept, the restarts, the wall time per rotation of the
 whole ``simulate`` call (restarts included) and of the kept run alone, the load average, and the
 digest of the per-rotation impulses; then the median of each and the ratio of the medians (the
-same-run comparison: both rules see the same machine load).
+same-run comparison: both rules see the same machine load). Six runs of 1 warm-up + 40 rotations per
+speed (and one short run that loads the kernels), minutes in all; it writes nothing (the table is printed).
 """
 from __future__ import annotations
 
+import argparse
 import os
 import statistics
-import sys
 import time
 
 from benchmarks.fast_scene_bench import impulse_digest
@@ -25,10 +26,17 @@ REPEATS = 3
 FRACTIONS = (0.01, None)  # None: the module's own value
 
 
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.fast_scene_step", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("rpm", nargs="*", type=float, help="inner-ring speeds [rpm] (default: 6000)")
+    return ap
+
+
 def main(argv=None) -> int:
+    speeds = parser().parse_args(argv).rpm or [6000.0]
     from bearingsim.multibody import core, simulate
 
-    speeds = [float(a) for a in (argv if argv is not None else sys.argv[1:])] or [6000.0]
     present = core.RIGID_IMPACT_OVERLAP_FRACTION
     simulate(Parameters.from_scenario(reference_scenario(6000, 1, 0, raceway_contact="rigid")))  # load kernels
     for rpm in speeds:

@@ -7,11 +7,14 @@ scenarios/multibody_6000rpm.toml`` writes ``outputs/multibody_6000rpm.h5``):
   first tenth of a rotation, as the animation draws it);
 * ``docs/report_top.png``: the top of ``bearingsim report``'s page as headless Chromium shows it
   (1200 x 900 px; ``/usr/bin/chromium`` through playwright, as tests/test_report.py opens it).
+
+It overwrites those two files of the checkout (the GIF and the page it draws them from go to temporary
+folders, removed after) and takes some seconds.
 """
 from __future__ import annotations
 
+import argparse
 import os
-import sys
 import tempfile
 from pathlib import Path
 
@@ -56,9 +59,16 @@ def report_top(archive: Path, out: Path) -> None:
             browser.close()
 
 
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.readme_images", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("archive", nargs="?", help="the archive to draw from (default: outputs/multibody_6000rpm.h5)")
+    return ap
+
+
 def main(argv=None) -> None:
-    argv = sys.argv[1:] if argv is None else argv
-    archive = Path(os.path.relpath(Path(argv[0]) if argv else MAIN))  # the page names it as given
+    given = parser().parse_args(argv).archive
+    archive = Path(os.path.relpath(Path(given) if given else MAIN))  # the page names it as given
     still(archive, ROOT / "docs" / "animation_still.png")
     report_top(archive, ROOT / "docs" / "report_top.png")
     print(f"wrote {ROOT / 'docs' / 'animation_still.png'}, {ROOT / 'docs' / 'report_top.png'} from {archive}")

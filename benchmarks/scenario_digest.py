@@ -6,10 +6,12 @@ prints a SHA-256 of every shipped scenario's resolved TOML, raw table and SI par
 (``scenarios/*.toml``, ``scenarios/hard/*.toml``), then, for each sweep file in ``scenarios/sweeps/``,
 its case count, a SHA-256 of every case (hash, swept values, TOML, model, validated scenario model) and
 the wall time :func:`bearingsim.sweeps.spec.resolve_cases` took. Run it on the code before and after
-a change and compare the digests (the times are this machine's, at this moment).
+a change and compare the digests (the times are this machine's, at this moment). It takes no arguments and
+writes nothing (the lines are printed); resolving the sweep files is most of its time (printed per file).
 """
 from __future__ import annotations
 
+import argparse
 import glob
 import hashlib
 import time
@@ -19,7 +21,13 @@ from bearingsim.scenario import load_scenario
 from bearingsim.sweeps.spec import load_sweep_file, resolve_cases
 
 
-def main() -> None:
+def parser() -> argparse.ArgumentParser:
+    return argparse.ArgumentParser(prog="python -m benchmarks.scenario_digest", description=__doc__,
+                                   formatter_class=argparse.RawDescriptionHelpFormatter)
+
+
+def main(argv=None) -> None:
+    parser().parse_args(argv)
     h = hashlib.sha256()
     files = sorted(glob.glob("scenarios/*.toml") + glob.glob("scenarios/hard/*.toml"))
     for f in files:

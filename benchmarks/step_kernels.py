@@ -8,11 +8,13 @@ the compiled loop calls before a step, called 20 000 times from compiled code on
 ``loop.arc_faces`` (placing the exact faces) and ``loop.face_masks``. Beside them: the whole step per
 rotation and pymunk's share, from the same run. The kernels' arithmetic is that of the run; only the
 state stays the same from call to call (the ring's Newton solve starts at its solution, so it takes
-no iteration here: a real step takes one or two).
+no iteration here: a real step takes one or two). Most of its time is compiling: the timing loops
+are not cached and compile on every start; the runs are 1 warm-up + 1 rotation per speed. It writes nothing
+(the table is printed).
 """
 from __future__ import annotations
 
-import sys
+import argparse
 import time
 
 import numpy as np
@@ -62,12 +64,19 @@ def _per_call(fn, *args) -> float:
     return (time.perf_counter() - t0) / CALLS
 
 
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.step_kernels", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("rpm", nargs="*", type=float, help="inner-ring speeds [rpm] (default: 1000)")
+    return ap
+
+
 def main(argv=None) -> int:
+    speeds = parser().parse_args(argv).rpm or [1000.0]
     from benchmarks.multibody_bench import reference_scenario
     from bearingsim.multibody import core
     from bearingsim.parameters import Parameters
 
-    speeds = [float(a) for a in (argv if argv is not None else sys.argv[1:])] or [1000.0]
     kept = {}
     raw_of = core._raw
 

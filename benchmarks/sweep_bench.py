@@ -13,9 +13,19 @@ index), ``case_s`` (the cases' own time, summed, measured around ``run_scenario`
 ``efficiency`` = wall(1 worker) / (2 wall(2 workers)) of the same engine, and the engine's
 ``overhead_per_case`` = (workers x wall - sum of case times) / cases, also as a share of the mean case
 time. Idle workers at the end of an uneven split count as overhead.
+
+From the checkout's root:
+
+    python -m benchmarks.sweep_bench                                # the scaling bench (minutes)
+    python -m benchmarks.sweep_bench map [--archives none|all] OUTDIR  # one run of the 100 x 100 map
+
+The scaling bench runs the sweep four times in temporary folders (removed after) and writes
+``outputs/bench/sweep_scaling.csv``; ``map`` runs the map (seconds to a minute on 2 workers) into ``OUTDIR``
+with no figures, with one archive per case unless ``--archives none``, and prints one line.
 """
 from __future__ import annotations
 
+import argparse
 import os
 import tempfile
 import time
@@ -207,10 +217,25 @@ def run_map_bench(outdir: str | Path = "outputs/bench", jobs: int = 2) -> list[d
     return rows
 
 
-if __name__ == "__main__":  # pragma: no cover
-    import sys
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.sweep_bench", description=__doc__,
+                                 usage="%(prog)s [-h] [map [--archives {none,all}] OUTDIR]",
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="command", metavar="map", help="run the map once instead of the scaling bench")
+    one = sub.add_parser("map", help="the 100 x 100 map into OUTDIR (see map_cost)",
+                         description="Run the 100 x 100 reduced-model map into OUTDIR and print what it cost.")
+    one.add_argument("--archives", choices=("none", "all"), default="all", help="(default: %(default)s)")
+    one.add_argument("outdir", metavar="OUTDIR")
+    return ap
 
-    if sys.argv[1:2] == ["map"]:
-        map_cost(sys.argv[-1], archives="none" if "none" in sys.argv[2:-1] else "all")
+
+def main(argv=None) -> None:
+    a = parser().parse_args(argv)
+    if a.command == "map":
+        map_cost(a.outdir, archives=a.archives)
     else:
         run_sweep_bench()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

@@ -3,10 +3,12 @@
 ``python -m benchmarks.wear_bench cost``: solver time per run with the wear profile recorded and with it
 switched off (psi_hi = psi_lo: the kernel skips it), repeats interleaved. ``python -m benchmarks.wear_bench
 life``: ``bearingsim life`` of the wear-test scene, fast scene, 10 stages, at the default mapping, wall time.
+``cost`` is the default; it runs each of its three rows 7 times (minutes); ``life`` takes about 10 s
+(docs/wear.md). Both print their numbers and write nothing (the life study goes to a temporary folder).
 """
 from __future__ import annotations
 
-import sys
+import argparse
 import tempfile
 import time
 
@@ -65,5 +67,16 @@ def life(stages: int = 10, rotations: int = 10) -> None:
           f"rotations): {wall:.1f} s wall; {cols['hours_end'][-1]:.4g} h to depth 0.1 mm")
 
 
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.wear_bench", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("what", nargs="?", choices=("cost", "life"), default="cost", help="(default: %(default)s)")
+    return ap
+
+
+def main(argv=None) -> None:
+    {"cost": cost, "life": life}[parser().parse_args(argv).what]()
+
+
 if __name__ == "__main__":
-    {"cost": cost, "life": life}[sys.argv[1] if len(sys.argv) > 1 else "cost"]()
+    main()

@@ -8,12 +8,13 @@
     python benchmarks/whole_bearing.py rig      # the rig's flat pocket 0 against the reduced model between the scenario files' speeds
 
 Each prints a markdown table; every run is an ordinary ``bearingsim.run`` of a scenario in ``scenarios/``
-with the ``--set`` overrides shown in its row.
+with the ``--set`` overrides shown in its row. Each table is several such runs, minutes or more; nothing is
+written. Also runs as ``python -m benchmarks.whole_bearing TABLE``.
 """
 from __future__ import annotations
 
+import argparse
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -175,5 +176,19 @@ def rig():
               f"{r['arc_pockets_I_dec_mean_Ns'] * 1e3:.2f} |", flush=True)
 
 
+TABLES = {"whatif": whatif, "orbit": orbit, "wear": wear, "extent": extent, "checks": checks, "rig": rig}
+
+
+def parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="python benchmarks/whole_bearing.py", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("table", choices=tuple(TABLES))
+    return ap
+
+
+def main(argv=None) -> None:
+    TABLES[parser().parse_args(argv).table]()
+
+
 if __name__ == "__main__":
-    {"whatif": whatif, "orbit": orbit, "wear": wear, "extent": extent, "checks": checks, "rig": rig}[sys.argv[1]]()
+    main()

@@ -1,0 +1,81 @@
+"""Every benchmark run as ``python -m benchmarks.X`` answers ``--help`` with its usage and does nothing else,
+and the argument forms the docs give still parse to the same values (parsed only: nothing runs)."""
+import importlib
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+MAIN_ENTRY = re.compile(r'^if __name__ == "__main__":', re.M)
+WITH_MAIN = sorted(p.stem for p in (ROOT / "benchmarks").glob("*.py") if MAIN_ENTRY.search(p.read_text()))
+
+
+def test_the_benchmarks_with_a_main_entry_are_found():
+    assert {"sweep_bench", "compile_time", "discretization", "whole_bearing", "digest"} <= set(WITH_MAIN)
+
+
+@pytest.mark.slow
+def test_help_prints_usage_exits_0_and_writes_nothing(tmp_path):
+    cwd, tmp = tmp_path / "cwd", tmp_path / "tmp"
+    cwd.mkdir()
+    tmp.mkdir()
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp), "PYTHONDONTWRITEBYTECODE": "1"}
+    procs = {m: subprocess.Popen([sys.executable, "-m", f"benchmarks.{m}", "--help"], cwd=cwd, env=env, text=True,
+                                 stdout=subprocess.PIPE, stderr=subprocess.PIPE) for m in WITH_MAIN}
+    failed = []
+    for m, p in procs.items():
+        try:
+            out, err = p.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            p.kill()
+            p.communicate()
+            failed.append(f"{m}: still running after 30 s")
+            continue
+        if p.returncode != 0 or not out.startswith("usage:") or err:
+            failed.append(f"{m}: exit {p.returncode}, {(out + err)[-300:]!r}")
+    assert not failed, "\n".join(failed)
+    assert not list(cwd.iterdir()) and not list(tmp.iterdir())
+
+
+def _parse(module, argv):
+    return vars(importlib.import_module(f"benchmarks.{module}").parser().parse_args(argv))
+
+
+def test_the_documented_invocations_parse_as_before():
+    """The forms docs/*.md, README.md and the modules' docstrings give, and what each meant before."""
+    assert _parse("animation_bench", []) == {"archive": "outputs/multibody_6000rpm.h5"}
+    assert _parse("animation_bench", ["outputs/x.h5"]) == {"archive": "outputs/x.h5"}
+    assert _parse("compile_time", []) == {"scenarios": []}
+    assert _parse("compile_time", ["a.toml", "b.toml"]) == {"scenarios": ["a.toml", "b.toml"]}
+    assert _parse("fast_scene_step", ["6000", "3000"]) == {"rpm": [6000.0, 3000.0]}
+    assert _parse("step_kernels", []) == {"rpm": []}
+    assert _parse("step_kernels", ["1000", "6000"]) == {"rpm": [1000.0, 6000.0]}
+    assert _parse("readme_images", []) == {"archive": None}
+    assert _parse("scenario_digest", []) == {}
+    assert _parse("wear_bench", []) == {"what": "cost"}
+    assert _parse("wear_bench", ["life"]) == {"what": "life"}
+    for table in ("whatif", "orbit", "wear", "extent", "checks", "rig"):
+        assert _parse("whole_bearing", [table]) == {"table": table}
+    for study in ("psi", "theta", "dt", "rig", "whatif", "life"):
+        assert _parse("discretization", [study]) == {"study": study, "bins": None, "set": [], "limit": None}
+    assert _parse("discretization", ["life", "--limit=clearance=0.4mm", "--bins=32,64", "--set=numerics.dt_s=2e-6",
+                                     "--set=numerics.warmup_rotations=41"]) == {
+        "study": "life", "bins": (32, 64), "limit": "clearance=0.4mm",
+        "set": ["numerics.dt_s=2e-6", "numerics.warmup_rotations=41"]}
+    assert _parse("sweep_bench", []) == {"command": None}
+    assert _parse("sweep_bench", ["map", "out"]) == {"command": "map", "archives": "all", "outdir": "out"}
+    assert _parse("sweep_bench", ["map", "--archives", "none", "out"]) == {"command": "map", "archives": "none",
+                                                                           "outdir": "out"}
+
+
+@pytest.mark.parametrize("module, argv", [("discretization", []), ("discretization", ["nope"]),
+                                          ("wear_bench", ["x"]), ("whole_bearing", []), ("sweep_bench", ["x"]),
+                                          ("fast_scene_step", ["--help-me"]), ("step_kernels", ["abc"])])
+def test_a_bad_argument_is_a_usage_error(module, argv, capsys):
+    with pytest.raises(SystemExit) as exc:
+        _parse(module, argv)
+    assert exc.value.code == 2 and "error:" in capsys.readouterr().err

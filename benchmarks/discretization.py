@@ -206,7 +206,10 @@ def parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> None:
-    a = parser().parse_args(argv)
+    ap = parser()
+    a = ap.parse_args(argv)
+    if a.limit and a.study != "life":
+        ap.error(f"--limit: only the life study reads it (not {a.study})")
     given = [a.bins] if a.bins else []
     study = {"psi": psi, "theta": theta, "life": life, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
     study(*given, sets=a.set, **({"limit": a.limit} if a.study == "life" and a.limit else {}))

@@ -79,3 +79,13 @@ def test_a_bad_argument_is_a_usage_error(module, argv, capsys):
     with pytest.raises(SystemExit) as exc:
         _parse(module, argv)
     assert exc.value.code == 2 and "error:" in capsys.readouterr().err
+
+
+def test_a_limit_for_a_study_that_does_not_read_it_is_refused(capsys):
+    """``discretization dt --limit=...`` ran the time-step study and dropped the limit without a word: only
+    the life study reads it, any other refuses it as a usage error (exit 2) before running anything."""
+    from benchmarks import discretization
+
+    with pytest.raises(SystemExit) as exc:
+        discretization.main(["dt", "--limit=depth=1mm"])
+    assert exc.value.code == 2 and "--limit: only the life study reads it (not dt)" in capsys.readouterr().err

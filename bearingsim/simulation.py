@@ -134,7 +134,9 @@ def check_run(scenario: Scenario, dt: float | None = None) -> None:
     try:
         model_module(scenario.model).check_start(scenario.parameters, dt)
     except UserError as exc:  # the model names the key; the scenario's refusals name its file too
-        raise UserError(f"{scenario.source}: {exc}") from None
+        named = UserError(f"{scenario.source}: {exc}")
+        named.involves = getattr(exc, "involves", ())  # the keys the check read, for the overrides' names
+        raise named from None
 
 
 @dataclass

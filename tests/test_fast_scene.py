@@ -161,6 +161,22 @@ def test_rigid_refusal_through_the_command_line(tmp_path):
     assert not out.exists()
 
 
+def test_rigid_refusal_comes_before_the_run_and_names_the_overrides(tmp_path):
+    """The dry run and :func:`bearingsim.simulation.check_run` refuse what the run refuses before its first
+    step: rigid raceways at 300 rpm (the run exits 2, so its dry run may not exit 0). The refusal says which
+    overrides gave the values it is about, as the other refusals of a scenario do."""
+    from bearingsim.simulation import check_run
+
+    with pytest.raises(UserError, match="raceway_contact = 'hertz'"):
+        check_run(_scenario("rigid", rpm=300, rotations=1))
+    out = tmp_path / "x.h5"
+    r = bearingsim("run", str(BASE), "--dry-run", "--set", "multibody.raceway_contact=rigid", "--set",
+                   "operating.inner_ring_speed_rpm=300", "-o", str(out))
+    assert_user_error(r, f"{BASE} with multibody.raceway_contact=rigid and operating.inner_ring_speed_rpm=300: "
+                         "multibody.raceway_contact = 'rigid': at 300 rpm")
+    assert not out.exists()
+
+
 def test_unknown_raceway_contact_is_refused():
     with pytest.raises(UserError, match="raceway_contact"):
         _scenario("springy")

@@ -343,17 +343,27 @@ def rigid_start(p, dt, play=None):
     return t_start, min(dt, dt_start)
 
 
+#: the scenario keys :func:`check_rigid` reads besides ``multibody.raceway_contact`` (the speed, gravity and
+#: the roller-centre radius r_c and cage speed they give; the roller mass cancels in the ratio)
+RIGID_CHECK_KEYS = ("operating.inner_ring_speed_rpm", "operating.gravity", "bearing.pitch_diameter_mm",
+                    "bearing.roller_diameter_mm", "bearing.radial_clearance_mm")
+
+
 def check_rigid(p):
-    """Refuse (UserError) what the rigid raceways cannot represent: rollers that would leave the outer race."""
+    """Refuse (UserError) what the rigid raceways cannot represent: rollers that would leave the outer race.
+    The refusal is marked with the keys it reads (``involves``: :data:`RIGID_CHECK_KEYS`), so that a refusal
+    of a scenario names the overrides that gave them."""
     g, op = p.bearing, p.operating
     fc = g.roller_mass * rigid_radius(p) * op.omega_c**2
     w = g.roller_mass * op.gravity
     if fc < RIGID_MIN_CENTRIFUGAL_RATIO * w:
-        raise UserError(
+        exc = UserError(
             f"multibody.raceway_contact = 'rigid': at {op.inner_ring_speed_rpm:g} rpm a roller's centrifugal load "
             f"({fc:.3g} N) is less than {RIGID_MIN_CENTRIFUGAL_RATIO:g} x its weight ({w:.3g} N), so the rollers at "
             f"the top leave the outer race, which rigid raceways do not model; use raceway_contact = 'hertz' "
             f"below {rigid_speed_floor(p):.0f} rpm")
+        exc.involves = RIGID_CHECK_KEYS
+        raise exc
 
 
 def face_geometry(sc, rr, margin):

@@ -1180,8 +1180,11 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
 
 
 def _check_motion(m: ScenarioModel, source: str) -> None:
-    """The motion window lies in the recorded rotations (a given start) and holds at most
-    :data:`MAX_MOTION_SAMPLES` poses. With start "last" a window longer than the run is the whole run."""
+    """The motion window of a multibody run lies in the recorded rotations (a given start) and holds at most
+    :data:`MAX_MOTION_SAMPLES` poses. With start "last" a window longer than the run is the whole run. The
+    reduced model stores no motion: it does not read ``[output]`` (:func:`unread_note` says so)."""
+    if m.model != "multibody":
+        return
     out, rotations = m.output, m.numerics.rotations
     start, length = out.motion_start_rotation, out.motion_rotations
     if start != "last" and start + length > rotations:

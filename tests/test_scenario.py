@@ -190,6 +190,23 @@ def test_a_motion_window_after_the_run_is_refused_with_advice_that_can_be_follow
     assert advice in str(err.value) and "earlier or set 'last'" not in str(err.value), str(err.value)
 
 
+def test_the_reduced_model_is_not_refused_over_a_motion_window_it_does_not_store():
+    """The reduced model stores no motion and reads no [output] key: a window after its recorded rotations
+    (start 0, the default 2 rotations, 1 recorded) was refused; it is the usual unread-key note instead,
+    from the API and the command line's dry run alike. The multibody model still refuses it."""
+    from tests.test_cli import bearingsim as cli
+
+    path = SCENARIOS / "paper_3000rpm.toml"
+    with pytest.warns(bearingsim.UnreadKeyWarning, match="output.motion_start_rotation: not used by the reduced"):
+        sc = bearingsim.load_scenario(path, set={"output.motion_start_rotation": 0})
+    assert sc.numerics.rotations < sc.output.motion_rotations
+    res = cli("run", path, "--dry-run", "--set", "output.motion_start_rotation=0")
+    assert res.returncode == 0, res.stderr
+    assert "output.motion_start_rotation: not used by the reduced model" in res.stderr
+    with pytest.raises(UserError, match="output.motion_start_rotation: the window 0 .. 2 ends after"):
+        load_scenario(path, ["output.motion_start_rotation=0", "model=multibody"])
+
+
 def test_the_api_warns_of_a_motion_window_longer_than_the_run_as_the_cli_notes_it():
     """`bearingsim run` notes a given output.motion_rotations longer than the recorded rotations with the start
     "last" (the run stores the recorded ones); bearingsim.load_scenario said nothing: it warns as it warns of

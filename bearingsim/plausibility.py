@@ -387,10 +387,11 @@ def warmup_not_judged(result) -> str | None:
 
 
 def _rest_span(result) -> tuple[float, float, float] | None:
-    """(span [deg], least and largest angle [deg]) of where a multibody result's cage rested over its
-    recorded rotations (/results/per_rotation/cage_rest_angle, taken round the circle from the first
-    rotation's), or None: an archive without them, fewer than 2 rotations, or a cage at the axis
-    (:data:`CAGE_REST_MIN_OFFSET`)."""
+    """(span [deg], first and last end [deg]) of where a multibody result's cage rested over its recorded
+    rotations (/results/per_rotation/cage_rest_angle), or None: an archive without them, fewer than 2
+    rotations, or a cage at the axis (:data:`CAGE_REST_MIN_OFFSET`). The span is taken round the circle
+    from the first rotation's angle; its ends are the stored angles at either end of the arc, which runs
+    from the first to the last in the direction of rotation (across 180 deg when the first is the larger)."""
     pr = result.per_rotation
     if result.parameters.model != "multibody" or "cage_rest_angle" not in pr:
         return None
@@ -401,7 +402,7 @@ def _rest_span(result) -> tuple[float, float, float] | None:
     if a.size < 2 or o.min() < CAGE_REST_MIN_OFFSET * result.parameters.bearing.pocket_clearance:
         return None
     d = (a - a[0] + 180.0) % 360.0 - 180.0
-    return float(d.max() - d.min()), float(a[0] + d.min()), float(a[0] + d.max())
+    return float(d.max() - d.min()), float(a[np.argmin(d)]), float(a[np.argmax(d)])
 
 
 def cage_rest_change(result) -> str | None:
@@ -412,8 +413,9 @@ def cage_rest_change(result) -> str | None:
     if got is None or got[0] <= CAGE_REST_SPAN_DEG:
         return None
     span, lo, hi = got
+    across = " across 180" if lo > hi else ""  # the stored angles lie in -180 .. 180 deg
     return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
-            f"the bottom spanned {span:.1f} deg over the recorded rotations ({lo:.1f} to {hi:.1f} deg, "
+            f"the bottom spanned {span:.1f} deg over the recorded rotations ({lo:.1f} to {hi:.1f} deg{across}, "
             f"/results/per_rotation/cage_rest_angle; a steady run's stays within a few, the bound is "
             f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in (under load a roller-guided "
             f"cage can rest in two: docs/whatif.md, Radial load)")

@@ -354,6 +354,10 @@ def test_a_cage_that_changes_where_it_rests_is_noted():
     note = with_angles([60.0] * 4 + [91.5] * 4)  # the note and the check give one span, rounded once
     row = next(c for c in plausibility.checks_made(r) if c[0] == "cage rests in one place")
     assert "spanned 31.5 deg" in note and "spanned 31.5 deg" in row[1], (note, row)
+    # the ends are quoted as stored (-180 .. 180 deg), so that a user finds them in the array, the span
+    # taken round the circle: 91.46 to -178.44 deg is 90.1 deg across 180 (not "-268.5 to -178.4")
+    note = with_angles([-178.44, 91.46] * 4)
+    assert "spanned 90.1 deg" in note and "(91.5 to -178.4 deg across 180, " in note, note
     assert with_angles([170.0, -170.0] * 4) is None  # 20 deg apart round the circle: not beyond the bound
     assert with_angles([170.0, -150.0] * 4) is not None  # 40 deg apart
     assert with_angles([60.0] * 4 + [130.0] * 4, offset=1e-6) is None  # a cage at the axis: no angle to judge

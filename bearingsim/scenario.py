@@ -78,7 +78,7 @@ DEFAULTS: dict[str, dict[str, Any]] = {
     # between "average" and "poor" lubrication (Rabinowicz 1981, J. Lubr. Technol. 103:188; the range and
     # what of it was read: the preset's [source.wear.wear_coefficient]). Dry, 60/40 brass on tool steel
     # gives 6e-4 (Archard & Hirst 1956, Proc. R. Soc. A 236:397). High-strength brass hardness ~HV 150
-    # -> 1.5e9 Pa.
+    # -> 1.5e9 Pa (a handbook value; the preset's [source.wear.hardness_Pa]).
     "wear": {"wear_coefficient": 5.0e-6, "hardness_Pa": 1.5e9},
     # motion of every body for animations (multibody model; docs/archive.md, docs/animation.md): the last
     # 2 recorded cage rotations (an animation shows 2 rotations by default), 240 poses per cage rotation

@@ -110,6 +110,10 @@ def test_keys_why_gives_the_presets_reason_and_range_for_a_package_default():
     assert keys["contact.cage_friction"].why == src["contact"]["cage_friction"]["range_reason"]  # no reason: the range's
     text = format_keys(list(keys.values()), "wear.wear_coefficient", why=True)
     assert "plausible 3e-07..0.0001" in text and "Rabinowicz, 'The Wear Coefficient" in text
+    # the hardness, a package default too, has its reason: `keys wear.hardness_Pa --why` printed the row alone
+    assert keys["wear.hardness_Pa"].why == src["wear"]["hardness_Pa"]["reason"] and "HV 150" in keys["wear.hardness_Pa"].why
+    text = format_keys(list(keys.values()), "wear.hardness_Pa", why=True)
+    assert len(text.splitlines()) == 3 and "high-strength brass" in text.splitlines()[2], text
 
 
 @pytest.mark.parametrize("key", ["wear.wear_coefficient", "wear.hardness_Pa"])

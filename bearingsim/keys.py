@@ -123,8 +123,8 @@ def _checked_bounds(section: str, name: str) -> str:
 
     lo, hi = sc.ROLLER_DENSITY_RANGE_KG_M3
     return {
-        ("numerics", "rotations"): f"+ numerics.warmup_rotations <= {sc.MAX_ROTATIONS}",
-        ("numerics", "warmup_rotations"): f"+ numerics.rotations <= {sc.MAX_ROTATIONS}",
+        ("numerics", "rotations"): f"<= {sc.MAX_ROTATIONS}, multibody: + numerics.warmup_rotations <= {sc.MAX_ROTATIONS}",
+        ("numerics", "warmup_rotations"): f"multibody: + numerics.rotations <= {sc.MAX_ROTATIONS}",
         ("operating", "inner_ring_speed_rpm"): f"x bearing.pitch_diameter_mm (dm*n) <= {sc.MAX_DM_N_MM_RPM:g} mm rpm",
         ("bearing", "roller_mass_kg"): f"density m / (pi/4 d^2 l) in [{lo:g}, {hi:g}] kg/m^3",
         ("bearing", "radial_clearance_mm"): f"<= {sc.MAX_RADIAL_CLEARANCE_TO_ROLLER:g} x bearing.roller_diameter_mm",

@@ -1117,12 +1117,13 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
     """Sizes, run length and physically absurd values, each refused with the limit and its reason
     (the constants above); ``scenario``: ``m`` as a scenario, whose SI parameters the last checks use."""
     b, o, n = m.bearing, m.operating, m.numerics
-    total = n.rotations + n.warmup_rotations
+    warmup = n.warmup_rotations if m.model == "multibody" else 0  # the reduced model runs no warm-up
+    total = n.rotations + warmup
     if total > MAX_ROTATIONS:
-        key = "numerics.rotations" if n.rotations > n.warmup_rotations else "numerics.warmup_rotations"
+        key = "numerics.rotations" if n.rotations > warmup else "numerics.warmup_rotations"
         exc = UserError(f"{source}: {key}: {total} rotations in all exceed {MAX_ROTATIONS} (memory and run "
                         "time grow with rotations); run fewer")
-        raise _involving(exc, "numerics.rotations", "numerics.warmup_rotations")
+        raise _involving(exc, "numerics.rotations", *(("numerics.warmup_rotations",) if warmup else ()))
     dmn = o.inner_ring_speed_rpm * b.pitch_diameter_mm
     if dmn > MAX_DM_N_MM_RPM:
         exc = UserError(f"{source}: operating.inner_ring_speed_rpm: {o.inner_ring_speed_rpm:g} rpm gives "

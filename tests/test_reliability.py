@@ -245,7 +245,8 @@ CASES: list[Case] = [
     # --set
     Case("set-rotations-1e9", "--set", run(*S("numerics.rotations=1000000000")), 2, ("numerics.rotations", "100000")),
     Case("set-rotations-float", "--set", run(*S("numerics.rotations=1e9")), 2, ("numerics.rotations",)),
-    Case("set-warmup-1e6", "--set", run(*S("numerics.warmup_rotations=1000000")), 2, ("numerics.warmup_rotations",)),
+    Case("set-warmup-1e6", "--set", run(*S("numerics.warmup_rotations=1000000"), scenario=MB), 2,
+         ("numerics.warmup_rotations",)),
     Case("set-multibody-warmup-0", "--set", run(*S("numerics.warmup_rotations=0"), scenario=MB), 2,
          ("numerics.warmup_rotations", "warm-up")),
     Case("set-output-rate-1e-9", "--set", run(*S("numerics.output_rate_hz=1e-9", *MB1), scenario=MB), 2,

@@ -207,6 +207,23 @@ def test_the_reduced_model_is_not_refused_over_a_motion_window_it_does_not_store
         load_scenario(path, ["output.motion_start_rotation=0", "model=multibody"])
 
 
+def test_the_total_rotations_count_a_warm_up_only_where_the_model_runs_one():
+    """`keys` says numerics.warmup_rotations is not used by the reduced model, which runs no warm-up: its
+    total-rotation limit (scenario.MAX_ROTATIONS) refused a reduced run over a huge warm-up. The reduced model
+    gets the unread-key note and is limited by its recorded rotations alone; the multibody model counts both."""
+    from bearingsim.scenario import MAX_ROTATIONS
+
+    paper, multibody = SCENARIOS / "paper_3000rpm.toml", SCENARIOS / "multibody_3000rpm.toml"
+    with pytest.warns(bearingsim.UnreadKeyWarning, match="numerics.warmup_rotations: not used by the reduced"):
+        sc = bearingsim.load_scenario(paper, set={"numerics.warmup_rotations": MAX_ROTATIONS})
+    assert sc.numerics.rotations + sc.numerics.warmup_rotations > MAX_ROTATIONS
+    with pytest.raises(UserError) as err:  # the recorded rotations alone: no warm-up override named
+        load_scenario(paper, ["numerics.rotations=100001", "numerics.warmup_rotations=3"])
+    assert "with numerics.rotations=100001: numerics.rotations: 100001 rotations in all exceed" in str(err.value)
+    with pytest.raises(UserError, match="numerics.warmup_rotations: 100004 rotations in all exceed"):
+        load_scenario(multibody, ["numerics.warmup_rotations=100000"])
+
+
 def test_the_api_warns_of_a_motion_window_longer_than_the_run_as_the_cli_notes_it():
     """`bearingsim run` notes a given output.motion_rotations longer than the recorded rotations with the start
     "last" (the run stores the recorded ones); bearingsim.load_scenario said nothing: it warns as it warns of

@@ -259,6 +259,8 @@ def check_replaceable(path: str | Path, signature, what: str) -> Path:
         if signature(p) if callable(signature) else head == signature:
             return p
         kind = "a file not written by bearingsim"
+        if signature in (is_own_png, is_own_gif, is_own_mp4):  # files of a bearingsim before the mark have none
+            kind = "a file without bearingsim's mark (not written by it, or by a version before its files carried it)"
     raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another path)")
 
 

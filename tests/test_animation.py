@@ -316,8 +316,9 @@ def test_only_an_animation_bearingsim_wrote_is_replaced(runs, tmp_path, capsys, 
     capsys.readouterr()
     assert main(["animate", str(runs[1]), "-o", str(mine), *args]) == 2
     what = "GIF" if suffix == ".gif" else "MP4"
-    assert capsys.readouterr().err == (f"bearingsim: error: {mine}: {what} animation path is a file not written by "
-                                       f"bearingsim; not replaced (remove it or choose another path)\n")
+    assert capsys.readouterr().err == (f"bearingsim: error: {mine}: {what} animation path is a file without "
+                                       "bearingsim's mark (not written by it, or by a version before its files "
+                                       "carried it); not replaced (remove it or choose another path)\n")
     assert mine.read_bytes() == data and sorted(p.name for p in tmp_path.iterdir()) == sorted([ours.name, mine.name])
     assert (outputs.is_own_gif if suffix == ".gif" else outputs.is_own_mp4)(ours)
 

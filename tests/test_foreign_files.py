@@ -132,8 +132,9 @@ def test_a_users_png_at_a_figure_path_is_refused_in_one_line_and_kept(tmp_path):
     for call in calls:
         with pytest.raises(UserError) as err:
             call()
-        assert str(err.value) == (f"{mine}: figure path is a file not written by bearingsim; not replaced "
-                                  "(remove it or choose another path)")
+        assert str(err.value) == (f"{mine}: figure path is a file without bearingsim's mark (not written by it, "
+                                  "or by a version before its files carried it); not replaced (remove it or choose "
+                                  "another path)")
     assert mine.read_bytes() == data and sorted(p.name for p in tmp_path.iterdir()) == ["o_pass.png"]
     own = save_figure(figure(), tmp_path / "own.png")
     assert is_own_png(own) and not is_own_png(mine) and f"Software\x00{MARK}".encode() in own.read_bytes()

@@ -307,7 +307,7 @@ CASES: list[Case] = [
     Case("out-figure-path-is-symlink", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
          ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_figure_symlink),
     Case("out-figure-path-is-not-png", "output path", ["run", str(PAPER), "-o", "{tmp}/out.h5"], 2,
-         ("out_pass.png", "not written by bearingsim", "not replaced"), setup=_setup_text("out_pass.png")),
+         ("out_pass.png", "without bearingsim's mark", "not replaced"), setup=_setup_text("out_pass.png")),
     Case("plot-figure-path-is-symlink", "archive tools", ["plot", "{tmp}/out.h5"], 2,
          ("out_pass.png", "symbolic link", "not replaced"), setup=_setup_archive_and_figure_symlink),
     Case("out-locked", "output path", run(), 2, ("another bearingsim run",), setup="lock"),

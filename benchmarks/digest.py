@@ -31,7 +31,7 @@ def digest(result) -> str:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("scenarios", nargs="*")
     ap.add_argument("--model", choices=("reduced", "multibody"), default="reduced")
     ap.add_argument("--rotations", type=int, default=3)

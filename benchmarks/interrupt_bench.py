@@ -48,7 +48,7 @@ def one_try(wait_s: float, signum: int, folder: Path) -> tuple[float, int, list[
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.interrupt_bench", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.interrupt_bench", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--tries", type=int, default=10)
     ap.add_argument("--signal", choices=("INT", "TERM"), default="INT")
     ap.add_argument("--seed", type=int, default=0)

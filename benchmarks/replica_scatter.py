@@ -83,7 +83,7 @@ def chi_interval(replicas: int) -> tuple[float, float]:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--replicas", type=int, default=12)
     ap.add_argument("--rotations", type=int, default=40)
     ap.add_argument("--jobs", type=int, default=2)

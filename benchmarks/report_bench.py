@@ -34,7 +34,7 @@ def time_report(path: Path, animation: str, out: Path) -> float:
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m benchmarks.report_bench", description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.report_bench", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("paths", nargs="*", type=Path, default=[MAIN])
     ap.add_argument("--repeats", type=int, default=3)
     args = ap.parse_args(argv)

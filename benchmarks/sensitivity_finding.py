@@ -132,7 +132,7 @@ def seed_table(a, b):
 
 
 def main(argv=None):
-    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--out", default="outputs/sensitivity_finding", help="folder of every study's folder")
     p.add_argument("--rotations", type=int, default=10, help="recorded rotations of the whole bearing (after 1 warm-up)")
     p.add_argument("--samples", type=int, default=16, help="uncertainty base sample N of the whole bearing")

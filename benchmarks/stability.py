@@ -48,7 +48,7 @@ def largest_dt(sc, limit, lo=1e-6, hi=4e-5, tol=1.05):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="fewer speeds and loads")
     a = ap.parse_args(argv)
     speeds = (1000, 6000) if a.quick else (1000, 3000, 6000, 12000)

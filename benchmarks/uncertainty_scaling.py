@@ -40,7 +40,7 @@ def main(argv=None) -> None:
     from bearingsim.studies.uncertainty import run_uncertainty
     from bearingsim.sweeps.engines import DaskEngine
 
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--samples", type=int, default=8)
     ap.add_argument("--rpm", type=int, default=3000)
     a = ap.parse_args(argv)

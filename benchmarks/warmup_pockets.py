@@ -43,7 +43,7 @@ def excess(contact: str, warmup: int, replicas: int) -> dict[str, np.ndarray]:
 
 
 def main(argv=None) -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--contacts", default="rigid,hertz", help="raceway contacts to run (default rigid,hertz)")
     ap.add_argument("--replicas", type=int, default=8)
     args = ap.parse_args(argv)

@@ -1,5 +1,6 @@
 """Every benchmark run as ``python -m benchmarks.X`` answers ``--help`` with its usage and does nothing else,
 and the argument forms the docs give still parse to the same values (parsed only: nothing runs)."""
+import ast
 import importlib
 import os
 import re
@@ -37,8 +38,14 @@ def test_help_prints_usage_exits_0_and_writes_nothing(tmp_path):
             continue
         if p.returncode != 0 or not out.startswith("usage:") or err:
             failed.append(f"{m}: exit {p.returncode}, {(out + err)[-300:]!r}")
+        elif _docstring(m).splitlines()[-1].strip() not in out:  # the whole docstring: runs, times, outputs
+            failed.append(f"{m}: its help leaves out the end of its docstring")
     assert not failed, "\n".join(failed)
     assert not list(cwd.iterdir()) and not list(tmp.iterdir())
+
+
+def _docstring(module) -> str:
+    return ast.get_docstring(ast.parse((ROOT / "benchmarks" / f"{module}.py").read_text())) or ""
 
 
 def _parse(module, argv):

@@ -22,7 +22,7 @@ from .test_cli import assert_user_error, bearingsim as cli
 
 BASE = SCENARIOS / "paper_3000rpm.toml"
 SPEED = "operating.inner_ring_speed_rpm"
-DT = "numerics.dt_s"
+DRAG = "lubrication.drag_coefficient"
 GUIDE = "bearing.cage_guidance"
 
 
@@ -32,18 +32,20 @@ def _same(a, b):
 
 
 def test_map_holds_the_index_numbers_over_the_axes(tmp_path):
-    """Euler at dt = 0.01 s is refused when the case runs: a failed cell, NaN in every quantity.
-    Every other cell is the single run's number, bit for bit, and the index's number at that case."""
-    spec = SweepSpec(scenario=BASE, sets=["reduced.method=euler"], axes=[(SPEED, [1000, 2000, 3000]), (DT, [1e-6, 0.01])])
+    """Without drag and gravity a run has no rear-face impact, which only the finished run shows: a failed
+    cell, NaN in every quantity. Every other cell is the single run's number, bit for bit, and the index's
+    number at that case."""
+    spec = SweepSpec(scenario=BASE, sets=["operating.gravity=false"], axes=[(SPEED, [1000, 2000, 3000]),
+                                                                            (DRAG, [0.02, 0.0])])
     out = run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
     assert out.map == tmp_path / "map.h5"
     assert not (tmp_path / "cases").exists() and all(r["archive"] == "" for r in out.rows)  # no reduced archive
     m = read_map(tmp_path)
-    assert m.dims == [SPEED, DT] and m.shape == (3, 2)
+    assert m.dims == [SPEED, DRAG] and m.shape == (3, 2)
     _same(m.coords[SPEED], [1000.0, 2000.0, 3000.0])
-    _same(m.coords[DT], [1e-6, 0.01])
+    _same(m.coords[DRAG], [0.02, 0.0])
     cols, meta = read_index(tmp_path / "sweep.h5")
-    summary = [c for c in meta["columns"] if c not in ("case", SPEED, DT, "status", "error", "archive", "notes")]
+    summary = [c for c in meta["columns"] if c not in ("case", SPEED, DRAG, "status", "error", "archive", "notes")]
     assert {"I_dec_mean_Ns", "I_acc_mean_Ns", "I_dec_sem_Ns", "first_impact_speed_m_s", "wall_s",
             "model_version"} <= set(summary)
     for k in summary:
@@ -55,12 +57,12 @@ def test_map_holds_the_index_numbers_over_the_axes(tmp_path):
     assert np.isnan(m["I_dec_mean_Ns"][:, 1]).all() and np.isnan(m["model_version"][:, 1]).all()
     assert (m["model_version"][:, 0] == MODEL_VERSIONS["reduced"]).all()
     for i, rpm in enumerate((1000, 2000, 3000)):
-        run = simulate(load_scenario(BASE, ["reduced.method=euler", f"{SPEED}={rpm}", f"{DT}=1e-06"])).summary
+        run = simulate(load_scenario(BASE, ["operating.gravity=false", f"{SPEED}={rpm}", f"{DRAG}=0.02"])).summary
         assert m["I_dec_mean_Ns"][i, 0] == run["I_dec_mean_Ns"] and m["I_acc_mean_Ns"][i, 0] == run["I_acc_mean_Ns"]
-    assert m.units[SPEED] == "rpm" and m.units[DT] == "s" and m.units["I_dec_mean_Ns"] == "N s"
+    assert m.units[SPEED] == "rpm" and m.units[DRAG] == "1" and m.units["I_dec_mean_Ns"] == "N s"
     assert m.units["first_impact_speed_m_s"] == "m/s" and m.long_names[SPEED] == "inner ring speed"
     assert m.attrs["bearingsim_version"] == bearingsim.__version__
-    assert m.attrs["scenario"] == load_scenario(BASE, ["reduced.method=euler"]).to_toml()
+    assert m.attrs["scenario"] == load_scenario(BASE, ["operating.gravity=false"]).to_toml()
 
 
 def test_xarray_reads_the_map_with_text_axes(tmp_path):

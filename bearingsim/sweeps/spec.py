@@ -397,7 +397,7 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
     for i, values in enumerate(points):
         try:
             sc = base.replace(**values)
-            check_run_request(sc)  # refused here as `bearingsim run` refuses it, before any case runs
+            _check_case(sc)  # refused here as `bearingsim run` refuses it, before any case runs
         except UserError as exc:  # "FILE with KEY=VALUE: ..." for the overrides and the case's values it is about
             exc = _with_override(exc, base.source, {**given, **{k: f"{k}={v}" for k, v in values.items()}})
             raise UserError(f"{exc} (sweep case {_label(values)})") from None
@@ -409,6 +409,19 @@ def resolve_cases(spec: SweepSpec) -> list[Case]:
         ran_at = {k: v for k in keys if k not in values and (v := resolved_value(sc, k)) is not None}
         cases.append(Case(hash=h, values=values, toml=text, model=sc.model, scenario=sc.model_, ran_at=ran_at))
     return cases
+
+
+def _check_case(sc) -> None:
+    """What ``bearingsim run`` of case ``sc`` would refuse before its first step: the run request, and where
+    a model checks its start (the multibody model's step and raceway contact, the reduced euler method's step)
+    that too (:func:`bearingsim.simulation.check_run`); the reduced event method checks nothing more, so its
+    many cheap cases are not given the parameters they would build for nothing."""
+    if sc.model == "multibody" or sc.reduced.method == "euler":
+        from bearingsim.simulation import check_run
+
+        check_run(sc)
+    else:
+        check_run_request(sc)
 
 
 def resolved_value(scenario, key: str) -> Any:

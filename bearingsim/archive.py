@@ -44,7 +44,7 @@ from bearingsim._version import __version__
 from bearingsim.datatypes import AttrGroup, NamedArray, Series
 from bearingsim import outputs
 from bearingsim.errors import UserError, check_path
-from bearingsim.wording import counted
+from bearingsim.wording import counted, run_notes
 
 FORMAT_VERSION = "2.0"
 READABLE_MAJORS = ("1", "2")  # 1.x: one HDF5 attribute per value; 2.x: attrs_json / units_json
@@ -1274,7 +1274,7 @@ def _notes_lines(notes: list[str] | None) -> list[str]:
                 "archive again)"]
     if not notes:
         return ["notes: none"]
-    return ["notes:", *(f"  {n.removeprefix('bearingsim: note: ')}" for n in notes)]
+    return ["notes:", *(f"  {n}" for n in run_notes(notes))]
 
 
 def describe(path: str | Path) -> str:

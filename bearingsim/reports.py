@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError, check_path
-from bearingsim.wording import counted
+from bearingsim.wording import counted, run_notes
 
 #: the first bytes of every report bearingsim writes: what ``-o`` may replace
 SIGNATURE = b"<!DOCTYPE html>\n<!-- bearingsim report"
@@ -319,7 +319,7 @@ def _checks_blocks(result) -> list[dict]:
     blocks.append({"kind": "text", "text": verdict})
     notes = list(dict.fromkeys([*result.notes, *again]))  # the run's stored notes, then those made again
     if notes:
-        blocks.append({"kind": "list", "items": [n.removeprefix("bearingsim: note: ") for n in notes]})
+        blocks.append({"kind": "list", "items": run_notes(notes)})
     return blocks
 
 

@@ -115,7 +115,7 @@ def table_of_archives(paths) -> Table:
     from bearingsim.scenario import flatten
     from bearingsim.simulation import COMPARED, load
     from bearingsim.stats import result_standard_errors
-    from bearingsim.sweeps.worker import run_notes
+    from bearingsim.wording import run_notes
 
     results = [load(p, only=COMPARED) for p in paths]
     flat = [flatten(r.scenario.raw) for r in results]

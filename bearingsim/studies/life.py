@@ -41,7 +41,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 from bearingsim.studies.engine import Study, case_of, load_result
-from bearingsim.wording import counted
+from bearingsim.wording import counted, run_notes
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -547,11 +547,10 @@ def stage_notes(cols: dict) -> list[str]:
 
     counts: dict[str, int] = {}
     for cell in cols.get("notes", ()):
-        for note in dict.fromkeys(notes_of(cell)):
+        for note in dict.fromkeys(run_notes(notes_of(cell))):
             counts[note] = counts.get(note, 0) + 1
     n = len(cols["stage"])
-    return [f"note ({k} of {counted(n, 'stage')}): {note.removeprefix('bearingsim: note: ')}"
-            for note, k in counts.items()]
+    return [f"note ({k} of {counted(n, 'stage')}): {note}" for note, k in counts.items()]
 
 
 def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:

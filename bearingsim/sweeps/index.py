@@ -267,7 +267,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     wall = got["wall_time_s"]
     rec = {"status": "cached", "error": "", "wall_s": wall, "summary": summary, "model_version": got["model_version"]}
     if got.get("notes") is not None:  # an archive that stores its run's notes
-        from bearingsim.sweeps.worker import run_notes
+        from bearingsim.wording import run_notes
 
         rec["notes"] = run_notes([got["notes"]] if isinstance(got["notes"], str) else got["notes"])
     return rec

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
+from bearingsim.wording import run_notes
+
 log = logging.getLogger(__name__)
 
 
@@ -41,15 +43,6 @@ def _numbers(summary: dict) -> dict[str, float]:
         if isinstance(v, (int, float, np.integer, np.floating)) and k != "wall_s":
             out[k] = float(v)
     return out
-
-
-NOTE_PREFIX = "bearingsim: note: "
-
-
-def run_notes(notes) -> list[str]:
-    """A run's notes (:func:`bearingsim.plausibility.check`, ``result.notes``) as a sweep's index keeps
-    them: one line each, without the command line's ``bearingsim: note:`` prefix."""
-    return [str(n)[len(NOTE_PREFIX):] if str(n).startswith(NOTE_PREFIX) else str(n) for n in notes or ()]
 
 
 def _per_rotation(res):
@@ -115,7 +108,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
     wall time, ``wall_time_s`` of its provenance, which its archive stores; of a failed case, the time to
     its failure),
     ``model_version`` (of the model that computed it), ``notes`` (the run's plausibility notes,
-    :func:`run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`.
+    :func:`bearingsim.wording.run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`.
     """
     from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml

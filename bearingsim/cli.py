@@ -284,7 +284,6 @@ def _study_table_drawer(path):
 
 
 def _cmd_rerun(args) -> int:
-    from bearingsim.archive import package_versions
     from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results, compared_arrays, other_numbers
     from bearingsim.simulation import COMPARED, run, run_scenario
@@ -302,10 +301,7 @@ def _cmd_rerun(args) -> int:
         new = run(old.scenario, progress=progress)
         for note in new.notes if not args.quiet else ():  # the rerun's notes, as `run` prints them
             print(note, file=sys.stderr)
-    from bearingsim import __version__ as version
-
-    new.provenance.update({f"version_{k}": v for k, v in package_versions().items()}, bearingsim_version=version)
-    c = compare_results(old, new)
+    c = compare_results(old, new)  # the versions: the rerun's provenance holds this code's (simulation.run)
     args.status = 0 if c.identical else 1  # the verdict, kept if the reader of stdout goes early (main)
     if args.output and not args.quiet:
         print(f"wrote {args.output}")

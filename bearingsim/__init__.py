@@ -39,13 +39,10 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     import warnings
 
     from bearingsim import scenario
-    from bearingsim.errors import UnreadKeyWarning
 
     sc = scenario.load_scenario(path, overrides, values=set)
-    keys = scenario.given_keys(path, overrides, set)
-    for note in (scenario.unread_note(sc, keys), scenario.motion_window_note(sc, keys)):
-        if note:
-            warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
+    for note in scenario.given_key_notes(sc, scenario.given_keys(path, overrides, set)):
+        warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
     return sc
 
 
@@ -57,7 +54,7 @@ def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None)
     (the reduced model's event method has no time step) is named in a :class:`bearingsim.UnreadKeyWarning`."""
     import warnings
 
-    from bearingsim.errors import PlausibilityWarning, UnreadKeyWarning
+    from bearingsim.errors import PlausibilityWarning
     from bearingsim.scenario import unread_note
     from bearingsim.simulation import run as _run
 

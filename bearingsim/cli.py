@@ -27,8 +27,7 @@ def _print_summary(summary) -> None:
 
 
 def _cmd_run(args) -> int:
-    from bearingsim.errors import UserError
-    from bearingsim.scenario import given_keys, load_scenario, motion_window_note, unread_note, with_overrides
+    from bearingsim.scenario import given_key_notes, given_keys, load_scenario, with_overrides
     from bearingsim.simulation import check_run, run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
@@ -37,10 +36,8 @@ def _cmd_run(args) -> int:
     except UserError as exc:  # a value a --set gave is not the file's
         raise with_overrides(exc, scenario.source, args.set) from None
     if not args.quiet:  # the keys given that have no effect on the run, or not the one asked, noted by the dry run too
-        keys = given_keys(args.scenario, args.set)
-        for note in (unread_note(scenario, keys), motion_window_note(scenario, keys)):
-            if note:
-                print(f"bearingsim: note: {note}", file=sys.stderr)
+        for note in given_key_notes(scenario, given_keys(args.scenario, args.set)):
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     if args.dry_run:
         return _dry_run(scenario, args)
     progress = not args.quiet and sys.stderr.isatty()

@@ -1206,6 +1206,13 @@ def _check_motion(m: ScenarioModel, source: str) -> None:
         raise _involving(exc, "numerics.rotations")
 
 
+def given_key_notes(scenario, keys) -> list[str]:
+    """The notes on the keys a user gave (``keys``, :func:`given_keys`) that ``bearingsim run`` prints before it
+    starts and the public ``load_scenario`` warns: those the run does not read (:func:`unread_note`) and a
+    motion window longer than the run (:func:`motion_window_note`)."""
+    return [n for n in (unread_note(scenario, keys), motion_window_note(scenario, keys)) if n]
+
+
 def motion_window_note(scenario, keys) -> str | None:
     """One line when ``output.motion_rotations``, among the keys given (:func:`given_keys`), asks a multibody
     run for a window longer than its recorded rotations: with ``motion_start_rotation = "last"`` such a window

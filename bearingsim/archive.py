@@ -1277,6 +1277,26 @@ def _notes_lines(notes: list[str] | None) -> list[str]:
     return ["notes:", *(f"  {n}" for n in run_notes(notes))]
 
 
+def _error_lines(f, model) -> list[str]:
+    """The "standard errors" line of :func:`describe`: the mean impulses' batch-means errors over the
+    recorded rotations (:func:`bearingsim.stats.impulse_standard_errors`, as ``bearingsim table`` gives
+    them), for a whole-bearing archive; none for the reduced model's, whose rotations repeat one pass, nor for
+    per-rotation arrays that are not the ``[rotations, pockets]`` numbers of a result."""
+    from bearingsim.stats import impulse_standard_errors
+
+    if _plain(model) == "reduced" or "results/per_rotation/I_dec" not in f or "results/per_rotation/I_acc" not in f:
+        return []
+    i_dec, i_acc = f["results/per_rotation/I_dec"][()], f["results/per_rotation/I_acc"][()]
+    if not all(isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype.kind in "fiu" and a.shape == i_dec.shape
+               for a in (i_dec, i_acc)):
+        return []  # a damaged archive is still listed (``bearingsim.load`` names what is wrong with it)
+    se = impulse_standard_errors(i_dec, i_acc, _plain(model))
+    text = ", ".join(f"{k.replace('_sem_', '_mean_')} \u00b1 {v:.2g} N s" for k, v in se.items() if v == v)
+    if not text:
+        return ["standard errors: none (1 recorded rotation gives no scatter)"]
+    return [f"standard errors (batch means over {len(i_dec)} recorded rotations): {text}"]
+
+
 def describe(path: str | Path) -> str:
     """Human-readable listing of an archive: header, provenance, summary, then every dataset."""
     f = open_archive(path)
@@ -1300,6 +1320,7 @@ def describe(path: str | Path) -> str:
                 v = sa[k]
                 vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
                 lines.append(f"  {k:32s} {vs} {unit}")
+            lines += _error_lines(f, g.attrs["model"])
         lines += _notes_lines(read_notes(f, path))
         lines.append("datasets:")
 

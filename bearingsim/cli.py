@@ -19,11 +19,27 @@ from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.wording import counted
 
 
-def _print_summary(summary) -> None:
+def _print_summary(result) -> None:
+    """The headline numbers of a finished run, each mean impulse of a whole-bearing run with its standard
+    error (:func:`bearingsim.stats.result_standard_errors`: batch means over the recorded rotations), as
+    ``bearingsim table`` gives it; the reduced model's are exact (every rotation repeats one pass)."""
+    from bearingsim.stats import result_standard_errors
+
+    summary = result.summary
+    se = result_standard_errors(result)
+    rotations = len(result.per_rotation["I_dec"])
     for key in ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip",
                 "load_zone_half_angle_deg", "land_normal_impulse_mean_Ns"):
-        if key in summary:
+        if key not in summary:
+            continue
+        err = se.get(key.replace("_mean_", "_sem_"))
+        if err is None or err == 0.0:
             print(f"  {key:28s} {summary[key]:.6g}")
+        elif err != err:  # NaN: one recorded rotation gives no scatter
+            print(f"  {key:28s} {summary[key]:.6g} (no standard error from {rotations} recorded rotation)")
+        else:
+            print(f"  {key:28s} {summary[key]:.6g} \u00b1 {err:.2g} (standard error, batch means over "
+                  f"{rotations} recorded rotations)")
 
 
 def _cmd_run(args) -> int:
@@ -48,7 +64,7 @@ def _cmd_run(args) -> int:
         print(f"wrote {out.archive}")
         for png in out.figures:
             print(f"wrote {png}")
-        _print_summary(out.result.summary)
+        _print_summary(out.result)
     return 0
 
 

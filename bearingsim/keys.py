@@ -26,6 +26,28 @@ DEFAULT_SOURCES = {
     "output.motion_start_rotation": "the end of the run, when the cage has settled",
     "output.motion_samples_per_rotation": "2 poses per frame of a 30 fps video at 4 s per cage rotation",
 }
+#: the units of the keys whose names carry none (:func:`bearingsim.sweeps.index.unit_of` reads a name's suffix):
+#: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md), is N^0.754 (s/m)^0.648
+KEY_UNITS = {"lubrication.drag_coefficient": "N^0.754 (s/m)^0.648"}
+#: words an engineer looks for that no key's name holds: the keys through which they enter, and how
+#: (``bearingsim keys WORD`` answers with those keys and this line)
+TOPICS = {
+    "viscosity": (("lubrication.drag_coefficient",), "a lubricant's viscosity enters through Eq. (2)'s c, as "
+                  "c' = c (eta'/eta)^0.648 (docs/whatif.md, Lubricant)"),
+    "oil": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+            "an oil enters through the oil-film drag's c and the raceways' traction curve (docs/whatif.md, "
+            "Lubricant)"),
+    "lubricant": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+                  "a lubricant enters through the oil-film drag's c and the raceways' traction curve "
+                  "(docs/whatif.md, Lubricant)"),
+    "material": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "contact.restitution", "contact.cage_friction",
+                  "contact.land_friction", "wear.wear_coefficient", "wear.hardness_Pa"),
+                 "a cage material enters through the cage's mass and inertia (its density), the roller-cage "
+                 "restitution and friction, and Archard's coefficient and hardness (docs/whatif.md, Cage material)"),
+    "density": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2"),
+                "the cage's density enters through its mass and inertia, both in proportion (docs/whatif.md, "
+                "Cage material)"),
+}
 #: longest preset reference shown in the table (the whole of it with --why)
 WHERE_CHARS = 60
 
@@ -207,13 +229,20 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
                    if any(key == p or (p.endswith(".") and key.startswith(p)) for p in prefixes))
     if key == "ranges":
         default, source = "the preset's", "plausible ranges of uncertain keys: [ranges.<section>.<key>] range, reason"
-    return KeyInfo(key, unit_of(key) if section else "1", kind, default, source, why, models, plausible)
+    unit = KEY_UNITS.get(key) or (unit_of(key) if section else "1")
+    return KeyInfo(key, unit, kind, default, source, why, models, plausible)
 
 
 def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
     """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, the preset's
     reasoning for each of its values and each package default it documents on the line below it."""
     rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
+    topic = TOPICS.get(pattern.strip().lower()) if pattern and not rows else None
+    if topic:  # a word no key's name holds: the keys it enters through, and how
+        rows = [k for k in keys if k.key in topic[0]]
+        return f"{pattern!r} is in no key's name: {topic[1]}:\n" + format_keys(rows, why=why)
+    if not rows:
+        return ""
     head = ("key", "unit", "type and bounds", "default", "source")
     cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,
               k.source + (f"; plausible {k.plausible}" if k.plausible else "")

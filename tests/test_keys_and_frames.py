@@ -207,8 +207,39 @@ def test_keys_command(tmp_path):
     assert any(ln.startswith("numerics.output_rate_hz") and " Hz " in ln and "20000.0" in ln for ln in lines)
     why = cli("keys", "pocket_clearance", "--why")
     assert why.returncode == 0 and "Table 4" in why.stdout  # the reasoning behind the preset's value
-    assert_user_error(cli("keys", "no_such_thing"), "no_such_thing")
+    assert_user_error(cli("keys", "no_such_thing"), "no_such_thing", "viscosity")
     assert_user_error(cli("keys", "--preset", "nope"), "--preset", "nope")
+
+
+def test_keys_gives_the_unit_of_eq_2s_drag_coefficient():
+    """Eq. (2), F_o = c N^0.246 V^0.648 with F_o and N in N and V in m/s (Suzuki et al. 2023, docs/physics.md):
+    c's unit is N^(1 - 0.246) (s/m)^0.648, not the blank of a dimensionless key (checked by its exponents)."""
+    from bearingsim.keys import KEY_UNITS, list_keys
+
+    info = next(k for k in list_keys() if k.key == "lubrication.drag_coefficient")
+    assert info.unit == KEY_UNITS[info.key] == f"N^{1 - 0.246:g} (s/m)^{0.648:g}"
+
+
+@pytest.mark.parametrize("word, keys", [("viscosity", {"lubrication.drag_coefficient"}),
+                                        ("Oil", {"lubrication.drag_coefficient", "multibody.traction_mu_max",
+                                                 "multibody.traction_slip_ref"}),
+                                        ("material", {"bearing.cage_mass_kg", "bearing.cage_inertia_kgm2",
+                                                      "contact.restitution", "contact.cage_friction",
+                                                      "contact.land_friction", "wear.wear_coefficient",
+                                                      "wear.hardness_Pa"})])
+def test_keys_answers_a_word_no_keys_name_holds_with_the_keys_it_enters_through(word, keys):
+    """``bearingsim keys viscosity`` was refused ("no scenario key contains it"); an engineer's word for what a
+    key carries gets the keys it enters through (each a real key), and a line saying how."""
+    from bearingsim.keys import format_keys, list_keys
+
+    all_keys = {k.key for k in list_keys()}
+    assert keys <= all_keys
+    text = format_keys(list_keys(), word)
+    lines = text.splitlines()
+    assert lines[0].startswith(f"{word!r} is in no key's name: ") and "docs/whatif.md" in lines[0]
+    assert lines[1].split()[:2] == ["key", "unit"]
+    assert {ln.split()[0] for ln in lines[2:]} == keys
+    assert format_keys(list_keys(), "no_such_thing") == ""
 
 
 # --- the resolved scenario before a run ------------------------------------------------------------------

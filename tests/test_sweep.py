@@ -614,6 +614,25 @@ def test_figures_from_the_index(tmp_path):
     assert [p.name for p in again] == ["sweep_I.png"] and again[0].stat().st_size > 10_000
 
 
+def test_a_sweep_over_an_integer_key_has_whole_ticks(tmp_path, monkeypatch):
+    """A roller count of 14 and 16 was drawn with ticks at 14.5 and 15.5: an integer key's axis (the schema's
+    type, :func:`bearingsim.scenario.is_integer_key`) has whole ticks only; a float key's keeps matplotlib's."""
+    from bearingsim import plotting
+
+    spec = SweepSpec(scenario=BASE, axes=[("bearing.roller_count", [14, 16])], sets=["numerics.rotations=1"])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    drawn = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: drawn.append(fig) or Path(path))
+    plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "figs")
+    ticks = [t for ax in drawn[0].axes for t in ax.get_xticks() if 14 <= t <= 16]
+    assert ticks and all(float(t).is_integer() for t in ticks), ticks
+    spec = SweepSpec(scenario=BASE, axes=[("bearing.pocket_clearance_mm", [0.14, 0.16, 0.18])],
+                     sets=["numerics.rotations=1"])
+    run_sweep(spec, tmp_path / "f", engine=LocalEngine(1), figures=False, progress=False)
+    plot_sweep_index(tmp_path / "f" / "sweep.h5", tmp_path / "figs2")
+    assert not all(float(t).is_integer() for t in drawn[1].axes[0].get_xticks())
+
+
 def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
     import psutil
 

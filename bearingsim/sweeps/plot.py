@@ -25,6 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import name_of, read_index, unit_of
 from bearingsim.wording import counted
 
@@ -171,6 +172,10 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
         ax.set_title(f"{sym} (error bars: ±1 standard error)", fontsize=9)
         if ticks is not None:
             ax.set_xticks(ticks, tick_labels)
+        elif is_integer_key(x_key):  # a roller count has no 14.5
+            from matplotlib.ticker import MaxNLocator
+
+            ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
     for ax in panels[::-1]:  # one legend, on the last panel with lines
         if others and ax.get_legend_handles_labels()[0]:

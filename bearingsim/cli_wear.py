@@ -20,8 +20,13 @@ def _cmd_wear(args) -> int:
     result = load(path)  # a missing file, a folder, a scenario file, a foreign file: one line saying which
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
-    with options_named("hours", "rotations"):  # refusals of the archive and the running time
-        rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
+    try:
+        with options_named("hours", "rotations"):  # refusals of the archive and the running time
+            rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
+    except UserError as exc:  # one about the archive's scenario (its k of 0) names the archive
+        if str(exc).startswith("wear."):
+            raise UserError(f"{path}: {exc}") from None
+        raise
     figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
     pngs = {}
     if not args.no_plots:  # the figures' folder and paths checked before anything is printed

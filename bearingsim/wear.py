@@ -130,12 +130,17 @@ def face_area(p, bins: int = 1) -> float:
 def wear_report(result, *, hours: float | None = None, rotations: float | None = None,
                 wear_coefficient: float | None = None, hardness: float | None = None) -> WearReport:
     """The :class:`WearReport` of ``result`` after a running time (``hours`` or inner-ring ``rotations``),
-    with Archard's k and H of the result's scenario (``[wear]``) unless given."""
+    with Archard's k and H of the result's scenario (``[wear]``) unless given. A scenario's k of 0, which the
+    scenario takes, is refused as a given k of 0 is (:func:`archard_values`), naming the scenario's key."""
     if not has_profile(result):
         raise UserError("this archive has no wear profile (written before bearingsim recorded one, or not a "
                         "multibody run): run its scenario again ('bearingsim rerun' or 'bearingsim run')")
     p = result.parameters
     k, h = p.wear.wear_coefficient, p.wear.hardness  # checked with the scenario (its k may be 0: no wear)
+    if wear_coefficient is None and not k > 0.0:  # the refusal of archard_values, naming the scenario's key
+        raise UserError(f"wear.wear_coefficient = {k:g} in the archive's scenario: nothing wears, so there is no "
+                        f"worn shape, spread or ratio to report; run it with a wear coefficient above 0 "
+                        f"(--set wear.wear_coefficient=5e-6)")
     if wear_coefficient is not None or hardness is not None:
         k, h = archard_values(k if wear_coefficient is None else wear_coefficient, h if hardness is None else hardness)
     shaft, hrs, cage_rot = running_time(result, hours=hours, rotations=rotations)

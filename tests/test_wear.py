@@ -1034,3 +1034,28 @@ def test_a_deepest_point_at_a_faces_edge_says_it_depends_on_the_bins():
     sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml")
     assert "1.85 deg of psi wide" in depth_limit_note(sc, parse_limit("depth=0.1mm"))
     assert depth_limit_note(sc, parse_limit("clearance=0.4mm")) is None
+
+
+def test_a_scenarios_wear_coefficient_of_0_is_refused_as_an_argument_of_0_is(tmp_path, capsys):
+    """A run whose scenario sets wear.wear_coefficient = 0 (a scenario takes it: nothing wears) gave `bearingsim
+    wear` a report of zeros with a coefficient of variation of nan, a front / rear ratio of nan .. nan, numpy's
+    'All-NaN slice' warnings and the end-bin caveat on a depth of 0, exit 0; the same k given as an argument was
+    refused. The scenario's k goes through the same check: one line naming the key (the command line: and the
+    archive), exit 2; another k given as an argument still reports."""
+    from bearingsim.cli import main
+    from bearingsim.simulation import load, run_scenario
+    from bearingsim.wear import wear_report
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"),
+                       ["numerics.rotations=1", "multibody.raceway_contact=rigid", "wear.wear_coefficient=0"])
+    path = tmp_path / "k0.h5"
+    run_scenario(sc, path, figures=False, notes=False)
+    res = load(path)
+    with pytest.raises(UserError, match=r"^wear\.wear_coefficient = 0 in the archive's scenario: nothing wears"):
+        res.wear_report(rotations=1e5)
+    assert wear_report(res, rotations=1e5, wear_coefficient=1e-5).max_depth > 0.0
+    code = main(["wear", str(path), "--rotations", "1e5", "--no-plots"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "", (code, out, err)
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"bearingsim: error: {path}: wear.wear_coefficient = 0 "), err

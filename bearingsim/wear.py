@@ -22,6 +22,7 @@ import numpy as np
 
 from bearingsim import laws
 from bearingsim.errors import UserError
+from bearingsim.wording import counted
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,10 @@ class WearReport:
     wear_coefficient: float  #: Archard's k [-]
     hardness: float  #: H [Pa]
     bin_area: float  #: face area of one bin [m^2]
+    #: (recorded rotations, pockets) worn volume of each recorded rotation scaled to the running time, front face
+    #: [m^3]: ``volume_front`` is its mean over rotations; None: not given (a report made without it)
+    rotations_front: np.ndarray | None = None
+    rotations_rear: np.ndarray | None = None  #: the same, rear face [m^3]
 
     @property
     def max_depth(self) -> float:
@@ -49,6 +54,24 @@ class WearReport:
         """Coefficient of variation (std / mean) of the worn volume over the pockets of one face [-]."""
         v = self.volume_front if face == "front" else self.volume_rear
         return float(v.std() / v.mean()) if v.mean() > 0 else float("nan")
+
+    @property
+    def recorded_rotations(self) -> int:
+        """The recorded cage rotations the report extrapolates from (0: not given)."""
+        return 0 if self.rotations_front is None else int(self.rotations_front.shape[0])
+
+    def volume_rotations(self, face: str) -> np.ndarray:
+        """(recorded rotations, pockets) worn volume of each recorded rotation, scaled to the running time [m^3]."""
+        v = self.rotations_front if face == "front" else self.rotations_rear
+        return np.zeros((0, len(self.volume_front))) if v is None else v
+
+    def volume_sem(self, face: str) -> float:
+        """Standard error of the worn volume mean over pockets of one face [m^3]: the batch-means error
+        (:func:`bearingsim.stats.batch_sem`) of the per-rotation face totals (the pockets' mean) over the
+        recorded rotations; NaN with fewer than 2."""
+        from bearingsim.stats import batch_sem, pocket_means
+
+        return batch_sem(pocket_means(self.volume_rotations(face)))
 
     def mean_depth(self, face: str) -> np.ndarray:
         """(pockets,) worn depth averaged over the face's extent (volume / face area) [m]."""
@@ -150,8 +173,10 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
     area = face_area(p, len(psi))
     vols = {f: laws.archard_volume_from_work(k, result.get(f"wear/profile_work_{f}") * scale, h)
             for f in ("front", "rear")}
+    per_rot = {f: laws.archard_volume_from_work(k, result.per_rotation[f"slide_work_{f}"] * cage_rot, h)
+               for f in ("front", "rear")}  # its mean over rotations is the profile's sum (1e-12)
     return WearReport(psi, vols["front"] / area, vols["rear"] / area, vols["front"].sum(axis=0),
-                      vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area)
+                      vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area, per_rot["front"], per_rot["rear"])
 
 
 def format_report(rep: WearReport) -> str:
@@ -164,10 +189,15 @@ def format_report(rep: WearReport) -> str:
     for i in range(len(rep.volume_front)):
         lines.append(f"{i:>6} {rep.volume_front[i] * 1e9:>15.4g} {rep.volume_rear[i] * 1e9:>14.4g} "
                      f"{rep.depth_front[:, i].max() * 1e6:>21.4g} {rep.depth_rear[:, i].max() * 1e6:>20.4g}")
+    n = rep.recorded_rotations
     for f in ("front", "rear"):
         v = rep.volume_front if f == "front" else rep.volume_rear
-        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, coefficient of variation "
-                     f"{rep.cov(f):.3f}")
+        sem = rep.volume_sem(f)
+        error = (f"standard error {sem * 1e9:.2g} mm^3 (batch means over the {n} recorded rotations it extrapolates "
+                 f"from)" if math.isfinite(sem) else f"no standard error ({counted(n, 'recorded rotation')}: "
+                 f"at least 2 give one)")
+        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, {error}, coefficient of "
+                     f"variation {rep.cov(f):.3f}")
     ratio = rep.volume_front / np.where(rep.volume_rear > 0, rep.volume_rear, np.nan)
     lines.append(f"front / rear volume per pocket: {np.nanmin(ratio):.3g} .. {np.nanmax(ratio):.3g} "
                  f"(mean {np.nanmean(ratio):.3g})")

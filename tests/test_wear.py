@@ -1059,3 +1059,25 @@ def test_a_scenarios_wear_coefficient_of_0_is_refused_as_an_argument_of_0_is(tmp
     assert code == 2 and out == "", (code, out, err)
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith(f"bearingsim: error: {path}: wear.wear_coefficient = 0 "), err
+
+
+def test_the_worn_volume_mean_gives_its_standard_error_and_the_rotations_it_extrapolates_from(fast_run):
+    """The worn volume mean over pockets of a face is the mean of the recorded rotations' face totals scaled to
+    the running time; the report printed it without its error. It gives the batch-means standard error
+    (stats.batch_sem over rotations of the per-rotation face totals: the pockets' mean sliding work per rotation,
+    scaled as the volume is) and the number of recorded rotations, in the data and in the text."""
+    from bearingsim.stats import batch_sem, pocket_means
+    from bearingsim.wear import format_report
+
+    res, _ = fast_run
+    rep = res.wear_report(rotations=1.6e5)
+    p = res.parameters
+    cage_rot = 1.6e5 * res.summary["cage_speed_mean_rad_s"] / p.operating.omega_i
+    assert rep.recorded_rotations == res.per_rotation["I_dec"].shape[0] == 2
+    for f, v in (("front", rep.volume_front), ("rear", rep.volume_rear)):
+        work = res.per_rotation[f"slide_work_{f}"]
+        expected = p.wear.wear_coefficient * batch_sem(pocket_means(work)) * cage_rot / p.wear.hardness
+        assert rep.volume_sem(f) == pytest.approx(expected, rel=1e-12) and rep.volume_sem(f) > 0.0
+        np.testing.assert_allclose(rep.volume_rotations(f).mean(axis=0), v, rtol=1e-12)
+        line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: worn volume mean"))
+        assert f"standard error {rep.volume_sem(f) * 1e9:.2g} mm^3" in line and "2 recorded rotations" in line, line

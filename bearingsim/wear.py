@@ -73,6 +73,19 @@ class WearReport:
 
         return batch_sem(pocket_means(self.volume_rotations(face)))
 
+    def sampling_cov(self, face: str) -> float:
+        """The coefficient of variation over pockets that identical pockets would show from the recorded
+        rotations' scatter alone [-]: the pockets' mean standard error of their worn volume (the batch-means
+        error over the recorded rotations, :func:`bearingsim.stats.batch_sem`) over the mean volume; NaN with
+        fewer than 2 recorded rotations. :meth:`cov` near it is that scatter, not a difference of the pockets
+        (the model's pockets are identical): both fall as 1/sqrt(recorded rotations)."""
+        from bearingsim.stats import batch_sem
+
+        v = self.volume_rotations(face)
+        if v.shape[0] < 2 or not v.mean() > 0.0:
+            return float("nan")
+        return float(np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean())
+
     def mean_depth(self, face: str) -> np.ndarray:
         """(pockets,) worn depth averaged over the face's extent (volume / face area) [m]."""
         v = self.volume_front if face == "front" else self.volume_rear
@@ -196,8 +209,12 @@ def format_report(rep: WearReport) -> str:
         error = (f"standard error {sem * 1e9:.2g} mm^3 (batch means over the {n} recorded rotations it extrapolates "
                  f"from)" if math.isfinite(sem) else f"no standard error ({counted(n, 'recorded rotation')}: "
                  f"at least 2 give one)")
-        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, {error}, coefficient of "
-                     f"variation {rep.cov(f):.3f}")
+        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, {error}")
+    for f in ("front", "rear"):
+        lines.append(f"{f}: coefficient of variation over pockets {rep.cov(f):.3f}; " + (
+            f"identical pockets would show {rep.sampling_cov(f):.3f} from the rotation-to-rotation scatter of the "
+            f"{n} recorded rotations alone" if math.isfinite(rep.sampling_cov(f)) else
+            f"no estimate of what the rotations' scatter alone gives ({counted(n, 'recorded rotation')})"))
     ratio = rep.volume_front / np.where(rep.volume_rear > 0, rep.volume_rear, np.nan)
     lines.append(f"front / rear volume per pocket: {np.nanmin(ratio):.3g} .. {np.nanmax(ratio):.3g} "
                  f"(mean {np.nanmean(ratio):.3g})")
@@ -257,12 +274,15 @@ def plot_wear_volume(rep: WearReport, title: str = ""):
 
     x = np.arange(len(rep.volume_front))
     fig, ax = subplots(figsize=(9, 4))
-    ax.bar(x - 0.2, rep.volume_front * 1e9, 0.4, color="C0", label=f"front face (CV {rep.cov('front'):.2f})")
-    ax.bar(x + 0.2, rep.volume_rear * 1e9, 0.4, color="C3", label=f"rear face (CV {rep.cov('rear'):.2f})")
+    for f, dx, c in (("front", -0.2, "C0"), ("rear", 0.2, "C3")):
+        v = rep.volume_front if f == "front" else rep.volume_rear
+        ax.bar(x + dx, v * 1e9, 0.4, color=c,
+               label=f"{f} face (CV {rep.cov(f):.3f}; sampling alone {rep.sampling_cov(f):.3f})")
     ax.set_xticks(x)
     ax.set_xlabel("pocket")
     ax.set_ylabel("worn volume [mm³]")
-    ax.set_title(f"{title}\nworn volume after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations); "
-                 f"CV: coefficient of variation over pockets", fontsize=9)
+    ax.set_title(f"{title}\nworn volume after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations)\n"
+                 f"CV: coefficient of variation over pockets; sampling alone: identical pockets' CV from the "
+                 f"scatter of the {counted(rep.recorded_rotations, 'recorded rotation')}", fontsize=9)
     legend_outside(ax)
     return fig

@@ -1081,3 +1081,34 @@ def test_the_worn_volume_mean_gives_its_standard_error_and_the_rotations_it_extr
         np.testing.assert_allclose(rep.volume_rotations(f).mean(axis=0), v, rtol=1e-12)
         line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: worn volume mean"))
         assert f"standard error {rep.volume_sem(f) * 1e9:.2g} mm^3" in line and "2 recorded rotations" in line, line
+
+
+def test_the_spread_over_pockets_is_given_beside_what_sampling_alone_gives(fast_run):
+    """The coefficient of variation over pockets falls as 1/sqrt(rotations) (0.132 / 0.080 / 0.060 / 0.048 at
+    4 / 10 / 20 / 40 rotations of one run; the model's pockets are identical): it is mostly the rotations'
+    scatter, and it was printed alone. Beside it the report gives what identical pockets would show from that
+    scatter alone (the pockets' mean batch-means standard error over their mean volume) and the rotations it
+    comes from. Identical pockets drawn at random show, on the average over draws, the spread it estimates."""
+    from bearingsim.stats import batch_sem
+    from bearingsim.wear import WearReport, format_report
+
+    res, _ = fast_run
+    rep = res.wear_report(rotations=1.6e5)
+    for f in ("front", "rear"):
+        v = rep.volume_rotations(f)
+        expected = np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean()
+        assert rep.sampling_cov(f) == pytest.approx(expected, rel=1e-12) and rep.sampling_cov(f) > 0.0
+        line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: coefficient of variation"))
+        assert f"{rep.cov(f):.3f}" in line and f"identical pockets would show {rep.sampling_cov(f):.3f}" in line
+        assert "2 recorded rotations" in line, line
+    rng = np.random.default_rng(7)
+    pairs = []
+    for _ in range(200):
+        draws = 1.0 + 0.2 * rng.standard_normal((40, 16))
+        z = np.zeros((32, 16))
+        r = WearReport(np.linspace(-30, 25, 32), z, z, draws.mean(axis=0), draws.mean(axis=0), 1.0, 1.0, 1.0, 1e-5,
+                       1e9, 1e-8, draws, draws)
+        pairs.append((r.cov("front"), r.sampling_cov("front")))
+    cov, sampling = np.mean(pairs, axis=0)
+    assert sampling == pytest.approx(cov, rel=0.1), (cov, sampling)  # both ~0.2 / sqrt(40) = 0.032
+    assert math.isnan(WearReport(*([np.zeros(1)] * 5), 1.0, 1.0, 1.0, 1e-5, 1e9, 1e-8).sampling_cov("rear"))

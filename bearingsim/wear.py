@@ -44,6 +44,8 @@ class WearReport:
     #: [m^3]: ``volume_front`` is its mean over rotations; None: not given (a report made without it)
     rotations_front: np.ndarray | None = None
     rotations_rear: np.ndarray | None = None  #: the same, rear face [m^3]
+    #: width of the cage bar between two pockets [m] (:func:`bar_width`); NaN: not given
+    bar_width: float = float("nan")
 
     @property
     def max_depth(self) -> float:
@@ -86,6 +88,16 @@ class WearReport:
             return float("nan")
         return float(np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean())
 
+    def worn_through(self) -> tuple[int, float] | None:
+        """``(i, depth)`` when the two faces on a cage bar, pocket ``i``'s front face and pocket ``i - 1``'s rear
+        face (:func:`bearingsim.laws.worn_bar_depth`, as a life study's stages and a worn scenario are checked),
+        wear together as deep as the bar is wide in a bin of psi: the deepest such bar and its depth [m]; None
+        when no bar does (or no bar width is given). Past it the linear extrapolation means nothing."""
+        on_bar = laws.worn_bar_depth(self.depth_front, self.depth_rear)  # (bins, bars)
+        if not on_bar.max() >= self.bar_width:
+            return None
+        return int(on_bar.max(axis=0).argmax()), float(on_bar.max())
+
     def mean_depth(self, face: str) -> np.ndarray:
         """(pockets,) worn depth averaged over the face's extent (volume / face area) [m]."""
         v = self.volume_front if face == "front" else self.volume_rear
@@ -93,15 +105,15 @@ class WearReport:
 
 
 #: The longest running time a wear report scales the recorded rotations to [h]: 1e6 h, 114 years of
-#: continuous running. The longest lives rolling bearings are designed for are ~1e5 h (the catalogues'
-#: guideline values of the specification life: 100 000 h and more for machines in continuous operation
-#: with high reliability, such as power stations and mine pumps), so this leaves ten times that; a longer
-#: time is a slip (a unit, an exponent), not a bearing's. It bounds the time, not the worn depth: the
-#: report extrapolates linearly and may wear through a cage bar (5.821 mm on the reference cage) within a
-#: realistic time (3 rotations of multibody_6000rpm at the default k = 5e-6: 7.1 mm deep at an edge after
-#: 100 h), which ``bearingsim life`` follows stage by stage instead. Within the bound every number is finite
-#: by far (that run: at most 2.3e-4 m^3 per face after 1e6 h; the coefficient of variation squares the
-#: volumes, which overflows above ~1e154 m^3: ``--rotations 1e300`` gave 4e284 m^3 and a variation of inf).
+#: continuous running. The longest lives rolling bearings are designed for are ~1e5 h (the catalogues' guideline
+#: values of the specification life: 100 000 h and more for machines in continuous operation with high reliability,
+#: such as power stations and mine pumps), so this leaves ten times that; a longer time is a slip (a unit, an
+#: exponent), not a bearing's. It bounds the time, not the worn depth: the report extrapolates linearly and may wear
+#: through a cage bar (5.821 mm on the reference cage), which it says (:meth:`WearReport.worn_through`), within a
+#: realistic time (3 rotations of multibody_6000rpm at the default k = 5e-6: 7.1 mm deep at an edge after 100 h),
+#: which ``bearingsim life`` follows stage by stage instead. Within the bound every number is finite by far (that
+#: run: at most 2.3e-4 m^3 per face after 1e6 h; the coefficient of variation squares the volumes, which overflows
+#: above ~1e154 m^3: ``--rotations 1e300`` gave 4e284 m^3 and a variation of inf).
 MAX_RUNNING_HOURS = 1e6
 
 
@@ -154,6 +166,13 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     return shaft, shaft / rot_per_hour, shaft * cage_speed / op.omega_i
 
 
+def bar_width(scenario) -> float:
+    """The width of the cage bar between two pockets of ``scenario`` [m] (:func:`bearingsim.laws.cage_bar_width`):
+    what the two faces on a bar can wear together before it is worn through."""
+    b = scenario.bearing
+    return laws.cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+
+
 def face_area(p, bins: int = 1) -> float:
     """The area of one arc pocket face of parameters ``p``, or of one of its ``bins`` equal bins of psi
     [m^2]: the face's arc on the pocket circle (its extent, ``multibody.pocket_face_extent``) times the
@@ -189,7 +208,8 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
     per_rot = {f: laws.archard_volume_from_work(k, result.per_rotation[f"slide_work_{f}"] * cage_rot, h)
                for f in ("front", "rear")}  # its mean over rotations is the profile's sum (1e-12)
     return WearReport(psi, vols["front"] / area, vols["rear"] / area, vols["front"].sum(axis=0),
-                      vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area, per_rot["front"], per_rot["rear"])
+                      vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area, per_rot["front"], per_rot["rear"],
+                      bar_width(result.scenario))
 
 
 def format_report(rep: WearReport) -> str:
@@ -224,7 +244,20 @@ def format_report(rep: WearReport) -> str:
         lines.append(f"{f}: mean depth over pockets at the bore end {ends['bore'] * 1e6:.4g} um, middle "
                      f"{ends['middle'] * 1e6:.4g} um, rim end {ends['rim'] * 1e6:.4g} um")
     lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um" + edge_caveat(rep))
+    if rep.worn_through() is not None:
+        lines.append(bar_line(rep))
     return "\n".join(lines)
+
+
+def bar_line(rep: WearReport) -> str:
+    """The line that says where the extrapolated wear goes through a cage bar (:meth:`WearReport.worn_through`)."""
+    i, depth = rep.worn_through()
+    k = int(laws.worn_bar_depth(rep.depth_front, rep.depth_rear)[:, i].argmax())
+    return (f"cage bar worn through: pocket {i}'s front face and pocket {(i - 1) % len(rep.volume_front)}'s rear "
+            f"face, either side of the bar between them, wear {depth * 1e3:.4g} mm deep together at psi = "
+            f"{rep.psi_deg[k]:.3g} deg, where the bar is {rep.bar_width * 1e3:.4g} mm wide: a linear extrapolation "
+            f"past that is meaningless ('bearingsim life' follows the wear stage by stage to where a bar wears "
+            f"through)")
 
 
 def edge_caveat(rep: WearReport) -> str:
@@ -261,10 +294,19 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
         ax.set_xlabel("ψ: bore end ← 0 (middle) → rim end [deg]")
         ax.set_title(f"{f} face", fontsize=9)
     axes[0].set_ylim(bottom=0.0)  # shared: after both faces are drawn, so the deeper face's ends stay on the figure
+    if rep.bar_width * 1e6 <= axes[0].get_ylim()[1]:  # within the depth axis: the bar's width as a line
+        for ax in axes:
+            ax.axhline(rep.bar_width * 1e6, color="0.3", lw=0.8, ls="--",
+                       label=f"cage bar width {rep.bar_width * 1e3:.4g} mm")
     axes[0].set_ylabel("worn depth [µm]")
     legend_outside(axes[1])
+    through = rep.worn_through()
     fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
-                 f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa", fontsize=9)
+                 f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa" + (
+                     "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % d.shape[1]} and "
+                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep against {rep.bar_width * 1e3:.4g} "
+                     f"mm wide): a linear extrapolation past it is meaningless"),
+                 fontsize=9)
     return fig
 
 

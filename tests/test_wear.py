@@ -1112,3 +1112,33 @@ def test_the_spread_over_pockets_is_given_beside_what_sampling_alone_gives(fast_
     cov, sampling = np.mean(pairs, axis=0)
     assert sampling == pytest.approx(cov, rel=0.1), (cov, sampling)  # both ~0.2 / sqrt(40) = 0.032
     assert math.isnan(WearReport(*([np.zeros(1)] * 5), 1.0, 1.0, 1.0, 1e-5, 1e9, 1e-8).sampling_cov("rear"))
+
+
+def test_wear_says_where_its_extrapolation_goes_through_a_cage_bar(fast_run):
+    """`bearingsim wear X.h5 --hours 1000` of a 6000 rpm run printed a deepest point of 7.6e4 um (76 mm)
+    beside a cage bar 5.821 mm wide, silently. When the two faces on one bar (pocket i's front face, pocket
+    i - 1's rear face: laws.worn_bar_depth, as the life study and a worn scenario check it) wear together as
+    deep as the bar is wide in a bin of psi, the report says so in one line (bar, depth against width, the
+    extrapolation past it meaningless, bearingsim life); the profile figure draws the bar's width when it lies
+    within the depth axis and says the bar is worn through. A short running time says nothing of the bar."""
+    from bearingsim.studies.life import _bar
+    from bearingsim.wear import format_report
+
+    res, _ = fast_run
+    short, long = res.wear_report(rotations=1e3), res.wear_report(hours=1000.0)
+    assert long.bar_width == _bar(res.scenario) == pytest.approx(5.821e-3, abs=1e-6)
+    assert short.worn_through() is None and "cage bar" not in format_report(short)
+    i, depth = long.worn_through()
+    on_bar = laws.worn_bar_depth(long.depth_front, long.depth_rear)
+    assert depth == on_bar.max() > long.bar_width and on_bar.max(axis=0).argmax() == i
+    lines = [ln for ln in format_report(long).splitlines() if "cage bar" in ln]
+    assert len(lines) == 1, lines
+    assert (f"pocket {i}'s front face and pocket {(i - 1) % 16}'s rear face" in lines[0]
+            and f"{depth * 1e3:.4g} mm" in lines[0] and "5.821 mm" in lines[0]
+            and "linear extrapolation" in lines[0] and "bearingsim life" in lines[0]), lines[0]
+    fig = res.plot_wear_profile(hours=1000.0)
+    for ax in fig.axes[:2]:
+        assert any(list(ln.get_ydata()) == [long.bar_width * 1e6] * 2 for ln in ax.get_lines()), ax.get_lines()
+    assert "worn through" in fig._suptitle.get_text()
+    fig = res.plot_wear_profile(rotations=1e3)
+    assert "worn through" not in fig._suptitle.get_text()

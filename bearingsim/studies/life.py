@@ -170,11 +170,11 @@ def _start_depth(scenario) -> np.ndarray | None:
 
 
 def _bar(scenario) -> float:
-    """The width of the cage bar between two pockets [m] (:func:`bearingsim.laws.cage_bar_width`)."""
-    from bearingsim.laws import cage_bar_width
+    """The width of the cage bar between two pockets [m] (:func:`bearingsim.wear.bar_width`, which the wear
+    report shares)."""
+    from bearingsim.wear import bar_width
 
-    b = scenario.bearing
-    return cage_bar_width(b.pitch_diameter_mm, b.roller_diameter_mm, b.pocket_clearance_mm, b.roller_count) * 1e-3
+    return bar_width(scenario)
 
 
 def _check_reachable(scenario, limit: Limit) -> None:

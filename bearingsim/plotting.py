@@ -36,6 +36,13 @@ def legend_outside(ax, **kw) -> None:
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8, **kw)
 
 
+def fixed_unit_axis(ax, axis: str = "y") -> None:
+    """Tick labels of ``axis`` in the unit its label names, whatever the numbers: no multiplier (``1e6``)
+    or offset that matplotlib would choose from the data, so that two figures of one quantity compare
+    without rescaling."""
+    ax.ticklabel_format(axis=axis, style="plain", useOffset=False)
+
+
 def save_figure(fig, path, *, dpi: int = 120, tight: bool = True) -> Path:
     """Lay out and write one report figure; return its path. (The figure is in no pyplot list: there
     is nothing to close; its memory goes with its last reference.)

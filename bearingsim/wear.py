@@ -283,7 +283,7 @@ def shape_of(psi_deg, depth) -> dict[str, float]:
 def plot_wear_profile(rep: WearReport, title: str = ""):
     """Fig. 13 analog: worn depth against psi on the front and the rear face, the mean over pockets and
     the band from the least to the most worn pocket at each psi."""
-    from bearingsim.plotting import legend_outside, subplots
+    from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
 
     fig, axes = subplots(1, 2, figsize=(10, 4), sharey=True)
     for ax, f, c in ((axes[0], "front", "C0"), (axes[1], "rear", "C3")):
@@ -299,6 +299,7 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
             ax.axhline(rep.bar_width * 1e6, color="0.3", lw=0.8, ls="--",
                        label=f"cage bar width {rep.bar_width * 1e3:.4g} mm")
     axes[0].set_ylabel("worn depth [µm]")
+    fixed_unit_axis(axes[0])  # shared with axes[1]
     legend_outside(axes[1])
     through = rep.worn_through()
     fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
@@ -312,7 +313,7 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
 
 def plot_wear_volume(rep: WearReport, title: str = ""):
     """Fig. 14 analog: worn volume of the front and the rear face of every pocket, with the spread."""
-    from bearingsim.plotting import legend_outside, subplots
+    from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
 
     x = np.arange(len(rep.volume_front))
     fig, ax = subplots(figsize=(9, 4))
@@ -323,6 +324,7 @@ def plot_wear_volume(rep: WearReport, title: str = ""):
     ax.set_xticks(x)
     ax.set_xlabel("pocket")
     ax.set_ylabel("worn volume [mm³]")
+    fixed_unit_axis(ax)
     ax.set_title(f"{title}\nworn volume after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations)\n"
                  f"CV: coefficient of variation over pockets; sampling alone: identical pockets' CV from the "
                  f"scatter of the {counted(rep.recorded_rotations, 'recorded rotation')}", fontsize=9)

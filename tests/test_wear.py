@@ -1142,3 +1142,29 @@ def test_wear_says_where_its_extrapolation_goes_through_a_cage_bar(fast_run):
     assert "worn through" in fig._suptitle.get_text()
     fig = res.plot_wear_profile(rotations=1e3)
     assert "worn through" not in fig._suptitle.get_text()
+
+
+def test_wear_figures_use_one_fixed_unit_per_quantity(fast_run, monkeypatch):
+    """The run's wear figure labelled its axis [10^6 um^3 per hour] for one archive and [10^9 um^3 per hour]
+    for another (an exponent chosen from the data), and matplotlib may put its own multiplier on an axis: two
+    designs' figures did not compare without rescaling. Volumes are in mm^3 per hour (the text's mm^3), depths
+    in um, whatever the numbers, and no axis carries a multiplier or offset."""
+    res, _ = fast_run
+    p = res.parameters
+    get = res.get
+    heights = []
+    for scale in (1.0, 1000.0):  # an archive of this run's wear, and one of 1000 times more (k 1000 times larger)
+        monkeypatch.setattr(res, "get", lambda name, s=scale: get(name) * s if name.startswith("wear/") else get(name))
+        fig = res.plot_wear()
+        ax = fig.axes[0]
+        fig.canvas.draw()
+        assert ax.get_ylabel() == "Archard wear volume\n[mm³ per hour]" and ax.yaxis.get_offset_text().get_text() == ""
+        heights.append(np.array([b.get_height() for b in ax.patches]))
+    np.testing.assert_allclose(heights[1], 1000.0 * heights[0], rtol=1e-12)
+    monkeypatch.setattr(res, "get", get)
+    per_hour = 3600.0 * p.operating.omega_c / (2.0 * math.pi)  # cage rotations per hour
+    np.testing.assert_allclose(heights[0][32:48], get("wear/sliding_work_front") * per_hour * 1e9, rtol=1e-12)
+    for hours in (1e-3, 1e5):
+        for fig in (res.plot_wear_profile(hours=hours), res.plot_wear_volume(hours=hours)):
+            fig.canvas.draw()
+            assert all(ax.yaxis.get_offset_text().get_text() == "" for ax in fig.axes), hours

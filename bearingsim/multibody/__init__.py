@@ -570,24 +570,23 @@ class MultibodyResult(Result):
 
     def plot_wear(self):
         """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
-        from bearingsim.plotting import legend_outside, subplots
+        from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
 
         op = self.parameters.operating
-        per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e18  # cage rotations per hour, m^3 -> µm^3
+        per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e9  # cage rotations per hour, m^3 -> mm^3 (the text's)
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = subplots(figsize=(9, 4))
         bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16)"),
                 (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16)"),
                 (self.get("wear/sliding_work_front"), "front face, sliding work"),
                 (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
-        top = max(float(np.max(v)) * per_hour for v, _ in bars)
-        exp = 3 * int(math.floor(math.log10(top) / 3.0)) if top > 0 else 0  # label in 10^(3k) µm³/h
         wdt = 0.2
         for j, (v, label) in enumerate(bars):
-            ax.bar(x + (j - 1.5) * wdt, v * per_hour / 10.0**exp, wdt, label=label)
+            ax.bar(x + (j - 1.5) * wdt, v * per_hour, wdt, label=label)
         ax.set_xlabel("pocket")
         ax.set_xticks(x)
-        ax.set_ylabel("Archard wear volume\n" + (f"[10$^{{{exp}}}$ µm³ per hour]" if exp else "[µm³ per hour]"))
+        ax.set_ylabel("Archard wear volume\n[mm³ per hour]")  # one unit for every run: figures compare as they are
+        fixed_unit_axis(ax)
         ax.set_title(f"{self.title()}\nwear of the pocket faces at this speed (k = {self.parameters.wear.wear_coefficient:g}, "
                      f"H = {self.parameters.wear.hardness / 1e9:g} GPa)", fontsize=9)
         legend_outside(ax)

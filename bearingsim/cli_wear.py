@@ -8,36 +8,69 @@ from pathlib import Path
 from bearingsim.errors import UserError
 
 
-def _cmd_wear(args) -> int:
+def _wear_of(path: Path, args):
+    """(result, :class:`bearingsim.wear.WearReport`) of the archive ``path`` after the running time ``args``
+    gives; every refusal one line naming the archive or the option."""
     from bearingsim import wear
-    from bearingsim.archive import check_writable_dir
-    from bearingsim.cli_common import options_named, say
-    from bearingsim.outputs import check_replaceable, figure_path, is_own_png
-    from bearingsim.plotting import save_figure
+    from bearingsim.cli_common import options_named
     from bearingsim.simulation import load
 
-    path = Path(args.archive)
     result = load(path)  # a missing file, a folder, a scenario file, a foreign file: one line saying which
     if result.model != "multibody":
         raise UserError(f"{path}: a {result.model}-model archive has no wear profile; the multibody model records it")
     try:
         with options_named("hours", "rotations"):  # refusals of the archive and the running time
-            rep = wear.wear_report(result, hours=args.hours, rotations=args.rotations)
+            return result, wear.wear_report(result, hours=args.hours, rotations=args.rotations)
     except UserError as exc:  # one about the archive's scenario (its k of 0) names the archive
         if str(exc).startswith("wear."):
             raise UserError(f"{path}: {exc}") from None
         raise
+
+
+def _cmd_wear(args) -> int:
+    from bearingsim import wear
+    from bearingsim.archive import check_writable_dir
+    from bearingsim.cli_common import say
+    from bearingsim.outputs import check_replaceable, figure_path, is_own_png
+    from bearingsim.plotting import save_figure
+
+    paths = [Path(a) for a in args.archive]
+    done = [_wear_of(path, args) for path in paths]  # every archive checked before anything is written
     figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
-    pngs = {}
-    if not args.no_plots:  # the figures' folder and paths checked before anything is printed
-        folder = check_writable_dir(args.output) if args.output else path.parent
-        pngs = {name: check_replaceable(figure_path(folder / path.stem, name), is_own_png, "figure")
-                for name in figures}
+    pngs = []
+    if not args.no_plots:  # the figures' folders and paths checked before anything is printed
+        folder = check_writable_dir(args.output) if args.output else None
+        for path in paths:
+            pngs.append({name: check_replaceable(figure_path((folder or path.parent) / path.stem, name), is_own_png,
+                                                 "figure") for name in figures})
+        seen = [p for named in pngs for p in named.values()]
+        if len(set(seen)) < len(seen):
+            raise UserError(f"{args.output}: archives of one file name would draw their figures onto each other "
+                            f"there; give no -o (each archive's figures beside it), or --no-plots")
     tell = say(args)
-    tell(f"{path}: " + wear.format_report(rep))
-    for name, png in pngs.items():
-        tell(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
+    if len(paths) == 1:
+        tell(f"{paths[0]}: " + wear.format_report(done[0][1]))
+    else:
+        tell(_comparison(paths, done))
+    for (result, rep), named in zip(done, pngs):
+        for name, png in named.items():
+            tell(f"wrote {save_figure(figures[name](rep, result.title()), png)}")
     return 0
+
+
+def _comparison(paths, done) -> str:
+    """The table of several archives' wear (:func:`bearingsim.wear.format_comparison`), labelled as
+    ``bearingsim table`` labels archives, with the scenario keys that differ between them above it."""
+    from bearingsim import wear
+    from bearingsim.scenario import flatten
+    from bearingsim.tables import distinguishing_labels
+
+    flat = [flatten(result.scenario.raw) for result, _ in done]
+    differ = [k for k in sorted(set().union(*flat)) if k != "name"
+              and len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    notes = [f"wear of {len(paths)} archives, each after the running time at its own speed; scenario keys that "
+             f"differ: {', '.join(differ) if differ else 'none'}"]
+    return wear.format_comparison(distinguishing_labels(paths), [rep for _, rep in done], notes)
 
 
 def _cmd_life(args) -> int:
@@ -71,7 +104,7 @@ def add_commands(sub) -> None:
     """Register ``wear`` and ``life`` on the subparsers ``sub``."""
     w = sub.add_parser("wear", help="worn depth profile and volume of every pocket face after a running time "
                                     "(from a multibody archive's wear profile)")
-    w.add_argument("archive", help="multibody archive (.h5)")
+    w.add_argument("archive", nargs="+", help="multibody archive (.h5); several: one table of their wear, a row each")
     t = w.add_mutually_exclusive_group(required=True)
     t.add_argument("--hours", type=float, help="running time [h] at the archive's speed")
     t.add_argument("--rotations", type=float, help="running time as inner-ring (shaft) rotations")

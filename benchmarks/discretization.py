@@ -6,6 +6,7 @@
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
     python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
     python -m benchmarks.discretization life    # the life study to depth = 0.1 mm (fast scene) with 16 / 32 / 64 bins of psi
+    python -m benchmarks.discretization stages  # the same life study in 5 / 10 / 20 stages
 
 ``--bins=32,64`` chooses the bin counts, ``--set=KEY=VALUE`` (repeatable) overrides a scenario key, e.g.
 ``--set=numerics.dt_s=2e-6`` or ``--set=numerics.warmup_rotations=41`` (the next 40 rotations).
@@ -141,6 +142,37 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
         recorder.accumulators.__defaults__, recorder.FACE_BINS = saved
 
 
+def stages(counts=(5, 10, 20), sets=(), limit="depth=0.1mm"):
+    """docs/wear.md's life study (the fast scene, ``--set multibody.raceway_contact=rigid``, k = 6e-4, stages of
+    1 warm-up + 10 rotations, the worn shape fed back) with 5 / 10 / 20 stages (``--bins`` gives the counts): a
+    life is the wear integrated stage by stage, each stage at the wear rate its run measured, so the stage count
+    is a discretization of that integral; the table shows how the life moves with it."""
+    import tempfile
+
+    from bearingsim.errors import UserError
+    from bearingsim.scenario import load_scenario
+    from bearingsim.studies.life import parse_limit, run_life
+
+    print(f"| stages | rotations to the limit ({limit}) | hours | change from the previous row | "
+          "I_dec, first / last stage [mN s] |")
+    print("|---|---|---|---|---|")
+    before = None
+    for n in counts:
+        sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
+                           ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
+        with tempfile.TemporaryDirectory() as d:
+            try:
+                c = run_life(sc, d, parse_limit(limit), stages=n, rotations=10)
+            except UserError as exc:  # a stage that failed, or a bar worn through first: a finding
+                print(f"| {n} | {exc} | | | |", flush=True)
+                continue
+        end = float(c["rotations_end"][-1])
+        change = f"{end / before - 1:+.1%}" if before else ""
+        before = end
+        print(f"| {n} | {end:.0f} | {c['hours_end'][-1]:.4g} | {change} | {c['I_dec_mean_mNs'][0]:.2f} / "
+              f"{c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
+
+
 def psi(bins=(16, 32, 64, 128), sets=()):
     from bearingsim import wear
     from bearingsim.multibody import recorder
@@ -197,22 +229,22 @@ def _bins(text: str) -> tuple[int, ...]:
 def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.discretization", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("study", choices=("psi", "theta", "dt", "rig", "whatif", "life"))
+    ap.add_argument("study", choices=("psi", "theta", "dt", "rig", "whatif", "life", "stages"))
     ap.add_argument("--bins", type=_bins, help="bin counts, e.g. 32,64 (psi, theta, life); the speeds of dt, rig, "
-                                               "whatif")
+                                               "whatif; the stage counts of stages")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario override (repeatable)")
-    ap.add_argument("--limit", help="life only: the life study's limit (default depth=0.1mm)")
+    ap.add_argument("--limit", help="life and stages only: the life study's limit (default depth=0.1mm)")
     return ap
 
 
 def main(argv=None) -> None:
     ap = parser()
     a = ap.parse_args(argv)
-    if a.limit and a.study != "life":
-        ap.error(f"--limit: only the life study reads it (not {a.study})")
+    if a.limit and a.study not in ("life", "stages"):
+        ap.error(f"--limit: only the life and stages studies read it (not {a.study})")
     given = [a.bins] if a.bins else []
-    study = {"psi": psi, "theta": theta, "life": life, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
-    study(*given, sets=a.set, **({"limit": a.limit} if a.study == "life" and a.limit else {}))
+    study = {"psi": psi, "theta": theta, "life": life, "stages": stages, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
+    study(*given, sets=a.set, **({"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}))
 
 
 if __name__ == "__main__":

@@ -95,4 +95,4 @@ def test_a_limit_for_a_study_that_does_not_read_it_is_refused(capsys):
 
     with pytest.raises(SystemExit) as exc:
         discretization.main(["dt", "--limit=depth=1mm"])
-    assert exc.value.code == 2 and "--limit: only the life study reads it (not dt)" in capsys.readouterr().err
+    assert exc.value.code == 2 and "--limit: only the life and stages studies read it (not dt)" in capsys.readouterr().err

@@ -268,6 +268,50 @@ def test_wear_cli_checks_its_output_before_printing(fast_run, tmp_path, capsys):
     assert [p.name for p in figs.iterdir()] == [f"{archive.stem}_wear_volume.png"]  # no figure written
 
 
+@pytest.mark.slow
+def test_wear_of_several_archives_is_one_table_of_their_volumes_with_errors(fast_run, tmp_path, capsys):
+    """An engineer comparing cage materials compared impulses only (``table``): ``bearingsim wear A B --hours T``
+    gives each archive's wear in a row, with the same numbers as ``wear_report`` of each (its k and H from its
+    own scenario; the volume mean over pockets and its batch-means error), and the scenario keys that differ.
+    Archives of one file name would draw their figures onto each other in one -o folder: refused, nothing drawn;
+    a reduced-model archive among them is refused naming it."""
+    import shutil
+
+    from bearingsim import wear
+    from bearingsim.cli import main
+    from bearingsim.simulation import load, run_scenario
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["numerics.rotations=2", "multibody.raceway_contact=rigid",
+                                                                   "wear.wear_coefficient=1e-5", "wear.hardness_Pa=1.2e8"])
+    other = tmp_path / "polymer.h5"
+    run_scenario(sc, other, figures=False, notes=False)
+    code = main(["wear", str(fast_run[1]), str(other), "--hours", "10", "--no-plots"])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    lines = out.splitlines()
+    assert lines[0].endswith("scenario keys that differ: wear.hardness_Pa, wear.wear_coefficient"), lines[0]
+    for path, row in zip((fast_run[1], other), lines[2:4]):
+        rep = wear.wear_report(load(path), hours=10)
+        cells = re.split(r"\s{2,}", row.strip())
+        assert cells[0] == path.name and cells[2] == f"{rep.wear_coefficient:g}"
+        for cell, face in zip(cells[4:6], ("front", "rear")):
+            v = (rep.volume_front if face == "front" else rep.volume_rear).mean()
+            assert cell == f"{v * 1e9:.4g} \u00b1 {rep.volume_sem(face) * 1e9:.2g}"
+        assert cells[7] == "2"
+    twin = tmp_path / "twin"
+    twin.mkdir()
+    shutil.copy(other, twin / fast_run[1].name)
+    code = main(["wear", str(fast_run[1]), str(twin / fast_run[1].name), "--hours", "1", "-o", str(tmp_path / "f")])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and "would draw their figures onto each other" in err
+    assert not list((tmp_path / "f").glob("*.png"))
+    red = tmp_path / "red.h5"
+    run_scenario(load_scenario(str(SCENARIOS / "paper_3000rpm.toml")), red, figures=False, notes=False)
+    code = main(["wear", str(fast_run[1]), str(red), "--hours", "1", "--no-plots"])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and f"{red}: a reduced-model archive has no wear profile" in err
+
+
 # --- life ---------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("text", ["depth=0.1", "depth=-1mm", "width=1mm", "volume=2mm", "depth=xmm", ""])
 def test_bad_limit_is_refused(text):

@@ -142,18 +142,19 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
         recorder.accumulators.__defaults__, recorder.FACE_BINS = saved
 
 
-def stages(counts=(5, 10, 20), sets=(), limit="depth=0.1mm"):
+def stages(counts=(5, 10, 20), sets=(), limit="depth=0.1mm", mapping="shape"):
     """docs/wear.md's life study (the fast scene, ``--set multibody.raceway_contact=rigid``, k = 6e-4, stages of
-    1 warm-up + 10 rotations, the worn shape fed back) with 5 / 10 / 20 stages (``--bins`` gives the counts): a
-    life is the wear integrated stage by stage, each stage at the wear rate its run measured, so the stage count
-    is a discretization of that integral; the table shows how the life moves with it."""
+    1 warm-up + 10 rotations, the worn shape fed back, or ``--mapping=uniform``) with 5 / 10 / 20 stages
+    (``--bins`` gives the counts): a life is the wear integrated stage by stage, each stage at the wear rate its
+    run measured, so the stage count is a discretization of that integral; the table shows how the life moves
+    with it."""
     import tempfile
 
     from bearingsim.errors import UserError
     from bearingsim.scenario import load_scenario
     from bearingsim.studies.life import parse_limit, run_life
 
-    print(f"| stages | rotations to the limit ({limit}) | hours | change from the previous row | "
+    print(f"| stages | rotations to the limit ({limit}, {mapping} mapping) | hours | change from the previous row | "
           "I_dec, first / last stage [mN s] |")
     print("|---|---|---|---|---|")
     before = None
@@ -162,7 +163,7 @@ def stages(counts=(5, 10, 20), sets=(), limit="depth=0.1mm"):
                            ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
         with tempfile.TemporaryDirectory() as d:
             try:
-                c = run_life(sc, d, parse_limit(limit), stages=n, rotations=10)
+                c = run_life(sc, d, parse_limit(limit), stages=n, rotations=10, mapping=mapping)
             except UserError as exc:  # a stage that failed, or a bar worn through first: a finding
                 print(f"| {n} | {exc} | | | |", flush=True)
                 continue
@@ -234,6 +235,7 @@ def parser() -> argparse.ArgumentParser:
                                                "whatif; the stage counts of stages")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario override (repeatable)")
     ap.add_argument("--limit", help="life and stages only: the life study's limit (default depth=0.1mm)")
+    ap.add_argument("--mapping", choices=("shape", "uniform"), help="stages only: how the wear acts back (default shape)")
     return ap
 
 
@@ -242,9 +244,14 @@ def main(argv=None) -> None:
     a = ap.parse_args(argv)
     if a.limit and a.study not in ("life", "stages"):
         ap.error(f"--limit: only the life and stages studies read it (not {a.study})")
+    if a.mapping and a.study != "stages":
+        ap.error(f"--mapping: only the stages study reads it (not {a.study})")
     given = [a.bins] if a.bins else []
     study = {"psi": psi, "theta": theta, "life": life, "stages": stages, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
-    study(*given, sets=a.set, **({"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}))
+    extra = {"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}
+    if a.mapping:
+        extra["mapping"] = a.mapping
+    study(*given, sets=a.set, **extra)
 
 
 if __name__ == "__main__":

@@ -298,7 +298,7 @@ def _study_table_drawer(path):
 
 def _cmd_rerun(args) -> int:
     from bearingsim.simulation import load as read
-    from bearingsim.compare import compare_results, compared_arrays, other_numbers
+    from bearingsim.compare import compare_results
     from bearingsim.simulation import COMPARED, run, run_scenario
 
     if args.force and not args.output:  # it was accepted and did nothing: a rerun without -o writes nothing
@@ -307,9 +307,10 @@ def _cmd_rerun(args) -> int:
     old = read(args.archive, only=COMPARED)
     progress = not args.quiet and sys.stderr.isatty()
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
-        new = run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=not args.quiet,
-                           force=args.force).result
+        run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=not args.quiet,
+                     force=args.force)
         args.written = Path(args.output)
+        new = read(args.output, only=COMPARED)  # as written: its time series went to the file, not the result
     else:
         new = run(old.scenario, progress=progress)
         for note in new.notes if not args.quiet else ():  # the rerun's notes, as `run` prints them
@@ -320,12 +321,12 @@ def _cmd_rerun(args) -> int:
         print(f"wrote {args.output}")
     if c.identical:
         say(args)(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
-                   f"{len(compared_arrays(old))} arrays, {len(other_numbers(old))} other numbers)")
+                   f"{c.arrays_compared} arrays and other numbers)")
         return 0
     print(f"{args.archive}: rerun differs")
     print(c.summary_table())
-    for name in c.arrays_differ:
-        print(f"  differs: {name}")
+    for line in c.difference_lines():
+        print(line)
     for k, va, vb in c.versions:
         print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
     return args.status
@@ -350,9 +351,10 @@ def _cmd_compare(args) -> int:
     else:
         print("scenarios: identical")
     print(c.summary_table())
-    for name in c.arrays_differ:
-        print(f"  differs: {name}")
-    print("results: identical" if c.identical else "results: differ")
+    for line in c.difference_lines():
+        print(line)
+    print(f"results: identical ({len(c.summary)} summary numbers, {c.arrays_compared} arrays and other numbers, "
+          "bit for bit)" if c.identical else "results: differ")
     return args.status
 
 

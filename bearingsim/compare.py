@@ -1,5 +1,8 @@
 """Comparing two results: scenario keys, summary numbers, the results' other stored numbers (attribute groups:
-the reduced model's wear rates, pass and operating point) and their per-rotation and wear arrays, bit for bit.
+the reduced model's wear rates, pass and operating point) and every array the run computed (each dataset under
+``/results`` and each time series under ``/observables``), bit for bit: same dtype, same shape, same bytes (a NaN
+equals a NaN of the same bits, -0.0 differs from 0.0). The provenance is not compared (its package versions are
+listed beside a difference).
 
 Used by ``bearingsim compare A.h5 B.h5`` and ``bearingsim rerun ARCHIVE``.
 """
@@ -21,6 +24,8 @@ class Comparison:
     absent: dict[str, str] = field(default_factory=dict)  # a summary key only one result has: "A" or "B", the other
     summary_differs: list[str] = field(default_factory=list)
     arrays_differ: list[str] = field(default_factory=list)
+    how: dict[str, str] = field(default_factory=dict)  # how each of arrays_differ differs, by its name
+    arrays_compared: int = 0  # the arrays and other numbers compared (of either result)
     versions: list[tuple[str, object, object]] = field(default_factory=list)
 
     @property
@@ -41,6 +46,17 @@ class Comparison:
         if self.summary_differs:
             rows.append(f"* : not bit-identical, however small the difference; {SIGNIFICANCE_HINT}")
         return "\n".join(rows)
+
+    def difference_lines(self, shown: int = 8) -> list[str]:
+        """The arrays and other numbers that differ, the first ``shown`` with how (their largest difference),
+        then how many more, then how many were compared."""
+        lines = [f"  differs: {k} ({self.how.get(k, 'differs')})" for k in self.arrays_differ[:shown]]
+        if len(self.arrays_differ) > shown:
+            lines.append(f"  ... and {len(self.arrays_differ) - shown} more")
+        if self.arrays_differ:
+            lines.append(f"  {len(self.arrays_differ)} of {self.arrays_compared} arrays and other numbers differ "
+                         "(bit for bit)")
+        return lines
 
 
 def relative_change(a: float, b: float) -> str:
@@ -68,17 +84,15 @@ def compare_results(a, b) -> Comparison:
         c.summary.append((k, va, vb))
         if k not in sa or k not in sb:
             c.absent[k] = "A" if k not in sa else "B"
-        if k not in sa or k not in sb or not same_value(va, vb):
+        if k not in sa or k not in sb or not same_bits(va, vb):
             c.summary_differs.append(k)
-    pa, pb = compared_arrays(a), compared_arrays(b)
-    for k in list(pa) + [k for k in pb if k not in pa]:
-        x, y = pa.get(k), pb.get(k)
-        if x is None or y is None or x.shape != y.shape or not np.array_equal(x, y, equal_nan=x.dtype.kind == "f"):
-            c.arrays_differ.append(k)
-    ga, gb = other_numbers(a), other_numbers(b)
-    for k in list(ga) + [k for k in gb if k not in ga]:
-        if k not in ga or k not in gb or not same_value(ga[k], gb[k]):
-            c.arrays_differ.append(k)
+    for pa, pb in ((compared_arrays(a), compared_arrays(b)), (other_numbers(a), other_numbers(b))):
+        for k in list(pa) + [k for k in pb if k not in pa]:
+            c.arrays_compared += 1
+            how = "only in B" if k not in pa else "only in A" if k not in pb else how_differs(pa[k], pb[k])
+            if how is not None:
+                c.arrays_differ.append(k)
+                c.how[k] = how
     va = {k: v for k, v in a.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
     vb = {k: v for k, v in b.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
     for k in sorted(set(va) | set(vb)):
@@ -88,18 +102,60 @@ def compare_results(a, b) -> Comparison:
 
 
 def compared_arrays(result) -> dict[str, np.ndarray]:
-    """The arrays compared bit for bit (:data:`bearingsim.simulation.COMPARED`: per rotation and wear), by
-    their name under ``results/``."""
-    from bearingsim.simulation import COMPARED
+    """The arrays compared bit for bit: every dataset under ``results/`` (by its name there) and the
+    ``step``, ``time`` and ``value`` of every time series (``observables/<name>/<field>``), the series
+    with the dtypes their archive stores (:class:`bearingsim.archive.TimeSeries`), so that a result in
+    memory compares as its archive would."""
+    arrays = {k.removeprefix("results/"): np.asarray(v.data) for k, v in result.data.items()
+              if k.startswith("results/")}
+    for name, s in getattr(result, "series", {}).items():  # a result-like object may hold no series
+        for what, dtype in (("step", np.int64), ("time", np.float64), ("value", np.float64)):
+            arrays[f"observables/{name}/{what}"] = np.asarray(getattr(s, what), dtype=dtype)
+    return arrays
 
-    under = tuple(f"{p}/" for p in COMPARED)
-    return {k.removeprefix("results/"): np.asarray(v.data) for k, v in result.data.items() if k.startswith(under)}
+
+def same_bits(a, b) -> bool:
+    """Two stored numbers are the same bit for bit: floats of one type with the same bits (-0.0 is not 0.0,
+    NaN is NaN of the same bits), anything else :func:`bearingsim.scenario.same_value`."""
+    if isinstance(a, (float, np.floating)) or isinstance(b, (float, np.floating)):
+        return type(a) is type(b) and np.asarray(a).tobytes() == np.asarray(b).tobytes()
+    return same_value(a, b)
+
+
+def how_differs(x, y) -> str | None:
+    """None when ``x`` and ``y`` are the same bit for bit (arrays: dtype, shape and bytes; text arrays: their
+    text, which an archive stores as bytes), else a few words of how: dtype or shape, or the largest
+    difference of numbers and where it is."""
+    if not isinstance(x, np.ndarray) or not isinstance(y, np.ndarray):
+        return None if same_bits(x, y) else f"{x!r} -> {y!r}"
+    if x.dtype.kind in "US" or y.dtype.kind in "US":
+        if x.dtype.kind == y.dtype.kind and x.shape == y.shape and x.tolist() == y.tolist():
+            return None
+        return f"shape {x.shape} -> {y.shape}" if x.shape != y.shape else f"{int(np.sum(x != y))} of {x.size} texts differ"
+    if x.dtype != y.dtype:
+        return f"dtype {x.dtype} -> {y.dtype}"
+    if x.shape != y.shape:
+        return f"shape {x.shape} -> {y.shape}"
+    if x.tobytes() == y.tobytes():
+        return None
+    xf, yf = (np.ascontiguousarray(v).reshape(-1) for v in (x, y))
+    differ = np.flatnonzero((xf.view(np.uint8).reshape(xf.size, -1) != yf.view(np.uint8).reshape(yf.size, -1)).any(1))
+    with np.errstate(invalid="ignore", over="ignore"):
+        d = np.abs(yf[differ].astype(np.float64) - xf[differ].astype(np.float64))
+    d = np.where(np.isnan(d), -1.0, d)  # a NaN on one side: shown where no larger number differs
+    i = differ[int(np.argmax(d))]
+    at = np.unravel_index(i, x.shape)
+    value = f"{d.max():.3g}" if d.max() > 0 else "0: the sign of a zero or a NaN's bits" if d.max() == 0 else "NaN"
+    where = f" at [{', '.join(map(str, at))}]" if x.ndim else ""
+    n = len(differ)
+    return f"{n} of {x.size} values, largest |B - A| {value}{where}: {x[at].item()!r} -> {y[at].item()!r}"
 
 
 def other_numbers(result) -> dict[str, object]:
-    """Every stored number of the result's attribute groups but the summary (compared on its own), by
-    ``group/name`` under ``results/``: the reduced model's wear rates, its pass and operating point."""
+    """Every stored value of the result's attribute groups but the summary's numbers (compared on their own),
+    by ``group/name`` under ``results/``: the reduced model's wear rates, its pass and operating point, and
+    the summary's text (a multibody run's ``scene``)."""
     from bearingsim.results import SUMMARY
 
-    return {f"{g.removeprefix('results/')}/{k}": v for g, group in result.groups.items() if g != SUMMARY
-            for k, v in group.attrs.items()}
+    return {f"{g.removeprefix('results/')}/{k}": v for g, group in result.groups.items()
+            for k, v in group.attrs.items() if g != SUMMARY or k not in result.summary}

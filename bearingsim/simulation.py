@@ -67,10 +67,11 @@ def animate(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None
 
 #: what each archive command reads besides the scenario, the summary and the provenance
 #: (``show`` prints the scenario; ``compare`` and ``rerun`` compare the attribute groups, the summary among
-#: them, and these datasets: per-rotation arrays and wear, the results an archive's readers take; not the
-#: time series or the figures' tables, which the compared numbers come from)
+#: them, and these datasets: every number the run computed, its results and its time series, bit for bit;
+#: ``table`` reads the per-rotation arrays its standard errors come from)
 SCENARIO_ONLY: tuple[str, ...] = ()
-COMPARED = ("results/per_rotation", "results/wear")
+COMPARED = ("results", "observables")
+TABLED = ("results/per_rotation",)
 
 
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):

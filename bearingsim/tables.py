@@ -113,11 +113,11 @@ def table_of_archives(paths) -> Table:
     (:func:`_run_notes`); the standard errors computed from each archive's per-rotation impulses
     (:func:`bearingsim.stats.result_standard_errors`)."""
     from bearingsim.scenario import flatten
-    from bearingsim.simulation import COMPARED, load
+    from bearingsim.simulation import TABLED, load
     from bearingsim.stats import result_standard_errors
     from bearingsim.wording import run_notes
 
-    results = [load(p, only=COMPARED) for p in paths]
+    results = [load(p, only=TABLED) for p in paths]
     flat = [flatten(r.scenario.raw) for r in results]
     differ = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
     shown = [k for k in differ if k != "name"][:4]

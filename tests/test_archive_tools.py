@@ -147,6 +147,41 @@ def test_rerun_sees_a_changed_wear_profile_of_a_multibody_archive(tmp_path, mult
     assert res.returncode == 1 and "differs: wear/profile_work_rear" in res.stdout, res.stdout
 
 
+def test_compare_and_rerun_see_every_array_and_time_series_bit_for_bit(tmp_path, multibody_archive, reduced_archive):
+    """"identical" and "bit-identical" are over every number the run computed: every dataset under /results
+    and every time series under /observables, bit for bit (-0.0 is not 0.0). They compared the per-rotation
+    and wear arrays only: a figure's table, an impact, the cage orbit or a time series changed in a copy, or
+    a -0.0 for a 0.0, gave "results: identical" (exit 0) and a clean rerun."""
+    edits = {"force_vs_theta": lambda d: d.__setitem__((0, 0), d[0, 0] + 100.0),
+             "impacts/impulse_Ns": lambda d: d.__setitem__(0, d[0] * 2.0),
+             "cage_orbit": lambda d: d.__setitem__((5, 1), d[5, 1] + 1e-6),
+             "observables/cage_slip/value": lambda d: d.__setitem__(3, d[3] + 1e-3),
+             "observables/motion_pocket_force/value": lambda d: d.__setitem__((2, 3, 1), d[2, 3, 1] + 1.0)}
+    for name, edit in edits.items():
+        tampered = tmp_path / f"{name.replace('/', '_')}.h5"
+        shutil.copy(multibody_archive, tampered)
+        with h5py.File(tampered, "r+") as f:
+            edit(f[name if name.startswith("observables") else f"results/{name}"])
+        res = cli("compare", multibody_archive, tampered)
+        assert res.returncode == 1 and f"differs: {name} (1 of " in res.stdout, res.stdout
+        assert "results: differ" in res.stdout and "1 of 67 arrays and other numbers differ" in res.stdout
+    res = cli("compare", multibody_archive, multibody_archive)
+    assert res.returncode == 0 and "results: identical (20 summary numbers, 67 arrays" in res.stdout, res.stdout
+    zero, signed = tmp_path / "zero.h5", tmp_path / "signed.h5"
+    for path, value in ((zero, 0.0), (signed, -0.0)):
+        shutil.copy(reduced_archive, path)
+        with h5py.File(path, "r+") as f:
+            f["results/per_rotation/I_acc"][0, 0] = value
+    res = cli("compare", zero, signed)
+    assert res.returncode == 1, res.stdout
+    assert "differs: per_rotation/I_acc (1 of 1 values, largest |B - A| 0: the sign of a zero" in res.stdout
+    with h5py.File(signed, "r+") as f:
+        f["results/trace/l_r"][10] += 1e-9
+    res = cli("rerun", signed)
+    assert res.returncode == 1 and "differs: trace/l_r (1 of " in res.stdout, res.stdout
+    assert "differs: per_rotation/I_acc" in res.stdout
+
+
 @pytest.mark.slow
 def test_show_gives_a_runnable_scenario_with_the_same_results(tmp_path, reduced_archive):
     res = cli("show", reduced_archive)

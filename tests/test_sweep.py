@@ -907,6 +907,45 @@ def test_a_case_that_fails_while_its_worker_is_ending_ends_the_worker_and_is_not
     assert stop.value.code == 128 + signal.SIGTERM
 
 
+def test_an_interrupted_batch_indexes_the_cases_it_finished(tmp_path, monkeypatch):
+    """A batch (up to 200 reduced cases) returns its records when all its cases have run: a sweep interrupted
+    while one ran left the rows of the cases it had finished 'pending' and counted them "not run", though
+    their archives were in cases/. They are indexed from their archives (the resume's check), with the numbers
+    the case's own record would have given. The signal comes from the pool's worker (forked with the patched
+    run_case) as soon as it has finished the batch's second case; the worker then waits to be ended."""
+    import bearingsim.sweeps.run as run_module
+    from bearingsim.sweeps import worker
+
+    finish = worker.run_case
+    speeds = [1000.0, 2000.0, 3000.0, 4000.0]
+    second = resolve_cases(SweepSpec(scenario=BASE, axes=[(SPEED, speeds)]))[1].hash
+
+    def run_case_then_signal(h, *args, **kwargs):
+        rec = finish(h, *args, **kwargs)
+        if h == second:
+            os.kill(os.getppid(), signal.SIGINT)
+            time.sleep(120)  # ended by the sweep's stop (SIGTERM) long before
+        return rec
+
+    monkeypatch.setattr(worker, "run_case", run_case_then_signal)
+    monkeypatch.setattr(run_module, "make_batches", lambda cases, workers: [[run_module._item(c) for c in cases]])
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, speeds)])
+    out = run_sweep(spec, tmp_path / "s", engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert out.interrupted == signal.SIGINT
+    assert [r["status"] for r in out.rows] == ["done", "done", "pending", "pending"]
+    cols, _ = read_index(tmp_path / "s" / "sweep.h5")
+    assert [str(x) for x in cols["status"]] == ["done", "done", "pending", "pending"]
+    assert sorted(p.name for p in (tmp_path / "s" / "cases").iterdir()) == sorted(
+        f"{r['case']}.h5" for r in out.rows[:2])
+    monkeypatch.undo()  # the workers of the next sweep, forked, run the cases as they are
+    whole = run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, speeds[:2])]), tmp_path / "w", figures=False,
+                      progress=False, archives="all")  # the same two cases, not interrupted
+    for cut, ran in zip(out.rows[:2], whole.rows):
+        assert cut["archive"] == ran["archive"] and cut["notes"] == ran["notes"] and cut["wall_s"] > 0
+        assert cut["summary"].keys() == ran["summary"].keys()
+        assert all(np.array_equal(cut["summary"][k], ran["summary"][k], equal_nan=True) for k in cut["summary"])
+
+
 def test_a_signal_while_the_sweep_writes_its_index_lets_it_finish_and_is_reported(tmp_path, monkeypatch):
     """A signal that landed while a sweep ended its workers or wrote its index and map (the clean-up after the
     cases) raised out of it: `bearingsim sweep` exited 1 with a traceback (1 of 6 SIGINTs of

@@ -406,6 +406,7 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
         engine.should_stop = lambda: signals.fired is not None
         bar = None
         interrupted = None
+        stale: set = set()
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
@@ -433,9 +434,28 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
                     if bar is not None:
                         bar.close()
                     _clean_temporaries(cases_dir)
+                    if signals.fired is not None:  # the workers have ended: what they finished is on disk
+                        _index_finished(cases, rows, index, cases_dir, stale)
                     index.write()
                     write_map()
     return interrupted if interrupted is not None else signals.fired
+
+
+def _index_finished(cases, rows, index, cases_dir: Path, stale: set) -> None:
+    """Index the cases of an interrupted sweep that a worker finished in a batch cut short: a batch returns
+    its records when all its cases have run (up to :data:`MAX_BATCH`), so the rows of the ones it had run
+    stayed ``pending`` though their archives were written. Each pending row whose case's archive is complete
+    and current (:func:`~bearingsim.sweeps.index.read_cached`, the resume's own check and numbers) becomes
+    ``done`` (``stale`` when it replaced a stale archive), as its record would have made it."""
+    for i, (c, row) in enumerate(zip(cases, rows)):
+        if row["status"] != "pending":
+            continue
+        rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
+        if rec is None or rec["status"] == "stale":
+            continue
+        rec["status"] = "stale" if c.hash in stale else "done"
+        row.update(rec, archive=f"cases/{c.hash}.h5", notes=rec.get("notes", []))
+        index.changed(i)
 
 
 def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str, check_folder: bool):

@@ -28,11 +28,14 @@ given), so they are never held in memory; :func:`write` then completes the same 
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import datetime as _dt
 import functools
 import json
 import os
 import platform
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -617,9 +620,40 @@ def run_facts() -> dict[str, Any]:
     (:func:`bearingsim.simulation.run`): ``bearingsim_version``, ``git_commit``, ``platform``, ``command``
     and ``version_<package>`` of python and the packages its numbers depend on."""
     facts = {"bearingsim_version": __version__, "git_commit": git_commit(), "platform": platform.platform(),
-             "command": " ".join(sys.argv)}
+             "command": command_line()}
     facts.update((f"version_{k}", v) for k, v in package_versions().items())
     return facts
+
+
+#: the command a run records instead of its own process's, where that is not the one the user gave: a sweep
+#: case on a dask worker records the sweep's (:func:`bearingsim.sweeps.worker.run_batch`); per thread of
+#: control, as a dask worker runs its tasks in threads
+_GIVEN_COMMAND: contextvars.ContextVar[str | None] = contextvars.ContextVar("bearingsim_command", default=None)
+
+
+def command_line() -> str:
+    """The command that runs this process, as a shell takes it again (:func:`shlex.join`: an argument with
+    spaces stays one), its program named ``bearingsim`` when it is bearingsim's own entry point (the
+    console script, or ``python -m bearingsim``, whose ``sys.argv[0]`` is the path of ``__main__.py``); the
+    command given to :func:`given_command` where one is."""
+    given = _GIVEN_COMMAND.get()
+    if given is not None:
+        return given
+    argv = list(sys.argv)
+    if argv and (Path(argv[0]).name == "bearingsim" or argv[0].endswith(".py")
+                 and Path(argv[0]).resolve() == Path(__file__).resolve().parent / "__main__.py"):
+        argv[0] = "bearingsim"
+    return shlex.join(argv)
+
+
+@contextlib.contextmanager
+def given_command(command: str | None):
+    """Within it :func:`command_line` gives ``command`` (None: this process's own)."""
+    token = _GIVEN_COMMAND.set(command)
+    try:
+        yield
+    finally:
+        _GIVEN_COMMAND.reset(token)
 
 
 def _provenance(result) -> dict[str, Any]:

@@ -485,3 +485,25 @@ def test_a_runs_notes_are_stored_and_read_inspected_and_reported_back(tmp_path):
     with h5py.File(out, "r+") as f:  # an archive that stores no notes
         del f["bearingsim/notes"]
     assert bearingsim.load(out).notes == [] and "\nnotes: not stored in this archive" in describe(out)
+
+
+def test_the_provenance_command_runs_again_as_it_was_given(monkeypatch):
+    """The provenance stored ``" ".join(sys.argv)``: an argument with spaces (``--set 'operating={...}'``)
+    came back as two, and ``python -m bearingsim`` was named by the path of its ``__main__.py``. It is the
+    command as a shell takes it again, bearingsim's own entry point named ``bearingsim``."""
+    import shlex
+    import sys
+    from pathlib import Path
+
+    table = "operating={inner_ring_speed_rpm=500, radial_load_N=2000}"
+    main = Path(archive.__file__).parent / "__main__.py"
+    for program in (str(main), "/usr/local/bin/bearingsim"):  # python -m bearingsim; the console script
+        monkeypatch.setattr(sys, "argv", [program, "run", "s.toml", "--set", table])
+        command = archive.run_facts()["command"]
+        assert command == f"bearingsim run s.toml --set '{table}'"
+        assert shlex.split(command) == ["bearingsim", "run", "s.toml", "--set", table]
+    monkeypatch.setattr(sys, "argv", ["/opt/tools/other.py", "a b"])  # another program: kept as it is
+    assert archive.run_facts()["command"] == "/opt/tools/other.py 'a b'"
+    with archive.given_command("bearingsim sweep x.toml"):  # a sweep case on a dask worker: the sweep's
+        assert archive.run_facts()["command"] == "bearingsim sweep x.toml"
+    assert archive.run_facts()["command"] == "/opt/tools/other.py 'a b'"

@@ -907,6 +907,22 @@ def test_a_case_that_fails_while_its_worker_is_ending_ends_the_worker_and_is_not
     assert stop.value.code == 128 + signal.SIGTERM
 
 
+def test_a_case_run_for_a_dask_sweep_records_the_sweeps_command(tmp_path, monkeypatch):
+    """A case run on a dask worker stored the worker's command line (``dask worker tcp://...``) in its
+    archive's provenance, where a local pool's case stores the sweep's: the sweep's command goes with
+    the batch (:func:`bearingsim.sweeps.worker.run_batch` as the dask engine calls it: no shared folder,
+    the archive back as bytes)."""
+    import bearingsim
+    from bearingsim.sweeps import worker
+
+    monkeypatch.setattr(sys, "argv", ["/usr/bin/dask", "worker", "tcp://127.0.0.1:8786"])
+    (case,) = resolve_cases(SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0])]))
+    command = "bearingsim sweep scenarios/paper_3000rpm.toml --param 'operating.inner_ring_speed_rpm=1000'"
+    (rec,) = worker.run_batch([(case.hash, case.toml)], None, "all", command)
+    (tmp_path / "case.h5").write_bytes(rec["archive"])
+    assert bearingsim.load(tmp_path / "case.h5").provenance["command"] == command
+
+
 def test_an_interrupted_batch_indexes_the_cases_it_finished(tmp_path, monkeypatch):
     """A batch (up to 200 reduced cases) returns its records when all its cases have run: a sweep interrupted
     while one ran left the rows of the cases it had finished 'pending' and counted them "not run", though

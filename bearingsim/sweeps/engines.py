@@ -369,14 +369,16 @@ class DaskEngine:
         ``archives``: which cases get one (:func:`bearingsim.sweeps.worker.keeps_archive`)."""
         from distributed import as_completed
 
+        from bearingsim.archive import command_line
         from bearingsim.sweeps.worker import run_batch
 
         self.start()
         stamp = f"{os.getpid()}-{time.time_ns()}"
         # the text only: a worker elsewhere resolves it with its own bearingsim (no pickled models)
         batches = [[(h, text) for h, text, *_ in b] for b in batches]
-        self._futures = [self.client.submit(run_batch, b, None, archives, key=f"bearingsim-sweep-{stamp}-{i}", pure=False)
-                         for i, b in enumerate(batches)]
+        command = command_line()  # each case's provenance records the sweep's command, not the worker's
+        self._futures = [self.client.submit(run_batch, b, None, archives, command, key=f"bearingsim-sweep-{stamp}-{i}",
+                                            pure=False) for i, b in enumerate(batches)]
         for fut in as_completed(self._futures, loop=self.client.loop):
             if self.should_stop():
                 return

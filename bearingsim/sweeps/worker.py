@@ -186,7 +186,8 @@ def warm_up(toml_text: str, archive: bool = True) -> None:
         warming = False
 
 
-def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archives: str = "all") -> list[dict]:
+def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archives: str = "all",
+              command: str | None = None) -> list[dict]:
     """Run ``items`` (``(hash, resolved TOML)`` pairs) one after the other.
 
     Parameters
@@ -201,11 +202,17 @@ def run_batch(items: list[tuple[str, str]], cases_dir: str | None = None, archiv
         folder.
     archives : str
         Which cases get an archive (:func:`keeps_archive`): ``all``, ``none`` or ``auto``.
+    command : str or None
+        The sweep's command, which each case's provenance records (a dask worker's own is ``dask worker
+        ...``); None: this process's (a local pool's forked worker has the sweep's).
     """
+    from bearingsim.archive import given_command
+
     records = []
-    for h, text, *model in items:
-        end_if_told()  # told to end while a case ran (its exception swallowed where it landed): no next case
-        records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
-                                model[0] if model else None, archives))
+    with given_command(command):
+        for h, text, *model in items:
+            end_if_told()  # told to end while a case ran (its exception swallowed where it landed): no next case
+            records.append(run_case(h, text, Path(cases_dir) / f"{h}.h5" if cases_dir is not None else None,
+                                    model[0] if model else None, archives))
     end_if_told()  # nor a wait for the next batch: the sweep that stopped it reads no more records
     return records

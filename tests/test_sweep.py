@@ -1348,3 +1348,16 @@ def test_another_sweeps_cases_are_counted_in_good_grammar(tmp_path):
     with pytest.raises(UserError) as exc:
         run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [2000])]), tmp_path, figures=False, progress=False)
     assert "(1 case of its 1 is not in this one)" in str(exc.value), str(exc.value)
+
+
+def test_the_sweeps_page_says_a_range_is_rounded_to_15_digits_as_it_is():
+    """A range's values are rounded to 15 significant digits (0.05:0.5:10 gives 0.15, where the floating-point
+    spacing gives 0.15000000000000002), on purpose: the page said only "NUM evenly spaced values". It says so,
+    with the values it gives, and they are the ones a range gives."""
+    from bearingsim.sweeps.spec import parse_param
+
+    text = " ".join((ROOT / "docs" / "sweeps.md").read_text().split())
+    assert "each rounded to 15 significant digits" in text
+    assert "0.05:0.5:10 gives 0.15 and 0.35, where the floating-point spacing gives 0.15000000000000002" in text
+    values = parse_param("bearing.pocket_clearance_mm=0.05:0.5:10")[1]
+    assert values[2] == 0.15 and values[6] == 0.35 and np.linspace(0.05, 0.5, 10)[2] == 0.15000000000000002

@@ -28,7 +28,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 
-__all__ = ["has_motion", "render_result", "SECONDS_PER_ROTATION"]
+__all__ = ["has_motion", "max_exaggeration", "render_result", "SECONDS_PER_ROTATION"]
 
 #: seconds of video per cage rotation: at 30 fps a frame every 3 deg of cage travel, slow enough to follow
 #: a roller across its pocket (at 6000 rpm a rotation takes 23 ms: the video is ~170 times slower)
@@ -38,6 +38,9 @@ FLASH_ALPHA = (1.0, 0.55, 0.25)
 #: the automatic exaggeration makes the drawn pocket play (K s / 2) about this fraction of the roller radius
 AUTO_PLAY_FRACTION = 0.3
 MAX_EXAGGERATION = 1000.0
+#: the fraction of the cage bar's width (between neighbouring pockets, at the pitch circle) that the drawn pockets
+#: must leave: it sets the largest exaggeration a bearing is drawn at (:func:`max_exaggeration`)
+BAR_KEPT = 0.25
 MAX_FPS = 120.0
 #: highest frame rate of a GIF: it stores each frame's delay in hundredths of a second, and browsers show a
 #: delay under 2 of them (20 ms) as 100 ms, so a GIF above 50 fps would play several times too slowly
@@ -149,15 +152,36 @@ def _as_number(value, name) -> float:
 
 def _exaggeration(p, given) -> float:
     """The factor K the clearances are drawn at: ``given``, or the 1-2-5 number at or below the one that
-    makes the drawn pocket play K s / 2 :data:`AUTO_PLAY_FRACTION` of the roller radius (10 for the NU214)."""
+    makes the drawn pocket play K s / 2 :data:`AUTO_PLAY_FRACTION` of the roller radius (10 for the NU214);
+    either at most :func:`max_exaggeration` of the bearing (a larger ``given`` is refused in one line)."""
+    top = max_exaggeration(p)
     if given is not None:
-        return check_number(given, "exaggerate", 1.0, MAX_EXAGGERATION)
+        k = check_number(given, "exaggerate", 1.0, MAX_EXAGGERATION)
+        if k > top:
+            raise UserError(f"exaggerate {k:g}: at most {top:g} for this archive's bearing: at a larger K its drawn "
+                            f"pockets leave less than {BAR_KEPT:.0%} of the cage bar between them "
+                            f"(docs/animation.md)")
+        return k
     g = p.bearing
-    want = AUTO_PLAY_FRACTION * g.roller_radius / (0.5 * g.pocket_clearance)
+    want = min(AUTO_PLAY_FRACTION * g.roller_radius / (0.5 * g.pocket_clearance), top)
     if want <= 1.0:
         return 1.0
     decade = 10.0 ** math.floor(math.log10(want))
     return max(m * decade for m in (1.0, 2.0, 5.0) if m * decade <= want)
+
+
+def max_exaggeration(p) -> float:
+    """The largest K, to 0.1 below, at which the bearing of ``p`` is drawn as it is: the pockets drawn K s / 2
+    wider (radius r + K s / 2) leave at least :data:`BAR_KEPT` of the cage bar between neighbours, whose width
+    at the pitch circle is w = 2 r_p sin(pi / Z) - 2 r - s, i.e. K <= 1 + (1 - BAR_KEPT) w / s (22.8 for the
+    NU214). Towards K = 1 + w / s the bars vanish, neighbouring rollers (each drawn up to K s / 2 off its
+    pocket's centre) may touch, and a roller drawn K times its tangential offset t drifts outwards by about
+    K^2 t^2 / 2 r_p, cutting into the outer ring (0.9 mm at K = 30 in the NU214). At least 1, at most
+    :data:`MAX_EXAGGERATION`."""
+    g = p.bearing
+    bar = 2.0 * g.pitch_radius * math.sin(math.pi / g.roller_count) - 2.0 * g.roller_radius - g.pocket_clearance
+    k = 1.0 + (1.0 - BAR_KEPT) * bar / g.pocket_clearance if g.pocket_clearance > 0.0 else MAX_EXAGGERATION
+    return min(MAX_EXAGGERATION, max(1.0, math.floor(10.0 * k + 1e-9) / 10.0))
 
 
 class _Motion:

@@ -43,7 +43,7 @@ def _cmd_animate(args) -> int:
             bar.update(done - bar.n)
 
     try:
-        with options_named("rotations", "fps"):
+        with options_named("rotations", "fps", "exaggerate"):
             out = render(args.archive, args.output, rotations=rotations, exaggerate=args.exaggerate, fps=args.fps,
                          progress=progress)
     finally:
@@ -61,7 +61,8 @@ def add_commands(sub) -> None:
     a.add_argument("-o", "--output", required=True, help="animation file, .mp4 (H.264) or .gif")
     a.add_argument("--rotations", metavar="A:B", help="recorded cage rotations to show (default: all stored)")
     a.add_argument("--exaggerate", type=float, metavar="K",
-                   help="draw the clearances K times their size (default: automatic, stated on the frame)")
+                   help="draw the clearances K times their size (default: automatic, stated on the frame; at most "
+                        "what the bearing's drawing holds, 22.8 for the NU214: docs/animation.md)")
     a.add_argument("--fps", type=float, default=30.0, help="frames per second of video (default 30; each cage "
                                                            "rotation takes 4 s of video)")
     a.add_argument("-q", "--quiet", action="store_true", help="no progress bar and nothing printed on success")

@@ -4,6 +4,7 @@ must hold.
 One short run of the fast scene (rigid raceways, 6000 rpm, 1 warm-up + 1 recorded rotation, the motion of the
 whole recorded rotation at 60 poses per rotation) is shared, with its twin that stores no motion.
 """
+import dataclasses
 import math
 import subprocess
 
@@ -409,3 +410,29 @@ def test_an_interrupted_animation_says_no_animation_is_written(runs, tmp_path, m
         signal.signal(signal.SIGINT, previous)
     assert capsys.readouterr().err.strip().splitlines() == [said]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_exaggeration_the_drawing_cannot_hold_is_refused_in_one_line(runs, tmp_path, capsys):
+    """`animate --exaggerate 100` (up to the cap of 1000) exited 0 and drew pockets wider than their pitch: the
+    cage bars vanished and rollers overlapped. The largest K is the bearing's own: the pockets drawn K s / 2 wider
+    leave a quarter of the cage bar (2 r_p sin(pi / Z) - 2 r - s at the pitch circle), 22.8 for the NU214, to 0.1
+    below. Above it the command line refuses in one line naming --exaggerate and that K, exit 2, nothing written;
+    the API refuses the same; at it the drawing is made."""
+    g = runs[0].parameters.bearing
+    bar = 2 * g.pitch_radius * math.sin(math.pi / g.roller_count) - 2 * g.roller_radius - g.pocket_clearance
+    top = math.floor(10 * (1 + 0.75 * bar / g.pocket_clearance)) / 10
+    assert top == 22.8
+    for k in ("100", "1000", "22.9"):
+        assert main(["animate", str(runs[1]), "-o", str(tmp_path / "a.gif"), "--exaggerate", k]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and err[0].startswith(f"bearingsim: error: --exaggerate {float(k):g}: at most 22.8 "), err
+    with pytest.raises(UserError, match="^exaggerate 30: at most 22.8 "):
+        bearingsim.animate(runs[1], tmp_path / "b.gif", exaggerate=30)
+    assert list(tmp_path.iterdir()) == []
+    drawing = animation._Drawing(runs[0], animation._Motion(runs[0]), top, np.array([0]))
+    drawing.draw(0)
+    pockets = np.asarray(drawing.pockets.get_offsets())
+    kept = np.hypot(*(pockets - np.roll(pockets, 1, axis=0)).T).min() - 2 * drawing.R
+    assert 0.25 * bar * 1e3 <= kept < 0.26 * bar * 1e3
+    fewer = dataclasses.replace(runs[0].parameters, bearing=dataclasses.replace(g, roller_count=12))
+    assert animation.max_exaggeration(fewer) > 2 * top  # wider bars: a larger K fits

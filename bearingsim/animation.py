@@ -9,7 +9,8 @@ archive alone:
   raceways, each roller's offset in its pocket and the pocket's clearance, the cage's and the inner ring's
   offsets from the axis; the parts themselves at their size), ``K`` stated on the frame;
 * each roller with a mark that turns with it (its spin);
-* each pocket face coloured by the mean circumferential force on it since the previous pose;
+* each pocket face coloured by the mean circumferential force on it since the previous pose (the scale ends
+  at :data:`FORCE_SCALE_PERCENTILE` of the window's forces, the larger drawn in its top colour, as it says);
 * impacts (``/results/impacts``) flashing on their face for three frames, larger for a larger impulse;
 * the cage centre's trail over the last cage rotation in an inset, time, cage rotation, pocket 0's
   angle theta from the load-zone centre and the cage slip as text.
@@ -54,6 +55,9 @@ TRAIL_COLOUR = "#d95f02"
 RING_COLOUR = "#b4bcc6"
 ROLLER_COLOUR = "#5f6b78"
 FORCE_COLOURS = ("#d0d0d0", "#4292c6", "#08306b")  # face force colour scale: no force light grey, then blues
+#: the face force colour scale ends at this percentile of the window's face forces (a few impacts' peaks would
+#: leave every other force pale); the forces above it are drawn in its top colour, which the scale says
+FORCE_SCALE_PERCENTILE = 99.5
 FLASH_COLOUR = "#e4002b"
 MOTION = "motion_roller_position"  # the series whose presence means an archive holds motion
 #: the archive paths an animation reads (besides the scenario and the summary)
@@ -329,8 +333,9 @@ class _Drawing:
         self.spin = ax.add_collection(LineCollection([], colors="white", linewidths=1.6, zorder=5))
         self.rows = rows
         self.forces = _face_forces(motion, rows)
-        top = float(np.percentile(self.forces, 99.5)) if self.forces.size else 0.0
+        top = float(np.percentile(self.forces, FORCE_SCALE_PERCENTILE)) if self.forces.size else 0.0
         self.norm = Normalize(0.0, top if top > 0.0 else 1.0)
+        self.force_max = float(self.forces.max()) if self.forces.size else 0.0
         self._flash_schedule(result)
         self.cmap = _force_cmap()
         self.faces = ax.add_collection(LineCollection([], cmap=self.cmap, norm=self.norm, linewidths=3.0,
@@ -383,10 +388,15 @@ class _Drawing:
                             f"radial {pd:.3g} mm;\nparts at their size)", fontsize=8, va="top", color="0.15")
         self.state = fig.text(x0, 0.77, "", fontsize=9, va="top", family="monospace")
         fig.text(x0, 0.545, "pocket faces: mean circumferential\nforce on the face [N]", fontsize=8, va="top")
-        cax = fig.add_axes((x0 + 0.005, 0.47, 0.22, 0.022))
-        fig.colorbar(ScalarMappable(self.norm, self.cmap), cax=cax, orientation="horizontal")
+        cax = fig.add_axes((x0 + 0.005, 0.47, 0.21, 0.022))
+        cut = self.force_max > self.norm.vmax  # the scale ends below the largest force: said, and its end drawn
+        self.scale = fig.colorbar(ScalarMappable(self.norm, self.cmap), cax=cax, orientation="horizontal",
+                                  extend="max" if cut else "neither")
         cax.tick_params(labelsize=7)
-        fig.text(x0, 0.43, "★ impact (size ∝ impulse)", fontsize=8, va="top", color=FLASH_COLOUR)
+        if cut:
+            fig.text(x0, 0.445, f"forces above {self.norm.vmax:.3g} N (up to {self.force_max:.3g} N)\n"
+                                f"are drawn in the top colour", fontsize=7.5, va="top", color="0.15")
+        fig.text(x0, 0.408, "★ impact (size ∝ impulse)", fontsize=8, va="top", color=FLASH_COLOUR)
         c_um = self.m.cage_xy * 1e6
         lim = max(1.0, 1.15 * float(np.max(np.abs(c_um)))) if c_um.size else 1.0
         tax = self.trail_ax = fig.add_axes((x0 + 0.035, 0.05, 0.2, 0.3))

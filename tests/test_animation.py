@@ -436,3 +436,19 @@ def test_an_exaggeration_the_drawing_cannot_hold_is_refused_in_one_line(runs, tm
     assert 0.25 * bar * 1e3 <= kept < 0.26 * bar * 1e3
     fewer = dataclasses.replace(runs[0].parameters, bearing=dataclasses.replace(g, roller_count=12))
     assert animation.max_exaggeration(fewer) > 2 * top  # wider bars: a larger K fits
+
+
+def test_forces_above_the_colour_scale_are_said_to_be_drawn_in_its_top_colour(runs):
+    """The face-force scale ends at the 99.5th percentile of the window's forces, so that a few impacts' peaks
+    do not leave every other face pale; the faces above it were drawn in its darkest colour without a word
+    (a reviewer's window: 39 face-frames above the top, 28.6 N, up to 73 N). The scale's end is drawn as an
+    arrow (extend="max") and a line says that forces above the top, up to the largest, take its colour."""
+    res = runs[0]
+    motion = animation._Motion(res)
+    drawing = animation._Drawing(res, motion, 10.0, np.arange(0, len(motion.time), 2))
+    top, biggest = drawing.norm.vmax, float(drawing.forces.max())
+    assert biggest > top == pytest.approx(np.percentile(drawing.forces, 99.5))  # the case this test is about
+    assert drawing.scale.extend == "max"
+    said = [t.get_text() for t in drawing.fig.texts if f"above {top:.3g} N" in t.get_text()]
+    assert len(said) == 1 and f"{biggest:.3g} N" in said[0] and "top colour" in said[0], said
+

@@ -12,8 +12,8 @@ archive alone:
 * each pocket face coloured by the mean circumferential force on it since the previous pose (the scale ends
   at :data:`FORCE_SCALE_PERCENTILE` of the window's forces, the larger drawn in its top colour, as it says);
 * impacts (``/results/impacts``) flashing on their face for three frames, larger for a larger impulse;
-* the cage centre's trail over the last cage rotation in an inset, time, cage rotation, pocket 0's
-  angle theta from the load-zone centre and the cage slip as text.
+* the cage centre's trail over the last cage rotation in an inset (before the window: ``cage_centre``),
+  time, cage rotation, pocket 0's angle theta from the load-zone centre and the cage slip as text.
 
 Frames are drawn by matplotlib's Agg canvas (the user's backend is never touched), MP4 written by the
 ffmpeg binary that ``imageio-ffmpeg`` packages (H.264), GIF by Pillow; the file appears complete or not at
@@ -205,6 +205,15 @@ class _Motion:
         self.ring_xy = None if ring is None else ring.value
         # recorded cage rotations: the cage's travel from t = 0, less the warm-up
         self.rotation = self.sign * self.cage_angle / (2.0 * math.pi) - p.numerics.warmup_rotations
+        # the cage centre before the window (the observables' samples from t = 0), for the trail of a frame
+        # less than a cage rotation into the window; a rotation taken as the window's mean time per rotation
+        centre = s.get("cage_centre")
+        span = self.rotation[-1] - self.rotation[0]
+        self.period = (self.time[-1] - self.time[0]) / span if span > 0.0 else 0.0
+        early = (None if centre is None or not len(centre.time) else
+                 (centre.time < self.time[0]) & (centre.time >= self.time[0] - self.period))
+        self.before_time = None if early is None else np.asarray(centre.time)[early]
+        self.before_xy = None if early is None else np.asarray(centre.value)[early]
         slip = s.get("cage_slip")
         self.slip = (None if slip is None or not len(slip.time)
                      else np.interp(self.time, slip.time, slip.value))
@@ -397,7 +406,8 @@ class _Drawing:
             fig.text(x0, 0.445, f"forces above {self.norm.vmax:.3g} N (up to {self.force_max:.3g} N)\n"
                                 f"are drawn in the top colour", fontsize=7.5, va="top", color="0.15")
         fig.text(x0, 0.408, "★ impact (size ∝ impulse)", fontsize=8, va="top", color=FLASH_COLOUR)
-        c_um = self.m.cage_xy * 1e6
+        c_um = np.concatenate([self.m.cage_xy, self.m.before_xy if self.m.before_xy is not None
+                               else np.zeros((0, 2))]) * 1e6
         lim = max(1.0, 1.15 * float(np.max(np.abs(c_um)))) if c_um.size else 1.0
         tax = self.trail_ax = fig.add_axes((x0 + 0.035, 0.05, 0.2, 0.3))
         tax.set_xlim(-lim, lim)
@@ -470,6 +480,8 @@ class _Drawing:
                             f"θ pocket 0 {theta:7.1f}°\ncage slip  {slip}\nframe      {f + 1:5d}")
         lo = int(np.searchsorted(m.rotation, m.rotation[j] - 1.0))
         c = m.cage_xy[lo:j + 1] * 1e6
+        if lo == 0 and m.before_xy is not None:  # less than a rotation into the window: the rest before it
+            c = np.concatenate([m.before_xy[m.before_time >= m.time[j] - m.period] * 1e6, c])
         self.trail.set_data(c[:, 0], c[:, 1])
         self.trail_now.set_data([c[-1, 0]], [c[-1, 1]])
 

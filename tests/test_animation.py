@@ -452,3 +452,20 @@ def test_forces_above_the_colour_scale_are_said_to_be_drawn_in_its_top_colour(ru
     said = [t.get_text() for t in drawing.fig.texts if f"above {top:.3g} N" in t.get_text()]
     assert len(said) == 1 and f"{biggest:.3g} N" in said[0] and "top colour" in said[0], said
 
+
+def test_the_cage_trail_at_the_start_of_the_window_is_taken_from_before_it(runs):
+    """The inset shows the cage centre's path over the last cage rotation; in a window's first rotation it was
+    taken from the window alone, so the first frame showed a dot, though the archive's cage_centre holds the
+    path from t = 0. There the trail is that path over the rotation before the frame (the window's mean time
+    per rotation), the window's poses after it."""
+    res = runs[0]
+    motion = animation._Motion(res)
+    drawing = animation._Drawing(res, motion, 10.0, np.arange(len(motion.time)))
+    drawing.draw(0)
+    x, y = drawing.trail.get_data()
+    period = (motion.time[-1] - motion.time[0]) / (motion.rotation[-1] - motion.rotation[0])
+    c = res.series["cage_centre"]
+    before = (c.time < motion.time[0]) & (c.time >= motion.time[0] - period)
+    assert before.sum() > 20  # the case this test is about: a rotation of path before the window
+    want = np.vstack([c.value[before], motion.cage_xy[:1]]) * 1e6
+    np.testing.assert_allclose(np.column_stack([x, y]), want)

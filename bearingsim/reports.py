@@ -515,16 +515,21 @@ def _sensitivity_sections(table: Path):
     def num(v, digits):
         return _cell(v, digits=digits) if math.isfinite(float(v)) else "n/a"
 
-    def slope(r):  # S ± SE, and S at half the step where the study ran it (a deterministic model)
+    # a deterministic study (the reduced model) ran half steps and has no standard error: S and S at half the step
+    deterministic = sens.ran_half_steps(rows)
+
+    def slope(r):  # S ± SE, or S and S at half the step (a deterministic model)
         half = float(r.get("sensitivity_half_step", math.nan))
-        return (f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}"
-                + (f" (half step: {num(half, 3)})" if math.isfinite(half) else ""))
+        if deterministic:
+            return num(r["sensitivity"], 3) + (f" (half step: {num(half, 3)})" if math.isfinite(half) else "")
+        return f"{num(r['sensitivity'], 3)} ± {num(r['sensitivity_se'], 2)}"
 
     cells = [[r["key"], r["quantity"], r["measure"], slope(r), num(r["over_range"], 3), sens.row_note(r)]
              for r in rows]
-    blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: d ln y / d ln x, "
-                          "lin: d y / d ln x; ± one standard error (docs/sensitivity.md)", head, cells,
-                          [False, False, False, True, True, False])]
+    errors = "S and S at half the step" if deterministic else "± one standard error"
+    blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: "
+                          f"d ln y / d ln x, lin: d y / d ln x; {errors} (docs/sensitivity.md)", head, cells,
+                          [False, False, False, True, True, False], sens.HALF_STEP_NOTE if deterministic else "")]
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))
     sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
     return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")

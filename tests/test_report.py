@@ -620,3 +620,47 @@ def test_an_uncertainty_reports_its_spread_in_the_units_the_command_prints(tmp_p
     median = re.findall(r">([^<]*)<", numbers)[0]
     spread = next(s for s in spreads if s["quantity"] == "I_dec")
     assert median == f"{spread['median'] * 1e3:.4g}"
+
+
+# --- study pages say what they show --------------------------------------------------------------
+@pytest.fixture(scope="module")
+def small_studies(tmp_path_factory):
+    """A reduced-model sensitivity study of one key (4 runs: the step and the half step) and a sweep of two
+    drag coefficients whose second case fails as it runs (no drag, no gravity: no rear-face impact)."""
+    d = tmp_path_factory.mktemp("small")
+    res = cli("sensitivity", PAPER, "--keys", "contact.restitution", "--set", "numerics.rotations=1", "-o",
+              d / "sens", "-j", "1", "-q")
+    assert res.returncode == 0, res.stderr
+    res = cli("sweep", PAPER, "--set", "operating.gravity=false", "--param", "lubrication.drag_coefficient=0.02,0",
+              "-o", d / "sweep", "-j", "1", "-q", "--no-plots")
+    assert res.returncode == 1, res.stderr
+    return d
+
+
+def _page(folder, out) -> str:
+    return bearingsim.report(folder, out).read_text()
+
+
+def _section_text(html, section) -> str:
+    import html as html_text
+
+    body = re.search(rf'<section id="{section}">(.*?)</section>', html, re.S).group(1)
+    return html_text.unescape(re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", body)))
+
+
+def test_a_deterministic_sensitivity_page_has_the_commands_caveat_and_no_standard_error(small_studies, tmp_path,
+                                                                                         monkeypatch):
+    """The reduced model has no standard error: its page showed "0.497 ± 0 (half step: -0.48)" as if the 0 were
+    measured, under a caption "± one standard error", and a tornado chart titled "± 1 standard error (batch means
+    over rotations)", without the command's line on what the half step says. The page shows S and S at half the
+    step, no "±", the command's line under the table, and the chart claims no batch-means errors."""
+    from bearingsim.studies import sensitivity as sens
+
+    titles = []
+    drawn = sens.plot_tornado
+    monkeypatch.setattr(sens, "plot_tornado", lambda rows, title="": titles.append(title) or drawn(rows, title))
+    html = _page(small_studies / "sens", tmp_path / "sens.html")
+    text = _section_text(html, "table")
+    assert "half step:" in text and "±" not in text.replace("(1 ± 10%)", ""), text
+    assert sens.HALF_STEP_NOTE in text and "a deterministic model has no standard error" in text
+    assert len(titles) == 1 and "batch means" not in titles[0] and "no standard error" in titles[0], titles

@@ -451,6 +451,12 @@ def ran_half_steps(rows) -> bool:
                for k in ("sensitivity_half_step", "x_minus_half"))
 
 
+#: the line under a deterministic study's table (the command's and the report's): its S has no standard error
+HALF_STEP_NOTE = ("S, half step: the same slope from runs at half the step (a deterministic model has no standard "
+                  "error; where the two differ, the difference is not a local slope; n/a where the key's range clips "
+                  "the half step onto the full step's values: no second slope to compare)")
+
+
 def format_table(rows: list[dict]) -> str:
     """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
     quantity, S ± its standard error and the change over the key's range (n/a and why where missing)."""
@@ -464,9 +470,7 @@ def format_table(rows: list[dict]) -> str:
                      + (f" {_num(float(r.get('sensitivity_half_step', math.nan)), '+12.3f')}" if half else "")
                      + (f"  ({note})" if note else ""))
     if half:
-        lines.append("S, half step: the same slope from runs at half the step (a deterministic model has no "
-                     "standard error; where the two differ, the difference is not a local slope; n/a where the "
-                     "key's range clips the half step onto the full step's values: no second slope to compare)")
+        lines.append(HALF_STEP_NOTE)
     return "\n".join(lines)
 
 
@@ -520,9 +524,11 @@ def plot_sensitivity(index_path, outdir) -> list[Path]:
     from bearingsim.plotting import save_figure
 
     rows, meta = read_table(index_path)
-    fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {step_text(meta['step'])}) within each key's "
-                             "range; bars: S ln(high / low), the change across the key's plausible range if linear, "
-                             "± 1 standard error (batch means over rotations)")
+    errors = ("no error bars: a deterministic model has no standard error (S at half the step: the table)"
+              if ran_half_steps(rows) else "± 1 standard error (batch means over rotations)")
+    fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {step_text(meta['step'])}) "
+                             "within each key's range; bars: S ln(high / low), the change across the key's plausible "
+                             f"range if linear, {errors}")
     return [save_figure(fig, Path(outdir) / "sensitivity.png")]
 
 

@@ -212,14 +212,15 @@ def _cell(v, scale: float = 1.0, digits: int = 4) -> str:
 
 
 def table_block(caption: str, head: list[str], rows: list[list[str]], numeric: list[bool] | None = None,
-                note: str = "") -> dict:
+                note: str | list[str] = "") -> dict:
     """A table: ``rows`` of text cells (at most :data:`MAX_ROWS`, then a note); ``numeric`` columns
-    right-aligned."""
+    right-aligned; ``note``: a line under it, or lines (each its own paragraph)."""
     numeric = numeric or [False] * len(head)
+    note = [note] if isinstance(note, str) else list(note)
     left = len(rows) - MAX_ROWS
     if left > 0:
         rows = rows[:MAX_ROWS]
-        note = (note + " " if note else "") + f"{left} more rows are not shown ('bearingsim table' prints them all)."
+        note.append(f"{left} more rows are not shown ('bearingsim table' prints them all).")
     return {"kind": "table", "caption": caption, "head": head, "rows": rows, "numeric": numeric, "note": note}
 
 
@@ -236,8 +237,9 @@ def _summary_table_block(table, caption: str) -> dict:
         cols.append([c.strip() for c in cells])
     rows = [list(r) for r in zip(*cols)] if cols else []
     rule = tables.RULE if any(k in tables.SEM_OF for k in keys) else ""
-    return table_block(caption, heads, rows, [False] * len(table.label_names) + [True] * len(keys),
-                       " ".join([*table.notes, rule]).strip())
+    # the table's notes as one sentence, the significance marks' key on its own line under it
+    said = " ".join(n if n.endswith(".") else n + "." for n in table.notes)
+    return table_block(caption, heads, rows, [False] * len(table.label_names) + [True] * len(keys), [said, rule])
 
 
 def _footnote_blocks(table) -> list[dict]:
@@ -395,8 +397,10 @@ def _sweep_sections(index: Path):
     figures = drawn_blocks(lambda d: plot_sweep_index(index, d, notes=notes))
     figures += [{"kind": "text", "text": n} for n in notes]
     keys = ", ".join(meta["axes"]) or "(none)"
+    # the figures' two-line title: the page's title, and what the cases share, a sentence under it
+    title, _, shared = sweep_title(meta, len(cols["case"])).partition("\n")
     head = {"kind": "text", "text": f"Base scenario {meta.get('scenario') or '(cases only)'}; swept keys: {keys}; "
-                                    f"mode {meta.get('mode', '?')}."}
+                                    f"mode {meta.get('mode', '?')}." + (f" What the cases share: {shared}." if shared else "")}
     map_path = index.parent / MAP_NAME
     toml = meta.get("scenario_toml") or None  # the base scenario resolved (a sweep of a scenario stores it)
     if toml is None and archive.is_grid_file(map_path, MAP_FORMAT):
@@ -405,7 +409,7 @@ def _sweep_sections(index: Path):
     sections = [Section("table", "Cases", [head, _summary_table_block(table, "Summary numbers of every case"),
                                            *_footnote_blocks(table)]),
                 Section("figures", "Figures", figures)]
-    return sweep_title(meta, len(cols["case"])), sections, toml
+    return title, sections, toml
 
 
 def _crosscheck_sections(table: Path):

@@ -664,3 +664,20 @@ def test_a_deterministic_sensitivity_page_has_the_commands_caveat_and_no_standar
     assert "half step:" in text and "±" not in text.replace("(1 ± 10%)", ""), text
     assert sens.HALF_STEP_NOTE in text and "a deterministic model has no standard error" in text
     assert len(titles) == 1 and "batch means" not in titles[0] and "no standard error" in titles[0], titles
+
+
+def test_a_sweep_pages_title_is_one_line_and_its_tables_note_ends_before_the_marks_key(small_studies, tmp_path):
+    """The sweep's two-line figure title was the page's <title> and <h1>, its two lines run together
+    ("... (2 cases) paper_3000rpm: reduced model ..."), and the table's note ran the marks' key into its
+    sentence ("... paper_3000rpm.toml * : |x - x_ref| > ..."). The title is the first line, what the cases share
+    a sentence under it; the note is a sentence, the key its own line."""
+    import html as html_text
+
+    html = _page(small_studies / "sweep", tmp_path / "sweep.html")
+    title = html_text.unescape(re.search(r"<title>(.*?)</title>", html, re.S).group(1))
+    h1 = html_text.unescape(re.search(r"<h1>(.*?)</h1>", html, re.S).group(1))
+    assert "\n" not in title and "\n" not in h1 and h1 == "sweep of drag coefficient (2 cases)", (title, h1)
+    assert "What the cases share: paper_3000rpm: reduced model" in _section_text(html, "table")
+    notes = [html_text.unescape(n) for n in re.findall(r'<p class="note">(.*?)</p>', html, re.S)]
+    assert len(notes) == 2 and notes[0].endswith("of a sweep of " + str(PAPER) + "."), notes
+    assert notes[1].startswith("* : |x - x_ref| >"), notes

@@ -394,7 +394,7 @@ def _sweep_sections(index: Path):
 
     cols, meta = read_index(index)
     notes: list[str] = []
-    figures = drawn_blocks(lambda d: plot_sweep_index(index, d, notes=notes))
+    figures = drawn_blocks(lambda d: plot_sweep_index(index, d, notes=notes), SWEEP_CAPTIONS)
     figures += [{"kind": "text", "text": n} for n in notes]
     keys = ", ".join(meta["axes"]) or "(none)"
     # the figures' two-line title: the page's title, and what the cases share, a sentence under it
@@ -425,7 +425,9 @@ def _crosscheck_sections(table: Path):
                           "error; each rung drops one assumption of the paper's model (docs/crosscheck.md)", head, cells,
                           [True, True, False, False, True, True, True, True, True]),
               {"kind": "list", "items": cc.verdicts(rows)}]
-    figures = drawn_blocks(lambda d: cc.plot_crosscheck(table, d))
+    figures = drawn_blocks(lambda d: cc.plot_crosscheck(table, d), {
+        "crosscheck.png": "I_dec and I_acc per pocket and cage rotation, mean over all pockets ± 1 standard error, "
+                          "at each rung of the ladder and each speed"})
     sections = [Section("table", "Cross-check", blocks), Section("figures", "Figures", figures)]
     return f"Cross-check of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
 
@@ -434,6 +436,16 @@ def _pm(mean, sem) -> str:
     """``mean ± sem`` of an impulse in mN s."""
     return f"{_cell(mean, 1e3)} ± {_cell(sem, 1e3, 2) if math.isfinite(sem) else 'n/a'}"
 
+
+#: a sweep's figures in the page, by file name (bearingsim.sweeps.plot)
+SWEEP_CAPTIONS = {
+    "sweep_I.png": "I_dec and I_acc per pocket and cage rotation against the first swept key, a line for each value "
+                   "of the others; error bars ± 1 standard error (batch means over rotations, where the model has one)",
+    "sweep_map.png": "I_dec and I_acc per pocket and cage rotation over the two swept keys, as heat maps (a blank "
+                     "cell: a case that failed or did not run)",
+    "sweep_cases.png": "I_dec and I_acc per pocket and cage rotation of every case, labelled by its values; error bars "
+                       "± 1 standard error (batch means over rotations, where the model has one)",
+}
 
 #: validate's figures in the page, by file name
 VALIDATE_CAPTIONS = {
@@ -534,7 +546,11 @@ def _sensitivity_sections(table: Path):
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: "
                           f"d ln y / d ln x, lin: d y / d ln x; {errors} (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False], sens.HALF_STEP_NOTE if deterministic else "")]
-    figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d))
+    bars = ("no error bars: a deterministic model has no standard error" if deterministic
+            else "± 1 standard error (batch means over rotations)")
+    figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d), {
+        "sensitivity.png": "Tornado chart: the change of ln I_dec and ln I_acc across each key's plausible range "
+                           f"(S ln(high / low), if linear), keys ordered by the change of I_dec; {bars}"})
     sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
     return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
 
@@ -559,7 +575,9 @@ def _uncertainty_sections(table: Path):
                           f"{_cell(r['S1_low'], digits=3)} .. {_cell(r['S1_high'], digits=3)}", _cell(r["ST"], digits=3),
                           f"{_cell(r['ST_low'], digits=3)} .. {_cell(r['ST_high'], digits=3)}"] for r in rows],
                         [False, False, True, True, True, True])
-    figures = drawn_blocks(lambda d: unc.plot_uncertainty(table, d))
+    figures = drawn_blocks(lambda d: unc.plot_uncertainty(table, d), {
+        "uncertainty.png": f"Sobol indices of each key, first order and total, with their {ci} bootstrap intervals; "
+                           "each panel's title gives its output's median and 5-95 % interval over the sampled ranges"})
     sections = [Section("table", "Uncertainty", [{"kind": "text", "text": f"{meta.get('samples')} base samples, "
                                                   f"{meta.get('runs')} runs, seed {meta.get('seed')}."}, spread, index]),
                 Section("figures", "Figures", figures)]

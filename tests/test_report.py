@@ -681,3 +681,19 @@ def test_a_sweep_pages_title_is_one_line_and_its_tables_note_ends_before_the_mar
     notes = [html_text.unescape(n) for n in re.findall(r'<p class="note">(.*?)</p>', html, re.S)]
     assert len(notes) == 2 and notes[0].endswith("of a sweep of " + str(PAPER) + "."), notes
     assert notes[1].startswith("* : |x - x_ref| >"), notes
+
+
+def test_a_studys_figures_have_captions_saying_what_they_show(small_studies, tmp_path):
+    """A run's page captions each figure with what it shows; a study's captioned them with their file names
+    ("sweep I", "sensitivity"). Each says what it shows, and the reduced model's tornado chart that it has no
+    error bars."""
+    from bearingsim import reports
+    from bearingsim.sweeps.plot import FIGURE_NAMES
+
+    sweep = re.findall(r"<figcaption>(.*?)</figcaption>", _page(small_studies / "sweep", tmp_path / "w.html"))
+    assert len(sweep) == 1 and "per pocket and cage rotation against the first swept key" in sweep[0], sweep
+    assert sweep == [reports.SWEEP_CAPTIONS["sweep_I.png"]]
+    sens = re.findall(r"<figcaption>(.*?)</figcaption>", _page(small_studies / "sens", tmp_path / "s.html"))
+    assert len(sens) == 1 and sens[0].startswith("Tornado chart: the change of ln I_dec"), sens
+    assert "no error bars: a deterministic model has no standard error" in sens[0]
+    assert set(reports.SWEEP_CAPTIONS) == set(FIGURE_NAMES)  # a caption for every figure a sweep draws

@@ -67,9 +67,23 @@ def kind_of(path) -> tuple[str, Path]:
     index = p / "sweep.h5" if p.is_dir() else p
     if index.name == "sweep.h5" and index.is_file() and archive.is_table_file(index, INDEX_FORMAT):
         return "sweep", index
-    raise archive.scenario_file_error(p) or archive.own_table_error(p, "report") or UserError(
+    if not p.is_dir():  # a file: what is wrong with it, as the commands that read an archive say
+        raise archive.scenario_file_error(p) or archive.own_table_error(p, "report") or _not_an_archive(p)
+    raise UserError(
         f"{p}: not a bearingsim archive, nor a sweep, cross-check, validate, sensitivity, uncertainty or life folder "
         f"(no sweep.h5, crosscheck.h5, fig9_idec_vs_speed.csv, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
+
+
+def _not_an_archive(p: Path) -> UserError:
+    """Why the file ``p`` is not a run archive (truncated, not HDF5, another program's HDF5, incomplete:
+    :func:`bearingsim.archive.open_archive`'s one line), where it is neither a study's nor a sweep's table."""
+    from bearingsim import archive
+
+    try:
+        archive.open_archive(p).close()
+    except UserError as exc:
+        return exc
+    return UserError(f"{p}: not a bearingsim archive, nor a sweep's or a study's table")
 
 
 # --- the report ---------------------------------------------------------------------------------

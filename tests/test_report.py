@@ -697,3 +697,17 @@ def test_a_studys_figures_have_captions_saying_what_they_show(small_studies, tmp
     assert len(sens) == 1 and sens[0].startswith("Tornado chart: the change of ln I_dec"), sens
     assert "no error bars: a deterministic model has no standard error" in sens[0]
     assert set(reports.SWEEP_CAPTIONS) == set(FIGURE_NAMES)  # a caption for every figure a sweep draws
+
+
+def test_a_damaged_file_is_refused_saying_what_is_wrong_with_it(runs, tmp_path):
+    """`report` of a truncated archive said it was "not a bearingsim archive, nor a sweep, ... folder (no
+    sweep.h5, ... in it)", words for a folder, where `animate` and `inspect` said the file was truncated. A
+    file given to report is refused with what the commands that read an archive say is wrong with it."""
+    data = (runs / "r.h5").read_bytes()
+    (tmp_path / "trunc.h5").write_bytes(data[:len(data) // 2])
+    (tmp_path / "empty.h5").write_bytes(b"")
+    for name, words in (("trunc.h5", "truncated file"), ("empty.h5", "not an HDF5 file")):
+        res = cli("report", tmp_path / name, "-o", tmp_path / "r.html")
+        assert_user_error(res, f"{tmp_path / name}: ", words)
+        assert "folder" not in res.stderr and "in it" not in res.stderr, res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.h5", "trunc.h5"]

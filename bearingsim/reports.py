@@ -650,14 +650,20 @@ def _life_limit_note(attrs: dict) -> str | None:
         return None
 
 
+def _case_values(cols, meta, i: int) -> str:
+    """What case ``i`` of an index varies (its row's axes: ``key = value, ...``), as the tables of its
+    folder's page name it."""
+    from bearingsim.tables import cell_text
+
+    return ", ".join(f"{k} = {cell_text(cols[k][i])}" for k in meta.get("axes", ()) if k in cols)
+
+
 def _run_notes_blocks(cols, meta) -> list[dict]:
     """The index's run notes (its ``notes`` column: a run that is plausible but not clean,
     :func:`bearingsim.plausibility.check`): a line saying how many cases have them and a table of them."""
     from bearingsim.sweeps.index import notes_of
-    from bearingsim.tables import cell_text
 
-    axes = [k for k in meta.get("axes", ()) if k in cols]
-    rows = [[str(c), ", ".join(f"{k} = {cell_text(cols[k][i])}" for k in axes), note]
+    rows = [[str(c), _case_values(cols, meta, i), note]
             for i, (c, cell) in enumerate(zip(cols["case"], cols.get("notes", ()))) for note in notes_of(cell)]
     if not rows:
         return []
@@ -673,7 +679,6 @@ def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None)
     folder's first case archive."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
-    from bearingsim.tables import cell_text
 
     index = folder / "sweep.h5"
     checks: list[dict] = []
@@ -682,19 +687,19 @@ def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None)
         cols, meta = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
-        failed = [[str(c), e] for c, s, e in zip(cols["case"], status, cols["error"]) if s == "failed"]
+        failed = [[str(c), _case_values(cols, meta, i), e]
+                  for i, (c, s, e) in enumerate(zip(cols["case"], status, cols["error"])) if s == "failed"]
         checks.append({"kind": "text", "text": f"{counted(len(status), 'case')}: {counts}. A case's archive is written only when "
                                                "its run passes the plausibility checks (docs/reliability.md); a "
                                                "failed case keeps its one-line error" +
                                                (":" if failed else ". No case failed.")})
         if failed:
-            checks.append(table_block("Failed cases", ["case", "error"], failed))
+            checks.append(table_block("Failed cases", ["case", "values", "error"], failed))
         checks += _run_notes_blocks(cols, meta)
         row = next((i for i, a in enumerate(cols["archive"]) if a and (folder / a).is_file()), None)
         first = folder / cols["archive"][row] if row is not None else None
         # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)
-        label = ", ".join(f"{k} = {cell_text(cols[k][row])}" for k in meta.get("axes", ()) if k in cols) \
-            if row is not None else ""
+        label = _case_values(cols, meta, row) if row is not None else ""
     if scenarios is None:
         blocks = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
         scenarios = [Section("scenario", "Scenario", blocks)]

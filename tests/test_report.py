@@ -711,3 +711,13 @@ def test_a_damaged_file_is_refused_saying_what_is_wrong_with_it(runs, tmp_path):
         assert_user_error(res, f"{tmp_path / name}: ", words)
         assert "folder" not in res.stderr and "in it" not in res.stderr, res.stderr
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty.h5", "trunc.h5"]
+
+
+def test_a_failed_case_is_listed_with_its_values(small_studies, tmp_path):
+    """A sweep page's "Failed cases" table listed each failed case by its hash alone, where the table of the
+    cases' notes beside it names the values too; it names them (the case with no drag failed)."""
+    html = _page(small_studies / "sweep", tmp_path / "f.html")
+    table = re.search(r"<caption>Failed cases</caption>(.*?)</table>", html, re.S).group(1)
+    assert [h for h in re.findall(r"<th>(.*?)</th>", table)] == ["case", "values", "error"], table
+    cells = re.findall(r"<td[^>]*>(.*?)</td>", table)
+    assert len(cells) == 3 and cells[1] == "lubrication.drag_coefficient = 0", cells

@@ -39,6 +39,8 @@ DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "
 SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns"}
 #: display scale and unit of units that read better scaled
 SCALED = {"N s": (1e3, "mN s")}
+#: display scale and unit of keys stored as a fraction (unit 1) that read better in per cent
+SCALED_KEYS = {"cage_slip": (100.0, "%")}
 
 
 @dataclass
@@ -310,7 +312,7 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
     """Header and cells of number column ``key`` (with its standard error and marks when it has one,
     against the first row that has a number)."""
     unit = table.units.get(key, "1")
-    scale, shown = SCALED.get(unit, (1.0, unit))
+    scale, shown = SCALED_KEYS.get(key, SCALED.get(unit, (1.0, unit)))
     head = _bare(key) + ("" if shown == "1" else f" [{shown}]")
     x = table.numbers[key]
     finite = np.flatnonzero(np.isfinite(x))

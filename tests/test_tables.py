@@ -416,3 +416,14 @@ def test_a_folder_of_nothing_names_every_folder_table_reads(tmp_path):
     assert str(err.value).startswith(f"{tmp_path}: holds no sweep.h5")
     for kind in tables.STUDY_NAMES.values():
         assert kind in str(err.value), kind
+
+
+def test_the_cage_slip_is_shown_in_per_cent_with_its_unit():
+    """The tables' cage_slip column had no unit in its header, beside columns that all have theirs, and showed
+    the fraction (0.004086); it is a percentage, headed cage_slip [%] (0.4086), in `bearingsim table` and the
+    report's tables alike (one function, tables.column_cells); `--columns` still names it cage_slip."""
+    t = tables.Table(["run"], {"run": ["a", "b"]}, {"cage_slip": np.array([0.00408585, -0.0012])}, {"cage_slip": "1"})
+    head, cells = tables.column_cells(t, "cage_slip")
+    assert head == "cage_slip [%]" and cells == ["0.4086", "-0.12"], (head, cells)
+    lines = tables.format_table(t, columns=["cage_slip"]).splitlines()
+    assert "cage_slip [%]" in lines[0] and lines[1].split() == ["a", "0.4086"], lines

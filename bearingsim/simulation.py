@@ -54,10 +54,11 @@ def animate(path, out, *, rotations=None, exaggerate=None, fps=30, progress=None
 
     ``rotations``: ``(a, b)``, the recorded cage rotations to show (default: the whole stored window);
     ``last``: only the last so many cage rotations of it; ``exaggerate``: the factor K the clearances are
-    drawn at (None: automatic, about 0.3 roller radii of drawn pocket play); ``fps``: frames per second of
+    drawn at (None: automatic, about 0.3 roller radii of drawn pocket play; at most
+    :func:`bearingsim.animation.max_exaggeration` of the archive's bearing); ``fps``: frames per second of
     video; ``progress``: ``progress(done, total)`` called after each frame. One-line :class:`UserError` for
-    an archive without motion, a window outside the stored one, or an output that is not ``.mp4``/``.gif``
-    or not replaceable.
+    an archive without motion, a window outside the stored one, an ``exaggerate`` above that limit, or an
+    output that is not ``.mp4``/``.gif`` or not replaceable.
     """
     from bearingsim import animation
 

@@ -67,12 +67,15 @@ def test_the_documented_invocations_parse_as_before():
     assert _parse("wear_bench", ["life"]) == {"what": "life"}
     for table in ("whatif", "orbit", "wear", "extent", "checks", "rig"):
         assert _parse("whole_bearing", [table]) == {"table": table}
-    for study in ("psi", "theta", "dt", "rig", "whatif", "life"):
-        assert _parse("discretization", [study]) == {"study": study, "bins": None, "set": [], "limit": None}
+    for study in ("psi", "theta", "dt", "rig", "whatif", "life", "stages"):
+        assert _parse("discretization", [study]) == {"study": study, "bins": None, "set": [], "limit": None,
+                                                     "mapping": None}
     assert _parse("discretization", ["life", "--limit=clearance=0.4mm", "--bins=32,64", "--set=numerics.dt_s=2e-6",
                                      "--set=numerics.warmup_rotations=41"]) == {
-        "study": "life", "bins": (32, 64), "limit": "clearance=0.4mm",
+        "study": "life", "bins": (32, 64), "limit": "clearance=0.4mm", "mapping": None,
         "set": ["numerics.dt_s=2e-6", "numerics.warmup_rotations=41"]}
+    assert _parse("discretization", ["stages", "--bins=5,10", "--mapping=uniform"]) == {
+        "study": "stages", "bins": (5, 10), "limit": None, "mapping": "uniform", "set": []}
     assert _parse("sweep_bench", []) == {"command": None}
     assert _parse("sweep_bench", ["map", "out"]) == {"command": "map", "archives": "all", "outdir": "out"}
     assert _parse("sweep_bench", ["map", "--archives", "none", "out"]) == {"command": "map", "archives": "none",

@@ -533,7 +533,7 @@ def _cmd_crosscheck(args) -> int:
               f"{counted(rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
               f"rotation, mean over all pockets ± batch-means standard error")
         print(cc.format_table(rows))
-        for line in cc.verdicts(rows):
+        for line in cc.verdicts(rows, rotations):
             print(line)
         for name in ("crosscheck.csv", "crosscheck.h5", "crosscheck.png"):
             print(f"wrote {Path(args.output) / name}")

@@ -438,7 +438,7 @@ def _crosscheck_sections(table: Path):
     blocks = [table_block("Impulses per pocket and cage rotation, mean over all pockets ± batch-means standard "
                           "error; each rung drops one assumption of the paper's model (docs/crosscheck.md)", head, cells,
                           [True, True, False, False, True, True, True, True, True]),
-              {"kind": "list", "items": cc.verdicts(rows)}]
+              {"kind": "list", "items": cc.verdicts(rows, cc.table_rotations(meta))}]
     figures = drawn_blocks(lambda d: cc.plot_crosscheck(table, d), {
         "crosscheck.png": "I_dec and I_acc per pocket and cage rotation, mean over all pockets ± 1 standard error, "
                           "at each rung of the ladder and each speed"})

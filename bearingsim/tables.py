@@ -7,12 +7,14 @@ columns (the file, the swept keys or the scenario keys that differ) and number c
 numbers). ``I_dec_mean_Ns`` and ``I_acc_mean_Ns`` carry their standard error, the one estimator of
 :mod:`bearingsim.stats` (batch means over rotations), and a mark:
 
-    ``*`` when |x - x_ref| > 2 sqrt(SE² + SE_ref²), x_ref the first row with a number
+    ``*`` when |x - x_ref| > t sqrt(SE² + SE_ref²), x_ref the first row with a number
 
-(two standard errors of the difference of two independent means, about 95 % for normal errors), and
-more than round-off, 1e-9 of the larger (:func:`bearingsim.stats.significant`, the one rule); no mark
-where the difference is within that, and none where a standard error is missing (fewer than 2
-rotations: NaN) so the difference cannot be judged. Impulses are shown in mN s; every other column in
+(t: Student's 97.5 % quantile of the Welch-Satterthwaite degrees of freedom of the two standard errors,
+each from its number of batch means less one: 2.31 for two runs of 5 or more rotations, 2.78 against an
+exact reference (SE 0); so 5 % of differences of equal true means are marked), and more than round-off,
+1e-9 of the larger (:func:`bearingsim.stats.significant`, the one rule); no mark where the difference is
+within that, and none where a standard error is missing (fewer than 2 rotations: NaN) so the difference
+cannot be judged. Impulses are shown in mN s; every other column in
 the unit its key names.
 """
 from __future__ import annotations
@@ -24,12 +26,13 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.stats import ROUND_OFF_REL, SIGNIFICANCE_SE, significant
+from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
-RULE = (f"* : |x - x_ref| > {SIGNIFICANCE_SE:g} sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) "
-        "(round-off), x_ref the first row with a number (SE: batch means over rotations, docs/statistics.md); "
-        "no mark: within that, or no SE to judge by")
+RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) (round-off), "
+        f"x_ref the first row with a number, t Student's {0.5 + SIGNIFICANCE_LEVEL / 2:.1%} quantile of the "
+        "Welch-Satterthwaite degrees of freedom (each SE: batch means over rotations, batches - 1; "
+        "docs/statistics.md); no mark: within that, or no SE to judge by")
 #: the line above the key of a table's ``[k]`` marks, the runs' notes (:attr:`Table.footnotes`)
 NOTES_HEAD = "notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):"
 #: number columns shown by default, those present
@@ -47,7 +50,9 @@ SCALED_KEYS = {"cage_slip": (100.0, "%")}
 class Table:
     """Rows of runs: ``labels[name]`` (text per row), ``numbers[key]`` (float per row, SI),
     ``units[key]``; ``notes`` are lines printed above the table; ``footnotes`` (row -> text) are printed
-    under it for the rows shown, each marked in the row's label column ``notes`` (``[1]``, ``[2]``, ...)."""
+    under it for the rows shown, each marked in the row's label column ``notes`` (``[1]``, ``[2]``, ...);
+    ``batches`` (per row) the number of batch means its standard errors came from (their degrees of freedom
+    plus one, :func:`bearingsim.stats.sem_batches`; None: :data:`bearingsim.stats.BATCHES` each)."""
 
     label_names: list[str]
     labels: dict[str, list[str]]
@@ -55,6 +60,7 @@ class Table:
     units: dict[str, str]
     notes: list[str] = field(default_factory=list)
     footnotes: dict[int, str] = field(default_factory=dict)
+    batches: list[int] | None = None
 
     def __len__(self) -> int:
         return len(next(iter(self.labels.values()))) if self.labels else 0
@@ -89,7 +95,23 @@ def table_of_index(path) -> Table:
 
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     footnotes = _run_notes([notes_of(c) for c in cols.get("notes", [""] * n)], names, labels)
-    return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes)
+    return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes,
+                 _index_batches(cols, meta, n))
+
+
+def _index_batches(cols: dict, meta: dict, n: int) -> list[int]:
+    """The batch means each case's standard errors came from (:func:`bearingsim.stats.sem_batches` of its
+    recorded rotations): ``numerics.rotations`` where the index has it as a column (swept), else the base
+    scenario's (``scenario_toml``), else :data:`bearingsim.stats.BATCHES` (every run of 5 or more rotations)."""
+    import tomllib
+
+    if "numerics.rotations" in cols:
+        return [sem_batches(int(v)) if math.isfinite(float(v)) else BATCHES for v in cols["numerics.rotations"]]
+    try:
+        rotations = int(tomllib.loads(meta.get("scenario_toml") or "")["numerics"]["rotations"])
+    except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
+        return [BATCHES] * n
+    return [sem_batches(rotations)] * n
 
 
 def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:
@@ -143,7 +165,8 @@ def table_of_archives(paths) -> Table:
     if not differ and len(results) > 1:
         notes.append("scenarios: identical")
     footnotes = _run_notes([run_notes(r.notes) for r in results], names, labels)  # worded as an index's
-    return Table(names, labels, numbers, units, notes, footnotes)
+    batches = [sem_batches(np.shape(r.per_rotation["I_dec"])[0]) for r in results]
+    return Table(names, labels, numbers, units, notes, footnotes, batches)
 
 
 def distinguishing_labels(paths) -> list[str]:
@@ -226,7 +249,8 @@ def study_text(kind: str, file: Path) -> str:
         speeds = len({r["rpm"] for r in rows})
         return "\n".join([f"{file}: cross-check of {meta.get('scenario_name', '?')}: {counted(speeds, 'speed')} x "
                           f"{len(crosscheck.RUNGS)} rungs; impulses per pocket and cage rotation, mean over all pockets ± "
-                          "batch-means standard error", crosscheck.format_table(rows), *crosscheck.verdicts(rows)])
+                          "batch-means standard error", crosscheck.format_table(rows),
+                          *crosscheck.verdicts(rows, crosscheck.table_rotations(meta))])
     if kind == "sensitivity":
         rows, meta = sensitivity.read_table(file)
         keys = len(dict.fromkeys(r["key"] for r in rows))
@@ -318,6 +342,7 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
     finite = np.flatnonzero(np.isfinite(x))
     ref = int(finite[0]) if finite.size else None
     se = table.numbers.get(SEM_OF.get(key, ""), None)
+    batches = table.batches or [BATCHES] * len(x)
     cells = []
     for i, v in enumerate(x):
         if not math.isfinite(v):
@@ -327,7 +352,7 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
         if se is not None:
             e = se[i]
             text += " ± " + (f"{e * scale:.2g}" if math.isfinite(e) else "n/a")
-            mark = None if ref is None or i == ref else significant(v, e, x[ref], se[ref])
+            mark = None if ref is None or i == ref else significant(v, e, x[ref], se[ref], batches[i], batches[ref])
             text += " *" if mark else "  "
         cells.append(text)
     return head, cells

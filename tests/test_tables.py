@@ -115,17 +115,49 @@ def test_reduced_model_error_is_zero_and_one_rotation_has_none():
 
 # --- significance marks ---------------------------------------------------------------------------
 
-def test_marks_only_where_the_difference_exceeds_two_standard_errors():
+def test_marks_only_where_the_difference_exceeds_t_standard_errors():
     t = tables.Table(["run"], {"run": ["ref", "within", "beyond", "no-se"]},
                      {"I_dec_mean_Ns": np.array([10e-3, 10.5e-3, 11e-3, 20e-3]),
                       "I_dec_sem_Ns": np.array([0.2e-3, 0.2e-3, 0.2e-3, math.nan])}, {"I_dec_mean_Ns": "N s"})
-    # 2 sqrt(0.2^2 + 0.2^2) = 0.566 mN s: 0.5 is within, 1.0 beyond; no SE: not judged
+    # t(0.975, 8) sqrt(0.2^2 + 0.2^2) = 2.306 x 0.283 = 0.652 mN s: 0.5 is within, 1.0 beyond; no SE: not judged
     lines = tables.format_table(t).splitlines()
     rows = {ln.split()[0]: ln for ln in lines[1:5]}
     assert rows["beyond"].endswith("*") and not rows["within"].endswith("*") and not rows["no-se"].endswith("*")
     assert not rows["ref"].endswith("*") and "± n/a" in rows["no-se"]
     assert "I_dec_mean [mN s]" in lines[0] and "11 ± 0.2" in rows["beyond"]
     assert lines[-1] == tables.RULE
+
+
+def test_student_t_quantiles_match_the_printed_tables():
+    """stats.t_quantile (no scipy at import): the two-sided 95 % and 99 % points of Student's t as printed in
+    the standard tables, the normal's at infinite degrees of freedom, and a fractional Welch count between
+    its whole neighbours."""
+    from bearingsim.stats import t_quantile
+
+    for dof, q975, q995 in ((1, 12.7062, 63.6567), (2, 4.3027, 9.9248), (4, 2.7764, 4.6041), (8, 2.3060, 3.3554),
+                            (30, 2.0423, 2.7500), (math.inf, 1.9600, 2.5758)):
+        assert t_quantile(0.975, dof) == pytest.approx(q975, abs=1e-4) and t_quantile(0.995, dof) == pytest.approx(
+            q995, abs=1e-4), dof
+    assert t_quantile(0.975, 8) < t_quantile(0.975, 5.5) < t_quantile(0.975, 5)
+
+
+@pytest.mark.parametrize("rotations", [4, 10])
+def test_the_marks_false_rate_is_the_stated_five_percent(rotations):
+    """Two standard errors marked 8 % of pairs of runs of one true mean and 12 % against an exact reference
+    (SE 0, a reduced-model row), each SE coming from 5 batch means (4 degrees of freedom), though the page said
+    "about 95 %". With Student's t of the Welch-Satterthwaite degrees of freedom: against an exact reference the
+    rate is 5 % exactly (one t), between two runs Welch's approximation keeps it at or a little under 5 %. 8000
+    pairs of normal runs: the binomial sd of 5 % is 0.24 %, so 3.9 % to 6.1 % (4.5 sd) holds it and excludes 8 %."""
+    from bearingsim.stats import sem_batches, significant
+
+    rng = np.random.default_rng(rotations)
+    a, b = rng.normal(14.4, 0.3, (2, 8000, rotations))
+    nb = sem_batches(rotations)
+    assert nb == min(5, rotations)
+    sem_a, sem_b = [batch_sem(r) for r in a], [batch_sem(r) for r in b]
+    pairs = np.mean([significant(x.mean(), s, y.mean(), e, nb, nb) for x, s, y, e in zip(a, sem_a, b, sem_b)])
+    exact = np.mean([significant(x.mean(), s, 14.4, 0.0, nb, nb) for x, s in zip(a, sem_a)])
+    assert 0.039 < exact < 0.061 and 0.039 < pairs < 0.061, (exact, pairs)
 
 
 def test_a_deterministic_models_round_off_is_not_marked_and_its_real_differences_are():

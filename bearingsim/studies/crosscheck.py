@@ -38,7 +38,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.stats import SIGNIFICANCE_SE, significant
+from bearingsim.stats import BATCHES, critical_ses, sem_batches, significant
 from bearingsim.studies.engine import Study, case_of, load_result
 
 INDEX_FORMAT = "bearingsim crosscheck index 1"
@@ -261,6 +261,17 @@ def write_table(outdir, rows: list[dict], scenario) -> tuple[Path, Path]:
     return csv_path, h5_path
 
 
+def table_rotations(meta: dict) -> int | None:
+    """The rungs' recorded rotations of a table's root attributes (``meta`` of :func:`read_table`: the
+    scenario it keeps has them), or None when it names none."""
+    import tomllib
+
+    try:
+        return int(tomllib.loads(meta.get("scenario") or "")["numerics"]["rotations"])
+    except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
+        return None
+
+
 def read_table(path) -> tuple[list[dict], dict]:
     """Read ``crosscheck.h5``: (rows as dicts, root attributes). One-line UserError if it is not one."""
     from bearingsim import archive
@@ -309,11 +320,13 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
     return [save_figure(fig, Path(outdir) / "crosscheck.png")]
 
 
-def verdicts(rows: list[dict]) -> list[str]:
-    """One sentence per speed: the rung whose I_dec change is largest, and each change against two
-    standard errors of the difference, sqrt(sem_a^2 + sem_b^2), by the tables' rule
-    (:func:`bearingsim.stats.significant`: round-off is no change). A change next to a failed rung (NaN)
-    is not judged; the failed rungs are named."""
+def verdicts(rows: list[dict], rotations: int | None = None) -> list[str]:
+    """One sentence per speed: the rung whose I_dec change is largest, and each change against t standard
+    errors of the difference, sqrt(sem_a^2 + sem_b^2), by the tables' rule (:func:`bearingsim.stats.significant`:
+    t Student's 97.5 % quantile of the Welch-Satterthwaite degrees of freedom, each rung's standard error from
+    :func:`bearingsim.stats.sem_batches` of ``rotations`` batch means, None: :data:`bearingsim.stats.BATCHES`;
+    round-off is no change). A change next to a failed rung (NaN) is not judged; the failed rungs are named."""
+    nb = BATCHES if rotations is None else sem_batches(rotations)
     out = []
     for rpm in sorted({r["rpm"] for r in rows}):
         rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
@@ -323,12 +336,12 @@ def verdicts(rows: list[dict]) -> list[str]:
             if math.isnan(d):
                 continue
             se = math.hypot(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"])
-            mark = significant(b["I_dec_mean_Ns"], b["I_dec_sem_Ns"], a["I_dec_mean_Ns"], a["I_dec_sem_Ns"])
+            mark = significant(b["I_dec_mean_Ns"], b["I_dec_sem_Ns"], a["I_dec_mean_Ns"], a["I_dec_sem_Ns"], nb, nb)
             if mark is None:  # a rung of fewer than 2 recorded rotations has no batch-means error
                 sig = "not judged: no standard error from fewer than 2 rotations"
             else:
-                sig = ("significant" if mark else "not significant") + f": {SIGNIFICANCE_SE:g} SE = " \
-                      f"{SIGNIFICANCE_SE * se * 1e3:.2g}"
+                t = critical_ses(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"], nb, nb)
+                sig = ("significant" if mark else "not significant") + f": {t:.3g} SE = {t * se * 1e3:.2g}"
             parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig})")
         failed = [f"{r['rung']} {r['scene']}" for r in rs if r.get("status", "done") == "failed"]
         changes = [r for r in rs[1:] if not math.isnan(r["change_from_previous"])]

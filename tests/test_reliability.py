@@ -528,8 +528,8 @@ class _FakeResult:
         self.parameters = Parameters.from_scenario(scenario if scenario is not None else _mb_scenario())
         self.provenance = dict(provenance or {})
         self.summary = {"I_dec_mean_Ns": 0.01, "steps": 1000, **summary}
-        # 4 steady rotations (the scenario's): enough to judge the warm-up, which then gives no note
-        self.per_rotation = {"I_dec": np.full((4, 16), 0.01), "I_acc": np.full((4, 16), 0.01)}
+        # 6 steady rotations: enough to judge the warm-up (START_TRANSIENT_MIN_ROTATIONS), which then gives no note
+        self.per_rotation = {"I_dec": np.full((6, 16), 0.01), "I_acc": np.full((6, 16), 0.01)}
         self.orbit = np.ones((10, 3))
 
     def get(self, name):

@@ -63,6 +63,7 @@ def test_the_documented_invocations_parse_as_before():
     assert _parse("step_kernels", ["1000", "6000"]) == {"rpm": [1000.0, 6000.0]}
     assert _parse("readme_images", []) == {"archive": None}
     assert _parse("scenario_digest", []) == {}
+    assert _parse("batch_means_coverage", []) == {}
     assert _parse("warmup_check", []) == {"contacts": ["hertz", "rigid"], "warmups": [1], "rotations": [4, 5, 6, 7],
                                           "runs": 20}
     assert _parse("warmup_check", ["--contacts", "rigid", "--warmups", "3", "--rotations", "5", "7"]) == {

@@ -90,9 +90,10 @@ def _cmd_life(args) -> int:
     code = report_study(outcome, "life")
     if code:
         return code
-    note = life.depth_limit_note(scenario, limit)  # how to read the history below
-    if note and not args.quiet:
-        print(f"bearingsim: note: {note}", file=sys.stderr)
+    notes = (life.depth_limit_note(scenario, limit), life.stage_count_note(args.stages, args.mapping))
+    for note in notes:  # how to read the history below
+        if note and not args.quiet:
+            print(f"bearingsim: note: {note}", file=sys.stderr)
     # the limit reached, or the cage bar worn through first (the end of the life all the same: exit 0)
     print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}", study.attrs()))
     for path in outcome.written:

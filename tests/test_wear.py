@@ -1080,6 +1080,22 @@ def test_a_deepest_point_at_a_faces_edge_says_it_depends_on_the_bins():
     assert depth_limit_note(sc, parse_limit("clearance=0.4mm")) is None
 
 
+def test_a_life_of_few_stages_with_the_shape_fed_back_is_noted_as_read_long():
+    """docs/wear.md, *The life depends on the stage count* (``python -m benchmarks.discretization stages``): with
+    the worn shape fed back 10 stages read the life 11-16 % long against 40, and 20 lie within 2 % of 40; with
+    the uniform growth any count within 1.2 %. So a shape-mapped study of fewer than 20 stages is noted, naming
+    its count and the count that resolves it; 20 and more, and the uniform mapping, are not."""
+    from bearingsim.studies.life import STAGES_RESOLVED, stage_count_note
+
+    assert STAGES_RESOLVED == 20
+    note = stage_count_note(10, "shape")
+    assert note.startswith("10 stages with the worn shape fed back") and "--stages 20 or more" in note
+    assert "11-16 %" in note and "docs/wear.md" in note
+    assert stage_count_note(19, "shape") is not None
+    assert stage_count_note(20, "shape") is None and stage_count_note(40, "shape") is None
+    assert stage_count_note(5, "uniform") is None
+
+
 def test_a_scenarios_wear_coefficient_of_0_is_refused_as_an_argument_of_0_is(tmp_path, capsys):
     """A run whose scenario sets wear.wear_coefficient = 0 (a scenario takes it: nothing wears) gave `bearingsim
     wear` a report of zeros with a coefficient of variation of nan, a front / rear ratio of nan .. nan, numpy's

@@ -101,6 +101,11 @@ def _cmd_life(args) -> int:
     return 0
 
 
+#: the default stage count of ``bearingsim life``, :data:`bearingsim.studies.life.STAGES_RESOLVED` (here as a
+#: number: the parser is built without importing the study; tests/test_wear.py holds the two equal)
+DEFAULT_STAGES = 20
+
+
 def add_commands(sub) -> None:
     """Register ``wear`` and ``life`` on the subparsers ``sub``."""
     w = sub.add_parser("wear", help="worn depth profile and volume of every pocket face after a running time "
@@ -118,7 +123,9 @@ def add_commands(sub) -> None:
     li.add_argument("--limit", required=True, help="depth=<x>mm (deepest worn point: an end bin's, which depends "
                                                    "on the bins of psi, docs/wear.md), clearance=<x>mm (pocket "
                                                    "clearance), or volume=<x>mm3 (worn volume of one face)")
-    li.add_argument("--stages", type=int, default=10, help="stages (default 10)")
+    li.add_argument("--stages", type=int, default=DEFAULT_STAGES,
+                    help=f"stages (default {DEFAULT_STAGES}: with the worn shape fed back fewer read the life long, "
+                         f"docs/wear.md)")
     li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")
     li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")

@@ -158,12 +158,11 @@ GOAL_COST_RATIO = 1.2  # exact faces against the 3-segment polyline, per cage ro
 
 
 def idec_sem(result) -> float:
-    """Standard error [N s] of a run's mean I_dec from its rotation-to-rotation scatter: the per-rotation
-    means over the pockets, std / sqrt(R) (rotations taken as independent)."""
-    import numpy as np
+    """Standard error [N s] of a run's mean I_dec: the batch-means error of the per-rotation means over the
+    pockets (:func:`bearingsim.stats.batch_sem`, the one every table of the package gives; docs/statistics.md)."""
+    from bearingsim.stats import batch_sem, pocket_means
 
-    per_rot = np.asarray(result.get("per_rotation/I_dec")).mean(axis=1)
-    return float(per_rot.std(ddof=1) / math.sqrt(len(per_rot))) if len(per_rot) > 1 else float("nan")
+    return batch_sem(pocket_means(result.get("per_rotation/I_dec")))
 
 
 def geometry_cases(quick: bool) -> list[dict]:

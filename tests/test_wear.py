@@ -1087,7 +1087,9 @@ def test_a_life_of_few_stages_with_the_shape_fed_back_is_noted_as_read_long():
     its count and the count that resolves it; 20 and more, and the uniform mapping, are not."""
     from bearingsim.studies.life import STAGES_RESOLVED, stage_count_note
 
-    assert STAGES_RESOLVED == 20
+    from bearingsim.cli_wear import DEFAULT_STAGES
+
+    assert STAGES_RESOLVED == DEFAULT_STAGES == 20  # bearingsim life's default is the resolving count
     note = stage_count_note(10, "shape")
     assert note.startswith("10 stages with the worn shape fed back") and "--stages 20 or more" in note
     assert "11-16 %" in note and "docs/wear.md" in note

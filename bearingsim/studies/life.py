@@ -91,10 +91,10 @@ def stage_count_note(stages: int, mapping: str) -> str | None:
     the measured amount (docs/wear.md); None otherwise (the uniform growth moves it by at most 1.2 %)."""
     if mapping != "shape" or stages >= STAGES_RESOLVED:
         return None
-    return (f"{stages} stages with the worn shape fed back: each stage wears at the rate its run measured at its "
-            f"start, and the rate grows as the edges wear, so few stages read the life long (on the wear-test "
-            f"bearing 10 stages gave 11-16 % more rotations than 40, and 20 stages within 2 % of 40; docs/wear.md); "
-            f"give --stages {STAGES_RESOLVED} or more")
+    return (f"{counted(stages, 'stage')} with the worn shape fed back: each stage wears at the rate its run "
+            "measured at its start, and the rate grows as the edges wear, so few stages read the life long (on the "
+            "wear-test bearing 10 stages gave 11-16 % more rotations than 40, and 20 stages within 2 % of 40; "
+            f"docs/wear.md); give --stages {STAGES_RESOLVED} or more")
 
 
 def parse_limit(text: str) -> Limit:
@@ -258,7 +258,7 @@ class LifeStudy(Study):
     name = "life"
     staged = True
 
-    def __init__(self, scenario, limit: Limit, *, stages: int = 10, rotations: int | None = None,
+    def __init__(self, scenario, limit: Limit, *, stages: int = STAGES_RESOLVED, rotations: int | None = None,
                  mapping: str = "shape", progress=None):
         from bearingsim import archive
         from bearingsim.outputs import is_own_png
@@ -473,7 +473,7 @@ class LifeStudy(Study):
         remove_folder_files(outdir)
 
 
-def run_life(scenario, folder, limit: Limit, *, stages: int = 10, rotations: int | None = None,
+def run_life(scenario, folder, limit: Limit, *, stages: int = STAGES_RESOLVED, rotations: int | None = None,
              force: bool = False, progress=None, mapping: str = "shape", engine=None) -> dict:
     """Run a life study (module docstring, :class:`LifeStudy`) into ``folder`` on the study engine (default:
     one local worker process); return the history's columns (also written as ``folder/life.h5``, with

@@ -720,7 +720,8 @@ def model_of(path) -> str:
     """The model name an archive was written by (one-line UserError for a bad file)."""
     f = open_archive(path)
     try:
-        return _model_attr(f, path)
+        with reading(path):
+            return _model_attr(f, path)
     finally:
         f.close()
 
@@ -730,8 +731,9 @@ def has_observable(path, name: str) -> bool:
     one-line UserError for a file that is not an archive)."""
     f = open_archive(path)
     try:
-        obs = f.get("observables")
-        return isinstance(obs, _lazy_h5py().Group) and name in obs
+        with reading(path):
+            obs = f["observables"] if "observables" in f else None
+            return isinstance(obs, _lazy_h5py().Group) and name in obs
     finally:
         f.close()
 
@@ -788,8 +790,8 @@ def read(path, result_class, only=None):
         notes = read_notes(f, path) or []
     except UserError:
         raise
-    except (KeyError, ValueError, TypeError, OSError) as exc:
-        raise UserError(f"{path}: damaged archive ({exc.__class__.__name__}: {exc})") from None
+    except H5_ERRORS as exc:
+        raise _damaged(path, f"{exc.__class__.__name__}: {exc}") from None
     finally:
         f.close()
     result = result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
@@ -822,8 +824,28 @@ def _in_result_order(data: dict, columns: dict[str, list[str]], layout) -> dict:
     return {name: data[name] for _, name in sorted(enumerate(data), key=rank)}
 
 
-def _damaged(path, what: str) -> UserError:
-    return UserError(f"{path}: damaged archive ({what})")
+def _damaged(path, what: str, kind: str = "archive") -> UserError:
+    return UserError(f"{path}: damaged {kind} ({what})")
+
+
+#: what h5py raises of a damaged file: RuntimeError (a B-tree, local heap or symbol table node whose signature
+#: is wrong: "Iteration operator failed (wrong B-tree signature)"), OSError (data it cannot read: a global heap
+#: collection, a compressed chunk), KeyError, ValueError and TypeError (an object or attribute it cannot open
+#: or decode)
+H5_ERRORS = (RuntimeError, OSError, KeyError, ValueError, TypeError)
+
+
+@contextlib.contextmanager
+def reading(path, kind: str = "archive"):
+    """Around the reading of an open HDF5 file: what h5py raises of a damaged file becomes one
+    :class:`UserError` naming ``path`` ("damaged archive (RuntimeError: ...)"; ``kind``: what the file is),
+    the one place the readers of this module turn h5py's errors into a line for the user."""
+    try:
+        yield
+    except UserError:
+        raise
+    except H5_ERRORS as exc:
+        raise _damaged(path, f"{exc.__class__.__name__}: {exc}", kind) from None
 
 
 def _model_attr(f, path) -> str:
@@ -953,23 +975,38 @@ def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str]
     return path
 
 
-def _open_table(p: Path):
-    """``p`` opened read-only with h5py (a one-line UserError for a path that is not a regular file or
-    not HDF5): the start of both table readers."""
+#: what each of bearingsim's files that is not a run archive is called in the line that says it is damaged,
+#: by its root ``format`` attribute
+_TABLE_KINDS = {"bearingsim sweep index": "sweep index", "bearingsim sweep map": "sweep map",
+                "bearingsim crosscheck index": "cross-check table", "bearingsim sensitivity index": "sensitivity table",
+                "bearingsim uncertainty index": "uncertainty table", "bearingsim life": "life history"}
+
+
+def _table_kind(fmt: str) -> str:
+    return _TABLE_KINDS.get(fmt.rstrip("0123456789. "), "HDF5 file")
+
+
+def _open_table(p: Path, fmt: str):
+    """``p`` opened read-only with h5py, or a one-line UserError naming it: not a regular file, not
+    readable, not HDF5, or damaged or truncated so that HDF5 cannot open it (``fmt``: the format looked for,
+    which names the file in that line). The start of both table readers."""
     h5py = _lazy_h5py()
     _check_regular(p)
+    if not _has_hdf5_signature(p):
+        raise UserError(f"{p}: not a {fmt} (not an HDF5 file)")
     try:
         return h5py.File(p, "r")
-    except (OSError, FileNotFoundError) as exc:
-        raise UserError(f"{p}: cannot open ({exc.__class__.__name__})") from None
+    except OSError as exc:
+        raise UserError(f"{p}: damaged or truncated {_table_kind(fmt)}, HDF5 cannot open it ({exc})") from None
 
 
 def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
     """Read a table written by :func:`write_table_file` whose root attribute ``format`` is ``fmt``:
-    (columns, root attributes). One-line UserError for anything else."""
+    (columns, root attributes). One-line UserError for anything else, naming the file (a damaged one:
+    :func:`reading`)."""
     p = Path(path)
-    f = _open_table(p)
-    with f:
+    f = _open_table(p, fmt)
+    with f, reading(p, _table_kind(fmt)):
         if f.attrs.get("format") != fmt or "index" not in f:
             raise UserError(f"{p}: not a {fmt}")
         attrs = {k: _plain(v) for k, v in f.attrs.items()}
@@ -1025,9 +1062,9 @@ def read_grid_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, dic
     (every dataset as an array, text as ``str`` objects; each dataset's attributes; root attributes).
     One-line UserError for anything else."""
     p = Path(path)
-    f = _open_table(p)
+    f = _open_table(p, fmt)
     skip = ("CLASS", "NAME", "REFERENCE_LIST", "DIMENSION_LIST")  # the dimension-scale bookkeeping
-    with f:
+    with f, reading(p, _table_kind(fmt)):
         if f.attrs.get("format") != fmt:
             raise UserError(f"{p}: not a {fmt}")
         root = {k: _plain(v) for k, v in f.attrs.items()}
@@ -1038,21 +1075,32 @@ def read_grid_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, dic
     return data, attrs, root
 
 
-def is_grid_file(path, fmt: str) -> bool:
-    """True when ``path`` is a grid file of format ``fmt`` (:func:`write_grid_file`)."""
-    h5py = _lazy_h5py()
+def root_format(path) -> str | None:
+    """The root ``format`` attribute of the HDF5 file ``path`` (what names bearingsim's own files that are
+    not run archives: :data:`OWN_FILES`), read alone; None for a path that is not a regular readable HDF5
+    file, nor one HDF5 can open, or whose root holds no such text: the reader of the file says what is
+    wrong with it."""
+    p = Path(path)
     try:
-        _check_regular(Path(path))
-        with h5py.File(Path(path), "r") as f:
-            return f.attrs.get("format") == fmt
-    except (UserError, OSError):
-        return False
+        if not p.is_file() or not _has_hdf5_signature(p):
+            return None
+        with _lazy_h5py().File(p, "r") as f:
+            fmt = _plain(f.attrs.get("format"))
+    except H5_ERRORS:
+        return None
+    return fmt if isinstance(fmt, str) else None
+
+
+def is_grid_file(path, fmt: str) -> bool:
+    """True when ``path`` is a grid file of format ``fmt`` (:func:`write_grid_file`; its root ``format``: a
+    damaged one too, which :func:`read_grid_file` then names)."""
+    return root_format(path) == fmt
 
 
 def table_units(path) -> dict[str, str]:
     """The ``unit`` of every column of a table file (:func:`write_table_file`) that has one."""
-    h5py = _lazy_h5py()
-    with h5py.File(Path(path), "r") as f:
+    p = Path(path)
+    with _lazy_h5py().File(p, "r") as f, reading(p, "table"):
         return {name: _plain(ds.attrs["unit"]) for name, ds in f["index"].items() if "unit" in ds.attrs}
 
 
@@ -1078,12 +1126,9 @@ def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[s
 
 
 def is_table_file(path, fmt: str) -> bool:
-    """True when ``path`` is a table of format ``fmt`` (:func:`write_table_file`)."""
-    try:
-        read_table_file(path, fmt)
-        return True
-    except UserError:
-        return False
+    """True when ``path`` is a table of format ``fmt`` (:func:`write_table_file`): its root ``format`` says
+    so (a damaged table too: :func:`read_table_file` then says what is wrong with it, naming it)."""
+    return root_format(path) == fmt
 
 
 def peek(path) -> dict[str, Any] | None:
@@ -1116,7 +1161,7 @@ def peek(path) -> dict[str, Any] | None:
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
                 "notes": read_notes(f, path),
             }
-    except (OSError, KeyError, ValueError, TypeError, UserError):
+    except (*H5_ERRORS, UserError):  # damaged, in any way h5py tells
         return None
 
 
@@ -1157,17 +1202,12 @@ def _study_tables(folder: Path) -> list[Path]:
     """The studies' tables in ``folder`` (``life.h5``, ``sensitivity.h5``, ...: its regular ``*.h5`` files whose
     root ``format`` is one of :data:`STUDY_TABLE_FORMATS`), by name; what :func:`bearingsim.tables.studies_of`
     finds of them, told by the format alone (this layer does not import the studies)."""
-    h5py = _lazy_h5py()
     found = []
     for f in sorted(folder.glob("*.h5")):
         if f.name == "sweep.h5" or not f.is_file():
             continue
-        try:
-            with h5py.File(f, "r") as h:
-                fmt = _plain(h.attrs.get("format"))
-        except (OSError, ValueError):
-            continue
-        if isinstance(fmt, str) and fmt.rstrip("0123456789. ") in STUDY_TABLE_FORMATS:
+        fmt = root_format(f)
+        if fmt is not None and fmt.rstrip("0123456789. ") in STUDY_TABLE_FORMATS:
             found.append(f)
     return found
 
@@ -1277,9 +1317,11 @@ def open_archive(path: str | Path):
     try:
         f = h5py.File(p, "r")
     except OSError as exc:
-        raise UserError(f"{p}: cannot open HDF5 file ({exc})") from None
+        raise UserError(f"{p}: damaged or truncated file, HDF5 cannot open it ({exc})") from None
+    kind = "HDF5 file"  # until its /bearingsim group is read: a damaged file of another kind is not called an archive
     try:
-        g = f.get("bearingsim")
+        g = f["bearingsim"] if "bearingsim" in f else None  # not f.get: it takes a damaged root group for none
+        kind = "archive" if g is not None else kind
         if g is None or "format_version" not in g.attrs:
             raise _own_file_error(p, f.attrs.get("format")) or UserError(
                 f"{p}: HDF5 file but not a bearingsim archive (no /bearingsim group)")
@@ -1296,8 +1338,29 @@ def open_archive(path: str | Path):
         raise
     except Exception as exc:  # damaged metadata
         f.close()
-        raise UserError(f"{p}: damaged archive ({exc.__class__.__name__}: {exc})") from None
+        raise _damaged(p, f"{exc.__class__.__name__}: {exc}", kind) from None
     return f
+
+
+def unreadable_error(path) -> UserError | None:
+    """The one-line error of a regular file at ``path`` that this process may not read ("cannot read
+    (Permission denied)"), or that has HDF5's signature but whose root HDF5 cannot read (damaged or
+    truncated); None for any other path (missing, a folder, a file that is not HDF5 or reads). What a
+    command that picks its input by what a file holds says of one it cannot tell (``bearingsim report``)."""
+    p = Path(path)
+    try:
+        if not p.is_file():
+            return None
+        _check_regular(p)
+        if not _has_hdf5_signature(p):
+            return None
+        with _lazy_h5py().File(p, "r") as f, reading(p, "HDF5 file"):
+            dict(f.attrs), list(f)
+    except UserError as exc:
+        return exc
+    except OSError as exc:
+        return UserError(f"{p}: damaged or truncated file, HDF5 cannot open it ({exc})")
+    return None
 
 
 def _notes_lines(notes: list[str] | None) -> list[str]:
@@ -1366,6 +1429,8 @@ def describe(path: str | Path) -> str:
         f.visititems(visit)
     except (KeyError, TypeError, ValueError) as exc:  # attributes missing or malformed
         raise UserError(f"{path}: damaged archive (missing or malformed attribute {exc})") from None
+    except (RuntimeError, OSError) as exc:  # a B-tree or heap damaged (h5py's errors: :data:`H5_ERRORS`)
+        raise _damaged(path, f"{exc.__class__.__name__}: {exc}") from None
     finally:
         f.close()
     return outputs.printable("\n".join(lines))  # attributes may carry terminal escape sequences

@@ -984,11 +984,15 @@ def _failed(exc: BaseException, args) -> int:
         print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
               "interval", file=sys.stderr)
         return 2
-    # OSError: a file the command reads or writes (validate/bench output folders, ...)
-    if getattr(args, "written", None) is not None and exc.filename is None:  # stdout, after the archive
+    # OSError: a file the command reads or writes (validate/bench output folders, ...); one without an errno is
+    # not the system's (h5py's of a damaged file, which bearingsim.archive names: never blamed on stdout)
+    stdout = exc.filename is None and exc.errno is not None
+    if getattr(args, "written", None) is not None and stdout:  # stdout, after the archive
         _stdout_lost(exc, args.written)
         return 0
-    if exc.filename is None:  # standard output: the files bearingsim writes go through outputs, which names them
+    if exc.filename is None and exc.errno is None:
+        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
+    elif exc.filename is None:  # standard output: the files bearingsim writes go through outputs, which names them
         print(f"bearingsim: error: cannot write to standard output ({_one_line(exc.strerror or exc)})",
               file=sys.stderr)
     else:

@@ -68,8 +68,10 @@ def kind_of(path) -> tuple[str, Path]:
     if index.name == "sweep.h5" and index.is_file() and archive.is_table_file(index, INDEX_FORMAT):
         return "sweep", index
     if not p.is_dir():  # a file: what is wrong with it, as the commands that read an archive say
-        raise archive.scenario_file_error(p) or archive.own_table_error(p, "report") or _not_an_archive(p)
-    raise UserError(
+        raise (archive.scenario_file_error(p) or archive.own_table_error(p, "report") or archive.unreadable_error(p)
+               or _not_an_archive(p))
+    candidates = [p / n for n in ("sweep.h5", *(name for _, name in tables.STUDY_TABLES))]
+    raise next((e for e in map(archive.unreadable_error, candidates) if e is not None), None) or UserError(
         f"{p}: not a bearingsim archive, nor a sweep, cross-check, validate, sensitivity, uncertainty or life folder "
         f"(no sweep.h5, crosscheck.h5, fig9_idec_vs_speed.csv, sensitivity.h5, uncertainty.h5 or life.h5 in it)")
 

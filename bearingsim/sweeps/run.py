@@ -180,6 +180,16 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
     from bearingsim.sweeps.plot import FIGURE_NAMES
 
     check_replaceable(outdir / "sweep.csv", CSV_SIGNATURE, "sweep index")
+    for name, fmt, read in (("sweep.h5", INDEX_FORMAT, archive.read_table_file),
+                            (MAP_NAME, MAP_FORMAT, archive.read_grid_file)):
+        try:  # damaged or unreadable: said so, not taken for a user's file, nor replaced as the sweep's own
+            err = archive.unreadable_error(outdir / name)
+            if err is None and archive.root_format(outdir / name) == fmt:
+                read(outdir / name, fmt)
+        except UserError as exc:
+            err = exc
+        if err is not None:
+            raise UserError(f"{err}; not replaced (remove it, or choose another -o folder)")
     check_replaceable(outdir / "sweep.h5", lambda p: archive.is_table_file(p, INDEX_FORMAT), "sweep index")
     check_replaceable(outdir / MAP_NAME, lambda p: archive.is_grid_file(p, MAP_FORMAT), "sweep map")
     for name in FIGURE_NAMES if figures else ():

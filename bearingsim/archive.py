@@ -1167,7 +1167,8 @@ def peek(path) -> dict[str, Any] | None:
 
 def _check_regular(p: Path) -> None:
     """Refuse a path that is not a regular file (a FIFO would block the reader forever, a device is
-    not a file to read), checked with ``stat`` before anything opens it."""
+    not a file to read), checked with ``stat`` before anything opens it, or a file this process may not
+    read ("cannot read (Permission denied)", as a scenario file's reader says)."""
     import stat
 
     try:
@@ -1180,6 +1181,10 @@ def _check_regular(p: Path) -> None:
         raise _directory_error(p)
     if not stat.S_ISREG(mode):
         raise UserError(f"{p}: not a regular file (a FIFO, socket or device), not an archive")
+    try:  # a file without read permission is not a damaged one: say which it is
+        os.close(os.open(p, os.O_RDONLY))
+    except OSError as exc:
+        raise UserError(f"{p}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
 
 
 def _directory_error(p: Path) -> UserError:

@@ -188,3 +188,43 @@ def test_an_oserror_without_an_errno_is_not_blamed_on_standard_output(capsys):
     assert _failed(OSError("Can't synchronously read data (bad global heap collection signature)"), Namespace()) == 2
     err = capsys.readouterr().err
     assert "standard output" not in err and "bad global heap collection signature" in err
+
+
+def _obeying_file_modes() -> list[str] | None:
+    """The prefix of a command line that obeys file modes: none for a user who is not root; for root,
+    ``setpriv`` without the capabilities that override them (None where there is no setpriv)."""
+    import os
+
+    if os.geteuid() != 0:
+        return []
+    setpriv = shutil.which("setpriv")
+    return [setpriv, "--bounding-set=-dac_override,-dac_read_search"] if setpriv else None
+
+
+@pytest.mark.parametrize("command", ["show", "inspect", "plot", "table", "report", "load"])
+def test_an_unreadable_archive_is_said_to_be_unreadable(run_archive, tmp_path, command):
+    """An archive without read permission was "not an HDF5 file (truncated, or not a bearingsim archive)" (show,
+    inspect, plot, table, ``bearingsim.load``) or "not a bearingsim archive, nor a sweep ... folder" (report):
+    words that could make a user delete a good file. It is "cannot read (Permission denied)", as a scenario
+    file's reader says."""
+    import subprocess
+    import sys
+
+    from . import forked_cli
+
+    prefix = _obeying_file_modes()
+    if prefix is None:
+        pytest.skip("root, and no setpriv to obey file modes")
+    path = tmp_path / "mine.h5"
+    shutil.copy(run_archive, path)
+    path.chmod(0)
+    code = "import bearingsim, sys\ntry:\n    bearingsim.load(sys.argv[1])\nexcept bearingsim.UserError as e:\n" \
+           "    sys.exit(f'bearingsim: error: {e}')"
+    args = ["-c", code, path] if command == "load" else ["-m", "bearingsim", command, path]
+    if command == "report":
+        args += ["-o", tmp_path / "r.html"]
+    res = subprocess.run([*prefix, sys.executable, *map(str, args)], capture_output=True, text=True,
+                         env=forked_cli.environment(), timeout=300)
+    res.returncode = 2 if res.returncode == 1 and command == "load" else res.returncode  # sys.exit(text): 1
+    assert_user_error(res, f"{path}: cannot read (Permission denied)")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]

@@ -75,7 +75,9 @@ def is_continuous(scenario, dotted: str) -> bool:
 
 def key_kind(scenario, dotted: str) -> str | None:
     """What ``section.key`` of a resolved scenario takes: "float" (a real number), "list" (a list of numbers),
-    "other" (a count or a choice); None for no such key."""
+    "other" (a count or a choice); None for no such key (a top-level one, ``name``, is no section's key)."""
+    if "." not in dotted:
+        return None
     section, key = dotted.split(".", 1)
     sec = getattr(scenario.model_, section, None)
     return _field_kind(sec, key) if sec is not None and hasattr(type(sec), "model_fields") else None

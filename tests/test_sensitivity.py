@@ -182,6 +182,9 @@ def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
     ("paper_3000rpm", [], "bearing.pocket_clearence_mm",
      "--keys bearing.pocket_clearence_mm: unknown key (did you mean bearing.pocket_clearance_mm?)"),
     ("paper_3000rpm", [], "bearing", "--keys bearing: a section, not a key"),
+    # a top-level setting (was: a traceback, ValueError: not enough values to unpack, in ranges.key_kind)
+    ("paper_3000rpm", [], "name", "--keys name: a top-level setting of the scenario, not a number"),
+    ("paper_3000rpm", [], "model", "--keys model: a top-level setting of the scenario"),
     # ranged keys the run never reads: both runs of a pair identical (was: S +0.000, I_acc n/a, exit 0)
     ("paper_3000rpm", [], "bearing.cage_mass_kg",
      "--keys bearing.cage_mass_kg: {src}: not used by the reduced model, so varying it changes no run; leave it out"),

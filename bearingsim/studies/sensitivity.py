@@ -171,6 +171,9 @@ def _check_given_key(scenario, key: str) -> None:
         raise UserError(f"--keys {key}: unknown key{did_you_mean(key)}")
     if any(k.startswith(key + ".") for k in known):
         raise UserError(f"--keys {key}: a section, not a key (give its keys, e.g. {key}.<key>)")
+    if "." not in key:  # name, model, schema_version: the scenario's own settings, none a number to vary
+        raise UserError(f"--keys {key}: a top-level setting of the scenario, not a number of the bearing or its "
+                        f"operation; give a key of a section (e.g. contact.restitution)")
     why = unmeasured_because(scenario, key)
     if why is not None:
         raise UserError(f"--keys {key}: {why}; leave it out")

@@ -31,6 +31,8 @@ from bearingsim.errors import UserError
 from bearingsim.studies.engine import Study, case_of, summary_of
 
 INDEX_FORMAT = "bearingsim uncertainty index 1"
+#: the largest --seed: the table stores it as a 64-bit signed integer (numpy's generator takes any)
+MAX_SEED = 2**63 - 1
 BOOTSTRAP = 1000
 CONFIDENCE = 0.95
 QUANTITIES = (("I_dec", "I_dec_mean_Ns", "N s"), ("I_acc", "I_acc_mean_Ns", "N s"), ("cage_slip", "cage_slip", "1"))
@@ -130,13 +132,20 @@ class Uncertainty(Study):
         from bearingsim.outputs import is_own_png
         from bearingsim.ranges import ranged_keys
         from bearingsim.studies.sensitivity import check_keys
+        from bearingsim.sweeps.spec import MAX_SWEEP_CASES
 
         if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
             raise UserError(f"--samples {samples!r}: give at least 2 base samples (a power of 2 such as 64 is best)")
-        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
-            raise UserError(f"--seed {seed!r}: give a non-negative integer")
+        if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed <= MAX_SEED:
+            raise UserError(f"--seed {seed!r}: give an integer from 0 to {MAX_SEED} (2**63 - 1, the largest the "
+                            f"study's table stores)")
         self.scenario, self.samples, self.seed = scenario, samples, seed
         self.keys = check_keys(scenario, keys, relative=False)  # the ranges are sampled: any value of the key
+        total = samples * (len(self.keys) + 2)
+        if total > MAX_SWEEP_CASES:  # counted before any case is built, as a sweep's
+            raise UserError(f"--samples {samples}: {total} cases ({samples} x {len(self.keys) + 2}: the samples A, B and "
+                            f"one block per key) are more than the {MAX_SWEEP_CASES} a sweep or study may have; "
+                            f"give at most --samples {MAX_SWEEP_CASES // (len(self.keys) + 2)}")
         r = ranged_keys(scenario)
         self.bounds = np.array([r[k][:2] for k in self.keys])
         self.a, self.b, self.ab = design(self.bounds, samples, seed)

@@ -27,8 +27,8 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     set : ``{"dotted.key": value}`` overrides with Python values (``{"numerics.rotations": 10}``).
     overrides : ``["dotted.key=VALUE", ...]`` overrides as on the command line (VALUE read as TOML).
 
-    ``overrides`` are applied in their order, then ``set``: a key given twice takes the value given last
-    (as a repeated ``--set``), so ``set`` wins over ``overrides``.
+    ``overrides`` are applied, then ``set``: a key given in both takes its value from ``set``; a key given
+    twice in ``overrides`` is refused (a ``UserError`` naming it, as a repeated ``--set``).
 
     Keys the file, ``overrides`` or ``set`` give that the run does not read (``numerics.dt_s`` with the
     reduced model's event method, a multibody key in a reduced scenario) are named in one

@@ -621,8 +621,9 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
                   values: dict[str, Any] | None = None) -> Scenario:
     """Read, merge with preset and defaults, apply overrides, and validate.
 
-    ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line);
-    ``values`` maps dotted keys to Python values; both name keys as ``section.key``.
+    ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line), each key
+    at most once (a key given twice is refused, naming both); ``values`` maps dotted keys to Python values,
+    applied after them; both name keys as ``section.key``.
     """
     from collections.abc import Mapping
 
@@ -643,6 +644,8 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     given = {}  # key -> the override that set it, as the user wrote it
     for item in overrides or []:
         key, value = parse_override(item)
+        if key in given:  # which one was meant is not ours to guess (a sweep refuses it the same way)
+            raise UserError(f"--set {key}: given twice ({given[key]} and {item.strip()}); give it once")
         _set_dotted(raw, key, value, origin="--set")
         given[key] = item.strip()
     for key, value in (values or {}).items():

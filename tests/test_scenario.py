@@ -530,3 +530,27 @@ def test_a_scenario_has_a_short_repr_naming_it_its_model_and_its_file(base_reduc
     assert repr(sc.replace(name="x")) == f"<Scenario 'x': multibody model, from {str(path)!r}>"
     assert repr(resolve(base_reduced)) == "<Scenario 't': reduced model, from '<dict>'>"
     assert repr(pickle.loads(pickle.dumps(sc))) == repr(sc) and "\n" not in repr(sc)
+
+
+def test_a_key_given_twice_in_the_overrides_is_refused_as_a_sweep_refuses_it():
+    """``--set numerics.rotations=2 --set numerics.rotations=3`` ran with 3 (run, show, crosscheck, life and the
+    API's ``overrides``), where a sweep refuses "numerics.rotations: given twice". One rule, where the overrides
+    are parsed: refused naming the key and both overrides; ``set`` after ``overrides`` still takes its value."""
+    path = SCENARIOS / "paper_3000rpm.toml"
+    for sets in (["numerics.rotations=2", "numerics.rotations=3"], ["numerics.rotations=2", " numerics.rotations = 2"]):
+        with pytest.raises(UserError, match=r"^--set numerics\.rotations: given twice \(numerics\.rotations=2 and "):
+            load_scenario(path, sets)
+        with pytest.raises(UserError, match="given twice"):
+            bearingsim.load_scenario(path, overrides=sets)
+    assert bearingsim.load_scenario(path, set={"numerics.rotations": 3},
+                                    overrides=["numerics.rotations=2"]).numerics.rotations == 3
+
+
+@pytest.mark.parametrize("command", ["run", "show"])
+def test_a_repeated_set_is_refused_on_the_command_line(command):
+    from .test_cli import assert_user_error, bearingsim as cli
+
+    args = ["--dry-run"] if command == "run" else []
+    assert_user_error(cli(command, SCENARIOS / "paper_3000rpm.toml", "--set", "numerics.rotations=2", "--set",
+                          "numerics.rotations=3", *args),
+                      "--set numerics.rotations: given twice (numerics.rotations=2 and numerics.rotations=3)")

@@ -1285,6 +1285,17 @@ def _own_file_error(p: Path, fmt) -> UserError | None:
                      f"it holds, 'bearingsim table {p.parent}' prints its folder's table")
 
 
+def own_file_target_error(p: Path) -> UserError | None:
+    """The one-line refusal of one of bearingsim's own files that is not a run archive (a sweep's index or
+    map, a study's table: :data:`OWN_FILES`) at a path a run's archive is to be written to, saying what it
+    is (the output layer's "exists and is not a bearingsim archive" would call it a user's); None for any
+    other file."""
+    err = _own_file_error(Path(p), root_format(p))
+    if err is None:
+        return None
+    return UserError(f"{str(err).split(';')[0]}; not replaced by a run's archive (choose another path)")
+
+
 def own_table_error(p: Path, command: str = "table") -> UserError | None:
     """The one-line refusal of a CSV table a sweep or study wrote (``sweep.csv``, ``crosscheck.csv``, ...:
     :data:`bearingsim.outputs.FOLDER_FILES`, told by its name and first bytes) given where an archive is

@@ -300,7 +300,10 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
             with open(q, "rb") as fh:
                 return fh.read(8) == _HDF5_SIGNATURE
     if p.exists() and not is_archive(p):
-        raise UserError(f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another path)")
+        from bearingsim.archive import own_file_target_error  # a sweep's index or a study's table: named as one
+
+        raise own_file_target_error(p) or UserError(
+            f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another path)")
     stem = p.with_suffix("")
     if figures is True and p.parent.is_dir():
         for fig in p.parent.glob(f"{_glob_escape(stem.name)}_*.png"):

@@ -572,6 +572,8 @@ def _copy(v):
 
 def read_toml_file(path: str | Path) -> dict[str, Any]:
     p = Path(path)
+    if not str(path):  # Path("") is "." (the current folder): "is a directory" would name no path given
+        raise UserError("scenario path is empty: give the path of a scenario file (.toml)")
     try:
         if "\x00" in str(path):
             raise UserError(f"{str(path)!r}: file name contains a NUL byte")

@@ -228,3 +228,16 @@ def test_an_unreadable_archive_is_said_to_be_unreadable(run_archive, tmp_path, c
     res.returncode = 2 if res.returncode == 1 and command == "load" else res.returncode  # sys.exit(text): 1
     assert_user_error(res, f"{path}: cannot read (Permission denied)")
     assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+def test_a_run_to_a_sweeps_index_says_it_is_one(run_archive, tmp_path):
+    """``run ... -o DIR/sweep.h5 --force`` said of bearingsim's own sweep index "exists and is not a bearingsim
+    archive", as of a user's file; it says which of bearingsim's files it is, and does not replace it
+    (``Result.save`` the same)."""
+    index = _sweep_index(tmp_path)
+    before = index.read_bytes()
+    res = cli("run", SCENARIOS / "paper_3000rpm.toml", "-o", index, "--force", "--no-plots")
+    assert_user_error(res, f"{index}: a sweep's index written by bearingsim, not a run archive; not replaced")
+    with pytest.raises(bearingsim.UserError, match="a sweep's index written by bearingsim"):
+        bearingsim.load(run_archive).save(index)
+    assert index.read_bytes() == before

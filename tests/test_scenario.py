@@ -554,3 +554,10 @@ def test_a_repeated_set_is_refused_on_the_command_line(command):
     assert_user_error(cli(command, SCENARIOS / "paper_3000rpm.toml", "--set", "numerics.rotations=2", "--set",
                           "numerics.rotations=3", *args),
                       "--set numerics.rotations: given twice (numerics.rotations=2 and numerics.rotations=3)")
+
+
+def test_an_empty_scenario_path_is_said_to_be_empty():
+    """``load_scenario("")`` said ".: is a directory, not a scenario file" (``Path("")`` is the current folder)."""
+    for load in (load_scenario, bearingsim.load_scenario):
+        with pytest.raises(UserError, match=r"^scenario path is empty: give the path of a scenario file"):
+            load("")

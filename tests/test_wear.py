@@ -321,6 +321,15 @@ def test_bad_limit_is_refused(text):
         parse_limit(text)
 
 
+@pytest.mark.parametrize("text", ["depth=1e400mm", "clearance=1e999um", "volume=1e400mm3"])
+def test_an_infinite_limit_is_not_called_negative(text):
+    """``--limit depth=1e400mm`` (infinite) said "must be positive"."""
+    from bearingsim.studies.life import parse_limit
+
+    with pytest.raises(UserError, match=r": must be a finite positive number$"):
+        parse_limit(text)
+
+
 def test_limit_parsing():
     from bearingsim.studies.life import parse_limit
 

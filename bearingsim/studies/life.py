@@ -110,7 +110,7 @@ def parse_limit(text: str) -> Limit:
     except ValueError:
         raise UserError(f"--limit {text!r}: {num!r} is not a number") from None
     if not (math.isfinite(value) and value > 0):
-        raise UserError(f"--limit {text!r}: must be positive")
+        raise UserError(f"--limit {text!r}: must be a finite positive number")
     return Limit(kind, value, text.strip())
 
 

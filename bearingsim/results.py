@@ -175,13 +175,21 @@ class Result:
 
         return render_result(self, out, **kw)
 
-    def save(self, path) -> Path:
+    def save(self, path, force: bool = False) -> Path:
         """Write this result as an archive at ``path`` (``.h5`` or ``.hdf5``; atomically: a temporary file
         renamed when complete) and return the path. Missing folders are created; a bearingsim archive at
-        ``path`` is replaced, any other file there, and a symbolic link (even to an archive: a link is the
-        user's, as at a figure path), is refused (:class:`bearingsim.UserError`, nothing written)."""
+        ``path`` of the same scenario is replaced, one of a different scenario only with ``force=True`` (as
+        ``bearingsim run -o`` replaces it only with ``--force``); any other file there, and a symbolic link
+        (even to an archive: a link is the user's, as at a figure path), is refused (:class:`bearingsim.UserError`,
+        nothing written)."""
         from bearingsim import archive
+        from bearingsim.simulation import check_same_scenario
 
+        check_path(path, "path", "the archive (.h5)")
+        if not isinstance(force, bool):
+            raise UserError(f"save(): force: expected True or False (got {type(force).__name__})")
+        if not force and not Path(path).is_symlink():  # a link is refused as it is, whatever it leads to
+            check_same_scenario(Path(path), self.scenario, "give another path, or save(..., force=True) to replace it")
         return archive.write(self, path)
 
     # --- figures ---------------------------------------------------------------------------

@@ -181,11 +181,12 @@ def _target(scenario: Scenario, out: str | Path | None, figures: bool) -> Path:
     return outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)
 
 
-def check_same_scenario(out: Path, scenario: Scenario) -> None:
+def check_same_scenario(out: Path, scenario: Scenario,
+                        advice: str = "write this run elsewhere with -o, or add --force to replace it") -> None:
     """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
     ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
-    that differ, and ``-o`` / ``--force``. A rerun of the same scenario, an unreadable or incomplete
-    archive (never a result) and no file at all pass."""
+    that differ, and ``advice`` (the command line's ``-o`` / ``--force``; :meth:`Result.save`'s ``force=True``).
+    A rerun of the same scenario, an unreadable or incomplete archive (never a result) and no file at all pass."""
     import tomllib
 
     from bearingsim import archive
@@ -205,8 +206,7 @@ def check_same_scenario(out: Path, scenario: Scenario) -> None:
     if old is not None:
         keys = [f"{k} {va} -> {vb}" for k, va, vb in differing_keys(old.raw, scenario.raw)]
     what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
-    raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: write this run elsewhere "
-                    f"with -o, or add --force to replace it")
+    raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: {advice}")
 
 
 def run_scenario(

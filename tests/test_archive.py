@@ -159,14 +159,17 @@ def test_a_fresh_result_has_the_provenance_it_reads_back_with_but_the_time_writt
 
 def test_save_makes_its_folders_replaces_an_archive_and_refuses_any_other_file(tmp_path, base_reduced):
     """Result.save as its docstring says: missing folders are made; a bearingsim archive at the path is
-    replaced (by this result's); a file that is not one is refused with one line and left as it was."""
+    replaced (by this result's: one of another scenario with force=True); a file that is not one is refused
+    with one line and left as it was."""
     import bearingsim
 
     r = bearingsim.run(resolve(base_reduced))
     path = tmp_path / "a" / "b" / "r.h5"
     assert r.save(path) == path and bearingsim.load(path).summary == r.summary
     other = bearingsim.run(resolve({**base_reduced, "name": "other"}))
-    other.save(path)
+    with pytest.raises(UserError, match="holds the run of a different scenario"):
+        other.save(path)
+    other.save(path, force=True)
     assert bearingsim.load(path).scenario.name == "other"
     mine = tmp_path / "mine.h5"
     mine.write_text("my notes\n")

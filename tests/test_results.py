@@ -135,3 +135,27 @@ def test_get_of_a_name_the_result_lacks_is_one_user_error_naming_what_it_has():
             r.get(name)
         text = str(err.value)
         assert "\n" not in text and all(w in text for w in words), text
+
+
+def test_save_over_an_archive_of_another_scenario_needs_force(tmp_path):
+    """``Result.save(path)`` replaced an archive of a different scenario silently, where ``bearingsim run -o``
+    refuses it without ``--force``; it refuses the same way, naming the file, the keys that differ and
+    ``force=True``, and writes nothing. The same scenario is replaced (saving again), and ``force=True``
+    replaces the other."""
+    path = tmp_path / "a.h5"
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")
+    first = bearingsim.run(sc)
+    first.save(path)
+    first.save(path)  # the same scenario: replaced
+    before = path.read_bytes()
+    other = bearingsim.run(sc.replace(**{"operating.radial_load_N": 1500.0}))
+    with pytest.raises(bearingsim.UserError) as info:
+        other.save(path)
+    msg = str(info.value)
+    assert msg.startswith(f"{path}: holds the run of a different scenario (operating.radial_load_N 970")
+    assert msg.endswith("not replaced: give another path, or save(..., force=True) to replace it"), msg
+    assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["a.h5"]
+    other.save(path, force=True)
+    assert bearingsim.load(path).scenario == other.scenario
+    with pytest.raises(bearingsim.UserError, match="force: expected True or False"):
+        other.save(path, force="yes")

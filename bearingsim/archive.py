@@ -174,7 +174,8 @@ def _prepare_target(path) -> Path:
     """Check that an archive can be written at ``path`` (one-line UserError if not); return it. Its folder
     is made here; the folders made are removed again when the check refuses the path."""
     path = Path(path)
-    outputs.check_target(path, (), is_archive, figures=False)  # .h5 name; never replaces a non-archive
+    outputs.check_target(path, (), is_archive, figures=False,  # .h5 name; never replaces a non-archive
+                         own_file_error=own_file_target_error)
     made = outputs.missing_folders(path.parent)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -1163,6 +1164,32 @@ def peek(path) -> dict[str, Any] | None:
             }
     except (*H5_ERRORS, UserError):  # damaged, in any way h5py tells
         return None
+
+
+def check_same_scenario(out: Path, scenario,
+                        advice: str = "write this run elsewhere with -o, or add --force to replace it") -> None:
+    """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
+    ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
+    that differ, and ``advice`` (the command line's ``-o`` / ``--force``; :meth:`Result.save`'s ``force=True``).
+    A rerun of the same scenario, an unreadable or incomplete archive (never a result) and no file at all pass."""
+    import tomllib
+
+    from bearingsim.scenario import differing_keys, resolve
+
+    got = peek(out) if out.is_file() else None
+    if got is None:
+        return
+    try:
+        old = resolve(tomllib.loads(got["scenario"]), f"{out}:/scenario")
+    except Exception:  # noqa: BLE001 - a scenario this version cannot read is not this run's
+        old = None
+    if old is not None and old == scenario:
+        return
+    keys = []
+    if old is not None:
+        keys = [f"{k} {va} -> {vb}" for k, va, vb in differing_keys(old.raw, scenario.raw)]
+    what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
+    raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: {advice}")
 
 
 def _check_regular(p: Path) -> None:

@@ -264,7 +264,8 @@ def check_replaceable(path: str | Path, signature, what: str) -> Path:
     raise UserError(f"{p}: {what} path is {kind}; not replaced (remove it or choose another path)")
 
 
-def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True) -> Path:
+def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=None, figures: bool = True,
+                 own_file_error=None) -> Path:
     """Check that a run may write its archive at ``path`` (rules in the module docstring).
 
     Parameters
@@ -276,6 +277,9 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
     figures : names of the figures the run also writes beside the archive (``<stem>_<name>.png``): each
         must be absent or a figure bearingsim drew (:func:`check_replaceable`, :func:`is_own_png`); True: only
         check that no ``<stem>_*.png`` is a folder; False or empty: no figures
+    own_file_error : ``own_file_error(path) -> UserError | None``, the refusal of a file bearingsim wrote that is
+        not an archive (:func:`bearingsim.archive.own_file_target_error`: a sweep's index, named as one); None:
+        any file that is not an archive is refused as not one
 
     Returns
     -------
@@ -300,9 +304,7 @@ def check_target(path: str | Path, inputs: list[str | Path] = (), is_archive=Non
             with open(q, "rb") as fh:
                 return fh.read(8) == _HDF5_SIGNATURE
     if p.exists() and not is_archive(p):
-        from bearingsim.archive import own_file_target_error  # a sweep's index or a study's table: named as one
-
-        raise own_file_target_error(p) or UserError(
+        raise (own_file_error(p) if own_file_error else None) or UserError(
             f"{p}: exists and is not a bearingsim archive; not replaced (remove it or choose another path)")
     stem = p.with_suffix("")
     if figures is True and p.parent.is_dir():

@@ -183,13 +183,13 @@ class Result:
         (even to an archive: a link is the user's, as at a figure path), is refused (:class:`bearingsim.UserError`,
         nothing written)."""
         from bearingsim import archive
-        from bearingsim.simulation import check_same_scenario
 
         check_path(path, "path", "the archive (.h5)")
         if not isinstance(force, bool):
             raise UserError(f"save(): force: expected True or False (got {type(force).__name__})")
         if not force and not Path(path).is_symlink():  # a link is refused as it is, whatever it leads to
-            check_same_scenario(Path(path), self.scenario, "give another path, or save(..., force=True) to replace it")
+            archive.check_same_scenario(Path(path), self.scenario,
+                                        "give another path, or save(..., force=True) to replace it")
         return archive.write(self, path)
 
     # --- figures ---------------------------------------------------------------------------

@@ -178,35 +178,19 @@ def _target(scenario: Scenario, out: str | Path | None, figures: bool) -> Path:
 
     out = Path(out) if out is not None else default_output(scenario)
     names = model_module(scenario.model).RESULT.FIGURES if figures else ()
-    return outputs.check_target(out, [scenario.source], archive.is_archive, figures=names)
+    return outputs.check_target(out, [scenario.source], archive.is_archive, figures=names,
+                                own_file_error=archive.own_file_target_error)
 
 
-def check_same_scenario(out: Path, scenario: Scenario,
-                        advice: str = "write this run elsewhere with -o, or add --force to replace it") -> None:
+def check_same_scenario(out: Path, scenario: Scenario) -> None:
     """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
     ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
-    that differ, and ``advice`` (the command line's ``-o`` / ``--force``; :meth:`Result.save`'s ``force=True``).
-    A rerun of the same scenario, an unreadable or incomplete archive (never a result) and no file at all pass."""
-    import tomllib
-
+    that differ, and ``-o`` / ``--force``. A rerun of the same scenario, an unreadable or incomplete
+    archive (never a result) and no file at all pass (:func:`bearingsim.archive.check_same_scenario`, which
+    :meth:`Result.save` calls too)."""
     from bearingsim import archive
-    from bearingsim.errors import UserError
-    from bearingsim.scenario import differing_keys, resolve
 
-    got = archive.peek(out) if out.is_file() else None
-    if got is None:
-        return
-    try:
-        old = resolve(tomllib.loads(got["scenario"]), f"{out}:/scenario")
-    except Exception:  # noqa: BLE001 - a scenario this version cannot read is not this run's
-        old = None
-    if old is not None and old == scenario:
-        return
-    keys = []
-    if old is not None:
-        keys = [f"{k} {va} -> {vb}" for k, va, vb in differing_keys(old.raw, scenario.raw)]
-    what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
-    raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: {advice}")
+    archive.check_same_scenario(out, scenario)
 
 
 def run_scenario(

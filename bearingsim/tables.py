@@ -35,6 +35,10 @@ RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(
         "docs/statistics.md); no mark: within that, or no SE to judge by")
 #: the line above the key of a table's ``[k]`` marks, the runs' notes (:attr:`Table.footnotes`)
 NOTES_HEAD = "notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):"
+#: the note above a table of archives of both models
+MIXED_MODELS = ("rows of both models: the reduced model's '± 0' is its exactness (every rotation repeats its one "
+                "pass), not a measured error, and a mark against a whole-bearing row is the difference of the models, "
+                "which 'bearingsim crosscheck' takes apart assumption by assumption (docs/crosscheck.md)")
 #: number columns shown by default, those present
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
                    "load_zone_half_angle_deg")
@@ -164,6 +168,9 @@ def table_of_archives(paths) -> Table:
         notes.append("scenario keys that also differ: " + ", ".join(rest))
     if not differ and len(results) > 1:
         notes.append("scenarios: identical")
+    models = {getattr(r.scenario, "model", None) for r in results}
+    if "reduced" in models and len(models) > 1:
+        notes.append(MIXED_MODELS)
     footnotes = _run_notes([run_notes(r.notes) for r in results], names, labels)  # worded as an index's
     batches = [sem_batches(np.shape(r.per_rotation["I_dec"])[0]) for r in results]
     return Table(names, labels, numbers, units, notes, footnotes, batches)
@@ -348,14 +355,31 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
         if not math.isfinite(v):
             cells.append("-")
             continue
-        text = f"{v * scale:.4g}"
         if se is not None:
             e = se[i]
-            text += " ± " + (f"{e * scale:.2g}" if math.isfinite(e) else "n/a")
+            text = with_error(v * scale, e * scale)
             mark = None if ref is None or i == ref else significant(v, e, x[ref], se[ref], batches[i], batches[ref])
             text += " *" if mark else "  "
+        else:
+            text = f"{v * scale:.4g}"
         cells.append(text)
     return head, cells
+
+
+def with_error(v: float, e: float) -> str:
+    """``v ± e`` as a table shows it: the error to 2 significant digits and the value to the same decimal
+    place, trailing zeros kept (``18.30 ± 0.17``, ``14.4070 ± 0.0095``), so the cell says how many digits mean
+    something; where that would print more than 10 decimals or no decimal of a large error (the error at or above
+    1e4 of the display unit, a damaged archive's), the value to 4 significant digits and the error to 2; an error
+    of 0 (an exact model's) or none (``n/a``) leaves the value at 4 significant digits."""
+    if not math.isfinite(e):
+        return f"{v:.4g} ± n/a"
+    if e == 0.0:
+        return f"{v:.4g} ± 0"
+    places = 1 - math.floor(math.log10(abs(float(f"{e:.2g}"))))
+    if not 0 <= places <= 10 or e >= 1e4:
+        return f"{v:.4g} ± {e:.2g}"
+    return f"{v:.{places}f} ± {e:.{places}f}"
 
 
 def column_keys(table: Table) -> list[str]:

@@ -124,7 +124,7 @@ def test_marks_only_where_the_difference_exceeds_t_standard_errors():
     rows = {ln.split()[0]: ln for ln in lines[1:5]}
     assert rows["beyond"].endswith("*") and not rows["within"].endswith("*") and not rows["no-se"].endswith("*")
     assert not rows["ref"].endswith("*") and "± n/a" in rows["no-se"]
-    assert "I_dec_mean [mN s]" in lines[0] and "11 ± 0.2" in rows["beyond"]
+    assert "I_dec_mean [mN s]" in lines[0] and "11.00 ± 0.20" in rows["beyond"]  # the value to its error's decimal place
     assert lines[-1] == tables.RULE
 
 
@@ -465,3 +465,34 @@ def test_the_cage_slip_is_shown_in_per_cent_with_its_unit():
     assert head == "cage_slip [%]" and cells == ["0.4086", "-0.12"], (head, cells)
     lines = tables.format_table(t, columns=["cage_slip"]).splitlines()
     assert "cage_slip [%]" in lines[0] and lines[1].split() == ["a", "0.4086"], lines
+
+
+@pytest.mark.parametrize("v, e, text", [(18.3, 0.17, "18.30 ± 0.17"), (14.407, 0.0095, "14.4070 ± 0.0095"),
+                                        (15.6, 0.7, "15.60 ± 0.70"), (18.3, 2.5, "18.3 ± 2.5"),
+                                        (1834.2, 25.0, "1834 ± 25"), (15.19, 3.1e31, "15.19 ± 3.1e+31"),
+                                        (5.28, 0.0, "5.28 ± 0"), (5.28, math.nan, "5.28 ± n/a"),
+                                        (0.5, 1e-12, "0.5 ± 1e-12")])
+def test_a_value_is_shown_to_its_errors_decimal_place(v, e, text):
+    """"18.3 ± 0.17" hid that the mean's second decimal means something (18.30): the value is shown to the
+    decimal place of its error's second significant digit, trailing zeros kept; an error of 0 (the reduced
+    model's), none, one far below the value (beyond 10 decimals) or a huge one keep the value's 4 digits."""
+    from bearingsim.tables import with_error
+
+    assert with_error(v, e) == text
+
+
+@pytest.mark.slow
+def test_a_table_of_both_models_says_what_the_reduced_models_zero_error_is(tmp_path):
+    """A table of a reduced and a whole-bearing archive put "5.28 ± 0" beside "14.76 ± 0.25 *" without a word: it
+    says the reduced model's ± 0 is its exactness and a mark is the models' difference; one model's table does
+    not."""
+    import bearingsim
+    from bearingsim.tables import MIXED_MODELS, table_of
+
+    red, whole = tmp_path / "r.h5", tmp_path / "m.h5"
+    bearingsim.run(bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")).save(red)
+    bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml",
+                                            set={"numerics.rotations": 2, "multibody.raceway_contact": "rigid"})
+                   ).save(whole)
+    assert MIXED_MODELS in table_of([red, whole]).notes
+    assert MIXED_MODELS not in table_of([whole, whole]).notes and MIXED_MODELS not in table_of([red]).notes

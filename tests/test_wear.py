@@ -1107,6 +1107,20 @@ def test_a_life_of_few_stages_with_the_shape_fed_back_is_noted_as_read_long():
     assert stage_count_note(5, "uniform") is None
 
 
+def test_a_life_figure_says_what_it_is_of():
+    """life.png's title gave the limit and the time alone: no scenario, speed, load, k or H, although the life
+    scales as H / k. Its second line names them, the mapping and the rotations per stage, from the history's
+    attributes (a history without a scenario says '?')."""
+    from bearingsim.studies.life import _life_subtitle
+
+    sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml", ["wear.wear_coefficient=6e-4"])
+    line = _life_subtitle({"scenario": sc.to_toml(), "mapping": "shape", "rotations": 10})
+    assert line == ("wear_test_6000rpm: 6000 rpm, 922 N; Archard k = 0.0006, H = 1.5e+09 Pa (the life scales as "
+                    "H / k); shape mapping, 10 recorded rotations per stage")
+    assert _life_subtitle({}) == ("?: ?, ?; Archard k = ?, H = ? (the life scales as H / k); ? mapping, ? recorded "
+                                  "rotations per stage")
+
+
 def test_a_scenarios_wear_coefficient_of_0_is_refused_as_an_argument_of_0_is(tmp_path, capsys):
     """A run whose scenario sets wear.wear_coefficient = 0 (a scenario takes it: nothing wears) gave `bearingsim
     wear` a report of zeros with a coefficient of variation of nan, a front / rear ratio of nan .. nan, numpy's

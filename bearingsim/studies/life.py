@@ -620,9 +620,29 @@ def plot_life(cols: dict, attrs: dict):
     _plot_worn_faces(axes[3], cols)
     end = "the cage bar worn through first, after " if attrs.get("worn_through") else ""
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} "
-                 f"inner-ring rotations, {counted(len(h_end), 'stage')}", fontsize=9)
+                 f"inner-ring rotations, {counted(len(h_end), 'stage')}\n{_life_subtitle(attrs)}", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _life_subtitle(attrs: dict) -> str:
+    """What a life figure is of, from its history's attributes: the scenario's name, speed and load, Archard's
+    k and H (the life scales as H / k), the mapping and the rotations per stage."""
+    import tomllib
+
+    try:
+        sc = tomllib.loads(str(attrs.get("scenario") or ""))
+    except tomllib.TOMLDecodeError:
+        sc = {}
+    op, wr = sc.get("operating", {}), sc.get("wear", {})
+
+    def num(d, key, unit):
+        v = d.get(key)
+        return f"{v:g} {unit}" if isinstance(v, (int, float)) and not isinstance(v, bool) else "?"
+    return (f"{sc.get('name', '?')}: {num(op, 'inner_ring_speed_rpm', 'rpm')}, {num(op, 'radial_load_N', 'N')}; "
+            f"Archard k = {num(wr, 'wear_coefficient', '').strip()}, H = {num(wr, 'hardness_Pa', 'Pa')} (the life "
+            f"scales as H / k); {attrs.get('mapping', '?')} mapping, {attrs.get('rotations', '?')} recorded rotations "
+            f"per stage")
 
 
 def _plot_worn_faces(ax, cols: dict) -> None:

@@ -433,10 +433,10 @@ def _crosscheck_sections(table: Path):
 
     rows, meta = cc.read_table(table)
     head = ["rpm", "rung", "scene", "relaxed", "I_dec [mN s]", "I_acc [mN s]", "first impact speed [m/s]",
-            "cage slip", "change of I_dec [mN s]"]
+            "cage slip [%]", "change of I_dec [mN s]"]
     cells = [[_cell(r["rpm"]), str(r["rung"]), r["scene"], r["relaxed"], _pm(r["I_dec_mean_Ns"], r["I_dec_sem_Ns"]),
-              _pm(r["I_acc_mean_Ns"], r["I_acc_sem_Ns"]), _cell(r["first_impact_speed_m_s"]), _cell(r["cage_slip"], digits=3),
-              _cell(r["change_from_previous"], 1e3)] for r in rows]
+              _pm(r["I_acc_mean_Ns"], r["I_acc_sem_Ns"]), _cell(r["first_impact_speed_m_s"]),
+              _cell(r["cage_slip"], 100.0, digits=3), _cell(r["change_from_previous"], 1e3)] for r in rows]
     blocks = [table_block("Impulses per pocket and cage rotation, mean over all pockets ± batch-means standard "
                           "error; each rung drops one assumption of the paper's model (docs/crosscheck.md)", head, cells,
                           [True, True, False, False, True, True, True, True, True]),
@@ -449,8 +449,14 @@ def _crosscheck_sections(table: Path):
 
 
 def _pm(mean, sem) -> str:
-    """``mean ± sem`` of an impulse in mN s."""
-    return f"{_cell(mean, 1e3)} ± {_cell(sem, 1e3, 2) if math.isfinite(sem) else 'n/a'}"
+    """``mean ± sem`` of an impulse in mN s, as ``bearingsim table`` gives it (:func:`bearingsim.tables.with_error`)."""
+    from bearingsim.tables import with_error
+
+    try:
+        m, e = float(mean) * 1e3, float(sem) * 1e3
+    except (TypeError, ValueError):
+        return f"{mean} ± {sem}"
+    return "-" if not math.isfinite(m) else with_error(m, e)
 
 
 #: a sweep's figures in the page, by file name (bearingsim.sweeps.plot)

@@ -721,3 +721,17 @@ def test_a_failed_case_is_listed_with_its_values(small_studies, tmp_path):
     assert [h for h in re.findall(r"<th>(.*?)</th>", table)] == ["case", "values", "error"], table
     cells = re.findall(r"<td[^>]*>(.*?)</td>", table)
     assert len(cells) == 3 and cells[1] == "lubrication.drag_coefficient = 0", cells
+
+
+def test_the_crosscheck_page_gives_slip_in_per_cent_and_impulses_as_the_table_does(tmp_path):
+    """The cross-check page's slip column was a bare fraction (0.01 for 1 %) where ``bearingsim table`` and the
+    command's own table give per cent, and its impulses "5 ± 0.2" where the table gives "5.00 ± 0.20": the same
+    quantity reads the same on every page."""
+    from bearingsim import reports
+
+    _crosscheck_table(tmp_path)
+    _, sections, _ = reports._crosscheck_sections(tmp_path / "crosscheck.h5")
+    block = sections[0].blocks[0]
+    slip = block["head"].index("cage slip [%]")
+    first = block["rows"][0]
+    assert first[slip] == "1" and first[4] == "5.00 ± 0.20" and first[5] == "3.00 ± 0.10", first

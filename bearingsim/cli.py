@@ -637,7 +637,7 @@ def _add_run_commands(sub) -> None:
     pl.set_defaults(func=_cmd_plot)
 
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
-    rr.add_argument("archive")
+    rr.add_argument("archive", help="a run archive (.h5) whose stored scenario is run again")
     rr.add_argument("-o", "--output", help="also write the new run's archive here")
     rr.add_argument("--force", action="store_true",
                     help="with -o: replace an archive of a different scenario there (default: refused)")
@@ -649,7 +649,7 @@ def _add_run_commands(sub) -> None:
     cp = sub.add_parser("compare", help="scenario keys and summary numbers of two or more archives side by side "
                                         "(exit 0 identical, 1 different, 2 bad file); two: bit for bit, every "
                                         "number; more: a table with standard errors and significance marks")
-    cp.add_argument("archives", nargs="+", metavar="ARCHIVE")
+    cp.add_argument("archives", nargs="+", metavar="ARCHIVE", help="two or more run archives (.h5)")
     cp.set_defaults(func=_cmd_compare)
 
     tb = sub.add_parser("table", help="summary numbers of a sweep folder (its index sweep.h5) or of archives, as "

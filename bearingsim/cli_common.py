@@ -47,10 +47,10 @@ def report_study(outcome, command: str) -> int:
 
 def with_notes(rows, what: str, where: str) -> str:
     """The end of a sweep's or study's closing line counting its ``rows`` (the case index's) with notes,
-    ``"; 1 case with notes (the table's notes column; 'bearingsim table DIR' lists them)"``; "" for none.
+    ``"; 1 case with notes ('bearingsim table DIR' marks them in its notes column and lists them)"``; "" for none.
     ``what``: what a row is (case, rung); ``where``: the path whose table lists them."""
     noted = sum(bool(r.get("notes")) for r in rows)
-    return (f"; {counted(noted, what)} with notes (the table's notes column; 'bearingsim table {where}' "
+    return (f"; {counted(noted, what)} with notes ('bearingsim table {where}' marks them in its notes column and "
             f"lists them)" if noted else "")
 
 

@@ -127,7 +127,8 @@ def add_commands(sub) -> None:
                     help=f"stages (default {DEFAULT_STAGES}: with the worn shape fed back fewer read the life long, "
                          f"docs/wear.md)")
     li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")
-    li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key")
+    li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="override a scenario key (repeatable)")
     li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
     li.add_argument("--scheduler", metavar="ADDRESS", help="run the stages on a dask cluster (tcp://host:8786); "
                                                           "default: one local worker process")

@@ -382,9 +382,9 @@ def start_transient(result) -> str | None:
         return None
     rel, t, n = off
     return (f"bearingsim: note: the first recorded rotation's I_dec is {rel:+.1%} off the mean of the {n} later "
-            f"ones (t = {t:.1f} against {start_transient_critical(n):.2f}, which {START_TRANSIENT_FALSE_ALARM:.0%} "
-            f"of steady runs pass): the warm-up did not reach a steady state, and the "
-            f"mean I_dec holds {rel / (n + 1):+.2%} of it; set more numerics.warmup_rotations (now "
+            f"ones (its test statistic t = {t:.1f} exceeds {start_transient_critical(n):.2f}, which "
+            f"{START_TRANSIENT_FALSE_ALARM:.0%} of steady runs exceed): the warm-up did not reach a steady state, "
+            f"and it biases the mean I_dec by {rel / (n + 1):+.2%}; set more numerics.warmup_rotations (now "
             f"{result.parameters.numerics.warmup_rotations}) or more numerics.rotations (docs/statistics.md)")
 
 

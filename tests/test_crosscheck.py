@@ -293,8 +293,8 @@ def test_the_closing_line_counts_the_rungs_with_notes(tmp_path, capsys):
     noted = sum(bool(notes_of(c)) for c in read_index(out / "sweep.h5")[0]["notes"])
     assert noted >= 1
     assert last.startswith("rungs: 5 done, 0 cached, 0 failed; ") and last.endswith(
-        f"; {noted} rung{'s' if noted > 1 else ''} with notes (the table's notes column; 'bearingsim table "
-        f"{out / 'sweep.h5'}' lists them)"), last
+        f"; {noted} rung{'s' if noted > 1 else ''} with notes ('bearingsim table {out / 'sweep.h5'}' marks them in "
+        f"its notes column and lists them)"), last
 
 
 def test_one_rotation_prints_no_nan_standard_error():
@@ -371,3 +371,15 @@ def test_table_of_the_folder_prints_the_ladder_and_its_verdicts(ladder, capsys):
     assert err.count("\n") == 1 and "--columns" in err and str(out / "sweep.h5") in err
     assert main(["table", str(out / "sweep.h5")]) == 0  # the case index, as before
     assert capsys.readouterr().out.splitlines()[1].split()[:3] == ["rpm", "rung", "scene"]
+
+
+def test_a_verdicts_threshold_carries_its_unit():
+    """"(significant: 3.18 SE = 0.00023)" gave the threshold without a unit, beside changes in mN s: it is in
+    mN s, t times the difference's standard error (1e-4 and 2e-4 N s: sqrt(5) 1e-4 N s = 0.224 mN s)."""
+    rows = [{"rpm": 3000.0, "rung": k, "scene": scene, "relaxed": what, "I_dec_mean_Ns": 5e-3 * (1 + k),
+             "I_dec_sem_Ns": 1e-4 * (1 + k % 2), "I_acc_mean_Ns": 3e-3, "I_acc_sem_Ns": 1e-4,
+             "first_impact_speed_m_s": 0.1, "cage_slip": 0.01, "archive": "", "wall_s": 1.0, "status": "done",
+             "error": ""} for k, scene, what in cc.rungs()[:2]]
+    (line,) = cc.verdicts(cc.add_changes(rows), rotations=10)
+    t = cc.critical_ses(1e-4, 2e-4, 5, 5)
+    assert f"(significant: {t:.3g} SE = {t * math.sqrt(5) * 1e-1:.2g} mN s)" in line, line

@@ -1263,8 +1263,8 @@ def test_a_runs_notes_are_kept_in_the_sweeps_index_table_and_report(tmp_path, ca
         assert list(cols["status"]) == ["cached" if again else "done"] * 2
         assert cols["notes"][0] == "" and "bearing.pocket_clearance_mm = 0.3" in cols["notes"][1], cols["notes"]
         assert "outside the plausible range" in cols["notes"][1] and "bearingsim: note:" not in cols["notes"][1]
-        assert printed.rstrip().splitlines()[-1].endswith(f"1 case with notes (the table's notes column; "
-                                                          f"'bearingsim table {out}' lists them)"), printed
+        assert printed.rstrip().splitlines()[-1].endswith(f"1 case with notes ('bearingsim table {out}' marks them "
+                                                          f"in its notes column and lists them)"), printed
         assert _rows(out)[1]["notes"] == cols["notes"][1]
     text = tables.format_table(tables.table_of_index(out / "sweep.h5"))
     head, first, second = text.splitlines()[1:4]

@@ -341,7 +341,7 @@ def verdicts(rows: list[dict], rotations: int | None = None) -> list[str]:
                 sig = "not judged: no standard error from fewer than 2 rotations"
             else:
                 t = critical_ses(a["I_dec_sem_Ns"], b["I_dec_sem_Ns"], nb, nb)
-                sig = ("significant" if mark else "not significant") + f": {t:.3g} SE = {t * se * 1e3:.2g}"
+                sig = ("significant" if mark else "not significant") + f": {t:.3g} SE = {t * se * 1e3:.2g} mN s"
             parts.append(f"rung {b['rung']} {b['scene']} {d * 1e3:+.2f} mN s ({sig})")
         failed = [f"{r['rung']} {r['scene']}" for r in rs if r.get("status", "done") == "failed"]
         changes = [r for r in rs[1:] if not math.isnan(r["change_from_previous"])]

@@ -546,6 +546,20 @@ def test_a_key_given_twice_in_the_overrides_is_refused_as_a_sweep_refuses_it():
                                     overrides=["numerics.rotations=2"]).numerics.rotations == 3
 
 
+def test_a_key_given_once_dotted_and_once_in_its_sections_table_is_given_twice():
+    """``--set operating.inner_ring_speed_rpm=1000 --set 'operating={inner_ring_speed_rpm=500}'`` ran with
+    whichever came last: a section's table sets each key it holds, as those keys given one by one would
+    (docs/usage.md), so the key is given twice, in either order; keys of the table that are not given twice
+    still go with the dotted ones."""
+    path = SCENARIOS / "paper_3000rpm.toml"
+    dotted, table = "operating.inner_ring_speed_rpm=1000", "operating={inner_ring_speed_rpm=500}"
+    for sets in ([dotted, table], [table, dotted]):
+        with pytest.raises(UserError, match=r"^--set operating\.inner_ring_speed_rpm: given twice \("):
+            load_scenario(path, sets)
+    sc = load_scenario(path, ["operating.radial_load_N=900", table])
+    assert (sc.raw["operating"]["radial_load_N"], sc.raw["operating"]["inner_ring_speed_rpm"]) == (900, 500)
+
+
 @pytest.mark.parametrize("command", ["run", "show"])
 def test_a_repeated_set_is_refused_on_the_command_line(command):
     from .test_cli import assert_user_error, bearingsim as cli

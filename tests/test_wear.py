@@ -701,6 +701,8 @@ def test_life_folder_of_other_stages_or_rotations_is_refused_and_a_limit_in_othe
         assert main([*base, "--limit", "depth=0.1mm", *extra]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and words in err[0] and "--force" in err[0], err
+        # a folder of another stage count (one of the earlier default, 10) says how to resume it
+        assert ("give --stages 2 to resume it" in err[0]) == (extra[1] == "3"), err
     assert main([*base, "--limit", "depth=100um", "--stages", "2", "--rotations", "1"]) == 0
     assert read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
 

@@ -453,7 +453,10 @@ class LifeStudy(Study):
             _, attrs = archive.read_table_file(path, LIFE_FORMAT)
             held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
             what = self._differs(attrs)
-            if what:
+            if what.startswith("number of stages") and "stages" in attrs:  # e.g. one of the earlier default, 10
+                other = (f"{path}: holds a life study of another {what}; give --stages {attrs['stages']} to resume "
+                         f"it, another folder, or --force to replace it")
+            elif what:
                 other = f"{path}: holds a life study of another {what}; give another folder or --force"
             elif held != self.mapping:
                 other = (f"{path}: holds a life study with another wear mapping (--mapping {held}; this one: "

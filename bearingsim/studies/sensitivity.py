@@ -462,14 +462,17 @@ HALF_STEP_NOTE = ("S, half step: the same slope from runs at half the step (a de
 
 def format_table(rows: list[dict]) -> str:
     """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
-    quantity, S ± its standard error and the change over the key's range (n/a and why where missing)."""
+    quantity, S ± its standard error and the change over the key's range (n/a and why where missing); a
+    deterministic study's (the reduced model's, :func:`ran_half_steps`) has no standard error to show, so no
+    ± column, and S at half the step beside S instead."""
     half = ran_half_steps(rows)
-    lines = [f"{'key':34s} {'quantity':18s} {'S':>9s} {'± SE':>8s} {'over range':>10s}"
+    lines = [f"{'key':34s} {'quantity':18s} {'S':>9s}" + ("" if half else f" {'± SE':>8s}") + f" {'over range':>10s}"
              + (f" {'S, half step':>12s}" if half else "")]
     for r in rows:
         note = row_note(r)
-        lines.append(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')} "
-                     f"{_num(r['sensitivity_se'], '8.3f')} {_num(r['over_range'], '+10.3f')}"
+        se = "" if half else f" {_num(r['sensitivity_se'], '8.3f')}"
+        lines.append(f"{r['key']:34s} {r['quantity']:18s} {_num(r['sensitivity'], '+9.3f')}{se} "
+                     f"{_num(r['over_range'], '+10.3f')}"
                      + (f" {_num(float(r.get('sensitivity_half_step', math.nan)), '+12.3f')}" if half else "")
                      + (f"  ({note})" if note else ""))
     if half:

@@ -633,6 +633,26 @@ def test_a_sweep_over_an_integer_key_has_whole_ticks(tmp_path, monkeypatch):
     assert not all(float(t).is_integer() for t in drawn[1].axes[0].get_xticks())
 
 
+def test_a_reduced_sweeps_figure_says_it_has_no_error_bars(tmp_path, monkeypatch):
+    """The reduced model's sweep figure was titled "error bars: ±1 standard error" over none (its errors are 0):
+    it says the model is exact; a sweep whose cases have standard errors (here edited into the index) keeps it."""
+    import h5py
+
+    from bearingsim import plotting
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])], sets=["numerics.rotations=1"])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    drawn = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: drawn.append(fig) or Path(path))
+    plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "figs")
+    assert [ax.get_title() for ax in drawn[0].axes] == [
+        f"{sym} (exact: the reduced model has no standard error)" for sym in ("$I_{dec}$", "$I_{acc}$")]
+    with h5py.File(tmp_path / "sweep.h5", "r+") as f:
+        f["index/I_dec_sem_Ns"][0] = 1e-4
+    plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "figs2")
+    assert drawn[1].axes[0].get_title() == "$I_{dec}$ (error bars: ±1 standard error)"
+
+
 def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
     import psutil
 

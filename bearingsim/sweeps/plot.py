@@ -169,7 +169,10 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
     for ax, (name, sym) in zip(panels, QUANTITIES):
         ax.set_xlabel(axis_label(x_key))
         ax.set_ylabel(f"{sym} {Y_LABEL}")
-        ax.set_title(f"{sym} (error bars: ±1 standard error)", fontsize=9)
+        sem = cols.get(f"{name}_sem_Ns")
+        exact = sem is not None and np.all(np.nan_to_num(np.asarray(sem, dtype=float)[list(rows)], nan=1.0) == 0.0)
+        ax.set_title(f"{sym} (" + ("exact: the reduced model has no standard error" if exact
+                                   else "error bars: ±1 standard error") + ")", fontsize=9)
         if ticks is not None:
             ax.set_xticks(ticks, tick_labels)
         elif is_integer_key(x_key):  # a roller count has no 14.5

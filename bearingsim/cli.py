@@ -156,9 +156,31 @@ def _life_lines(meta: dict) -> list[str]:
 def _cmd_inspect(args) -> int:
     from bearingsim.archive import describe
 
+    folder = _folder_listing(Path(args.archive))
+    if folder is not None:
+        print(folder)
+        return 0
     index = _describe_index(args.archive)
     print(index[0] if index is not None else describe(args.archive))
     return 0
+
+
+def _folder_listing(p: Path) -> str | None:
+    """``inspect`` of a sweep's or a study's folder (one holding ``sweep.h5``): each of its study tables and
+    its case index, as ``inspect`` of each file lists it, one after the other; None for anything else (a
+    folder that holds no sweep is refused by the archive reader, naming what it is)."""
+    from bearingsim.tables import studies_of
+
+    if not (p.is_dir() and (p / "sweep.h5").is_file()):
+        return None
+    files = [f for _, f in studies_of(p)] + [p / "sweep.h5"]
+    listed = [(f, _describe_index(f)) for f in files]
+    listed = [(f, d) for f, d in listed if d is not None]
+    if not listed:
+        return None
+    head = f"{p}: a sweep or study folder; " + ("its file" if len(listed) == 1 else "its files") + " below: " + \
+        ", ".join(f.name for f, _ in listed)
+    return "\n\n".join([head, *(d[0] for _, d in listed)])
 
 
 def _is_scenario_file(path) -> bool:

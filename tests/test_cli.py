@@ -369,7 +369,7 @@ def test_a_sweep_file_given_for_an_archive_says_what_it_is(tmp_path):
 
 @pytest.mark.slow
 def test_a_sweep_folder_given_for_an_archive_sends_to_case_archives_only_when_there_are_some(tmp_path):
-    """A sweep folder given to `inspect` said "its cases' archives are in DIR/cases" of a reduced-model sweep,
+    """A sweep folder given for an archive said "its cases' archives are in DIR/cases" of a reduced-model sweep,
     whose cases keep no archive by default: there is no DIR/cases. The line says so, and names the folder
     where the cases did keep their archives (--archives all)."""
     for archives, kept in (([], False), (["--archives", "all"], True)):
@@ -378,7 +378,7 @@ def test_a_sweep_folder_given_for_an_archive_sends_to_case_archives_only_when_th
                          *archives, "-q", "--no-plots", "-o", folder)
         assert res.returncode == 0, res.stderr
         assert (folder / "cases").is_dir() == kept
-        res = bearingsim("inspect", folder)
+        res = bearingsim("show", folder)  # a command that reads an archive (inspect lists the folder's files)
         assert_user_error(res, f"{folder}: is a sweep or study folder, not an archive")
         if kept:
             assert f"its cases' archives are in {folder / 'cases'}" in res.stderr
@@ -582,7 +582,7 @@ def test_a_study_folder_given_to_plot_names_the_studys_own_table(tmp_path):
     life.mkdir()
     (life / "sweep.h5").write_bytes(b"")
     archive.write_table_file(life / "life.h5", {"stage": np.arange(2)}, {}, {"format": life_study.LIFE_FORMAT})
-    res = bearingsim("inspect", life)
+    res = bearingsim("show", life)
     assert_user_error(res, f"'bearingsim plot {life / 'life.h5'}' draws the study's figure")
     assert "sweep.h5" not in res.stderr
     # the archive finds the tables by their format (it does not import the studies): as bearingsim.tables does
@@ -733,3 +733,17 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
     res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", red, "--no-plots")
     assert res.returncode == 0 and "\u00b1" not in res.stdout and "standard error" not in res.stdout
     assert "standard errors" not in bearingsim("inspect", red).stdout
+
+
+def test_inspect_of_a_sweep_or_study_folder_lists_its_files(tmp_path):
+    """``inspect DIR`` of a sweep's folder was refused ("is a sweep or study folder, not an archive") where
+    ``table DIR`` and ``report DIR`` read it: it lists the folder's study tables and its case index, each as
+    ``inspect FILE`` lists it; a folder without a sweep is still refused in one line."""
+    out = tmp_path / "sw"
+    assert bearingsim("sweep", SCENARIOS / "paper_3000rpm.toml", "--param", "operating.inner_ring_speed_rpm=1000,2000",
+                      "-o", out, "-q", "--no-plots").returncode == 0
+    res = bearingsim("inspect", out)
+    assert res.returncode == 0, res.stderr
+    one = bearingsim("inspect", out / "sweep.h5").stdout
+    assert res.stdout == f"{out}: a sweep or study folder; its file below: sweep.h5\n\n{one}", res.stdout
+    assert_user_error(bearingsim("inspect", tmp_path), str(tmp_path), "is a directory, not an archive")

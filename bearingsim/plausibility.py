@@ -33,9 +33,8 @@ MAX_NEWTON_FAILURE_FRACTION = 0.01
 # 2 or 3) across that kink for its 60 iterations; the step then uses the last iterate, whose residual
 # was 1 to 735 N against a 970 N load, for that one step's raceway forces.
 NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converge in {fails} of {steps} steps "
-               "({share:.2%}; provenance ring_newton_failures): in those isolated steps the quasi-static ring "
-               "solve cycled where a roller's contact opens and kept its last iterate for that step's raceway "
-               "forces; runs with more than 1 % such steps are refused (docs/archive.md, provenance)")
+               "({share:.2%}; refused above 1%): those isolated steps kept the solve's last iterate for their raceway "
+               "forces (provenance ring_newton_failures, docs/archive.md)")
 # A statistically steady multibody run: the cage speed fluctuates about its mean (roller impacts move
 # it by < 1 % at 3000 rpm), it does not drift. A change from the start to the end of the recorded
 # rotations of more than this fraction of the mean cage speed is a trend (a cage still accelerating

@@ -46,8 +46,9 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     return sc
 
 
-def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None):
-    """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result.
+def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None, check_step: bool = False):
+    """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result; ``check_step``:
+    run it again at half its time step and note the change of each mean impulse (``bearingsim run --check-step``).
 
     A run that is plausible but not clean returns its result with its one-line notes in ``result.notes``,
     each also issued as a :class:`bearingsim.errors.PlausibilityWarning`. A ``dt`` the run does not read
@@ -58,7 +59,7 @@ def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None)
     from bearingsim.scenario import unread_note
     from bearingsim.simulation import run as _run
 
-    result = _run(scenario, progress=progress, sink=sink, dt=dt)
+    result = _run(scenario, progress=progress, sink=sink, dt=dt, check_step=check_step)
     note = unread_note(result.scenario, ["numerics.dt_s"]) if dt is not None else None
     if note:
         warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)

@@ -44,13 +44,15 @@ def _print_summary(result) -> None:
 
 def _cmd_run(args) -> int:
     from bearingsim.scenario import given_key_notes, given_keys, load_scenario, with_overrides
-    from bearingsim.simulation import check_run, run_scenario
+    from bearingsim.simulation import check_run, check_step_possible, run_scenario
 
     scenario = load_scenario(args.scenario, args.set)
     try:
         check_run(scenario)  # what the run would refuse before its first step: the dry run refuses it too
     except UserError as exc:  # a value a --set gave is not the file's
         raise with_overrides(exc, scenario.source, args.set) from None
+    if args.check_step:
+        check_step_possible(scenario)
     if not args.quiet:  # the keys given that have no effect on the run, or not the one asked, noted by the dry run too
         for note in given_key_notes(scenario, given_keys(args.scenario, args.set)):
             print(f"bearingsim: note: {note}", file=sys.stderr)
@@ -58,7 +60,7 @@ def _cmd_run(args) -> int:
         return _dry_run(scenario, args)
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
-                       force=args.force)
+                       force=args.force, check_step=args.check_step)
     args.written = out.archive  # from here an error of standard output is not "no archive" (main)
     if not args.quiet:
         print(f"wrote {out.archive}")
@@ -635,6 +637,9 @@ def _add_run_commands(sub) -> None:
     r.add_argument("--dry-run", action="store_true",
                    help="print the resolved scenario (every key, as TOML) and the archive it would write, refusing what "
                         "the run would refuse before its first step; run and write nothing")
+    r.add_argument("--check-step", action="store_true",
+                   help="run it again at half its time step and note how much each mean impulse changes and whether "
+                        "that is resolved (about twice the run's cost; the note goes into the archive)")
     r.set_defaults(func=_cmd_run)
 
     i = sub.add_parser("inspect", help=f"print what a file holds: {_INDEX_KINDS}")

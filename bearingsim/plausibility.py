@@ -545,3 +545,47 @@ def _few_samples_advice(result) -> str:
                 f"{nominal:.4g} rad/s (Eq. 11), so its recorded rotations took little time: check "
                 "multibody.traction_mu_max, multibody.traction_slip_ref and lubrication.drag_coefficient")
     return "raise numerics.output_rate_hz or numerics.rotations"
+
+
+def step_check_note(result, half) -> str:
+    """The note of a run checked at half its time step (``bearingsim run --check-step``): each mean impulse at
+    the step and at half of it with their standard errors (batch means; none for the reduced model, exact),
+    the change and whether it is resolved by the tables' rule (:func:`bearingsim.stats.significant`). The
+    whole bearing is chaotic: the two runs are two trajectories, so an unresolved change bounds the step's
+    error by about twice the combined standard error, not to zero (docs/statistics.md)."""
+    from bearingsim.stats import critical_ses, result_standard_errors, sem_batches, significant
+
+    dt = step_of(result)
+    se_a, se_b = result_standard_errors(result), result_standard_errors(half)
+    nb = sem_batches(len(result.per_rotation["I_dec"]))
+    parts = []
+    for q in ("I_dec", "I_acc"):
+        a, b = result.summary[f"{q}_mean_Ns"], half.summary[f"{q}_mean_Ns"]
+        ea, eb = se_a[f"{q}_sem_Ns"], se_b[f"{q}_sem_Ns"]
+        if not a > 0.0:
+            parts.append(f"{q} {a * 1e3:.4g} against {b * 1e3:.4g} mN s")
+            continue
+        rel, rel_se = b / a - 1.0, math.hypot(ea, eb) / a
+        mark = significant(b, eb, a, ea, nb, nb)
+        if mark is None:
+            verdict = "not judged: no standard error from one rotation"
+        elif ea == 0.0 and eb == 0.0:
+            verdict = "the step's error: the model is exact" if mark else "no change beyond round-off"
+        elif mark:
+            verdict = "resolved: the number depends on the step"
+        else:
+            bound = critical_ses(ea, eb, nb, nb) * rel_se
+            verdict = f"not resolved: the step's error is below about {bound:.1%}"
+        spread = f" ± {rel_se * 100:.2g}%" if rel_se > 0.0 else ""
+        parts.append(f"{q} {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {rel * 100:+.2g}%{spread} "
+                     f"({verdict})")
+    return (f"bearingsim: note: time step checked at half of it ({dt:.3g} s and {dt / 2:.3g} s): " + "; ".join(parts))
+
+
+def step_of(result) -> float:
+    """The time step [s] a result ran at (its summary's, or its provenance's), NaN for none."""
+    for where in (result.summary, result.provenance):
+        v = where.get("dt_s")
+        if isinstance(v, (int, float)) and math.isfinite(v) and v > 0:
+            return float(v)
+    return math.nan

@@ -75,7 +75,7 @@ COMPARED = ("results", "observables")
 TABLED = ("results/per_rotation",)
 
 
-def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None):
+def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None, check_step: bool = False):
     """Run a resolved scenario and return its :class:`bearingsim.results.Result`.
 
     Parameters
@@ -86,6 +86,10 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     dt : time step [s] overriding ``numerics.dt_s`` and the automatic choice; it becomes the scenario's
         ``numerics.dt_s`` (validated as that key, a refusal naming the argument: "run(): dt: ...", and
         stored with the result, so its archive reruns it).
+    check_step : run the scenario again at half the step it ran at, and add a note with the change of each mean
+        impulse and whether it is resolved (:func:`bearingsim.plausibility.step_check_note`; the second run
+        costs about twice the first and is not kept). Refused for a model without a time step
+        (:func:`check_step_possible`).
 
     The checks are those of ``bearingsim run``: the step is validated as a scenario key, the run request
     too (:func:`bearingsim.scenario.check_run_request`: a multibody run needs a warm-up rotation), and a finished
@@ -99,6 +103,8 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     if not isinstance(scenario, Scenario):
         raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
                         f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
+    if check_step:
+        check_step_possible(scenario, "run(): check_step")
     t0 = time.perf_counter()
     try:
         if dt is not None:
@@ -114,7 +120,21 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     result.provenance = {**archive.run_facts(), **result.provenance}  # the code that computed it
     result.provenance["wall_time_s"] = time.perf_counter() - t0
     result.notes = plausibility.check(result)
+    if check_step:
+        step = plausibility.step_of(result)
+        half = run(scenario.replace(**{"numerics.dt_s": step / 2.0}), progress=progress)
+        result.notes.append(plausibility.step_check_note(result, half))
     return result
+
+
+def check_step_possible(scenario: Scenario, name: str = "--check-step") -> None:
+    """Refuse a step check (``name``) of a model that has no time step: the reduced model's event method,
+    whose impacts are found to machine precision between closed-form flights."""
+    from bearingsim.errors import UserError
+
+    if scenario.model == "reduced" and scenario.reduced.method == "event":
+        raise UserError(f"{name}: the reduced model's event method has no time step to halve (its impacts are "
+                        f"exact); reduced.method = \"euler\" has one")
 
 
 def _of_argument(exc, source: str):
@@ -202,6 +222,7 @@ def run_scenario(
     exclusive: bool = True,
     notes: bool = True,
     force: bool = False,
+    check_step: bool = False,
 ) -> RunOutput:
     """Run ``scenario``, write its archive (atomically, time series streamed into it) and, optionally,
     its PNG figures, drawn from the archive as written.
@@ -221,6 +242,8 @@ def run_scenario(
         ``bearingsim run -q`` and sweep cases pass False (the counts stay in the archive's provenance)
     force : replace an archive of a different scenario at ``out`` (default: refused,
         :func:`check_same_scenario`; a rerun of the same scenario replaces its archive)
+    check_step : run it again at half its step and note the change (:func:`run`'s ``check_step``); the note is
+        in the archive with the run's others
     """
     from bearingsim import archive, outputs
     from bearingsim.errors import UserError
@@ -239,7 +262,7 @@ def run_scenario(
         if exclusive:
             outputs.clean_stale_temporaries(out.parent)
         with archive.Spool(out) as spool:
-            result = run(scenario, progress=progress, sink=spool)  # checked: exit 3 before anything is written
+            result = run(scenario, progress=progress, sink=spool, check_step=check_step)  # exit 3: nothing written
             if notes:
                 for note in result.notes:
                     log.info(note)

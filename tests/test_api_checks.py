@@ -4,6 +4,7 @@ plausibility checks of a finished run (:mod:`bearingsim.plausibility`) itself; t
 only prints what it raises."""
 from __future__ import annotations
 
+import re
 import warnings
 
 import pytest
@@ -443,3 +444,55 @@ def test_the_reduced_model_notes_a_load_zone_of_zero():
     assert len(notes("operating.radial_load_N=0", "reduced.load_zone_half_angle_deg='auto'")) == 1
     assert notes("operating.radial_load_N=1", "reduced.load_zone_half_angle_deg='auto'") == []
     assert notes("operating.radial_load_N=0") == []  # the file's 23.5 deg: the load is not read
+
+
+# --- a run checked at half its time step ---------------------------------------------------------------------
+def test_a_step_check_notes_the_change_at_half_the_step_as_a_second_run_gives_it():
+    """``run(check_step=True)`` (``bearingsim run --check-step``) runs the scenario again at half the step it ran
+    at and notes each mean impulse at both steps: the numbers are those of that second run made on its own
+    (the paper's explicit scheme, Eqs. 7-8, deterministic: equal to the last digit), the change is theirs, and
+    an exact model's change is called the step's error (no standard error to judge it by)."""
+    import re
+
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"reduced.method": "euler"})
+    r = bearingsim.run(sc, check_step=True)
+    (note,) = [n for n in r.notes if "time step checked" in n]
+    dt = r.provenance["dt_s"]
+    half = bearingsim.run(sc.replace(**{"numerics.dt_s": dt / 2}))
+    a, b = r.summary["I_dec_mean_Ns"], half.summary["I_dec_mean_Ns"]
+    assert f"({dt:.3g} s and {dt / 2:.3g} s)" in note
+    assert f"I_dec {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {(b / a - 1) * 100:+.2g}%" in note
+    assert re.search(r"I_dec [^;]*\((the step's error: the model is exact|no change beyond round-off)\)", note)
+    plain = bearingsim.run(sc)  # the check changes nothing of the run itself
+    assert plain.summary == r.summary and not any("time step checked" in n for n in plain.notes)
+
+
+def test_a_step_check_of_a_model_without_a_step_is_refused():
+    """The reduced model's event method has no time step (its impacts are found to machine precision): a step
+    check of it is refused before anything runs, in the API naming the argument and on the command line
+    naming the option, with no archive written."""
+    from bearingsim.errors import UserError
+    from .test_cli import assert_user_error
+
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")
+    with pytest.raises(UserError, match=r"^run\(\): check_step: the reduced model's event method has no time step"):
+        bearingsim.run(sc, check_step=True)
+    assert_user_error(cli("run", SCENARIOS / "paper_3000rpm.toml", "--check-step", "-o", ROOT / "never.h5"),
+                      "--check-step: the reduced model's event method has no time step")
+    assert not (ROOT / "never.h5").exists()
+
+
+@pytest.mark.slow
+def test_a_whole_bearing_runs_step_check_is_kept_in_its_archive(tmp_path):
+    """``bearingsim run --check-step`` of a whole-bearing run: the note (each impulse at both steps with the
+    change's standard error and the verdict) is printed and kept in the archive with the run's other notes."""
+    out = tmp_path / "m.h5"
+    res = cli("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "numerics.rotations=3", "--set",
+              "multibody.raceway_contact=rigid", "--check-step", "--no-plots", "-o", out)
+    assert res.returncode == 0, res.stderr
+    (line,) = [ln for ln in res.stderr.splitlines() if "time step checked at half of it" in ln]
+    assert re.search(r"I_dec [\d.]+ at the step, [\d.]+ mN s at half of it: [+-][\d.e-]+% ± [\d.e-]+% "
+                     r"\((resolved: the number depends on the step|"
+                     r"not resolved: the step's error is below about [\d.]+%)\)", line)
+    stored = bearingsim.load(out).notes
+    assert any("note: time step checked at half of it" in n for n in stored), stored

@@ -20,10 +20,12 @@ from bearingsim.wording import counted
 
 
 def _print_summary(result) -> None:
-    """The headline numbers of a finished run, each mean impulse of a whole-bearing run with its standard
-    error (:func:`bearingsim.stats.result_standard_errors`: batch means over the recorded rotations), as
-    ``bearingsim table`` gives it; the reduced model's are exact (every rotation repeats one pass)."""
+    """The headline numbers of a finished run, by their SI keys, and beside each in the units ``bearingsim
+    table`` shows: the mean impulses per pocket and cage rotation in mN s, a whole-bearing run's with their
+    standard errors (:func:`bearingsim.stats.result_standard_errors`: batch means over the recorded rotations;
+    the reduced model's are exact, every rotation repeating one pass), the cage slip in per cent."""
     from bearingsim.stats import result_standard_errors
+    from bearingsim.tables import with_error
 
     summary = result.summary
     se = result_standard_errors(result)
@@ -32,14 +34,22 @@ def _print_summary(result) -> None:
                 "load_zone_half_angle_deg", "land_normal_impulse_mean_Ns"):
         if key not in summary:
             continue
-        err = se.get(key.replace("_mean_", "_sem_"))
-        if err is None or err == 0.0:
-            print(f"  {key:28s} {summary[key]:.6g}")
-        elif err != err:  # NaN: one recorded rotation gives no scatter
-            print(f"  {key:28s} {summary[key]:.6g} (no standard error from {rotations} recorded rotation)")
-        else:
-            print(f"  {key:28s} {summary[key]:.6g} \u00b1 {err:.2g} (standard error, batch means over "
-                  f"{rotations} recorded rotations)")
+        v, err = summary[key], se.get(key.replace("_mean_", "_sem_"))
+        text = f"  {key:28s} {v:.6g}"
+        if key == "cage_slip":
+            text += f"  ({v * 100:.4g} %)"
+        elif key in ("I_dec_mean_Ns", "I_acc_mean_Ns") and err is not None:
+            if err == 0.0:
+                human = f"{v * 1e3:.5g} mN s per pocket and cage rotation"
+            elif err != err:  # NaN: one recorded rotation gives no scatter
+                human = (f"{v * 1e3:.5g} mN s per pocket and cage rotation; no standard error from {rotations} "
+                         f"recorded rotation")
+            else:
+                human = (f"{with_error(v * 1e3, err * 1e3)} mN s per pocket and cage rotation; standard error, "
+                         f"batch means over {rotations} recorded rotations")
+            text += f" \u00b1 {err:.2g}" if err == err and err > 0.0 else ""
+            text += f"  ({human})"
+        print(text)
 
 
 def _cmd_run(args) -> int:

@@ -692,7 +692,8 @@ def test_a_motion_window_longer_than_the_run_is_noted_before_it(tmp_path):
 def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_path):
     """A whole-bearing run's headline impulses are means over rotations: ``run`` and ``inspect`` print each with
     its batch-means standard error (the one ``table`` shows, docs/statistics.md), recomputed here from the archive's
-    per-rotation arrays; the reduced model's, exact, carry none."""
+    per-rotation arrays, and ``run`` beside it in mN s per pocket and cage rotation as ``table`` shows it; the
+    reduced model's, exact, carry none."""
     import math
     import re
 
@@ -700,23 +701,25 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
 
     from bearingsim import archive
     from bearingsim.stats import batch_sem, pocket_means
+    from bearingsim.tables import with_error
 
     out = tmp_path / "m.h5"
     res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "-o", out, "--no-plots",
                      "--set", "numerics.rotations=4")
     assert res.returncode == 0, res.stderr
-    shown = {m[1]: (float(m[2]), float(m[3]))
-             for m in re.finditer(r"(I_(?:dec|acc)_mean_Ns) +(\S+) \u00b1 (\S+) \(standard error, batch means over "
-                                  r"4 recorded rotations\)", res.stdout)}
+    shown = {m[1]: (float(m[2]), float(m[3]), m[4])
+             for m in re.finditer(r"(I_(?:dec|acc)_mean_Ns) +(\S+) \u00b1 (\S+)  \((\S+ \u00b1 \S+) mN s per pocket and "
+                                  r"cage rotation; standard error, batch means over 4 recorded rotations\)", res.stdout)}
     assert set(shown) == {"I_dec_mean_Ns", "I_acc_mean_Ns"}, res.stdout
     listing = bearingsim("inspect", out).stdout
     with h5py.File(out, "r") as f:
         summary = archive.group_attrs(f["results/summary"])[0]
-        for key, (mean, se) in shown.items():
+        for key, (mean, se, human) in shown.items():
             rows = f[f"results/per_rotation/{key[:5]}"][()]
             want = batch_sem(pocket_means(rows))
             assert math.isclose(se, float(f"{want:.2g}"), rel_tol=1e-12) and want > 0
             assert math.isclose(mean, float(f"{summary[key]:.6g}"), rel_tol=1e-12)
+            assert human == with_error(summary[key] * 1e3, want * 1e3)  # as bearingsim table shows it
             assert f"{key} \u00b1 {want:.2g} N s" in listing
     assert "standard errors (batch means over 4 recorded rotations)" in listing
     with h5py.File(out, "a") as f:  # a damaged archive is still listed: no error line from text per rotation
@@ -727,11 +730,12 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
     one = tmp_path / "one.h5"
     res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "-o", one, "--no-plots",
                      "--set", "numerics.rotations=1")
-    assert "(no standard error from 1 recorded rotation)" in res.stdout, res.stdout
+    assert "mN s per pocket and cage rotation; no standard error from 1 recorded rotation)" in res.stdout, res.stdout
     assert "standard errors: none (1 recorded rotation gives no scatter)" in bearingsim("inspect", one).stdout
     red = tmp_path / "p.h5"
     res = bearingsim("run", SCENARIOS / "paper_3000rpm.toml", "-o", red, "--no-plots")
     assert res.returncode == 0 and "\u00b1" not in res.stdout and "standard error" not in res.stdout
+    assert "(5.2802 mN s per pocket and cage rotation)" in res.stdout  # docs/validation.md: 5.280 mN s at 3000 rpm
     assert "standard errors" not in bearingsim("inspect", red).stdout
 
 

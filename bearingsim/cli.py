@@ -181,15 +181,19 @@ def _folder_listing(p: Path) -> str | None:
     """``inspect`` of a sweep's or a study's folder (one holding ``sweep.h5``): each of its study tables and
     its case index, as ``inspect`` of each file lists it, one after the other; None for anything else (a
     folder that holds no sweep is refused by the archive reader, naming what it is)."""
+    from bearingsim.archive import unreadable_error
     from bearingsim.tables import studies_of
 
     if not (p.is_dir() and (p / "sweep.h5").is_file()):
         return None
-    files = [f for _, f in studies_of(p)] + [p / "sweep.h5"]
-    listed = [(f, _describe_index(f)) for f in files]
-    listed = [(f, d) for f, d in listed if d is not None]
-    if not listed:
-        return None
+    files = [f for _, f in studies_of(p)] + [f for f in (p / "sweep.h5", p / "map.h5") if f.is_file()]
+    listed = []
+    for f in files:
+        described = _describe_index(f)
+        if described is None:  # what is wrong with it, as inspect of the file says (a sweep's own file is not foreign)
+            raise unreadable_error(f) or UserError(f"{f}: not a bearingsim sweep index, though a sweep writes one by "
+                                                   f"that name into its folder")
+        listed.append((f, described))
     head = f"{p}: a sweep or study folder; " + ("its file" if len(listed) == 1 else "its files") + " below: " + \
         ", ".join(f.name for f, _ in listed)
     return "\n\n".join([head, *(d[0] for _, d in listed)])

@@ -35,6 +35,11 @@ def _cmd_wear(args) -> int:
     from bearingsim.plotting import save_figure
 
     paths = [Path(a) for a in args.archive]
+    seen = {}
+    for path in paths:  # one archive twice would be one row twice, its figures drawn twice onto each other
+        first = seen.setdefault(path.resolve(), path)
+        if first is not path:
+            raise UserError(f"{path}: given twice ({first} and {path} are one file); give each archive once")
     done = [_wear_of(path, args) for path in paths]  # every archive checked before anything is written
     figures = {"wear_profile": wear.plot_wear_profile, "wear_volume": wear.plot_wear_volume}
     pngs = []

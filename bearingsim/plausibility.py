@@ -547,6 +547,20 @@ def _few_samples_advice(result) -> str:
     return "raise numerics.output_rate_hz or numerics.rotations"
 
 
+#: how the note of a step check begins (:func:`step_check_note`): a measurement asked for, not a warning
+STEP_CHECK_HEAD = "bearingsim: note: time step checked at half of it"
+
+
+def percent_text(x: float) -> str:
+    """A relative change as the step check gives it: ``+80%``, ``-1.00%``, ``+0.036%``, ``+6.2e-07%``."""
+    pc = x * 100.0
+    if abs(pc) >= 10.0:
+        return f"{pc:+.0f}%"
+    if abs(pc) >= 0.1:
+        return f"{pc:+.2f}%"
+    return f"{pc:+.2g}%"
+
+
 def step_check_note(result, half) -> str:
     """The note of a run checked at half its time step (``bearingsim run --check-step``): each mean impulse at
     the step and at half of it with their standard errors (batch means; none for the reduced model, exact),
@@ -563,7 +577,8 @@ def step_check_note(result, half) -> str:
         a, b = result.summary[f"{q}_mean_Ns"], half.summary[f"{q}_mean_Ns"]
         ea, eb = se_a[f"{q}_sem_Ns"], se_b[f"{q}_sem_Ns"]
         if not a > 0.0:
-            parts.append(f"{q} {a * 1e3:.4g} against {b * 1e3:.4g} mN s")
+            parts.append(f"{q} {a * 1e3:.4g} at the step, {b * 1e3:.4g} mN s at half of it (no impulse at the step "
+                         f"to compare with)")
             continue
         rel, rel_se = b / a - 1.0, math.hypot(ea, eb) / a
         mark = significant(b, eb, a, ea, nb, nb)
@@ -576,10 +591,10 @@ def step_check_note(result, half) -> str:
         else:
             bound = critical_ses(ea, eb, nb, nb) * rel_se
             verdict = f"not resolved: the step's error is below about {bound:.1%}"
-        spread = f" ± {rel_se * 100:.2g}%" if rel_se > 0.0 else ""
-        parts.append(f"{q} {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {rel * 100:+.2g}%{spread} "
+        spread = f" ± {percent_text(rel_se)[1:]}" if rel_se > 0.0 else ""
+        parts.append(f"{q} {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {percent_text(rel)}{spread} "
                      f"({verdict})")
-    return (f"bearingsim: note: time step checked at half of it ({dt:.3g} s and {dt / 2:.3g} s): " + "; ".join(parts))
+    return f"{STEP_CHECK_HEAD} ({dt:.3g} s and {dt / 2:.3g} s): " + "; ".join(parts)
 
 
 def step_of(result) -> float:

@@ -656,10 +656,8 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     for item in overrides or []:
         key, value = parse_override(item)
         twice = [k for k in _leaf_keys(key, value) if k in leaves]
-        if key in given or twice:  # which one was meant is not ours to guess (a sweep refuses it the same way)
-            first = given.get(key) or leaves[twice[0]]
-            raise UserError(f"--set {key if key in given else twice[0]}: given twice ({first} and {item.strip()}); "
-                            f"give it once")
+        if twice:  # which one was meant is not ours to guess (a sweep refuses it the same way)
+            raise UserError(f"--set {twice[0]}: given twice ({leaves[twice[0]]} and {item.strip()}); give it once")
         _set_dotted(raw, key, value, origin="--set")
         given[key] = item.strip()
         leaves.update(dict.fromkeys(_leaf_keys(key, value), item.strip()))

@@ -103,8 +103,6 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     if not isinstance(scenario, Scenario):
         raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
                         f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
-    if check_step:
-        check_step_possible(scenario, "run(): check_step")
     t0 = time.perf_counter()
     try:
         if dt is not None:
@@ -114,6 +112,8 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
         if dt is None:
             raise
         raise _of_argument(exc, scenario.source) from None
+    if check_step:
+        check_step_possible(scenario, "run(): check_step")
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
@@ -128,13 +128,23 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
 
 
 def check_step_possible(scenario: Scenario, name: str = "--check-step") -> None:
-    """Refuse a step check (``name``) of a model that has no time step: the reduced model's event method,
-    whose impacts are found to machine precision between closed-form flights."""
+    """Refuse, before anything runs, a step check (``name``) of a model that has no time step (the reduced
+    model's event method, whose impacts are found to machine precision between closed-form flights), and one
+    whose half step the run at half the step would refuse (:func:`check_run` of it: the euler method's step
+    count, a rigid scene's bounds), naming ``name`` and the half step."""
+    from bearingsim import plausibility
     from bearingsim.errors import UserError
 
     if scenario.model == "reduced" and scenario.reduced.method == "event":
         raise UserError(f"{name}: the reduced model's event method has no time step to halve (its impacts are "
                         f"exact); reduced.method = \"euler\" has one")
+    p = scenario.parameters
+    step = p.numerics.dt if p.numerics.dt is not None else plausibility.automatic_dt(p)
+    try:
+        check_run(scenario.replace(**{"numerics.dt_s": step / 2.0}))
+    except UserError as exc:
+        why = str(exc).removeprefix(f"{scenario.source}: ")
+        raise UserError(f"{name}: half the time step, {step / 2.0:.3g} s, is refused: {why}") from None
 
 
 def _of_argument(exc, source: str):

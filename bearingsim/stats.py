@@ -172,3 +172,22 @@ def result_standard_errors(result) -> dict[str, float]:
     scenario, its arrays from ``per_rotation``)."""
     return impulse_standard_errors(result.per_rotation["I_dec"], result.per_rotation["I_acc"],
                                    getattr(result.scenario, "model", None))
+
+
+def with_error(v: float, e: float) -> str:
+    """``v ± e`` as the tables show it: the error to 2 significant digits and the value to the same decimal place,
+    trailing zeros kept (``18.30 ± 0.17``, ``14.4070 ± 0.0095``, ``1230 ± 170``), so the text says how many digits
+    mean something; an error of 0 (an exact model's) or none (``n/a``) leaves the value at 4 significant digits,
+    and so does one beyond 10 decimals or at or above 1e4 of the unit (a damaged archive's), then with the error
+    to 2 significant digits."""
+    if not math.isfinite(e):
+        return f"{v:.4g} ± n/a"
+    if e == 0.0:
+        return f"{v:.4g} ± 0"
+    e2 = float(f"{abs(e):.2g}")
+    places = 1 - math.floor(math.log10(e2))
+    if places > 10 or e >= 1e4:
+        return f"{v:.4g} ± {e:.2g}"
+    if places < 0:  # an error of 100 or more: both to its second digit, no decimals
+        return f"{round(v, places):.0f} ± {e2:.0f}"
+    return f"{v:.{places}f} ± {e:.{places}f}"

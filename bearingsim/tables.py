@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant
+from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
 RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) (round-off), "
@@ -34,7 +34,8 @@ RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(
         "Welch-Satterthwaite degrees of freedom (each SE: batch means over rotations, batches - 1; "
         "docs/statistics.md); no mark: within that, or no SE to judge by")
 #: the line above the key of a table's ``[k]`` marks, the runs' notes (:attr:`Table.footnotes`)
-NOTES_HEAD = "notes: the runs' plausibility notes (a run that is plausible but not clean; docs/reliability.md):"
+NOTES_HEAD = ("notes: the runs' notes (of a run that is plausible but not clean, docs/reliability.md; of a step check "
+              "asked for, docs/multibody.md):")
 #: the note above a table of archives of both models
 MIXED_MODELS = ("rows of both models: the reduced model's '± 0' is its exactness (every rotation repeats its one "
                 "pass), not a measured error, and a mark against a whole-bearing row is the difference of the models, "
@@ -364,22 +365,6 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
             text = f"{v * scale:.4g}"
         cells.append(text)
     return head, cells
-
-
-def with_error(v: float, e: float) -> str:
-    """``v ± e`` as a table shows it: the error to 2 significant digits and the value to the same decimal
-    place, trailing zeros kept (``18.30 ± 0.17``, ``14.4070 ± 0.0095``), so the cell says how many digits mean
-    something; where that would print more than 10 decimals or no decimal of a large error (the error at or above
-    1e4 of the display unit, a damaged archive's), the value to 4 significant digits and the error to 2; an error
-    of 0 (an exact model's) or none (``n/a``) leaves the value at 4 significant digits."""
-    if not math.isfinite(e):
-        return f"{v:.4g} ± n/a"
-    if e == 0.0:
-        return f"{v:.4g} ± 0"
-    places = 1 - math.floor(math.log10(abs(float(f"{e:.2g}"))))
-    if not 0 <= places <= 10 or e >= 1e4:
-        return f"{v:.4g} ± {e:.2g}"
-    return f"{v:.{places}f} ± {e:.{places}f}"
 
 
 def column_keys(table: Table) -> list[str]:

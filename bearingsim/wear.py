@@ -22,6 +22,7 @@ import numpy as np
 
 from bearingsim import laws
 from bearingsim.errors import UserError
+from bearingsim.stats import with_error
 from bearingsim.wording import counted
 
 
@@ -260,7 +261,7 @@ def format_comparison(labels: list[str], reports: list[WearReport], notes: list[
     for label, rep in zip(labels, reports):
         def mean(face):
             v, e = (rep.volume_front if face == "front" else rep.volume_rear).mean(), rep.volume_sem(face)
-            return f"{v * 1e9:.4g} \u00b1 {e * 1e9:.2g}" if math.isfinite(e) else f"{v * 1e9:.4g} \u00b1 n/a"
+            return with_error(v * 1e9, e * 1e9)
         through = rep.worn_through() if math.isfinite(rep.bar_width) else None
         rows.append((label, f"{rep.hours:.4g}", f"{rep.wear_coefficient:g}", f"{rep.hardness:.3g}", mean("front"),
                      mean("rear"), f"{rep.max_depth * 1e6:.4g}", str(rep.recorded_rotations),

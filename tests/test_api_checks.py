@@ -454,17 +454,37 @@ def test_a_step_check_notes_the_change_at_half_the_step_as_a_second_run_gives_it
     an exact model's change is called the step's error (no standard error to judge it by)."""
     import re
 
+    from bearingsim.plausibility import percent_text
+
+    assert [percent_text(x) for x in (0.8, -0.01, 3.6e-4, 6.2e-9, 1.5)] == ["+80%", "-1.00%", "+0.036%", "+6.2e-07%",
+                                                                           "+150%"]
     sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"reduced.method": "euler"})
-    r = bearingsim.run(sc, check_step=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the check asked for is a measurement in result.notes, not a warning
+        r = bearingsim.run(sc, check_step=True)
     (note,) = [n for n in r.notes if "time step checked" in n]
     dt = r.provenance["dt_s"]
     half = bearingsim.run(sc.replace(**{"numerics.dt_s": dt / 2}))
     a, b = r.summary["I_dec_mean_Ns"], half.summary["I_dec_mean_Ns"]
     assert f"({dt:.3g} s and {dt / 2:.3g} s)" in note
-    assert f"I_dec {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {(b / a - 1) * 100:+.2g}%" in note
+    assert f"I_dec {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {percent_text(b / a - 1)}" in note
     assert re.search(r"I_dec [^;]*\((the step's error: the model is exact|no change beyond round-off)\)", note)
     plain = bearingsim.run(sc)  # the check changes nothing of the run itself
     assert plain.summary == r.summary and not any("time step checked" in n for n in plain.notes)
+
+
+def test_a_step_check_whose_half_step_would_be_refused_is_refused_before_anything_runs(tmp_path):
+    """An euler step just above its floor: half of it needs more steps than a run takes. The check refused it
+    only after the first run had finished, blaming the scenario file for a step it does not hold, and the dry
+    run let it through: refused before anything runs, naming --check-step and the half step, dry run too."""
+    from .test_cli import assert_user_error
+
+    args = ["run", SCENARIOS / "paper_3000rpm.toml", "--set", "reduced.method=euler", "--set", "numerics.dt_s=4.1e-10",
+            "--check-step", "-o", tmp_path / "e.h5", "--no-plots"]
+    for extra in ([], ["--dry-run"]):
+        assert_user_error(cli(*args, *extra), "--check-step: half the time step, 2.05e-10 s, is refused: "
+                                              "numerics.dt_s: 2.05e-10 s needs")
+    assert not (tmp_path / "e.h5").exists()
 
 
 def test_a_step_check_of_a_model_without_a_step_is_refused():

@@ -748,6 +748,9 @@ def test_inspect_of_a_sweep_or_study_folder_lists_its_files(tmp_path):
                       "-o", out, "-q", "--no-plots").returncode == 0
     res = bearingsim("inspect", out)
     assert res.returncode == 0, res.stderr
-    one = bearingsim("inspect", out / "sweep.h5").stdout
-    assert res.stdout == f"{out}: a sweep or study folder; its file below: sweep.h5\n\n{one}", res.stdout
+    index, grid = (bearingsim("inspect", out / name).stdout for name in ("sweep.h5", "map.h5"))
+    assert res.stdout == f"{out}: a sweep or study folder; its files below: sweep.h5, map.h5\n\n{index}\n{grid}", \
+        res.stdout
     assert_user_error(bearingsim("inspect", tmp_path), str(tmp_path), "is a directory, not an archive")
+    (out / "sweep.h5").write_bytes((out / "sweep.h5").read_bytes()[:3000])  # damaged: said as inspect FILE says it
+    assert_user_error(bearingsim("inspect", out), f"{out / 'sweep.h5'}: damaged or truncated file")

@@ -558,6 +558,8 @@ def test_a_key_given_once_dotted_and_once_in_its_sections_table_is_given_twice()
             load_scenario(path, sets)
     sc = load_scenario(path, ["operating.radial_load_N=900", table])
     assert (sc.raw["operating"]["radial_load_N"], sc.raw["operating"]["inner_ring_speed_rpm"]) == (900, 500)
+    sc = load_scenario(path, ["operating={radial_load_N=900}", table])  # two tables of other keys: none twice
+    assert (sc.raw["operating"]["radial_load_N"], sc.raw["operating"]["inner_ring_speed_rpm"]) == (900, 500)
 
 
 @pytest.mark.parametrize("command", ["run", "show"])

@@ -236,7 +236,7 @@ def test_a_table_of_archives_marks_and_lists_the_notes_they_store(reduced_runs, 
     head = next(i for i, line in enumerate(lines) if line.startswith("archive"))
     assert lines[head].split()[:2] == ["archive", "bearing.pocket_clearance_mm"] and "notes" in lines[head].split()
     assert "[1]" not in lines[head + 1] and "[1]" in lines[head + 2]
-    assert lines[head + 3].startswith("notes: the runs' plausibility notes")
+    assert lines[head + 3].startswith("notes: the runs' notes (of a run that is plausible but not clean")
     assert lines[head + 4].startswith("[1] bearing.pocket_clearance_mm = 0.3"), lines
     assert tables.table_of_archives([reduced_runs / "a.h5"]).footnotes == {}
 
@@ -469,7 +469,8 @@ def test_the_cage_slip_is_shown_in_per_cent_with_its_unit():
 
 @pytest.mark.parametrize("v, e, text", [(18.3, 0.17, "18.30 ± 0.17"), (14.407, 0.0095, "14.4070 ± 0.0095"),
                                         (15.6, 0.7, "15.60 ± 0.70"), (18.3, 2.5, "18.3 ± 2.5"),
-                                        (1834.2, 25.0, "1834 ± 25"), (15.19, 3.1e31, "15.19 ± 3.1e+31"),
+                                        (1834.2, 25.0, "1834 ± 25"), (1234.5, 170.0, "1230 ± 170"),
+                                        (15.19, 3.1e31, "15.19 ± 3.1e+31"),
                                         (5.28, 0.0, "5.28 ± 0"), (5.28, math.nan, "5.28 ± n/a"),
                                         (0.5, 1e-12, "0.5 ± 1e-12")])
 def test_a_value_is_shown_to_its_errors_decimal_place(v, e, text):

@@ -280,6 +280,7 @@ def test_wear_of_several_archives_is_one_table_of_their_volumes_with_errors(fast
     from bearingsim import wear
     from bearingsim.cli import main
     from bearingsim.simulation import load, run_scenario
+    from bearingsim.stats import with_error
 
     sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["numerics.rotations=2", "multibody.raceway_contact=rigid",
                                                                    "wear.wear_coefficient=1e-5", "wear.hardness_Pa=1.2e8"])
@@ -296,7 +297,7 @@ def test_wear_of_several_archives_is_one_table_of_their_volumes_with_errors(fast
         assert cells[0] == path.name and cells[2] == f"{rep.wear_coefficient:g}"
         for cell, face in zip(cells[4:6], ("front", "rear")):
             v = (rep.volume_front if face == "front" else rep.volume_rear).mean()
-            assert cell == f"{v * 1e9:.4g} \u00b1 {rep.volume_sem(face) * 1e9:.2g}"
+            assert cell == with_error(v * 1e9, rep.volume_sem(face) * 1e9)  # as bearingsim table shows a value
         assert cells[7] == "2"
     twin = tmp_path / "twin"
     twin.mkdir()
@@ -305,6 +306,9 @@ def test_wear_of_several_archives_is_one_table_of_their_volumes_with_errors(fast
     out, err = capsys.readouterr()
     assert code == 2 and out == "" and "would draw their figures onto each other" in err
     assert not list((tmp_path / "f").glob("*.png"))
+    code = main(["wear", str(fast_run[1]), str(fast_run[1]), "--hours", "1"])  # one archive twice: one row twice
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and f"{fast_run[1]}: given twice" in err and "None" not in err, err
     red = tmp_path / "red.h5"
     run_scenario(load_scenario(str(SCENARIOS / "paper_3000rpm.toml")), red, figures=False, notes=False)
     code = main(["wear", str(fast_run[1]), str(red), "--hours", "1", "--no-plots"])

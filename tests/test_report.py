@@ -400,7 +400,7 @@ def test_a_sweep_pages_notes_marks_have_their_key_under_the_table(tmp_path):
     html = bearingsim.report(tmp_path / "s", tmp_path / "s.html").read_text()
     section = re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1)
     text = html_text.unescape(re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", section)))
-    table, after = text.split("notes: the runs' plausibility notes")
+    table, after = text.split("notes: the runs' notes (of a run that is plausible")
     assert "[1]" in table, text
     assert "[1] bearing.pocket_clearance_mm = 0.3" in after, text
 

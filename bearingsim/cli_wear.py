@@ -67,12 +67,10 @@ def _comparison(paths, done) -> str:
     """The table of several archives' wear (:func:`bearingsim.wear.format_comparison`), labelled as
     ``bearingsim table`` labels archives, with the scenario keys that differ between them above it."""
     from bearingsim import wear
-    from bearingsim.scenario import flatten
+    from bearingsim.scenario import differing_keys
     from bearingsim.tables import distinguishing_labels
 
-    flat = [flatten(result.scenario.raw) for result, _ in done]
-    differ = [k for k in sorted(set().union(*flat)) if k != "name"
-              and len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    differ = [row[0] for row in differing_keys(*(result.scenario.raw for result, _ in done)) if row[0] != "name"]
     notes = [f"wear of {len(paths)} archives, each after the running time at its own speed; scenario keys that "
              f"differ: {', '.join(differ) if differ else 'none'}"]
     return wear.format_comparison(distinguishing_labels(paths), [rep for _, rep in done], notes)

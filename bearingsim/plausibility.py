@@ -533,7 +533,7 @@ def _few_samples_advice(result) -> str:
     and the run length themselves."""
     p = result.parameters
     rate = p.numerics.output_rate
-    dt = float(result.provenance.get("dt_s", float("nan")))
+    dt = step_of(result)
     if math.isfinite(dt) and dt * rate > 1.0:
         step = _given_step_advice(result)
         return step or (f"the step {dt:.3g} s is longer than the sampling interval 1/numerics.output_rate_hz = "
@@ -598,9 +598,5 @@ def step_check_note(result, half) -> str:
 
 
 def step_of(result) -> float:
-    """The time step [s] a result ran at (its summary's, or its provenance's), NaN for none."""
-    for where in (result.summary, result.provenance):
-        v = where.get("dt_s")
-        if isinstance(v, (int, float)) and math.isfinite(v) and v > 0:
-            return float(v)
-    return math.nan
+    """The time step [s] a result ran at (its provenance's ``dt_s``), NaN for none (the reduced event method)."""
+    return float(result.provenance.get("dt_s", math.nan))

@@ -429,14 +429,16 @@ def _sweep_sections(index: Path):
 
 
 def _crosscheck_sections(table: Path):
+    from bearingsim import tables
     from bearingsim.studies import crosscheck as cc
 
     rows, meta = cc.read_table(table)
+    slip, slip_unit = tables.shown_as("cage_slip", "1")
     head = ["rpm", "rung", "scene", "relaxed", "I_dec [mN s]", "I_acc [mN s]", "first impact speed [m/s]",
-            "cage slip [%]", "change of I_dec [mN s]"]
+            f"cage slip [{slip_unit}]", "change of I_dec [mN s]"]
     cells = [[_cell(r["rpm"]), str(r["rung"]), r["scene"], r["relaxed"], _pm(r["I_dec_mean_Ns"], r["I_dec_sem_Ns"]),
               _pm(r["I_acc_mean_Ns"], r["I_acc_sem_Ns"]), _cell(r["first_impact_speed_m_s"]),
-              _cell(r["cage_slip"], 100.0, digits=3), _cell(r["change_from_previous"], 1e3)] for r in rows]
+              _cell(r["cage_slip"], slip, digits=3), _cell(r["change_from_previous"], 1e3)] for r in rows]
     blocks = [table_block("Impulses per pocket and cage rotation, mean over all pockets ± batch-means standard "
                           "error; each rung drops one assumption of the paper's model (docs/crosscheck.md)", head, cells,
                           [True, True, False, False, True, True, True, True, True]),

@@ -619,14 +619,6 @@ def parse_toml_text(text: str, where: str) -> dict[str, Any]:
     return raw
 
 
-def _leaf_keys(key: str, value) -> list[str]:
-    """The dotted keys an override ``key = value`` sets: ``key`` itself, or for a table (``operating={...}``)
-    each key it holds, as those keys given one by one would."""
-    if isinstance(value, dict) and value:
-        return [leaf for k, v in value.items() for leaf in _leaf_keys(f"{key}.{k}", v)]
-    return [key]
-
-
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
                   values: dict[str, Any] | None = None) -> Scenario:
     """Read, merge with preset and defaults, apply overrides, and validate.
@@ -655,12 +647,13 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     leaves = {}  # every dotted key an override sets (a section's table sets each key it holds) -> that override
     for item in overrides or []:
         key, value = parse_override(item)
-        twice = [k for k in _leaf_keys(key, value) if k in leaves]
+        set_keys = list(flatten({key: value})) or [key]  # a table (operating={...}) sets each key it holds
+        twice = [k for k in set_keys if k in leaves]
         if twice:  # which one was meant is not ours to guess (a sweep refuses it the same way)
             raise UserError(f"--set {twice[0]}: given twice ({leaves[twice[0]]} and {item.strip()}); give it once")
         _set_dotted(raw, key, value, origin="--set")
         given[key] = item.strip()
-        leaves.update(dict.fromkeys(_leaf_keys(key, value), item.strip()))
+        leaves.update(dict.fromkeys(set_keys, item.strip()))
     for key, value in (values or {}).items():
         if not isinstance(key, str) or not key or any(not part for part in key.split(".")):
             raise UserError(f"set: {key!r}: expected a dotted key such as operating.inner_ring_speed_rpm")

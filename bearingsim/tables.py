@@ -51,6 +51,12 @@ SCALED = {"N s": (1e3, "mN s")}
 SCALED_KEYS = {"cage_slip": (100.0, "%")}
 
 
+def shown_as(key: str, unit: str) -> tuple[float, str]:
+    """(scale, unit) in which the tables show summary key ``key`` of SI unit ``unit``: cage slip in per cent,
+    impulses in mN s, the rest as stored (``bearingsim run`` and the report's tables show them so too)."""
+    return SCALED_KEYS.get(key, SCALED.get(unit, (1.0, unit)))
+
+
 @dataclass
 class Table:
     """Rows of runs: ``labels[name]`` (text per row), ``numbers[key]`` (float per row, SI),
@@ -141,14 +147,14 @@ def table_of_archives(paths) -> Table:
     differ between them (at most 4 as columns; the others listed in ``notes``), and its notes' mark
     (:func:`_run_notes`); the standard errors computed from each archive's per-rotation impulses
     (:func:`bearingsim.stats.result_standard_errors`)."""
-    from bearingsim.scenario import flatten
+    from bearingsim.scenario import differing_keys, flatten
     from bearingsim.simulation import TABLED, load
     from bearingsim.stats import result_standard_errors
     from bearingsim.wording import run_notes
 
     results = [load(p, only=TABLED) for p in paths]
     flat = [flatten(r.scenario.raw) for r in results]
-    differ = [k for k in sorted(set().union(*flat)) if len({repr(f.get(k, "(unset)")) for f in flat}) > 1]
+    differ = [row[0] for row in differing_keys(*(r.scenario.raw for r in results))]
     shown = [k for k in differ if k != "name"][:4]
     names = ["archive", *shown]
     labels = {"archive": distinguishing_labels(paths)}
@@ -344,7 +350,7 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
     """Header and cells of number column ``key`` (with its standard error and marks when it has one,
     against the first row that has a number)."""
     unit = table.units.get(key, "1")
-    scale, shown = SCALED_KEYS.get(key, SCALED.get(unit, (1.0, unit)))
+    scale, shown = shown_as(key, unit)
     head = _bare(key) + ("" if shown == "1" else f" [{shown}]")
     x = table.numbers[key]
     finite = np.flatnonzero(np.isfinite(x))

@@ -107,17 +107,34 @@ def whatif(rpms=(3000, 6000), sets=()):
                   f"{xb.mean() * 1e3:.2f} ± {batch_sem(xb) * 1e3:.2f} |", flush=True)
 
 
-def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
-    """docs/wear.md's life study to the deepest point's limit, ``depth=0.1mm`` (or ``--limit=clearance=0.4mm``), with the worn shape fed back (the
-    default), on the fast scene (``--set multibody.raceway_contact=rigid``, k = 6e-4, 10 stages of 1 warm-up +
-    10 rotations), its wear profile recorded and fed back in other bin counts. The stages run in a worker
-    process forked from this one, which carries the changed bin count."""
+def _life_of(sets, limit: str, stages: int, mapping: str = "shape") -> tuple[dict, str]:
+    """docs/wear.md's rigid life study (``wear_test_6000rpm``, k = 6e-4, stages of 1 warm-up + 10 rotations) in a
+    temporary folder: its history's columns, and what wore through the cage bar before the limit ("" if none).
+    A stage that fails raises its UserError."""
     import tempfile
 
-    from bearingsim.errors import UserError
-    from bearingsim.multibody import recorder
     from bearingsim.scenario import load_scenario
     from bearingsim.studies.life import parse_limit, read_life, run_life
+
+    sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
+                       ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
+    with tempfile.TemporaryDirectory() as d:
+        c = run_life(sc, d, parse_limit(limit), stages=stages, rotations=10, mapping=mapping)
+        return c, read_life(f"{d}/life.h5")[1].get("worn_through") or ""
+
+
+def _end(c: dict, worn: str) -> str:
+    """The start of a row whose life ended where a cage bar wore through, before its limit."""
+    return f"not reached: the cage bar wears through first, in stage {c['stage'][-1]} ({worn}); " if worn else ""
+
+
+def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
+    """docs/wear.md's life study to the deepest point's limit, ``depth=0.1mm`` (or ``--limit=clearance=0.4mm``),
+    with the worn shape fed back (the default), on the fast scene (``--set multibody.raceway_contact=rigid``,
+    k = 6e-4, 10 stages of 1 warm-up + 10 rotations), its wear profile recorded and fed back in other bin counts.
+    The stages run in a worker process forked from this one, which carries the changed bin count."""
+    from bearingsim.errors import UserError
+    from bearingsim.multibody import recorder
 
     saved = recorder.accumulators.__defaults__, recorder.FACE_BINS
     print("| bins of psi | rotations to the limit | hours | deepest point's rate, first / last stage [mm/h] | I_dec, first / last stage [mN s] |")
@@ -125,19 +142,15 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
     try:
         for nb in bins:
             recorder.accumulators.__defaults__, recorder.FACE_BINS = (nb,), nb
-            sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
-                               ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
-            with tempfile.TemporaryDirectory() as d:
-                try:
-                    c = run_life(sc, d, parse_limit(limit), stages=10, rotations=10)
-                except UserError as exc:  # a stage that failed: a finding
-                    print(f"| {nb} | {exc} | | | |", flush=True)
-                    continue
-                worn = read_life(f"{d}/life.h5")[1].get("worn_through")  # the cage bar before the limit
+            try:
+                c, worn = _life_of(sets, limit, 10)
+            except UserError as exc:  # a stage that failed: a finding
+                print(f"| {nb} | {exc} | | | |", flush=True)
+                continue
             rate = c["max_depth_rate_um_per_h"]
-            end = f"not reached: the cage bar wears through first, in stage {c['stage'][-1]} ({worn}); " if worn else ""
-            print(f"| {nb} | {end}{c['rotations_end'][-1]:.0f} | {c['hours_end'][-1]:.4g} | {rate[0] / 1e3:.2f} / "
-                  f"{rate[-1] / 1e3:.2f} | {c['I_dec_mean_mNs'][0]:.2f} / {c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
+            print(f"| {nb} | {_end(c, worn)}{c['rotations_end'][-1]:.0f} | {c['hours_end'][-1]:.4g} | "
+                  f"{rate[0] / 1e3:.2f} / {rate[-1] / 1e3:.2f} | {c['I_dec_mean_mNs'][0]:.2f} / "
+                  f"{c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
     finally:
         recorder.accumulators.__defaults__, recorder.FACE_BINS = saved
 
@@ -148,30 +161,23 @@ def stages(counts=(5, 10, 20), sets=(), limit="depth=0.1mm", mapping="shape"):
     (``--bins`` gives the counts): a life is the wear integrated stage by stage, each stage at the wear rate its
     run measured, so the stage count is a discretization of that integral; the table shows how the life moves
     with it."""
-    import tempfile
-
     from bearingsim.errors import UserError
-    from bearingsim.scenario import load_scenario
-    from bearingsim.studies.life import parse_limit, run_life
 
     print(f"| stages | rotations to the limit ({limit}, {mapping} mapping) | hours | change from the previous row | "
           "I_dec, first / last stage [mN s] |")
     print("|---|---|---|---|---|")
     before = None
     for n in counts:
-        sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
-                           ["multibody.raceway_contact=rigid", "wear.wear_coefficient=6e-4", *sets])
-        with tempfile.TemporaryDirectory() as d:
-            try:
-                c = run_life(sc, d, parse_limit(limit), stages=n, rotations=10, mapping=mapping)
-            except UserError as exc:  # a stage that failed, or a bar worn through first: a finding
-                print(f"| {n} | {exc} | | | |", flush=True)
-                continue
+        try:
+            c, worn = _life_of(sets, limit, n, mapping)
+        except UserError as exc:  # a stage that failed: a finding
+            print(f"| {n} | {exc} | | | |", flush=True)
+            continue
         end = float(c["rotations_end"][-1])
         change = f"{end / before - 1:+.1%}" if before else ""
         before = end
-        print(f"| {n} | {end:.0f} | {c['hours_end'][-1]:.4g} | {change} | {c['I_dec_mean_mNs'][0]:.2f} / "
-              f"{c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
+        print(f"| {n} | {_end(c, worn)}{end:.0f} | {c['hours_end'][-1]:.4g} | {change} | "
+              f"{c['I_dec_mean_mNs'][0]:.2f} / {c['I_dec_mean_mNs'][-1]:.2f} |", flush=True)
 
 
 def psi(bins=(16, 32, 64, 128), sets=()):

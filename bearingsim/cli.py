@@ -338,6 +338,7 @@ def _study_table_drawer(path):
 def _cmd_rerun(args) -> int:
     from bearingsim.simulation import load as read
     from bearingsim.compare import compare_results
+    from bearingsim.plausibility import STEP_CHECK_HEAD
     from bearingsim.simulation import COMPARED, run, run_scenario
 
     if args.force and not args.output:  # it was accepted and did nothing: a rerun without -o writes nothing
@@ -345,13 +346,14 @@ def _cmd_rerun(args) -> int:
                         "scenario there); without -o the rerun writes nothing")
     old = read(args.archive, only=COMPARED)
     progress = not args.quiet and sys.stderr.isatty()
+    check_step = any(n.startswith(STEP_CHECK_HEAD) for n in old.notes)  # the check the archive holds, repeated
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
         run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=not args.quiet,
-                     force=args.force)
+                     force=args.force, check_step=check_step)
         args.written = Path(args.output)
         new = read(args.output, only=COMPARED)  # as written: its time series went to the file, not the result
     else:
-        new = run(old.scenario, progress=progress)
+        new = run(old.scenario, progress=progress, check_step=check_step)
         for note in new.notes if not args.quiet else ():  # the rerun's notes, as `run` prints them
             print(note, file=sys.stderr)
     c = compare_results(old, new)  # the versions: the rerun's provenance holds this code's (simulation.run)

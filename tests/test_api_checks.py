@@ -516,3 +516,11 @@ def test_a_whole_bearing_runs_step_check_is_kept_in_its_archive(tmp_path):
                      r"not resolved: the step's error is below about [\d.]+%)\)", line)
     stored = bearingsim.load(out).notes
     assert any("note: time step checked at half of it" in n for n in stored), stored
+    # a rerun repeats the check its archive holds: with -o the new archive keeps the same note (it lost it),
+    # without -o the note is printed as run prints it; both bit for bit the original's (runs are deterministic)
+    again = tmp_path / "again.h5"
+    res = cli("rerun", out, "-o", again)
+    assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr
+    assert bearingsim.load(again).notes == stored
+    res = cli("rerun", out)
+    assert res.returncode == 0 and line in res.stderr.splitlines(), res.stderr

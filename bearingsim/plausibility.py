@@ -170,7 +170,7 @@ def check(result) -> list[str]:
         if samples < MIN_ORBIT_SAMPLES:
             raise SimulationUnstable(f"{counted(samples, 'time-series sample')} recorded; {_few_samples_advice(result)}")
         for note in (cage_speed_drift(result), start_transient(result), warmup_not_judged(result),
-                     cage_rest_change(result)):
+                     cage_rest_change(result), impact_table_note(result)):
             if note is not None:
                 notes.append(note)
         fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
@@ -183,6 +183,20 @@ def check(result) -> list[str]:
                     "multibody.inner_ring=dynamic")
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def impact_table_note(result) -> str | None:
+    """The note of a run whose impact table (``/results/impacts``) filled its rows (``multibody.core.
+    IMPACT_CAPACITY``; provenance ``impacts_table_full``): up to when it lists impacts. The impulses, wear and
+    every other result are summed in the step loop, not from the table, and count every impact."""
+    if not result.provenance.get("impacts_table_full", False):
+        return None
+    imp = result.impacts
+    rows, rotations = len(imp["time_s"]), int(result.parameters.numerics.rotations)
+    when = (f" in recorded rotation {int(imp['rotation'][-1]) + 1} of {rotations} (t = {float(imp['time_s'][-1]):.4g} s)"
+            if rows else "")
+    return (f"bearingsim: note: the impact table filled its {rows} rows{when}: /results/impacts lists the impacts "
+            "up to there only; the impulses, wear and every other result count every impact")
 
 
 def _lift_off_note(p) -> str | None:

@@ -524,3 +524,27 @@ def test_a_whole_bearing_runs_step_check_is_kept_in_its_archive(tmp_path):
     assert bearingsim.load(again).notes == stored
     res = cli("rerun", out)
     assert res.returncode == 0 and line in res.stderr.splitlines(), res.stderr
+
+
+def test_a_full_impact_table_is_noted_and_kept_in_the_archive(tmp_path, monkeypatch):
+    """The impact table holds at most ``core.IMPACT_CAPACITY`` rows (200 000: about 600 recorded rotations at
+    3000 rpm); beyond it the recorder drops rows, and a run said nothing of it (the table's description still
+    said "in the recorded rotations"). Shrunk to 20 rows here: the run notes that the table stops early, in
+    which rotation, and that the impulses count every impact; the note and the provenance flag are archived.
+    The impulses do not depend on the table: the same run with the full table gives them bit for bit."""
+    from bearingsim.multibody import core
+
+    sc = bearingsim.load_scenario(MULTIBODY, overrides=["multibody.raceway_contact=rigid", "numerics.rotations=2"])
+    full = bearingsim.run(sc)
+    assert len(full.impacts["face"]) > 20 and not full.provenance.get("impacts_table_full", False)
+    assert not any("impact table" in n for n in full.notes), full.notes
+    monkeypatch.setattr(core, "IMPACT_CAPACITY", 20)
+    r = bearingsim.run(sc)
+    assert len(r.impacts["face"]) == 20 and r.provenance["impacts_table_full"] is True
+    last = int(r.impacts["rotation"][-1])
+    (note,) = [n for n in r.notes if "impact table" in n]
+    assert f"filled its 20 rows in recorded rotation {last + 1} of 2" in note and "count every impact" in note, note
+    assert r.summary["I_dec_mean_Ns"] == full.summary["I_dec_mean_Ns"]
+    r.save(tmp_path / "t.h5")
+    back = bearingsim.load(tmp_path / "t.h5")
+    assert note in back.notes and back.provenance["impacts_table_full"] is True

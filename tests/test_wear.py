@@ -1253,7 +1253,10 @@ def test_wear_figures_use_one_fixed_unit_per_quantity(fast_run, monkeypatch):
         heights.append(np.array([b.get_height() for b in ax.patches]))
     np.testing.assert_allclose(heights[1], 1000.0 * heights[0], rtol=1e-12)
     monkeypatch.setattr(res, "get", get)
-    per_hour = 3600.0 * p.operating.omega_c / (2.0 * math.pi)  # cage rotations per hour
+    # per hour at the run's measured cage speed, as `bearingsim wear --hours 1` (it took the nominal epicyclic
+    # speed, 1 + slip times the report's: 0.4 % apart at 6000 rpm)
+    np.testing.assert_allclose(heights[0][32:48], res.wear_report(hours=1.0).volume_front * 1e9, rtol=1e-12)
+    per_hour = 3600.0 * res.summary["cage_speed_mean_rad_s"] / (2.0 * math.pi)  # cage rotations per hour
     np.testing.assert_allclose(heights[0][32:48], get("wear/sliding_work_front") * per_hour * 1e9, rtol=1e-12)
     for hours in (1e-3, 1e5):
         for fig in (res.plot_wear_profile(hours=hours), res.plot_wear_volume(hours=hours)):

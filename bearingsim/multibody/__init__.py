@@ -414,6 +414,8 @@ def _provenance(raw) -> dict:
         "solver_wall_s": float(raw.wall_s), "pymunk_step_s": float(raw.pymunk_step_s),
         "step_loop": raw.step_loop, "step_loop_reason": raw.step_loop_reason,
     }
+    if raw.impacts_dropped:  # the impact table stopped at its capacity (plausibility.impact_table_note)
+        provenance["impacts_table_full"] = True
     if su.t_start > 0.0:  # rigid raceways: the cage's settling at a step of its own
         provenance.update(start_phase_s=float(su.t_start), start_phase_dt_s=float(su.dt_start))
     return provenance
@@ -484,7 +486,9 @@ class MultibodyResult(Result):
                                                 "pockets": p.bearing.roller_count}, {**units, "pockets": "1"})}
         tables = {"results/impacts": f"roller-cage impacts (approach speed > {IMPACT_SPEED_THRESHOLD_M_S} m/s) in the "
                                      "recorded rotations; face 'rear' or 'front'; impulse = normal impulse; theta of the "
-                                     "pocket centre; rotation = row of /results/per_rotation the impact counts in"}
+                                     "pocket centre; rotation = row of /results/per_rotation the impact counts in"
+                                     + ("; the table filled up: its first rows only (provenance impacts_table_full)"
+                                        if raw.impacts_dropped else "")}
         res = cls(None, data, groups, provenance=_provenance(raw), tables=tables, raw=raw)
         res._parameters = p
         return res
@@ -571,9 +575,10 @@ class MultibodyResult(Result):
     def plot_wear(self):
         """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
         from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
+        from bearingsim.wear import running_time
 
-        op = self.parameters.operating
-        per_hour = 3600.0 * op.omega_c / (2.0 * math.pi) * 1e9  # cage rotations per hour, m^3 -> mm^3 (the text's)
+        # cage rotations per hour at the run's measured cage speed, as `bearingsim wear`; m^3 -> mm^3 (the text's)
+        per_hour = running_time(self, hours=1.0)[2] * 1e9
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = subplots(figsize=(9, 4))
         bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16)"),

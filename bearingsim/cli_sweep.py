@@ -46,9 +46,7 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     out = run_sweep(spec, outdir, engine=engine, figures=figures, force=force, archives=archives,
                     progress=progress if progress is not None else (not quiet and sys.stderr.isatty()))
     n = len(out.rows)
-    counts = f"{out.count('done')} done, {out.count('cached')} cached, {out.count('failed')} failed"
-    if out.count("stale"):
-        counts += f", {out.count('stale')} stale (computed by another model version: run again)"
+    counts = out.counts()
     if out.interrupted is not None:
         print(f"bearingsim: sweep interrupted ({signal.Signals(out.interrupted).name}): {counts}, "
               f"{out.count('pending')} not run, of {n}; index {out.h5}; run the same command again to resume",

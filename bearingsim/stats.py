@@ -42,12 +42,15 @@ def significant(x: float, se: float, x0: float, se0: float, batches: int = BATCH
     (:func:`critical_ses`: Student's t of the Welch-Satterthwaite degrees of freedom of ``se`` and ``se0``,
     each from ``batches`` / ``batches0`` batch means, :func:`sem_batches`) and exceeds :data:`ROUND_OFF_REL`
     of the larger magnitude (round-off is no difference); None when it cannot be judged (a number or a
-    standard error missing: None or NaN)."""
+    standard error missing: None or NaN; a non-zero standard error of a single batch mean)."""
     vals = (x, se, x0, se0)
     if any(v is None or not math.isfinite(v) for v in vals):
         return None
     floor = ROUND_OFF_REL * max(abs(x), abs(x0))
-    return abs(x - x0) > max(critical_ses(se, se0, batches, batches0) * math.hypot(se, se0), floor)
+    t = critical_ses(se, se0, batches, batches0)
+    if math.isnan(t):  # a standard error of one batch mean: no degrees of freedom, no t
+        return None
+    return abs(x - x0) > max(t * math.hypot(se, se0), floor)
 
 
 def critical_ses(se: float, se0: float, batches: int = BATCHES, batches0: int = BATCHES) -> float:

@@ -299,6 +299,8 @@ def test_resume_reruns_archives_of_another_model_version(tmp_path):
     again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in again.rows] == ["cached", "stale", "stale"]
     assert again.count("stale") == 2
+    # the count says what was done, not what to do: the stale cases ran already (it read "run again")
+    assert again.counts() == "0 done, 1 cached, 0 failed, 2 stale (another model version's: computed again)"
     assert archives[0].stat().st_mtime_ns == kept
     assert [peek(a)["model_version"] for a in archives] == [MODEL_VERSIONS["reduced"]] * 3  # replaced
     for a, b in zip(first.rows, again.rows):

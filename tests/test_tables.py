@@ -160,6 +160,23 @@ def test_the_marks_false_rate_is_the_stated_five_percent(rotations):
     assert 0.039 < exact < 0.061 and 0.039 < pairs < 0.061, (exact, pairs)
 
 
+def test_a_difference_whose_error_has_no_degrees_of_freedom_is_not_judged():
+    """A standard error from one batch mean has no degrees of freedom (batches - 1 = 0), so no Student's t:
+    significant() returned False ("not significant", from comparing with NaN), though its docstring promises
+    None where it cannot judge. Now None, whichever side has the one batch; an exact reference (SE 0) beside
+    a one-batch SE is not judged either, and two exact numbers still are (by round-off alone)."""
+    from bearingsim.stats import significant
+
+    assert significant(1.0, 0.1, 1.5, 0.1, batches=1) is None
+    assert significant(1.0, 0.1, 1.5, 0.1, batches0=1) is None
+    assert significant(1.0, 0.1, 1.5, 0.0, batches=1) is None
+    assert significant(1.0, 0.0, 1.5, 0.0, batches=1) is True
+    # two batches each: Welch's 2 degrees of freedom, t = 4.30 times 0.141 = 0.61 needed, 0.5 apart; 5 beside
+    # 2 batches: 3.2 degrees of freedom, t = 3.07, 0.43 needed
+    assert significant(1.0, 0.1, 1.5, 0.1, batches=2, batches0=2) is False
+    assert significant(1.0, 0.1, 1.5, 0.1, batches=2) is True
+
+
 def test_a_deterministic_models_round_off_is_not_marked_and_its_real_differences_are():
     """The reduced model's standard error is 0, so every difference was marked, also the last bits a pocket
     clearance leaves in I_dec through the flight's round-off (a sweep's 1000 rpm rows, 0.16/0.20/0.24 mm:

@@ -129,11 +129,8 @@ class StudiesOutcome:
         return self.sweep.count(status)
 
     def counts(self) -> str:
-        """``"3 done, 2 cached, 0 failed"`` (and stale cases when there are)."""
-        text = f"{self.count('done')} done, {self.count('cached')} cached, {self.count('failed')} failed"
-        if self.count("stale"):
-            text += f", {self.count('stale')} stale (computed by another model version: run again)"
-        return text
+        """``"3 done, 2 cached, 0 failed"`` (and stale cases when there are: :meth:`SweepOutcome.counts`)."""
+        return self.sweep.counts()
 
 
 def make_engine(jobs: int | None = None, scheduler: str | None = None, option: str = "-j"):

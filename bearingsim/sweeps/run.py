@@ -80,6 +80,13 @@ class SweepOutcome:
     def count(self, status: str) -> int:
         return sum(r["status"] == status for r in self.rows)
 
+    def counts(self) -> str:
+        """``"3 done, 2 cached, 0 failed"``, and the stale cases when there are (computed again this time)."""
+        text = f"{self.count('done')} done, {self.count('cached')} cached, {self.count('failed')} failed"
+        if self.count("stale"):
+            text += f", {self.count('stale')} stale (another model version's: computed again)"
+        return text
+
     @property
     def failed(self) -> list[dict]:
         return [r for r in self.rows if r["status"] == "failed"]

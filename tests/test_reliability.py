@@ -680,32 +680,43 @@ from bearingsim import cli
 from bearingsim.scenario import load_scenario
 from bearingsim.parameters import Parameters
 from bearingsim.reduced.core import PassInputs
-from bearingsim.reduced.euler import solve_euler
+from bearingsim.reduced.euler import CHUNK_STEPS, solve_euler
 inp = PassInputs.from_parameters(Parameters.from_scenario(load_scenario(PAPER, [])))
-solve_euler(inp, 1e-5)  # compiled (or loaded from the cache) before the timed call
+solve_euler(inp, 1e-5)  # compiled (or loaded from the cache) before the timed calls
+# CPU time (what other processes of a busy machine take is not this loop's) of two chunks of steps: a pass of
+# 1e8 steps at 4.02e-10 s is 2e7 steps at 2.01e-9 s, so 2 * CHUNK_STEPS steps at 2.01e-9 * 1e7 / CHUNK_STEPS s
+t0 = time.process_time()
+solve_euler(inp, 2.01e-9 * 1e7 / CHUNK_STEPS)
+chunk = (time.process_time() - t0) / 2.0
+fired = []
+def fire():
+    fired.append(time.process_time())
+    os.kill(os.getpid(), signal.SIGTERM)
 signal.signal(signal.SIGTERM, cli._raise_terminated)
-threading.Timer(0.3, os.kill, (os.getpid(), signal.SIGTERM)).start()
-t0 = time.process_time()  # CPU time: what other processes of a busy machine take is not this loop's
+threading.Timer(0.3, fire).start()
 try:
     solve_euler(inp, 4.02e-10)  # 1e8 steps in the compiled loop (seconds)
     print("finished")
 except cli.Terminated:
-    print(f"terminated after {time.process_time() - t0:.2f} s of CPU")
+    print(f"terminated {time.process_time() - fired[0]:.4f} s of CPU after the signal; a chunk takes {chunk:.4f} s")
 """
 
 
 @pytest.mark.slow
 def test_sigterm_inside_the_compiled_euler_loop_raises_cleanly():
     """A SIGTERM landing in the euler method's compiled loop: its handler's exception comes out of
-    ``solve_euler`` within a chunk of steps (1.5 s of the loop's CPU time from its call, the signal sent
-    0.3 s into it; the wall time on a busy machine is longer). Before issue 30 the kernel returned arrays,
-    numba ran the pending handler while boxing them, ignored its exception and the process died of SIGSEGV."""
+    ``solve_euler`` within a chunk of steps (``CHUNK_STEPS``), the signal sent 0.3 s into the call. Judged in
+    CPU time against the same process's own chunk (two chunks' worth, for the chunk under way when the signal
+    comes and the handler's unwinding), so on any host: a fixed bound in seconds held on a fast host only.
+    Before issue 30 the kernel returned arrays, numba ran the pending handler while boxing them, ignored its
+    exception and the process died of SIGSEGV."""
     script = _EULER_SIGNAL_SCRIPT.replace("PAPER", repr(str(PAPER)))
     with started([sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                  env=ENV) as proc:
         out, err = proc.communicate(timeout=120)
-    assert proc.returncode == 0 and out.startswith("terminated after"), (proc.returncode, out, err)
-    assert float(out.split()[2]) < 1.5, out
+    assert proc.returncode == 0 and out.startswith("terminated "), (proc.returncode, out, err)
+    after, chunk = float(out.split()[1]), float(out.split()[-2])
+    assert after < 2.0 * chunk, out
 
 
 def test_a_signal_swallowed_in_a_weakref_callback_is_delivered_again(monkeypatch):
@@ -888,8 +899,9 @@ def _children_cpu_s() -> float:
 def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
     """Start a long run (:data:`LONG_RUNS`), signal it once its temporary archive exists, and measure the
     CPU time it used from the signal to its exit: the work it did after the signal (its last chunk of
-    compiled steps, its clean-up). The other processes of a busy machine do not lengthen it as they lengthen
-    the wall time (1.6-2.0 s instead of 0.3-0.5 s beside two busy loops on two CPUs)."""
+    compiled steps, its clean-up), judged against the CPU time it had used before the signal (start-up and
+    running), a ratio of one process, so on any host. The other processes of a busy machine do not lengthen
+    CPU time as they lengthen the wall time (1.6-2.0 s instead of 0.3-0.5 s beside two busy loops on two CPUs)."""
     import psutil
 
     before = _children_cpu_s()
@@ -903,8 +915,9 @@ def signal_case(tmp: Path, sig, kind="multibody") -> Observed:
     left = [p.name for p in tmp.iterdir()]
     if left:
         obs.problems.append(f"left {left}")
-    if used > 1.5:
-        obs.problems.append(f"used {used:.2f} s of CPU after the signal")
+    ran = times.user + times.system
+    if used > ran:  # a ratio in the same process, so on any host: the work after the signal is a chunk and clean-up
+        obs.problems.append(f"used {used:.2f} s of CPU after the signal, more than the {ran:.2f} s before it")
     if "Traceback" in err or len([ln for ln in err.splitlines() if ln.strip()]) != 1:
         obs.problems.append("not one line on stderr")
     return obs
@@ -974,8 +987,8 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
         first = next((ln for ln in obs.err.splitlines() if ln.strip()), "")
         status = "OK" if (obs.code == code and not obs.problems) else "FAIL: " + "; ".join(obs.problems)
         lines.append(f"| {sig.name} | signal | `bearingsim run scenarios/multibody_3000rpm.toml -o {{tmp}}/m.h5 "
-                     f"--set numerics.rotations=200`, {sig.name} once running | exit {code} within 1.5 s of its CPU "
-                     f"time, no archive, no temporary file | exit {obs.code}: {cell(first)} | {status} |")
+                     f"--set numerics.rotations=200`, {sig.name} once running | exit {code}, less CPU time after the "
+                     f"signal than before it, no archive, no temporary file | exit {obs.code}: {cell(first)} | {status} |")
     lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
               "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
               "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "

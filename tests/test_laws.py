@@ -83,6 +83,31 @@ def test_load_zone_rule():
     assert delta > 40e-6
 
 
+def test_the_quasi_static_ring_balances_the_load_on_two_contacts_in_series():
+    """The ring displacement delta_r of the quasi-static load zone balances the load (Harris & Kotzalas Sec.
+    7.2, rollers smeared over the circumference): W = Z / (2 pi) integral over the load zone of
+    Q(psi) cos psi, Q = K_s (delta_r cos psi - P_d / 2)^(10/9), with K_s the stiffness of a roller's inner and
+    outer Palmgren contacts in series. Two equal contacts carry the same Q at half the approach each, so
+    K_s = K / 2^(10/9), not K / 2 (which moved the angle by 0.5 deg, inside the rule test's window). The
+    integral is done here by adaptive quadrature, independently of the code's 3600-point sum: tolerance
+    1e-4 (that sum's error, a few 1e-6 at this angle). And Palmgren's approach inverts Palmgren's load."""
+    from scipy.integrate import quad
+
+    load, z, length, pd = 970.0, 16, 13e-3, 80e-6
+    phi, delta_r = laws.quasi_static_load_zone(load, z, length, pd)
+    k_s = laws.palmgren_stiffness(length) / 2.0 ** (10.0 / 9.0)
+    q = lambda psi: k_s * max(delta_r * math.cos(psi) - pd / 2.0, 0.0) ** (10.0 / 9.0)  # noqa: E731
+    total = z / (2.0 * math.pi) * 2.0 * quad(lambda psi: q(psi) * math.cos(psi), 0.0, phi, epsabs=0.0, epsrel=1e-10)[0]
+    assert total == pytest.approx(load, rel=1e-4)
+    assert math.cos(phi) == pytest.approx(pd / 2.0 / delta_r, rel=1e-12)
+    for qn in (1.0, 50.0, 970.0, 2e4):  # delta = (Q / K)^0.9: Q = K delta^(10/9) back, to round-off
+        approach = laws.palmgren_approach(qn, length)
+        assert laws.palmgren_load(laws.palmgren_stiffness(length), approach) == pytest.approx(qn, rel=1e-12)
+    # Harris & Kotzalas Eq. 6.40: delta = 3.84e-5 Q^0.9 / l^0.8 [mm, N, mm]; its three digits: 0.2 %
+    assert laws.palmgren_approach(970.0, length) == pytest.approx(3.84e-5 * 970.0 ** 0.9 / 13.0 ** 0.8 * 1e-3, rel=2e-3)
+    assert laws.palmgren_approach(0.0, length) == 0.0 and laws.palmgren_approach(-5.0, length) == 0.0
+
+
 def test_archard_eq16():
     """Eq. (16): V = k W L / H with W L = I r_r omega_r: linear in each factor."""
     v = laws.archard_wear_volume(6e-4, 5e-3, 6.5e-3, 2000.0, 1.5e9)

@@ -268,18 +268,19 @@ def test_reduced_equivalent_matches_event_model(rpm):
 
 @pytest.mark.slow
 def test_I_dec_converges_with_dt():
-    """Time-step convergence: over three halvings of dt the change of I_dec shrinks (deterministic
-    reduced-equivalent scene at 3000 rpm, dt from 0.5x to 1/16x of the explicit Hertz limit). The
-    scheme is first order at impacts (a new contact is detected one step late, overlap v dt), so the
-    differences need not shrink at every single halving (measured: 5.9e-7, 7.0e-7, 2.8e-7 N s, all
-    ~1e-4 of I_dec); the last one must be smaller than the first, and all four agree to 0.1 %."""
+    """Time-step convergence of the deterministic reduced-equivalent scene at 3000 rpm, dt from 0.5x to 1/16x
+    of the explicit Hertz limit: all four I_dec agree to 0.1 % (the accuracy goal of issue 3 is 1 %), and the
+    last halving moves I_dec by less than 1e-4 of it. The scheme is first order at impacts (a new contact is
+    detected one step late, overlap v dt), so the differences need not shrink at every single halving: a
+    test that the last one be smaller than the first failed at cage_friction 0.05, inside its plausible
+    range, with the steps agreeing better than at the default (differences 1.6e-7, 4.5e-7, 3.8e-7 N s).
+    Measured at the default: 5.2717 / 5.2704 / 5.2693 / 5.2690 mN s, differences 1.3e-6, 1.1e-6, 2.3e-7 N s
+    (4e-5 of I_dec last)."""
     sc = _scenario(rpm=3000, scene="reduced_equivalent", rotations=1)
     _, _, lim = choose_dt(si(sc))
     vals = [simulate(sc, dt=lim * f).per_rotation["I_dec"].mean() for f in (0.5, 0.25, 0.125, 0.0625)]
-    d = np.abs(np.diff(vals))
-    assert d[-1] < d[0], vals
-    # and the whole sequence already agrees to 0.1 % of I_dec (the accuracy goal of issue 3 is 1 %)
     assert np.ptp(vals) < 1e-3 * np.mean(vals), vals
+    assert abs(vals[-1] - vals[-2]) < 1e-4 * np.mean(vals), vals
 
 
 def test_dt_far_too_large_is_user_error():

@@ -230,6 +230,33 @@ def test_traction_opposes_slip(spin):
     assert np.sign(diag[0]["slip_out"]) == np.sign(slide)
 
 
+@pytest.mark.parametrize("off", [-0.005, 0.002, 0.01, 0.025])
+def test_traction_follows_its_tanh_curve_below_saturation(off):
+    """The traction law mu(slip) = mu_max tanh(slip / slip_ref) (the shape of measured EHL traction curves,
+    Johnson & Tevaarwerk 1977) where the cage works, slip of the order of slip_ref: the test above holds it
+    only at 200 slip_ref, where tanh is 1, so a slip_ref taken twice passed every test. A roller orbiting at
+    v = 5 m/s on the fixed outer race, its spin ``off`` (fraction) beyond pure rolling, one contact of
+    :func:`_contact` (no implicit correction): the slip is the sliding speed over the entrainment speed (the
+    mean surface speed relative to the orbiting contact point), computed here by hand, and the traction along
+    the tangent and its torque are mu Q. Tolerance 1e-12 (the same floating-point formula)."""
+    prm = _params(traction=True, spin_free=True, traction_slip_ref=0.01, traction_mu_max=0.05)
+    r0, v = 0.04875, 5.0
+    orbit = v / r0
+    w = -(v / ROLLER_RADIUS) * (1.0 + off)  # pure rolling on the outer race at off = 0: -v - w r_r = 0
+    delta = (50.0 / K) ** 0.9  # Q = 50 N at no approach rate
+    f, jac = np.zeros(3), np.zeros((3, 3))
+    q, _, slip, _ = fk._contact(r0, 0.0, 0.0, v, w, -1.0, 0.0, delta, 0.0, 0.0, 0.0, prm.outer_race_geom_radius,
+                                0.0, orbit, prm, jac, f)
+    # contact at +x: N = (-1, 0), T = rot90(N) = (0, -1); the roller's surface slides along T at -v - w r_r
+    sliding = -v - w * ROLLER_RADIUS
+    entrainment = 0.5 * (abs(w - orbit) * ROLLER_RADIUS + abs(orbit) * prm.outer_race_geom_radius)
+    assert q == pytest.approx(50.0, rel=1e-12) and slip == pytest.approx(sliding / entrainment, rel=1e-12)
+    assert abs(slip / prm.traction_slip_ref) < 3.0  # below saturation: tanh(3) = 0.995
+    mu = prm.traction_mu_max * math.tanh(slip / prm.traction_slip_ref)
+    assert -f[1] == pytest.approx(-mu * q, rel=1e-12)  # the force along T opposes the sliding
+    assert f[2] == pytest.approx(ROLLER_RADIUS * mu * q, rel=1e-12)  # torque -r_r (-mu Q)
+
+
 # --- recording ------------------------------------------------------------------------------------
 N_POCKETS = 4
 IDS = np.array([10, 11, 12, 13, 20], dtype=np.uint64)  # rollers 0..3, cage

@@ -132,6 +132,26 @@ def test_archard_volume_is_k_W_over_H(fast_run):
     assert laws.archard_volume_from_work(1e-5, 3.0, 1.5e9) == pytest.approx(2e-14, rel=1e-15)
 
 
+def test_a_face_bins_area_is_the_arc_the_rollers_hit_times_the_roller_length(fast_run):
+    """A worn depth is a bin's worn volume over the bin's area, and the Archard test above checks the depths
+    against that same area, so it held for any area (a pocket radius of r_r + s in the area passed the wear
+    tests). The area is pinned here to the face the rollers collide with: the arc of the scene the run builds
+    (its pocket radius R = r_r + s/2 and extent), times the roller length, split into the profile's bins."""
+    from bearingsim.multibody.scene import build_scene
+    from bearingsim.wear import face_area
+
+    res, _ = fast_run
+    p = res.parameters
+    sc = build_scene(p.bearing, p.operating, p.contact.restitution, p.contact.cage_friction,
+                     extent=p.multibody.pocket_face_extent, n_seg=0, kinematic_cage=False, spin_free=True)
+    lo, hi = sc.extent
+    rep = res.wear_report(rotations=1.6e5)
+    bins = rep.depth_rear.shape[0]
+    assert rep.bin_area == pytest.approx(sc.pocket_radius * (hi - lo) / bins * p.bearing.roller_length, rel=1e-12)
+    assert rep.bin_area == face_area(p, bins) and sc.pocket_radius == pytest.approx(
+        p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance, rel=1e-15)
+
+
 def test_wear_profile_figure_shows_the_deepest_point_of_either_face(fast_run):
     """The Fig. 13 analog shares its depth axis between the faces; its limit was fixed by the front face
     alone (set before the rear face was drawn), so the rear face's bore end, the deepest point of the

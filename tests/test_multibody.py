@@ -137,6 +137,24 @@ def test_forward_reverse_same_I_dec(full_3000, full_3000_reverse):
 
 
 @pytest.mark.slow
+def test_each_pockets_rotation_starts_where_it_crosses_the_load_zone_centre(full_3000, full_3000_reverse):
+    """A pocket's recorded rotation k is its own window, from its k-th crossing of the load-zone centre (theta =
+    0, after the warm-up) to the next: so within one (pocket, rotation) the theta of its impacts, taken in time
+    order, only grows, from 0 to 360 deg, in either direction of rotation. Windows that started at a common
+    time for all pockets, or anywhere else, would hold a wrap from 360 back to 0 (dropping each pocket's start
+    angle from the window index passed every physics test). Every impact of the 20 rotations checked, both
+    directions; none is in the warm-up or beyond the last rotation."""
+    for res in (full_3000, full_3000_reverse):
+        imp = res.impacts
+        rotations = res.per_rotation["I_dec"].shape[0]
+        assert set(np.unique(imp["rotation"]).tolist()) == set(range(rotations))
+        for i in range(res.per_rotation["I_dec"].shape[1]):
+            for k in range(rotations):
+                m = (imp["pocket"] == i) & (imp["rotation"] == k)
+                th = imp["theta_deg"][m][np.argsort(imp["time_s"][m], kind="stable")]
+                assert np.all(np.diff(th) >= 0.0) and np.all((th >= 0.0) & (th < 360.0)), (i, k, th)
+
+
 def test_where_the_cage_rests_is_its_orbit_mean_and_mirrors_with_the_rotation(full_3000, full_3000_reverse):
     """The summary's cage_rest_offset_m / cage_rest_angle_deg are the mean of the result's own
     /results/cage_orbit (1e-12), and mirror symmetry (paper Fig. 7): reversed, the cage rests at the

@@ -383,20 +383,23 @@ def _impact_arrays(imp) -> dict:
 
 
 _WEAR_DESC = {
-    "paper_index_front": "Archard wear per cage rotation, front face, k I_acc r_r omega_r / H (paper Eq. 16), per pocket",
-    "paper_index_rear": "Archard wear per cage rotation, rear face, k I_dec r_r omega_r / H, per pocket",
+    "paper_index_front": "Archard wear per cage rotation, front face, k J_n r_r omega_r / H (paper Eq. 16 with the normal "
+                         "impulse J_n, the contact force's), per pocket",
+    "paper_index_rear": "Archard wear per cage rotation, rear face, k J_n r_r omega_r / H (Eq. 16), per pocket",
     "sliding_work_front": "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket",
     "sliding_work_rear": "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket",
 }
 
 
 def _wear_arrays(p, per) -> dict:
-    """Archard wear per cage rotation and pocket face [m^3]: the paper's index and the sliding work."""
+    """Archard wear per cage rotation and pocket face [m^3]: the paper's index and the sliding work. Eq. 16's
+    impulse is that of the contact force, the normal impulse J_n: on an arc face I_acc and I_dec are its
+    circumferential component only (on the paper's flat faces the two are one)."""
     geo, op, w_ = p.bearing, p.operating, p.wear
     wear = {
-        "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["I_acc"].mean(axis=0),
+        "paper_index_front": laws.archard_wear_volume(w_.wear_coefficient, per["Jn_front"].mean(axis=0),
                                                       geo.roller_radius, op.omega_r, w_.hardness),
-        "paper_index_rear": laws.archard_wear_volume(w_.wear_coefficient, per["I_dec"].mean(axis=0),
+        "paper_index_rear": laws.archard_wear_volume(w_.wear_coefficient, per["Jn_rear"].mean(axis=0),
                                                      geo.roller_radius, op.omega_r, w_.hardness),
         "sliding_work_front": w_.wear_coefficient * per["slide_work_front"].mean(axis=0) / w_.hardness,
         "sliding_work_rear": w_.wear_coefficient * per["slide_work_rear"].mean(axis=0) / w_.hardness,
@@ -581,8 +584,8 @@ class MultibodyResult(Result):
         per_hour = running_time(self, hours=1.0)[2] * 1e9
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = subplots(figsize=(9, 4))
-        bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16)"),
-                (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16)"),
+        bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16, normal impulse)"),
+                (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16, normal impulse)"),
                 (self.get("wear/sliding_work_front"), "front face, sliding work"),
                 (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
         wdt = 0.2

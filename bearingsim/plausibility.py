@@ -193,8 +193,8 @@ def impact_table_note(result) -> str | None:
         return None
     imp = result.impacts
     rows, rotations = len(imp["time_s"]), int(result.parameters.numerics.rotations)
-    when = (f" in recorded rotation {int(imp['rotation'][-1]) + 1} of {rotations} (t = {float(imp['time_s'][-1]):.4g} s)"
-            if rows else "")
+    last, t = int(imp["rotation"][-1]) + 1 if rows else 0, float(imp["time_s"][-1]) if rows else 0.0
+    when = f" in recorded rotation {last} of {rotations} (t = {t:.4g} s)" if rows else ""
     return (f"bearingsim: note: the impact table filled its {rows} rows{when}: /results/impacts lists the impacts "
             "up to there only; the impulses, wear and every other result count every impact")
 
@@ -600,7 +600,8 @@ def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> s
     from bearingsim.stats import critical_ses, significant
 
     if not a > 0.0:
-        return f"{q} {a * 1e3:.4g} at the step, {b * 1e3:.4g} mN s at half of it (no impulse at the step to compare with)"
+        return (f"{q} {a * 1e3:.4g} at the step, {b * 1e3:.4g} mN s at half of it (no impulse at the step to "
+                "compare with)")
     rel, rel_se = b / a - 1.0, math.hypot(ea, eb) / a
     mark = significant(b, eb, a, ea, nb, nb)
     if mark is None:

@@ -558,7 +558,8 @@ def _series_result(series, dt=4e-6):
 
     x = np.repeat(np.asarray(series, float)[:, None], 16, axis=1)
     mean = float(x.mean())
-    return SimpleNamespace(per_rotation={"I_dec": x, "I_acc": x}, summary={"I_dec_mean_Ns": mean, "I_acc_mean_Ns": mean},
+    return SimpleNamespace(per_rotation={"I_dec": x, "I_acc": x},
+                           summary={"I_dec_mean_Ns": mean, "I_acc_mean_Ns": mean},
                            provenance={"dt_s": dt}, scenario=SimpleNamespace(model="multibody"),
                            parameters=SimpleNamespace(model="multibody"))
 
@@ -584,7 +585,7 @@ def test_a_step_check_compares_steady_states_when_a_run_starts_with_a_transient(
                      first), note
     assert again.startswith(" the later ones), which the means and errors above hold; without each run's first "
                             "recorded rotation: I_dec 50.8"), note
-    assert re.search(r"51\.09\d* mN s at half of it: \+0\.4\d% ± 0\.0\d+% \(resolved: the number depends on the step\)",
-                     again), note
+    assert re.search(r"51\.09\d* mN s at half of it: \+0\.4\d% ± 0\.0\d+% "
+                     r"\(resolved: the number depends on the step\)", again), note
     plain = step_check_note(_series_result(steady_a), _series_result(steady_b, dt=2e-6))
     assert "start transient" not in plain and "(resolved: the number depends on the step)" in plain, plain

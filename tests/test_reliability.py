@@ -988,7 +988,8 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
         status = "OK" if (obs.code == code and not obs.problems) else "FAIL: " + "; ".join(obs.problems)
         lines.append(f"| {sig.name} | signal | `bearingsim run scenarios/multibody_3000rpm.toml -o {{tmp}}/m.h5 "
                      f"--set numerics.rotations=200`, {sig.name} once running | exit {code}, less CPU time after the "
-                     f"signal than before it, no archive, no temporary file | exit {obs.code}: {cell(first)} | {status} |")
+                     f"signal than before it, no archive, no temporary file | exit {obs.code}: {cell(first)} | "
+                     f"{status} |")
     lines += ["", "Also in `tests/test_reliability.py`, not in this table: a real second run to an archive another "
               "run is writing (refused, exit 2; the first, stopped by SIGTERM, leaves nothing; a third run then "
               "writes), a run killed by SIGKILL (its temporary file is removed, with a note, by the next run "

@@ -383,8 +383,8 @@ def _impact_arrays(imp) -> dict:
 
 
 _WEAR_DESC = {
-    "paper_index_front": "Archard wear per cage rotation, front face, k J_n r_r omega_r / H (paper Eq. 16 with the normal "
-                         "impulse J_n, the contact force's), per pocket",
+    "paper_index_front": "Archard wear per cage rotation, front face, k J_n r_r omega_r / H (paper Eq. 16 with the "
+                         "normal impulse J_n, the contact force's), per pocket",
     "paper_index_rear": "Archard wear per cage rotation, rear face, k J_n r_r omega_r / H (Eq. 16), per pocket",
     "sliding_work_front": "Archard wear per cage rotation, front face, k sum(J_n |v_slide|) / H, per pocket",
     "sliding_work_rear": "Archard wear per cage rotation, rear face, k sum(J_n |v_slide|) / H, per pocket",

@@ -47,11 +47,30 @@ class WearReport:
     rotations_rear: np.ndarray | None = None  #: the same, rear face [m^3]
     #: width of the cage bar between two pockets [m] (:func:`bar_width`); NaN: not given
     bar_width: float = float("nan")
+    #: (bins, pockets) the depth the front face starts with, the scenario's own (``[wear] worn_depth_front_um``,
+    #: :func:`start_depth`) [m]: ``depth_front`` is worn on top of it; None: an unworn start
+    start_front: np.ndarray | None = None
+    start_rear: np.ndarray | None = None  #: the same, rear face [m]
+
+    def total_depth(self, face: str) -> np.ndarray:
+        """(bins, pockets) the depth of one face after the running time: the starting depth plus the wear [m]."""
+        d, s = (self.depth_front, self.start_front) if face == "front" else (self.depth_rear, self.start_rear)
+        return d if s is None else s + d
 
     @property
     def max_depth(self) -> float:
-        """The deepest worn point of any face [m]."""
+        """The deepest point of any face after the running time, its starting depth included [m]."""
+        return float(max(self.total_depth("front").max(), self.total_depth("rear").max()))
+
+    @property
+    def max_new_depth(self) -> float:
+        """The deepest point of the wear of the running time alone, without the starting depth [m]."""
         return float(max(self.depth_front.max(), self.depth_rear.max()))
+
+    @property
+    def max_start_depth(self) -> float:
+        """The deepest point of the starting depth (0: an unworn start) [m]."""
+        return float(max(0.0 if s is None else s.max() for s in (self.start_front, self.start_rear)))
 
     def cov(self, face: str) -> float:
         """Coefficient of variation (std / mean) of the worn volume over the pockets of one face [-]."""
@@ -92,12 +111,18 @@ class WearReport:
     def worn_through(self) -> tuple[int, float] | None:
         """``(i, depth)`` when the two faces on a cage bar, pocket ``i``'s front face and pocket ``i - 1``'s rear
         face (:func:`bearingsim.laws.worn_bar_depth`, as a life study's stages and a worn scenario are checked),
-        wear together as deep as the bar is wide in a bin of psi: the deepest such bar and its depth [m]; None
-        when no bar does (or no bar width is given). Past it the linear extrapolation means nothing."""
-        on_bar = laws.worn_bar_depth(self.depth_front, self.depth_rear)  # (bins, bars)
+        together as deep as the bar is wide in a bin of psi, their starting depths included (:meth:`total_depth`):
+        the deepest such bar and its depth [m]; None when no bar is (or no bar width is given). Past it the
+        linear extrapolation means nothing."""
+        on_bar = self.bar_depth()  # (bins, bars)
         if not on_bar.max() >= self.bar_width:
             return None
         return int(on_bar.max(axis=0).argmax()), float(on_bar.max())
+
+    def bar_depth(self) -> np.ndarray:
+        """(bins, bars) the depth the two faces on each cage bar reach together after the running time, their
+        starting depths included (:func:`bearingsim.laws.worn_bar_depth`) [m]."""
+        return laws.worn_bar_depth(self.total_depth("front"), self.total_depth("rear"))
 
     def mean_depth(self, face: str) -> np.ndarray:
         """(pockets,) worn depth averaged over the face's extent (volume / face area) [m]."""
@@ -183,11 +208,31 @@ def face_area(p, bins: int = 1) -> float:
     return pocket_radius * (hi - lo) / bins * p.bearing.roller_length
 
 
+def start_depth(p, psi_deg) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """(front, rear) the depth the faces of parameters ``p`` start with, the scenario's own (``[wear]
+    worn_depth_*_um``), at the wear profile's bins ``psi_deg`` ((bins, pockets) [m] each), or (None, None) for
+    unworn faces. A profile of other bins (both span the faces' extent in equal bins) is read as the step loop
+    reads it: linear in psi between its bin centres, constant in the half bins at the ends."""
+    if p.wear.worn_depth is None:
+        return None, None
+    given = np.array(p.wear.worn_depth, dtype=np.float64)  # (pockets, 2, given bins)
+    psi = np.asarray(psi_deg, dtype=np.float64)
+    n = given.shape[2]
+    if n != len(psi):
+        width = (psi[-1] - psi[0]) / (len(psi) - 1) if len(psi) > 1 else 0.0
+        lo, hi = psi[0] - 0.5 * width, psi[-1] + 0.5 * width
+        centres = lo + (np.arange(n) + 0.5) * (hi - lo) / n
+        given = np.array([[np.interp(psi, centres, row) for row in pocket] for pocket in given])
+    return given[:, 0, :].T.copy(), given[:, 1, :].T.copy()
+
+
 def wear_report(result, *, hours: float | None = None, rotations: float | None = None,
                 wear_coefficient: float | None = None, hardness: float | None = None) -> WearReport:
     """The :class:`WearReport` of ``result`` after a running time (``hours`` or inner-ring ``rotations``),
     with Archard's k and H of the result's scenario (``[wear]``) unless given. A scenario's k of 0, which the
-    scenario takes, is refused as a given k of 0 is (:func:`archard_values`), naming the scenario's key."""
+    scenario takes, is refused as a given k of 0 is (:func:`archard_values`), naming the scenario's key. The
+    faces start at the scenario's own worn depth (:func:`start_depth`): the deepest point and the cage bar
+    count it, the volumes and ``depth_*`` are the wear of the running time."""
     if not has_profile(result):
         raise UserError("this archive has no wear profile (written before bearingsim recorded one, or not a "
                         "multibody run): run its scenario again ('bearingsim rerun' or 'bearingsim run')")
@@ -210,7 +255,7 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
                for f in ("front", "rear")}  # its mean over rotations is the profile's sum (1e-12)
     return WearReport(psi, vols["front"] / area, vols["rear"] / area, vols["front"].sum(axis=0),
                       vols["rear"].sum(axis=0), shaft, hrs, cage_rot, k, h, area, per_rot["front"], per_rot["rear"],
-                      bar_width(result.scenario))
+                      bar_width(result.scenario), *start_depth(p, psi))
 
 
 def format_report(rep: WearReport) -> str:
@@ -218,6 +263,7 @@ def format_report(rep: WearReport) -> str:
     spread over pockets, and the mean depth profile at the face's ends and middle."""
     lines = [f"running time: {rep.hours:.4g} h = {rep.shaft_rotations:.4g} inner-ring rotations = "
              f"{rep.cage_rotations:.4g} cage rotations; Archard k = {rep.wear_coefficient:.3g}, H = {rep.hardness:.3g} Pa",
+             *start_note(rep),
              f"{'pocket':>6} {'V front [mm^3]':>15} {'V rear [mm^3]':>14} {'max depth front [um]':>21} "
              f"{'max depth rear [um]':>20}"]
     for i in range(len(rep.volume_front)):
@@ -244,7 +290,9 @@ def format_report(rep: WearReport) -> str:
         ends = shape_of(rep.psi_deg, d)
         lines.append(f"{f}: mean depth over pockets at the bore end {ends['bore'] * 1e6:.4g} um, middle "
                      f"{ends['middle'] * 1e6:.4g} um, rim end {ends['rim'] * 1e6:.4g} um")
-    lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um" + edge_caveat(rep))
+    lines.append(f"deepest point of any face: {rep.max_depth * 1e6:.4g} um" + (
+        f", the starting depth included (this running time's wear alone: {rep.max_new_depth * 1e6:.4g} um)"
+        if rep.max_start_depth > 0.0 else "") + edge_caveat(rep))
     if rep.worn_through() is not None:
         lines.append(bar_line(rep))
     return "\n".join(lines)
@@ -272,27 +320,39 @@ def format_comparison(labels: list[str], reports: list[WearReport], notes: list[
     out = [*notes, line(head), *(line(r) for r in rows)]
     out.append("V: worn volume of one face, mean over pockets \u00b1 its standard error (batch means over the "
                "recorded rotations the archive extrapolates from, 'rotations'); deepest: any face's deepest point, "
-               "an end bin's as a rule (docs/wear.md); cage bar: whether the two faces on one bar wear through it "
-               "('bearingsim wear ARCHIVE' gives one archive's whole report)")
+               "an end bin's as a rule, the scenario's own starting depth included (docs/wear.md); cage bar: "
+               "whether the two faces on one bar, starting depth included, wear through it ('bearingsim wear ARCHIVE' "
+               "gives one archive's whole report)")
     return "\n".join(out)
 
 
 def bar_line(rep: WearReport) -> str:
     """The line that says where the extrapolated wear goes through a cage bar (:meth:`WearReport.worn_through`)."""
     i, depth = rep.worn_through()
-    k = int(laws.worn_bar_depth(rep.depth_front, rep.depth_rear)[:, i].argmax())
+    k = int(rep.bar_depth()[:, i].argmax())
     return (f"cage bar worn through: pocket {i}'s front face and pocket {(i - 1) % len(rep.volume_front)}'s rear "
-            f"face, either side of the bar between them, wear {depth * 1e3:.4g} mm deep together at psi = "
+            f"face, either side of the bar between them, are {depth * 1e3:.4g} mm deep together"
+            f"{', their starting depth included,' if rep.max_start_depth > 0.0 else ''} at psi = "
             f"{rep.psi_deg[k]:.3g} deg, where the bar is {rep.bar_width * 1e3:.4g} mm wide: a linear extrapolation "
             f"past that is meaningless ('bearingsim life' follows the wear stage by stage to where a bar wears "
             f"through)")
+
+
+def start_note(rep: WearReport) -> list[str]:
+    """The line that says the faces start worn (the scenario's ``[wear] worn_depth_*_um``) and which numbers
+    count it; none for an unworn start."""
+    if not rep.max_start_depth > 0.0:
+        return []
+    return [f"the faces start worn (the scenario's [wear] worn_depth_*_um, deepest {rep.max_start_depth * 1e6:.4g} "
+            f"um): the volumes and depths per pocket and face below are the wear of this running time; the deepest "
+            f"point and the cage bar add the starting depth"]
 
 
 def edge_caveat(rep: WearReport) -> str:
     """`` (an end bin's ...)`` when the deepest point lies in a bin at an end of a face's extent: the wear
     there is that of the face's edge, a line, so its depth is the edge's volume over one bin's area and
     doubles each time the bins halve (docs/wear.md, *Discretization errors*); '' otherwise."""
-    ends = [d[[0, -1]].max() for d in (rep.depth_front, rep.depth_rear)]
+    ends = [rep.total_depth(f)[[0, -1]].max() for f in ("front", "rear")]
     if max(ends) < rep.max_depth:
         return ""
     width = float(np.diff(rep.psi_deg).mean()) if len(rep.psi_deg) > 1 else float("nan")
@@ -332,8 +392,10 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
     through = rep.worn_through()
     fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
                  f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa" + (
+                     f", on the scenario's starting depth (deepest {rep.max_start_depth * 1e6:.4g} µm, not drawn)"
+                     if rep.max_start_depth > 0.0 else "") + (
                      "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % d.shape[1]} and "
-                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep against {rep.bar_width * 1e3:.4g} "
+                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep, starting depth included, against {rep.bar_width * 1e3:.4g} "
                      f"mm wide): a linear extrapolation past it is meaningless"),
                  fontsize=9)
     return fig

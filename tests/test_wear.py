@@ -1301,3 +1301,59 @@ def test_wear_figures_use_one_fixed_unit_per_quantity(fast_run, monkeypatch):
         for fig in (res.plot_wear_profile(hours=hours), res.plot_wear_volume(hours=hours)):
             fig.canvas.draw()
             assert all(ax.yaxis.get_offset_text().get_text() == "" for ax in fig.axes), hours
+
+
+def test_wear_counts_the_scenarios_own_worn_depth_in_the_deepest_point_and_the_cage_bar(tmp_path, capsys):
+    """`bearingsim wear` of a run whose scenario starts worn 2900 um deep at the bore end of every face (the
+    bar then carries 5.8 of its 5.821 mm, accepted) reported after 10 h a deepest point of 555 um and no bar
+    worn through, where starting depth and new wear put 6.12 mm on one bar: the report left out the scenario's
+    own worn depth, which `bearingsim life` counts. Now the deepest point, the cage bar (line, table, figure)
+    count it; the volumes and per-face depths stay the wear of the running time. Exact sums (1e-15 m)."""
+    from bearingsim import wear
+    from bearingsim.cli import main
+    from bearingsim.simulation import load, run_scenario
+
+    start = [[2900.0] + [0.0] * 31 for _ in range(16)]
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"),
+                       ["numerics.rotations=2", "multibody.raceway_contact=rigid",
+                        f"wear.worn_depth_front_um={start}", f"wear.worn_depth_rear_um={start}"])
+    path = tmp_path / "worn.h5"
+    run_scenario(sc, path, figures=False, notes=False)
+    rep = wear.wear_report(load(path), hours=10.0)
+    new = max(rep.depth_front.max(), rep.depth_rear.max())
+    total = np.array([rep.depth_front, rep.depth_rear])
+    total[:, 0, :] += 2.9e-3
+    assert rep.max_depth == pytest.approx(total.max(), abs=1e-15) and rep.max_depth > 2.9e-3
+    assert 0.0 < new < 2.0e-3 and rep.max_new_depth == new  # the wear of the running time alone
+    on_bar = laws.worn_bar_depth(total[0], total[1])
+    assert on_bar.max() > rep.bar_width  # 5.8 mm + the bore ends' new wear on 5.821 mm
+    i, depth = rep.worn_through()
+    assert depth == pytest.approx(on_bar.max(), abs=1e-15) and i == int(on_bar.max(axis=0).argmax())
+    text = wear.format_report(rep)
+    assert "the faces start worn" in text and "deepest 2900 um" in text
+    assert f"deepest point of any face: {rep.max_depth * 1e6:.4g} um, the starting depth included" in text
+    assert f"pocket {i}'s front face" in text and f"{depth * 1e3:.4g} mm deep together" in text
+    table = wear.format_comparison(["worn.h5"], [rep])
+    assert f"{rep.max_depth * 1e6:.4g}" in table and f"worn through (pocket {i})" in table
+    assert main(["wear", str(path), "--hours", "10", "--no-plots"]) == 0
+    assert "cage bar worn through" in capsys.readouterr().out
+
+
+def test_a_start_depth_of_other_bins_is_read_as_the_step_loop_reads_it():
+    """A worn depth given in other bins than the profile's 32 is put on them as the step loop reads a
+    profile: linear between its bin centres, constant in the half bins at the ends (1e-18 m: interpolation of
+    a uniform or linear profile is exact to rounding)."""
+    from bearingsim.wear import start_depth
+
+    psi = np.linspace(-32.9, 26.2, 33)
+    psi = 0.5 * (psi[1:] + psi[:-1])
+    one = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), [f"wear.worn_depth_rear_um={[[100.0]] * 16}"])
+    front, rear = start_depth(one.parameters, psi)
+    assert front.shape == rear.shape == (32, 16) and np.all(front == 0.0)
+    np.testing.assert_allclose(rear, 100e-6, rtol=0, atol=1e-18)
+    two = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), [f"wear.worn_depth_front_um={[[0.0, 200.0]] * 16}"])
+    front, _ = start_depth(two.parameters, psi)
+    centres = (-32.9 + 0.25 * 59.1, -32.9 + 0.75 * 59.1)
+    want = np.clip((psi - centres[0]) / (centres[1] - centres[0]), 0.0, 1.0) * 200e-6
+    np.testing.assert_allclose(front[:, 3], want, rtol=0, atol=1e-18)
+    assert start_depth(load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml")).parameters, psi) == (None, None)

@@ -522,7 +522,7 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
     return {
         "stage": j, "clearance_start_mm": clearance * 1e3, "stage_rotations": n_stage,
         "rotations_end": st.shaft, "hours_end": st.hours,
-        "max_depth_rate_um_per_h": rate.max_depth * per_hour * 1e6,
+        "max_depth_rate_um_per_h": rate.max_new_depth * per_hour * 1e6,
         "max_volume_rate_mm3_per_h": float(max(rate.volume_front.max(), rate.volume_rear.max())) * per_hour * 1e9,
         "max_depth_um": float(st.depth.max()) * 1e6, "max_volume_mm3": float(st.volume.max()) * 1e9,
         "clearance_end_mm": st.clearance() * 1e3, "I_dec_mean_mNs": res.summary["I_dec_mean_Ns"] * 1e3,

@@ -39,7 +39,7 @@ FLASH_ALPHA = (1.0, 0.55, 0.25)
 #: the automatic exaggeration makes the drawn pocket play (K s / 2) about this fraction of the roller radius
 AUTO_PLAY_FRACTION = 0.3
 MAX_EXAGGERATION = 1000.0
-#: the fraction of the cage bar's width (between neighbouring pockets, at the pitch circle) that the drawn pockets
+#: the fraction of the cage bar's narrowest width (between neighbouring pockets' centres) that the drawn pockets
 #: must leave: it sets the largest exaggeration a bearing is drawn at (:func:`max_exaggeration`)
 BAR_KEPT = 0.25
 MAX_FPS = 120.0
@@ -176,10 +176,11 @@ def _exaggeration(p, given) -> float:
 
 def max_exaggeration(p) -> float:
     """The largest K, to 0.1 below, at which the bearing of ``p`` is drawn as it is: the pockets drawn K s / 2
-    wider (radius r + K s / 2) leave at least :data:`BAR_KEPT` of the cage bar between neighbours, whose width
-    at the pitch circle is w = 2 r_p sin(pi / Z) - 2 r - s, i.e. K <= 1 + (1 - BAR_KEPT) w / s (22.8 for the
-    NU214). Towards K = 1 + w / s the bars vanish, neighbouring rollers (each drawn up to K s / 2 off its
-    pocket's centre) may touch, and a roller drawn K times its tangential offset t drifts outwards by about
+    wider (radius r + K s / 2) leave at least :data:`BAR_KEPT` of the cage bar between neighbours, whose
+    narrowest width (along the line of their centres) is w = 2 r_p sin(pi / Z) - 2 r - s, i.e.
+    K <= 1 + (1 - BAR_KEPT) w / s (22.8 for the NU214). Towards K = 1 + w / s the bars vanish, neighbouring
+    rollers (each drawn up to K s / 2 off its pocket's centre) may touch, and a roller drawn K times its
+    tangential offset t drifts outwards by about
     K^2 t^2 / 2 r_p, cutting into the outer ring (0.9 mm at K = 30 in the NU214). At least 1, at most
     :data:`MAX_EXAGGERATION`."""
     g = p.bearing

@@ -148,9 +148,12 @@ def pocket_face_extent(pitch_radius, pocket_radius, wall_inner_radius, wall_oute
 
 
 def cage_bar_width(pitch_diameter, roller_diameter, pocket_clearance, roller_count):
-    """Width of the cage bar between two neighbouring pockets at the pitch circle: the chord between their
-    centres, ``d_p sin(pi / Z)``, less one pocket's width ``D + s`` (any length unit in, the same out).
-    What the two faces on a bar (:func:`worn_bar_depth`) can wear together before it is worn through."""
+    """The narrowest width of the cage bar between two neighbouring pockets: the distance between their
+    centres, ``d_p sin(pi / Z)``, less one pocket's width ``D + s``, along the line joining the centres (which
+    meets the faces at psi = -pi / Z; any length unit in, the same out). What the two faces on a bar
+    (:func:`worn_bar_depth`) can wear together before it is worn through, taken for every bin of psi:
+    conservative elsewhere (the bar is wider along the pitch circle, and faces worn in the direction psi meet in
+    the bar's middle at ``d_p sin(pi / Z) / cos(psi + pi / Z) - D - s``; docs/wear.md, *The cage bar*)."""
     return pitch_diameter * math.sin(math.pi / roller_count) - roller_diameter - pocket_clearance
 
 

@@ -395,8 +395,9 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
                      f", on the scenario's starting depth (deepest {rep.max_start_depth * 1e6:.4g} µm, not drawn)"
                      if rep.max_start_depth > 0.0 else "") + (
                      "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % d.shape[1]} and "
-                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep, starting depth included, against {rep.bar_width * 1e3:.4g} "
-                     f"mm wide): a linear extrapolation past it is meaningless"),
+                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep"
+                     f"{', starting depth included,' if rep.max_start_depth > 0.0 else ''} against "
+                     f"{rep.bar_width * 1e3:.4g} mm wide): a linear extrapolation past it is meaningless"),
                  fontsize=9)
     return fig
 

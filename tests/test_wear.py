@@ -1269,7 +1269,7 @@ def test_wear_says_where_its_extrapolation_goes_through_a_cage_bar(fast_run):
     fig = res.plot_wear_profile(hours=1000.0)
     for ax in fig.axes[:2]:
         assert any(list(ln.get_ydata()) == [long.bar_width * 1e6] * 2 for ln in ax.get_lines()), ax.get_lines()
-    assert "worn through" in fig._suptitle.get_text()
+    assert "worn through" in fig._suptitle.get_text() and "starting depth" not in fig._suptitle.get_text()
     fig = res.plot_wear_profile(rotations=1e3)
     assert "worn through" not in fig._suptitle.get_text()
 
@@ -1335,6 +1335,8 @@ def test_wear_counts_the_scenarios_own_worn_depth_in_the_deepest_point_and_the_c
     assert f"pocket {i}'s front face" in text and f"{depth * 1e3:.4g} mm deep together" in text
     table = wear.format_comparison(["worn.h5"], [rep])
     assert f"{rep.max_depth * 1e6:.4g}" in table and f"worn through (pocket {i})" in table
+    title = load(path).plot_wear_profile(hours=10.0)._suptitle.get_text()
+    assert "deepest 2900 µm, not drawn" in title and f"{depth * 1e3:.4g} mm deep, starting depth included" in title
     assert main(["wear", str(path), "--hours", "10", "--no-plots"]) == 0
     assert "cage bar worn through" in capsys.readouterr().out
 

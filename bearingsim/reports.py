@@ -464,11 +464,13 @@ def _pm(mean, sem) -> str:
 #: a sweep's figures in the page, by file name (bearingsim.sweeps.plot)
 SWEEP_CAPTIONS = {
     "sweep_I.png": "I_dec and I_acc per pocket and cage rotation against the first swept key, a line for each value "
-                   "of the others; error bars ± 1 standard error (batch means over rotations, where the model has one)",
+                   "of the others; error bars ± 1 standard error (batch means over rotations, where the model has one; "
+                   "a point without one, n/a in the table, has an open marker and no bar)",
     "sweep_map.png": "I_dec and I_acc per pocket and cage rotation over the two swept keys, as heat maps (a blank "
                      "cell: a case that failed or did not run)",
     "sweep_cases.png": "I_dec and I_acc per pocket and cage rotation of every case, labelled by its values; error bars "
-                       "± 1 standard error (batch means over rotations, where the model has one)",
+                       "± 1 standard error (batch means over rotations, where the model has one; a case without one, "
+                       "n/a in the table, has a hatched bar and no error bar)",
 }
 
 #: validate's figures in the page, by file name

@@ -3,6 +3,9 @@ or says in one line why not; heat maps of sampled cells only; I_dec and I_acc ap
 
 The indexes are written directly (:func:`bearingsim.sweeps.index.write_index`): nothing is simulated."""
 import json
+import math
+
+import numpy as np
 
 import pytest
 
@@ -17,14 +20,17 @@ GUIDE = "bearing.cage_guidance"
 CLEAR = "bearing.pocket_clearance_mm"
 
 
-def _index(folder, points, keys, *, grid=None, grid_rows=None, mode="product", failed=(), results=True):
+def _index(folder, points, keys, *, grid=None, grid_rows=None, mode="product", failed=(), results=True,
+           sem=lambda i: 1e-4):
+    """An index of ``points``; case i's I_dec is 5 + i mN s, I_acc 2 + i / 2, their standard errors
+    ``sem(i)`` and half of it [N s] (NaN: none, as a run of one recorded rotation has)."""
     rows = []
     for i, values in enumerate(points):
         ok = results and i not in failed
         rows.append({"case": f"c{i}", "values": values, "status": "done" if ok else "failed", "error": "",
                      "archive": "", "wall_s": 0.1,
-                     "summary": {"I_dec_mean_Ns": 0.005 + 0.001 * i, "I_dec_sem_Ns": 1e-4,
-                                 "I_acc_mean_Ns": 0.002 + 0.0005 * i, "I_acc_sem_Ns": 5e-5} if ok else {}})
+                     "summary": {"I_dec_mean_Ns": 0.005 + 0.001 * i, "I_dec_sem_Ns": sem(i),
+                                 "I_acc_mean_Ns": 0.002 + 0.0005 * i, "I_acc_sem_Ns": 0.5 * sem(i)} if ok else {}})
     grid = keys if grid is None else grid
     meta = {"mode": mode, "grid": json.dumps(grid), "grid_rows": len(points) if grid_rows is None else grid_rows,
             "scenario": "scenarios/paper_3000rpm.toml"}
@@ -54,6 +60,73 @@ def figures(monkeypatch):
 
     monkeypatch.setattr(plotting, "save_figure", capture)
     return seen
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The matplotlib figures the sweep plot saves, by file name, whole (their artists)."""
+    import bearingsim.plotting as plotting
+
+    seen = {}
+    real = plotting.save_figure
+
+    def keep(fig, path, **kw):
+        seen[path.name] = fig
+        return real(fig, path, **kw)
+
+    monkeypatch.setattr(plotting, "save_figure", keep)
+    return seen
+
+
+def _bars(ax) -> list:
+    """The error bars an axes draws: the segments of its errorbar containers (one of length 0 included:
+    its caps show; a NaN error leaves none)."""
+    return [seg for c in ax.containers if hasattr(c, "has_yerr") or hasattr(c, "has_xerr")
+            for col in c.lines[2] for seg in col.get_segments() if len(seg)]
+
+
+def _open_markers(ax) -> list:
+    """(x, y) of the markers drawn open (white face): the values without a standard error."""
+    return [(float(x), float(y)) for line in ax.lines if line.get_markerfacecolor() in ("white", "w", (1, 1, 1, 1))
+            for x, y in zip(line.get_xdata(), line.get_ydata())]
+
+
+def test_a_missing_standard_error_is_no_bar_and_is_said(tmp_path, drawn):
+    """A sweep of one recorded rotation per case has no standard error (the table: ``18.41 ± n/a``); the
+    line figure drew it as an error bar of 0 (``np.nan_to_num``) under "error bars: ±1 standard error".
+    Now such a point has no bar, an open marker, and the panel's title counts it."""
+    speeds = (1000.0, 2000.0, 3000.0)
+    h5 = _index(tmp_path, [{SPEED: s} for s in speeds], [SPEED], sem=lambda i: 1e-4 if i == 1 else math.nan)
+    plot_sweep_index(h5, tmp_path / "f")
+    for ax, sem, ends in zip(drawn["sweep_I.png"].axes, (0.1, 0.05), ((5.0, 7.0), (2.0, 3.0))):
+        (bar,) = _bars(ax)  # the middle point's only: ± 0.1 mN s (I_acc: ± 0.05)
+        assert np.allclose(np.ptp(bar, axis=0), [0.0, 2 * sem])
+        assert sorted(_open_markers(ax)) == pytest.approx([(1000.0, ends[0]), (3000.0, ends[1])])
+        assert ax.get_title().endswith("(error bars: ±1 standard error; open markers: none (n/a), 2 of 3 points)")
+    (tmp_path / "one").mkdir(), (tmp_path / "all").mkdir()
+    h5 = _index(tmp_path / "one", [{SPEED: s} for s in speeds], [SPEED], sem=lambda i: math.nan)
+    plot_sweep_index(h5, tmp_path / "g")
+    for ax in drawn["sweep_I.png"].axes:
+        assert _bars(ax) == [] and len(_open_markers(ax)) == 3
+        assert ax.get_title().endswith("(no error bars: no point has a standard error (n/a))")
+    h5 = _index(tmp_path / "all", [{SPEED: s} for s in speeds], [SPEED])  # every point has one: unchanged
+    plot_sweep_index(h5, tmp_path / "h")
+    for ax in drawn["sweep_I.png"].axes:
+        assert len(_bars(ax)) == 3 and _open_markers(ax) == []
+        assert ax.get_title().endswith("(error bars: ±1 standard error)")
+
+
+def test_a_case_without_a_standard_error_is_a_hatched_bar_without_an_error_bar(tmp_path, drawn):
+    """The per-case chart drew a missing standard error as an error bar of 0 too."""
+    points = [{SPEED: 1000.0}, {SPEED: 2000.0, "contact.restitution": 0.6}]
+    h5 = _index(tmp_path, points, [SPEED, "contact.restitution"], grid=[], grid_rows=0,
+                sem=lambda i: math.nan if i == 1 else 1e-4)
+    plot_sweep_index(h5, tmp_path / "f")
+    for ax in drawn["sweep_cases.png"].axes:
+        (bar,) = _bars(ax)
+        assert np.allclose(bar[:, 1], 0.0)  # case 0's, on its row
+        assert [p.get_hatch() for p in ax.patches] == [None, "//"]
+        assert ax.get_title().endswith("(error bars: ±1 standard error; hatched: none (n/a), 1 of 2 bars)")
 
 
 def test_a_text_key_is_a_categorical_axis(tmp_path, figures):

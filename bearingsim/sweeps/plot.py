@@ -4,7 +4,10 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
 
 * the grid of its axes (``sweep_I.png`` or ``sweep_map.png``), I_dec and I_acc per cage rotation in two
   panels, error bars of one standard error (``I_*_sem_Ns``; see
-  :func:`bearingsim.stats.impulse_standard_errors`):
+  :func:`bearingsim.stats.impulse_standard_errors`). A point without one (``n/a`` in the tables: one
+  recorded rotation, or an index without the column) has no bar and an open marker, a case chart's bar
+  is hatched, a map's cell value starred, and the panel's title says so (:func:`error_title`); a map's
+  title gives its cells' largest standard error instead of bars:
 
   - one axis, or zipped axes: a line plot against the (first numeric) axis;
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
@@ -46,6 +49,21 @@ def axis_label(key: str) -> str:
     """``operating.inner_ring_speed_rpm`` -> ``inner ring speed [rpm]`` (no unit: the name alone)."""
     unit = unit_of(key)
     return f"{name_of(key)} [{unit}]" if unit != "1" else name_of(key)
+
+
+def error_title(sem, what: str = "point") -> str:
+    """What a panel's errors are, from the standard errors ``sem`` [mN s] of the values it draws (None: the
+    index has no such column): exact (all 0, the reduced model), none (all NaN: the tables' ``n/a``), some
+    missing (``k of n points: none (n/a)``), or ±1 standard error on every one."""
+    sem = np.full(0, math.nan) if sem is None else np.asarray(sem, dtype=float)
+    missing = int(np.isnan(sem).sum())
+    if sem.size and missing == 0 and np.all(sem == 0.0):
+        return "exact: the reduced model has no standard error"
+    if missing == sem.size:
+        return f"no error bars: no {what} has a standard error (n/a)"
+    mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
+    return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
+                                                if missing else ""))
 
 
 def _numeric(col) -> bool:
@@ -163,16 +181,17 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
             if f"{name}_mean_Ns" not in cols:
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
-            sem = cols.get(f"{name}_sem_Ns")
-            err = np.nan_to_num(np.asarray(sem)[idx] * 1e3) if sem is not None else None
+            err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
             ax.errorbar(x, y, yerr=err, fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
+            none = np.isnan(err) & np.isfinite(y)  # a value without an error: an open marker
+            ax.plot(x[none], y[none], "o", ms=4, color=f"C{gi}", mfc="white", zorder=3)
+    drawn = [i for idx in groups.values() for i in idx]
     for ax, (name, sym) in zip(panels, QUANTITIES):
         ax.set_xlabel(axis_label(x_key))
         ax.set_ylabel(f"{sym} {Y_LABEL}")
-        sem = cols.get(f"{name}_sem_Ns")
-        exact = sem is not None and np.all(np.nan_to_num(np.asarray(sem, dtype=float)[list(rows)], nan=1.0) == 0.0)
-        ax.set_title(f"{sym} (" + ("exact: the reduced model has no standard error" if exact
-                                   else "error bars: ±1 standard error") + ")", fontsize=9)
+        y = np.asarray(cols.get(f"{name}_mean_Ns", np.full(len(x_all), math.nan)), dtype=float)
+        shown = [i for i in drawn if math.isfinite(y[i])]
+        ax.set_title(f"{sym} ({error_title(_sem_mN_s(cols, name, len(x_all))[shown])})", fontsize=9)
         if ticks is not None:
             ax.set_xticks(ticks, tick_labels)
         elif is_integer_key(x_key):  # a roller count has no 14.5
@@ -188,6 +207,13 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
+
+
+def _sem_mN_s(cols, name: str, n: int) -> np.ndarray:
+    """The standard errors of ``name``'s means [mN s]; NaN where there is none (and for every row of an
+    index without the column)."""
+    sem = cols.get(f"{name}_sem_Ns")
+    return np.full(n, math.nan) if sem is None else np.asarray(sem, dtype=float) * 1e3
 
 
 def _show(v) -> str:
@@ -255,12 +281,14 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
     for k, (ax, (name, sym)) in enumerate(zip(panels, QUANTITIES)):
         if f"{name}_mean_Ns" in cols:
             y = np.asarray(cols[f"{name}_mean_Ns"]) * 1e3
-            sem = cols.get(f"{name}_sem_Ns")
-            err = np.nan_to_num(np.asarray(sem) * 1e3) if sem is not None else None
+            err = _sem_mN_s(cols, name, total)  # NaN: no error bar (matplotlib draws none), not a 0 one
             ok = np.isfinite(y)  # failed or not run: no bar (a gap, not a zero)
-            ax.barh(pos[ok], y[ok], xerr=None if err is None else err[ok], color=f"C{k}", capsize=3)
+            bars = ax.barh(pos[ok], y[ok], xerr=err[ok], color=f"C{k}", capsize=3)
+            for bar, e in zip(bars.patches, err[ok]):
+                if math.isnan(e):  # a value without an error: hatched
+                    bar.set_hatch("//")
+            ax.set_title(f"{sym} ({error_title(err[ok], 'bar')})", fontsize=9)
         ax.set_xlabel(f"{sym} {Y_LABEL}")
-        ax.set_title(f"{sym} (error bars: ±1 standard error)", fontsize=9)
         ax.grid(alpha=0.3, axis="x")
     panels[0].set_yticks(pos, labels, fontsize=7)
     panels[0].invert_yaxis()

@@ -467,7 +467,8 @@ SWEEP_CAPTIONS = {
                    "of the others; error bars ± 1 standard error (batch means over rotations, where the model has one; "
                    "a point without one, n/a in the table, has an open marker and no bar)",
     "sweep_map.png": "I_dec and I_acc per pocket and cage rotation over the two swept keys, as heat maps (a blank "
-                     "cell: a case that failed or did not run)",
+                     "cell: a case that failed or did not run); each panel's title gives its cells' largest standard "
+                     "error X: a difference of cells below 2√2 X may be noise (a starred value: none, n/a)",
     "sweep_cases.png": "I_dec and I_acc per pocket and cage rotation of every case, labelled by its values; error bars "
                        "± 1 standard error (batch means over rotations, where the model has one; a case without one, "
                        "n/a in the table, has a hatched bar and no error bar)",

@@ -157,13 +157,44 @@ def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
     h5 = _index(tmp_path, points, [SPEED, CLEAR], failed=(1,))
     assert [p.name for p in plot_sweep_index(h5, tmp_path / "f")] == ["sweep_map.png"]
     panels = figures["sweep_map.png"]["axes"]
-    assert [a["title"] for a in panels] == ["$I_{dec}$", "$I_{acc}$"]  # apart, each with its own scale
+    assert [a["title"].split(":")[0] for a in panels] == ["$I_{dec}$", "$I_{acc}$"]  # apart, own scales
     for a in panels:
         assert a["xticks"] == ["1000", "2000", "6000"] and a["yticks"] == ["0.1", "0.2"]
         assert a["xlim"] == (-0.5, 2.5) and a["ylim"] == (-0.5, 1.5)  # no edge beyond a sampled value
         assert len(a["texts"]) == 6 and "–" in a["texts"]  # every cell's value written; the failed one a gap
     assert set(panels[0]["texts"]) == {"5", "–", "7", "8", "9", "10"}  # mN s, case i: 5 + i
     assert set(panels[1]["texts"]) == {"2", "–", "3", "3.5", "4", "4.5"}  # case i: 2 + i / 2
+
+
+def test_a_maps_title_says_how_large_a_difference_its_standard_errors_leave_unresolved(tmp_path, figures):
+    """A map has no error bars: a 2 x 2 multibody map of 3 rotations coloured I_acc 17.8-18.2 mN s with
+    no word of its cells' standard errors of 0.52-1.1 mN s (the colours were noise). The title gives the
+    largest standard error X and 2√2 X, two standard errors of a difference of two cells of X
+    (sqrt(X² + X²)), and the colours' span when it is smaller; a cell without one (n/a) is starred;
+    the reduced model's exact maps say so; a map of one rotation per case that it has none."""
+    points = [{SPEED: s, CLEAR: c} for s in (1000.0, 2000.0, 6000.0) for c in (0.1, 0.2)]
+    folders = iter(range(10))
+
+    def titles(sem):
+        (tmp_path / (d := f"i{next(folders)}")).mkdir()
+        plot_sweep_index(_index(tmp_path / d, points, [SPEED, CLEAR], sem=sem), tmp_path / d / "f")
+        return [a["title"] for a in figures["sweep_map.png"]["axes"]], figures["sweep_map.png"]["axes"]
+
+    # I_dec 5-10 mN s with standard errors 0.1-0.6 (case 2: none); I_acc 2-4.5 with half of them
+    got, panels = titles(lambda i: math.nan if i == 2 else 1e-4 * (i + 1))
+    assert got == ["$I_{dec}$: cells' standard errors up to 0.6 mN s:\ndifferences below 2√2 × 0.6 = 1.7 mN s "
+                   "may be noise\n*: 1 of 6 cells without one (n/a)",
+                   "$I_{acc}$: cells' standard errors up to 0.3 mN s:\ndifferences below 2√2 × 0.3 = 0.85 mN s "
+                   "may be noise\n*: 1 of 6 cells without one (n/a)"]
+    assert [t for t in panels[0]["texts"] if t.endswith("*")] == ["7*"]  # case 2's value, starred
+    got, _ = titles(lambda i: 3e-3)  # standard errors of 3 mN s over colours spanning 5
+    assert got[0] == ("$I_{dec}$: cells' standard errors up to 3 mN s:\ndifferences below 2√2 × 3 = 8.5 mN s "
+                      "may be noise\n(the colours span 5 mN s)")
+    got, panels = titles(lambda i: 0.0)  # the reduced model
+    assert got == [f"{sym} (exact: the reduced model has no standard error)" for sym in ("$I_{dec}$", "$I_{acc}$")]
+    got, panels = titles(lambda i: math.nan)  # one recorded rotation per case
+    assert got == [f"{sym} (no cell has a standard error (n/a))" for sym in ("$I_{dec}$", "$I_{acc}$")]
+    assert not any(t.endswith("*") for a in panels for t in a["texts"])  # all without: the title says it
 
 
 @pytest.mark.slow

@@ -60,7 +60,7 @@ def error_title(sem, what: str = "point") -> str:
     if sem.size and missing == 0 and np.all(sem == 0.0):
         return "exact: the reduced model has no standard error"
     if missing == sem.size:
-        return f"no error bars: no {what} has a standard error (n/a)"
+        return ("" if what == "cell" else "no error bars: ") + f"no {what} has a standard error (n/a)"
     mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
     return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
                                                 if missing else ""))
@@ -235,13 +235,15 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
     text = len(xs) <= MAP_TEXT_CELLS and len(ys) <= MAP_TEXT_CELLS  # values written while they fit their cells
     n_gap = 0
     for ax, (name, sym) in zip(panels, QUANTITIES):
-        grid = np.full((len(ys), len(xs)), np.nan)
-        col = cols.get(f"{name}_mean_Ns")
+        grid, err = np.full((len(ys), len(xs)), np.nan), np.full((len(ys), len(xs)), np.nan)
+        col, sem = cols.get(f"{name}_mean_Ns"), _sem_mN_s(cols, name, len(cols["case"]))
         for i in rows:
             xi, yi = xpos.get(_show(cols[xk][i])), ypos.get(_show(cols[yk][i]))
             if xi is not None and yi is not None and col is not None:
-                grid[yi, xi] = col[i] * 1e3
+                grid[yi, xi], err[yi, xi] = col[i] * 1e3, sem[i]
         n_gap = max(n_gap, int(np.isnan(grid).sum()))
+        has = np.isfinite(grid)
+        star = np.isnan(err) & has if np.isfinite(err[has]).any() else np.zeros_like(has)  # some cells lack one
         mesh = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
                              np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
         fig.colorbar(mesh, ax=ax, label=f"{sym} {Y_LABEL}")
@@ -249,18 +251,38 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
         mid = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
         if text:
             for (yi, xi), z in np.ndenumerate(grid):
-                ax.text(xi, yi, f"{z:.3g}" if math.isfinite(z) else "–", ha="center", va="center", fontsize=7,
+                ax.text(xi, yi, f"{z:.3g}{'*' if star[yi, xi] else ''}" if math.isfinite(z) else "–", ha="center",
+                        va="center", fontsize=7,
                         color="black" if not math.isfinite(z) or z > mid else "white")
         kx, ky = -(-len(xs) // MAP_TICKS), -(-len(ys) // MAP_TICKS)  # every k-th value labelled
         ax.set_xticks(range(0, len(xs), kx), [_show(v) for v in xs[::kx]], rotation=90 if kx > 1 else 0)
         ax.set_yticks(range(0, len(ys), ky), [_show(v) for v in ys[::ky]])
         ax.set_xlabel(axis_label(xk))
         ax.set_ylabel(axis_label(yk))
-        ax.set_title(sym, fontsize=9)
+        ax.set_title(map_title(sym, grid[has], err[has], marked=text), fontsize=7)
     fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""), fontsize=10)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
+
+
+def map_title(sym: str, values, sem, marked: bool = True) -> str:
+    """A heat map panel's title: what its cells' standard errors ``sem`` [mN s] say of the colours of their
+    ``values`` (failed cells left out). A map has no error bars, so the title gives the largest standard
+    error X and 2√2 X, two standard errors of a difference of two such cells: a smaller difference (and a
+    colour span below it) may be noise. Exact cells (all 0) and cells without one (n/a) as
+    :func:`error_title` says them; ``marked``: such cells' values are starred (written in the cells)."""
+    sem = np.asarray(sem, dtype=float)
+    missing = int(np.isnan(sem).sum())
+    if not sem.size or missing == sem.size or np.nanmax(sem) == 0.0:
+        return f"{sym} ({error_title(sem, 'cell')})"
+    top = float(f"{np.nanmax(sem):.2g}")
+    noise, span = 2.0 * math.sqrt(2.0) * top, float(np.ptp(values))
+    text = (f"{sym}: cells' standard errors up to {top:g} mN s:\ndifferences below 2√2 × {top:g} = {noise:.2g} mN s "
+            "may be noise" + (f"\n(the colours span {span:.2g} mN s)" if span < noise else ""))
+    if missing:
+        text += f"\n{'*: ' if marked else ''}{missing} of {counted(sem.size, 'cell')} without one (n/a)"
+    return text
 
 
 def _cases_chart(cols, meta, path: Path, title: str) -> Path:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside"]
+__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title"]
 
 
 def figure(**kw):
@@ -29,6 +29,26 @@ def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, constrained_layout
     (``kw``: ``sharex``, ``sharey``, ``squeeze``, ... of :meth:`matplotlib.figure.Figure.subplots`)."""
     fig = figure(figsize=figsize, layout="constrained" if constrained_layout else None)
     return fig, fig.subplots(nrows, ncols, **kw)
+
+
+def error_title(sem, what: str = "point") -> str:
+    """What a panel's error bars are, from the standard errors ``sem`` of the values it draws (None: the
+    table has no such column): exact (all 0, the reduced model), none (all NaN: the tables' ``n/a``), some
+    missing (``open markers: none (n/a), k of n points``: such a value is drawn without a bar, marked as
+    ``what`` says: an open marker, a hatched bar, a starred cell), or ±1 standard error on every one."""
+    import numpy as np
+
+    from bearingsim.wording import counted
+
+    sem = np.full(0, np.nan) if sem is None else np.asarray(sem, dtype=float)
+    missing = int(np.isnan(sem).sum())
+    if sem.size and missing == 0 and np.all(sem == 0.0):
+        return "exact: the reduced model has no standard error"
+    if missing == sem.size:
+        return ("" if what == "cell" else "no error bars: ") + f"no {what} has a standard error (n/a)"
+    mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
+    return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
+                                                if missing else ""))
 
 
 def legend_outside(ax, **kw) -> None:

@@ -573,8 +573,7 @@ def _sensitivity_sections(table: Path):
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: "
                           f"d ln y / d ln x, lin: d y / d ln x; {errors} (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False], sens.HALF_STEP_NOTE if deterministic else "")]
-    bars = ("no error bars: a deterministic model has no standard error" if deterministic
-            else "± 1 standard error (batch means over rotations)")
+    bars = sens.tornado_errors(rows)
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d), {
         "sensitivity.png": "Tornado chart: the change of ln I_dec and ln I_acc across each key's plausible range "
                            f"(S ln(high / low), if linear), keys ordered by the change of I_dec; {bars}"})

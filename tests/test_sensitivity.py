@@ -471,12 +471,48 @@ def test_the_tornado_draws_the_change_across_each_range_it_is_ordered_by():
     bars = sorted(ax.patches, key=lambda b: -b.get_y())  # top first, the order of the labels from the top
     assert labels == ["lubrication.drag_coefficient", "bearing.pitch_diameter_mm",
                             "contact.cage_friction (range from 0)"]
-    assert [b.get_width() for b in bars] == pytest.approx([0.3 * math.log(4.0), -0.2 * math.log(1.01), 0.0])
+    assert [b.get_width() for b in bars] == pytest.approx([0.3 * math.log(4.0), -0.2 * math.log(1.01)])
     assert ax.get_xlabel() == "change of ln y across the range" and ax.get_title() == "I_dec"
     import matplotlib.pyplot as plt
 
     plt.close(fig)
 
+
+
+def test_the_tornado_draws_no_bar_for_a_missing_number_nor_an_error_bar_for_a_missing_error():
+    """The tornado passed np.nan_to_num(over_range) and np.nan_to_num(SE): a failed pair was a bar of 0 and a
+    slope of n/a standard error (a run of one recorded rotation) an error bar of 0, under "± 1 standard
+    error". Now neither is drawn: "n/a" at 0, a hatched bar counted in the panel's title; the error bar of a
+    slope of 0 is SE(S) ln(high / low), ln(high / low) from the key's other row (it was 0 x SE / 0: NaN)."""
+    from bearingsim.studies.sensitivity import plot_tornado
+
+    def row(key, q, s, se, ratio):
+        return {"key": key, "quantity": q, "sensitivity": s, "sensitivity_se": se,
+                "over_range": s * math.log(ratio)}
+
+    def error_bars(ax):  # the segments of its error bars (a NaN error leaves none, an error of 0 one of length 0)
+        return [seg for c in ax.containers if hasattr(c, "has_xerr") for col in c.lines[2]
+                for seg in col.get_segments() if len(seg)]
+
+    rows = [row("lubrication.drag_coefficient", "I_dec", 0.3, 0.02, 4.0),
+            row("lubrication.drag_coefficient", "I_acc", 0.0, 0.05, 4.0),
+            row("bearing.pitch_diameter_mm", "I_dec", -0.2, math.nan, 1.01),  # one rotation: no SE
+            row("bearing.pitch_diameter_mm", "I_acc", -0.1, math.nan, 1.01),
+            row("contact.restitution", "I_dec", math.nan, math.nan, 2.0),  # a failed pair
+            row("contact.restitution", "I_acc", math.nan, math.nan, 2.0)]
+    fig = plot_tornado(rows)
+    dec, acc = fig.axes
+    for ax in (dec, acc):
+        assert len(ax.patches) == 2 and [t.get_text() for t in ax.texts] == [" n/a"]
+        assert sorted(str(b.get_hatch()) for b in ax.patches) == ["//", "None"]
+        (bar,) = error_bars(ax)  # the drag coefficient's
+        assert ax.get_title().endswith("\nerror bars: ±1 standard error; hatched: none (n/a), 1 of 2 bars")
+    (bar,) = error_bars(acc)
+    assert np.ptp(bar[:, 0]) == pytest.approx(2 * 0.05 * math.log(4.0))  # ± SE ln 4 about a slope of 0
+    from bearingsim.studies.sensitivity import tornado_errors  # the chart's title and the report's caption
+
+    assert tornado_errors([r for r in rows if r["key"] != "lubrication.drag_coefficient"]).startswith(
+        "no error bars: no slope has a standard error (n/a")
 
 
 @pytest.mark.parametrize("step, shown, half", [("0.1%", "0.1%", "0.05%"), ("12.5%", "12.5%", "6.25%"),

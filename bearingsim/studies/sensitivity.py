@@ -495,8 +495,10 @@ def plot_tornado(rows, title: str = ""):
     """A tornado chart: one panel per headline number, one bar per key: the change of ln y (of y for the
     cage slip) across the key's plausible range, ``over_range`` = S ln(high / low), ± 1 SE scaled alike;
     keys ordered by that change of ln I_dec, the largest on top. A key whose range starts at 0 has no
-    such change (no bar; its label says so); its local slope S is in the table."""
-    from bearingsim.plotting import subplots
+    such change (no bar; its label says so), nor has a failed pair or a slope of n/a (no bar, "n/a" at 0);
+    its local slope S is in the table. A bar without a standard error (n/a) is hatched, its panel's title
+    says how many (:func:`bearingsim.plotting.error_title`)."""
+    from bearingsim.plotting import error_title, subplots
 
     quantities = [q for q in QUANTITIES if any(r["quantity"] == q[0] for r in rows)]
     fig, axes = subplots(1, len(quantities), figsize=(3.6 * len(quantities) + 1.5, 0.35 * len(
@@ -508,21 +510,47 @@ def plot_tornado(rows, title: str = ""):
         by = {r["key"]: r for r in rows if r["quantity"] == q}
         y = np.arange(len(order))[::-1]
         over = np.array([by[k]["over_range"] for k in order], dtype=float)
-        s = np.array([by[k]["sensitivity"] for k in order], dtype=float)
-        with np.errstate(invalid="ignore", divide="ignore"):  # ln(high / low) = over / S
-            se = np.array([by[k]["sensitivity_se"] for k in order], dtype=float) * np.abs(over / s)
-        ax.barh(y, np.nan_to_num(over), xerr=np.nan_to_num(se), color=np.where(over >= 0, "C3", "C0"), capsize=2)
+        se = np.array([by[k]["sensitivity_se"] * _log_range(rows, k) for k in order], dtype=float)
+        ok = np.isfinite(over)  # n/a: no bar (not one of 0); a NaN error: no error bar (not one of 0)
+        exact = np.all(se[ok] == 0.0)  # a deterministic model's: no error bars (not ones of 0)
+        bars = ax.barh(y[ok], over[ok], xerr=None if exact else se[ok], color=np.where(over[ok] >= 0, "C3", "C0"), capsize=2)
+        for bar, e in zip(bars.patches, se[ok]):
+            if math.isnan(e):
+                bar.set_hatch("//")
+        for yi in y[~ok]:
+            ax.text(0.0, yi, " n/a", va="center", fontsize=7, color="0.3")
         ax.axvline(0.0, color="0.3", lw=0.6)
         ax.set_yticks(y)
         ranged = [k if np.isfinite(next(r["over_range"] for r in rows if r["key"] == k)) else f"{k} (range from 0)"
                   for k in order]
         ax.set_yticklabels(ranged if ax is axes[0][0] else [""] * len(order), fontsize=8)
         ax.set_xlabel("change of ln y across the range" if measure == "log" else "change of y across the range")
-        ax.set_title(q, fontsize=9)
+        errors = error_title(se[ok], "bar")
+        ax.set_title(q + (f"\n{errors}" if "n/a" in errors else ""), fontsize=9)
         ax.grid(axis="x", alpha=0.3)
     fig.suptitle(title, fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _log_range(rows, key) -> float:
+    """ln(high / low) of ``key``'s range, over_range / S of a row with a slope (NaN without one)."""
+    for r in rows:
+        if r["key"] == key and math.isfinite(r["over_range"]) and math.isfinite(r["sensitivity"]) \
+                and r["sensitivity"] != 0.0:
+            return abs(r["over_range"] / r["sensitivity"])
+    return math.nan
+
+
+def tornado_errors(rows) -> str:
+    """What the tornado's error bars are, for its title and the report's caption: none for a deterministic
+    model (:func:`ran_half_steps`), none where no pair has a standard error (fewer than 2 recorded
+    rotations), else ± 1 standard error."""
+    if ran_half_steps(rows):
+        return "no error bars: a deterministic model has no standard error (S at half the step: the table)"
+    if not any(math.isfinite(float(r["sensitivity_se"])) for r in rows):
+        return "no error bars: no slope has a standard error (n/a: fewer than 2 recorded rotations)"
+    return "± 1 standard error (batch means over rotations)"
 
 
 def plot_sensitivity(index_path, outdir) -> list[Path]:
@@ -530,8 +558,7 @@ def plot_sensitivity(index_path, outdir) -> list[Path]:
     from bearingsim.plotting import save_figure
 
     rows, meta = read_table(index_path)
-    errors = ("no error bars: a deterministic model has no standard error (S at half the step: the table)"
-              if ran_half_steps(rows) else "± 1 standard error (batch means over rotations)")
+    errors = tornado_errors(rows)
     fig = plot_tornado(rows, f"Sensitivity of {meta.get('scenario_name', '?')}: runs at x (1 ± {step_text(meta['step'])}) "
                              "within each key's range; bars: S ln(high / low), the change across the key's plausible "
                              f"range if linear, {errors}")

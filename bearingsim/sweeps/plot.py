@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bearingsim.plotting import error_title
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -49,21 +50,6 @@ def axis_label(key: str) -> str:
     """``operating.inner_ring_speed_rpm`` -> ``inner ring speed [rpm]`` (no unit: the name alone)."""
     unit = unit_of(key)
     return f"{name_of(key)} [{unit}]" if unit != "1" else name_of(key)
-
-
-def error_title(sem, what: str = "point") -> str:
-    """What a panel's errors are, from the standard errors ``sem`` [mN s] of the values it draws (None: the
-    index has no such column): exact (all 0, the reduced model), none (all NaN: the tables' ``n/a``), some
-    missing (``k of n points: none (n/a)``), or ±1 standard error on every one."""
-    sem = np.full(0, math.nan) if sem is None else np.asarray(sem, dtype=float)
-    missing = int(np.isnan(sem).sum())
-    if sem.size and missing == 0 and np.all(sem == 0.0):
-        return "exact: the reduced model has no standard error"
-    if missing == sem.size:
-        return ("" if what == "cell" else "no error bars: ") + f"no {what} has a standard error (n/a)"
-    mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
-    return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
-                                                if missing else ""))
 
 
 def _numeric(col) -> bool:
@@ -271,7 +257,7 @@ def map_title(sym: str, values, sem, marked: bool = True) -> str:
     ``values`` (failed cells left out). A map has no error bars, so the title gives the largest standard
     error X and 2√2 X, two standard errors of a difference of two such cells: a smaller difference (and a
     colour span below it) may be noise. Exact cells (all 0) and cells without one (n/a) as
-    :func:`error_title` says them; ``marked``: such cells' values are starred (written in the cells)."""
+    ``error_title`` says them; ``marked``: such cells' values are starred (written in the cells)."""
     sem = np.asarray(sem, dtype=float)
     missing = int(np.isnan(sem).sum())
     if not sem.size or missing == sem.size or np.nanmax(sem) == 0.0:

@@ -515,6 +515,28 @@ def test_the_tornado_draws_no_bar_for_a_missing_number_nor_an_error_bar_for_a_mi
         "no error bars: no slope has a standard error (n/a")
 
 
+def test_the_sobol_chart_draws_no_bar_for_an_index_of_na_nor_an_error_bar_for_a_missing_interval():
+    """uncertainty.png drew np.nan_to_num of the indices and their intervals: an index the table gives as n/a
+    ("its variance is 0 or unknown") was a bar of 0, a missing interval an error bar of 0 under "bars: 95 %
+    bootstrap intervals". Now neither is drawn: "n/a" at 0, a hatched bar, both counted in the title."""
+    from bearingsim.studies.uncertainty import plot_indices
+
+    def row(key, v, half):
+        return {"quantity": "I_dec", "key": key, **{f"{n}{end}": v + d for n in ("S1", "ST")
+                                                    for end, d in (("", 0.0), ("_low", -half), ("_high", half))}}
+
+    rows = [row("lubrication.drag_coefficient", 0.6, 0.1), row("contact.restitution", 0.2, math.nan),
+            row("contact.cage_friction", math.nan, math.nan)]
+    spread = [{"quantity": "I_dec", "median": 0.018, "p05": 0.017, "p95": 0.019}]
+    (ax,) = plot_indices(rows, spread).axes
+    assert len(ax.patches) == 4 and [str(b.get_hatch()) for b in ax.patches].count("//") == 2
+    segs = [seg for c in ax.containers if hasattr(c, "has_xerr") for col in c.lines[2] for seg in col.get_segments()
+            if len(seg)]
+    assert len(segs) == 2 and all(np.ptp(seg[:, 0]) == pytest.approx(0.2) for seg in segs)  # the drag's ± 0.1
+    assert sorted(t.get_text() for t in ax.texts) == [" S1 n/a", " ST n/a"]
+    assert ax.get_title().endswith("\nn/a (variance 0 or unknown): 2 of 6 indices\nhatched (no interval): 2 of 6 indices")
+
+
 @pytest.mark.parametrize("step, shown, half", [("0.1%", "0.1%", "0.05%"), ("12.5%", "12.5%", "6.25%"),
                                               ("0.1", "10%", "5%")])
 def test_the_step_is_shown_as_given(tmp_path, capsys, monkeypatch, step, shown, half):

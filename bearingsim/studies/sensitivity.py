@@ -519,6 +519,7 @@ def plot_tornado(rows, title: str = ""):
                 bar.set_hatch("//")
         for yi in y[~ok]:
             ax.text(0.0, yi, " n/a", va="center", fontsize=7, color="0.3")
+        ax.set_ylim(-0.6, len(order) - 0.4)  # every key's row, with a bar or not
         ax.axvline(0.0, color="0.3", lw=0.6)
         ax.set_yticks(y)
         ranged = [k if np.isfinite(next(r["over_range"] for r in rows if r["key"] == k)) else f"{k} (range from 0)"

@@ -237,31 +237,56 @@ def write_tables(outdir, indices, spreads, study) -> list[Path]:
 
 def plot_indices(indices, spreads, title: str = ""):
     """One panel per output: S1 and ST of every key with their confidence intervals, and the output's
-    median and 5-95 % interval in the panel's title."""
+    median and 5-95 % interval in the panel's title. An index of n/a (its output's variance 0 or unknown,
+    as the table says) has no bar, "n/a" at 0; one without an interval a hatched bar, counted in the title."""
     from bearingsim.plotting import subplots
 
     qs = list(dict.fromkeys(r["quantity"] for r in indices))
     keys = list(dict.fromkeys(r["key"] for r in indices))
     fig, axes = subplots(1, len(qs), figsize=(3.8 * len(qs) + 1.5, 0.35 * len(keys) + 2.0), squeeze=False)
     y = np.arange(len(keys))[::-1]
+    said = 0  # most lines a panel's title says of its missing bars: the figure grows by them
     for ax, q in zip(axes[0], qs):
         rows = {r["key"]: r for r in indices if r["quantity"] == q}
-        for off, name, color in ((0.18, "S1", "C0"), (-0.18, "ST", "C3")):
-            v = np.array([rows[k][name] for k in keys])
-            err = np.abs(np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]]) - v)
-            ax.barh(y + off, np.nan_to_num(v), 0.36, xerr=np.nan_to_num(err), color=color, capsize=2,
-                    label="first order" if name == "S1" else "total")
+        missing = _index_bars(ax, rows, keys, y)
+        said = max(said, sum(n > 0 for n in missing.values()))
         sp = next(s for s in spreads if s["quantity"] == q)
-        ax.set_title(f"{q.replace('_', ' ')}: median {sp['median']:.4g}\n5-95 %: {sp['p05']:.4g} .. {sp['p95']:.4g}",
-                     fontsize=8)
+        ax.set_title(f"{q.replace('_', ' ')}: median {sp['median']:.4g}\n5-95 %: {sp['p05']:.4g} .. {sp['p95']:.4g}"
+                     + "".join(f"\n{w}: {n} of {2 * len(keys)} indices" for w, n in missing.items() if n), fontsize=8)
         ax.set_yticks(y)
         ax.set_yticklabels(keys if ax is axes[0][0] else [""] * len(keys), fontsize=8)
         ax.set_xlabel("Sobol index (share of the variance)")
         ax.grid(axis="x", alpha=0.3)
     axes[0][0].legend(fontsize=8, loc="lower right")
     fig.suptitle(title, fontsize=9)
+    fig.set_figheight(fig.get_figheight() + 0.3 * said)
     fig.tight_layout()
     return fig
+
+
+def _index_bars(ax, rows, keys, y) -> dict[str, int]:
+    """S1 and ST of ``keys`` (``rows`` by key) as bars with their intervals, and how many have none:
+    ``{"n/a (variance 0 or unknown)": indices of n/a, no bar (not one of 0), "n/a" at 0;
+    "hatched (no interval)": bars without an error bar (not one of 0)}``."""
+    missing = {"n/a (variance 0 or unknown)": 0, "hatched (no interval)": 0}
+    for off, name, color in ((0.18, "S1", "C0"), (-0.18, "ST", "C3")):
+        v = np.array([rows[k][name] for k in keys], dtype=float)
+        err = np.abs(np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]],
+                              dtype=float) - v)
+        ok = np.isfinite(v)
+        bars = ax.barh(y[ok] + off, v[ok], 0.36, xerr=err[:, ok], color=color, capsize=2,
+                       label="first order" if name == "S1" else "total")
+        for bar, e in zip(bars.patches, np.isnan(err[:, ok]).any(axis=0)):
+            if e:
+                bar.set_hatch("//")
+        for yi in y[~ok]:
+            ax.text(0.0, yi + off, f" {name} n/a", va="center", fontsize=6, color="0.3")
+        missing["n/a (variance 0 or unknown)"] += int((~ok).sum())
+        missing["hatched (no interval)"] += int(np.isnan(err[:, ok]).any(axis=0).sum())
+    ax.set_ylim(-0.6, len(keys) - 0.4)  # the rows of bars, drawn or not (n/a alone: no data to scale to)
+    if not any(len(c) for c in ax.containers if hasattr(c, "patches")):
+        ax.set_xlim(-0.05, 1.05)  # no index drawn: the indices' range
+    return missing
 
 
 def read_table(path):

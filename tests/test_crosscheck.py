@@ -309,6 +309,32 @@ def test_one_rotation_prints_no_nan_standard_error():
     assert "not judged" in text and "n/a" in text
 
 
+def test_a_rung_without_a_standard_error_is_an_open_marker_the_title_counts(tmp_path, monkeypatch):
+    """crosscheck.png of one rotation (the table: "± n/a") drew its multibody rungs without bars under "mean
+    over all pockets ± 1 standard error": matplotlib leaves out a NaN bar, and nothing said so. Such a rung
+    now has an open marker and the title counts it; the reduced rung's exact 0 stays a bar of 0."""
+    from bearingsim import plotting
+
+    nan = math.nan
+    rows = [dict(rpm=3000.0, rung=k, scene=s, relaxed="", I_dec_mean_Ns=m, I_dec_sem_Ns=e, I_acc_mean_Ns=m / 2,
+                 I_acc_sem_Ns=e, first_impact_speed_m_s=0.08, cage_slip=0.0, change_from_previous=nan,
+                 archive="", wall_s=1.0, status="done", error="")
+            for k, s, m, e in ((1, "reduced", 5e-3, 0.0), (2, "full", 6e-3, nan), (3, "full", 7e-3, 1e-4))]
+    cc.write_table(tmp_path, rows, load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
+    figs = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: figs.append(fig) or Path(path))
+    cc.plot_crosscheck(tmp_path / "crosscheck.h5", tmp_path)
+    dec, acc = figs[0].axes[:2]
+    for ax, m in ((dec, 6.0), (acc, 3.0)):
+        opened = [(float(x), float(y)) for line in ax.lines if line.get_markerfacecolor() == "white"
+                  for x, y in zip(line.get_xdata(), line.get_ydata())]
+        assert opened == [(2.0, pytest.approx(m))]  # rung 2's, in mN s
+        segs = [seg for c in ax.containers for col in c.lines[2] for seg in col.get_segments() if len(seg)]
+        assert len(segs) == 2  # rung 1's of length 0, rung 3's ± 0.1 mN s; none for rung 2
+    assert dec.get_title().endswith("± 1 standard error (batch means over rotations); open markers: none (n/a), "
+                                    "2 of 6 points")
+
+
 def test_terminal_table_gives_cage_slip_in_per_cent_as_the_docs_do():
     """The cage slip (a fraction in crosscheck.h5/.csv) printed as 1e-2 numbers ("-4.10e-03") under a
     header without a unit, while docs/crosscheck.md quotes it in per cent; the terminal table gives it

@@ -38,3 +38,33 @@ def test_batch_sem_of_independent_samples():
     est = [batch_sem(rng.normal(size=400)) for _ in range(2000)]
     assert np.mean(est) == pytest.approx(0.9400 / np.sqrt(400), rel=0.03)
     assert batch_sem(np.ones(20)) == 0.0
+
+
+def test_a_pocket_std_of_na_is_an_open_marker_the_legend_names(tmp_path, monkeypatch):
+    """rig_idec_vs_speed.png of one rotation (the table: "± n/a (std)") drew pocket 0 without bars under the
+    label "mean ± std over rotations": matplotlib leaves out a NaN bar, and nothing said so. Such a point
+    now has an open marker and the label says the std is n/a (here at 1 of 2 speeds)."""
+    import math
+    from pathlib import Path
+
+    import numpy as np
+
+    from bearingsim import plotting
+    from bearingsim.studies.rig import save_rig
+
+    theta = np.linspace(0.0, 360.0, 8)
+    rows = [{"rpm": rpm, "rotations": 1.0, "pocket0_I_dec_mean_Ns": 8e-3, "pocket0_I_dec_std_Ns": std,
+             "pocket0_I_dec_sem_Ns": math.nan, "pocket0_I_acc_mean_Ns": 1e-3, "arc_pockets_I_dec_mean_Ns": 0.03,
+             "arc_pockets_I_dec_std_Ns": 2e-3, "reduced_I_dec_Ns": 7e-3, "theta_deg": theta,
+             "F_acc_pocket0": np.zeros(8), "F_dec_pocket0": np.zeros(8), "load_zone_half_angle_deg": 23.5}
+            for rpm, std in ((1000.0, math.nan), (2000.0, 5e-4))]
+    figs = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: figs.append(fig) or Path(path))
+    save_rig(tmp_path, rows)
+    (ax,) = figs[0].axes
+    opened = [(float(x), float(y)) for line in ax.lines if line.get_markerfacecolor() == "white"
+              for x, y in zip(line.get_xdata(), line.get_ydata())]
+    assert opened == [(1000.0, pytest.approx(8.0))]  # pocket 0 at 1000 rpm, in mN s
+    labels = ax.get_legend_handles_labels()[1]
+    assert "rig scene, flat pocket 0: mean ± std over rotations (open marker: std n/a, 1 of 2 speeds)" in labels
+    assert "rig scene, the 15 arc pockets: mean ± std" in labels  # its std is over pockets too: a number

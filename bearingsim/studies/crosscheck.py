@@ -291,11 +291,19 @@ def read_table(path) -> tuple[list[dict], dict]:
 
 
 def plot_crosscheck(index_path, outdir) -> list[Path]:
-    """Draw ``crosscheck.png`` from the index alone: I_dec and I_acc against the rung, one line per
-    speed, error bars ± 1 standard error (batch means)."""
-    from bearingsim.plotting import legend_outside, subplots, save_figure
+    """Draw ``crosscheck.png`` from the index alone (:func:`plot_ladder`)."""
+    from bearingsim.plotting import save_figure
 
     rows, meta = read_table(index_path)
+    return [save_figure(plot_ladder(rows, meta), Path(outdir) / "crosscheck.png")]
+
+
+def plot_ladder(rows: list[dict], meta: dict):
+    """I_dec and I_acc against the rung, one line per speed, error bars ± 1 standard error (batch means);
+    a rung without one (n/a: fewer than 2 recorded rotations) an open marker, no bar, counted in the title
+    (:func:`bearingsim.plotting.error_title`)."""
+    from bearingsim.plotting import error_title, legend_outside, subplots
+
     speeds = sorted({r["rpm"] for r in rows})
     labels = {r["rung"]: f"{r['rung']} {r['scene']}" for r in rows}
     fig, axes = subplots(2, 1, figsize=(9, 6.5), sharex=True)
@@ -303,8 +311,10 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
         rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
         x = np.array([r["rung"] for r in rs]) + (k - 0.5 * (len(speeds) - 1)) * 0.06
         for ax, q in zip(axes, ("I_dec", "I_acc")):
-            ax.errorbar(x, [r[f"{q}_mean_Ns"] * 1e3 for r in rs], yerr=[r[f"{q}_sem_Ns"] * 1e3 for r in rs],
-                        marker="o", ms=4, capsize=3, color=f"C{k}", label=f"{rpm:g} rpm")
+            y, err = (np.array([r[f"{q}_{c}_Ns"] * 1e3 for r in rs], dtype=float) for c in ("mean", "sem"))
+            ax.errorbar(x, y, yerr=err, marker="o", ms=4, capsize=3, color=f"C{k}", label=f"{rpm:g} rpm")
+            none = np.isnan(err) & np.isfinite(y)
+            ax.plot(x[none], y[none], "o", ms=4, color=f"C{k}", mfc="white", zorder=3)
     axes[0].set_ylabel("$I_{dec}$ per pocket and\ncage rotation [mN s]")
     axes[1].set_ylabel("$I_{acc}$ per pocket and\ncage rotation [mN s]")
     for ax in axes:
@@ -314,10 +324,13 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
     axes[1].set_xticks(ticks)
     axes[1].set_xticklabels([labels[t] for t in ticks], rotation=15)
     axes[1].set_xlabel("rung of the cross-check (each drops one assumption of the paper's model)")
-    axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets ± 1 standard error "
-                      "(batch means over rotations)", fontsize=9)
+    drawn = [r for r in rows if math.isfinite(r["I_dec_mean_Ns"])]
+    errors = error_title([r["I_dec_sem_Ns"] for r in drawn] + [r["I_acc_sem_Ns"] for r in drawn])
+    errors = ("± 1 standard error (batch means over rotations)" + errors[len("error bars: ±1 standard error"):]
+              if errors.startswith("error bars") else f"({errors})")
+    axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets {errors}", fontsize=9)
     legend_outside(axes[0], title="inner ring speed")
-    return [save_figure(fig, Path(outdir) / "crosscheck.png")]
+    return fig
 
 
 def verdicts(rows: list[dict], rotations: int | None = None) -> list[str]:

@@ -130,6 +130,17 @@ def format_table(rows: list[dict], rotations: int) -> str:
     return "\n".join(lines)
 
 
+def _spread_points(ax, n, rows, name: str, marker: str, color: str, label: str) -> None:
+    """``name``'s I_dec mean ± std against the speeds ``n``; a std of n/a (one rotation: the table's n/a) is
+    no bar and an open marker, and the legend's label says so."""
+    y, std = (np.array([r[f"{name}_I_dec_{c}_Ns"] * 1e3 for r in rows], dtype=float) for c in ("mean", "std"))
+    none = np.isnan(std) & np.isfinite(y)
+    if none.any():
+        label += " (open marker: std n/a" + ("" if none.all() else f", {int(none.sum())} of {counted(len(y), 'speed')}") + ")"
+    ax.errorbar(n, y, yerr=std, fmt=marker, color=color, capsize=3, label=label)
+    ax.plot(n[none], y[none], marker, color=color, mfc="white", zorder=3)
+
+
 def save_rig(outdir, rows: list[dict]) -> list[Path]:
     """Write ``rig_idec_vs_speed.{csv,png}`` and ``rig_pocket0_forces.png`` (Fig. 5 analog) to ``outdir``."""
     from bearingsim.plotting import legend_outside, subplots, save_figure
@@ -147,11 +158,8 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
             label="reduced model (paper's model, φ = 23.5°)")
     ax.fill_between(n, [r["reduced_I_dec_Ns"] * 0.75e3 for r in rows], [r["reduced_I_dec_Ns"] * 1.25e3 for r in rows],
                     color="0.85", label="reduced model ± 25 %")
-    ax.errorbar(n, [r["pocket0_I_dec_mean_Ns"] * 1e3 for r in rows], yerr=[r["pocket0_I_dec_std_Ns"] * 1e3 for r in rows],
-                fmt="s", color="C0", capsize=3, label="rig scene, flat pocket 0: mean ± std over rotations")
-    ax.errorbar(n, [r["arc_pockets_I_dec_mean_Ns"] * 1e3 for r in rows],
-                yerr=[r["arc_pockets_I_dec_std_Ns"] * 1e3 for r in rows], fmt="^", color="C3", capsize=3,
-                label="rig scene, the 15 arc pockets: mean ± std")
+    _spread_points(ax, n, rows, "pocket0", "s", "C0", "rig scene, flat pocket 0: mean ± std over rotations")
+    _spread_points(ax, n, rows, "arc_pockets", "^", "C3", "rig scene, the 15 arc pockets: mean ± std")
     ax.set_xlabel("inner ring speed [rpm]")
     ax.set_ylabel("$I_{dec}$ per cage rotation [mN s]")
     ax.set_ylim(bottom=0)

@@ -534,7 +534,8 @@ def test_the_sobol_chart_draws_no_bar_for_an_index_of_na_nor_an_error_bar_for_a_
             if len(seg)]
     assert len(segs) == 2 and all(np.ptp(seg[:, 0]) == pytest.approx(0.2) for seg in segs)  # the drag's ± 0.1
     assert sorted(t.get_text() for t in ax.texts) == [" S1 n/a", " ST n/a"]
-    assert ax.get_title().endswith("\nn/a (variance 0 or unknown): 2 of 6 indices\nhatched (no interval): 2 of 6 indices")
+    assert ax.get_title().endswith("\nn/a (variance 0 or unknown): 2 of 6 indices"
+                                   "\nhatched (no interval): 2 of 6 indices")
 
 
 @pytest.mark.parametrize("step, shown, half", [("0.1%", "0.1%", "0.05%"), ("12.5%", "12.5%", "6.25%"),

@@ -136,7 +136,8 @@ def _spread_points(ax, n, rows, name: str, marker: str, color: str, label: str) 
     y, std = (np.array([r[f"{name}_I_dec_{c}_Ns"] * 1e3 for r in rows], dtype=float) for c in ("mean", "std"))
     none = np.isnan(std) & np.isfinite(y)
     if none.any():
-        label += " (open marker: std n/a" + ("" if none.all() else f", {int(none.sum())} of {counted(len(y), 'speed')}") + ")"
+        some = "" if none.all() else f", {int(none.sum())} of {counted(len(y), 'speed')}"
+        label += f" (open marker: std n/a{some})"
     ax.errorbar(n, y, yerr=std, fmt=marker, color=color, capsize=3, label=label)
     ax.plot(n[none], y[none], marker, color=color, mfc="white", zorder=3)
 

@@ -513,7 +513,8 @@ def plot_tornado(rows, title: str = ""):
         se = np.array([by[k]["sensitivity_se"] * _log_range(rows, k) for k in order], dtype=float)
         ok = np.isfinite(over)  # n/a: no bar (not one of 0); a NaN error: no error bar (not one of 0)
         exact = np.all(se[ok] == 0.0)  # a deterministic model's: no error bars (not ones of 0)
-        bars = ax.barh(y[ok], over[ok], xerr=None if exact else se[ok], color=np.where(over[ok] >= 0, "C3", "C0"), capsize=2)
+        bars = ax.barh(y[ok], over[ok], xerr=None if exact else se[ok], color=np.where(over[ok] >= 0, "C3", "C0"),
+                       capsize=2)
         for bar, e in zip(bars.patches, se[ok]):
             if math.isnan(e):
                 bar.set_hatch("//")

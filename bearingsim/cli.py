@@ -369,7 +369,11 @@ def _cmd_rerun(args) -> int:
     for line in c.difference_lines():
         print(line)
     for k, va, vb in c.versions:
-        print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
+        if k == "model_version":
+            print(f"  model version: archive {va}, now {vb} (bumped when a change moves the model's numbers: "
+                  "CHANGELOG.md says which)")
+        else:
+            print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
     return args.status
 
 

@@ -93,8 +93,9 @@ def compare_results(a, b) -> Comparison:
             if how is not None:
                 c.arrays_differ.append(k)
                 c.how[k] = how
-    va = {k: v for k, v in a.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
-    vb = {k: v for k, v in b.provenance.items() if k.startswith("version_") or k == "bearingsim_version"}
+    named = ("bearingsim_version", "model_version")  # and every version_<package>
+    va = {k: v for k, v in a.provenance.items() if k.startswith("version_") or k in named}
+    vb = {k: v for k, v in b.provenance.items() if k.startswith("version_") or k in named}
     for k in sorted(set(va) | set(vb)):
         if va.get(k) != vb.get(k):
             c.versions.append((k, va.get(k, "?"), vb.get(k, "?")))

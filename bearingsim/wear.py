@@ -349,11 +349,12 @@ def start_note(rep: WearReport) -> list[str]:
 
 
 def edge_caveat(rep: WearReport) -> str:
-    """`` (an end bin's ...)`` when the deepest point lies in a bin at an end of a face's extent: the wear
-    there is that of the face's edge, a line, so its depth is the edge's volume over one bin's area and
-    doubles each time the bins halve (docs/wear.md, *Discretization errors*); '' otherwise."""
-    ends = [rep.total_depth(f)[[0, -1]].max() for f in ("front", "rear")]
-    if max(ends) < rep.max_depth:
+    """`` (an end bin's ...)`` when the deepest point of the running time's wear lies in a bin at an end of a
+    face's extent: the wear there is that of the face's edge, a line, so its depth is the edge's volume over
+    one bin's area and doubles each time the bins halve (docs/wear.md, *Discretization errors*); '' otherwise.
+    A scenario's own starting depth is given, not binned by the report: it takes no part."""
+    ends = [d[[0, -1]].max() for d in (rep.depth_front, rep.depth_rear)]
+    if max(ends) < rep.max_new_depth:
         return ""
     width = float(np.diff(rep.psi_deg).mean()) if len(rep.psi_deg) > 1 else float("nan")
     return (f" (an end bin's, {width:.3g} deg of psi wide: the wear at a face's edge is a line, whose depth "

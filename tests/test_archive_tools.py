@@ -90,9 +90,16 @@ def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive
     with h5py.File(tampered, "r+") as f:
         _edit_json_attr(f["results/summary"], "I_dec_mean_Ns", lambda v: v * (1.0 + 1e-12))
         _edit_json_attr(f["provenance"], "version_numpy", lambda v: "0.0.1")
+        _edit_json_attr(f["provenance"], "model_version", lambda v: v - 1)  # written by the model before
     res = cli("rerun", tampered)
     assert res.returncode == 1
     assert "I_dec_mean_Ns" in res.stdout and "differs" in res.stdout and "numpy: archive 0.0.1" in res.stdout
+    # the model's own version, bumped when a change moves numbers, is the likeliest reason: named too
+    from bearingsim.model_versions import MODEL_VERSIONS
+
+    v = MODEL_VERSIONS["reduced"]
+    assert f"model version: archive {v - 1}, now {v} (bumped when a change moves the model's numbers: " \
+           "CHANGELOG.md says which)" in res.stdout, res.stdout
 
 
 @pytest.mark.slow

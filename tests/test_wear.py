@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 import signal
 import sys
 import time
@@ -1115,6 +1116,8 @@ def test_a_deepest_point_at_a_faces_edge_says_it_depends_on_the_bins():
     and not when it lies inside the face; a depth limit of the life study says so, the other limits not."""
     from bearingsim.scenario import load_scenario
     from bearingsim.studies.life import depth_limit_note, parse_limit
+    import dataclasses
+
     from bearingsim.wear import WearReport, edge_caveat
 
     psi = np.linspace(-30.0, 25.0, 32)
@@ -1129,6 +1132,14 @@ def test_a_deepest_point_at_a_faces_edge_says_it_depends_on_the_bins():
     assert "doubles each time the bins halve" in edge_caveat(report(edge))
     assert "1.77 deg of psi wide" in edge_caveat(report(edge))  # 55 deg over 31 bin steps
     assert edge_caveat(report(inside)) == ""
+    # a worn start (the scenario's own depth, given, not binned by this report): the caveat is about the wear of
+    # the running time; a starting depth at an end bin, deeper than any wear, carried it before
+    start = np.zeros((32, 2))
+    start[0, 0] = 50e-6
+    worn = WearReport(psi, inside * 1e-3, np.zeros((32, 2)), np.zeros(2), np.zeros(2), 1.0, 1.0, 1.0, 1e-5, 1e9,
+                      1e-8, start_front=start, start_rear=np.zeros((32, 2)))
+    assert worn.max_depth == 50e-6 and edge_caveat(worn) == ""
+    assert "doubles each time the bins halve" in edge_caveat(dataclasses.replace(worn, depth_front=edge * 1e-3))
     sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml")
     assert "1.85 deg of psi wide" in depth_limit_note(sc, parse_limit("depth=0.1mm"))
     assert depth_limit_note(sc, parse_limit("clearance=0.4mm")) is None
@@ -1272,6 +1283,28 @@ def test_wear_says_where_its_extrapolation_goes_through_a_cage_bar(fast_run):
     assert "worn through" in fig._suptitle.get_text() and "starting depth" not in fig._suptitle.get_text()
     fig = res.plot_wear_profile(rotations=1e3)
     assert "worn through" not in fig._suptitle.get_text()
+
+
+def test_the_wear_figure_names_the_impulse_its_archive_computed_the_index_from(fast_run, tmp_path):
+    """The paper's index is computed from the normal impulse since model version 7, from its circumferential
+    component before; an archive keeps its own (the dataset's description says which). The figure's legend
+    followed the code, so an older archive's bars were labelled "normal impulse": it follows the archive."""
+    import h5py
+
+    from bearingsim.simulation import load
+
+    res, path = fast_run
+    labels = [t.get_text() for t in res.plot_wear().axes[0].get_legend().get_texts()]
+    assert labels[0] == "front face, impulse index (Eq. 16, normal impulse)", labels
+    old = tmp_path / "v6.h5"
+    shutil.copy(path, old)
+    with h5py.File(old, "r+") as f:  # as model version 6 described it
+        for face, q in (("front", "I_acc"), ("rear", "I_dec")):
+            f[f"results/wear/paper_index_{face}"].attrs["description"] = (
+                f"Archard wear per cage rotation, {face} face, k {q} r_r omega_r / H (paper Eq. 16), per pocket")
+    labels = [t.get_text() for t in load(old).plot_wear().axes[0].get_legend().get_texts()]
+    assert labels[:2] == ["front face, impulse index (Eq. 16, circumferential impulse I_acc)",
+                          "rear face, impulse index (Eq. 16, circumferential impulse I_dec)"], labels
 
 
 def test_wear_figures_use_one_fixed_unit_per_quantity(fast_run, monkeypatch):

@@ -575,6 +575,13 @@ class MultibodyResult(Result):
         legend_outside(ax)
         return fig
 
+    def _index_impulse(self, face: str) -> str:
+        """Which impulse the archive's paper index of ``face`` was computed from, as its dataset's description
+        says: the normal impulse (model version 7 on), or before it the circumferential I_acc / I_dec."""
+        desc = getattr(self.data.get(f"results/wear/paper_index_{face}"), "description", "") or ""
+        q = "I_acc" if face == "front" else "I_dec"
+        return f"circumferential impulse {q}" if f"k {q} " in desc else "normal impulse"
+
     def plot_wear(self):
         """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
         from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
@@ -584,10 +591,10 @@ class MultibodyResult(Result):
         per_hour = running_time(self, hours=1.0)[2] * 1e9
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = subplots(figsize=(9, 4))
-        bars = [(self.get("wear/paper_index_front"), "front face, impulse index (Eq. 16, normal impulse)"),
-                (self.get("wear/paper_index_rear"), "rear face, impulse index (Eq. 16, normal impulse)"),
-                (self.get("wear/sliding_work_front"), "front face, sliding work"),
-                (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
+        bars = [(self.get(f"wear/paper_index_{f}"), f"{f} face, impulse index (Eq. 16, {self._index_impulse(f)})")
+                for f in ("front", "rear")]
+        bars += [(self.get("wear/sliding_work_front"), "front face, sliding work"),
+                 (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
         wdt = 0.2
         for j, (v, label) in enumerate(bars):
             ax.bar(x + (j - 1.5) * wdt, v * per_hour, wdt, label=label)

@@ -989,8 +989,8 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
 
 def sweep_context(scenario: "Scenario", swept) -> str:
     """What a sweep's cases share, for its figures' titles: ``multibody_6000rpm: multibody, full scene,
-    6000 rpm forward, 970 N, 1 warm-up + 3 rotations; raceway rigid``. The speed, direction and load are
-    named unless ``swept`` (the varied keys) holds them; the base's differences from its preset
+    6000 rpm forward, 970 N, 1 warm-up + 3 rotations; raceway rigid``. The speed, direction, load and the
+    (warm-up) rotation counts are named unless ``swept`` (the varied keys) holds them; the base's differences from its preset
     (:func:`differences_from_preset`) leave the swept keys out."""
     op, swept = scenario.operating, set(swept)
     what = (f"multibody, {scenario.multibody.scene} scene" if scenario.model == "multibody"
@@ -1000,8 +1000,14 @@ def sweep_context(scenario: "Scenario", swept) -> str:
     parts = [what] + ([point] if point else []) + (
         [f"{op.radial_load_N:g} N"] if "operating.radial_load_N" not in swept else [])
     n = scenario.numerics
-    if scenario.model == "multibody":
-        parts.append(f"{n.warmup_rotations} warm-up + {n.rotations} rotations")
+    if scenario.model == "multibody":  # a swept count is no case's: left out
+        from bearingsim.wording import counted
+
+        rec = "numerics.rotations" not in swept
+        counts = [(f"{n.warmup_rotations} warm-up" if rec else counted(n.warmup_rotations, "warm-up rotation"))
+                  ] if "numerics.warmup_rotations" not in swept else []
+        counts += [counted(n.rotations, "rotation")] if rec else []
+        parts += [" + ".join(counts)] if counts else []
     flat = flatten(scenario.raw)
     skip = {_title_value(k, flat[k]) for k in swept if k in flat}
     diffs = [d for d in differences_from_preset(scenario) if d not in skip]

@@ -262,3 +262,18 @@ def test_too_many_lines_is_said(tmp_path):
     notes = []
     assert plot_sweep_index(_index(tmp_path, points, [SPEED, CLEAR, GUIDE]), tmp_path / "f", notes=notes) == []
     assert len(notes) == 1 and "9 combinations" in notes[0]
+
+
+def test_a_title_states_no_rotation_count_the_sweep_varies():
+    """A sweep over ``numerics.rotations=1,2,3`` was titled "... 1 warm-up + 40 rotations", the base
+    scenario's count, which no case ran. A swept count (recorded or warm-up rotations) is left out of the
+    title; the other one stays."""
+    from bearingsim.scenario import load_scenario, sweep_context
+
+    base = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["multibody.raceway_contact=rigid"])
+    rotations = sweep_context(base, ["numerics.rotations"])
+    assert "rotations" not in rotations.replace("warm-up rotation", "") and "1 warm-up rotation" in rotations
+    warmup = sweep_context(base, ["numerics.warmup_rotations"])
+    assert "warm-up" not in warmup and f"{base.numerics.rotations} rotations" in warmup
+    both = sweep_context(base, ["numerics.rotations", "numerics.warmup_rotations"])
+    assert "rotation" not in both and "warm-up" not in both

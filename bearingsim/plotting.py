@@ -35,12 +35,15 @@ def error_title(sem, what: str = "point") -> str:
     """What a panel's error bars are, from the standard errors ``sem`` of the values it draws (None: the
     table has no such column): exact (all 0, the reduced model), none (all NaN: the tables' ``n/a``), some
     missing (``open markers: none (n/a), k of n points``: such a value is drawn without a bar, marked as
-    ``what`` says: an open marker, a hatched bar, a starred cell), or ±1 standard error on every one."""
+    ``what`` says: an open marker, a hatched bar, a starred cell), or ±1 standard error on every one; "" for
+    an empty ``sem`` (a panel that draws no value)."""
     import numpy as np
 
     from bearingsim.wording import counted
 
-    sem = np.full(0, np.nan) if sem is None else np.asarray(sem, dtype=float)
+    if sem is not None and not np.size(sem):  # nothing drawn (every value n/a): nothing to say of its errors
+        return ""
+    sem = np.full(1, np.nan) if sem is None else np.asarray(sem, dtype=float)
     missing = int(np.isnan(sem).sum())
     if sem.size and missing == 0 and np.all(sem == 0.0):
         return "exact: the reduced model has no standard error"

@@ -515,6 +515,27 @@ def test_the_tornado_draws_no_bar_for_a_missing_number_nor_an_error_bar_for_a_mi
         "no error bars: no slope has a standard error (n/a")
 
 
+def test_a_tornado_panel_without_a_slope_has_no_error_remark():
+    """The reduced model at 3000 rpm has I_acc = 0: every I_acc slope is n/a, and its panel was titled "no
+    error bars: no bar has a standard error (n/a)" under a figure titled exact (plotting.error_title took
+    an empty panel for one of n/a bars). A panel without a bar has no error remark, nor has an exact
+    model's panel (its slopes' standard errors 0, or n/a where there is no slope)."""
+    from bearingsim.plotting import error_title
+    from bearingsim.studies.sensitivity import plot_tornado
+
+    def row(key, q, s, se):
+        return {"key": key, "quantity": q, "sensitivity": s, "sensitivity_se": se,
+                "over_range": s * math.log(2.0), "sensitivity_half_step": s}
+
+    keys = ("lubrication.drag_coefficient", "contact.restitution")
+    exact = [row(k, "I_dec", 0.3, 0.0) for k in keys] + [row(k, "I_acc", math.nan, math.nan) for k in keys]
+    for rows in (exact, [{**r, "sensitivity_half_step": math.nan, "sensitivity_se": 0.01 if r["quantity"] ==
+                          "I_dec" else math.nan} for r in exact]):  # the reduced model's, a multibody one's
+        fig = plot_tornado(rows)
+        assert [ax.get_title() for ax in fig.axes] == ["I_dec", "I_acc"]
+    assert error_title([]) == ""  # nothing drawn: nothing to say of its errors
+
+
 def test_the_sobol_chart_draws_no_bar_for_an_index_of_na_nor_an_error_bar_for_a_missing_interval():
     """uncertainty.png drew np.nan_to_num of the indices and their intervals: an index the table gives as n/a
     ("its variance is 0 or unknown") was a bar of 0, a missing interval an error bar of 0 under "bars: 95 %

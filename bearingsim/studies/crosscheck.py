@@ -327,7 +327,7 @@ def plot_ladder(rows: list[dict], meta: dict):
     drawn = [r for r in rows if math.isfinite(r["I_dec_mean_Ns"])]
     errors = error_title([r["I_dec_sem_Ns"] for r in drawn] + [r["I_acc_sem_Ns"] for r in drawn])
     errors = ("± 1 standard error (batch means over rotations)" + errors[len("error bars: ±1 standard error"):]
-              if errors.startswith("error bars") else f"({errors})")
+              if errors.startswith("error bars") else f"({errors})" if errors else "")
     axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets {errors}", fontsize=9)
     legend_outside(axes[0], title="inner ring speed")
     return fig

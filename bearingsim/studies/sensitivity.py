@@ -527,7 +527,7 @@ def plot_tornado(rows, title: str = ""):
                   for k in order]
         ax.set_yticklabels(ranged if ax is axes[0][0] else [""] * len(order), fontsize=8)
         ax.set_xlabel("change of ln y across the range" if measure == "log" else "change of y across the range")
-        errors = error_title(se[ok], "bar")
+        errors = "" if ran_half_steps(rows) else error_title(se[ok], "bar")  # exact: the figure's title says so
         ax.set_title(q + (f"\n{errors}" if "n/a" in errors else ""), fontsize=9)
         ax.grid(axis="x", alpha=0.3)
     fig.suptitle(title, fontsize=9)

@@ -177,7 +177,7 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
         ax.set_ylabel(f"{sym} {Y_LABEL}")
         y = np.asarray(cols.get(f"{name}_mean_Ns", np.full(len(x_all), math.nan)), dtype=float)
         shown = [i for i in drawn if math.isfinite(y[i])]
-        ax.set_title(f"{sym} ({error_title(_sem_mN_s(cols, name, len(x_all))[shown])})", fontsize=9)
+        ax.set_title(_titled(sym, error_title(_sem_mN_s(cols, name, len(x_all))[shown])), fontsize=9)
         if ticks is not None:
             ax.set_xticks(ticks, tick_labels)
         elif is_integer_key(x_key):  # a roller count has no 14.5
@@ -200,6 +200,11 @@ def _sem_mN_s(cols, name: str, n: int) -> np.ndarray:
     index without the column)."""
     sem = cols.get(f"{name}_sem_Ns")
     return np.full(n, math.nan) if sem is None else np.asarray(sem, dtype=float) * 1e3
+
+
+def _titled(sym: str, errors: str) -> str:
+    """A panel's title: its quantity and what its error bars are (nothing to say: the quantity alone)."""
+    return f"{sym} ({errors})" if errors else sym
 
 
 def _show(v) -> str:
@@ -261,7 +266,7 @@ def map_title(sym: str, values, sem, marked: bool = True) -> str:
     sem = np.asarray(sem, dtype=float)
     missing = int(np.isnan(sem).sum())
     if not sem.size or missing == sem.size or np.nanmax(sem) == 0.0:
-        return f"{sym} ({error_title(sem, 'cell')})"
+        return _titled(sym, error_title(sem, "cell"))
     top = float(f"{np.nanmax(sem):.2g}")
     noise, span = 2.0 * math.sqrt(2.0) * top, float(np.ptp(values))
     text = (f"{sym}: cells' standard errors up to {top:g} mN s:\ndifferences below 2√2 × {top:g} = {noise:.2g} mN s "
@@ -295,7 +300,7 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
             for bar, e in zip(bars.patches, err[ok]):
                 if math.isnan(e):  # a value without an error: hatched
                     bar.set_hatch("//")
-            ax.set_title(f"{sym} ({error_title(err[ok], 'bar')})", fontsize=9)
+            ax.set_title(_titled(sym, error_title(err[ok], "bar")), fontsize=9)
         ax.set_xlabel(f"{sym} {Y_LABEL}")
         ax.grid(alpha=0.3, axis="x")
     panels[0].set_yticks(pos, labels, fontsize=7)

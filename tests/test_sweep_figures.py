@@ -277,3 +277,21 @@ def test_a_title_states_no_rotation_count_the_sweep_varies():
     assert "warm-up" not in warmup and f"{base.numerics.rotations} rotations" in warmup
     both = sweep_context(base, ["numerics.rotations", "numerics.warmup_rotations"])
     assert "rotation" not in both and "warm-up" not in both
+
+
+def test_an_exact_model_draws_no_error_bars_of_0(tmp_path, drawn):
+    """The reduced model's standard errors are 0: the line figure and the per-case chart drew error bars of
+    length 0 (their caps, a tick across every marker) under "exact: the reduced model has no standard
+    error". Now a value of standard error 0 has no error bar (nor an open marker: it is exact), as the
+    tornado has none for an exact model."""
+    speeds = (1000.0, 2000.0, 3000.0)
+    plot_sweep_index(_index(tmp_path, [{SPEED: s} for s in speeds], [SPEED], sem=lambda i: 0.0), tmp_path / "f")
+    for ax in drawn["sweep_I.png"].axes:
+        assert _bars(ax) == [] and _open_markers(ax) == [] and ax.get_title().endswith("(exact: the reduced "
+                                                                                       "model has no standard error)")
+    (tmp_path / "c").mkdir()
+    points = [{SPEED: 1000.0}, {SPEED: 2000.0, "contact.restitution": 0.6}]
+    h5 = _index(tmp_path / "c", points, [SPEED, "contact.restitution"], grid=[], grid_rows=0, sem=lambda i: 0.0)
+    plot_sweep_index(h5, tmp_path / "g")
+    for ax in drawn["sweep_cases.png"].axes:
+        assert _bars(ax) == [] and [p.get_hatch() for p in ax.patches] == [None, None]

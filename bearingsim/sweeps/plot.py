@@ -168,7 +168,7 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
-            ax.errorbar(x, y, yerr=err, fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
+            ax.errorbar(x, y, yerr=_bar_lengths(err), fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
             none = np.isnan(err) & np.isfinite(y)  # a value without an error: an open marker
             ax.plot(x[none], y[none], "o", ms=4, color=f"C{gi}", mfc="white", zorder=3)
     drawn = [i for idx in groups.values() for i in idx]
@@ -200,6 +200,13 @@ def _sem_mN_s(cols, name: str, n: int) -> np.ndarray:
     index without the column)."""
     sem = cols.get(f"{name}_sem_Ns")
     return np.full(n, math.nan) if sem is None else np.asarray(sem, dtype=float) * 1e3
+
+
+def _bar_lengths(err) -> np.ndarray:
+    """The error bars to draw for standard errors ``err``: NaN (no bar, not one of 0) where there is none
+    (NaN) and where it is 0 (an exact model's value: no error to draw, the panel's title says exact)."""
+    err = np.asarray(err, dtype=float)
+    return np.where(err > 0.0, err, np.nan)
 
 
 def _titled(sym: str, errors: str) -> str:
@@ -296,7 +303,7 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
             y = np.asarray(cols[f"{name}_mean_Ns"]) * 1e3
             err = _sem_mN_s(cols, name, total)  # NaN: no error bar (matplotlib draws none), not a 0 one
             ok = np.isfinite(y)  # failed or not run: no bar (a gap, not a zero)
-            bars = ax.barh(pos[ok], y[ok], xerr=err[ok], color=f"C{k}", capsize=3)
+            bars = ax.barh(pos[ok], y[ok], xerr=_bar_lengths(err[ok]), color=f"C{k}", capsize=3)
             for bar, e in zip(bars.patches, err[ok]):
                 if math.isnan(e):  # a value without an error: hatched
                     bar.set_hatch("//")

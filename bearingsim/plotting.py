@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title"]
+__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title", "fit_titles"]
 
 
 def figure(**kw):
@@ -52,6 +52,25 @@ def error_title(sem, what: str = "point") -> str:
     mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
     return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
                                                 if missing else ""))
+
+
+def fit_titles(fig, axes) -> None:
+    """Wrap each of ``axes``' titles (at spaces, lines kept) to lines no wider than its axes, measured on
+    ``fig`` laid out as it stands: a long title would run past the figure's edge or into the next panel's.
+    One layout pass without rendering, then a few text measurements per title."""
+    import textwrap
+
+    fig.draw_without_rendering()
+    renderer = fig.canvas.get_renderer()
+    for ax in axes:
+        width = ax.get_window_extent(renderer).width
+        for _ in range(8):  # each pass narrows the longest line by the measured excess
+            drawn = ax.title.get_window_extent(renderer).width
+            if drawn <= width:
+                break
+            lines = ax.title.get_text().split("\n")
+            chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
+            ax.title.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
 
 
 def legend_outside(ax, **kw) -> None:

@@ -102,7 +102,8 @@ def test_a_missing_standard_error_is_no_bar_and_is_said(tmp_path, drawn):
         (bar,) = _bars(ax)  # the middle point's only: ± 0.1 mN s (I_acc: ± 0.05)
         assert np.allclose(np.ptp(bar, axis=0), [0.0, 2 * sem])
         assert sorted(_open_markers(ax)) == pytest.approx([(1000.0, ends[0]), (3000.0, ends[1])])
-        assert ax.get_title().endswith("(error bars: ±1 standard error; open markers: none (n/a), 2 of 3 points)")
+        assert " ".join(ax.get_title().split()).endswith(
+            "(error bars: ±1 standard error; open markers: none (n/a), 2 of 3 points)")  # its words (wrapped)
     (tmp_path / "one").mkdir(), (tmp_path / "all").mkdir()
     h5 = _index(tmp_path / "one", [{SPEED: s} for s in speeds], [SPEED], sem=lambda i: math.nan)
     plot_sweep_index(h5, tmp_path / "g")
@@ -295,3 +296,33 @@ def test_an_exact_model_draws_no_error_bars_of_0(tmp_path, drawn):
     plot_sweep_index(h5, tmp_path / "g")
     for ax in drawn["sweep_cases.png"].axes:
         assert _bars(ax) == [] and [p.get_hatch() for p in ax.patches] == [None, None]
+
+
+def _title_inside(fig) -> list[bool]:
+    """Whether each panel's title, as drawn, lies within the figure and clear of the other panels' titles
+    (its renderer's bounding boxes, px)."""
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    edge, boxes = fig.bbox, [ax.title.get_window_extent(renderer) for ax in fig.axes]
+    return [edge.x0 <= b.x0 and b.x1 <= edge.x1 and b.y1 <= edge.y1
+            and not any(b.overlaps(o) for o in boxes if o is not b) for b in boxes]
+
+
+def test_a_long_panel_title_is_wrapped_within_the_figure(tmp_path, drawn):
+    """A sweep over numerics.rotations=1,2,3 titled its I_acc panel "... open markers: none (n/a), 1 of 3
+    poin", cut off at the figure's right edge (sweep_I.png, 1200 px), and the per-case chart's titles ran
+    into each other and past the edge. Titles are now wrapped to their panel's width: with 12 of 100 points
+    (12 of 60 cases) without a standard error every title lies within the figure, its words all there."""
+    sem = lambda i: math.nan if i % 8 == 0 and i < 96 else 1e-4  # noqa: E731  (12 of 100: i = 0, 8, ..., 88)
+    plot_sweep_index(_index(tmp_path, [{SPEED: 100.0 * (i + 1)} for i in range(100)], [SPEED], sem=sem),
+                     tmp_path / "f")
+    fig = drawn["sweep_I.png"]
+    assert _title_inside(fig) == [True, True]
+    assert " ".join(fig.axes[1].get_title().split()).endswith("open markers: none (n/a), 12 of 100 points)")
+    (tmp_path / "c").mkdir()
+    points = [{SPEED: 100.0 * (i + 1), "contact.restitution": 0.6} for i in range(60)]
+    plot_sweep_index(_index(tmp_path / "c", points, [SPEED, "contact.restitution"], grid=[], grid_rows=0,
+                            sem=lambda i: math.nan if i % 5 == 0 else 1e-4), tmp_path / "g")  # 12 of 60
+    fig = drawn["sweep_cases.png"]
+    assert _title_inside(fig) == [True, True]
+    assert " ".join(fig.axes[1].get_title().split()).endswith("hatched: none (n/a), 12 of 60 bars)")

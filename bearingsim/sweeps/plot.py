@@ -18,7 +18,8 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
 * explicit extra ``[[cases]]`` (or a sweep of cases alone): a per-case chart of every case
   (``sweep_cases.png``), each labelled with its swept values.
 
-Titles name the sweep by its varied keys. Axes are labelled with the parameter's name and unit, read
+Titles name the sweep by its varied keys; a panel's title is wrapped to the panel's width
+(:func:`bearingsim.plotting.fit_titles`). Axes are labelled with the parameter's name and unit, read
 from the key's unit suffix. Failed and not-run cases are gaps (NaN), never zeros.
 """
 from __future__ import annotations
@@ -28,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.plotting import error_title
+from bearingsim.plotting import error_title, fit_titles
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -190,6 +191,7 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
             ax.legend(fontsize=7, loc="best")
             break
     fig.suptitle(title, fontsize=10)
+    fit_titles(fig, panels)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
@@ -259,6 +261,7 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
         ax.set_ylabel(axis_label(yk))
         ax.set_title(map_title(sym, grid[has], err[has], marked=text), fontsize=7)
     fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""), fontsize=10)
+    fit_titles(fig, panels)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
@@ -313,6 +316,7 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
     panels[0].set_yticks(pos, labels, fontsize=7)
     panels[0].invert_yaxis()
     fig.suptitle(title, fontsize=10)
+    fit_titles(fig, panels)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)

@@ -468,7 +468,9 @@ SWEEP_CAPTIONS = {
                    "a point without one, n/a in the table, has an open marker and no bar)",
     "sweep_map.png": "I_dec and I_acc per pocket and cage rotation over the two swept keys, as heat maps (a blank "
                      "cell: a case that failed or did not run); each panel's title gives its cells' largest standard "
-                     "error X: a difference of cells below 2√2 X may be noise (a starred value: none, n/a)",
+                     "error X and t √2 X, above which the tables' test resolves any difference of two cells (t: "
+                     "Student's, of the fewest batch means less one; below it, the table says; a starred value: "
+                     "none, n/a)",
     "sweep_cases.png": "I_dec and I_acc per pocket and cage rotation of every case, labelled by its values; error bars "
                        "± 1 standard error (batch means over rotations, where the model has one; a case without one, "
                        "n/a in the table, has a hatched bar and no error bar)",

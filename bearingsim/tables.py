@@ -87,7 +87,7 @@ def cell_text(v) -> str:
 def table_of_index(path) -> Table:
     """The table of a sweep's or study's index (``DIR/sweep.h5`` or the file): one row per case,
     labelled by its swept keys (and its status where it is not done or cached)."""
-    from bearingsim.sweeps.index import FIXED, notes_of, read_index, unit_of
+    from bearingsim.sweeps.index import FIXED, index_batches, notes_of, read_index, unit_of
 
     cols, meta = read_index(path)
     n = len(cols["case"])
@@ -107,22 +107,7 @@ def table_of_index(path) -> Table:
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     footnotes = _run_notes([notes_of(c) for c in cols.get("notes", [""] * n)], names, labels)
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes,
-                 _index_batches(cols, meta, n))
-
-
-def _index_batches(cols: dict, meta: dict, n: int) -> list[int]:
-    """The batch means each case's standard errors came from (:func:`bearingsim.stats.sem_batches` of its
-    recorded rotations): ``numerics.rotations`` where the index has it as a column (swept), else the base
-    scenario's (``scenario_toml``), else :data:`bearingsim.stats.BATCHES` (every run of 5 or more rotations)."""
-    import tomllib
-
-    if "numerics.rotations" in cols:
-        return [sem_batches(int(v)) if math.isfinite(float(v)) else BATCHES for v in cols["numerics.rotations"]]
-    try:
-        rotations = int(tomllib.loads(meta.get("scenario_toml") or "")["numerics"]["rotations"])
-    except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
-        return [BATCHES] * n
-    return [sem_batches(rotations)] * n
+                 index_batches(cols, meta, n))
 
 
 def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:

@@ -170,9 +170,11 @@ def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
 def test_a_maps_title_says_how_large_a_difference_its_standard_errors_leave_unresolved(tmp_path, figures):
     """A map has no error bars: a 2 x 2 multibody map of 3 rotations coloured I_acc 17.8-18.2 mN s with
     no word of its cells' standard errors of 0.52-1.1 mN s (the colours were noise). The title gives the
-    largest standard error X and 2√2 X, two standard errors of a difference of two cells of X
-    (sqrt(X² + X²)), and the colours' span when it is smaller; a cell without one (n/a) is starred;
-    the reduced model's exact maps say so; a map of one rotation per case that it has none."""
+    largest standard error X and the difference the tables' test resolves for any two cells,
+    t sqrt(2) X with t Student's 97.5 % quantile at the fewest batch means less one (here 5 each, an index
+    without a rotations column: t = 2.776 at 4 degrees of freedom, test_a_maps_threshold_is_the_tables_test),
+    and the colours' span when it is smaller; a cell without one (n/a) is starred; the reduced model's
+    exact maps say so; a map of one rotation per case that it has none."""
     points = [{SPEED: s, CLEAR: c} for s in (1000.0, 2000.0, 6000.0) for c in (0.1, 0.2)]
     folders = iter(range(10))
 
@@ -183,19 +185,48 @@ def test_a_maps_title_says_how_large_a_difference_its_standard_errors_leave_unre
 
     # I_dec 5-10 mN s with standard errors 0.1-0.6 (case 2: none); I_acc 2-4.5 with half of them
     got, panels = titles(lambda i: math.nan if i == 2 else 1e-4 * (i + 1))
-    assert got == ["$I_{dec}$: cells' standard errors up to 0.6 mN s:\ndifferences below 2√2 × 0.6 = 1.7 mN s "
-                   "may be noise\n*: 1 of 6 cells without one (n/a)",
-                   "$I_{acc}$: cells' standard errors up to 0.3 mN s:\ndifferences below 2√2 × 0.3 = 0.85 mN s "
-                   "may be noise\n*: 1 of 6 cells without one (n/a)"]
+    test = "(5+ batch means):\nthe tables' test resolves every difference\nabove 2.78 × √2 × "
+    starred = "\n*: 1 of 6 cells without one (n/a)"
+    assert got == [f"$I_{{dec}}$: standard errors up to 0.6 mN s {test}0.6 = 2.4 mN s{starred}",
+                   f"$I_{{acc}}$: standard errors up to 0.3 mN s {test}0.3 = 1.2 mN s{starred}"]
     assert [t for t in panels[0]["texts"] if t.endswith("*")] == ["7*"]  # case 2's value, starred
     got, _ = titles(lambda i: 3e-3)  # standard errors of 3 mN s over colours spanning 5
-    assert got[0] == ("$I_{dec}$: cells' standard errors up to 3 mN s:\ndifferences below 2√2 × 3 = 8.5 mN s "
-                      "may be noise\n(the colours span 5 mN s)")
+    assert got[0] == f"$I_{{dec}}$: standard errors up to 3 mN s {test}3 = 12 mN s\n(the colours span 5 mN s)"
     got, panels = titles(lambda i: 0.0)  # the reduced model
     assert got == [f"{sym} (exact: the reduced model has no standard error)" for sym in ("$I_{dec}$", "$I_{acc}$")]
     got, panels = titles(lambda i: math.nan)  # one recorded rotation per case
     assert got == [f"{sym} (no cell has a standard error (n/a))" for sym in ("$I_{dec}$", "$I_{acc}$")]
     assert not any(t.endswith("*") for a in panels for t in a["texts"])  # all without: the title says it
+
+
+def test_a_maps_threshold_is_the_tables_test(tmp_path, figures):
+    """A 2 x 2 map of 2 rotations per case said "differences below 2√2 × 0.36 = 1 mN s may be noise" while
+    `bearingsim table` did not resolve a difference of 2.74 mN s between cells of 0.36 and 0.14 mN s (its
+    rule, docs/statistics.md: Student's t of the Welch-Satterthwaite degrees of freedom of the two errors,
+    from 2 batch means each: t = 7.5). The title's threshold is now one the tables' test
+    (stats.significant) resolves for every pair of cells: any difference above it, between the map's cells
+    here and between any two standard errors up to the map's largest of at least its fewest batch means
+    (a bound, not an estimate: exact, no tolerance)."""
+    import re
+
+    from bearingsim.stats import significant
+
+    load, sems = "operating.radial_load_N", (0.14e-3, 0.29e-3, 0.36e-3, 0.07e-3)  # I_dec 5, 6, 7, 8 mN s
+    points = [{SPEED: s, load: f, "numerics.rotations": 2.0} for s in (4000.0, 6000.0) for f in (900.0, 1000.0)]
+    meta_grid = [SPEED, load]
+    plot_sweep_index(_index(tmp_path, points, [SPEED, load, "numerics.rotations"], grid=meta_grid,
+                            sem=lambda i: sems[i]), tmp_path / "f")
+    title = figures["sweep_map.png"]["axes"][0]["title"]
+    above = float(re.search(r"= ([0-9.]+) mN s", title).group(1))
+    for i in range(4):
+        for j in range(i):  # the map's pairs: a difference above the title's is resolved (here 2 and 3 mN s)
+            diff = abs(i - j)
+            assert diff <= above or significant(5 + i, sems[i] * 1e3, 5 + j, sems[j] * 1e3, 2, 2), (i, j)
+    assert "2+ batch means" in title and "the tables' test resolves every difference" in title
+    top = max(sems) * 1e3
+    for se in np.linspace(0.0, top, 11):  # any two cells of standard errors up to the map's largest
+        for b0, b1 in ((2, 2), (2, 5), (5, 40)):
+            assert significant(10 + above * 1.0001, top, 10.0, se, b0, b1)
 
 
 @pytest.mark.slow

@@ -316,3 +316,21 @@ def trusted_row(row: dict | None, model: str) -> dict | None:
         return {"status": "stale"}
     return {"status": "cached", "error": "", "wall_s": row["wall_s"], "summary": dict(row["summary"]),
             "model_version": row["model_version"], "notes": list(row.get("notes", ()))}
+
+
+def index_batches(cols: dict, meta: dict, n: int) -> list[int]:
+    """The batch means each case's standard errors came from (:func:`bearingsim.stats.sem_batches` of its
+    recorded rotations): ``numerics.rotations`` where the index has it as a column (swept), else the base
+    scenario's (``scenario_toml``), else :data:`bearingsim.stats.BATCHES` (every run of 5 or more rotations)."""
+    import tomllib
+
+    from bearingsim import stats
+
+    if "numerics.rotations" in cols:
+        return [stats.sem_batches(int(v)) if math.isfinite(float(v)) else stats.BATCHES
+                for v in cols["numerics.rotations"]]
+    try:
+        rotations = int(tomllib.loads(meta.get("scenario_toml") or "")["numerics"]["rotations"])
+    except (KeyError, TypeError, ValueError, tomllib.TOMLDecodeError):
+        return [stats.BATCHES] * n
+    return [stats.sem_batches(rotations)] * n

@@ -7,7 +7,8 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
   :func:`bearingsim.stats.impulse_standard_errors`). A point without one (``n/a`` in the tables: one
   recorded rotation, or an index without the column) has no bar and an open marker, a case chart's bar
   is hatched, a map's cell value starred, and the panel's title says so (:func:`error_title`); a map's
-  title gives its cells' largest standard error instead of bars:
+  title gives its cells' largest standard error and the difference the tables' test resolves instead of
+  bars (:func:`map_title`):
 
   - one axis, or zipped axes: a line plot against the (first numeric) axis;
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
@@ -31,7 +32,7 @@ import numpy as np
 
 from bearingsim.plotting import error_title, fit_titles
 from bearingsim.scenario import is_integer_key
-from bearingsim.sweeps.index import name_of, read_index, unit_of
+from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
 from bearingsim.wording import counted
 
 #: every figure a sweep may draw into its folder (a sweep checks them before it starts)
@@ -130,7 +131,7 @@ def _grid_figure(cols, meta, grid, rows, outdir, title, notes) -> Path | None:
     if meta.get("mode") == "zip":  # zipped axes move together: one abscissa
         return _lines(cols, (numeric or grid)[:1], rows, outdir / "sweep_I.png", title, notes)
     if len(grid) == 2 and len(numeric) != 1:  # both numeric or both text: a map of the pairs
-        return _heat_map(cols, grid, rows, outdir / "sweep_map.png", title)
+        return _heat_map(cols, meta, grid, rows, outdir / "sweep_map.png", title)
     axes = numeric[:1] + [k for k in grid if k not in numeric[:1]]  # numeric abscissa when there is one
     return _lines(cols, axes, rows, outdir / "sweep_I.png", title, notes)
 
@@ -220,7 +221,7 @@ def _show(v) -> str:
     return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)
 
 
-def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
+def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
     """One cell per sampled pair, centred on its tick (sampled values only: no extrapolated edges),
     equal cells, each with its value written; I_dec and I_acc in two panels with their own scales."""
     xk, yk = axes
@@ -233,14 +234,15 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
     height = min(MAP_HEIGHT_IN[1], max(MAP_HEIGHT_IN[0], 0.45 * len(ys) + 2.5))
     fig, panels = subplots(1, 2, figsize=(max(9.0, 2 * panel + 3), height), constrained_layout=True)
     text = len(xs) <= MAP_TEXT_CELLS and len(ys) <= MAP_TEXT_CELLS  # values written while they fit their cells
+    batches = index_batches(cols, meta, len(cols["case"]))  # each case's batch means (the tables' test)
     n_gap = 0
     for ax, (name, sym) in zip(panels, QUANTITIES):
-        grid, err = np.full((len(ys), len(xs)), np.nan), np.full((len(ys), len(xs)), np.nan)
+        grid, err, nb = (np.full((len(ys), len(xs)), np.nan) for _ in range(3))
         col, sem = cols.get(f"{name}_mean_Ns"), _sem_mN_s(cols, name, len(cols["case"]))
         for i in rows:
             xi, yi = xpos.get(_show(cols[xk][i])), ypos.get(_show(cols[yk][i]))
             if xi is not None and yi is not None and col is not None:
-                grid[yi, xi], err[yi, xi] = col[i] * 1e3, sem[i]
+                grid[yi, xi], err[yi, xi], nb[yi, xi] = col[i] * 1e3, sem[i], batches[i]
         n_gap = max(n_gap, int(np.isnan(grid).sum()))
         has = np.isfinite(grid)
         star = np.isnan(err) & has if np.isfinite(err[has]).any() else np.zeros_like(has)  # some cells lack one
@@ -259,7 +261,7 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
         ax.set_yticks(range(0, len(ys), ky), [_show(v) for v in ys[::ky]])
         ax.set_xlabel(axis_label(xk))
         ax.set_ylabel(axis_label(yk))
-        ax.set_title(map_title(sym, grid[has], err[has], marked=text), fontsize=7)
+        ax.set_title(map_title(sym, grid[has], err[has], marked=text, batches=nb[has]), fontsize=7)
     fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""), fontsize=10)
     fit_titles(fig, panels)
     from bearingsim.plotting import save_figure
@@ -267,20 +269,34 @@ def _heat_map(cols, axes, rows, path: Path, title: str) -> Path:
     return save_figure(fig, path, tight=False)
 
 
-def map_title(sym: str, values, sem, marked: bool = True) -> str:
-    """A heat map panel's title: what its cells' standard errors ``sem`` [mN s] say of the colours of their
-    ``values`` (failed cells left out). A map has no error bars, so the title gives the largest standard
-    error X and 2√2 X, two standard errors of a difference of two such cells: a smaller difference (and a
-    colour span below it) may be noise. Exact cells (all 0) and cells without one (n/a) as
-    ``error_title`` says them; ``marked``: such cells' values are starred (written in the cells)."""
+def map_title(sym: str, values, sem, marked: bool = True, batches=None) -> str:
+    """A heat map panel's title: what its cells' standard errors ``sem`` [mN s], each from ``batches`` batch
+    means (None: :data:`bearingsim.stats.BATCHES` each), say of the colours of their ``values`` (failed
+    cells left out). A map has no error bars, so the title gives the largest standard error X and the
+    difference the tables' test (:func:`bearingsim.stats.significant`) resolves for any two of the cells:
+    t sqrt(se1^2 + se2^2) is at most t sqrt(2) X, and the Welch-Satterthwaite degrees of freedom of two
+    errors are at least the fewer's, b - 1 for the fewest batch means b of a cell with an error, so t is at
+    most :func:`bearingsim.stats.critical_ses` of X and an exact partner (0) of b batches each: the tables
+    resolve every difference above t sqrt(2) X; below it, only the table says (and the colours span below
+    it is said). One t per panel, whatever the map's size. Exact cells (all 0) and cells without one (n/a)
+    as ``error_title`` says them; ``marked``: such cells' values are starred (written in the cells)."""
+    from bearingsim.stats import BATCHES, critical_ses
+
     sem = np.asarray(sem, dtype=float)
     missing = int(np.isnan(sem).sum())
     if not sem.size or missing == sem.size or np.nanmax(sem) == 0.0:
         return _titled(sym, error_title(sem, "cell"))
-    top = float(f"{np.nanmax(sem):.2g}")
-    noise, span = 2.0 * math.sqrt(2.0) * top, float(np.ptp(values))
-    text = (f"{sym}: cells' standard errors up to {top:g} mN s:\ndifferences below 2√2 × {top:g} = {noise:.2g} mN s "
-            "may be noise" + (f"\n(the colours span {span:.2g} mN s)" if span < noise else ""))
+    nb = np.full(sem.size, BATCHES) if batches is None else np.asarray(batches, dtype=float)
+    fewest = int(np.min(nb[sem > 0.0]))  # NaN > 0 is False: cells with an error only
+    top = float(np.nanmax(sem))
+    t = critical_ses(top, 0.0, fewest, fewest)  # the fewest degrees of freedom two such errors can have
+    text = f"{sym}: standard errors up to {top:.2g} mN s ({fewest}+ batch means"
+    if not math.isfinite(t):  # a standard error of one batch mean: no degrees of freedom, no test
+        text += "):\nno difference is judged by the tables' test"
+    else:
+        noise, span = t * math.sqrt(2.0) * top, float(np.ptp(values))
+        text += (f"):\nthe tables' test resolves every difference\nabove {t:.3g} × √2 × {top:.2g} = "
+                 f"{noise:.2g} mN s" + (f"\n(the colours span {span:.2g} mN s)" if span < noise else ""))
     if missing:
         text += f"\n{'*: ' if marked else ''}{missing} of {counted(sem.size, 'cell')} without one (n/a)"
     return text

@@ -154,6 +154,7 @@ def test_rerun_sees_a_changed_wear_profile_of_a_multibody_archive(tmp_path, mult
     assert res.returncode == 1 and "differs: wear/profile_work_rear" in res.stdout, res.stdout
 
 
+@pytest.mark.slow
 def test_compare_and_rerun_see_every_array_and_time_series_bit_for_bit(tmp_path, multibody_archive, reduced_archive):
     """"identical" and "bit-identical" are over every number the run computed: every dataset under /results
     and every time series under /observables, bit for bit (-0.0 is not 0.0). They compared the per-rotation

@@ -130,6 +130,7 @@ def test_a_case_the_run_would_refuse_at_its_start_is_refused_before_any_case_run
     assert str(err.value).startswith(f"{path} {named}") and "(sweep case " in str(err.value), str(err.value)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("spec_or_cases", ["spec", "cases"])
 def test_the_pool_has_no_more_workers_than_the_sweep_has_cases(tmp_path, spec_or_cases):
     """`-j 1000` for a sweep of two cases started a thousand worker processes (the trial's machine ran out

@@ -167,6 +167,7 @@ def test_heat_map_cells_are_the_sampled_values_only(tmp_path, figures):
     assert set(panels[1]["texts"]) == {"2", "–", "3", "3.5", "4", "4.5"}  # case i: 2 + i / 2
 
 
+@pytest.mark.slow
 def test_a_maps_title_says_how_large_a_difference_its_standard_errors_leave_unresolved(tmp_path, figures):
     """A map has no error bars: a 2 x 2 multibody map of 3 rotations coloured I_acc 17.8-18.2 mN s with
     no word of its cells' standard errors of 0.52-1.1 mN s (the colours were noise). The title gives the
@@ -339,6 +340,7 @@ def _title_inside(fig) -> list[bool]:
             and not any(b.overlaps(o) for o in boxes if o is not b) for b in boxes]
 
 
+@pytest.mark.slow
 def test_a_long_panel_title_is_wrapped_within_the_figure(tmp_path, drawn):
     """A sweep over numerics.rotations=1,2,3 titled its I_acc panel "... open markers: none (n/a), 1 of 3
     poin", cut off at the figure's right edge (sweep_I.png, 1200 px), and the per-case chart's titles ran

@@ -141,6 +141,7 @@ def test_student_t_quantiles_match_the_printed_tables():
     assert t_quantile(0.975, 8) < t_quantile(0.975, 5.5) < t_quantile(0.975, 5)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rotations", [4, 10])
 def test_the_marks_false_rate_is_the_stated_five_percent(rotations):
     """Two standard errors marked 8 % of pairs of runs of one true mean and 12 % against an exact reference

@@ -464,8 +464,8 @@ def _pm(mean, sem) -> str:
 #: a sweep's figures in the page, by file name (bearingsim.sweeps.plot)
 SWEEP_CAPTIONS = {
     "sweep_I.png": "I_dec and I_acc per pocket and cage rotation against the first swept key, a line for each value "
-                   "of the others; error bars ± 1 standard error (batch means over rotations, where the model has one; "
-                   "a point without one, n/a in the table, has an open marker and no bar)",
+                   "of the others; error bars ± 1 standard error (batch means over rotations, where the model has "
+                   "one; a point without one, n/a in the table, has an open marker and no bar)",
     "sweep_map.png": "I_dec and I_acc per pocket and cage rotation over the two swept keys, as heat maps (a blank "
                      "cell: a case that failed or did not run); each panel's title gives its cells' largest standard "
                      "error X and t √2 X, above which the tables' test resolves any difference of two cells (t: "

@@ -990,8 +990,8 @@ def differences_from_preset(scenario: "Scenario") -> list[str]:
 def sweep_context(scenario: "Scenario", swept) -> str:
     """What a sweep's cases share, for its figures' titles: ``multibody_6000rpm: multibody, full scene,
     6000 rpm forward, 970 N, 1 warm-up + 3 rotations; raceway rigid``. The speed, direction, load and the
-    (warm-up) rotation counts are named unless ``swept`` (the varied keys) holds them; the base's differences from its preset
-    (:func:`differences_from_preset`) leave the swept keys out."""
+    (warm-up) rotation counts are named unless ``swept`` (the varied keys) holds them; the base's differences
+    from its preset (:func:`differences_from_preset`) leave the swept keys out."""
     op, swept = scenario.operating, set(swept)
     what = (f"multibody, {scenario.multibody.scene} scene" if scenario.model == "multibody"
             else f"reduced model ({scenario.reduced.method})")

@@ -286,6 +286,19 @@ def _face_forces(motion, rows) -> np.ndarray:
     return out
 
 
+def impact_marks_end(result, t_frames) -> str:
+    """What the legend says when the archive's impact table (``/results/impacts``) filled up (provenance
+    ``impacts_table_full``, the run's note) before the last frame's time of ``t_frames`` [s]: from when no impact
+    is marked, and why; "" otherwise."""
+    imp = result.impacts
+    if not result.provenance.get("impacts_table_full", False) or "time_s" not in imp or not len(imp["time_s"]):
+        return ""
+    t_last = float(np.asarray(imp["time_s"])[-1])
+    if not len(t_frames) or t_last >= float(t_frames[-1]):
+        return ""
+    return f"★ none marked after t = {t_last:.4g} s:\nthe archive's impact table\nfilled up (its run's note)"
+
+
 class _Drawing:
     """The figure of an animation, made once; :meth:`draw` moves its parts to a frame's pose and returns
     the frame's RGB pixels. Lengths in mm; clearances drawn ``k`` times their size (module docstring)."""
@@ -407,6 +420,9 @@ class _Drawing:
             fig.text(x0, 0.445, f"forces above {self.norm.vmax:.3g} N (up to {self.force_max:.3g} N)\n"
                                 f"are drawn in the top colour", fontsize=7.5, va="top", color="0.15")
         fig.text(x0, 0.408, "★ impact (size ∝ impulse)", fontsize=8, va="top", color=FLASH_COLOUR)
+        ended = impact_marks_end(result, self.m.time[self.rows])
+        if ended:  # between the frame's numbers and the force scale, where the panel has room
+            fig.text(x0, 0.615, ended, fontsize=7.5, va="top", color=FLASH_COLOUR)
         c_um = np.concatenate([self.m.cage_xy, self.m.before_xy if self.m.before_xy is not None
                                else np.zeros((0, 2))]) * 1e6
         lim = max(1.0, 1.15 * float(np.max(np.abs(c_um)))) if c_um.size else 1.0

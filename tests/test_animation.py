@@ -469,3 +469,23 @@ def test_the_cage_trail_at_the_start_of_the_window_is_taken_from_before_it(runs)
     assert before.sum() > 20  # the case this test is about: a rotation of path before the window
     want = np.vstack([c.value[before], motion.cage_xy[:1]]) * 1e6
     np.testing.assert_allclose(np.column_stack([x, y]), want)
+
+
+def test_frames_after_a_full_impact_tables_end_say_why_they_show_no_impacts(monkeypatch):
+    """The impacts an animation marks come from the archive's impact table, which stops at its capacity
+    (``multibody.core.IMPACT_CAPACITY``, about 600 recorded rotations at 3000 rpm; the run notes it). Frames after
+    its last row showed no impact and said nothing; the legend now says from when no impact is marked and why.
+    Shrunk to 20 rows here (the table fills within the window); a run whose table held every impact says
+    nothing of it."""
+    from bearingsim.multibody import core
+
+    sc = _scenario(1.0).replace(**{"numerics.rotations": 2})
+    full = bearingsim.run(sc)
+    assert animation.impact_marks_end(full, np.array([0.0, 1.0])) == ""
+    monkeypatch.setattr(core, "IMPACT_CAPACITY", 20)
+    cut = bearingsim.run(sc)
+    t_last = float(cut.impacts["time_s"][-1])
+    text = animation.impact_marks_end(cut, np.array([t_last - 1e-3, t_last + 1e-3]))
+    assert text == (f"★ none marked after t = {t_last:.4g} s:\nthe archive's impact table\nfilled up "
+                    "(its run's note)"), text
+    assert animation.impact_marks_end(cut, np.array([t_last - 2e-3, t_last])) == ""  # the window ends with it

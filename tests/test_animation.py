@@ -471,6 +471,7 @@ def test_the_cage_trail_at_the_start_of_the_window_is_taken_from_before_it(runs)
     np.testing.assert_allclose(np.column_stack([x, y]), want)
 
 
+@pytest.mark.slow
 def test_frames_after_a_full_impact_tables_end_say_why_they_show_no_impacts(monkeypatch):
     """The impacts an animation marks come from the archive's impact table, which stops at its capacity
     (``multibody.core.IMPACT_CAPACITY``, about 600 recorded rotations at 3000 rpm; the run notes it). Frames after

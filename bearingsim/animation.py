@@ -290,11 +290,10 @@ def impact_marks_end(result, t_frames) -> str:
     """What the legend says when the archive's impact table (``/results/impacts``) filled up (provenance
     ``impacts_table_full``, the run's note) before the last frame's time of ``t_frames`` [s]: from when no impact
     is marked, and why; "" otherwise."""
-    imp = result.impacts
-    if not result.provenance.get("impacts_table_full", False) or "time_s" not in imp or not len(imp["time_s"]):
-        return ""
-    t_last = float(np.asarray(imp["time_s"])[-1])
-    if not len(t_frames) or t_last >= float(t_frames[-1]):
+    from bearingsim.plausibility import impact_table_end
+
+    t_last = impact_table_end(result)
+    if t_last is None or not len(t_frames) or t_last >= float(t_frames[-1]):
         return ""
     return f"★ none marked after t = {t_last:.4g} s:\nthe archive's impact table\nfilled up (its run's note)"
 

@@ -185,16 +185,25 @@ def check(result) -> list[str]:
     return notes
 
 
+def impact_table_end(result) -> float | None:
+    """The time [s] of the last row of a result's impact table (``/results/impacts``) when it filled its rows
+    (``multibody.core.IMPACT_CAPACITY``; provenance ``impacts_table_full``), else None."""
+    imp = result.impacts
+    if not result.provenance.get("impacts_table_full", False) or not len(imp.get("time_s", ())):
+        return None
+    return float(imp["time_s"][-1])
+
+
 def impact_table_note(result) -> str | None:
-    """The note of a run whose impact table (``/results/impacts``) filled its rows (``multibody.core.
-    IMPACT_CAPACITY``; provenance ``impacts_table_full``): up to when it lists impacts. The impulses, wear and
-    every other result are summed in the step loop, not from the table, and count every impact."""
-    if not result.provenance.get("impacts_table_full", False):
+    """The note of a run whose impact table filled its rows (:func:`impact_table_end`): up to when it lists
+    impacts. The impulses, wear and every other result are summed in the step loop, not from the table, and
+    count every impact."""
+    t = impact_table_end(result)
+    if t is None:
         return None
     imp = result.impacts
     rows, rotations = len(imp["time_s"]), int(result.parameters.numerics.rotations)
-    last, t = int(imp["rotation"][-1]) + 1 if rows else 0, float(imp["time_s"][-1]) if rows else 0.0
-    when = f" in recorded rotation {last} of {rotations} (t = {t:.4g} s)" if rows else ""
+    when = f" in recorded rotation {int(imp['rotation'][-1]) + 1} of {rotations} (t = {t:.4g} s)"
     return (f"bearingsim: note: the impact table filled its {rows} rows{when}: /results/impacts lists the impacts "
             "up to there only; the impulses, wear and every other result count every impact")
 

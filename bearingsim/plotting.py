@@ -11,7 +11,8 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title", "fit_titles"]
+__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title", "fit_titles",
+           "mark_without_error", "hatch_without_error"]
 
 
 def figure(**kw):
@@ -31,12 +32,29 @@ def subplots(nrows: int = 1, ncols: int = 1, *, figsize=None, constrained_layout
     return fig, fig.subplots(nrows, ncols, **kw)
 
 
-def error_title(sem, what: str = "point") -> str:
+def mark_without_error(ax, x, y, err, color, marker: str = "o", **style) -> int:
+    """Open markers over the drawn values ``y`` at ``x`` whose standard error ``err`` is missing (NaN: the tables'
+    ``n/a``; matplotlib draws no error bar for it), in ``color``; returns how many."""
+    import numpy as np
+
+    none = np.isnan(np.asarray(err, dtype=float)) & np.isfinite(np.asarray(y, dtype=float))
+    ax.plot(np.asarray(x)[none], np.asarray(y)[none], marker, color=color, mfc="white", zorder=3, **style)
+    return int(none.sum())
+
+
+def hatch_without_error(bars, missing) -> None:
+    """Hatch the ``bars`` (a bar container) whose value has no standard error (``missing``, one flag a bar)."""
+    for bar, m in zip(bars.patches, missing):
+        if m:
+            bar.set_hatch("//")
+
+
+def error_title(sem, what: str = "point", bars: str = "±1 standard error") -> str:
     """What a panel's error bars are, from the standard errors ``sem`` of the values it draws (None: the
     table has no such column): exact (all 0, the reduced model), none (all NaN: the tables' ``n/a``), some
     missing (``open markers: none (n/a), k of n points``: such a value is drawn without a bar, marked as
-    ``what`` says: an open marker, a hatched bar, a starred cell), or ±1 standard error on every one; "" for
-    an empty ``sem`` (a panel that draws no value)."""
+    ``what`` says: an open marker, a hatched bar, a starred cell), or ``bars`` on every one; "" for an empty
+    ``sem`` (a panel that draws no value)."""
     import numpy as np
 
     from bearingsim.wording import counted
@@ -50,8 +68,7 @@ def error_title(sem, what: str = "point") -> str:
     if missing == sem.size:
         return ("" if what == "cell" else "no error bars: ") + f"no {what} has a standard error (n/a)"
     mark = {"point": "open markers", "bar": "hatched", "cell": "*"}[what]
-    return ("error bars: ±1 standard error" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}"
-                                                if missing else ""))
+    return f"error bars: {bars}" + (f"; {mark}: none (n/a), {missing} of {counted(sem.size, what)}" if missing else "")
 
 
 def fit_titles(fig, axes) -> None:

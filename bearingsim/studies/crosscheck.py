@@ -302,7 +302,7 @@ def plot_ladder(rows: list[dict], meta: dict):
     """I_dec and I_acc against the rung, one line per speed, error bars ± 1 standard error (batch means);
     a rung without one (n/a: fewer than 2 recorded rotations) an open marker, no bar, counted in the title
     (:func:`bearingsim.plotting.error_title`)."""
-    from bearingsim.plotting import error_title, legend_outside, subplots
+    from bearingsim.plotting import error_title, legend_outside, mark_without_error, subplots
 
     speeds = sorted({r["rpm"] for r in rows})
     labels = {r["rung"]: f"{r['rung']} {r['scene']}" for r in rows}
@@ -313,8 +313,7 @@ def plot_ladder(rows: list[dict], meta: dict):
         for ax, q in zip(axes, ("I_dec", "I_acc")):
             y, err = (np.array([r[f"{q}_{c}_Ns"] * 1e3 for r in rs], dtype=float) for c in ("mean", "sem"))
             ax.errorbar(x, y, yerr=err, marker="o", ms=4, capsize=3, color=f"C{k}", label=f"{rpm:g} rpm")
-            none = np.isnan(err) & np.isfinite(y)
-            ax.plot(x[none], y[none], "o", ms=4, color=f"C{k}", mfc="white", zorder=3)
+            mark_without_error(ax, x, y, err, f"C{k}", ms=4)
     axes[0].set_ylabel("$I_{dec}$ per pocket and\ncage rotation [mN s]")
     axes[1].set_ylabel("$I_{acc}$ per pocket and\ncage rotation [mN s]")
     for ax in axes:
@@ -325,9 +324,10 @@ def plot_ladder(rows: list[dict], meta: dict):
     axes[1].set_xticklabels([labels[t] for t in ticks], rotation=15)
     axes[1].set_xlabel("rung of the cross-check (each drops one assumption of the paper's model)")
     drawn = [r for r in rows if math.isfinite(r["I_dec_mean_Ns"])]
-    errors = error_title([r["I_dec_sem_Ns"] for r in drawn] + [r["I_acc_sem_Ns"] for r in drawn])
-    errors = ("± 1 standard error (batch means over rotations)" + errors[len("error bars: ±1 standard error"):]
-              if errors.startswith("error bars") else f"({errors})" if errors else "")
+    errors = error_title([r["I_dec_sem_Ns"] for r in drawn] + [r["I_acc_sem_Ns"] for r in drawn],
+                         bars="± 1 standard error (batch means over rotations)")
+    errors = (errors.removeprefix("error bars: ") if errors.startswith("error bars: ")
+              else f"({errors})" if errors else "")
     axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets {errors}", fontsize=9)
     legend_outside(axes[0], title="inner ring speed")
     return fig

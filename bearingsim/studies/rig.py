@@ -133,13 +133,15 @@ def format_table(rows: list[dict], rotations: int) -> str:
 def _spread_points(ax, n, rows, name: str, marker: str, color: str, label: str) -> None:
     """``name``'s I_dec mean ± std against the speeds ``n``; a std of n/a (one rotation: the table's n/a) is
     no bar and an open marker, and the legend's label says so."""
+    from bearingsim.plotting import mark_without_error
+
     y, std = (np.array([r[f"{name}_I_dec_{c}_Ns"] * 1e3 for r in rows], dtype=float) for c in ("mean", "std"))
     none = np.isnan(std) & np.isfinite(y)
     if none.any():
         some = "" if none.all() else f", {int(none.sum())} of {counted(len(y), 'speed')}"
         label += f" (open marker: std n/a{some})"
     ax.errorbar(n, y, yerr=std, fmt=marker, color=color, capsize=3, label=label)
-    ax.plot(n[none], y[none], marker, color=color, mfc="white", zorder=3)
+    mark_without_error(ax, n, y, std, color, marker)
 
 
 def save_rig(outdir, rows: list[dict]) -> list[Path]:

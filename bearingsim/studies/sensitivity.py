@@ -498,7 +498,7 @@ def plot_tornado(rows, title: str = ""):
     such change (no bar; its label says so), nor has a failed pair or a slope of n/a (no bar, "n/a" at 0);
     its local slope S is in the table. A bar without a standard error (n/a) is hatched, its panel's title
     says how many (:func:`bearingsim.plotting.error_title`)."""
-    from bearingsim.plotting import error_title, subplots
+    from bearingsim.plotting import error_title, hatch_without_error, subplots
 
     quantities = [q for q in QUANTITIES if any(r["quantity"] == q[0] for r in rows)]
     fig, axes = subplots(1, len(quantities), figsize=(3.6 * len(quantities) + 1.5, 0.35 * len(
@@ -515,9 +515,7 @@ def plot_tornado(rows, title: str = ""):
         exact = np.all(se[ok] == 0.0)  # a deterministic model's: no error bars (not ones of 0)
         bars = ax.barh(y[ok], over[ok], xerr=None if exact else se[ok], color=np.where(over[ok] >= 0, "C3", "C0"),
                        capsize=2)
-        for bar, e in zip(bars.patches, se[ok]):
-            if math.isnan(e):
-                bar.set_hatch("//")
+        hatch_without_error(bars, np.isnan(se[ok]))
         for yi in y[~ok]:
             ax.text(0.0, yi, " n/a", va="center", fontsize=7, color="0.3")
         ax.set_ylim(-0.6, len(order) - 0.4)  # every key's row, with a bar or not

@@ -268,6 +268,8 @@ def _index_bars(ax, rows, keys, y) -> dict[str, int]:
     """S1 and ST of ``keys`` (``rows`` by key) as bars with their intervals, and how many have none:
     ``{"n/a (variance 0 or unknown)": indices of n/a, no bar (not one of 0), "n/a" at 0;
     "hatched (no interval)": bars without an error bar (not one of 0)}``."""
+    from bearingsim.plotting import hatch_without_error
+
     missing = {"n/a (variance 0 or unknown)": 0, "hatched (no interval)": 0}
     for off, name, color in ((0.18, "S1", "C0"), (-0.18, "ST", "C3")):
         v = np.array([rows[k][name] for k in keys], dtype=float)
@@ -276,9 +278,7 @@ def _index_bars(ax, rows, keys, y) -> dict[str, int]:
         ok = np.isfinite(v)
         bars = ax.barh(y[ok] + off, v[ok], 0.36, xerr=err[:, ok], color=color, capsize=2,
                        label="first order" if name == "S1" else "total")
-        for bar, e in zip(bars.patches, np.isnan(err[:, ok]).any(axis=0)):
-            if e:
-                bar.set_hatch("//")
+        hatch_without_error(bars, np.isnan(err[:, ok]).any(axis=0))
         for yi in y[~ok]:
             ax.text(0.0, yi + off, f" {name} n/a", va="center", fontsize=6, color="0.3")
         missing["n/a (variance 0 or unknown)"] += int((~ok).sum())

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.plotting import error_title, fit_titles
+from bearingsim.plotting import error_title, fit_titles, hatch_without_error, mark_without_error
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -171,8 +171,7 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
             ax.errorbar(x, y, yerr=_bar_lengths(err), fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
-            none = np.isnan(err) & np.isfinite(y)  # a value without an error: an open marker
-            ax.plot(x[none], y[none], "o", ms=4, color=f"C{gi}", mfc="white", zorder=3)
+            mark_without_error(ax, x, y, err, f"C{gi}", ms=4)  # a value without an error: an open marker
     drawn = [i for idx in groups.values() for i in idx]
     for ax, (name, sym) in zip(panels, QUANTITIES):
         ax.set_xlabel(axis_label(x_key))
@@ -323,9 +322,7 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
             err = _sem_mN_s(cols, name, total)  # NaN: no error bar (matplotlib draws none), not a 0 one
             ok = np.isfinite(y)  # failed or not run: no bar (a gap, not a zero)
             bars = ax.barh(pos[ok], y[ok], xerr=_bar_lengths(err[ok]), color=f"C{k}", capsize=3)
-            for bar, e in zip(bars.patches, err[ok]):
-                if math.isnan(e):  # a value without an error: hatched
-                    bar.set_hatch("//")
+            hatch_without_error(bars, np.isnan(err[ok]))  # a value without an error: hatched
             ax.set_title(_titled(sym, error_title(err[ok], "bar")), fontsize=9)
         ax.set_xlabel(f"{sym} {Y_LABEL}")
         ax.grid(alpha=0.3, axis="x")

@@ -188,10 +188,10 @@ def check(result) -> list[str]:
 def impact_table_end(result) -> float | None:
     """The time [s] of the last row of a result's impact table (``/results/impacts``) when it filled its rows
     (``multibody.core.IMPACT_CAPACITY``; provenance ``impacts_table_full``), else None."""
-    imp = result.impacts
-    if not result.provenance.get("impacts_table_full", False) or not len(imp.get("time_s", ())):
+    if not result.provenance.get("impacts_table_full", False):  # first: most results need not read the table
         return None
-    return float(imp["time_s"][-1])
+    times = result.impacts.get("time_s", ())
+    return float(times[-1]) if len(times) else None
 
 
 def impact_table_note(result) -> str | None:

@@ -187,8 +187,9 @@ def _folder_listing(p: Path) -> str | None:
 
     if not (p.is_dir() and (p / "sweep.h5").is_file()):
         return None
-    files = [f for _, f in studies_of(p)] + [f for f in (p / "sweep.h5", p / "map.h5") if f.is_file()]
-    listed = []
+    studies = studies_of(p)
+    files = [f for _, f in studies if f.suffix != ".csv"] + [f for f in (p / "sweep.h5", p / "map.h5") if f.is_file()]
+    listed = [(f, (_csv_study_text(kind, p),)) for kind, f in studies if f.suffix == ".csv"]
     for f in files:
         described = _describe_index(f)
         if described is None:  # what is wrong with it, as inspect of the file says (a sweep's own file is not foreign)
@@ -198,6 +199,16 @@ def _folder_listing(p: Path) -> str | None:
     head = f"{p}: a sweep or study folder; " + ("its file" if len(listed) == 1 else "its files") + " below: " + \
         ", ".join(f.name for f, _ in listed)
     return "\n\n".join([head, *(d[0] for _, d in listed)])
+
+
+def _csv_study_text(kind: str, folder: Path) -> str:
+    """What ``inspect`` of a study folder says of the study whose tables are CSV (``validate``): its tables,
+    and the command that prints them (:func:`bearingsim.tables.study_text`)."""
+    from bearingsim.studies.validate import own_tables
+    from bearingsim.tables import STUDY_NAMES
+
+    return (f"{folder}: bearingsim {STUDY_NAMES[kind]} tables (CSV, one row per speed): "
+            f"{', '.join(own_tables(folder))}\n'bearingsim table {folder}' prints them; its cases: sweep.h5 below")
 
 
 def _is_scenario_file(path) -> bool:

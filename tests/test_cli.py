@@ -754,3 +754,19 @@ def test_inspect_of_a_sweep_or_study_folder_lists_its_files(tmp_path):
     assert_user_error(bearingsim("inspect", tmp_path), str(tmp_path), "is a directory, not an archive")
     (out / "sweep.h5").write_bytes((out / "sweep.h5").read_bytes()[:3000])  # damaged: said as inspect FILE says it
     assert_user_error(bearingsim("inspect", out), f"{out / 'sweep.h5'}: damaged or truncated file")
+
+
+@pytest.mark.slow
+def test_inspect_of_a_validate_folder_names_its_csv_tables(tmp_path):
+    """``inspect DIR`` of the folder ``validate`` writes was refused ("fig9_idec_vs_speed.csv: not a bearingsim
+    sweep index"): it handed the study's CSV table to the reader of HDF5 indexes. It now names the study's
+    tables, the command that prints them, and lists the folder's case index as ``inspect sweep.h5`` does."""
+    out = tmp_path / "val"
+    assert bearingsim("validate", "--rig-rotations", "0", "-o", out, "-q").returncode == 0
+    res = bearingsim("inspect", out)
+    assert res.returncode == 0, res.stderr
+    index = bearingsim("inspect", out / "sweep.h5").stdout
+    assert res.stdout.startswith(f"{out}: a sweep or study folder; its files below: fig9_idec_vs_speed.csv, sweep.h5\n\n"
+                                 f"{out}: bearingsim validate tables (CSV, one row per speed): fig9_idec_vs_speed.csv\n"
+                                 f"'bearingsim table {out}' prints them"), res.stdout
+    assert res.stdout.endswith(index), res.stdout

@@ -62,6 +62,14 @@ def is_validate_table(path) -> bool:
     return path.name == fig9.CSV_NAME and _starts_with(path, fig9.CSV_SIGNATURE) and "fig9" in studies_in(path.parent)
 
 
+def own_tables(folder) -> list[str]:
+    """The names of the tables the validate study wrote in ``folder``: the Fig. 9 table, and the rig's when
+    the folder's cases include the rig (a user's CSV of another name is not the study's)."""
+    folder = Path(folder)
+    has_rig = "rig" in studies_in(folder) and _starts_with(folder / rig.CSV_NAME, rig.CSV_SIGNATURE)
+    return [fig9.CSV_NAME, *([rig.CSV_NAME] if has_rig else [])]
+
+
 def read_validate(folder) -> ValidateTables:
     """The tables and figures of validate folder ``folder`` (:func:`is_validate_table` of its Fig. 9
     table is the caller's to check); its figures are those bearingsim drew there (:func:`bearingsim.outputs.is_own_png`:

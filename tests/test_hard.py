@@ -184,3 +184,24 @@ def test_automatic_dt_restart_is_recorded():
     how = r.provenance["dt_choice"]
     assert how.startswith("auto:") and "restarted at dt" in how, how
     assert r.summary["max_penetration_all_m"] <= 0.01 * si(sc).bearing.pocket_clearance
+
+
+def test_a_given_step_too_small_to_finish_is_refused_before_the_run():
+    """A given ``numerics.dt_s`` far below the automatic step (a mistyped exponent, 1e-12 s for 1e-6 s) was
+    accepted by the dry run and ran for hours; one needing more than ``MAX_STEPS_PER_ROTATION`` steps per
+    nominal cage rotation (2 pi / omega_c, Eq. 5's cage speed) is refused in one line naming the key and the
+    smallest step it takes, which itself is accepted: the bound is the stated one, not a round-off away."""
+    import bearingsim as api
+    from bearingsim.multibody import core
+
+    sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml")
+    p = sc.parameters
+    smallest = 2.0 * math.pi / p.operating.omega_c / core.MAX_STEPS_PER_ROTATION
+    with pytest.raises(UserError, match=r"needs 1(\.0\d)?e\+07 steps per cage rotation, more than 1e\+07"):
+        core.choose_dt(p, 0.999 * smallest)
+    assert core.choose_dt(p, 1.001 * smallest)[0] == 1.001 * smallest
+    res = bearingsim("run", SCENARIOS / "multibody_3000rpm.toml", "--set", "numerics.dt_s=1e-12", "--dry-run")
+    assert res.returncode == 2 and res.stderr.count("\n") == 1 and "Traceback" not in res.stderr, res.stderr
+    assert "numerics.dt_s = 1e-12 s needs" in res.stderr and f"use at least {smallest:.3g} s" in res.stderr, res.stderr
+    with pytest.raises(UserError, match=r"dt \(run\(\)'s dt argument\) = 1e-12 s needs .* or give none"):
+        api.run(sc, dt=1e-12)

@@ -374,6 +374,8 @@ CASES: list[Case] = [
     # the euler method's step count is bounded before the run (issue 30): ~4e8 and ~2.6e9 steps asked
     Case("euler-dt-1e-10", "--set", run(*S("reduced.method=euler", "numerics.dt_s=1e-10")), 2,
          ("numerics.dt_s", "steps", "more than 1e+08")),
+    Case("multibody-dt-1e-12", "--set", run(*S("numerics.dt_s=1e-12"), scenario=MB), 2,
+         ("numerics.dt_s", "steps per cage rotation", "more than 1e+07")),
     Case("euler-pocket-clearance-1e-9-automatic-step", "--set",
          run(*S("reduced.method=euler", "bearing.pocket_clearance_mm=1e-9")), 2,
          ("bearing.pocket_clearance_mm", "automatic", "more than 1e+08")),

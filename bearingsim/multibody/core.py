@@ -69,6 +69,11 @@ LAND_ORBIT_MARGIN = 0.1
 # bearing's runs at 1000, 3000 and 6000 rpm, late in the run (docs/fast_scene.md, *Time step*)
 RIGID_IMPACT_OVERLAP_FRACTION = RESTART_MARGIN * PENETRATION_LIMIT
 RIGID_DT_CAP_S = 1.0e-4  # never above this
+# A given step (numerics.dt_s) needing more steps per cage rotation than this is refused before the run:
+# the automatic step takes ~6e3 per rotation at 6000 rpm and ~5e4 at 500 rpm, a step costs ~14 us on
+# one core (the main job: 237 011 steps in 3.3 s), so 1e7 is ~2 min a rotation, a convergence study's
+# finest step with room to spare, where a mistyped exponent (1e-9 for 1e-6 s) would run for hours.
+MAX_STEPS_PER_ROTATION = 10_000_000
 RIGID_START_OVERLAP_FRACTION = 0.005  # the start phase's step: the cage's fall within 0.5 % of s per step
 # the roller must press on the outer race with its centrifugal load: m r omega_c^2 >= this multiple of
 # its weight, so the rollers at the top stay on the race against gravity and the cage's pushes
@@ -283,6 +288,7 @@ def choose_dt(p, dt=None, play=None):
                f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
                f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
                + _play_text(p, play))
+    _check_step_count(p, dt, how)
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of this bearing "
@@ -310,11 +316,28 @@ def _choose_dt_rigid(p, dt, play=None):
                + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
                   if math.isfinite(lim) else "")
                + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p, play))
+    _check_step_count(p, dt, how)
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of the cage on its land "
             f"(2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s")
     return float(dt), how, lim
+
+
+def _check_step_count(p, dt: float, how: str) -> None:
+    """Refuse a given step (``how`` not automatic) that needs more than :data:`MAX_STEPS_PER_ROTATION` steps
+    per nominal cage rotation (one line naming the key, the steps and the run time they stand for)."""
+    if how.startswith("auto"):
+        return
+    per_rotation = 2.0 * math.pi / abs(p.operating.omega_c) / dt
+    if per_rotation > MAX_STEPS_PER_ROTATION:
+        given, instead = (("numerics.dt_s", "remove numerics.dt_s") if how == "numerics.dt_s" else
+                          ("dt (run()'s dt argument)", "give none"))
+        raise UserError(
+            f"{given} = {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
+            f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
+            f"{2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION:.3g} s, or {instead} "
+            f"for the automatic step")
 
 
 def rigid_start(p, dt, play=None):

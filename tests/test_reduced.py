@@ -98,13 +98,32 @@ def test_previous_model_departs_at_low_speed_agrees_at_high_speed():
 
 @pytest.mark.parametrize("rpm", [500, 3000])
 def test_forward_and_reverse_identical(rpm):
-    """Fig. 7: forward and reverse rotation give the same I_dec. In the reduced model reverse rotation is
-    the mirror image of forward rotation (θ is measured along the cage's rotation), so the whole pass,
-    run through the scenario layer with direction = reverse, must agree to rounding (1e-12)."""
+    """Fig. 7: forward and reverse rotation give the same I_dec. The reduced model's pass is written in the
+    pocket's frame, θ measured along the cage's rotation from the load-zone centre (the bottom), and reads
+    no direction: its equation, a(θ) = -g sin θ - F_o(N(θ))/m with N = m (r_p ω_c² + g cos θ) (Eqs. 1-3),
+    must then be what the lab frame gives for either sense of rotation. Derived here independently: a pocket
+    at lab angle α = -π/2 + sθ moving in the sense s = ±1 has the unit vector of its motion
+    e_t = s (-sin α, cos α) and the outward radius e_r = (cos α, sin α); gravity (0, -g) pushes the roller
+    along the motion by g·e_t and onto the outer race by g·e_r. The model's a(θ) and N(θ) equal those for
+    both senses to rounding (1e-12 of g), and the whole pass run through the scenario layer with
+    direction = reverse equals the forward one to rounding (1e-12)."""
+    from bearingsim import laws
+
     fwd = simulate(paper_scenario(rpm, direction="forward"))
     rev = simulate(paper_scenario(rpm, direction="reverse"))
     assert rev.summary["I_dec_mean_Ns"] == pytest.approx(fwd.summary["I_dec_mean_Ns"], rel=1e-12)
     assert rev.summary["I_acc_mean_Ns"] == pytest.approx(fwd.summary["I_acc_mean_Ns"], rel=1e-12, abs=1e-18)
+    theta = np.linspace(0.0, 2.0 * np.pi, 721)
+    for direction, sense in (("forward", 1.0), ("reverse", -1.0)):
+        inp = _inputs(rpm, direction=direction)
+        alpha = -0.5 * np.pi + sense * theta
+        g_t = -inp.gravity * sense * np.cos(alpha)  # (0, -g) · s (-sin α, cos α)
+        g_r = -inp.gravity * np.sin(alpha)  # (0, -g) · (cos α, sin α)
+        n_lab = inp.mass * (inp.centripetal + g_r)
+        drag = laws.oil_film_drag(inp.drag_coefficient, n_lab, inp.rolling_velocity) / inp.mass
+        assert np.max(np.abs(inp.acceleration(theta) - (g_t - drag))) <= 1e-12 * inp.gravity, direction
+        n_model = laws.outer_race_normal_load(inp.mass, inp.pitch_radius, inp.omega_c, theta, inp.gravity)
+        assert np.max(np.abs(n_model - n_lab)) <= 1e-12 * inp.mass * inp.gravity, direction
 
 
 @pytest.mark.parametrize("rpm", [500, 1000, 6000])

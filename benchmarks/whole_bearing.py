@@ -139,7 +139,10 @@ def checks():
     phi = s["load_zone_half_angle_deg"]
     drive, onset, th, fdec = where_forces_act(fwd)
     band = (th >= 240) & (th <= 300)
-    print(f"drive within phi + 15 deg {drive:.1%}; F_dec onset {onset:.1f} deg (phi {phi:.2f}); "
+    facc = fwd.get("force_vs_theta_acc").mean(axis=1)
+    lz = (th <= phi + 15) | (th >= 360 - phi - 15)
+    print(f"drive within phi + 15 deg {drive:.1%} (F_acc itself {facc[lz].sum() / facc.sum():.1%}, at 60-180 deg "
+          f"{facc[(th > 60) & (th < 180)].sum() / facc.sum():.1%}); F_dec onset {onset:.1f} deg (phi {phi:.2f}); "
           f"share of F_dec at 240-300 deg {fdec[band].sum() / fdec.sum():.2f}")
     # the reduced-equivalent scene against the event model, and its dt convergence
     from bearingsim.multibody.core import choose_dt

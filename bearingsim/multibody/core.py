@@ -74,6 +74,12 @@ RIGID_DT_CAP_S = 1.0e-4  # never above this
 # one core (the main job: 237 011 steps in 3.3 s), so 1e7 is ~2 min a rotation, a convergence study's
 # finest step with room to spare, where a mistyped exponent (1e-9 for 1e-6 s) would run for hours.
 MAX_STEPS_PER_ROTATION = 10_000_000
+# Steps in which the quasi-static inner ring's force balance (Newton iteration) did not converge: a
+# few isolated steps are harmless (the next step starts again from the last iterate) and are noted
+# (bearingsim.plausibility); in more than 1 % of the steps the ring equilibrium the model assumes is
+# not met and the run is refused, as soon as the failures exceed 1 % of the most steps it may take
+# (LoopLimits.max_steps), which no later step can bring back under.
+MAX_NEWTON_FAILURE_FRACTION = 0.01
 RIGID_START_OVERLAP_FRACTION = 0.005  # the start phase's step: the cage's fall within 0.5 % of s per step
 # the roller must press on the outer race with its centrifugal load: m r omega_c^2 >= this multiple of
 # its weight, so the rollers at the top stay on the race against gravity and the cage's pushes
@@ -929,6 +935,10 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
             if done > bar_done:
                 bar.update(done - bar_done)
                 bar_done = done
+        if int(st["newton_failures"]) > MAX_NEWTON_FAILURE_FRACTION * su.limits.max_steps:
+            if bar is not None:
+                bar.close()
+            raise SimulationUnstable(_newton_refusal(int(st["newton_failures"]), int(st["step"]), su.limits.max_steps))
         if code == lp.CODE_BLOCK_FULL:
             continue
         if code == lp.CODE_PHASE_END:
@@ -945,6 +955,14 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
     if bar is not None:
         bar.update(total_rot - bar_done)
         bar.close()
+
+
+def _newton_refusal(fails: int, step: int, max_steps: int) -> str:
+    """The refusal of a run whose quasi-static ring's force balance failed in more than
+    :data:`MAX_NEWTON_FAILURE_FRACTION` of the most steps it may take, said as soon as that is certain."""
+    return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps ({fails / step:.2%}), "
+            f"already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} steps the run may take "
+            "(provenance ring_newton_failures); set a smaller numerics.dt_s or multibody.inner_ring=dynamic")
 
 
 def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):

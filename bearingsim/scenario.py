@@ -1209,10 +1209,11 @@ def _check_motion(m: ScenarioModel, source: str) -> None:
             ways.append(f"start it at {rotations - length:g} or earlier")
         if start < rotations:
             ways.append(f"shorten output.motion_rotations to {rotations - start:g} or less")
+        ways.append(f"set numerics.rotations to {math.ceil(start + length):g} or more")
         exc = UserError(f"{source}: output.motion_start_rotation: the window {start:g} .. {start + length:g} ends "
-                        f"after the {rotations} recorded rotations (numerics.rotations); {', '.join(ways)} or set "
+                        f"after the {rotations} recorded rotations (numerics.rotations); {', '.join(ways)}, or set "
                         f"output.motion_start_rotation = 'last' (the last recorded rotations)")
-        raise _involving(exc, "output.motion_rotations")
+        raise _involving(exc, "output.motion_rotations", "numerics.rotations")
     length = min(out.motion_rotations, rotations)
     if length * out.motion_samples_per_rotation > MAX_MOTION_SAMPLES:
         exc = UserError(f"{source}: output.motion_rotations: {length:g} rotations x {out.motion_samples_per_rotation} "

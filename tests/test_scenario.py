@@ -176,14 +176,18 @@ def test_pocket_shape_keys_are_validated(override, words):
 
 
 @pytest.mark.parametrize("start, length, advice", [
-    (0, 50, "; shorten output.motion_rotations to 3 or less or set output.motion_start_rotation = 'last'"),
-    (2, 2, "; start it at 1 or earlier, shorten output.motion_rotations to 1 or less or set "
-           "output.motion_start_rotation = 'last'"),
-    (5, 1, "; start it at 2 or earlier or set output.motion_start_rotation = 'last'"),
+    (0, 50, "; shorten output.motion_rotations to 3 or less, set numerics.rotations to 50 or more, or set "
+            "output.motion_start_rotation = 'last'"),
+    (2, 2, "; start it at 1 or earlier, shorten output.motion_rotations to 1 or less, set numerics.rotations to 4 or "
+           "more, or set output.motion_start_rotation = 'last'"),
+    (5, 1, "; start it at 2 or earlier, set numerics.rotations to 6 or more, or set output.motion_start_rotation = "
+           "'last'"),
+    (5, 4, "; set numerics.rotations to 9 or more, or set output.motion_start_rotation = 'last'"),
 ])
 def test_a_motion_window_after_the_run_is_refused_with_advice_that_can_be_followed(start, length, advice):
     """A window from rotation 0 longer than the run was told to "start it earlier", which it cannot: the advice
-    names only what moves the window into the recorded rotations."""
+    names only what moves the window into the recorded rotations, and always the longer run that holds it (a
+    window longer than the run starting after it was told nothing but 'last', after an empty list)."""
     with pytest.raises(UserError) as err:
         load_scenario(SCENARIOS / "multibody_3000rpm.toml", values={
             "numerics.rotations": 3, "output.motion_start_rotation": start, "output.motion_rotations": length})

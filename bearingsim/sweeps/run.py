@@ -484,7 +484,10 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
 
     outdir = check_writable_dir(outdir)
     own = lock is None
-    if own:
+    if own:  # checked before the lock file too: a refusal leaves the folder as it was
+        check_sweep_outputs(outdir, figures)
+        if check_folder:
+            check_same_sweep(outdir, cases, force)
         lock = FolderLock(outdir).acquire()
     elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
         raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")

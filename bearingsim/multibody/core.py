@@ -982,8 +982,7 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
             f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if su.rigid else 0.0):.3g} m "
             f"(limit {lim.raceway_approach:.3g} m, 3x the "
             f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
-            f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); try a smaller "
-            f"numerics.dt_s than {h:.3g} s")
+            f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); {_blowup_advice(su.p, h)}")
     if code == lp.CODE_STALLED:
         total_rot = su.p.numerics.warmup_rotations + su.p.numerics.rotations
         raise SimulationUnstable(
@@ -1002,6 +1001,22 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
             f"t = {t:.6g} s, beyond the radial reach of its pocket faces ({su.face_reach * 1e3:.4g} mm): the rollers no "
             f"longer hold it; {_hold_advice(su.p)}")
     raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
+
+
+def _blowup_advice(p, h: float) -> str:
+    """What to change after an energy blow-up with step ``h``: a smaller step, unless the ring is held
+    quasi-static while it rests on a single roller (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre`
+    < 2 under load, where ``multibody.inner_ring = "auto"`` makes it dynamic). Such a ring has no stable
+    sideways equilibrium (docs/stability.md, The inner ring): the instability is the ring's, and a smaller
+    step does not remove it."""
+    g, load = p.bearing, p.operating.radial_load
+    if inner_ring_mode(p)[0] == "quasi_static" and load > 0.0:
+        k = laws.loaded_rollers_with_one_at_centre(load, g.roller_count, g.roller_length, g.radial_clearance)
+        if k < 2:
+            return (f"the quasi-static inner ring rests on one roller here ({k} loaded with one at the load-zone "
+                    f"centre), which has no stable sideways equilibrium and a smaller numerics.dt_s does not give "
+                    f"it one: set multibody.inner_ring = \"dynamic\" (or \"auto\", which chooses it here)")
+    return f"try a smaller numerics.dt_s than {h:.3g} s"
 
 
 def _hold_advice(p) -> str:

@@ -252,21 +252,44 @@ def _no_classical_load_zone_note(result) -> str | None:
     """The classical half angle arccos(P_d / 2 delta_r) is 0 ("no roller loaded") when the ring's mean
     displacement along the load is at most P_d/2. Under load that happens when the ring does not rest in a
     load zone but rides from roller to roller (a dynamic ring on few rollers: 3 rollers at 970 N, 24.6 um
-    against 40 um), while the inner race carried load: the 0 is no result, which the note says."""
+    against 40 um), while the inner race carried load: the 0 is no result, which the note says. The contact
+    half angle is 0 when the theta bin just before the load-zone centre carried under 1 % of the largest mean
+    load (:func:`_inner_race_load_text`): under load that 0 is no result either, and the note says so too."""
     p = result.parameters
     summary = result.summary
     if p.operating.radial_load <= 0.0 or "inner_ring_displacement_m" not in summary:
         return None
     phi = float(summary.get("load_zone_half_angle_deg", float("nan")))
     contact = float(summary.get("load_zone_contact_half_angle_deg", float("nan")))
-    if phi != 0.0 or not contact > 0.0:
+    loaded = _inner_race_load_text(result) if contact == 0.0 else None
+    if loaded is not None:
+        zero = "load_zone_contact_half_angle_deg = 0 is no result"
+        if phi != 0.0:
+            return f"bearingsim: note: {zero}: the inner race carried load {loaded}"
+        carried = f"{loaded}; {zero} either"
+    elif phi == 0.0 and contact > 0.0:
+        carried = f"over +-{contact:.3g} deg (load_zone_contact_half_angle_deg)"
+    else:
         return None
     disp = float(summary["inner_ring_displacement_m"])
     return (f"bearingsim: note: load_zone_half_angle_deg = 0 is no result: the inner ring's mean displacement "
             f"along the load, {disp * 1e6:.3g} um, is not more than half the radial clearance "
             f"({0.5 * p.bearing.radial_clearance * 1e6:.3g} um), so arccos(P_d / 2 delta_r) finds no roller loaded, "
-            f"while the inner race carried load over +-{contact:.3g} deg (load_zone_contact_half_angle_deg): the "
+            f"while the inner race carried load {carried}: the "
             f"ring ({str(result.provenance.get('inner_ring', '?')).split(';')[0]}) did not rest in a load zone")
+
+
+def _inner_race_load_text(result) -> str | None:
+    """Where the inner race carried load, when it did (``/results/raceway_load_inner`` above 1 % of its maximum
+    in some theta bin) but not in the bin just before theta = 0, where the contact half angle's loaded range
+    starts (:func:`bearingsim.multibody._load_zone_half_angle`), which is then 0; else None."""
+    arr = getattr(result, "data", {}).get("results/raceway_load_inner")
+    q = np.asarray(arr.data, float) if arr is not None else np.zeros(0)
+    if q.size == 0 or not q.max() > 0.0 or q[-1] > 0.01 * q.max():
+        return None
+    return (f"in {np.count_nonzero(q > 0.01 * q.max())} of {q.size} theta bins (/results/raceway_load_inner above "
+            f"1 % of its maximum, {q.max():.4g} N) but not in the bin just before the load-zone centre "
+            f"({-360.0 / q.size:g} to 0 deg: {q[-1]:.3g} N), where the contact half angle's loaded range starts")
 
 
 def _pinched_note(result) -> str | None:

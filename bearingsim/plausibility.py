@@ -486,17 +486,24 @@ def _rest_span(result) -> tuple[float, float, float] | None:
 def cage_rest_change(result) -> str | None:
     """A note when a multibody run's cage did not rest in one place over its recorded rotations (a span of
     its resting angle beyond :data:`CAGE_REST_SPAN_DEG`), else None; the span to 0.1 deg, as the check of
-    :func:`checks_made` gives it."""
+    :func:`checks_made` gives it. Its explanation follows the guidance: a roller-guided cage can rest in two
+    places under load; a land-guided cage runs on its land."""
     got = _rest_span(result)
     if got is None or got[0] <= CAGE_REST_SPAN_DEG:
         return None
     span, lo, hi = got
     across = " across 180" if lo > hi else ""  # the stored angles lie in -180 .. 180 deg
+    guidance = result.parameters.bearing.cage_guidance
+    if guidance == "rollers":
+        why = "under load a roller-guided cage can rest in two: docs/whatif.md, Radial load"
+    else:
+        why = (f"this cage runs on its {guidance.split('_')[0]} ring's land, within half the land clearance of that "
+               f"ring's centre (docs/stability.md, Land-guided cage), and the angle says where along the land; the "
+               f"two resting places of docs/whatif.md, Radial load are a roller-guided cage's")
     return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
             f"the bottom spanned {span:.1f} deg over the recorded rotations ({lo:.1f} to {hi:.1f} deg{across}, "
             f"/results/per_rotation/cage_rest_angle; a steady run's stays within a few, the bound is "
-            f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in (under load a roller-guided "
-            f"cage can rest in two: docs/whatif.md, Radial load)")
+            f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in ({why})")
 
 
 def cage_speed_drift(result) -> str | None:

@@ -630,3 +630,29 @@ def test_a_contact_half_angle_of_zero_under_load_is_noted_as_no_result():
     contact, found = run(1)
     assert contact["load_zone_half_angle_deg"] > 0.0 and contact["load_zone_contact_half_angle_deg"] == 0.0, contact
     assert len(found) == 1 and found[0].startswith("bearingsim: note: load_zone_contact_half_angle_deg = 0 is no"), found
+
+
+@pytest.mark.slow  # two 3000 rpm runs of 2 rotations with rigid raceways (~2 s each)
+def test_a_land_guided_cage_that_changes_where_it_rests_is_not_blamed_on_roller_guidance():
+    """The note of a cage that did not rest in one place explained it by docs/whatif.md, Radial load ("under load
+    a roller-guided cage can rest in two") for a cage running on its outer land too (20000 rpm, outer land: a span
+    of 112.6 deg). A land-guided cage runs on its land, within half the land clearance of that ring's centre
+    (docs/stability.md, Land-guided cage): its note says that, and names the two places as a roller-guided cage's;
+    a roller-guided cage's note keeps its explanation. The arrays are the runs' own with the resting angle moved
+    from 60 to 130 deg halfway, as in the test above."""
+    from bearingsim import plausibility
+    from bearingsim.datatypes import NamedArray
+
+    def note(guidance):
+        r = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={
+            "multibody.raceway_contact": "rigid", "numerics.rotations": 2, "bearing.cage_guidance": guidance}))
+        r.data["results/per_rotation/cage_rest_angle"] = NamedArray(np.array([60.0, 130.0]), "deg")
+        r.data["results/per_rotation/cage_rest_offset"] = NamedArray(np.full(2, 1e-4), "m")
+        return plausibility.cage_rest_change(r)
+
+    land = note("outer_land")
+    assert land is not None and "spanned 70.0 deg" in land, land
+    assert "a roller-guided cage can rest in two" not in land, land
+    assert "runs on its outer ring's land" in land and "docs/stability.md, Land-guided cage" in land, land
+    rollers = note("rollers")
+    assert rollers is not None and "under load a roller-guided cage can rest in two" in rollers, rollers

@@ -540,3 +540,19 @@ def test_a_frame_that_is_not_there_is_a_user_error(multibody_result, what):
 
     with pytest.raises(UserError, match=r"give one of per_rotation, impacts, observables, summary"):
         multibody_result.to_dataframe(what)
+
+
+def test_keys_why_says_what_resting_contact_counts():
+    """`bearingsim keys resting --why` printed the row alone and docs/usage.md named the key without saying what it
+    does, though it moves I_dec from 5.44 to 1.10 mN s at e = 0 (scenarios/paper_3000rpm.toml): it counts Eq. (9)'s
+    resting-contact impulse; false counts impacts only, as the paper's previous model (docs/physics.md)."""
+    from bearingsim.keys import format_keys, list_keys
+
+    res = cli("keys", "resting", "--why")
+    lines = res.stdout.splitlines()
+    assert res.returncode == 0 and len(lines) == 3 and lines[1].startswith("reduced.resting_contact"), res.stdout
+    assert "Eq. (9)" in lines[2] and "previous model" in lines[2], lines
+    assert "Eq. (9)" in {k.key: k for k in list_keys()}["reduced.resting_contact"].source
+    assert format_keys(list_keys(), "reduced.resting_contact", why=True).splitlines()[2] == lines[2]
+    usage = (SCENARIOS.parent / "docs" / "usage.md").read_text()
+    assert "`reduced.resting_contact` (`true`, default) counts" in usage, "usage.md: the key without what it does"

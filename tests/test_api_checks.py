@@ -597,13 +597,15 @@ def test_a_quasi_static_ring_on_one_roller_that_blows_up_is_told_to_go_dynamic()
     and held quasi-static with 4 rollers at 970 N the raceway approach blows up at t = 0.012 s. The stop said
     "try a smaller numerics.dt_s than 1.69e-07 s", and at 1e-7 s the same blow-up came at the same moment: the
     instability is the ring's, not the step's. With the ring on one roller (laws.loaded_rollers_with_one_at_centre
-    < 2, the rule of multibody.inner_ring = "auto") the stop names the dynamic ring instead."""
+    < 2, the rule of multibody.inner_ring = "auto") the stop names the dynamic ring instead. Its force balance
+    fails in nearly every step, so the run stops on that as soon as it is certain (more than 1 % of the most
+    steps the run may take), before the blow-up: either stop names the dynamic ring, neither a smaller step."""
     sc = bearingsim.load_scenario(MULTIBODY, overrides=["multibody.inner_ring=quasi_static", "bearing.roller_count=4",
                                                         "numerics.rotations=1"])
     with pytest.raises(bearingsim.SimulationUnstable) as err:
         bearingsim.run(sc)
     msg = str(err.value)
-    assert "energy blow-up" in msg and "\n" not in msg, msg
+    assert ("energy blow-up" in msg or "force balance did not converge" in msg) and "\n" not in msg, msg
     assert 'multibody.inner_ring = "dynamic"' in msg and "try a smaller" not in msg, msg
 
 

@@ -935,10 +935,12 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
             if done > bar_done:
                 bar.update(done - bar_done)
                 bar_done = done
-        if int(st["newton_failures"]) > MAX_NEWTON_FAILURE_FRACTION * su.limits.max_steps:
+        if code in (lp.CODE_BLOCK_FULL, lp.CODE_PHASE_END) and \
+                int(st["newton_failures"]) > MAX_NEWTON_FAILURE_FRACTION * su.limits.max_steps:  # a stop says its own
             if bar is not None:
                 bar.close()
-            raise SimulationUnstable(_newton_refusal(int(st["newton_failures"]), int(st["step"]), su.limits.max_steps))
+            raise SimulationUnstable(_newton_refusal(su.p, int(st["newton_failures"]), int(st["step"]),
+                                                     su.limits.max_steps))
         if code == lp.CODE_BLOCK_FULL:
             continue
         if code == lp.CODE_PHASE_END:
@@ -957,12 +959,13 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
         bar.close()
 
 
-def _newton_refusal(fails: int, step: int, max_steps: int) -> str:
+def _newton_refusal(p, fails: int, step: int, max_steps: int) -> str:
     """The refusal of a run whose quasi-static ring's force balance failed in more than
     :data:`MAX_NEWTON_FAILURE_FRACTION` of the most steps it may take, said as soon as that is certain."""
-    return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps ({fails / step:.2%}), "
-            f"already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} steps the run may take "
-            "(provenance ring_newton_failures); set a smaller numerics.dt_s or multibody.inner_ring=dynamic")
+    advice = _one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
+    return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps "
+            f"({fails / step:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} steps the run may take "
+            f"(provenance ring_newton_failures); {advice}")
 
 
 def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
@@ -1005,10 +1008,15 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
 
 def _blowup_advice(p, h: float) -> str:
     """What to change after an energy blow-up with step ``h``: a smaller step, unless the ring is held
-    quasi-static while it rests on a single roller (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre`
-    < 2 under load, where ``multibody.inner_ring = "auto"`` makes it dynamic). Such a ring has no stable
-    sideways equilibrium (docs/stability.md, The inner ring): the instability is the ring's, and a smaller
-    step does not remove it."""
+    quasi-static while it rests on a single roller (:func:`_one_roller_ring_advice`)."""
+    return _one_roller_ring_advice(p) or f"try a smaller numerics.dt_s than {h:.3g} s"
+
+
+def _one_roller_ring_advice(p) -> str | None:
+    """The remedy of a quasi-static ring resting on a single roller
+    (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre` < 2 under load, where ``multibody.inner_ring =
+    "auto"`` makes it dynamic), or None for any other ring. Such a ring has no stable sideways equilibrium
+    (docs/stability.md, The inner ring): its force balance fails and it blows up whatever the step."""
     g, load = p.bearing, p.operating.radial_load
     if inner_ring_mode(p)[0] == "quasi_static" and load > 0.0:
         k = laws.loaded_rollers_with_one_at_centre(load, g.roller_count, g.roller_length, g.radial_clearance)
@@ -1016,7 +1024,7 @@ def _blowup_advice(p, h: float) -> str:
             return (f"the quasi-static inner ring rests on one roller here ({k} loaded with one at the load-zone "
                     f"centre), which has no stable sideways equilibrium and a smaller numerics.dt_s does not give "
                     f"it one: set multibody.inner_ring = \"dynamic\" (or \"auto\", which chooses it here)")
-    return f"try a smaller numerics.dt_s than {h:.3g} s"
+    return None
 
 
 def _hold_advice(p) -> str:

@@ -454,12 +454,15 @@ def warmup_not_judged(result) -> str | None:
         return None
     warmup = result.parameters.numerics.warmup_rotations
     first = 10.0 if warmup < 2 else 1.0  # [%] the first recorded rotation's excess, docs/statistics.md
+    means = np.nanmean(arr, axis=1) * 1e3 if n >= 2 else np.zeros(0)  # this run's evidence [mN s]
+    own = (f"; this run's rotations read I_dec {' / '.join(f'{v:.4g}' for v in means)} mN s (mean over pockets)"
+           if len(means) else "")
     return (f"bearingsim: note: the warm-up could not be judged: {counted(n, 'recorded rotation')}, and the check "
             f"of the start's transient needs at least {START_TRANSIENT_MIN_ROTATIONS} (with fewer the later ones "
             f"scatter too much: it would see the transient below in under half of the runs); on the reference "
             f"bearing the first recorded rotation after one warm-up rotation reads 9 to 10 % high at 3000 rpm, "
             f"after two within about 1 % (docs/statistics.md), "
-            f"so up to about +{first / n:.2g} % in the mean of {counted(n, 'rotation')} after {warmup}; set "
+            f"so up to about +{first / n:.2g} % in the mean of {counted(n, 'rotation')} after {warmup}{own}; set "
             f"numerics.rotations to {START_TRANSIENT_MIN_ROTATIONS} or more (now {n}), or more "
             f"numerics.warmup_rotations")
 

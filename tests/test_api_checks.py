@@ -250,7 +250,9 @@ def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
     3000 rpm and a run says so in a note. Such a run gets one note: the warm-up could not be judged, what the
     check needs, and how large the transient is (docs/statistics.md); a run of 6 rotations, whose warm-up is
     judged, and a reduced-model run get none. (The check judged runs from 4 rotations, where it saw the 3000 rpm
-    transient in 4 of 20 rigid runs: a judgement it could seldom make.)"""
+    transient in 4 of 20 rigid runs: a judgement it could seldom make.) The note gives the run's own rotations'
+    I_dec too: a run far from the reference bearing (60 kN: 12.9 / 60.2 / 73.2 mN s) was told only the
+    reference bearing's +3.3 %."""
     from bearingsim import plausibility
 
     assert plausibility.START_TRANSIENT_MIN_ROTATIONS == 6
@@ -263,7 +265,10 @@ def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
     for words in ("9 to 10 % high at 3000 rpm", "up to about +3.3 % in the mean of 3 rotations after 1",
                   "docs/statistics.md", "numerics.rotations to 6 or more (now 3)", "or more numerics.warmup_rotations"):
         assert words in lines[0], words
-    assert bearingsim.load(tmp_path / "r3.h5").notes.count(lines[0]) == 1  # stored with the run's others
+    stored = bearingsim.load(tmp_path / "r3.h5")
+    assert stored.notes.count(lines[0]) == 1  # stored with the run's others
+    own = " / ".join(f"{v:.4g}" for v in stored.per_rotation["I_dec"].mean(axis=1) * 1e3)  # the run's own evidence
+    assert f"after 1; this run's rotations read I_dec {own} mN s (mean over pockets); set" in lines[0], lines[0]
     with pytest.warns(bearingsim.errors.PlausibilityWarning, match="warm-up could not be judged: 1 recorded rotation,"):
         one = bearingsim.run(bearingsim.load_scenario(MULTIBODY, set={"numerics.rotations": 1}))
     assert len([n for n in one.notes if "warm-up could not be judged" in n]) == 1, one.notes

@@ -159,7 +159,8 @@ def check(result) -> list[str]:
             raise SimulationUnstable(
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
                 f"for this load and clearance; {_advice(result)}")
-        for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result), _pinched_note(result)):
+        for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result), _pinched_note(result),
+                     land_overlap_note(result)):
             if note is not None:
                 notes.append(note)
         orbit = result.get("cage_orbit")
@@ -182,6 +183,29 @@ def check(result) -> list[str]:
                     "multibody.inner_ring=dynamic")
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def land_overlap_note(result) -> str | None:
+    """The note of a land-guided cage whose rim went further into its land than the design bound,
+    ``LAND_OVERLAP_FRACTION`` of c_L/2: the penalty stiffness keeps that bound under the steady reference force
+    only, and an impact on the land goes beyond it (docs/stability.md, *Land-guided cage*)."""
+    from bearingsim.multibody.core import LAND_OVERLAP_FRACTION
+
+    p = result.parameters
+    overlap = result.summary.get("land_overlap_max_m")
+    if overlap is None or p.bearing.cage_guidance == "rollers" or not p.bearing.cage_land_clearance:
+        return None
+    half = 0.5 * p.bearing.cage_land_clearance
+    if not overlap > LAND_OVERLAP_FRACTION * half:
+        return None
+    inner = p.bearing.cage_guidance == "inner_land"
+    cause = ("a quasi-static inner ring's centre can jump between steps and carry its land into the cage "
+             "(multibody.inner_ring = dynamic has no such jumps), or the cage hit the land in the start's fall"
+             if inner else "the cage hit the land, as in the start's fall at a small radial load")
+    return (f"bearingsim: note: the cage rim overlapped its {p.bearing.cage_guidance.replace('_', ' ')} by "
+            f"{overlap * 1e6:.3g} um, {overlap / half * 100:.2g} % of half the land clearance, beyond the "
+            f"{LAND_OVERLAP_FRACTION * 100:g} % its penalty stiffness holds under a steady force "
+            f"(summary land_overlap_max_m; docs/stability.md, Land-guided cage): an impact on the land; {cause}")
 
 
 def impact_table_end(result) -> float | None:

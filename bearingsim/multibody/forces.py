@@ -620,8 +620,10 @@ def land_force(state, h, lp, ring_c, ring_c_prev, out_f, out):
     evaluated at the predicted cage position ``x + h v`` (pymunk moves positions with the old
     velocities first), the damping with the overlap rate over the step.
 
-    The reaction on an inner ring is not fed back into the ring's balance (the land force is of the
-    order of the cage weight, three orders below the radial load the ring carries).
+    The reaction on an inner ring is not fed back into the ring's balance (the land force is mostly of
+    the order of the cage weight, three orders below the radial load the ring carries; an impact can
+    reach more: 37 kN when a quasi-static ring's centre jumped into the cage at 20000 rpm,
+    docs/stability.md, *Land-guided cage*).
 
     Parameters
     ----------

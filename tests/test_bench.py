@@ -207,3 +207,23 @@ def test_bench_refuses_options_it_would_not_read(tmp_path, monkeypatch, capsys):
     assert ran == [] and not (tmp_path / "b").exists()
     assert cli.main(["bench", "--geometry", "--rotations", "2", "-o", out]) == 0
     assert ran == ["geometry"]
+
+
+def test_the_long_runs_peak_memory_is_that_of_its_own_process():
+    """The long run's rss_MiB is the peak memory of the fresh process that ran it (docs/bench.md). getrusage's
+    ru_maxrss of a child started by a large parent reports the parent's peak (Linux carries it over exec):
+    the full bench printed 699.4 MiB for 20 and for 200 rotations, its own process's peak. A parent holding
+    300 MiB here starts a child that allocates nothing: the child's peak must be far below 300 MiB."""
+    import json
+    import subprocess
+    import sys
+
+    import numpy as np
+
+    from benchmarks.bench import PEAK_RSS_CODE
+
+    held = np.ones(300 * 2**20 // 8)  # 300 MiB, touched
+    code = "import resource, json\n" + PEAK_RSS_CODE + "print(json.dumps(rss))\n"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    rss = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert held.sum() > 0 and 1.0 < rss < 150.0, rss

@@ -270,3 +270,47 @@ def test_error_verdict_uses_students_t_of_both_standard_errors():
     assert error_verdict(0.02, 0.001, 0.001, 5, 5)["verdict"] == "not met"
     assert error_verdict(0.0018, math.nan, 0.001, 5, 5)["verdict"] == "not resolved"
     assert error_verdict(0.0018, 0.001, 0.001, 1, 5)["verdict"] == "not resolved"
+
+
+def test_reduced_rows_and_goal_give_the_error_of_i_acc_beside_i_dec(monkeypatch):
+    """Euler's error of I_acc, the other wear index, is larger than of I_dec (2000 rpm, dt 3e-7: 9.2e-5 and
+    3.6e-4), so "euler reaches 1e-4 at dt = 3e-7" held for I_dec only: the rows carry rel_error_I_acc, the
+    table prints it and the goal lines say where euler reaches 1e-4 in I_acc (here never on the grid)."""
+    from benchmarks.bench import _markdown, reduced_goal
+
+    euler = [(1e-6, 1e-3, 2e-4, 6e-4), (3e-7, 3e-3, 9e-5, 3.6e-4), (1e-7, 1e-2, 2e-5, 1.5e-4)]
+    rows = []
+    for rpm in (500, 2000, 6000):
+        rows += [dict(model="reduced", method="event", rpm=rpm, wall_s=1e-5, rel_error=1e-15, rel_error_I_acc=3e-15)]
+        rows += [dict(model="reduced", method="euler", rpm=rpm, dt_s=dt, wall_s=w, rel_error=e, rel_error_I_acc=a)
+                 for dt, w, e, a in euler]
+    lines = reduced_goal(rows)
+    assert "dt = 3e-07 s" in lines[0]
+    assert lines[1] == "  I_acc (event error 3.0e-15): euler does not reach 1e-4 on the dt grid " \
+                       "(dt = 1e-07 s: 1.5e-04, I_dec 2.0e-05)", lines[1]
+    head = [c.strip() for c in _markdown(rows[:2]).splitlines()[0].strip("|").split("|")]
+    assert "rel_error_I_acc" in head
+    rows[2]["rel_error_I_acc"] = 9e-5
+    rows[3]["rel_error_I_acc"] = 8e-5
+    assert "euler needs dt = 3e-07 s and 3.000 ms for 1e-4 (I_acc 9.0e-05" in reduced_goal(rows)[1]
+
+
+def test_reduced_rows_measure_the_error_of_i_acc():
+    """reduced_rows' errors come from both indices of the pass (no timing asserted)."""
+    from types import SimpleNamespace
+
+    from benchmarks.bench import _index_errors
+
+    e = _index_errors(SimpleNamespace(I_dec=1.01, I_acc=0.2 * 1.03), SimpleNamespace(I_dec=1.0, I_acc=0.2))
+    assert abs(e["rel_error"] - 0.01) < 1e-12 and abs(e["rel_error_I_acc"] - 0.03) < 1e-12
+
+
+def test_a_full_scene_row_gives_the_error_of_i_acc_against_its_reference():
+    from types import SimpleNamespace
+
+    from benchmarks.multibody_bench import _row
+
+    run = SimpleNamespace(provenance={"solver_wall_s": 1.0, "pymunk_step_s": 0.5},
+                          summary={"I_dec_mean_Ns": 0.0181, "I_acc_mean_Ns": 0.0042, "steps": 10})
+    row = _row("full", 6000, 4e-6, [run], 3, 0.018, "full scene at dt = 1e-06 s", 0.004)
+    assert abs(row["rel_error_I_acc"] - 0.05) < 1e-12 and abs(row["rel_error"] - 0.1 / 18) < 1e-12

@@ -77,9 +77,11 @@ def test_geometry_and_cost_lines_read_their_own_rows():
     base = dict(model="multibody", method="pymunk", dt_s=4e-6, pymunk_step_s=0.05, rel_error=nan)
     rows = [dict(base, scene="full_polyline_5", rpm=3000, I_dec_Ns=0.0183, wall_s=0.2, signed_error=0.274,
                  sem_rel=0.004),
-            dict(base, scene="full", rpm=1000, I_dec_Ns=0.027, wall_s=0.55, cost_ratio=1.1),
+            dict(base, scene="full", rpm=1000, I_dec_Ns=0.027, wall_s=0.55, cost_ratio=1.1, cost_ratio_low=1.05,
+                 cost_ratio_high=1.15, cost_verdict="met", repeats=5),
             dict(base, scene="full_polyline_3", rpm=1000, I_dec_Ns=0.037, wall_s=0.5, cost_ratio=nan),
-            dict(base, scene="full_rigid_raceways", rpm=6000, I_dec_Ns=0.018, wall_s=0.026, cost_ratio=1.3),
+            dict(base, scene="full_rigid_raceways", rpm=6000, I_dec_Ns=0.018, wall_s=0.026, cost_ratio=1.3,
+                 cost_ratio_low=1.25, cost_ratio_high=1.4, cost_verdict="not met", repeats=5),
             dict(base, scene="full", rpm=6000, I_dec_Ns=nan, wall_s=nan, notes="stopped: overlap")]
     lines = geometry_lines(rows)
     assert len(lines) == 3
@@ -314,3 +316,18 @@ def test_a_full_scene_row_gives_the_error_of_i_acc_against_its_reference():
                           summary={"I_dec_mean_Ns": 0.0181, "I_acc_mean_Ns": 0.0042, "steps": 10})
     row = _row("full", 6000, 4e-6, [run], 3, 0.018, "full scene at dt = 1e-06 s", 0.004)
     assert abs(row["rel_error_I_acc"] - 0.05) < 1e-12 and abs(row["rel_error"] - 0.1 / 18) < 1e-12
+
+
+def test_the_cost_goal_is_judged_on_the_spread_of_interleaved_repeats():
+    """Exact faces against the 3-segment polyline (rigid, 1000 rpm) read 1.24 x in the full bench ("not met")
+    and 1.06 x in --quick ("met") from medians of 3 and 1 repeats: the verdict flipped with the machine's load.
+    It now rests on the ratio of the minima and the spread of the pairs' ratios: "not resolved" where the
+    spread straddles 1.2 or fewer than 3 pairs ran."""
+    from benchmarks.multibody_bench import cost_verdict
+
+    v = cost_verdict([0.30, 0.26, 0.28], [0.25, 0.24, 0.22])  # pairs 1.20, 1.083, 1.273
+    assert v["verdict"] == "not resolved" and abs(v["ratio"] - 0.26 / 0.22) < 1e-12
+    assert abs(v["low"] - 0.26 / 0.24) < 1e-12 and abs(v["high"] - 0.28 / 0.22) < 1e-12
+    assert cost_verdict([0.2, 0.21, 0.2], [0.2, 0.2, 0.19])["verdict"] == "met"
+    assert cost_verdict([0.3, 0.31, 0.3], [0.2, 0.2, 0.19])["verdict"] == "not met"
+    assert cost_verdict([0.2], [0.2])["verdict"] == "not resolved"  # one pair: no spread

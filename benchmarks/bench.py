@@ -85,9 +85,11 @@ def reduced_rows(quick: bool) -> list[dict]:
 
 def _index_errors(sol, ref) -> dict:
     """Relative errors of both wear indices of a pass against a reference pass: ``rel_error`` of I_dec and
-    ``rel_error_I_acc`` of I_acc (the front face's, smaller, with larger relative errors under euler)."""
-    return dict(rel_error=abs(sol.I_dec - ref.I_dec) / abs(ref.I_dec),
-                rel_error_I_acc=abs(sol.I_acc - ref.I_acc) / abs(ref.I_acc), I_acc_Ns=sol.I_acc)
+    ``rel_error_I_acc`` of I_acc (the front face's, smaller, with larger relative errors under euler). Where the
+    reference's I_acc is 0 (no front-face contact: 6000 rpm) the error is 0 if the pass's is 0 too, else inf."""
+    d_acc = abs(sol.I_acc - ref.I_acc)
+    rel_acc = d_acc / abs(ref.I_acc) if ref.I_acc != 0.0 else (0.0 if d_acc == 0.0 else math.inf)
+    return dict(rel_error=abs(sol.I_dec - ref.I_dec) / abs(ref.I_dec), rel_error_I_acc=rel_acc, I_acc_Ns=sol.I_acc)
 
 
 @functools.cache

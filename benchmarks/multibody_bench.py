@@ -77,7 +77,9 @@ def _row(scene, rpm, dt, runs, total_rot, ref_idec, ref_what, ref_iacc=None):
     if ref_iacc is not None:
         iacc = runs[0].summary["I_acc_mean_Ns"]
         row["I_acc_Ns"] = iacc
-        row["rel_error_I_acc"] = float("nan") if ref_what == "itself" else abs(iacc - ref_iacc) / ref_iacc
+        d_acc = abs(iacc - ref_iacc)
+        rel_acc = d_acc / abs(ref_iacc) if ref_iacc else (0.0 if d_acc == 0.0 else math.inf)  # I_acc may be 0
+        row["rel_error_I_acc"] = float("nan") if ref_what == "itself" else rel_acc
     return row
 
 

@@ -307,6 +307,19 @@ def test_reduced_rows_measure_the_error_of_i_acc():
     assert abs(e["rel_error"] - 0.01) < 1e-12 and abs(e["rel_error_I_acc"] - 0.03) < 1e-12
 
 
+def test_an_i_acc_of_zero_has_an_error_of_its_own():
+    """At 6000 rpm no roller touches the front face in the event solution (I_acc = 0): the bench stopped
+    with ZeroDivisionError. Both 0: error 0; a non-zero I_acc against 0: inf (no relative error is finite)."""
+    import math
+    from types import SimpleNamespace
+
+    from benchmarks.bench import _index_errors
+
+    ref = SimpleNamespace(I_dec=1.0, I_acc=0.0)
+    assert _index_errors(SimpleNamespace(I_dec=1.0, I_acc=0.0), ref)["rel_error_I_acc"] == 0.0
+    assert _index_errors(SimpleNamespace(I_dec=1.0, I_acc=1e-9), ref)["rel_error_I_acc"] == math.inf
+
+
 def test_a_full_scene_row_gives_the_error_of_i_acc_against_its_reference():
     from types import SimpleNamespace
 

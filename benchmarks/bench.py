@@ -4,7 +4,8 @@ Writes to the output folder:
 
 * ``bench.csv``: one row per solver setting with at least ``model, method, scene, dt_s, wall_s,
   rel_error`` (wall time of one no-load pass for the reduced model, of one cage rotation for the
-  multibody model; ``rel_error`` = error of the mean I_dec against the row's reference, and for the
+  multibody model; ``rel_error`` = error of the mean I_dec against the row's reference, ``rel_error_I_acc``
+  that of the mean I_acc, and for the
   multibody model's chaotic full scene ``ref_sem_rel`` = that reference run's standard error, relative);
 * ``bench.png``: wall time against error, log-log;
 * ``bench_meta.json``: machine, package versions, date, command, and the long-run check;
@@ -187,8 +188,10 @@ def _i_acc_line(ev: dict, eu: list[dict]) -> str:
     head = f"  I_acc (event error {ev['rel_error_I_acc']:.1e}): euler "
     if need is None:
         last = eu[-1] if eu else None
-        return head + "does not reach 1e-4 on the dt grid" + (
-            f" (dt = {last['dt_s']:.0e} s: {last['rel_error_I_acc']:.1e}, I_dec {last['rel_error']:.1e})" if last else "")
+        if last is None:
+            return head + "has no row"
+        return head + (f"does not reach 1e-4 on the dt grid (dt = {last['dt_s']:.0e} s: "
+                       f"{last['rel_error_I_acc']:.1e}, I_dec {last['rel_error']:.1e})")
     return head + (f"needs dt = {need['dt_s']:.0e} s and {need['wall_s'] * 1e3:.3f} ms for 1e-4 "
                    f"(I_acc {need['rel_error_I_acc']:.1e}, I_dec {need['rel_error']:.1e} there)")
 

@@ -173,6 +173,11 @@ def test_rung_scenarios():
     expect["operating"]["inner_ring_speed_rpm"] = 1000.0
     expect["numerics"]["rotations"] = 7
     assert full.raw == expect
+    # rung 3 warms up for two rotations at least: with the file's one its first recorded rotation is its start
+    # transient (docs/crosscheck.md), every other rung keeps the scenario's warm-up
+    assert sc.numerics.warmup_rotations == 1
+    assert [r[3].numerics.warmup_rotations for r in rungs[1:]] == [1, cc.KINEMATIC_WARMUP_ROTATIONS, 1, 1]
+    assert cc.KINEMATIC_WARMUP_ROTATIONS == 2
     # the table's stored scenario (`bearingsim show crosscheck.h5`) has the rungs' count, not the file's 4
     assert cc.CrossCheck(sc, speeds=(1000,), rotations=7).scenario.numerics.rotations == 7
 

@@ -53,9 +53,10 @@ DT_MAX_FACTOR = 2.0  # dt above this multiple of 2/omega_n is refused (UserError
 IMPACT_OVERLAP_FRACTION = 0.005  # auto dt: one step's approach at the impact speed <= 0.5 % of s
 DT_CAP_S = 2.0e-5  # never above this (impact resolution: s / v_rel >> dt for v_rel ~ 1 m/s)
 # kinematic_cage scene (cross-check rung 3): the automatic step divided by this. A cage turned at a prescribed
-# speed pushes every roller from behind through the load zone, where the traction's implicit velocity update
-# and pymunk's contact share the force: I_dec converges at first order there (+3.6 %, +1.9 % per halving from
-# 4 us at 3000 rpm, 2 + 2 rotations), where the free cage's is not resolved. Divided by 8, a halving
+# speed holds every roller at that speed through the load zone against the traction, whose velocity stiffness
+# C (relaxation m / C ~ 50 us) the implicit update and pymunk's contact share at first order in h C / m: I_dec
+# converges at first order there (+3.6 %, +1.9 % per halving from 4 us at 3000 rpm, 2 + 2 rotations; +0.14 %
+# with slip_ref 10 x larger), where the free cage's is not resolved. Divided by 8, a halving
 # changes it by less than 1 % at 1000, 3000 and 6000 rpm, the step error the full scene's step is shown to
 # keep (docs/multibody.md, *Its time step*; docs/crosscheck.md)
 KINEMATIC_DT_DIVISOR = 8

@@ -646,8 +646,9 @@ def step_check_note(result, half) -> str:
     """The note of a run checked at half its time step (``bearingsim run --check-step``): each mean impulse at
     the step and at half of it with their standard errors (batch means; none for the reduced model, exact),
     the change and whether it is resolved by the tables' rule (:func:`bearingsim.stats.significant`). The
-    whole bearing is chaotic: the two runs are two trajectories, so an unresolved change bounds the step's
-    error by about twice the combined standard error, not to zero (docs/statistics.md). When either run's
+    whole bearing is chaotic: the two runs are two trajectories, so an unresolved change is bounded by about
+    twice the combined standard error, not to zero (docs/statistics.md); for the first-order scheme the step's
+    error is about twice the change, and the verdict says so (:func:`_step_change`). When either run's
     first recorded rotation is a start transient (:func:`start_transient`), the means and their standard
     errors hold it (it can hide a change of the steady state): the note compares them again without each
     run's first recorded rotation."""
@@ -663,7 +664,10 @@ def step_check_note(result, half) -> str:
 
 def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> str:
     """``"I_dec 50.858 at the step, 51.101 mN s at half of it: +0.48% ± 0.30% (verdict)"``: the mean impulse
-    ``a`` ± ``ea`` at the step against ``b`` ± ``eb`` at half of it [N s], each error from ``nb`` batch means."""
+    ``a`` ± ``ea`` at the step against ``b`` ± ``eb`` at half of it [N s], each error from ``nb`` batch means.
+    The change is not the step's error: at the first order the whole bearing's scheme converges at
+    (docs/multibody.md, *Its time step*), the error is about twice the change (Richardson: the limit is about
+    2 b - a), so the verdict gives that error, or twice the bound on the change when the change is not resolved."""
     from bearingsim.stats import critical_ses, significant
 
     if not a > 0.0:
@@ -674,13 +678,25 @@ def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> s
     if mark is None:
         verdict = "not judged: no standard error from one rotation"
     elif ea == 0.0 and eb == 0.0:
-        verdict = "the step's error: the model is exact" if mark else "no change beyond round-off"
+        verdict = f"exact, the model is deterministic; {_first_order_error(rel)}" if mark else \
+            "no change beyond round-off"
     elif mark:
-        verdict = "resolved: the number depends on the step"
+        verdict = f"resolved: the number depends on the step; {_first_order_error(rel)}"
     else:
-        verdict = f"not resolved: the step's error is below about {critical_ses(ea, eb, nb, nb) * rel_se:.1%}"
+        bound = critical_ses(ea, eb, nb, nb) * rel_se
+        verdict = (f"not resolved: the change is below about {bound:.1%}, so the step's error is below about "
+                   f"{2 * bound:.1%} for a first-order scheme")
     spread = f" ± {percent_text(rel_se)[1:]}" if rel_se > 0.0 else ""
     return f"{q} {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {percent_text(rel)}{spread} ({verdict})"
+
+
+def _first_order_error(rel: float) -> str:
+    """What a change ``rel`` from the step to half of it says of the step's error for a first-order scheme: the
+    run at the step off the extrapolated limit 2 b - a, -2 rel / (1 + 2 rel) (about twice the change)."""
+    if not rel > -0.5:  # the extrapolation has no meaning for a change this large
+        return "the step's error is at least twice this change for a first-order scheme"
+    return (f"the step's error is about twice this change for a first-order scheme: the run at the step is "
+            f"{percent_text(-2.0 * rel / (1.0 + 2.0 * rel))} off the extrapolated limit")
 
 
 def _steady_step_change(result, half) -> str:

@@ -3,6 +3,7 @@
     python -m benchmarks.discretization psi     # wear profile: 16 / 32 / 64 / 128 bins of psi (wear-test scene)
     python -m benchmarks.discretization theta   # load-zone contact extent, F_dec onset: 180 / 360 / 720 / 1440 bins of theta
     python -m benchmarks.discretization dt      # I_dec at the automatic step and at half of it, 1 warm-up + 40 rotations
+    python -m benchmarks.discretization order   # I_dec at the step and 3 halvings: observed order, extrapolated error
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
     python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
     python -m benchmarks.discretization life    # the life study to depth = 0.1 mm (fast scene) with 16 / 32 / 64 bins of psi
@@ -64,6 +65,74 @@ def dt(rpms=(1000, 3000, 6000), sets=(), raceways=("hertz", "rigid"), rotations=
             diff = (ia - ib) / ib
             print(f"| {rpm} | {raceway} | {step * 1e6:.1f} | {ia * 1e3:.3f} ± {sa * 1e3:.3f} | {ib * 1e3:.3f} ± "
                   f"{sb * 1e3:.3f} | {diff:+.2%} | {(ia - ib) / math.hypot(sa, sb):+.2f} |", flush=True)
+
+
+def _halvings(rpm, raceway, sets, halvings, rotations):
+    """Mean I_dec over 1 warm-up + ``rotations`` without the first recorded rotation (the warm-up's trace,
+    docs/statistics.md) at the automatic step and ``halvings`` halvings of it: ``[(dt, mean, s.e., wall s per
+    simulated rotation)]``, the CPU time of this process (``time.process_time``: the wall time of a host that runs
+    other work too is not the run's); a first run of one rotation before them leaves the kernels' compilation out."""
+    import time
+
+    from bearingsim.stats import batch_sem, pocket_means
+
+    name = f"multibody_{rpm}rpm" if (SCENARIOS / f"multibody_{rpm}rpm.toml").exists() else "multibody_3000rpm"
+    base = [f"operating.inner_ring_speed_rpm={rpm}", f"multibody.raceway_contact={raceway}", *sets]
+    _run(name, [*base, "numerics.warmup_rotations=1", "numerics.rotations=1"])
+    base += ["numerics.warmup_rotations=1", f"numerics.rotations={rotations}"]
+    rows, step = [], None
+    for k in range(halvings + 1):
+        t0 = time.process_time()
+        r = _run(name, base if step is None else [*base, f"numerics.dt_s={step / 2 ** k!r}"])
+        wall = (time.process_time() - t0) / (rotations + 1)
+        step = step or r.provenance["dt_s"]
+        x = pocket_means(r.per_rotation["I_dec"])[1:]
+        rows.append((r.provenance["dt_s"], float(x.mean()), batch_sem(x), wall))
+    return rows
+
+
+def _order(m, s, k):
+    """The observed order of convergence from the means ``m`` (standard errors ``s``) at steps k, k + 1, k + 2,
+    each half the one before: log2 of the ratio of the two changes, with its standard error (delta method, the
+    three runs independent); NaN where the changes differ in sign."""
+    import math
+
+    d1, d2 = m[k] - m[k + 1], m[k + 1] - m[k + 2]
+    if d1 * d2 <= 0:
+        return float("nan"), float("nan")
+    g = (1 / d1, -1 / d1 - 1 / d2, 1 / d2)
+    return math.log2(d1 / d2), math.sqrt(sum((gi * s[k + i]) ** 2 for i, gi in enumerate(g))) / math.log(2)
+
+
+def order(rpms=(500, 1000), sets=(), raceways=("hertz", "rigid"), halvings=3, rotations=20):
+    """The step's error of the mean I_dec, measured: 1 warm-up + ``rotations`` (the first recorded rotation
+    dropped) at the automatic step and 3 halvings of it. Each row gives the change from the step before with its
+    standard error (batch means, the runs independent), the observed order from each three successive steps
+    (``_order``), and the offset from the first-order Richardson extrapolation of the two finest steps,
+    2 I(dt / 8) - I(dt / 4) (the scheme converges at about first order, docs/fast_scene.md). With both raceways,
+    the rigid rows also give their offset from the Hertz extrapolation, and the last column is the CPU time per
+    simulated rotation, warm-up included (``_halvings``)."""
+    import math
+
+    print("| rpm | raceways | dt [us] | I_dec ± s.e. [mN s] | change from the step before | observed order "
+          "| off the extrapolation | off Hertz extrapolated | CPU s per rotation |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for rpm in rpms:
+        hertz = None
+        for raceway in raceways:
+            rows = _halvings(rpm, raceway, sets, halvings, rotations)
+            m, s = [r[1] for r in rows], [r[2] for r in rows]
+            ext, se_ext = 2 * m[-1] - m[-2], math.hypot(2 * s[-1], s[-2])
+            hertz = (ext, se_ext) if raceway == "hertz" else hertz
+            for k, (step, mk, sk, wall) in enumerate(rows):
+                change = (f"{mk / m[k - 1] - 1:+.2%} ± {math.hypot(sk, s[k - 1]) / m[k - 1]:.2%}" if k else "")
+                p, sp = _order(m, s, k - 2) if k >= 2 else (math.nan, math.nan)
+                off = f"{mk / ext - 1:+.2%} ± {math.hypot(sk, se_ext) / ext:.2%}"
+                vs = (f"{mk / hertz[0] - 1:+.2%} ± {math.hypot(sk, hertz[1]) / hertz[0]:.2%}"
+                      if raceway != "hertz" and hertz else "")
+                print(f"| {rpm} | {raceway} | {step * 1e6:.2f} | {mk * 1e3:.3f} ± {sk * 1e3:.3f} | {change} | "
+                      f"{'' if math.isnan(p) else f'{p:.2f} ± {sp:.2f}'} | {off} | {vs} | {wall:.3f} |", flush=True)
+            print(f"| {rpm} | {raceway} | extrapolated | {ext * 1e3:.3f} ± {se_ext * 1e3:.3f} | | | | | |", flush=True)
 
 
 def rig(rpms=(2000, 2500, 3000, 3500, 4000), sets=()):
@@ -236,9 +305,9 @@ def _bins(text: str) -> tuple[int, ...]:
 def parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="python -m benchmarks.discretization", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("study", choices=("psi", "theta", "dt", "rig", "whatif", "life", "stages"))
-    ap.add_argument("--bins", type=_bins, help="bin counts, e.g. 32,64 (psi, theta, life); the speeds of dt, rig, "
-                                               "whatif; the stage counts of stages")
+    ap.add_argument("study", choices=("psi", "theta", "dt", "order", "rig", "whatif", "life", "stages"))
+    ap.add_argument("--bins", type=_bins, help="bin counts, e.g. 32,64 (psi, theta, life); the speeds of dt, order, "
+                                               "rig, whatif; the stage counts of stages")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario override (repeatable)")
     ap.add_argument("--limit", help="life and stages only: the life study's limit (default depth=0.1mm)")
     ap.add_argument("--mapping", choices=("shape", "uniform"), help="stages only: how the wear acts back (default shape)")
@@ -253,7 +322,8 @@ def main(argv=None) -> None:
     if a.mapping and a.study != "stages":
         ap.error(f"--mapping: only the stages study reads it (not {a.study})")
     given = [a.bins] if a.bins else []
-    study = {"psi": psi, "theta": theta, "life": life, "stages": stages, "whatif": whatif, "rig": rig, "dt": dt}[a.study]
+    study = {"psi": psi, "theta": theta, "life": life, "stages": stages, "whatif": whatif, "rig": rig, "dt": dt,
+             "order": order}[a.study]
     extra = {"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}
     if a.mapping:
         extra["mapping"] = a.mapping

@@ -665,9 +665,10 @@ def step_check_note(result, half) -> str:
 def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> str:
     """``"I_dec 50.858 at the step, 51.101 mN s at half of it: +0.48% ± 0.30% (verdict)"``: the mean impulse
     ``a`` ± ``ea`` at the step against ``b`` ± ``eb`` at half of it [N s], each error from ``nb`` batch means.
-    The change is not the step's error: at the first order the whole bearing's scheme converges at
-    (docs/multibody.md, *Its time step*), the error is about twice the change (Richardson: the limit is about
-    2 b - a), so the verdict gives that error, or twice the bound on the change when the change is not resolved."""
+    The change is not the step's error: for a scheme of order p the error is the change over 1 - 2^-p, twice it
+    at first order (Richardson: the limit is about 2 b - a) and more below it; the whole bearing's scheme
+    converges at first order or slower at 500-1000 rpm (docs/multibody.md, *Its time step*). So the verdict
+    gives the first-order error, or twice the bound on the change when the change is not resolved."""
     from bearingsim.stats import critical_ses, significant
 
     if not a > 0.0:
@@ -685,7 +686,7 @@ def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> s
     else:
         bound = critical_ses(ea, eb, nb, nb) * rel_se
         verdict = (f"not resolved: the change is below about {bound:.1%}, so the step's error is below about "
-                   f"{2 * bound:.1%} for a first-order scheme")
+                   f"{2 * bound:.1%} for a first-order scheme, more for a slower one")
     spread = f" ± {percent_text(rel_se)[1:]}" if rel_se > 0.0 else ""
     return f"{q} {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {percent_text(rel)}{spread} ({verdict})"
 
@@ -695,8 +696,8 @@ def _first_order_error(rel: float) -> str:
     run at the step off the extrapolated limit 2 b - a, -2 rel / (1 + 2 rel) (about twice the change)."""
     if not rel > -0.5:  # the extrapolation has no meaning for a change this large
         return "the step's error is at least twice this change for a first-order scheme"
-    return (f"the step's error is about twice this change for a first-order scheme: the run at the step is "
-            f"{percent_text(-2.0 * rel / (1.0 + 2.0 * rel))} off the extrapolated limit")
+    return (f"the step's error is about twice this change for a first-order scheme, more for a slower one: the run "
+            f"at the step is {percent_text(-2.0 * rel / (1.0 + 2.0 * rel))} off the first-order extrapolation")
 
 
 def _steady_step_change(result, half) -> str:

@@ -72,7 +72,7 @@ def test_the_documented_invocations_parse_as_before():
     assert _parse("wear_bench", ["life"]) == {"what": "life"}
     for table in ("whatif", "orbit", "wear", "extent", "checks", "rig"):
         assert _parse("whole_bearing", [table]) == {"table": table}
-    for study in ("psi", "theta", "dt", "rig", "whatif", "life", "stages"):
+    for study in ("psi", "theta", "dt", "order", "rig", "whatif", "life", "stages"):
         assert _parse("discretization", [study]) == {"study": study, "bins": None, "set": [], "limit": None,
                                                      "mapping": None}
     assert _parse("discretization", ["life", "--limit=clearance=0.4mm", "--bins=32,64", "--set=numerics.dt_s=2e-6",
@@ -104,3 +104,24 @@ def test_a_limit_for_a_study_that_does_not_read_it_is_refused(capsys):
     with pytest.raises(SystemExit) as exc:
         discretization.main(["dt", "--limit=depth=1mm"])
     assert exc.value.code == 2 and "--limit: only the life and stages studies read it (not dt)" in capsys.readouterr().err
+
+
+def test_the_observed_order_of_the_step_study_is_that_of_the_means_it_is_given():
+    """``discretization order`` publishes the observed order of convergence, log2 of the ratio of two successive
+    changes at steps halved each time (Richardson extrapolation; Roache, Verification and Validation in
+    Computational Science and Engineering, 1998): means I0 + C dt^p give exactly p (to round-off, 1e-9), for
+    p = 1 and 2; changes of opposite sign have no order (NaN); its standard error is the delta method's over
+    three independent means, checked against the partial derivatives taken by finite differences (1e-6)."""
+    import math
+
+    from benchmarks.discretization import _order
+
+    for p in (1.0, 2.0):
+        m = [27.9 - 0.3 * (4e-6 / 2 ** k * 1e6) ** p for k in range(4)]
+        assert abs(_order(m, [0.0] * 4, 0)[0] - p) < 1e-9 and abs(_order(m, [0.0] * 4, 1)[0] - p) < 1e-9
+    assert math.isnan(_order([1.0, 1.1, 1.0], [0.01] * 3, 0)[0])
+    m, s = [27.580, 27.705, 27.804], [0.004, 0.014, 0.003]
+    h = 1e-7
+    grad = [(_order([x + h * (i == j) for j, x in enumerate(m)], s, 0)[0] - _order(m, s, 0)[0]) / h for i in range(3)]
+    expected = math.sqrt(sum((g * e) ** 2 for g, e in zip(grad, s)))
+    assert abs(_order(m, s, 0)[1] - expected) < 1e-6 * max(expected, 1.0)

@@ -670,8 +670,9 @@ def _add_run_commands(sub) -> None:
                    help="print the resolved scenario (every key, as TOML) and the archive it would write, refusing what "
                         "the run would refuse before its first step; run and write nothing")
     r.add_argument("--check-step", action="store_true",
-                   help="run it again at half its time step and note how much each mean impulse changes and whether "
-                        "that is resolved (about twice the run's cost; the note goes into the archive)")
+                   help="run it again at half its time step and note how much each mean impulse changes, whether "
+                        "that is resolved, and the step's error it implies (about twice the change for a first-order "
+                        "scheme); about twice the run's cost; the note goes into the archive")
     r.set_defaults(func=_cmd_run)
 
     i = sub.add_parser("inspect", help=f"print what a file holds: {_INDEX_KINDS}")

@@ -2,7 +2,7 @@
 
     python -m benchmarks.discretization psi     # wear profile: 16 / 32 / 64 / 128 bins of psi (wear-test scene)
     python -m benchmarks.discretization theta   # load-zone contact extent, F_dec onset: 180 / 360 / 720 / 1440 bins of theta
-    python -m benchmarks.discretization dt      # I_dec at the automatic step and at half of it, 1 warm-up + 40 rotations
+    python -m benchmarks.discretization dt      # I_dec at the automatic step and half of it (the change, not the error)
     python -m benchmarks.discretization order   # I_dec at the step and 3 halvings: observed order, extrapolated error
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
     python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
@@ -43,10 +43,11 @@ def _run(name, sets):
 
 
 def dt(rpms=(1000, 3000, 6000), sets=(), raceways=("hertz", "rigid"), rotations=40):
-    """The time step's error of the mean I_dec over 1 warm-up + ``rotations``: the automatic step against
-    half of it, each with its batch-means standard error (``bearingsim.stats``). The full scene is chaotic:
-    the two runs are two trajectories, so their difference is the dt error plus statistical scatter, judged
-    against the combined standard error."""
+    """The change of the mean I_dec over 1 warm-up + ``rotations`` from the automatic step to half of it, each
+    with its batch-means standard error (``bearingsim.stats``). The full scene is chaotic: the two runs are two
+    trajectories, so their difference is the step's effect plus statistical scatter, judged against the
+    combined standard error. It is not the step's error: for the first-order scheme the change is about half
+    of it, less where the convergence is slower (``order`` measures the error from three halvings)."""
     import math
 
     from bearingsim.stats import batch_sem, pocket_means

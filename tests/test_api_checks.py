@@ -277,7 +277,8 @@ def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
     assert not [n for n in bearingsim.run(bearingsim.load_scenario(PAPER)).notes if "warm-up" in n]
 
 
-@pytest.mark.parametrize("scene, noted", [("reduced_equivalent", False), ("kinematic_cage", True)])
+@pytest.mark.parametrize("scene, noted", [("reduced_equivalent", False),
+                                          pytest.param("kinematic_cage", True, marks=pytest.mark.slow)])  # ~7 s
 def test_a_scene_whose_rotations_repeat_gets_no_warm_up_note(scene, noted):
     """The warm-up note was given to every short multibody run, the cross-check's reduced_equivalent rung too,
     whose rotations repeat (each pass starts at the front of its pocket: standard error about 0) and hold no

@@ -25,10 +25,11 @@ DISPLACEMENT_MARGIN = 2.0
 # Fewest recorded samples of the cage orbit that make a figure and a mean of it.
 MIN_ORBIT_SAMPLES = 2
 # What the note of a few steps in which the quasi-static ring's force balance did not converge says
-# (more than multibody.core.MAX_NEWTON_FAILURE_FRACTION of the steps are refused). Measured (multibody_3000rpm, 1 warm-up + 1 rotation: 5 of 22922 steps): where a
-# roller's inner-race contact is opening, its damped force is cut off at zero, and Newton cycles (period
-# 2 or 3) across that kink for its 60 iterations; the step then uses the last iterate, whose residual
-# was 1 to 735 N against a 970 N load, for that one step's raceway forces.
+# (more than multibody.core.MAX_NEWTON_FAILURE_FRACTION of the steps are refused). Measured
+# (multibody_3000rpm, 1 warm-up + 1 rotation: 5 of 22922 steps): where a roller's inner-race contact is
+# opening, its damped force is cut off at zero, and Newton cycles (period 2 or 3) across that kink for
+# its 60 iterations; the step then uses the last iterate, whose residual was 1 to 735 N against a 970 N
+# load, for that one step's raceway forces.
 NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converge in {fails} of {steps} steps "
                "({share:.2%}; refused above 1%): those isolated steps kept the solve's last iterate for their raceway "
                "forces (provenance ring_newton_failures, docs/archive.md)")

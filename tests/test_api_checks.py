@@ -671,7 +671,8 @@ def test_a_contact_half_angle_of_zero_under_load_is_noted_as_no_result():
     assert "load_zone_contact_half_angle_deg = 0 is no result either" in found[0], found
     contact, found = run(1)
     assert contact["load_zone_half_angle_deg"] > 0.0 and contact["load_zone_contact_half_angle_deg"] == 0.0, contact
-    assert len(found) == 1 and found[0].startswith("bearingsim: note: load_zone_contact_half_angle_deg = 0 is no"), found
+    assert len(found) == 1, found
+    assert found[0].startswith("bearingsim: note: load_zone_contact_half_angle_deg = 0 is no"), found
 
 
 @pytest.mark.slow  # two 3000 rpm runs of 2 rotations with rigid raceways (~2 s each)

@@ -766,7 +766,7 @@ def test_inspect_of_a_validate_folder_names_its_csv_tables(tmp_path):
     res = bearingsim("inspect", out)
     assert res.returncode == 0, res.stderr
     index = bearingsim("inspect", out / "sweep.h5").stdout
-    assert res.stdout.startswith(f"{out}: a sweep or study folder; its files below: fig9_idec_vs_speed.csv, sweep.h5\n\n"
-                                 f"{out}: bearingsim validate tables (CSV, one row per speed): fig9_idec_vs_speed.csv\n"
-                                 f"'bearingsim table {out}' prints them"), res.stdout
+    head = f"{out}: a sweep or study folder; its files below: fig9_idec_vs_speed.csv, sweep.h5\n\n"
+    assert res.stdout.startswith(head + f"{out}: bearingsim validate tables (CSV, one row per speed): "
+                                 f"fig9_idec_vs_speed.csv\n'bearingsim table {out}' prints them"), res.stdout
     assert res.stdout.endswith(index), res.stdout

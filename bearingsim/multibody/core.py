@@ -976,8 +976,8 @@ def _newton_refusal(p, fails: int, step: int, max_steps: int) -> str:
     :data:`MAX_NEWTON_FAILURE_FRACTION` of the most steps it may take, said as soon as that is certain."""
     advice = _one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
     return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps "
-            f"({fails / step:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} steps the run may take "
-            f"(provenance ring_newton_failures); {advice}")
+            f"({fails / step:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} "
+            f"steps the run may take (provenance ring_newton_failures); {advice}")
 
 
 def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):

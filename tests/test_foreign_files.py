@@ -224,6 +224,23 @@ def test_sweep_refuses_a_folder_holding_a_users_file(tmp_path, name, kind):
 
 
 @pytest.mark.slow
+def test_a_forced_sweep_into_a_folder_another_sweep_is_writing_removes_nothing(tmp_path):
+    """``--force`` replaces another sweep's files, but never while that sweep holds the folder's lock: a forced
+    sweep into a folder another was writing removed its index and case archives and only then was refused
+    ("another sweep or study is writing this folder"), so the running sweep's index pointed at missing files.
+    The other sweep is stood in for by its lock, held here, over a finished sweep's files."""
+    from bearingsim.outputs import FolderLock
+
+    out = tmp_path / "sw"
+    assert _sweep(out).returncode == 0
+    before = sorted(p.relative_to(out) for p in out.rglob("*"))
+    with FolderLock(out):
+        res = cli("sweep", PAPER, "--param", "contact.restitution=0.7", "--force", "-o", out, "-j", "1")
+    _one_line_refusal(res, str(out), "another sweep or study is writing this folder")
+    assert sorted(p.relative_to(out) for p in out.rglob("*")) == before
+
+
+@pytest.mark.slow
 def test_sweep_rewrites_its_own_files(tmp_path):
     """Its own index and figure are replaced by the next sweep into the folder (resume)."""
     out = tmp_path / "sw"

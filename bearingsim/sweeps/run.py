@@ -484,10 +484,11 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
 
     outdir = check_writable_dir(outdir)
     own = lock is None
-    if own:  # checked before the lock file too: a refusal leaves the folder as it was
+    if own:
+        # a user's file is refused before the lock file is made too (a read-only check), so that refusal leaves
+        # the folder as it was; another sweep's files are judged, and with --force removed, only under the lock,
+        # never while that sweep may still be writing them
         check_sweep_outputs(outdir, figures)
-        if check_folder:
-            check_same_sweep(outdir, cases, force)
         lock = FolderLock(outdir).acquire()
     elif not lock.held or lock.path.parent.resolve() != outdir.resolve():
         raise ValueError("run_sweep(lock=...): give the held FolderLock of the sweep folder")

@@ -241,6 +241,25 @@ def test_a_forced_sweep_into_a_folder_another_sweep_is_writing_removes_nothing(t
 
 
 @pytest.mark.slow
+def test_a_folder_of_cases_from_an_earlier_model_version_is_refused_with_the_way_on(tmp_path):
+    """A cross-check folder written before its rung 3 changed (multibody model version 7 to 8, its warm-up and
+    step) was refused to the very command that made it, telling the user that command resumes it. When every case
+    not in the new sweep was computed by a model version this bearingsim does not have, the refusal says so and
+    that --force computes them again; another sweep's folder keeps "the same command as before resumes it"."""
+    import h5py
+
+    out = tmp_path / "sw"
+    assert _sweep(out).returncode == 0
+    other = cli("sweep", PAPER, "--param", "contact.restitution=0.7", "-o", out, "-j", "1")
+    _one_line_refusal(other, str(out), "(the same command as before resumes it)")
+    with h5py.File(out / "sweep.h5", "r+") as f:
+        f["index/model_version"][...] = 99.0  # a version no model has: computed by another bearingsim
+    res = cli("sweep", PAPER, "--param", "contact.restitution=0.7", "-o", out, "-j", "1")
+    _one_line_refusal(res, str(out), "computed by an earlier version of the model", "--force replaces them")
+    assert "(the same command as before resumes it)" not in res.stderr
+
+
+@pytest.mark.slow
 def test_sweep_rewrites_its_own_files(tmp_path):
     """Its own index and figure are replaced by the next sweep into the folder (resume)."""
     out = tmp_path / "sw"

@@ -218,10 +218,12 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
 
     new = {c.hash for c in cases}
     old = set()
+    versions = {}  # the model version that computed each of the index's cases
     index = outdir / "sweep.h5"
     if archive.is_table_file(index, INDEX_FORMAT):
         with contextlib.suppress(UserError, OSError, KeyError, ValueError):
             cols = read_index(index)[0]
+            versions = dict(zip((str(h) for h in cols.get("case", [])), cols.get("model_version", [])))
             status = [str(x) for x in cols.get("status", [])]
             # a failed case left no result to mix in: the same study run again with it mended resumes; nor
             # did a pending one (its sweep was interrupted before it ran): a sweep interrupted and run again
@@ -238,10 +240,28 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
         verb = "is" if len(other) == 1 else "are"
         raise UserError(f"{outdir}: holds another sweep or study ({counted(len(other), 'case')} of its {len(old)} "
                         f"{verb} not in this one); not mixed in: give another -o folder, or add --force to replace it "
-                        f"(the same command as before resumes it)")
+                        f"{_resume_hint(other, versions)}")
     for h in other:
         _remove_if_own(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
+
+
+def _resume_hint(other: set[str], versions: dict) -> str:
+    """How the folder's own command would fare: the cases not in this sweep were all computed by a model
+    version this bearingsim does not have (:data:`bearingsim.model_versions.MODEL_VERSIONS`): a study whose
+    cases changed with the model (the cross-check's rung 3 at multibody version 8) is refused to the command that
+    made it too, and --force computes them again; otherwise the same command as before resumes it."""
+    import math
+
+    from bearingsim.model_versions import MODEL_VERSIONS
+
+    known = set(MODEL_VERSIONS.values())
+    got = [float(versions.get(h, math.nan)) for h in other]
+    if got and all(math.isfinite(v) and v not in known for v in got):
+        return ("(they were computed by an earlier version of the model, whose cases this bearingsim defines "
+                "otherwise, so the command that made them is refused too: --force replaces them and computes them "
+                "again)")
+    return "(the same command as before resumes it)"
 
 
 def _case_archives(cases_dir: Path) -> set[str]:

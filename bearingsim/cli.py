@@ -183,6 +183,7 @@ def _folder_listing(p: Path) -> str | None:
     its case index, as ``inspect`` of each file lists it, one after the other; None for anything else (a
     folder that holds no sweep is refused by the archive reader, naming what it is)."""
     from bearingsim.archive import unreadable_error
+    from bearingsim.studies.validate import own_tables
     from bearingsim.tables import studies_of
 
     if not (p.is_dir() and (p / "sweep.h5").is_file()):
@@ -196,8 +197,9 @@ def _folder_listing(p: Path) -> str | None:
             raise unreadable_error(f) or UserError(f"{f}: not a bearingsim sweep index, though a sweep writes one by "
                                                    f"that name into its folder")
         listed.append((f, described))
-    head = f"{p}: a sweep or study folder; " + ("its file" if len(listed) == 1 else "its files") + " below: " + \
-        ", ".join(f.name for f, _ in listed)
+    names = [n for f, _ in listed for n in (own_tables(p) if f.suffix == ".csv" else [f.name])]
+    head = f"{p}: a sweep or study folder; " + ("its file" if len(names) == 1 else "its files") + " below: " + \
+        ", ".join(names)
     return "\n\n".join([head, *(d[0] for _, d in listed)])
 
 

@@ -318,6 +318,9 @@ def test_report_of_a_validate_folder_is_its_own_kind(folders, tmp_path):
 
     folder = folders / "val"
     assert reports.kind_of(folder) == ("validate", folder / fig9.CSV_NAME)
+    listing = cli("inspect", folder)  # its first line names every table it lists, the rig's too
+    assert listing.returncode == 0 and listing.stdout.startswith(
+        f"{folder}: a sweep or study folder; its files below: {fig9.CSV_NAME}, {rig.CSV_NAME}, sweep.h5\n"), listing
     assert reports.kind_of(folder / "sweep.h5")[0] == "sweep"  # the case index alone, as for every study
     html = bearingsim.report(folder, tmp_path / "v.html").read_text()
     title = re.search(r"<h1>(.*?)</h1>", html).group(1)

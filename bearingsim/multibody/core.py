@@ -295,24 +295,31 @@ def choose_dt(p, dt=None, play=None):
     elif dt is not None:
         how = "simulate(dt=...)"
     else:
-        play = play or worn_play(p)
-        dti = impact_dt(p, play)
-        dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
-        how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
-               f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
-               f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
-               + _play_text(p, play))
-        if p.multibody.scene == "kinematic_cage":
-            dt /= KINEMATIC_DT_DIVISOR
-            how += (f"; divided by {KINEMATIC_DT_DIVISOR} for the kinematic cage (its rollers pushed through the "
-                    f"load zone: I_dec converges at first order in the step)")
+        dt, how = _automatic_dt(p, lim, play)
     _check_step_count(p, dt, how)
     if dt > largest:
         raise UserError(
             f"numerics.dt_s = {dt:.3g} s is far above the stable time step of this bearing "
             f"(Hertz limit 2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s "
-            f"for the automatic {min(DT_FRACTION * lim, DT_CAP_S):.3g} s")
+            f"for the automatic {_automatic_dt(p, lim, play)[0]:.3g} s")
     return float(dt), how, lim
+
+
+def _automatic_dt(p, lim: float, play=None) -> tuple[float, str]:
+    """The automatic step of Hertz raceways and how it was chosen: the smallest of a fraction of the stiffest
+    contact's 2/omega_n (``lim``), the impact resolution and a cap; an eighth of it in the kinematic cage."""
+    play = play or worn_play(p)
+    dti = impact_dt(p, play)
+    dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
+    how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
+           f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
+           f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
+           + _play_text(p, play))
+    if p.multibody.scene == "kinematic_cage":
+        dt /= KINEMATIC_DT_DIVISOR
+        how += (f"; divided by {KINEMATIC_DT_DIVISOR} for the kinematic cage (its rollers pushed through the "
+                f"load zone: I_dec converges at first order in the step)")
+    return dt, how
 
 
 def _choose_dt_rigid(p, dt, play=None):
@@ -354,8 +361,14 @@ def _check_step_count(p, dt: float, how: str) -> None:
         raise UserError(
             f"{given} = {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
             f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
-            f"{2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION:.3g} s, or {instead} "
+            f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s, or {instead} "
             f"for the automatic step")
+
+
+def _up3(x: float) -> float:
+    """``x`` > 0 rounded up to 3 significant digits (a bound a user types from a message and is not refused)."""
+    q = 10.0 ** (math.floor(math.log10(x)) - 2)
+    return math.ceil(x / q * (1.0 - 1e-12)) * q * (1.0 + 1e-12)
 
 
 def rigid_start(p, dt, play=None):
@@ -974,7 +987,7 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
 def _newton_refusal(p, fails: int, step: int, max_steps: int) -> str:
     """The refusal of a run whose quasi-static ring's force balance failed in more than
     :data:`MAX_NEWTON_FAILURE_FRACTION` of the most steps it may take, said as soon as that is certain."""
-    advice = _one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
+    advice = one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
     return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps "
             f"({fails / step:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} "
             f"steps the run may take (provenance ring_newton_failures); {advice}")
@@ -1020,11 +1033,11 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
 
 def _blowup_advice(p, h: float) -> str:
     """What to change after an energy blow-up with step ``h``: a smaller step, unless the ring is held
-    quasi-static while it rests on a single roller (:func:`_one_roller_ring_advice`)."""
-    return _one_roller_ring_advice(p) or f"try a smaller numerics.dt_s than {h:.3g} s"
+    quasi-static while it rests on a single roller (:func:`one_roller_ring_advice`)."""
+    return one_roller_ring_advice(p) or f"try a smaller numerics.dt_s than {h:.3g} s"
 
 
-def _one_roller_ring_advice(p) -> str | None:
+def one_roller_ring_advice(p) -> str | None:
     """The remedy of a quasi-static ring resting on a single roller
     (:func:`bearingsim.laws.loaded_rollers_with_one_at_centre` < 2 under load, where ``multibody.inner_ring =
     "auto"`` makes it dynamic), or None for any other ring. Such a ring has no stable sideways equilibrium

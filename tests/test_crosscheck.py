@@ -414,3 +414,14 @@ def test_a_verdicts_threshold_carries_its_unit():
     (line,) = cc.verdicts(cc.add_changes(rows), rotations=10)
     t = cc.critical_ses(1e-4, 2e-4, 5, 5)
     assert f"(significant: {t:.3g} SE = {t * math.sqrt(5) * 1e-1:.2g} mN s)" in line, line
+
+
+def test_a_rung_without_a_rear_face_impact_prints_n_a_as_the_docs_do():
+    """The kinematic cage pushes its rollers continuously at 3000 and 6000 rpm: no rear-face impact, a first
+    impact speed of NaN, which the terminal table printed as "nan" where docs/crosscheck.md has n/a."""
+    row = dict(rpm=3000.0, rung=3, scene="kinematic_cage", I_dec_mean_Ns=1.2555e-2, I_dec_sem_Ns=1e-9,
+               I_acc_mean_Ns=0.0, I_acc_sem_Ns=0.0, first_impact_speed_m_s=float("nan"), cage_slip=0.0,
+               change_from_previous=7.287e-3, status="done")
+    line = cc.format_table([row]).splitlines()[1]
+    assert line.split()[-3:] == ["n/a", "0.00", "+7.287"] and "nan" not in line, line
+    assert cc.format_table([{**row, "first_impact_speed_m_s": 0.0485}]).splitlines()[1].split()[-3] == "0.0485"

@@ -392,8 +392,14 @@ def format_table(rows: list[dict]) -> str:
         lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
                      f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_dec_sem_Ns'])} "
                      f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_acc_sem_Ns'])} "
-                     f"{r['first_impact_speed_m_s']:9.4f} {_percent(r['cage_slip']):>9s} {ch:>13s}")
+                     f"{_first_impact(r['first_impact_speed_m_s'])} {_percent(r['cage_slip']):>9s} {ch:>13s}")
     return "\n".join(lines)
+
+
+def _first_impact(v: float) -> str:
+    """The first rear-face impact's speed [m/s], or n/a where a rung's rollers met no rear face at speed (the
+    kinematic cage pushes them continuously), as docs/crosscheck.md prints it."""
+    return f"{'n/a':>9s}" if math.isnan(v) else f"{v:9.4f}"
 
 
 def _percent(fraction: float) -> str:

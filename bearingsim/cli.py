@@ -754,7 +754,7 @@ def _add_study_commands(sub) -> None:
                        description="Speed against error of every solver (CSV, table, plot). The benchmarks are "
                                    "not installed with the package: run this from a source checkout of bearingsim "
                                    "(its benchmarks/ folder); docs/bench.md.")
-    b.add_argument("--quick", action="store_true", help="short version (about 20 s on 2 cores: docs/bench.md)")
+    b.add_argument("--quick", action="store_true", help="short version (about 30 s on 2 quiet cores: docs/bench.md)")
     b.add_argument("--sweep", action="store_true",
                    help="scaling of a small multibody sweep on 1 and 2 workers, local pool and dask LocalCluster")
     b.add_argument("--fast-scene", action="store_true",

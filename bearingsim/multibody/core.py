@@ -78,7 +78,7 @@ LAND_ORBIT_MARGIN = 0.1
 RIGID_IMPACT_OVERLAP_FRACTION = RESTART_MARGIN * PENETRATION_LIMIT
 RIGID_DT_CAP_S = 1.0e-4  # never above this
 # A given step (numerics.dt_s) needing more steps per cage rotation than this is refused before the run:
-# the automatic step takes ~6e3 per rotation at 6000 rpm and ~5e4 at 500 rpm, a step costs ~14 us on
+# the automatic step takes ~6e3 per rotation at 6000 rpm and ~7e4 at 500 rpm, a step costs ~14 us on
 # one core (the main job: 237 011 steps in 3.3 s), so 1e7 is ~2 min a rotation, a convergence study's
 # finest step with room to spare, where a mistyped exponent (1e-9 for 1e-6 s) would run for hours.
 MAX_STEPS_PER_ROTATION = 10_000_000

@@ -244,6 +244,7 @@ def test_a_first_rotation_still_in_the_start_transient_gets_a_note():
     assert abs(rel) < plausibility.START_TRANSIENT_MIN_REL and t < plausibility.start_transient_critical(later)
 
 
+@pytest.mark.slow  # over 2 s (quick subset under a minute)
 def test_a_run_too_short_to_judge_its_warm_up_says_so_in_one_note(tmp_path):
     """The start-transient check needs START_TRANSIENT_MIN_ROTATIONS (6) recorded rotations; a whole-bearing
     run of fewer printed its numbers with no word of it, though the README says a short run reads high at

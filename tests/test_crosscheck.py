@@ -23,7 +23,7 @@ from bearingsim.scenario import load_scenario, parse_toml_text
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 REFERENCE = SCENARIOS / "multibody_3000rpm.toml"
 RPM = 3000.0
-ROTATIONS = 4
+ROTATIONS = 2
 WARMUP = 2  # not the scenario file's 1: the header says the warm-up the rungs ran
 
 

@@ -103,6 +103,7 @@ def test_a_rarely_nonzero_output_has_finite_intervals():
     assert np.all(r["ST_low"] <= r["ST"]) and np.all(r["ST"] <= r["ST_high"])
 
 
+@pytest.mark.slow  # over 2 s (quick subset under a minute)
 def test_a_failing_case_is_kept_and_the_rerun_runs_only_it(tmp_path, monkeypatch):
     """The + run of the drag coefficient given the explicit Euler method at a 5 ms step fails
     (unstable): its key's rows have NaN numbers, status failed and the error; the other key's rows are

@@ -264,6 +264,7 @@ def test_every_file_a_sweep_or_study_writes_into_its_folder_is_one_force_removes
             assert signature.startswith(FOLDER_FILES[name]), name
 
 
+@pytest.mark.slow  # over 2 s (quick subset under a minute)
 def test_force_removes_the_tables_and_figures_of_the_study_it_replaces(tmp_path, capsys):
     """A sweep run with --force into the folder of another study removes that study's table and figure
     (they were left: `table` and `report` of the folder then showed a life study the sweep had replaced);

@@ -380,6 +380,7 @@ def test_failed_case_is_recorded_and_the_others_go_on(tmp_path):
     assert not (tmp_path / "cases" / f"{rows[1]['case']}.h5").exists()
 
 
+@pytest.mark.slow  # over 2 s (quick subset under a minute)
 def test_failure_of_any_kind_is_one_line(tmp_path, monkeypatch, capsys):
     # forked pool workers inherit the patch: a case at 2000 rpm raises as an unstable run would
     import bearingsim.simulation as simulation

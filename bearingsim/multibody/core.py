@@ -355,14 +355,12 @@ def _check_step_count(p, dt: float, how: str) -> None:
     if how.startswith("auto"):
         return
     per_rotation = 2.0 * math.pi / abs(p.operating.omega_c) / dt
-    if per_rotation > MAX_STEPS_PER_ROTATION:
-        given, instead = (("numerics.dt_s", "remove numerics.dt_s") if how == "numerics.dt_s" else
-                          ("dt (run()'s dt argument)", "give none"))
+    if per_rotation > MAX_STEPS_PER_ROTATION:  # said as the key's refusal ("run(): dt: ..." of the API's dt)
         raise UserError(
-            f"{given} = {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
+            f"numerics.dt_s: {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
             f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
-            f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s, or {instead} "
-            f"for the automatic step")
+            f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s (or leave the step "
+            f"to the automatic choice)")
 
 
 def _up3(x: float) -> float:

@@ -183,34 +183,34 @@ def _folder_listing(p: Path) -> str | None:
     its case index, as ``inspect`` of each file lists it, one after the other; None for anything else (a
     folder that holds no sweep is refused by the archive reader, naming what it is)."""
     from bearingsim.archive import unreadable_error
-    from bearingsim.studies.validate import own_tables
     from bearingsim.tables import studies_of
 
     if not (p.is_dir() and (p / "sweep.h5").is_file()):
         return None
     studies = studies_of(p)
     files = [f for _, f in studies if f.suffix != ".csv"] + [f for f in (p / "sweep.h5", p / "map.h5") if f.is_file()]
-    listed = [(f, (_csv_study_text(kind, p),)) for kind, f in studies if f.suffix == ".csv"]
+    listed = [_csv_study_text(kind, p) for kind, f in studies if f.suffix == ".csv"]  # ([names], text)
     for f in files:
         described = _describe_index(f)
         if described is None:  # what is wrong with it, as inspect of the file says (a sweep's own file is not foreign)
             raise unreadable_error(f) or UserError(f"{f}: not a bearingsim sweep index, though a sweep writes one by "
                                                    f"that name into its folder")
-        listed.append((f, described))
-    names = [n for f, _ in listed for n in (own_tables(p) if f.suffix == ".csv" else [f.name])]
+        listed.append(([f.name], described[0]))
+    names = [n for shown, _ in listed for n in shown]
     head = f"{p}: a sweep or study folder; " + ("its file" if len(names) == 1 else "its files") + " below: " + \
         ", ".join(names)
-    return "\n\n".join([head, *(d[0] for _, d in listed)])
+    return "\n\n".join([head, *(text for _, text in listed)])
 
 
-def _csv_study_text(kind: str, folder: Path) -> str:
-    """What ``inspect`` of a study folder says of the study whose tables are CSV (``validate``): its tables,
-    and the command that prints them (:func:`bearingsim.tables.study_text`)."""
+def _csv_study_text(kind: str, folder: Path) -> tuple[list[str], str]:
+    """What ``inspect`` of a study folder says of the study whose tables are CSV (``validate``): (its tables'
+    names, a text naming them and the command that prints them, :func:`bearingsim.tables.study_text`)."""
     from bearingsim.studies.validate import own_tables
     from bearingsim.tables import STUDY_NAMES
 
-    return (f"{folder}: bearingsim {STUDY_NAMES[kind]} tables (CSV, one row per speed): "
-            f"{', '.join(own_tables(folder))}\n'bearingsim table {folder}' prints them; its cases: sweep.h5 below")
+    names = own_tables(folder)
+    return names, (f"{folder}: bearingsim {STUDY_NAMES[kind]} tables (CSV, one row per speed): {', '.join(names)}\n"
+                   f"'bearingsim table {folder}' prints them; its cases: sweep.h5 below")
 
 
 def _is_scenario_file(path) -> bool:

@@ -175,12 +175,10 @@ def check(result) -> list[str]:
         fails = int(result.provenance.get("ring_newton_failures", 0) or 0)
         steps = int(summary.get("steps", 0) or 0)
         if fails and steps:
-            from bearingsim.multibody.core import MAX_NEWTON_FAILURE_FRACTION, one_roller_ring_advice
+            from bearingsim.multibody.core import MAX_NEWTON_FAILURE_FRACTION, newton_refusal
 
             if fails > MAX_NEWTON_FAILURE_FRACTION * steps:
-                advice = one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
-                raise SimulationUnstable(f"the inner ring's force balance did not converge in {fails} of {steps} steps "
-                                         f"({fails / steps:.2%}; provenance ring_newton_failures); {advice}")
+                raise SimulationUnstable(newton_refusal(p, fails, steps))
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
 

@@ -70,7 +70,7 @@ def dt(rpms=(1000, 3000, 6000), sets=(), raceways=("hertz", "rigid"), rotations=
 
 def _halvings(rpm, raceway, sets, halvings, rotations):
     """Mean I_dec over 1 warm-up + ``rotations`` without the first recorded rotation (the warm-up's trace,
-    docs/statistics.md) at the automatic step and ``halvings`` halvings of it: ``[(dt, mean, s.e., wall s per
+    docs/statistics.md) at the automatic step and ``halvings`` halvings of it: ``[(dt, mean, s.e., CPU s per
     simulated rotation)]``, the CPU time of this process (``time.process_time``: the wall time of a host that runs
     other work too is not the run's); a first run of one rotation before them leaves the kernels' compilation out."""
     import time
@@ -85,10 +85,10 @@ def _halvings(rpm, raceway, sets, halvings, rotations):
     for k in range(halvings + 1):
         t0 = time.process_time()
         r = _run(name, base if step is None else [*base, f"numerics.dt_s={step / 2 ** k!r}"])
-        wall = (time.process_time() - t0) / (rotations + 1)
+        cpu = (time.process_time() - t0) / (rotations + 1)
         step = step or r.provenance["dt_s"]
         x = pocket_means(r.per_rotation["I_dec"])[1:]
-        rows.append((r.provenance["dt_s"], float(x.mean()), batch_sem(x), wall))
+        rows.append((r.provenance["dt_s"], float(x.mean()), batch_sem(x), cpu))
     return rows
 
 
@@ -125,14 +125,14 @@ def order(rpms=(500, 1000), sets=(), raceways=("hertz", "rigid"), halvings=3, ro
             m, s = [r[1] for r in rows], [r[2] for r in rows]
             ext, se_ext = 2 * m[-1] - m[-2], math.hypot(2 * s[-1], s[-2])
             hertz = (ext, se_ext) if raceway == "hertz" else hertz
-            for k, (step, mk, sk, wall) in enumerate(rows):
+            for k, (step, mk, sk, cpu) in enumerate(rows):
                 change = (f"{mk / m[k - 1] - 1:+.2%} ± {math.hypot(sk, s[k - 1]) / m[k - 1]:.2%}" if k else "")
                 p, sp = _order(m, s, k - 2) if k >= 2 else (math.nan, math.nan)
                 off = f"{mk / ext - 1:+.2%} ± {math.hypot(sk, se_ext) / ext:.2%}"
                 vs = (f"{mk / hertz[0] - 1:+.2%} ± {math.hypot(sk, hertz[1]) / hertz[0]:.2%}"
                       if raceway != "hertz" and hertz else "")
                 print(f"| {rpm} | {raceway} | {step * 1e6:.2f} | {mk * 1e3:.3f} ± {sk * 1e3:.3f} | {change} | "
-                      f"{'' if math.isnan(p) else f'{p:.2f} ± {sp:.2f}'} | {off} | {vs} | {wall:.3f} |", flush=True)
+                      f"{'' if math.isnan(p) else f'{p:.2f} ± {sp:.2f}'} | {off} | {vs} | {cpu:.3f} |", flush=True)
             print(f"| {rpm} | {raceway} | extrapolated | {ext * 1e3:.3f} ± {se_ext * 1e3:.3f} | | | | | |", flush=True)
 
 

@@ -962,8 +962,8 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
                 int(st["newton_failures"]) > MAX_NEWTON_FAILURE_FRACTION * su.limits.max_steps:  # a stop says its own
             if bar is not None:
                 bar.close()
-            raise SimulationUnstable(_newton_refusal(su.p, int(st["newton_failures"]), int(st["step"]),
-                                                     su.limits.max_steps))
+            raise SimulationUnstable(newton_refusal(su.p, int(st["newton_failures"]), int(st["step"]),
+                                                    su.limits.max_steps))
         if code == lp.CODE_BLOCK_FULL:
             continue
         if code == lp.CODE_PHASE_END:
@@ -982,12 +982,16 @@ def _drive(su: MultibodySetup, pl: _Placed, acc, ls, series, motion, progress) -
         bar.close()
 
 
-def _newton_refusal(p, fails: int, step: int, max_steps: int) -> str:
+def newton_refusal(p, fails: int, steps: int, max_steps: int | None = None) -> str:
     """The refusal of a run whose quasi-static ring's force balance failed in more than
-    :data:`MAX_NEWTON_FAILURE_FRACTION` of the most steps it may take, said as soon as that is certain."""
+    :data:`MAX_NEWTON_FAILURE_FRACTION` of its ``steps`` (:func:`bearingsim.plausibility.check`, the run done), or,
+    with ``max_steps``, of the most steps it may take, said as soon as that is certain (the step loop)."""
     advice = one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
-    return (f"the inner ring's force balance did not converge in {fails} of the first {step} steps "
-            f"({fails / step:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} "
+    if max_steps is None:
+        return (f"the inner ring's force balance did not converge in {fails} of {steps} steps ({fails / steps:.2%}; "
+                f"provenance ring_newton_failures); {advice}")
+    return (f"the inner ring's force balance did not converge in {fails} of the first {steps} steps "
+            f"({fails / steps:.2%}), already more than {MAX_NEWTON_FAILURE_FRACTION:.0%} of the at most {max_steps} "
             f"steps the run may take (provenance ring_newton_failures); {advice}")
 
 

@@ -251,8 +251,6 @@ def _resume_hint(other: set[str], versions: dict) -> str:
     version this bearingsim does not have (:data:`bearingsim.model_versions.MODEL_VERSIONS`): a study whose
     cases changed with the model (the cross-check's rung 3 at multibody version 8) is refused to the command that
     made it too, and --force computes them again; otherwise the same command as before resumes it."""
-    import math
-
     from bearingsim.model_versions import MODEL_VERSIONS
 
     known = set(MODEL_VERSIONS.values())

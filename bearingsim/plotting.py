@@ -11,8 +11,15 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title", "fit_titles",
-           "mark_without_error", "hatch_without_error"]
+__all__ = ["FRONT", "REAR", "figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title",
+           "fit_titles", "mark_without_error", "hatch_without_error"]
+
+#: the house colours of the two pocket faces, the same in every figure: FRONT is the front face, where the roller
+#: pushes the cage (I_acc, F_acc), REAR the rear face, where the cage drags a lagging roller (I_dec, F_dec).
+#: A dark blue and a light orange (Okabe-Ito): distinct for colour-blind readers and in greyscale (luminance
+#: 0.37 and 0.64).
+FRONT = "#0072B2"
+REAR = "#E69F00"
 
 
 def figure(**kw):

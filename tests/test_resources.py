@@ -117,7 +117,7 @@ def archive_with_unread_data(tmp_path_factory):
 @pytest.mark.parametrize("command, reads", [
     ("show", {"/scenario", "/bearingsim/notes"}),
     ("plot", {"/scenario", "/bearingsim/notes", "/results/trace/theta_deg", "/results/trace/l_r",
-              "/results/trace/dl_r_dt", "/results/trace/I_dec_cumulative"}),
+              "/results/trace/dl_r_dt", "/results/trace/I_dec_cumulative", "/results/trace/I_acc_cumulative"}),
 ])
 def test_archive_commands_read_only_the_datasets_they_need(archive_with_unread_data, tmp_path, monkeypatch,
                                                            capsys, command, reads):

@@ -80,15 +80,16 @@ class ReducedResult(Result):
     model = "reduced"
     FIGURES = MODEL_FIGURES["reduced"]
     _TRACE = ("theta_deg", "l_r", "dl_r_dt", "I_dec_cumulative")
+    _TRACE_ADDED = ("I_acc_cumulative",)  # archives written before it was recorded lack it
     _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation",
                 "zeno_closure")
     LAYOUT = {
         "results/per_rotation/I_dec": ("rotations", "pockets"),
         "results/per_rotation/I_acc": ("rotations", "pockets"),
         **{f"results/impacts/{c}": ("impacts",) for c in _IMPACTS},
-        **{f"results/trace/{c}": ("trace points",) for c in _TRACE},
+        **{f"results/trace/{c}": ("trace points",) for c in _TRACE + _TRACE_ADDED},
     }
-    OPTIONAL = (frozenset(f"results/trace/{c}" for c in _TRACE),)
+    OPTIONAL = (frozenset(f"results/trace/{c}" for c in _TRACE), frozenset(f"results/trace/{c}" for c in _TRACE_ADDED))
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(SUMMARY_UNITS)
     FIGURE_DATA = ("results/trace",)
@@ -133,6 +134,8 @@ class ReducedResult(Result):
                 "results/trace/l_r": NamedArray(tr["l_r"], "m", "roller position in the pocket (0 rear face, s front face)"),
                 "results/trace/dl_r_dt": NamedArray(tr["dl_r_dt"], "m/s", "roller speed relative to the cage"),
                 "results/trace/I_dec_cumulative": NamedArray(tr["I_dec_cumulative"], "N s", "cumulative rear-face impulse"),
+                "results/trace/I_acc_cumulative": NamedArray(tr["I_acc_cumulative"], "N s",
+                                                             "cumulative front-face impulse"),
             })
         rear = np.flatnonzero(imp["face"] == FACE_REAR)
         u = float(imp["approach_speed"][rear[0]]) if rear.size else math.nan
@@ -184,8 +187,10 @@ class ReducedResult(Result):
 
     # --- figures -----------------------------------------------------------------------------
     def plot_pass(self):
-        """Fig. 8 analog: l_r, dl_r/dt and cumulative I_dec against θ over the no-load pass."""
-        from bearingsim.plotting import subplots
+        """Fig. 8 analog: l_r, dl_r/dt and the cumulative I_dec and I_acc against θ over the no-load pass, the
+        rear face and I_dec in :data:`~bearingsim.plotting.REAR`, the front face and I_acc in
+        :data:`~bearingsim.plotting.FRONT`."""
+        from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
         fig, ax = subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
         if "results/trace/theta_deg" not in self.data:
@@ -193,24 +198,30 @@ class ReducedResult(Result):
             return fig
         th = self.get("trace/theta_deg")
         p = self.parameters
-        ax[0].plot(th, self.get("trace/l_r") * 1e6, lw=1.0)
-        ax[0].axhline(0.0, color="0.5", lw=0.6, ls="--", label="rear face")
-        ax[0].axhline(p.bearing.pocket_clearance * 1e6, color="0.5", lw=0.6, ls="-.", label="front face")
+        ax[0].plot(th, self.get("trace/l_r") * 1e6, lw=1.0, color="0.2")
+        ax[0].axhline(0.0, color=REAR, lw=1.0, ls="--", label="rear face")
+        ax[0].axhline(p.bearing.pocket_clearance * 1e6, color=FRONT, lw=1.0, ls="-.", label="front face")
         ax[0].set_ylabel("roller position $l_r$ [µm]")
-        ax[1].plot(th, self.get("trace/dl_r_dt"), lw=1.0)
+        ax[1].plot(th, self.get("trace/dl_r_dt"), lw=1.0, color="0.2")
         ax[1].set_ylabel("speed in the pocket\n$dl_r/dt$ [m/s]")
-        ax[2].plot(th, self.get("trace/I_dec_cumulative") * 1e3, lw=1.2)
-        ax[2].set_ylabel("cumulative $I_{dec}$ [mN s]")
-        ax[2].set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
         s = self.summary
+        i_acc = s["I_acc_mean_Ns"]
+        dec = f"$I_{{dec}}$ = {s['I_dec_mean_Ns'] * 1e3:.3f} mN s"
+        both = (f"{dec}, $I_{{acc}}$ = {i_acc * 1e3:.3f} mN s per pass" if i_acc
+                else f"{dec} per pass, $I_{{acc}}$ = 0: no front-face impact")
+        ax[2].plot(th, self.get("trace/I_dec_cumulative") * 1e3, lw=1.2, color=REAR, label="$I_{dec}$ (rear face)")
+        if "results/trace/I_acc_cumulative" in self.data:  # archives written before it was recorded lack it
+            ax[2].plot(th, self.get("trace/I_acc_cumulative") * 1e3, lw=1.2, color=FRONT, ls="--",
+                       label="$I_{acc}$ (front face)" + ("" if i_acc else " = 0"))
+        ax[2].set_ylabel("cumulative impulse [mN s]")
+        ax[2].set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
         ax[0].set_title(f"{self.title()}\nc = {p.contact.drag_coefficient:g}, e = {p.contact.restitution:g}, "
-                        f"$I_{{dec}}$ = {s['I_dec_mean_Ns'] * 1e3:.3f} mN s per pass", fontsize=9)
+                        f"{both}", fontsize=9)
         for a in ax:
             a.grid(alpha=0.3)
             a.axvline(180.0, color="0.6", lw=0.6, label="θ = 180° (top)")
-        from bearingsim.plotting import legend_outside
-
         legend_outside(ax[0])
+        legend_outside(ax[2])
         return fig
 
 

@@ -95,6 +95,7 @@ def _euler_steps(par, dt, nsteps, stride, fst, ist, impacts, trace, max_steps):
             trace[ntrace, 1] = l
             trace[ntrace, 2] = v
             trace[ntrace, 3] = I_dec
+            trace[ntrace, 4] = I_acc
             ntrace += 1
         n += 1
         a = net_accel(th, K, A, g)
@@ -160,6 +161,7 @@ def _euler_steps(par, dt, nsteps, stride, fst, ist, impacts, trace, max_steps):
             trace[ntrace, 1] = l
             trace[ntrace, 2] = v
             trace[ntrace, 3] = I_dec
+            trace[ntrace, 4] = I_acc
             ntrace += 1
     fst[F_T], fst[F_L], fst[F_V] = t, l, v
     fst[F_IDEC], fst[F_IACC], fst[F_IDEC_REST], fst[F_IACC_REST] = I_dec, I_acc, I_dec_rest, I_acc_rest
@@ -242,7 +244,7 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
     par = pass_constants(inp, 0.0, 0.0)
     stride = max(1, int(math.ceil(inp.pass_duration / dt)) // max(trace_points, 1))
     impacts = np.zeros((max(int(capacity), 1), 5))
-    trace = np.zeros((nsteps // stride + 2, 4))  # theta, l, v, I_dec cumulative
+    trace = np.zeros((nsteps // stride + 2, 5))  # theta, l, v, I_dec and I_acc cumulative
     fst = np.zeros(7)
     ist = np.zeros(5, dtype=np.int64)
     t0 = time.perf_counter()
@@ -282,7 +284,7 @@ def solve_euler(inp: PassInputs, dt: float, *, trace_points: int = 2000, capacit
     )
     if trace_points > 0:
         sol.trace = dict(theta=trace[:, 0].copy(), l_r=trace[:, 1].copy(), dl_r_dt=trace[:, 2].copy(),
-                         I_dec_cumulative=trace[:, 3].copy())
+                         I_dec_cumulative=trace[:, 3].copy(), I_acc_cumulative=trace[:, 4].copy())
     return sol
 
 

@@ -876,13 +876,14 @@ def _event_pass(par, tab, npan, roots, cap):
 
 @njit(cache=True)
 def _trace(par, tab, npan, pieces, n_pc, thetas, left):
-    """l, v and cumulative I_dec at sorted θ (left[i]: take the limit from the left at θ)."""
+    """l, v, cumulative I_dec and cumulative I_acc at sorted θ (left[i]: take the limit from the left at θ)."""
     m, omega, g = par.mass, par.omega_c, par.gravity
     resting = par.resting_contact
     n = thetas.shape[0]
     lo = np.empty(n)
     vo = np.empty(n)
     io = np.empty(n)
+    ao = np.empty(n)
     starts = pieces[:n_pc, 0].copy()
     fs = np.empty(10)
     fs_piece = -1  # the piece whose flight constants fs holds (they depend on the piece only)
@@ -896,22 +897,27 @@ def _trace(par, tab, npan, pieces, n_pc, thetas, left):
             kk = 0
         ths = pieces[kk, 0]
         mode = int(pieces[kk, 1])
+        idec = pieces[kk, 4]
+        iacc = pieces[kk, 5]
         if mode == FREE:
             if kk != fs_piece:
                 fs = _flight_start(tab, npan, omega, ths, pieces[kk, 2], pieces[kk, 3])
                 fs_piece = kk
             l, v, _, _, _ = _flight(tab, npan, omega, g, fs, th)
-            idec = pieces[kk, 4]
         else:
             l = pieces[kk, 2]
             v = 0.0
-            idec = pieces[kk, 4]
-            if mode == REST_REAR and resting:
-                idec += m * (-gravity_dv(ths, th, omega, g) + _F1(tab, npan, th) - _F1(tab, npan, ths))
+            if resting:  # the resting push so far, as the pass adds it at the piece's end
+                push = m * (-gravity_dv(ths, th, omega, g) + _F1(tab, npan, th) - _F1(tab, npan, ths))
+                if mode == REST_REAR:
+                    idec += push
+                elif mode == REST_FRONT:
+                    iacc -= push
         lo[i] = l
         vo[i] = v
         io[i] = idec
-    return lo, vo, io
+        ao[i] = iacc
+    return lo, vo, io, ao
 
 
 @njit(cache=True)
@@ -964,7 +970,8 @@ class PassSolution:
     impacts : dict of arrays ``theta`` [rad], ``time`` [s from the pass start], ``approach_speed``
         [m/s], ``impulse`` [N s], ``face`` (0 rear, 1 front), ``kind`` (0 impact, 1 Zeno closure)
     l_end, v_end : state at the end of the pass [m], [m/s]
-    trace : dict ``theta`` [rad], ``l_r`` [m], ``dl_r_dt`` [m/s], ``I_dec_cumulative`` [N s], or None
+    trace : dict ``theta`` [rad], ``l_r`` [m], ``dl_r_dt`` [m/s], ``I_dec_cumulative``, ``I_acc_cumulative``
+        [N s], or None
     wall_s : wall time of the solve (table, roots and pass; not the trace) [s]
     termination : why the solve stopped
     dt : time step [s] (``None`` for the event method)
@@ -1084,8 +1091,8 @@ def solve_event(
         order = np.lexsort((~left, th_all))  # at equal θ the left limit comes first
         th_all = th_all[order]
         left = left[order]
-        lr, vr, ir = _trace(par, tab, npan, pieces, n_pc, th_all, left)
-        sol.trace = dict(theta=th_all, l_r=lr, dl_r_dt=vr, I_dec_cumulative=ir)
+        lr, vr, ir, ia = _trace(par, tab, npan, pieces, n_pc, th_all, left)
+        sol.trace = dict(theta=th_all, l_r=lr, dl_r_dt=vr, I_dec_cumulative=ir, I_acc_cumulative=ia)
     return sol
 
 

@@ -371,11 +371,11 @@ def shape_of(psi_deg, depth) -> dict[str, float]:
 
 def plot_wear_profile(rep: WearReport, title: str = ""):
     """Fig. 13 analog: worn depth against psi on the front and the rear face, the mean over pockets and
-    the band from the least to the most worn pocket at each psi."""
-    from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
+    the band from the least to the most worn pocket at each psi; each face in its house colour."""
+    from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
 
     fig, axes = subplots(1, 2, figsize=(10, 4), sharey=True)
-    for ax, f, c in ((axes[0], "front", "C0"), (axes[1], "rear", "C3")):
+    for ax, f, c in ((axes[0], "front", FRONT), (axes[1], "rear", REAR)):
         d = (rep.depth_front if f == "front" else rep.depth_rear) * 1e6
         ax.fill_between(rep.psi_deg, d.min(axis=1), d.max(axis=1), step="mid", color=c, alpha=0.25,
                         label="least to most worn pocket")
@@ -404,12 +404,13 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
 
 
 def plot_wear_volume(rep: WearReport, title: str = ""):
-    """Fig. 14 analog: worn volume of the front and the rear face of every pocket, with the spread."""
-    from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
+    """Fig. 14 analog: worn volume of the front and the rear face of every pocket (each in its house colour),
+    with the spread."""
+    from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
 
     x = np.arange(len(rep.volume_front))
     fig, ax = subplots(figsize=(9, 4))
-    for f, dx, c in (("front", -0.2, "C0"), ("rear", 0.2, "C3")):
+    for f, dx, c in (("front", -0.2, FRONT), ("rear", 0.2, REAR)):
         v = rep.volume_front if f == "front" else rep.volume_rear
         ax.bar(x + dx, v * 1e9, 0.4, color=c,
                label=f"{f} face (CV {rep.cov(f):.3f}; sampling alone {rep.sampling_cov(f):.3f})")

@@ -72,3 +72,122 @@ def test_reduced_pass_figure_of_an_archive_without_cumulative_I_acc(tmp_path):
     fig = bearingsim.load(path).plot_pass()
     assert same(_line(fig.axes[2], "$I_{dec}$").get_color(), REAR)
     assert "$I_{acc}$ = 8.742 mN s" in fig.axes[0].get_title()
+
+
+# --- the two faces in their house colours, in every figure that draws them --------------------------------
+def _face_of(label: str) -> str | None:
+    """Which face an artist's label names: I_acc, F_acc, front face -> FRONT; I_dec, F_dec, rear face -> REAR."""
+    if any(w in label for w in ("I_{acc}", "F_{acc}", "front face")):
+        return FRONT
+    if any(w in label for w in ("I_{dec}", "F_{dec}", "rear face")):
+        return REAR
+    return None
+
+
+def _faces_drawn(ax) -> list[tuple[str, str, tuple]]:
+    """(label, its face's house colour, the colour drawn) of every labelled line, error-bar series and bar series
+    of ``ax`` that names a face."""
+    from matplotlib.colors import to_rgb
+
+    out = []
+    for line in ax.get_lines():
+        if _face_of(line.get_label()):
+            out.append((line.get_label(), _face_of(line.get_label()), to_rgb(line.get_color())))
+    for c in ax.containers:
+        label = c.get_label() or ""
+        if not _face_of(label):
+            continue
+        if hasattr(c, "patches"):
+            out += [(label, _face_of(label), to_rgb(p.get_facecolor())) for p in c.patches]
+        else:  # an error-bar series: its markers and its bars
+            out.append((label, _face_of(label), to_rgb(c.lines[0].get_color())))
+            out += [(label, _face_of(label), to_rgb(col.get_color()[0])) for col in c.lines[2]]
+    return out
+
+
+def _assert_house_colours(fig, least: int):
+    drawn = [d for ax in fig.axes for d in _faces_drawn(ax)]
+    assert len({label for label, _, _ in drawn}) >= least, drawn
+    wrong = [(label, colour) for label, house, colour in drawn if not np.allclose(colour, to_rgb(house))]
+    assert not wrong, wrong
+
+
+@pytest.fixture(scope="module")
+def multibody_run():
+    import warnings
+
+    sc = bearingsim.load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
+                                  set={"numerics.rotations": 2, "multibody.raceway_contact": "rigid"})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a short run's note on its warm-up: its figures' colours are the same
+        return bearingsim.run(sc)
+
+
+@pytest.mark.parametrize("name, least", [("forces", 4), ("impulses", 2), ("wear", 4), ("wear_volume", 2)])
+def test_multibody_figures_draw_each_face_in_its_house_colour(multibody_run, name, least):
+    """_impulses.png drew I_acc blue and I_dec orange, _forces.png F_dec red, _wear.png the rear face orange and
+    red, _wear_volume.png the rear face red: each face now has one colour in every figure."""
+    fig = getattr(multibody_run, f"plot_{name}")()
+    _assert_house_colours(fig, least)
+
+
+def test_wear_profile_draws_each_face_in_its_house_colour(multibody_run):
+    fig = multibody_run.plot_wear_profile(hours=1.0)
+    for ax, house in zip(fig.axes, (FRONT, REAR)):
+        assert ax.get_title().startswith("front" if house == FRONT else "rear")
+        assert [to_rgb(line.get_color()) for line in ax.get_lines() if line.get_label() == "mean over pockets"] == [
+            to_rgb(house)]
+        assert all(np.allclose(c.get_facecolor()[0][:3], to_rgb(house)) for c in ax.collections)
+
+
+def test_the_wear_figure_hatches_the_sliding_work_and_keeps_each_face_one_colour(multibody_run):
+    """_wear.png's four series had three of one grey (front impulse, front and rear sliding work); the two laws
+    of a face are now its colour, the sliding work hatched, and the faces differ in lightness."""
+    (ax,) = multibody_run.plot_wear().axes
+    series = {c.get_label(): c.patches for c in ax.containers if hasattr(c, "patches")}
+    assert len(series) == 4
+    for label, patches in series.items():
+        assert all(bool(p.get_hatch()) == ("sliding work" in label) for p in patches), label
+    front = [luminance(p.get_facecolor()) for lab, ps in series.items() if lab.startswith("front") for p in ps]
+    rear = [luminance(p.get_facecolor()) for lab, ps in series.items() if lab.startswith("rear") for p in ps]
+    assert min(abs(f - r) for f in set(front) for r in set(rear)) >= 0.15
+
+
+def test_rig_pocket0_forces_draw_each_face_in_its_house_colour(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from bearingsim import plotting
+    from bearingsim.studies.rig import save_rig
+
+    theta = np.linspace(0.0, 360.0, 8)
+    rows = [{"rpm": rpm, "rotations": 2.0, "pocket0_I_dec_mean_Ns": 8e-3, "pocket0_I_dec_std_Ns": 1e-3,
+             "pocket0_I_dec_sem_Ns": 1e-3, "pocket0_I_acc_mean_Ns": 1e-3, "arc_pockets_I_dec_mean_Ns": 0.03,
+             "arc_pockets_I_dec_std_Ns": 2e-3, "reduced_I_dec_Ns": 7e-3, "theta_deg": theta,
+             "F_acc_pocket0": np.ones(8), "F_dec_pocket0": np.ones(8), "load_zone_half_angle_deg": 23.5}
+            for rpm in (1000.0, 2000.0)]
+    figs = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: figs.append(fig) or Path(path))
+    save_rig(tmp_path, rows)
+    _assert_house_colours(figs[1], 2)
+
+
+def test_sweep_figures_draw_I_dec_and_I_acc_in_their_house_colours(tmp_path, monkeypatch):
+    """sweep_I.png drew both panels blue, sweep_cases.png I_dec blue and I_acc orange."""
+    from pathlib import Path
+
+    from bearingsim import plotting
+    from bearingsim.sweeps.plot import plot_sweep_index
+
+    from .test_sweep_figures import SPEED, _index
+
+    figs = {}
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: figs.setdefault(Path(path).name, fig)
+                        or Path(path))
+    points = [{SPEED: 1000.0}, {SPEED: 2000.0}, {SPEED: 3000.0, "contact.restitution": 0.6}]
+    plot_sweep_index(_index(tmp_path, points, [SPEED, "contact.restitution"], grid=[SPEED], grid_rows=2),
+                     tmp_path / "f")
+    assert sorted(figs) == ["sweep_I.png", "sweep_cases.png"]
+    for name, fig in figs.items():
+        for ax, house in zip(fig.axes, (REAR, FRONT)):  # I_dec left, I_acc right
+            drawn = [p.get_facecolor() for p in ax.patches] or [line.get_color() for line in ax.get_lines()]
+            assert drawn and all(same(c, house) for c in drawn), (name, ax.get_title(), drawn)

@@ -505,16 +505,17 @@ class MultibodyResult(Result):
         return self.per_rotation["I_dec"].shape[0]
 
     def plot_forces(self):
-        """Fig. 5 analog: mean circumferential pocket force against θ, pocket 0 and the mean over pockets."""
-        from bearingsim.plotting import legend_outside, subplots
+        """Fig. 5 analog: mean circumferential pocket force against θ, pocket 0 and the mean over pockets; F_acc
+        in the house colour of the front face, F_dec in the rear face's."""
+        from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
         th = self.get("theta_deg")
         fa, fd = self.get("force_vs_theta_acc"), self.get("force_vs_theta_dec")
         fig, ax = subplots(figsize=(9, 4))
-        ax.plot(th, fa[:, 0], lw=0.8, color="C0", label="$F_{acc}$ (front face), pocket 0")
-        ax.plot(th, -fd[:, 0], lw=0.8, color="C3", label="$-F_{dec}$ (rear face), pocket 0")
-        ax.plot(th, fa.mean(axis=1), lw=1.5, color="C0", ls="--", label="$F_{acc}$, mean over pockets")
-        ax.plot(th, -fd.mean(axis=1), lw=1.5, color="C3", ls="--", label="$-F_{dec}$, mean over pockets")
+        ax.plot(th, fa[:, 0], lw=0.8, color=FRONT, label="$F_{acc}$ (front face), pocket 0")
+        ax.plot(th, -fd[:, 0], lw=0.8, color=REAR, label="$-F_{dec}$ (rear face), pocket 0")
+        ax.plot(th, fa.mean(axis=1), lw=1.5, color=FRONT, ls="--", label="$F_{acc}$, mean over pockets")
+        ax.plot(th, -fd.mean(axis=1), lw=1.5, color=REAR, ls="--", label="$-F_{dec}$, mean over pockets")
         phi = self.summary["load_zone_half_angle_deg"]
         ax.axvline(phi, color="grey", lw=0.8, ls=":", label=f"load-zone limits ±{phi:.1f}°")
         ax.axvline(360 - phi, color="grey", lw=0.8, ls=":")
@@ -528,14 +529,17 @@ class MultibodyResult(Result):
         return fig
 
     def plot_impulses(self):
-        """Fig. 7 analog: I_acc and I_dec per pocket, mean ± std over rotations."""
-        from bearingsim.plotting import legend_outside, subplots
+        """Fig. 7 analog: I_acc (front face's colour, circles) and I_dec (rear face's, squares) per pocket, mean ±
+        std over rotations."""
+        from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
         ia, idc = self.per_rotation["I_acc"], self.per_rotation["I_dec"]
         x = np.arange(ia.shape[1])
         fig, ax = subplots(figsize=(9, 4))
-        ax.errorbar(x - 0.12, ia.mean(0) * 1e3, yerr=ia.std(0) * 1e3, fmt="o", label="$I_{acc}$ (front face)")
-        ax.errorbar(x + 0.12, idc.mean(0) * 1e3, yerr=idc.std(0) * 1e3, fmt="s", label="$I_{dec}$ (rear face)")
+        ax.errorbar(x - 0.12, ia.mean(0) * 1e3, yerr=ia.std(0) * 1e3, fmt="o", color=FRONT,
+                    label="$I_{acc}$ (front face)")
+        ax.errorbar(x + 0.12, idc.mean(0) * 1e3, yerr=idc.std(0) * 1e3, fmt="s", color=REAR,
+                    label="$I_{dec}$ (rear face)")
         ax.set_xlabel("pocket")
         ax.set_xticks(x)
         ax.set_ylabel("impulse per cage rotation [mN s]")
@@ -583,21 +587,24 @@ class MultibodyResult(Result):
         return f"circumferential impulse {q}" if f"k {q} " in desc else "normal impulse"
 
     def plot_wear(self):
-        """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work."""
-        from bearingsim.plotting import fixed_unit_axis, legend_outside, subplots
+        """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work; each
+        face in its house colour, the sliding work's bars hatched."""
+        from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
         from bearingsim.wear import running_time
 
         # cage rotations per hour at the run's measured cage speed, as `bearingsim wear`; m^3 -> mm^3 (the text's)
         per_hour = running_time(self, hours=1.0)[2] * 1e9
         x = np.arange(self.per_rotation["I_dec"].shape[1])
         fig, ax = subplots(figsize=(9, 4))
-        bars = [(self.get(f"wear/paper_index_{f}"), f"{f} face, impulse index (Eq. 16, {self._index_impulse(f)})")
-                for f in ("front", "rear")]
-        bars += [(self.get("wear/sliding_work_front"), "front face, sliding work"),
-                 (self.get("wear/sliding_work_rear"), "rear face, sliding work")]
+        colour = {"front": FRONT, "rear": REAR}
+        bars = [(self.get(f"wear/paper_index_{f}"), f"{f} face, impulse index (Eq. 16, {self._index_impulse(f)})",
+                 colour[f], None) for f in ("front", "rear")]
+        bars += [(self.get(f"wear/sliding_work_{f}"), f"{f} face, sliding work", colour[f], "////")
+                 for f in ("front", "rear")]
         wdt = 0.2
-        for j, (v, label) in enumerate(bars):
-            ax.bar(x + (j - 1.5) * wdt, v * per_hour, wdt, label=label)
+        for j, (v, label, c, hatch) in enumerate(bars):  # a hatch is drawn in the bar's edge colour: white
+            ax.bar(x + (j - 1.5) * wdt, v * per_hour, wdt, label=label, color=c, hatch=hatch,
+                   edgecolor="white" if hatch else None, linewidth=0)
         ax.set_xlabel("pocket")
         ax.set_xticks(x)
         ax.set_ylabel("Archard wear volume\n[mm³ per hour]")  # one unit for every run: figures compare as they are

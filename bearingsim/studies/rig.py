@@ -146,7 +146,7 @@ def _spread_points(ax, n, rows, name: str, marker: str, color: str, label: str) 
 
 def save_rig(outdir, rows: list[dict]) -> list[Path]:
     """Write ``rig_idec_vs_speed.{csv,png}`` and ``rig_pocket0_forces.png`` (Fig. 5 analog) to ``outdir``."""
-    from bearingsim.plotting import legend_outside, subplots, save_figure
+    from bearingsim.plotting import FRONT, REAR, legend_outside, subplots, save_figure
 
     outdir = Path(outdir)
     cells = []
@@ -175,8 +175,8 @@ def save_rig(outdir, rows: list[dict]) -> list[Path]:
 
     fig, axes = subplots(len(rows), 1, figsize=(8.5, 1.8 * len(rows) + 0.8), sharex=True, squeeze=False)
     for ax, r in zip(axes[:, 0], rows):
-        ax.plot(r["theta_deg"], r["F_acc_pocket0"], lw=0.8, color="C0", label="$F_{acc}$ (front face)")
-        ax.plot(r["theta_deg"], -r["F_dec_pocket0"], lw=0.8, color="C3", label="$-F_{dec}$ (rear face)")
+        ax.plot(r["theta_deg"], r["F_acc_pocket0"], lw=0.8, color=FRONT, label="$F_{acc}$ (front face)")
+        ax.plot(r["theta_deg"], -r["F_dec_pocket0"], lw=0.8, color=REAR, label="$-F_{dec}$ (rear face)")
         phi = r["load_zone_half_angle_deg"]
         ax.axvline(phi, color="grey", lw=0.7, ls=":", label="load-zone limits")
         ax.axvline(360 - phi, color="grey", lw=0.7, ls=":")

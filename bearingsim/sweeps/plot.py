@@ -15,6 +15,10 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
     sampled pair, the sampled values ticked and each cell's value written in it;
   - otherwise: one line per combination of the other axes (at most 8).
 
+  The lines and bars of I_dec are drawn in the house colour of the rear face, those of I_acc in the front
+  face's (:data:`bearingsim.plotting.REAR`, :data:`~bearingsim.plotting.FRONT`); the lines of one panel
+  differ in marker and line style.
+
   A text key (``bearing.cage_guidance``) is a categorical axis: its values in the order swept.
 * explicit extra ``[[cases]]`` (or a sweep of cases alone): a per-case chart of every case
   (``sweep_cases.png``), each labelled with its swept values.
@@ -30,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.plotting import error_title, fit_titles, hatch_without_error, mark_without_error
+from bearingsim.plotting import FRONT, REAR, error_title, fit_titles, hatch_without_error, mark_without_error
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -46,6 +50,9 @@ MAP_PANEL_IN = (3.0, 9.0)  # width of a heat map's panel [in]: 1.2 in per cell w
 MAP_HEIGHT_IN = (4.2, 12.0)  # height of a heat map [in]: 0.45 in per cell and 2.5 in of titles within these
 QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
 Y_LABEL = "per pocket and cage rotation [mN s]"
+FACE_COLOURS = {"I_dec": REAR, "I_acc": FRONT}  # the house colours: I_dec the rear face's, I_acc the front's
+#: (marker, line style) of the lines of a line figure, in turn (as many as MAX_LINES)
+LINE_STYLES = (("o", "-"), ("s", "--"), ("^", ":"), ("D", "-."), ("v", "-"), ("P", "--"), ("X", ":"), ("*", "-."))
 
 
 def axis_label(key: str) -> str:
@@ -160,7 +167,8 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
     from bearingsim.plotting import subplots
 
     fig, panels = subplots(1, 2, figsize=(10, 4.2), sharex=True, constrained_layout=True)
-    for gi, (other, idx) in enumerate(groups.items()):
+    for gi, (other, idx) in enumerate(groups.items()):  # each panel in its face's colour; a line's own style
+        marker, ls = LINE_STYLES[gi % len(LINE_STYLES)]
         idx = sorted(idx, key=lambda i: x_all[i])
         x = x_all[idx]
         extra = ", ".join(f"{name_of(k)} = {v} {unit_of(k) if unit_of(k) != '1' else ''}".strip()
@@ -170,8 +178,9 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
-            ax.errorbar(x, y, yerr=_bar_lengths(err), fmt="-o", color=f"C{gi}", capsize=3, ms=4, label=extra or None)
-            mark_without_error(ax, x, y, err, f"C{gi}", ms=4)  # a value without an error: an open marker
+            ax.errorbar(x, y, yerr=_bar_lengths(err), marker=marker, ls=ls, color=FACE_COLOURS[name], capsize=3, ms=4,
+                        label=extra or None)
+            mark_without_error(ax, x, y, err, FACE_COLOURS[name], marker, ms=4)  # no error: an open marker
     drawn = [i for idx in groups.values() for i in idx]
     for ax, (name, sym) in zip(panels, QUANTITIES):
         ax.set_xlabel(axis_label(x_key))
@@ -321,7 +330,7 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
             y = np.asarray(cols[f"{name}_mean_Ns"]) * 1e3
             err = _sem_mN_s(cols, name, total)  # NaN: no error bar (matplotlib draws none), not a 0 one
             ok = np.isfinite(y)  # failed or not run: no bar (a gap, not a zero)
-            bars = ax.barh(pos[ok], y[ok], xerr=_bar_lengths(err[ok]), color=f"C{k}", capsize=3)
+            bars = ax.barh(pos[ok], y[ok], xerr=_bar_lengths(err[ok]), color=FACE_COLOURS[name], capsize=3)
             hatch_without_error(bars, np.isnan(err[ok]))  # a value without an error: hatched
             ax.set_title(_titled(sym, error_title(err[ok], "bar")), fontsize=9)
         ax.set_xlabel(f"{sym} {Y_LABEL}")

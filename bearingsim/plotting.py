@@ -11,7 +11,7 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["FRONT", "REAR", "figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title",
+__all__ = ["FRONT", "REAR", "LINE_STYLES", "figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title",
            "fit_titles", "mark_without_error", "hatch_without_error"]
 
 #: the house colours of the two pocket faces, the same in every figure: FRONT is the front face, where the roller
@@ -20,6 +20,9 @@ __all__ = ["FRONT", "REAR", "figure", "subplots", "save_figure", "figure_png", "
 #: 0.37 and 0.64).
 FRONT = "#0072B2"
 REAR = "#E69F00"
+#: (marker, line style) of the lines one panel compares (a sweep's lines, a cross-check's speeds), in turn: drawn in
+#: one colour (the panel's face), they differ in these
+LINE_STYLES = (("o", "-"), ("s", "--"), ("^", ":"), ("D", "-."), ("v", "-"), ("P", "--"), ("X", ":"), ("*", "-."))
 
 
 def figure(**kw):

@@ -191,3 +191,54 @@ def test_sweep_figures_draw_I_dec_and_I_acc_in_their_house_colours(tmp_path, mon
         for ax, house in zip(fig.axes, (REAR, FRONT)):  # I_dec left, I_acc right
             drawn = [p.get_facecolor() for p in ax.patches] or [line.get_color() for line in ax.get_lines()]
             assert drawn and all(same(c, house) for c in drawn), (name, ax.get_title(), drawn)
+
+
+# --- series a figure compares differ in more than hue -------------------------------------------------------
+def _distinct(a: dict, b: dict) -> bool:
+    """Two series' styles (colour, marker, linestyle, hatch) tell apart in greyscale: luminance 0.15 apart, or
+    another marker, line style or hatch."""
+    return (abs(luminance(a["colour"]) - luminance(b["colour"])) >= 0.15
+            or any(a.get(k) != b.get(k) for k in ("marker", "linestyle", "hatch")))
+
+
+def test_crosscheck_speeds_differ_in_greyscale_and_each_panel_has_its_face_colour():
+    """crosscheck.png drew 1000 rpm blue and 6000 rpm green, the same grey, marker and line; now each speed has
+    its own marker and line style, I_dec drawn in REAR and I_acc in FRONT."""
+    import itertools
+    import math
+
+    from bearingsim.studies import crosscheck as cc
+
+    rows = [dict(rpm=rpm, rung=k, scene=s, I_dec_mean_Ns=5e-3 * k, I_dec_sem_Ns=1e-4, I_acc_mean_Ns=2e-3 * k,
+                 I_acc_sem_Ns=1e-4, change_from_previous=math.nan)
+            for rpm in (1000.0, 3000.0, 6000.0) for k, s in ((1, "reduced"), (2, "full"))]
+    fig = cc.plot_ladder(rows, {"scenario_name": "t"})
+    for ax, house in zip(fig.axes[:2], (REAR, FRONT)):
+        series = {c.get_label(): {"colour": c.lines[0].get_color(), "marker": c.lines[0].get_marker(),
+                                  "linestyle": c.lines[0].get_linestyle()} for c in ax.containers}
+        assert sorted(series) == ["1000 rpm", "3000 rpm", "6000 rpm"]
+        assert all(same(s["colour"], house) for s in series.values())
+        for a, b in itertools.combinations(series, 2):
+            assert _distinct(series[a], series[b]), (a, b, series)
+
+
+def test_uncertainty_first_order_and_total_differ_in_lightness():
+    """uncertainty.png drew S1 blue and ST red, the same grey (the hatch marks a bar without an interval)."""
+    from bearingsim.studies.uncertainty import plot_indices
+
+    rows = [{"quantity": "I_dec", "key": k, **{f"{n}{end}": 0.4 + d for n in ("S1", "ST")
+                                               for end, d in (("", 0.0), ("_low", -0.1), ("_high", 0.1))}}
+            for k in ("contact.restitution", "lubrication.drag_coefficient")]
+    (ax,) = plot_indices(rows, [{"quantity": "I_dec", "median": 0.018, "p05": 0.017, "p95": 0.019}]).axes
+    colours = {c.get_label(): {p.get_facecolor() for p in c.patches} for c in ax.containers if hasattr(c, "patches")}
+    assert sorted(colours) == ["first order", "total"] and all(len(v) == 1 for v in colours.values())
+    (s1,), (st,) = colours["first order"], colours["total"]
+    assert abs(luminance(s1) - luminance(st)) >= 0.15
+
+
+def test_wear_volume_faces_differ_in_lightness(multibody_run):
+    """_wear_volume.png drew the front face blue and the rear red, the same grey."""
+    (ax,) = multibody_run.plot_wear_volume(hours=1.0).axes
+    colours = [{p.get_facecolor() for p in c.patches} for c in ax.containers if hasattr(c, "patches")]
+    assert len(colours) == 2 and all(len(v) == 1 for v in colours)
+    assert abs(luminance(colours[0].pop()) - luminance(colours[1].pop())) >= 0.15

@@ -308,8 +308,10 @@ def plot_crosscheck(index_path, outdir) -> list[Path]:
 def plot_ladder(rows: list[dict], meta: dict):
     """I_dec and I_acc against the rung, one line per speed, error bars ± 1 standard error (batch means);
     a rung without one (n/a: fewer than 2 recorded rotations) an open marker, no bar, counted in the title
-    (:func:`bearingsim.plotting.error_title`)."""
-    from bearingsim.plotting import error_title, legend_outside, mark_without_error, subplots
+    (:func:`bearingsim.plotting.error_title`). I_dec in the house colour of the rear face, I_acc in the front
+    face's; the speeds differ in marker and line style."""
+    from bearingsim.plotting import (FRONT, LINE_STYLES, REAR, error_title, legend_outside, mark_without_error,
+                                     subplots)
 
     speeds = sorted({r["rpm"] for r in rows})
     labels = {r["rung"]: f"{r['rung']} {r['scene']}" for r in rows}
@@ -317,10 +319,11 @@ def plot_ladder(rows: list[dict], meta: dict):
     for k, rpm in enumerate(speeds):
         rs = sorted((r for r in rows if r["rpm"] == rpm), key=lambda r: r["rung"])
         x = np.array([r["rung"] for r in rs]) + (k - 0.5 * (len(speeds) - 1)) * 0.06
-        for ax, q in zip(axes, ("I_dec", "I_acc")):
+        marker, ls = LINE_STYLES[k % len(LINE_STYLES)]
+        for ax, q, colour in zip(axes, ("I_dec", "I_acc"), (REAR, FRONT)):
             y, err = (np.array([r[f"{q}_{c}_Ns"] * 1e3 for r in rs], dtype=float) for c in ("mean", "sem"))
-            ax.errorbar(x, y, yerr=err, marker="o", ms=4, capsize=3, color=f"C{k}", label=f"{rpm:g} rpm")
-            mark_without_error(ax, x, y, err, f"C{k}", ms=4)
+            ax.errorbar(x, y, yerr=err, marker=marker, ls=ls, ms=5, capsize=3, color=colour, label=f"{rpm:g} rpm")
+            mark_without_error(ax, x, y, err, colour, marker, ms=5)
     axes[0].set_ylabel("$I_{dec}$ per pocket and\ncage rotation [mN s]")
     axes[1].set_ylabel("$I_{acc}$ per pocket and\ncage rotation [mN s]")
     for ax in axes:

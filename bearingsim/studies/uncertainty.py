@@ -267,16 +267,18 @@ def plot_indices(indices, spreads, title: str = ""):
 def _index_bars(ax, rows, keys, y) -> dict[str, int]:
     """S1 and ST of ``keys`` (``rows`` by key) as bars with their intervals, and how many have none:
     ``{"n/a (variance 0 or unknown)": indices of n/a, no bar (not one of 0), "n/a" at 0;
-    "hatched (no interval)": bars without an error bar (not one of 0)}``."""
+    "hatched (no interval)": bars without an error bar (not one of 0)}``. S1 light (sand), ST dark (green):
+    they differ in greyscale too, and neither is a face's colour; a hatch in black on S1, in white on ST."""
     from bearingsim.plotting import hatch_without_error
 
     missing = {"n/a (variance 0 or unknown)": 0, "hatched (no interval)": 0}
-    for off, name, color in ((0.18, "S1", "C0"), (-0.18, "ST", "C3")):
+    for off, name, color, hatch_colour in ((0.18, "S1", "#DDCC77", "black"), (-0.18, "ST", "#117733", "white")):
         v = np.array([rows[k][name] for k in keys], dtype=float)
         err = np.abs(np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]],
                               dtype=float) - v)
         ok = np.isfinite(v)
-        bars = ax.barh(y[ok] + off, v[ok], 0.36, xerr=err[:, ok], color=color, capsize=2,
+        bars = ax.barh(y[ok] + off, v[ok], 0.36, xerr=err[:, ok], color=color, edgecolor=hatch_colour, linewidth=0,
+                       capsize=2,
                        label="first order" if name == "S1" else "total")
         hatch_without_error(bars, np.isnan(err[:, ok]).any(axis=0))
         for yi in y[~ok]:

@@ -34,7 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.plotting import FRONT, REAR, error_title, fit_titles, hatch_without_error, mark_without_error
+from bearingsim.plotting import (FRONT, LINE_STYLES, REAR, error_title, fit_titles, hatch_without_error,
+                                 mark_without_error)
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -51,8 +52,6 @@ MAP_HEIGHT_IN = (4.2, 12.0)  # height of a heat map [in]: 0.45 in per cell and 2
 QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
 Y_LABEL = "per pocket and cage rotation [mN s]"
 FACE_COLOURS = {"I_dec": REAR, "I_acc": FRONT}  # the house colours: I_dec the rear face's, I_acc the front's
-#: (marker, line style) of the lines of a line figure, in turn (as many as MAX_LINES)
-LINE_STYLES = (("o", "-"), ("s", "--"), ("^", ":"), ("D", "-."), ("v", "-"), ("P", "--"), ("X", ":"), ("*", "-."))
 
 
 def axis_label(key: str) -> str:

@@ -15,7 +15,7 @@ import numpy as np
 from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.stats import t_quantile
-from bearingsim.wording import counted
+from bearingsim.wording import counted, given_step
 
 # The mean inner-ring displacement along the load is at most half the diametral clearance plus the
 # approach at the inner and the outer race of a roller that carries the whole load alone; twice that
@@ -612,11 +612,8 @@ def _given_step_advice(result) -> str | None:
         return None
     if auto is None or not float(dt) > auto:
         return None
-    if how.startswith("simulate(dt="):  # the dt argument of bearingsim.run, stored as numerics.dt_s
-        return (f"the given step dt = {float(dt):.3g} s (run()'s dt argument) is {float(dt) / auto:.3g} times the "
-                f"automatic {auto:.3g} s: give a smaller dt, or none")
-    return (f"the given step numerics.dt_s = {float(dt):.3g} s is {float(dt) / auto:.3g} times the automatic "
-            f"{auto:.3g} s: remove numerics.dt_s or set a smaller one")
+    # simulate(dt=...): the dt argument of bearingsim.run, stored as numerics.dt_s
+    return given_step(float(dt), auto, how.startswith("simulate(dt="))
 
 
 def _few_samples_advice(result) -> str:

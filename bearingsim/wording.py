@@ -17,3 +17,14 @@ def counted(n, noun: str, plural: str | None = None, fmt: str = "") -> str:
     ``counted(3, "case")`` "3 cases", ``counted(2, "speed", fmt="g")`` "2 speeds". ``plural``: the
     plural when it is not ``noun + "s"``; ``fmt``: the number's format spec."""
     return f"{n:{fmt}} {noun if n == 1 else plural or noun + 's'}"
+
+
+def given_step(dt: float, auto: float, argument: bool) -> str:
+    """Advice for a run whose given step ``dt`` [s], longer than the automatic ``auto`` [s], did not give a
+    result; ``argument``: the step came from the ``dt`` argument of :func:`bearingsim.run` (stored as
+    ``numerics.dt_s``), else from the key ``numerics.dt_s``."""
+    if argument:
+        return (f"the given step dt = {dt:.3g} s (run()'s dt argument) is {dt / auto:.3g} times the "
+                f"automatic {auto:.3g} s: give a smaller dt, or none")
+    return (f"the given step numerics.dt_s = {dt:.3g} s is {dt / auto:.3g} times the automatic "
+            f"{auto:.3g} s: remove numerics.dt_s or set a smaller one")

@@ -49,7 +49,7 @@ def test_hard_case(path, tmp_path):
     sc = load_scenario(path, REDUCED_LENGTH)
     out = tmp_path / "h.h5"
     if "dt_too_large" in path.stem:
-        with pytest.raises(UserError, match=r"numerics\.dt_s.*at most"):
+        with pytest.raises(UserError, match=r"numerics\.dt_s.*(at most|steps up to)"):
             run_scenario(sc, out, figures=False)
         assert not out.exists() and list(tmp_path.iterdir()) == []
         return
@@ -215,14 +215,46 @@ def test_a_given_step_too_small_to_finish_is_refused_before_the_run():
 def test_the_far_above_refusal_quotes_the_scenes_own_automatic_step():
     """A given step far above the stable one is refused naming the automatic step to fall back on; in the
     kinematic-cage scene, whose automatic step is the Hertz step / KINEMATIC_DT_DIVISOR, it quoted the full
-    scene's (4.03e-06 s where the scene takes 5.04e-07 s at 3000 rpm)."""
+    scene's (4.03e-06 s where the scene takes 5.04e-07 s at 3000 rpm). The largest step it takes reads as
+    accepted, not as safe: steps between the automatic one and it may blow up (1.5e-05 s at 6000 rpm does);
+    the rigid raceways' refusal of a step far above the land's limit named no automatic step at all."""
     from bearingsim.multibody import core
 
-    for scene in ("full", "kinematic_cage"):
-        p = load_scenario(SCENARIOS / "multibody_3000rpm.toml", [f"multibody.scene={scene}"]).parameters
-        automatic = core.choose_dt(p)[0]
-        with pytest.raises(UserError, match=rf"for the automatic {automatic:.3g} s$"):
+    for scene in ("full", "kinematic_cage", "rigid"):
+        sets = [f"multibody.scene={scene}"] if scene != "rigid" else [
+            "multibody.raceway_contact=rigid", "bearing.cage_guidance=outer_land"]
+        p = load_scenario(SCENARIOS / "multibody_3000rpm.toml", sets).parameters
+        automatic, _, limit = core.choose_dt(p)
+        with pytest.raises(UserError) as err:
             core.choose_dt(p, 1e-3)
+        assert str(err.value).endswith(
+            f"steps up to {2 * limit:.3g} s are accepted, but only the automatic {automatic:.3g} s is shown "
+            f"stable: remove numerics.dt_s for it"), (scene, str(err.value))
+
+
+@pytest.mark.parametrize("dt", [1.5e-5, 1e-5, 8e-6])
+def test_a_given_step_that_blows_up_is_told_the_automatic_step(dt):
+    """A given step between the automatic one and the refusal's bound that blows up (6000 rpm: 1.5e-5 and 1e-5 s
+    overlap a face, 8e-6 s blows the raceway approach up within 1e-4 s) names the scene's automatic step, as the
+    refusal before the run does. It named a bound computed from the approach speed of the state that had already
+    diverged (39 m/s: "use numerics.dt_s <= 2.04e-08 s", 200 times below the automatic step) or "a smaller
+    numerics.dt_s than 8e-06 s". Said of the argument for the API's dt, of the key for numerics.dt_s."""
+    import bearingsim as api
+    from bearingsim.errors import SimulationUnstable
+    from bearingsim.multibody import core
+
+    sc = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["numerics.rotations=1"])
+    automatic = core.choose_dt(sc.parameters)[0]
+    with pytest.raises(SimulationUnstable) as err:
+        api.run(sc, dt=dt)
+    msg = str(err.value)
+    assert msg.endswith(f"the given step dt = {dt:.3g} s (run()'s dt argument) is {dt / automatic:.3g} times the "
+                        f"automatic {automatic:.3g} s: give a smaller dt, or none"), msg
+    with pytest.raises(SimulationUnstable) as err:
+        api.run(sc.replace(**{"numerics.dt_s": dt}))
+    msg = str(err.value)
+    assert msg.endswith(f"the given step numerics.dt_s = {dt:.3g} s is {dt / automatic:.3g} times the automatic "
+                        f"{automatic:.3g} s: remove numerics.dt_s or set a smaller one"), msg
 
 
 @pytest.mark.slow  # a 6000 rpm run of 1 + 1 rotations that stops (~2 s)

@@ -68,7 +68,7 @@ from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, assembly_refusal, check_assembly, check_rigid,
-                                       choose_dt, paper_assumptions, rigid, run)
+                                       choose_dt, paper_assumptions, rigid, run, unstable_advice)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
 from bearingsim.results import MemorySink, Result
@@ -116,7 +116,8 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     clearance: the overlap is the approach covered in the step in which a contact is found, ~v dt.
     With the automatic time step the run is restarted with a step shortened to the measured approach
     speed (at most ``MAX_DT_RETRIES`` times; the history goes into ``dt_choice``); with a given time
-    step it stops with :class:`SimulationUnstable` naming the largest step that would do.
+    step it stops with :class:`SimulationUnstable` naming the automatic step when the given one is longer
+    (:func:`core.unstable_advice`), else the largest step that would keep the measured approach within the limit.
     """
     if sink is None:
         sink = MemorySink()
@@ -139,9 +140,10 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
             new_dt = exc.suggested_dt()
             if not auto or len(retries) >= MAX_DT_RETRIES:
                 key = "numerics.dt_s" if not auto else "the automatic time step"
+                advice = ((not auto and unstable_advice(p, exc.dt, exc.how))
+                          or f"{key} is too long for this scene, use numerics.dt_s <= {new_dt:.3g} s")
                 raise SimulationUnstable(
-                    f"{exc}: more than {PENETRATION_LIMIT:.0%} of the pocket clearance; {key} is too long "
-                    f"for this scene, use numerics.dt_s <= {new_dt:.3g} s") from None
+                    f"{exc}: more than {PENETRATION_LIMIT:.0%} of the pocket clearance; {advice}") from None
             retries.append(f"restarted at dt = {new_dt:.3g} s after overlap {exc.pen:.3g} m > "
                            f"{PENETRATION_LIMIT:.0%} s at dt = {exc.dt:.3g} s (approach {exc.approach:.3g} m/s)")
             dt = new_dt

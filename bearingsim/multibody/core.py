@@ -33,6 +33,7 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
 from bearingsim.parameters import inner_ring_mode
 from bearingsim.parameters import paper_assumptions  # noqa: F401 - re-exported: the scene of the paper's assumptions
+from bearingsim.wording import given_step
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
 # exact arc faces: a roller further than this fraction of the play R - r from its pocket centre has its faces
@@ -298,11 +299,35 @@ def choose_dt(p, dt=None, play=None):
         dt, how = _automatic_dt(p, lim, play)
     _check_step_count(p, dt, how)
     if dt > largest:
-        raise UserError(
-            f"numerics.dt_s = {dt:.3g} s is far above the stable time step of this bearing "
-            f"(Hertz limit 2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s "
-            f"for the automatic {_automatic_dt(p, lim, play)[0]:.3g} s")
+        raise UserError(_far_above(dt, f"this bearing (Hertz limit 2/omega_n = {lim:.3g} s)", largest,
+                                   _automatic_dt(p, lim, play)[0]))
     return float(dt), how, lim
+
+
+def _far_above(dt: float, what: str, largest: float, auto: float) -> str:
+    """The refusal of a given step ``dt`` [s] above ``largest`` [s] (:data:`DT_MAX_FACTOR` times the explicit
+    limit of ``what``): steps up to ``largest`` are taken, but between the automatic step ``auto`` and it a run
+    may still blow up."""
+    return (f"numerics.dt_s = {dt:.3g} s is far above the stable time step of {what}: steps up to {largest:.3g} s "
+            f"are accepted, but only the automatic {auto:.3g} s is shown stable: remove numerics.dt_s for it")
+
+
+def automatic_step(p, play=None) -> float:
+    """The step [s] :func:`choose_dt` chooses for ``p`` when no step is given (``numerics.dt_s`` set aside).
+    ``play``: :func:`worn_play` of ``p`` when the caller has it."""
+    if rigid(p):
+        return _automatic_dt_rigid(p, land_stability_limit(p), play)[0]
+    return _automatic_dt(p, stability_limit(p), play)[0]
+
+
+def unstable_advice(p, h: float, how: str) -> str | None:
+    """What to change after a run at a given step ``h`` [s] (chosen ``how``, its ``dt_choice``) went unstable,
+    when ``h`` is longer than the automatic step: that step (a bound from the stopped state's speeds would be one
+    of a state that has already diverged). None for the automatic step or a given one not longer than it."""
+    if how.startswith("auto"):
+        return None
+    auto = automatic_step(p)
+    return given_step(h, auto, how.startswith("simulate(dt=")) if h > auto else None
 
 
 def _automatic_dt(p, lim: float, play=None) -> tuple[float, str]:
@@ -332,21 +357,27 @@ def _choose_dt_rigid(p, dt, play=None):
     elif dt is not None:
         how = "simulate(dt=...)"
     else:
-        s = p.bearing.pocket_clearance
-        play = play or worn_play(p)
-        dti = RIGID_IMPACT_OVERLAP_FRACTION / IMPACT_OVERLAP_FRACTION * impact_dt(p, play)
-        dt = min(dti, DT_FRACTION * lim, RIGID_DT_CAP_S)
-        how = (f"auto (rigid raceways): min of impact resolution {RIGID_IMPACT_OVERLAP_FRACTION:g} s / v_impact = "
-               f"{dti:.3e} s (s = {s * 1e3:.3g} mm)"
-               + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
-                  if math.isfinite(lim) else "")
-               + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p, play))
+        dt, how = _automatic_dt_rigid(p, lim, play)
     _check_step_count(p, dt, how)
     if dt > largest:
-        raise UserError(
-            f"numerics.dt_s = {dt:.3g} s is far above the stable time step of the cage on its land "
-            f"(2/omega_n = {lim:.3g} s): use at most {largest:.3g} s, or remove numerics.dt_s")
+        raise UserError(_far_above(dt, f"the cage on its land (2/omega_n = {lim:.3g} s)", largest,
+                                   _automatic_dt_rigid(p, lim, play)[0]))
     return float(dt), how, lim
+
+
+def _automatic_dt_rigid(p, lim: float, play=None) -> tuple[float, str]:
+    """The automatic step of rigid raceways and how it was chosen: the smallest of the impact resolution, a
+    fraction of the land's 2/omega_n (``lim``, inf for a roller-guided cage) and a cap."""
+    s = p.bearing.pocket_clearance
+    play = play or worn_play(p)
+    dti = RIGID_IMPACT_OVERLAP_FRACTION / IMPACT_OVERLAP_FRACTION * impact_dt(p, play)
+    dt = min(dti, DT_FRACTION * lim, RIGID_DT_CAP_S)
+    how = (f"auto (rigid raceways): min of impact resolution {RIGID_IMPACT_OVERLAP_FRACTION:g} s / v_impact = "
+           f"{dti:.3e} s (s = {s * 1e3:.3g} mm)"
+           + (f", {DT_FRACTION} x 2/omega_n of the cage on its land = {DT_FRACTION * lim:.3e} s"
+              if math.isfinite(lim) else "")
+           + f" and {RIGID_DT_CAP_S:.0e} s" + _play_text(p, play))
+    return dt, how
 
 
 def _check_step_count(p, dt: float, how: str) -> None:
@@ -1002,7 +1033,8 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
     lim = su.limits
     if code == lp.CODE_NONFINITE:
         raise SimulationUnstable(f"non-finite state at t = {t:.6g} s (step {step}); "
-                                 f"try a smaller numerics.dt_s than {h:.3g} s")
+                                 + (unstable_advice(su.p, h, su.dt_how)
+                                    or f"try a smaller numerics.dt_s than {h:.3g} s"))
     if code == lp.CODE_PENETRATION:
         g = acc.glob[0]
         raise PenetrationExceeded(g["maxpen_all"], lim.penetration, h, g["maxpen_time"], g["maxpen_approach"],
@@ -1012,7 +1044,7 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
             f"raceway approach {max(wk.diag['delta_out'].max(), wk.diag['delta_in'].max() if su.rigid else 0.0):.3g} m "
             f"(limit {lim.raceway_approach:.3g} m, 3x the "
             f"Palmgren approach under the whole operating.radial_load_N) or cage speed {state[n, 5]:.3g} rad/s "
-            f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); {_blowup_advice(su.p, h)}")
+            f"(limit {lim.omega:.3g}) out of bounds at t = {t:.6g} s (energy blow-up); {_blowup_advice(su, h)}")
     if code == lp.CODE_STALLED:
         total_rot = su.p.numerics.warmup_rotations + su.p.numerics.rotations
         raise SimulationUnstable(
@@ -1024,7 +1056,8 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
             f"the cage centre moved {off:.4g} mm off the bearing axis at "
             f"t = {t:.6g} s, more than {LAND_ORBIT_MARGIN:.0%} of half the land clearance "
             f"(bearing.cage_land_clearance_mm) beyond its {su.p.bearing.cage_guidance.replace('_', ' ')}: the land "
-            f"contact did not hold it; try a smaller numerics.dt_s than {h:.3g} s")
+            f"contact did not hold it; "
+            + (unstable_advice(su.p, h, su.dt_how) or f"try a smaller numerics.dt_s than {h:.3g} s"))
     if code == lp.CODE_CAGE_LOST:
         raise SimulationUnstable(
             f"the cage centre moved {off:.4g} mm off the bearing axis at "
@@ -1033,10 +1066,12 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
     raise RuntimeError(f"multibody step loop: pymunk grew a batch buffer at step {step} (code {code})")
 
 
-def _blowup_advice(p, h: float) -> str:
-    """What to change after an energy blow-up with step ``h``: a smaller step, unless the ring is held
-    quasi-static while it rests on a single roller (:func:`one_roller_ring_advice`)."""
-    return one_roller_ring_advice(p) or f"try a smaller numerics.dt_s than {h:.3g} s"
+def _blowup_advice(su: MultibodySetup, h: float) -> str:
+    """What to change after an energy blow-up with step ``h``: a smaller step (the automatic one for a given step
+    longer than it, :func:`unstable_advice`), unless the ring is held quasi-static while it rests on a single
+    roller (:func:`one_roller_ring_advice`)."""
+    return (one_roller_ring_advice(su.p) or unstable_advice(su.p, h, su.dt_how)
+            or f"try a smaller numerics.dt_s than {h:.3g} s")
 
 
 def one_roller_ring_advice(p) -> str | None:

@@ -51,6 +51,27 @@ def test_a_refused_step_names_the_argument_that_gave_it():
         bearingsim.run(euler.replace(**{"numerics.dt_s": 1.0}))
 
 
+@pytest.mark.parametrize("sets", [[], ["multibody.raceway_contact=rigid", "bearing.cage_guidance=outer_land"]],
+                         ids=["hertz", "rigid_on_a_land"])
+def test_a_step_far_above_the_stable_one_is_refused_as_the_arguments(sets):
+    """``run(sc, dt=1e-3)`` of a multibody scenario blamed the scenario file ("multibody_3000rpm.toml:
+    numerics.dt_s = 0.001 s is far above ...") where its other bad steps name the argument: every refusal of the
+    argument reads "run(): dt: ...", and the same step in the file is the file's key."""
+    from bearingsim.multibody import core
+
+    sc = bearingsim.load_scenario(MULTIBODY, overrides=sets)
+    automatic = core.choose_dt(sc.parameters)[0]
+    with pytest.raises(bearingsim.UserError) as err:
+        bearingsim.run(sc, dt=1e-3)
+    msg = str(err.value)
+    assert msg.startswith("run(): dt: 0.001 s is far above the stable time step of "), msg
+    assert msg.endswith(f"only the automatic {automatic:.3g} s is shown stable (leave the step to the automatic "
+                        f"choice)") and "numerics.dt_s" not in msg and str(MULTIBODY.name) not in msg, msg
+    with pytest.raises(bearingsim.UserError) as err:
+        bearingsim.run(sc.replace(**{"numerics.dt_s": 1e-3}))
+    assert str(err.value).startswith(f"{sc.source}: numerics.dt_s: 0.001 s is far above"), str(err.value)
+
+
 def test_run_with_dt_stores_it_in_the_scenario():
     """The step a run was given is the scenario's ``numerics.dt_s``: its archive reruns the same run."""
     sc = bearingsim.load_scenario(PAPER, set={"reduced.method": "euler"})

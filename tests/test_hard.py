@@ -229,7 +229,7 @@ def test_the_far_above_refusal_quotes_the_scenes_own_automatic_step():
             core.choose_dt(p, 1e-3)
         assert str(err.value).endswith(
             f"steps up to {2 * limit:.3g} s are accepted, but only the automatic {automatic:.3g} s is shown "
-            f"stable: remove numerics.dt_s for it"), (scene, str(err.value))
+            f"stable (leave the step to the automatic choice)"), (scene, str(err.value))
 
 
 @pytest.mark.parametrize("dt", [1.5e-5, 1e-5, 8e-6])

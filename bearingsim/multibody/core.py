@@ -306,10 +306,11 @@ def choose_dt(p, dt=None, play=None):
 
 def _far_above(dt: float, what: str, largest: float, auto: float) -> str:
     """The refusal of a given step ``dt`` [s] above ``largest`` [s] (:data:`DT_MAX_FACTOR` times the explicit
-    limit of ``what``): steps up to ``largest`` are taken, but between the automatic step ``auto`` and it a run
-    may still blow up."""
-    return (f"numerics.dt_s = {dt:.3g} s is far above the stable time step of {what}: steps up to {largest:.3g} s "
-            f"are accepted, but only the automatic {auto:.3g} s is shown stable: remove numerics.dt_s for it")
+    limit of ``what``), said as the key's ("run(): dt: ..." of the API's dt): steps up to ``largest`` are taken,
+    but between the automatic step ``auto`` and it a run may still blow up."""
+    return (f"numerics.dt_s: {dt:.3g} s is far above the stable time step of {what}: steps up to {largest:.3g} s "
+            f"are accepted, but only the automatic {auto:.3g} s is shown stable (leave the step to the automatic "
+            f"choice)")
 
 
 def automatic_step(p, play=None) -> float:

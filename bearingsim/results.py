@@ -29,6 +29,14 @@ IMPACTS = "results/impacts"
 SUMMARY = "results/summary"
 
 
+def read_only(a) -> np.ndarray:
+    """A read-only view of the array ``a`` (what a result hands out: writing into it raises numpy's "assignment
+    destination is read-only", so the result, its summary and the archive it saves stay as the run made them)."""
+    view = np.asarray(a).view()
+    view.setflags(write=False)
+    return view
+
+
 class Result:
     """One run's results (base class; :class:`bearingsim.reduced.ReducedResult` and
     :class:`bearingsim.multibody.MultibodyResult` add the model's figures).
@@ -116,7 +124,7 @@ class Result:
         arr = self.data.get(f"results/{name}") if isinstance(name, str) else None
         if arr is None:
             raise UserError(self._unknown_array(name))
-        return arr.data
+        return read_only(arr.data)
 
     def _unknown_array(self, name) -> str:
         """The message of :meth:`get` for ``name``: the closest names (if any) and every name there is, those
@@ -139,7 +147,8 @@ class Result:
 
     def _under(self, prefix: str) -> dict[str, np.ndarray]:
         p = prefix + "/"
-        return {k[len(p):]: v.data for k, v in self.data.items() if k.startswith(p) and "/" not in k[len(p):]}
+        return {k[len(p):]: read_only(v.data) for k, v in self.data.items()
+                if k.startswith(p) and "/" not in k[len(p):]}
 
     def to_dataframe(self, what: str = "per_rotation", units_in_names: bool = False):
         """A pandas DataFrame of ``what`` (needs the extra ``bearingsim[frames]``):

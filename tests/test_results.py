@@ -126,7 +126,7 @@ def test_get_of_a_name_the_result_lacks_is_one_user_error_naming_what_it_has():
     """``r.get("nope")`` raised a bare ``KeyError: 'results/nope'``; a name of the caller's that is not there is
     one ``bearingsim.UserError`` line (docs/usage.md) naming it, the closest names and every array there is."""
     r = bearingsim.run(_short_scenarios()[0])
-    assert r.get("trace/theta_deg") is r.data["results/trace/theta_deg"].data
+    assert r.get("trace/theta_deg").base is r.data["results/trace/theta_deg"].data  # a read-only view of it
     for name, words in (("nope", ["get('nope'): no array results/nope in this reduced result; its arrays: "
                                   "per_rotation/{I_dec, I_acc}, impacts/{time_s, "]),
                         ("trace/theta", ["(did you mean trace/theta_deg "]),
@@ -159,3 +159,29 @@ def test_save_over_an_archive_of_another_scenario_needs_force(tmp_path):
     assert bearingsim.load(path).scenario == other.scenario
     with pytest.raises(bearingsim.UserError, match="force: expected True or False"):
         other.save(path, force="yes")
+
+
+@pytest.mark.parametrize("model", ["reduced", "multibody"])
+def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
+    """``a = r.per_rotation["I_dec"]; a *= 1e3`` changed the result in place: its summary no longer agreed with
+    it and its archive held the changed numbers (``bearingsim rerun`` then called it different). The arrays of
+    ``per_rotation``, ``impacts`` and ``get`` are read-only, of a run and of an archive read back, and computing
+    from them gives new arrays."""
+    if model == "reduced":
+        sc = _short_scenarios()[0]
+    else:
+        sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+            "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
+    r = bearingsim.run(sc)
+    before = r.summary["I_dec_mean_Ns"]
+    for result in (r, bearingsim.load(r.save(tmp_path / "r.h5"))):
+        arrays = [result.per_rotation["I_dec"], result.get("per_rotation/I_acc"), result.impacts["time_s"]]
+        for a in arrays:
+            kept = a.copy()
+            with pytest.raises(ValueError, match="read-only"):
+                a *= 1e3
+            with pytest.raises(ValueError, match="read-only"):
+                a[...] = 0
+            assert np.array_equal(a, kept) and np.array_equal(a * 1e3, kept * 1e3)
+        assert np.mean(result.per_rotation["I_dec"]) == pytest.approx(before, rel=1e-12)
+    assert bearingsim.load(tmp_path / "r.h5").summary["I_dec_mean_Ns"] == before

@@ -40,7 +40,7 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
 
     from bearingsim import scenario
 
-    sc = scenario.load_scenario(path, overrides, values=set)
+    sc = scenario.load_scenario(path, overrides, values=set, origin="overrides")
     for note in scenario.given_key_notes(sc, scenario.given_keys(path, overrides, set)):
         warnings.warn(f"bearingsim: note: {note}", UnreadKeyWarning, stacklevel=2)
     return sc

@@ -25,7 +25,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from bearingsim.errors import UserError
-from bearingsim.wording import counted
+from bearingsim.wording import counted, given_by
 
 SCHEMA_VERSION = 1
 
@@ -470,23 +470,24 @@ def _preset(name: str) -> dict[str, Any]:
     return data
 
 
-def parse_override(item: str) -> tuple[str, Any]:
-    """``KEY=VALUE`` with VALUE read as a TOML value; a bare word is a string."""
+def parse_override(item: str, origin: str = "--set") -> tuple[str, Any]:
+    """``KEY=VALUE`` with VALUE read as a TOML value; a bare word is a string. ``origin``: what gave it, as its
+    refusals name it (:func:`bearingsim.wording.given_by`: the command line's ``--set``, the API's ``overrides``)."""
     if "=" not in item:
-        raise UserError(f"--set {item!r}: expected KEY=VALUE")
+        raise UserError(f"{given_by(origin, repr(item))}: expected KEY=VALUE")
     key, text = item.split("=", 1)
     key = key.strip()
     if not key or any(not part for part in key.split(".")):
-        raise UserError(f"--set {item!r}: empty key")
+        raise UserError(f"{given_by(origin, repr(item))}: empty key")
     if len(item) > MAX_SCENARIO_BYTES:
-        raise UserError(f"--set {key}: value longer than {MAX_SCENARIO_BYTES} bytes")
+        raise UserError(f"{given_by(origin, key)}: value longer than {MAX_SCENARIO_BYTES} bytes")
     try:
         value = tomllib.loads(f"v = {text}")["v"]
     except tomllib.TOMLDecodeError:
         value = text.strip()
     except RecursionError:
-        raise UserError(f"--set {key}: value nested too deeply") from None
-    _check_depth(value, f"--set {key}", depth=len(key.split(".")))
+        raise UserError(f"{given_by(origin, key)}: value nested too deeply") from None
+    _check_depth(value, given_by(origin, key), depth=len(key.split(".")))
     return key, value
 
 
@@ -620,12 +621,13 @@ def parse_toml_text(text: str, where: str) -> dict[str, Any]:
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
-                  values: dict[str, Any] | None = None) -> Scenario:
+                  values: dict[str, Any] | None = None, origin: str = "--set") -> Scenario:
     """Read, merge with preset and defaults, apply overrides, and validate.
 
     ``overrides`` are ``KEY=VALUE`` strings (VALUE read as TOML, as ``--set`` on the command line), each key
     at most once (a key given twice is refused, naming both); ``values`` maps dotted keys to Python values,
-    applied after them; both name keys as ``section.key``.
+    applied after them; both name keys as ``section.key``. ``origin``: what gave ``overrides``, as their
+    refusals name it (``--set`` of the command line, ``overrides`` of :func:`bearingsim.load_scenario`).
     """
     from collections.abc import Mapping
 
@@ -646,12 +648,13 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
     given = {}  # key -> the override that set it, as the user wrote it
     leaves = {}  # every dotted key an override sets (a section's table sets each key it holds) -> that override
     for item in overrides or []:
-        key, value = parse_override(item)
+        key, value = parse_override(item, origin)
         set_keys = list(flatten({key: value})) or [key]  # a table (operating={...}) sets each key it holds
         twice = [k for k in set_keys if k in leaves]
         if twice:  # which one was meant is not ours to guess (a sweep refuses it the same way)
-            raise UserError(f"--set {twice[0]}: given twice ({leaves[twice[0]]} and {item.strip()}); give it once")
-        _set_dotted(raw, key, value, origin="--set")
+            raise UserError(f"{given_by(origin, twice[0])}: given twice ({leaves[twice[0]]} and {item.strip()}); "
+                            f"give it once")
+        _set_dotted(raw, key, value, origin=origin)
         given[key] = item.strip()
         leaves.update(dict.fromkeys(set_keys, item.strip()))
     for key, value in (values or {}).items():
@@ -1067,10 +1070,14 @@ def is_integer_key(key: str) -> bool:
 
 
 def did_you_mean(key: str) -> str:
-    """`` (did you mean X?)`` for the accepted key closest to an unknown ``key`` (difflib), or ``""``."""
+    """`` (did you mean X?)`` for the accepted key closest to an unknown ``key`` (difflib), or ``""``; a ``key``
+    that is the last part of exactly one accepted key (``rotations``: ``numerics.rotations``) names that key."""
     import difflib
 
     known = known_keys()
+    ending = [k for k in known if k.rpartition(".")[2] == key and k != key]
+    if len(ending) == 1:
+        return f" (did you mean {ending[0]}?)"
     section, _, leaf = key.rpartition(".")
     same = [k for k in known if k.rpartition(".")[0] == section]  # the keys beside it (or the top level)
     close = [f"{section}.{m}" if section else m for m in difflib.get_close_matches(

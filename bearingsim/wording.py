@@ -28,3 +28,9 @@ def given_step(dt: float, auto: float, argument: bool) -> str:
                 f"automatic {auto:.3g} s: give a smaller dt, or none")
     return (f"the given step numerics.dt_s = {dt:.3g} s is {dt / auto:.3g} times the automatic "
             f"{auto:.3g} s: remove numerics.dt_s or set a smaller one")
+
+
+def given_by(origin: str, what: str) -> str:
+    """``what`` (a key or an override) as a refusal names it with the option or argument ``origin`` that gave
+    it: "--set KEY" of a command-line option, "overrides: KEY" of a Python argument."""
+    return f"{origin} {what}" if origin.startswith("--") else f"{origin}: {what}"

@@ -581,3 +581,36 @@ def test_an_empty_scenario_path_is_said_to_be_empty():
     for load in (load_scenario, bearingsim.load_scenario):
         with pytest.raises(UserError, match=r"^scenario path is empty: give the path of a scenario file"):
             load("")
+
+
+@pytest.mark.parametrize("overrides, api, cli", [
+    (["numerics.rotations"], "overrides: 'numerics.rotations': expected KEY=VALUE",
+     "--set 'numerics.rotations': expected KEY=VALUE"),
+    (["=1"], "overrides: '=1': empty key", "--set '=1': empty key"),
+    (["numerics.rotations=2", "numerics.rotations=3"], "overrides: numerics.rotations: given twice",
+     "--set numerics.rotations: given twice"),
+    (["numerics=1", "numerics.rotations=2"], "overrides: numerics.rotations: 'numerics' is a value",
+     "--set: numerics.rotations: 'numerics' is a value"),
+])
+def test_a_bad_override_of_the_api_names_the_argument_and_of_the_cli_the_option(capsys, overrides, api, cli):
+    """``bearingsim.load_scenario(p, overrides=["numerics.rotations"])`` said "--set 'numerics.rotations':
+    expected KEY=VALUE", an option the caller never gave: the API's refusal names its argument, the command
+    line's its option."""
+    from bearingsim.cli import main
+
+    path = SCENARIOS / "paper_3000rpm.toml"
+    with pytest.raises(UserError) as err:
+        bearingsim.load_scenario(path, overrides=overrides)
+    assert str(err.value).startswith(api) and "--set" not in str(err.value), str(err.value)
+    assert main(["run", str(path), "--dry-run", *[a for o in overrides for a in ("--set", o)]]) == 2
+    assert capsys.readouterr().err.startswith(f"bearingsim: error: {cli}")
+
+
+@pytest.mark.parametrize("given, meant", [("rotations", "numerics.rotations"), ("restitution", "contact.restitution"),
+                                          ("numerics.rotation", "numerics.rotations")])
+def test_an_unknown_key_that_ends_one_known_key_is_told_that_key(given, meant):
+    """``set={"rotations": 1}`` said "did you mean lubrication?" (the closest top-level name); a key that is the
+    last part of exactly one known key names that key, the others keep the closest match."""
+    with pytest.raises(UserError) as err:
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={given: 1})
+    assert str(err.value).endswith(f"{given}: unknown key (did you mean {meant}?)"), str(err.value)

@@ -676,3 +676,20 @@ def test_the_largest_seed_is_kept_in_the_table(tmp_path):
     from bearingsim.studies.uncertainty import INDEX_FORMAT
 
     assert archive.read_table_file(tmp_path / "u" / "uncertainty.h5", INDEX_FORMAT)[1]["seed"] == MAX_SEED
+
+
+@pytest.mark.parametrize("study", ["sensitivity", "uncertainty"])
+@pytest.mark.parametrize("key, words", [("nope.key", "keys: nope.key: unknown key"),
+                                        ("bearing", "keys: bearing: a section, not a key"),
+                                        ("bearing.cage_mass_kg", "keys: bearing.cage_mass_kg: ")])
+def test_a_bad_key_of_the_api_is_named_as_its_argument(tmp_path, study, key, words):
+    """``bearingsim.sensitivity(sc, keys=["nope.key"])`` said "--keys nope.key: unknown key", the command line's
+    option: the API's refusal names its argument ``keys`` (the command line keeps --keys, tested above)."""
+    sc = load_scenario(PAPER_3000)
+    with pytest.raises(bearingsim.UserError) as err:
+        if study == "sensitivity":
+            bearingsim.sensitivity(sc, tmp_path / "o", keys=[key])
+        else:
+            bearingsim.uncertainty(sc, 4, tmp_path / "o", keys=[key])
+    assert str(err.value).startswith(words) and "--keys" not in str(err.value), str(err.value)
+    assert not (tmp_path / "o").exists()

@@ -38,6 +38,7 @@ import numpy as np
 from bearingsim.errors import UserError
 from bearingsim.scenario import unread_because  # why a key's paired runs would be identical
 from bearingsim.studies.engine import Study, batch_sem, case_of, load_result
+from bearingsim.wording import given_by
 
 INDEX_FORMAT = "bearingsim sensitivity index 1"
 DEFAULT_STEP = 0.10
@@ -126,12 +127,14 @@ def default_keys(scenario) -> list[str]:
     return [k for k in ranged_keys(scenario) if unmeasured_because(scenario, k) is None]
 
 
-def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None) -> list[str]:
+def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None = None,
+               origin: str = "--keys") -> list[str]:
     """``keys`` (None: :func:`default_keys`) checked: each must have a range (one-line UserError
     naming it otherwise) and, with ``relative`` (the sensitivity study's steps x (1 -+ step)), a nonzero
     numeric value. A default key whose value is 0 is left out (a relative step cannot move it), named with
     why in ``left_out``; one given in ``keys`` is refused. The uncertainty study samples the ranges
-    themselves (``relative=False``): a key's own value does not matter there."""
+    themselves (``relative=False``): a key's own value does not matter there. ``origin``: what gave ``keys``,
+    as the refusals name it (``--keys`` of the command line, ``keys`` of the Python API's argument)."""
     from bearingsim.ranges import ranged_keys, value_of
 
     have = ranged_keys(scenario)
@@ -143,14 +146,14 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
     kept = []
     for k in keys:
         if given:
-            _check_given_key(scenario, k)
+            _check_given_key(scenario, k, origin)
         if k not in have:
-            raise UserError(f"--keys {k}: no range for this key in {scenario.source} or its preset (give "
+            raise UserError(f"{given_by(origin, k)}: no range for this key in {scenario.source} or its preset (give "
                             f"[ranges.{k}] range = [low, high] and reason)")
         x = value_of(scenario, k)
         if relative and (not isinstance(x, (int, float)) or isinstance(x, bool) or x == 0):
             if given:
-                raise UserError(f"--keys {k}: its value ({x!r}) has no relative step; give the key a nonzero number")
+                raise UserError(f"{given_by(origin, k)}: its value ({x!r}) has no relative step; give the key a nonzero number")
             if left_out is not None:
                 left_out.append((k, f"its value is {x!r}: a relative step x (1 ± step) cannot move it"))
             continue
@@ -161,28 +164,30 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
     return kept
 
 
-def _check_given_key(scenario, key: str) -> None:
-    """A one-line UserError naming ``key`` (given to ``--keys``) when no scenario has it (with the closest
-    accepted key) or varying it moves no number the study measures (:func:`unmeasured_because`)."""
+def _check_given_key(scenario, key: str, origin: str = "--keys") -> None:
+    """A one-line UserError naming ``key`` (given to ``origin``: ``--keys``, or the API's ``keys``) when no
+    scenario has it (with the closest accepted key) or varying it moves no number the study measures
+    (:func:`unmeasured_because`)."""
     from bearingsim.scenario import did_you_mean, known_keys
 
+    named = given_by(origin, key)
     known = known_keys()
     if key not in known:
-        raise UserError(f"--keys {key}: unknown key{did_you_mean(key)}")
+        raise UserError(f"{named}: unknown key{did_you_mean(key)}")
     if any(k.startswith(key + ".") for k in known):
-        raise UserError(f"--keys {key}: a section, not a key (give its keys, e.g. {key}.<key>)")
+        raise UserError(f"{named}: a section, not a key (give its keys, e.g. {key}.<key>)")
     if "." not in key:  # name, model, schema_version: the scenario's own settings, none a number to vary
-        raise UserError(f"--keys {key}: a top-level setting of the scenario, not a number of the bearing or its "
+        raise UserError(f"{named}: a top-level setting of the scenario, not a number of the bearing or its "
                         f"operation; give a key of a section (e.g. contact.restitution)")
     why = unmeasured_because(scenario, key)
     if why is not None:
-        raise UserError(f"--keys {key}: {why}; leave it out")
+        raise UserError(f"{named}: {why}; leave it out")
     from bearingsim.ranges import key_kind
 
     kind = key_kind(scenario, key)
     if kind != "float":
         what = "a list of numbers" if kind == "list" else "a count or a choice"
-        raise UserError(f"--keys {key}: not a continuous number ({what}): it has no range or derivative; "
+        raise UserError(f"{named}: not a continuous number ({what}): it has no range or derivative; "
                         f"sweep its values instead (bearingsim sweep --param {key}=A,B,...)")
 
 
@@ -336,7 +341,7 @@ class Sensitivity(Study):
 
     name = "sensitivity"
 
-    def __init__(self, scenario, keys=None, step: float = DEFAULT_STEP):
+    def __init__(self, scenario, keys=None, step: float = DEFAULT_STEP, origin: str = "--keys"):
         from bearingsim import archive
         from bearingsim.outputs import is_own_png
 
@@ -344,7 +349,7 @@ class Sensitivity(Study):
             raise UserError(f"step {step!r}: the relative step must be above 0 and below 1 (0.1 = 10 %)")
         self.scenario, self.step = scenario, float(step)
         self.left_out: list[tuple[str, str]] = []  # default keys at 0, which a relative step cannot move
-        self.keys = check_keys(scenario, keys, left_out=self.left_out)
+        self.keys = check_keys(scenario, keys, left_out=self.left_out, origin=origin)
         self.runs = {}  # (key, side) -> (value, case); no half sides where they are the full step's values
         self.half_values = {}  # key -> (x-, x+) of the half step, clipped to the key's range
         self.half = scenario.model == "reduced"  # deterministic: S at half the step too (HALF_SIDES)
@@ -588,7 +593,7 @@ def run_sensitivity(scenario, outdir=None, keys=None, step: float = DEFAULT_STEP
     """Run the paired cases on the sweep engine into ``outdir`` (None: a temporary folder) and return
     the table. Archives already in ``outdir`` from the same cases are reused; a failed case leaves its
     key's rows with NaN numbers, its status and error."""
-    study = Sensitivity(scenario, keys, step)
+    study = Sensitivity(scenario, keys, step, origin="keys")
     return SensitivityResult(study, run_study(study, outdir, jobs=jobs, engine=engine, progress=progress, log=log,
                                               force=force))
 

@@ -127,7 +127,7 @@ class Uncertainty(Study):
 
     name = "uncertainty"
 
-    def __init__(self, scenario, samples: int, seed: int = 0, keys=None):
+    def __init__(self, scenario, samples: int, seed: int = 0, keys=None, origin: str = "--keys"):
         from bearingsim import archive
         from bearingsim.outputs import is_own_png
         from bearingsim.ranges import ranged_keys
@@ -140,7 +140,7 @@ class Uncertainty(Study):
             raise UserError(f"--seed {seed!r}: give an integer from 0 to {MAX_SEED} (2**63 - 1, the largest the "
                             f"study's table stores)")
         self.scenario, self.samples, self.seed = scenario, samples, seed
-        self.keys = check_keys(scenario, keys, relative=False)  # the ranges are sampled: any value of the key
+        self.keys = check_keys(scenario, keys, relative=False, origin=origin)  # the ranges are sampled: any value of the key
         total = samples * (len(self.keys) + 2)
         if total > MAX_SWEEP_CASES:  # counted before any case is built, as a sweep's
             raise UserError(f"--samples {samples}: {total} cases ({samples} x {len(self.keys) + 2}: the samples A, B and "
@@ -365,6 +365,6 @@ def run_uncertainty(scenario, outdir=None, samples: int = 64, seed: int = 0, key
     the indices and spreads (archives in ``outdir`` reused; failed rows left out, counted in ``runs_used``)."""
     from bearingsim.studies.sensitivity import run_study
 
-    study = Uncertainty(scenario, samples, seed, keys)
+    study = Uncertainty(scenario, samples, seed, keys, origin="keys")
     return UncertaintyResult(study, run_study(study, outdir, jobs=jobs, engine=engine, progress=progress, log=log,
                                               force=force))

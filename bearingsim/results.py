@@ -253,7 +253,8 @@ class Result:
     def __repr__(self) -> str:
         s = self.summary
         head = ", ".join(f"{k}={s[k]:.4g}" for k in ("I_dec_mean_Ns", "I_acc_mean_Ns") if k in s)
-        return f"<{type(self).__name__} {self.scenario.name!r}: {head}>"
+        given = getattr(self.scenario, "overrides_text", str)()  # its scenario's overrides ("" without any)
+        return f"<{type(self).__name__} {self.scenario.name!r}{given}: {head}>"
 
 
 class MemorySink:

@@ -327,15 +327,20 @@ class Scenario:
     toml : str, optional
         ``model``'s TOML text if the caller has it already (:meth:`to_toml` of a scenario with the same
         model, e.g. a sweep case's text): then it is not formatted again.
+    overrides : the overrides applied to ``source``'s values (:attr:`overrides`).
     """
 
-    def __init__(self, model: ScenarioModel, source: str, toml: str | None = None):
+    def __init__(self, model: ScenarioModel, source: str, toml: str | None = None, overrides=()):
         self.model_ = model
         self.source = source
         self._toml = toml
         self._parameters = None
+        self._overrides = tuple(overrides)
 
-    _OWN = frozenset({"model_", "source", "_toml", "_parameters"})
+    _OWN = frozenset({"model_", "source", "_toml", "_parameters", "_overrides"})
+
+    #: at most this many overrides are named in the repr (then "and N more")
+    REPR_OVERRIDES = 3
 
     def __setattr__(self, item, value):
         """Only the constructor sets attributes: a scenario is validated once and frozen (``sc.name =
@@ -355,12 +360,30 @@ class Scenario:
         return getattr(model, item)
 
     def __repr__(self) -> str:
-        """``<Scenario 'paper_3000rpm': reduced model, from 'scenarios/paper_3000rpm.toml'>``: its name, model
-        and where it came from."""
+        """``<Scenario 'paper_3000rpm': reduced model, from 'scenarios/paper_3000rpm.toml' with
+        numerics.rotations=1>``: its name, model, where it came from and the overrides applied to it
+        (:meth:`overrides_text`)."""
         model = self.__dict__.get("model_")
         if model is None:  # not filled in yet (unpickling)
             return f"<{type(self).__name__} (empty)>"
-        return f"<{type(self).__name__} {model.name!r}: {model.model} model, from {self.source!r}>"
+        return (f"<{type(self).__name__} {model.name!r}: {model.model} model, from {self.source!r}"
+                f"{self.overrides_text()}>")
+
+    @property
+    def overrides(self) -> tuple[str, ...]:
+        """The overrides applied to the values of :attr:`source`, as ``KEY=VALUE`` texts in the order applied:
+        :func:`load_scenario`'s ``overrides`` (as written) and ``values`` (``repr`` of each value), then
+        :meth:`replace`'s keys. Empty for a scenario as its source holds it (an archive's: its resolved values)."""
+        return self.__dict__.get("_overrides", ())
+
+    def overrides_text(self) -> str:
+        """`` with A=1, B=2, C=3 and 2 more``: the first :data:`REPR_OVERRIDES` :attr:`overrides` on one line
+        ("" without any), for reprs."""
+        given = [" ".join(o.split()) for o in self.overrides]
+        n = self.REPR_OVERRIDES
+        if not given:
+            return ""
+        return f" with {', '.join(given[:n])}" + (f" and {len(given) - n} more" if len(given) > n else "")
 
     def __eq__(self, other) -> bool:
         """Two scenarios are equal when they resolve to the same values (wherever they came from)."""
@@ -399,7 +422,9 @@ class Scenario:
         raw = self.raw
         for key, value in dotted.items():
             _set_dotted(raw, key, value, origin="replace()")
-        return _validate(raw, self.source)
+        new = _validate(raw, self.source)
+        new._overrides = self.overrides + tuple(f"{k}={v!r}" for k, v in dotted.items())
+        return new
 
 
 _TOML_TABLES: dict[tuple[str, str], str] = {}  # (table name, repr of its content) -> its TOML text
@@ -664,9 +689,11 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
         given[key] = f"{key}={value!r}"
     raw.setdefault("name", Path(path).stem)
     try:
-        return resolve(raw, str(path))
+        scenario = resolve(raw, str(path))
     except UserError as exc:
         raise _with_override(exc, str(path), given) from None
+    scenario._overrides = tuple(given.values())
+    return scenario
 
 
 #: a dotted scenario key as a message names it (``bearing.pocket_clearance_mm``)

@@ -531,7 +531,7 @@ def test_a_scenario_has_a_short_repr_naming_it_its_model_and_its_file(base_reduc
     path = SCENARIOS / "multibody_3000rpm.toml"
     sc = load_scenario(path)
     assert repr(sc) == f"<Scenario 'multibody_3000rpm': multibody model, from {str(path)!r}>"
-    assert repr(sc.replace(name="x")) == f"<Scenario 'x': multibody model, from {str(path)!r}>"
+    assert repr(sc.replace(name="x")) == f"<Scenario 'x': multibody model, from {str(path)!r} with name='x'>"
     assert repr(resolve(base_reduced)) == "<Scenario 't': reduced model, from '<dict>'>"
     assert repr(pickle.loads(pickle.dumps(sc))) == repr(sc) and "\n" not in repr(sc)
 
@@ -614,3 +614,23 @@ def test_an_unknown_key_that_ends_one_known_key_is_told_that_key(given, meant):
     with pytest.raises(UserError) as err:
         bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={given: 1})
     assert str(err.value).endswith(f"{given}: unknown key (did you mean {meant}?)"), str(err.value)
+
+
+def test_the_repr_of_a_scenario_and_its_result_shows_its_overrides():
+    """Two scenarios of one file with different overrides printed alike, and a 500 rpm run of
+    paper_3000rpm.toml printed as ``<ReducedResult 'paper_3000rpm': ...>``: the repr names the overrides in the
+    order given (``overrides``, then ``set``, then ``replace``), the first three and how many more."""
+    path = SCENARIOS / "paper_3000rpm.toml"
+    plain = bearingsim.load_scenario(path)
+    slow = bearingsim.load_scenario(path, overrides=["numerics.rotations=1"],
+                                    set={"operating.inner_ring_speed_rpm": 500})
+    head = f"<Scenario 'paper_3000rpm': reduced model, from {str(path)!r}"
+    assert repr(plain) == head + ">"
+    assert repr(slow) == head + " with numerics.rotations=1, operating.inner_ring_speed_rpm=500>", repr(slow)
+    many = slow.replace(**{"contact.restitution": 0.5, "operating.direction": "reverse"})
+    assert repr(many) == head + (" with numerics.rotations=1, operating.inner_ring_speed_rpm=500, "
+                                 "contact.restitution=0.5 and 1 more>"), repr(many)
+    assert many.overrides[-1] == "operating.direction='reverse'" and plain.overrides == ()
+    r = bearingsim.run(slow)
+    assert repr(r).startswith("<ReducedResult 'paper_3000rpm' with numerics.rotations=1, "
+                              "operating.inner_ring_speed_rpm=500: I_dec_mean_Ns="), repr(r)

@@ -153,7 +153,8 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
         x = value_of(scenario, k)
         if relative and (not isinstance(x, (int, float)) or isinstance(x, bool) or x == 0):
             if given:
-                raise UserError(f"{given_by(origin, k)}: its value ({x!r}) has no relative step; give the key a nonzero number")
+                raise UserError(f"{given_by(origin, k)}: its value ({x!r}) has no relative step; give the key a "
+                                f"nonzero number")
             if left_out is not None:
                 left_out.append((k, f"its value is {x!r}: a relative step x (1 ± step) cannot move it"))
             continue

@@ -140,7 +140,8 @@ class Uncertainty(Study):
             raise UserError(f"--seed {seed!r}: give an integer from 0 to {MAX_SEED} (2**63 - 1, the largest the "
                             f"study's table stores)")
         self.scenario, self.samples, self.seed = scenario, samples, seed
-        self.keys = check_keys(scenario, keys, relative=False, origin=origin)  # the ranges are sampled: any value of the key
+        # the ranges are sampled: any value of the key
+        self.keys = check_keys(scenario, keys, relative=False, origin=origin)
         total = samples * (len(self.keys) + 2)
         if total > MAX_SWEEP_CASES:  # counted before any case is built, as a sweep's
             raise UserError(f"--samples {samples}: {total} cases ({samples} x {len(self.keys) + 2}: the samples A, B and "

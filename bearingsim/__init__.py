@@ -14,11 +14,26 @@ Every module and subpackage is an attribute of the package on first use (``beari
 ``bearingsim.studies.life.read_life`` after a plain ``import bearingsim``): imported then, not before
 (PEP 562), so ``import bearingsim`` stays light.
 """
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
 from bearingsim._version import __version__  # noqa: E402
 from bearingsim.errors import SimulationUnstable, UnreadKeyWarning, UserError  # noqa: E402
 
+if TYPE_CHECKING:  # the annotations' classes; imported when used, so that `import bearingsim` stays light
+    import os
+    from pathlib import Path
 
-def load_scenario(path, set: dict | None = None, overrides: list[str] | None = None):
+    from bearingsim.results import Result
+    from bearingsim.scenario import Scenario
+    from bearingsim.studies.sensitivity import SensitivityResult
+    from bearingsim.studies.uncertainty import UncertaintyResult
+    from bearingsim.sweeps.engines import DaskEngine, LocalEngine
+
+
+def load_scenario(path: str | os.PathLike[str], set: dict[str, Any] | None = None,
+                  overrides: list[str] | None = None) -> Scenario:
     """Read a scenario file, merge its preset and the package defaults, apply overrides, validate.
 
     Parameters
@@ -46,7 +61,8 @@ def load_scenario(path, set: dict | None = None, overrides: list[str] | None = N
     return sc
 
 
-def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None, check_step: bool = False):
+def run(scenario: Scenario, *, progress: bool = False, sink: Any = None, dt: float | None = None,
+        check_step: bool = False) -> Result:
     """Run a resolved scenario (see :func:`bearingsim.simulation.run`) and return its result; ``check_step``:
     run it again at half its time step and note the change of each mean impulse (``bearingsim run --check-step``).
 
@@ -70,14 +86,15 @@ def run(scenario, *, progress: bool = False, sink=None, dt: float | None = None,
     return result
 
 
-def load(path):
+def load(path: str | os.PathLike[str]) -> Result:
     """Read an archive back into its result (:func:`bearingsim.simulation.load`)."""
     from bearingsim.simulation import load as _load
 
     return _load(path)
 
 
-def sensitivity(scenario, outdir=None, *, keys=None, step: float = 0.10, jobs: int = 1, engine=None):
+def sensitivity(scenario: Scenario, outdir: str | os.PathLike[str] | None = None, *, keys: list[str] | None = None,
+                step: float = 0.10, jobs: int = 1, engine: LocalEngine | DaskEngine | None = None) -> SensitivityResult:
     """Normalised sensitivities of I_dec, I_acc, cage slip and eccentricity to every ranged key
     (:func:`bearingsim.studies.sensitivity.run_sensitivity`, docs/sensitivity.md): ``.table``,
     ``.plot_tornado()``. ``outdir`` keeps the case archives (None: a temporary folder)."""
@@ -86,7 +103,9 @@ def sensitivity(scenario, outdir=None, *, keys=None, step: float = 0.10, jobs: i
     return run_sensitivity(scenario, outdir, keys, step, jobs=jobs, engine=engine)
 
 
-def uncertainty(scenario, samples: int, outdir=None, *, seed: int = 0, keys=None, jobs: int = 1, engine=None):
+def uncertainty(scenario: Scenario, samples: int, outdir: str | os.PathLike[str] | None = None, *, seed: int = 0,
+                keys: list[str] | None = None, jobs: int = 1,
+                engine: LocalEngine | DaskEngine | None = None) -> UncertaintyResult:
     """Every ranged key sampled over its range (Sobol' design, N (k + 2) runs): median and 5-95 %
     interval of each headline number and first-order and total Sobol indices with bootstrap intervals
     (:func:`bearingsim.studies.uncertainty.run_uncertainty`): ``.table``, ``.spread``, ``.plot_indices()``."""
@@ -95,7 +114,8 @@ def uncertainty(scenario, samples: int, outdir=None, *, seed: int = 0, keys=None
     return run_uncertainty(scenario, outdir, samples, seed, keys, jobs=jobs, engine=engine)
 
 
-def report(path, out=None, *, animation: str | None = "gif"):
+def report(path: str | os.PathLike[str], out: str | os.PathLike[str] | None = None, *,
+           animation: str | None = "gif") -> Path:
     """Write one self-contained HTML report of a run archive, or of a sweep or study folder, to ``out``
     (None: beside ``path``, named after it) and return its path (:func:`bearingsim.reports.report`,
     docs/report.md)."""
@@ -104,7 +124,7 @@ def report(path, out=None, *, animation: str | None = "gif"):
     return _report(path, out, animation=animation)
 
 
-def animate(path, out, **kw):
+def animate(path: str | os.PathLike[str], out: str | os.PathLike[str], **kw: Any) -> Path:
     """Animate the motion stored in a multibody archive into ``out`` (.mp4 or .gif) and return its path
     (:func:`bearingsim.simulation.animate`, docs/animation.md)."""
     from bearingsim.simulation import animate as _animate

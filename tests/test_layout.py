@@ -300,3 +300,31 @@ def test_the_checkout_commits_no_results_and_nothing_beside_its_layout():
     assert not strays, f"committed outside the layout: {strays}"
     assert not results, f"results committed (outputs/ is for them, ignored by git): {results}"
     assert [f for f in files if f.startswith("outputs/")] == ["outputs/.gitkeep"]
+
+
+def test_the_package_is_typed_and_its_public_functions_are_annotated():
+    """PEP 561: ``bearingsim/py.typed`` marks the package as typed and is installed with it (package data); every
+    function of ``bearingsim.__all__`` annotates its parameters and its return, and the annotations name what
+    exists (resolved with the names the module imports for type checking only)."""
+    import inspect
+    import tomllib
+    import typing
+
+    import bearingsim
+
+    assert (PACKAGE / "py.typed").is_file()
+    data = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["bearingsim"]
+    assert "py.typed" in data, data
+    checking = {}  # the names imported under `if TYPE_CHECKING:` in bearingsim/__init__.py
+    for node in ast.parse((PACKAGE / "__init__.py").read_text()).body:
+        if isinstance(node, ast.If) and ast.unparse(node.test) == "TYPE_CHECKING":
+            exec(compile(ast.Module(node.body, []), "<TYPE_CHECKING>", "exec"), checking)
+    functions = [n for n in bearingsim.__all__ if inspect.isfunction(getattr(bearingsim, n))]
+    assert {"load_scenario", "run", "load", "animate", "sensitivity", "uncertainty", "report"} <= set(functions)
+    for name in functions:
+        f = getattr(bearingsim, name)
+        sig = inspect.signature(f)
+        bare = [p for p in sig.parameters if sig.parameters[p].annotation is inspect.Parameter.empty]
+        assert not bare and sig.return_annotation is not inspect.Signature.empty, (name, bare, str(sig))
+        hints = typing.get_type_hints(f, globalns={**vars(bearingsim), **checking})
+        assert set(hints) == {*sig.parameters, "return"}, (name, hints)

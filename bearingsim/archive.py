@@ -950,9 +950,11 @@ def _plain(v):
     return v
 
 
-def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str], attrs: dict[str, Any]) -> Path:
+def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str], attrs: dict[str, Any],
+                     descriptions: dict[str, str] | None = None) -> Path:
     """Write a stand-alone table (``/index/<column>`` datasets, root ``attrs``) atomically: a sweep's
-    ``sweep.h5``. String columns are stored as variable-length UTF-8."""
+    ``sweep.h5``. String columns are stored as variable-length UTF-8; a column's ``unit`` and, where
+    ``descriptions`` has one, its ``description`` are attributes of its dataset."""
     h5py = _lazy_h5py()
     path = Path(path)
     tmp = outputs.temporary_name(path)
@@ -969,6 +971,8 @@ def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str]
                     ds = g.create_dataset(name, data=arr)
                 if name in units:
                     ds.attrs["unit"] = units[name]
+                if descriptions and name in descriptions:
+                    ds.attrs["description"] = descriptions[name]
         os.replace(tmp, path)
     except BaseException:
         tmp.unlink(missing_ok=True)
@@ -1098,31 +1102,33 @@ def is_grid_file(path, fmt: str) -> bool:
     return root_format(path) == fmt
 
 
-def table_units(path) -> dict[str, str]:
-    """The ``unit`` of every column of a table file (:func:`write_table_file`) that has one."""
+def table_units(path, attr: str = "unit") -> dict[str, str]:
+    """The ``unit`` (or another text ``attr``: ``description``) of every column of a table file
+    (:func:`write_table_file`) that has one."""
     p = Path(path)
     with _lazy_h5py().File(p, "r") as f, reading(p, "table"):
-        return {name: _plain(ds.attrs["unit"]) for name, ds in f["index"].items() if "unit" in ds.attrs}
+        return {name: _plain(ds.attrs[attr]) for name, ds in f["index"].items() if attr in ds.attrs}
 
 
 def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[str], lines: list[str],
                    noun: str = "row") -> str:
     """Listing of an index table (a sweep's ``sweep.h5``, a cross-check's ``crosscheck.h5``): what it is,
     how many rows (counted as ``noun``: a sweep's are cases, a life history's stages) and by status, the
-    ``lines`` the caller adds, then every column with its unit."""
+    ``lines`` the caller adds, then every column with its unit and its description, where it has one."""
     n = len(cols[columns[0]]) if columns else 0
     status = cols.get("status")
     by = {}
     for v in (status if status is not None else []):
         by[str(v)] = by.get(str(v), 0) + 1
     counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
-    units = table_units(path)
+    units, said = table_units(path), table_units(path, "description")
     out = [f"{path}: {what}: {counted(n, noun)}{counts}", *lines, "columns:"]
     for c in columns:
         arr = np.asarray(cols[c])
         kind = "text" if arr.dtype.kind in "OUS" else "number"
         unit = units.get(c, "")
-        out.append(f"  {c:32s} {kind}" + (f" [{unit}]" if unit and unit != "1" else ""))
+        out.append(f"  {c:32s} {kind}" + (f" [{unit}]" if unit and unit != "1" else "")
+                   + (f": {said[c]}" if said.get(c) else ""))
     return "\n".join(out)
 
 

@@ -144,7 +144,9 @@ def _describe_study_table(path) -> tuple[str, str | None] | None:
 
                 name = tomllib.loads(meta["scenario"]).get("name")
             lines = [f"scenario {name or '?'} (its TOML: 'bearingsim show {path}')"]
-            lines += [f"{k}: {meta[k]}" for k in ("step", "samples", "runs", "seed", "limit", "stages", "rotations", "left_out") if k in meta]
+            shown = ("step", "samples", "runs", "seed", "limit", "stages", "rotations", "left_out")
+            lines += [f"{k}: {meta[k]}" + (" recorded cage rotations per stage" if k == "rotations" else "")
+                      for k in shown if k in meta]
             if fmt == life.LIFE_FORMAT:
                 lines += _life_lines(meta)
             return archive.describe_table(path, what, cols, columns, lines, noun=noun), meta.get("scenario")

@@ -59,6 +59,15 @@ TOPICS = {
                 "the cage's density enters through its mass and inertia, both in proportion (docs/whatif.md, "
                 "Cage material)"),
 }
+#: what a key counts, in the table's source column: these count the cage's rotations, not the inner ring's
+#: (which turns inner-ring speed / cage speed times as often)
+KEY_MEANINGS = {
+    "numerics.rotations": "counts recorded cage rotations (not inner-ring rotations)",
+    "numerics.warmup_rotations": "counts cage rotations run before the recorded ones (not inner-ring rotations)",
+    "output.motion_rotations": "counts cage rotations (not inner-ring rotations)",
+    "output.motion_start_rotation": "the recorded cage rotation the motion starts at",
+    "output.motion_samples_per_rotation": "poses per cage rotation",
+}
 #: longest preset reference shown in the table (the whole of it with --why)
 WHERE_CHARS = 60
 
@@ -257,7 +266,8 @@ def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = Fal
         return ""
     head = ("key", "unit", "type and bounds", "default", "source")
     cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,
-              k.source + (f"; plausible {k.plausible}" if k.plausible else "")
+              k.source + (f"; {KEY_MEANINGS[k.key]}" if k.key in KEY_MEANINGS else "")
+              + (f"; plausible {k.plausible}" if k.plausible else "")
               + (f"; not used by the {', '.join(k.unused_by)} model" if k.unused_by else ""))
              for k in rows]
     widths = [max([len(h)] + [len(c[j]) for c in cells]) for j, h in enumerate(head[:-1])]

@@ -303,8 +303,8 @@ def format_comparison(labels: list[str], reports: list[WearReport], notes: list[
     k and H of each, each face's worn volume mean over pockets with its standard error (batch means over the
     recorded rotations), the deepest point and whether a cage bar wears through; ``notes`` above it (the
     scenario keys that differ)."""
-    head = ("archive", "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]", "rotations",
-            "cage bar")
+    head = ("archive", "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]",
+            "cage rotations", "cage bar")
     rows = []
     for label, rep in zip(labels, reports):
         def mean(face):
@@ -319,8 +319,8 @@ def format_comparison(labels: list[str], reports: list[WearReport], notes: list[
                                    for j, (c, w) in enumerate(zip(cells, widths))).rstrip()
     out = [*notes, line(head), *(line(r) for r in rows)]
     out.append("V: worn volume of one face, mean over pockets \u00b1 its standard error (batch means over the "
-               "recorded rotations the archive extrapolates from, 'rotations'); deepest: any face's deepest point, "
-               "an end bin's as a rule, the scenario's own starting depth included (docs/wear.md); cage bar: "
+               "recorded cage rotations the archive extrapolates from, 'cage rotations'); deepest: any face's deepest "
+               "point, an end bin's as a rule, the scenario's own starting depth included (docs/wear.md); cage bar: "
                "whether the two faces on one bar, starting depth included, wear through it ('bearingsim wear ARCHIVE' "
                "gives one archive's whole report)")
     return "\n".join(out)

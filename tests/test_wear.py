@@ -1172,9 +1172,9 @@ def test_a_life_figure_says_what_it_is_of():
     sc = load_scenario(SCENARIOS / "wear_test_6000rpm.toml", ["wear.wear_coefficient=6e-4"])
     line = _life_subtitle({"scenario": sc.to_toml(), "mapping": "shape", "rotations": 10})
     assert line == ("wear_test_6000rpm: 6000 rpm, 922 N; Archard k = 0.0006, H = 1.5e+09 Pa (the life scales as "
-                    "H / k); shape mapping, 10 recorded rotations per stage")
+                    "H / k); shape mapping, 10 recorded cage rotations per stage")
     assert _life_subtitle({}) == ("?: ?, ?; Archard k = ?, H = ? (the life scales as H / k); ? mapping, ? recorded "
-                                  "rotations per stage")
+                                  "cage rotations per stage")
 
 
 def test_a_scenarios_wear_coefficient_of_0_is_refused_as_an_argument_of_0_is(tmp_path, capsys):
@@ -1418,3 +1418,43 @@ def test_sliding_work_per_normal_impulse_is_the_rollers_surface_speed_relative_t
         work, jn = res.per_rotation[f"slide_work_{face}"].sum(), res.per_rotation[f"Jn_{face}"].sum()
         assert jn > 0.0
         assert work / jn == pytest.approx(surface, rel=0.03), (face, work / jn, surface)
+
+
+def test_every_count_of_rotations_says_which_body_turns(fast_run, tmp_path, capsys):
+    """`numerics.rotations` and `life --rotations` count cage rotations, `wear --rotations` and the life
+    history's rotations the inner ring's (2.3 times as many at 6000 rpm), and the life table's header said
+    `rotations`, its progress line 'worn on for N rotations', `keys numerics.rotations` nothing and life.h5's
+    datasets only the unit 1. Each now names the body: the table's `shaft rotations`, the progress line's and
+    life.h5's 'inner-ring (shaft) rotations' (its datasets' description, listed by inspect), inspect's and the
+    figure's 'recorded cage rotations per stage', the keys table's 'recorded cage rotations', and the wear
+    comparison's 'cage rotations' (the recorded ones it extrapolates from)."""
+    import shutil
+
+    import h5py
+
+    from bearingsim.cli import main
+
+    out_dir = tmp_path / "l"
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "depth=1mm", "--stages", "1",
+                 "--rotations", "1", "--set", "multibody.raceway_contact=rigid", "-o", str(out_dir)])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert re.search(r"worn on for [0-9.e+]+ inner-ring \(shaft\) rotations, deepest", out + err), out + err
+    head = next(ln for ln in out.splitlines() if ln.lstrip().startswith("stage "))
+    assert "shaft rotations" in head and " rotations " not in head.replace("shaft rotations", ""), head
+    with h5py.File(out_dir / "life.h5", "r") as f:
+        for name in ("stage_rotations", "rotations_end"):
+            assert "inner-ring (shaft) rotations" in f["index"][name].attrs["description"]
+    assert main(["inspect", str(out_dir / "life.h5")]) == 0
+    listed = capsys.readouterr().out.splitlines()
+    assert "rotations: 1 recorded cage rotations per stage" in listed, listed
+    assert any(ln.split()[0] == "rotations_end" and "inner-ring (shaft) rotations" in ln for ln in listed), listed
+    assert main(["keys", "numerics.rotations"]) == 0
+    assert "recorded cage rotations" in capsys.readouterr().out
+    other = tmp_path / "again.h5"
+    shutil.copy(fast_run[1], other)
+    assert main(["wear", str(fast_run[1]), str(other), "--hours", "1", "--no-plots"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    head = next(ln for ln in lines if ln.startswith("archive "))
+    assert re.split(r"\s{2,}", head.strip())[7] == "cage rotations", lines
+    assert "recorded cage rotations the archive extrapolates from" in lines[-1]

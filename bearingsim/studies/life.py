@@ -370,8 +370,8 @@ class LifeStudy(Study):
         self.rows.append(_row(j, clearance, res, rate, n_stage, st, record["status"] == "cached"))
         if self.progress:
             self.progress(f"stage {j:02d} of {self.planned}: {'reused' if self.rows[-1]['reused'] else 'run'}, "
-                          f"I_dec {res.summary['I_dec_mean_Ns'] * 1e3:.4g} mN s; worn on for {n_stage:.4g} rotations, "
-                          f"deepest worn point {st.depth.max() * 1e6:.4g} um"
+                          f"I_dec {res.summary['I_dec_mean_Ns'] * 1e3:.4g} mN s; worn on for {n_stage:.4g} inner-ring "
+                          f"(shaft) rotations, deepest worn point {st.depth.max() * 1e6:.4g} um"
                           + ("; the cage bar wears through: the life ends here" if self.worn_through else ""))
         if j + 1 == self.planned or self.worn_through:
             return []
@@ -398,7 +398,7 @@ class LifeStudy(Study):
         if len(self.rows) < self.planned and not self.worn_through:
             return []
         cols, attrs = self.columns(), self.attrs()
-        archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs)
+        archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs, LIFE_DESCRIPTIONS)
         return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
 
     def attrs(self) -> dict:
@@ -502,6 +502,16 @@ LIFE_UNITS = {"stage": "1", "clearance_start_mm": "mm", "stage_rotations": "1", 
               "hours_end": "h", "max_depth_rate_um_per_h": "um/h", "max_volume_rate_mm3_per_h": "mm^3/h",
               "max_depth_um": "um", "max_volume_mm3": "mm^3", "clearance_end_mm": "mm", "I_dec_mean_mNs": "mN s",
               "reused": "1", "psi_deg": "deg", "worn_depth_front_um": "um", "worn_depth_rear_um": "um"}
+#: what the history's columns are (their datasets' ``description`` in ``life.h5``, which ``inspect`` lists); the
+#: rotations are the inner ring's, as the stage's time: the recorded cage rotations per stage are the root's
+#: ``rotations``
+LIFE_DESCRIPTIONS = {
+    "stage_rotations": "inner-ring (shaft) rotations the stage wears on for",
+    "rotations_end": "inner-ring (shaft) rotations from the start to the stage's end",
+    "hours_end": "running time from the start to the stage's end",
+    "clearance_start_mm": "effective pocket clearance at the stage's start (worst pocket: s + mean worn depth)",
+    "clearance_end_mm": "effective pocket clearance at the stage's end (worst pocket: s + mean worn depth)",
+}
 
 
 #: the history's column of the effective pocket clearance at a stage's start, under the name it had before
@@ -537,7 +547,7 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
 #: pocket clearance the stage ran at (the worst pocket's s plus its front and rear mean worn depth), not the
 #: scenario's s, which the shape mapping keeps
 HISTORY_TABLE = (("stage", "stage", 5, "d"), ("clearance_start_mm", "s_eff [mm]", 10, ".4f"),
-                 ("stage_rotations", "rotations", 11, ".4g"), ("hours_end", "h at end", 9, ".4g"),
+                 ("stage_rotations", "shaft rotations", 15, ".4g"), ("hours_end", "h at end", 9, ".4g"),
                  ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
                  ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
 #: the columns of a volume limit's quantity in place of the deepest point's (:func:`history_table`)
@@ -644,8 +654,8 @@ def _life_subtitle(attrs: dict) -> str:
         return f"{v:g} {unit}" if isinstance(v, (int, float)) and not isinstance(v, bool) else "?"
     return (f"{sc.get('name', '?')}: {num(op, 'inner_ring_speed_rpm', 'rpm')}, {num(op, 'radial_load_N', 'N')}; "
             f"Archard k = {num(wr, 'wear_coefficient', '').strip()}, H = {num(wr, 'hardness_Pa', 'Pa')} (the life "
-            f"scales as H / k); {attrs.get('mapping', '?')} mapping, {attrs.get('rotations', '?')} recorded rotations "
-            f"per stage")
+            f"scales as H / k); {attrs.get('mapping', '?')} mapping, {attrs.get('rotations', '?')} recorded cage "
+            f"rotations per stage")
 
 
 def _plot_worn_faces(ax, cols: dict) -> None:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 from pydantic import BaseModel
 
-from bearingsim.sweeps.index import unit_of
+from bearingsim.sweeps.index import DRAG_COEFFICIENT_UNIT, unit_of
 
 #: the sources of the package defaults that have one (bearingsim/scenario.py DEFAULTS, beside each value)
 DEFAULT_SOURCES = {
@@ -38,8 +38,8 @@ DEFAULT_REASONS = {
         "contact.restitution=0 [--set reduced.resting_contact=false])"),
 }
 #: the units of the keys whose names carry none (:func:`bearingsim.sweeps.index.unit_of` reads a name's suffix):
-#: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md), is N^0.754 (s/m)^0.648
-KEY_UNITS = {"lubrication.drag_coefficient": "N^0.754 (s/m)^0.648"}
+#: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md)
+KEY_UNITS = {"lubrication.drag_coefficient": DRAG_COEFFICIENT_UNIT}
 #: words an engineer looks for that no key's name holds: the keys through which they enter, and how
 #: (``bearingsim keys WORD`` answers with those keys and this line)
 TOPICS = {

@@ -217,6 +217,28 @@ def test_validate_refuses_a_rig_rotations_it_cannot_run(n, words, tmp_path, caps
     assert not (tmp_path / "v").exists()
 
 
+def test_the_validate_studys_index_gives_its_speed_and_drag_coefficient_their_units(tmp_path, capsys):
+    """validate's sweep.h5 stored `rpm` and `drag` (the drag coefficient c) with unit '1', as if dimensionless:
+    `rpm` is in rpm (as crosscheck.h5 has it) and `drag` in c's unit, the one `bearingsim keys
+    lubrication.drag_coefficient` gives; `inspect` lists them so."""
+    import h5py
+
+    from bearingsim.cli import main
+
+    assert main(["keys", "lubrication.drag_coefficient"]) == 0
+    row = capsys.readouterr().out.splitlines()[1].split()
+    c_unit = " ".join(row[1:3])
+    assert c_unit == "N^0.754 (s/m)^0.648", row
+    assert main(["validate", "--rig-rotations", "0", "-j", "1", "-q", "-o", str(tmp_path / "v")]) == 0
+    with h5py.File(tmp_path / "v" / "sweep.h5", "r") as f:
+        assert f["index/rpm"].attrs["unit"] == "rpm" and f["index/drag"].attrs["unit"] == c_unit
+    capsys.readouterr()
+    assert main(["inspect", str(tmp_path / "v" / "sweep.h5")]) == 0
+    listed = capsys.readouterr().out.splitlines()
+    assert any(ln.split()[:3] == ["drag", "number", "[N^0.754"] for ln in listed), listed
+    assert any(ln.split() == ["rpm", "number", "[rpm]"] for ln in listed), listed
+
+
 @pytest.mark.slow
 def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
     """The rungs sent to a dask cluster (a LocalCluster of one worker process, ended with the block) come

@@ -225,8 +225,18 @@ UNITS = (("_kgm2", "kg m²"), ("_N_m", "N/m"), ("_Nms", "N m s"), ("_Ns", "N s")
          ("_J", "J"), ("_s", "s"), ("_um", "µm"), ("_m", "m"))
 
 
+#: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md)
+DRAG_COEFFICIENT_UNIT = "N^0.754 (s/m)^0.648"
+#: the units of the names whose suffix carries none: the drag coefficient's key, and the validate study's
+#: columns of its cases (``rpm``: the inner ring's speed; ``drag``: the drag coefficient c)
+NAMED_UNITS = {"lubrication.drag_coefficient": DRAG_COEFFICIENT_UNIT, "drag": DRAG_COEFFICIENT_UNIT, "rpm": "rpm"}
+
+
 def unit_of(key: str) -> str:
-    """Unit from a key's suffix (``operating.inner_ring_speed_rpm`` -> ``rpm``); ``1`` if none."""
+    """Unit of a name (:data:`NAMED_UNITS`), else from its suffix (``operating.inner_ring_speed_rpm`` ->
+    ``rpm``); ``1`` if none."""
+    if key in NAMED_UNITS:
+        return NAMED_UNITS[key]
     leaf = key.split(".")[-1]
     for suffix, unit in UNITS:
         if leaf.endswith(suffix):

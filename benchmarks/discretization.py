@@ -207,7 +207,8 @@ def life(bins=(16, 32, 64), sets=(), limit="depth=0.1mm"):
     from bearingsim.multibody import recorder
 
     saved = recorder.accumulators.__defaults__, recorder.FACE_BINS
-    print("| bins of psi | rotations to the limit | hours | deepest point's rate, first / last stage [mm/h] | I_dec, first / last stage [mN s] |")
+    print("| bins of psi | inner-ring rotations to the limit | hours | fastest point's depth rate, first / last stage "
+          "[mm/h] | I_dec, first / last stage [mN s] |")
     print("|---|---|---|---|---|")
     try:
         for nb in bins:

@@ -258,7 +258,7 @@ def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "t
     ("sens", "sensitivity", ["contact.restitution", "lubrication.drag_coefficient", "d ln y / d ln x"]),
     ("unc", "uncertainty", ["Sobol indices", "2 base samples, 8 runs, seed 0", "contact.restitution"]),
     ("cc", "crosscheck", ["centred_cage", "largest change of I_dec"]),
-    ("life", "life", ["clearance=0.23mm", "deepest [um]", "depth rate [um/h]"]),
+    ("life", "life", ["clearance=0.23mm", "deepest [um]", "depth rate, fastest point [um/h]"]),
     ("val", "validate", ["Fig. 9 analog", "previous c = 0.02", "pocket 0 I_dec", "rig_idec_vs_speed.png"]),
 ])
 def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name, kind, words):

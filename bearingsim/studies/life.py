@@ -511,6 +511,9 @@ LIFE_DESCRIPTIONS = {
     "hours_end": "running time from the start to the stage's end",
     "clearance_start_mm": "effective pocket clearance at the stage's start (worst pocket: s + mean worn depth)",
     "clearance_end_mm": "effective pocket clearance at the stage's end (worst pocket: s + mean worn depth)",
+    "max_depth_rate_um_per_h": "the fastest point's depth rate in the stage: the largest of any point of any face, "
+                               "which drives a depth limit (not the deepest point's own rate)",
+    "max_volume_rate_mm3_per_h": "the largest worn-volume rate of any face in the stage",
 }
 
 
@@ -548,16 +551,19 @@ def _row(j, clearance, res, rate, n_stage, st, reused) -> dict:
 #: scenario's s, which the shape mapping keeps
 HISTORY_TABLE = (("stage", "stage", 5, "d"), ("clearance_start_mm", "s_eff [mm]", 10, ".4f"),
                  ("stage_rotations", "shaft rotations", 15, ".4g"), ("hours_end", "h at end", 9, ".4g"),
-                 ("max_depth_rate_um_per_h", "depth rate [um/h]", 18, ".4g"), ("max_depth_um", "deepest [um]", 13, ".4g"),
+                 ("max_depth_rate_um_per_h", "depth rate, fastest point [um/h]", 32, ".4g"),
+                 ("max_depth_um", "deepest [um]", 13, ".4g"),
                  ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
-#: the columns of a volume limit's quantity in place of the deepest point's (:func:`history_table`)
+#: the columns of a volume limit's quantity in place of the deepest point and the fastest point's depth rate
+#: (:func:`history_table`)
 VOLUME_COLUMNS = {"max_depth_rate_um_per_h": ("max_volume_rate_mm3_per_h", "volume rate [mm3/h]", 19, ".4g"),
                   "max_depth_um": ("max_volume_mm3", "largest volume [mm3]", 20, ".4g")}
 
 
 def history_table(limit: str | None = None) -> tuple:
     """:data:`HISTORY_TABLE` for a study to ``limit`` (its text, ``volume=2mm3``): for a volume limit, the
-    quantity it reads, the largest worn volume of a face, and its rate in place of the deepest point's."""
+    quantity it reads, the largest worn volume of a face, and its rate in place of the deepest point and the
+    fastest point's depth rate (the largest of any point, which a depth limit reads)."""
     if str(limit or "").split("=")[0].strip() != "volume":
         return HISTORY_TABLE
     return tuple(VOLUME_COLUMNS.get(c[0], c) for c in HISTORY_TABLE)
@@ -626,7 +632,7 @@ def plot_life(cols: dict, attrs: dict):
                                                                    cols["clearance_end_mm"]]), "o-", color="C2")
     axes[1].set_ylabel("effective pocket clearance [mm]\n(worst pocket: s + mean worn depth)")
     axes[2].hlines(cols["max_depth_rate_um_per_h"], h_start, h_end, color="C3")
-    axes[2].set_ylabel("deepest point's wear rate [µm/h]")
+    axes[2].set_ylabel("fastest point's depth rate [µm/h]\n(largest of any point, not the deepest's)")
     axes[2].set_ylim(bottom=0.0)
     for ax in axes[:3]:
         ax.set_xlabel("running time [h]")

@@ -67,6 +67,15 @@ KEY_MEANINGS = {
     "output.motion_rotations": "counts cage rotations (not inner-ring rotations)",
     "output.motion_start_rotation": "the recorded cage rotation the motion starts at",
     "output.motion_samples_per_rotation": "poses per cage rotation",
+    "wear.wear_coefficient": ("Archard's dimensionless k = k' H (k': specific wear rate [m^3/(N m)]; "
+                              "H: wear.hardness_Pa)"),
+}
+#: what the ``--why`` line of a key says first, beside the preset's reasoning
+KEY_WHY = {
+    "wear.wear_coefficient": (
+        "k is Archard's dimensionless wear coefficient, V = k W / H (W: sliding work, H: wear.hardness_Pa). A data "
+        "sheet's specific wear rate k' in m^3/(N m) is k / H, so give k = k' H: k' = 1e-15 m^3/(N m) at H = 1.5e9 Pa "
+        "is k = 1.5e-6; k' given as k reads the wear about 1e9 times low."),
 }
 #: longest preset reference shown in the table (the whole of it with --why)
 WHERE_CHARS = 60
@@ -254,9 +263,16 @@ def _info(key, field, section, name, defaults, preset_values, sources, preset, u
     return KeyInfo(key, unit, kind, default, source, why, models, plausible)
 
 
+def _is_number(kind: str) -> bool:
+    """Whether a key of type and bounds ``kind`` (``int >= 1``, ``float > 0 | "auto"``) takes a number: such a key
+    without a unit shows ``1``, as archives write it; a text or a switch shows none."""
+    return any(part.split(" ")[0] in ("int", "float") for part in kind.split(" | "))
+
+
 def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
     """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, the preset's
-    reasoning for each of its values and each package default it documents on the line below it."""
+    reasoning for each of its values and each package default it documents on the line below it, after what
+    :data:`KEY_WHY` says of the key."""
     rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
     topic = TOPICS.get(pattern.strip().lower()) if pattern and not rows else None
     if topic:  # a word no key's name holds: the keys it enters through, and how
@@ -265,7 +281,7 @@ def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = Fal
     if not rows:
         return ""
     head = ("key", "unit", "type and bounds", "default", "source")
-    cells = [(k.key, "" if k.unit == "1" else k.unit, k.kind, k.default,
+    cells = [(k.key, k.unit if k.unit != "1" or _is_number(k.kind) else "", k.kind, k.default,
               k.source + (f"; {KEY_MEANINGS[k.key]}" if k.key in KEY_MEANINGS else "")
               + (f"; plausible {k.plausible}" if k.plausible else "")
               + (f"; not used by the {', '.join(k.unused_by)} model" if k.unused_by else ""))
@@ -274,6 +290,7 @@ def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = Fal
     lines = ["  ".join(h.ljust(w) for h, w in zip(head[:-1], widths)) + "  " + head[-1]]
     for k, c in zip(rows, cells):
         lines.append("  ".join(v.ljust(w) for v, w in zip(c[:-1], widths)) + "  " + c[-1])
-        if why and k.why:
-            lines.append(" " * 4 + k.why)
+        said = " ".join(w for w in (KEY_WHY.get(k.key, ""), k.why) if w)
+        if why and said:
+            lines.append(" " * 4 + said)
     return "\n".join(lines)

@@ -896,6 +896,12 @@ def unread_note(scenario, keys, method: str | None = "", varied=()) -> str | Non
     return "; ".join(parts) or None
 
 
+#: what a value below its plausible range may be (:func:`out_of_range_note`): a specific wear rate k' [m^3/(N m)]
+#: given as Archard's dimensionless k = k' H reads the wear ~1e9 times low
+BELOW_RANGE = {"wear.wear_coefficient": "; k is Archard's dimensionless coefficient, k = k' H: a specific wear rate k' "
+                                        "in m^3/(N m) given as k reads the wear about 1e9 times low"}
+
+
 def out_of_range_note(scenario) -> str | None:
     """One line naming the keys of a resolved scenario that are set outside their plausible range (its
     ``[ranges]``, from the preset or the file: what the sensitivity and uncertainty studies sample),
@@ -911,7 +917,7 @@ def out_of_range_note(scenario) -> str | None:
         lo, hi, _ = ranged[k]
         v = value_of(scenario, k)
         if isinstance(v, (int, float)) and not isinstance(v, bool) and not lo <= v <= hi:
-            out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g})")
+            out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g}" + (BELOW_RANGE.get(k, "") if v < lo else "") + ")")
     if not out:
         return None
     return (f"bearingsim: note: {'; '.join(out)}: outside the plausible range of the preset's bearing "

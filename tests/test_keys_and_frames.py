@@ -4,6 +4,7 @@ with unit, bounds, default and source (``bearingsim keys``), "did you mean" on a
 from __future__ import annotations
 
 import json
+import re
 import sys
 import tomllib
 from pathlib import Path
@@ -556,3 +557,33 @@ def test_keys_why_says_what_resting_contact_counts():
     assert format_keys(list_keys(), "reduced.resting_contact", why=True).splitlines()[2] == lines[2]
     usage = (SCENARIOS.parent / "docs" / "usage.md").read_text()
     assert "`reduced.resting_contact` (`true`, default) counts" in usage, "usage.md: the key without what it does"
+
+
+def test_keys_shows_1_for_a_dimensionless_number_and_says_what_the_wear_coefficient_is(capsys):
+    """`bearingsim keys` left the unit blank for dimensionless keys (wear.wear_coefficient, contact.restitution,
+    numerics.rotations ...), which archives write as 1, and said nowhere that the wear coefficient is Archard's
+    dimensionless k = k' H: a data sheet's specific wear rate k' = 1e-15 m^3/(N m) given as k reads the wear
+    about 1e9 times low, without a word. The table gives 1 for such a number (none for a text or a switch), the
+    row and its --why line say what k is, and a run's note of k = 1e-15, below its plausible range, says why."""
+    from bearingsim.cli import main
+
+    for key in ("wear.wear_coefficient", "contact.restitution", "contact.cage_friction",
+                "multibody.traction_mu_max", "numerics.rotations"):
+        assert main(["keys", key]) == 0
+        row = next(ln for ln in capsys.readouterr().out.splitlines() if ln.startswith(key + " "))
+        assert row.split()[1] == "1", row
+    assert main(["keys", "multibody.raceway_contact"]) == 0
+    row = capsys.readouterr().out.splitlines()[1]
+    assert row.split()[1] == '"hertz"', row  # a text key: no unit
+    assert main(["keys", "wear.wear_coefficient", "--why"]) == 0
+    out = capsys.readouterr().out
+    assert "Archard's dimensionless k = k' H" in out.splitlines()[1]
+    assert "k is Archard's dimensionless wear coefficient" in out and "1e9 times low" in out
+    plausible = re.search(r"plausible ([0-9.e+-]+)\.\.([0-9.e+-]+)", out)
+    assert not float(plausible.group(1)) <= 1e-15 <= float(plausible.group(2))
+    assert main(["run", str(SCENARIOS / "wear_test_6000rpm.toml"), "--dry-run",
+                 "--set", "wear.wear_coefficient=1e-15"]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"wear\.wear_coefficient = 1e-15 \(plausible [^)]*k is Archard's dimensionless coefficient, "
+                     r"k = k' H: a specific wear rate k' in m\^3/\(N m\) given as k reads the wear about 1e9 "
+                     r"times low\)", err), err

@@ -338,7 +338,8 @@ def _automatic_dt(p, lim: float, play=None) -> tuple[float, str]:
     dti = impact_dt(p, play)
     dt = min(DT_FRACTION * lim, dti, DT_CAP_S)
     how = (f"auto: min of {DT_FRACTION} x 2/omega_n of the stiffest raceway contact "
-           f"(Palmgren, Q_max = {max_roller_load(p):.0f} N; 2/omega_n = {lim:.3e} s), "
+           f"(Palmgren, Q_max ≈ {max_roller_load(p):.0f} N, Stribeck's estimate 5W/Z + m omega_c^2 r_p, not the "
+           f"run's roller loads; 2/omega_n = {lim:.3e} s), "
            f"impact resolution {IMPACT_OVERLAP_FRACTION} s / v_impact = {dti:.3e} s, and {DT_CAP_S:.0e} s"
            + _play_text(p, play))
     if p.multibody.scene == "kinematic_cage":

@@ -1443,6 +1443,24 @@ def _error_lines(f, model) -> list[str]:
     return [f"standard errors (batch means over {len(i_dec)} recorded rotations): {text}"]
 
 
+def _attribute_group_lines(f) -> list[str]:
+    """The numbers an archive stores as attributes of a group under ``/results`` other than the summary (the
+    reduced model's operating point, pass and wear rates): the group, its description, and each number with
+    its unit."""
+    lines = []
+    for name, grp in f["results"].items() if "results" in f else ():
+        if name == "summary" or not hasattr(grp, "keys") or ATTRS_JSON not in grp.attrs:
+            continue
+        values, units = group_attrs(grp)
+        said = _plain(grp.attrs["description"]) if "description" in grp.attrs else ""
+        lines.append(f"/results/{name}:" + (f" {said}" if said else ""))
+        for k in sorted(values):
+            v = values[k]
+            vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
+            lines.append(f"  {k:32s} {vs} {units.get(k, '')}".rstrip())
+    return lines
+
+
 def describe(path: str | Path) -> str:
     """Human-readable listing of an archive: header, provenance, summary, then every dataset."""
     f = open_archive(path)
@@ -1467,6 +1485,7 @@ def describe(path: str | Path) -> str:
                 vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
                 lines.append(f"  {k:32s} {vs} {unit}")
             lines += _error_lines(f, g.attrs["model"])
+        lines += _attribute_group_lines(f)
         lines += _notes_lines(read_notes(f, path))
         lines.append("datasets:")
 

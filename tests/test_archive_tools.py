@@ -213,3 +213,26 @@ def test_inspect_calls_the_automatic_steps_largest_roller_load_an_estimate(multi
     m = re.search(r"Palmgren, Q_max ≈ ([0-9]+) N, Stribeck's estimate 5W/Z \+ m omega_c\^2 r_p, not the run's roller "
                   r"loads; 2/omega_n", res.stdout)
     assert m, res.stdout
+
+
+def test_inspect_of_a_reduced_archive_lists_its_operating_point_pass_and_wear(reduced_archive):
+    """`bearingsim inspect` of a reduced-model archive listed the summary and the datasets only, not the
+    operating point (cage and roller speeds, rolling velocity), the pass or the wear rates that the archive
+    stores, with units, as attributes of /results/operating_point, /results/pass and /results/wear: it lists
+    each group with its numbers and units, as the archive holds them."""
+    from bearingsim.archive import group_attrs
+
+    res = cli("inspect", reduced_archive)
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.splitlines()
+    with h5py.File(reduced_archive, "r") as f:
+        stored = {g: group_attrs(f["results"][g]) for g in ("operating_point", "pass", "wear")}
+    for group, (values, units) in stored.items():
+        (at,) = [i for i, ln in enumerate(lines) if ln.startswith(f"/results/{group}:")]
+        shown = lines[at + 1:at + 1 + len(values)]
+        assert [ln.split()[0] for ln in shown] == sorted(values), (group, shown)
+        for k, line in zip(sorted(values), shown):
+            if isinstance(values[k], float):
+                assert line.split()[1:] == [f"{values[k]:.6g}", *units[k].split()], line
+    assert any(ln.split()[:3] == ["omega_c_rad_s", f"{stored['operating_point'][0]['omega_c_rad_s']:.6g}", "rad/s"]
+               for ln in lines), lines

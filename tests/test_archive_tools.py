@@ -205,9 +205,8 @@ def test_run_on_an_archive_gets_a_hint(reduced_archive):
 
 
 def test_inspect_calls_the_automatic_steps_largest_roller_load_an_estimate(multibody_archive):
-    """The automatic step's provenance said 'Palmgren, Q_max = 351 N' as if the run's largest roller load, while
-    the run's own loads reach 837 N at 0.08 mm clearance: it is Stribeck's a-priori 5W/Z plus the centrifugal
-    load, and `bearingsim inspect` says so."""
+    """The automatic step's Q_max is Stribeck's a-priori 5W/Z plus the centrifugal load, not the run's largest
+    roller load: `bearingsim inspect` calls it an estimate."""
     res = cli("inspect", multibody_archive)
     assert res.returncode == 0, res.stderr
     m = re.search(r"Palmgren, Q_max ≈ ([0-9]+) N, Stribeck's estimate 5W/Z \+ m omega_c\^2 r_p, not the run's roller "

@@ -1461,11 +1461,9 @@ def test_every_count_of_rotations_says_which_body_turns(fast_run, tmp_path, caps
 
 
 def test_the_life_historys_depth_rate_is_called_the_fastest_points_not_the_deepest_points(tmp_path, capsys):
-    """The life table's 'depth rate [um/h]' and life.png's 'deepest point's wear rate' gave the largest depth rate
-    of any point (what drives a depth limit), which is not the deepest point's when another bin is deeper (a
-    stage of the wear-test bearing: 9165 um/h so labelled, its deepest bin wearing at 8472). The table, the
-    figure and life.h5's description of the column (listed by inspect) call it the fastest point's depth rate
-    (the table: 'depth rate, fastest point')."""
+    """The life history's depth rate is the largest of any point (what drives a depth limit), which is not the
+    deepest point's when another bin is deeper. The table, the figure and life.h5's description of the column
+    (listed by inspect) call it the fastest point's depth rate (the table: 'depth rate, fastest point')."""
     from bearingsim.cli import main
     from bearingsim.studies.life import plot_life, read_life
 

@@ -48,7 +48,8 @@ def figures(monkeypatch):
 
     def capture(fig, path, **kw):
         seen[path.name] = {"title": fig._suptitle.get_text() if fig._suptitle else "",
-                           "axes": [{"title": ax.get_title(), "ylabel": ax.get_ylabel(), "xlim": ax.get_xlim(),
+                           "axes": [{"title": ax.get_title(), "ylabel": ax.get_ylabel(), "xlabel": ax.get_xlabel(),
+                                     "xlim": ax.get_xlim(),
                                      "ylim": ax.get_ylim(),
                                      "xticks": [t.get_text() for t in ax.get_xticklabels()],
                                      "yticks": [t.get_text() for t in ax.get_yticklabels()],
@@ -359,3 +360,24 @@ def test_a_long_panel_title_is_wrapped_within_the_figure(tmp_path, drawn):
     fig = drawn["sweep_cases.png"]
     assert _title_inside(fig) == [True, True]
     assert " ".join(fig.axes[1].get_title().split()).endswith("hatched: none (n/a), 12 of 60 bars)")
+
+
+def test_a_zipped_axis_names_every_zipped_key_and_its_values(tmp_path, figures):
+    """A zipped sweep of speed and drag coefficient labelled its x axis "inner ring speed [rpm]" alone, so a
+    rise of I_dec that the drag coefficient (0.01 -> 0.03, zipped) makes read as the speed's; its title put
+    "(zipped)" after the extra cases' keys ("...; cases over restitution, direction (zipped)"). The axis
+    names the zipped key, a second tick row gives its values, and "(zipped)" goes with the zipped keys."""
+    drag = "lubrication.drag_coefficient"
+    points = [{SPEED: s, drag: c} for s, c in ((1000.0, 0.01), (2000.0, 0.015), (4000.0, 0.02), (6000.0, 0.03))]
+    points.append({SPEED: 3000.0, drag: 0.02, "contact.restitution": 0.6})
+    h5 = _index(tmp_path, points, [SPEED, drag, "contact.restitution"], grid=[SPEED, drag], grid_rows=4, mode="zip")
+    plot_sweep_index(h5, tmp_path / "f")
+    fig = figures["sweep_I.png"]
+    for ax in fig["axes"]:
+        assert ax["xticks"] == ["1000\n0.01", "2000\n0.015", "4000\n0.02", "6000\n0.03"], ax["xticks"]
+    labels = {ax["xlabel"] for ax in fig["axes"]}
+    assert labels == {"inner ring speed [rpm]\nzipped with drag coefficient [N^0.754 (s/m)^0.648]\n"
+                      "(its values: the second tick row)"}, labels
+    first = fig["title"].split("\n")[0]
+    assert "inner ring speed, drag coefficient (zipped, 4 cases)" in first, first
+    assert first.endswith("1 case over restitution"), first

@@ -10,7 +10,8 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
   title gives its cells' largest standard error and the difference the tables' test resolves instead of
   bars (:func:`map_title`):
 
-  - one axis, or zipped axes: a line plot against the (first numeric) axis;
+  - one axis, or zipped axes: a line plot against the (first numeric) axis; the other zipped keys' values
+    in a tick row each under its values, named in the axis label (their change is not the axis's);
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
     sampled pair, the sampled values ticked and each cell's value written in it;
   - otherwise: one line per combination of the other axes (at most 8).
@@ -46,6 +47,7 @@ FIGURE_NAMES = ("sweep_I.png", "sweep_map.png", "sweep_cases.png")
 MAX_LINES = 8
 MAX_CASES = 60  # most cases a per-case chart labels one by one
 MAP_TICKS = 20  # most labelled ticks on a heat map's axis (a longer axis labels every k-th value)
+ZIP_TICKS = 10  # most labelled ticks on a zipped sweep's abscissa (each a column of the zipped keys' values)
 MAP_TEXT_CELLS = 20  # most cells along either axis of a heat map that still get their value written
 MAP_PANEL_IN = (3.0, 9.0)  # width of a heat map's panel [in]: 1.2 in per cell within these bounds
 MAP_HEIGHT_IN = (4.2, 12.0)  # height of a heat map [in]: 0.45 in per cell and 2.5 in of titles within these
@@ -79,17 +81,20 @@ def _sampled(col, rows) -> list:
 
 
 def sweep_title(meta: dict, n_cases: int) -> str:
-    """``sweep of inner ring speed × pocket clearance (12 cases)``: the sweep's varied keys."""
+    """``sweep of inner ring speed × pocket clearance (12 cases)``: the sweep's varied keys; zipped keys
+    ``speed, drag coefficient (zipped, 4 cases)``; extra cases ``; 2 cases over restitution, direction``."""
     keys = list(meta.get("axes", []))
     grid = list(meta.get("grid", []))
+    n_grid = min(int(meta.get("grid_rows", n_cases)), n_cases) if grid else 0
     sep = " × " if meta.get("mode") == "product" else ", "
-    names = sep.join(name_of(k) for k in grid) if grid else ""
+    zipped = "zipped, " if meta.get("mode") == "zip" and len(grid) > 1 else ""
+    parts = [f"{sep.join(name_of(k) for k in grid)} ({zipped}{counted(n_grid, 'case')})"] if grid else []
     extra = [k for k in keys if k not in grid]
-    if extra:
-        names = (names + "; " if names else "") + "cases over " + ", ".join(name_of(k) for k in extra)
-    zipped = " (zipped)" if meta.get("mode") == "zip" and len(grid) > 1 else ""
+    if n_cases > n_grid:  # the cases off the grid, with the keys they set
+        parts.append(f"{counted(n_cases - n_grid, 'case')}" + (" over " + ", ".join(map(name_of, extra)) if extra
+                                                               else " off the grid"))
     context = f"\n{meta['context']}" if meta.get("context") else ""  # what the cases share (older indexes: none)
-    return f"sweep of {names or 'cases'}{zipped} ({counted(n_cases, 'case')}){context}"
+    return f"sweep of {'; '.join(parts) or counted(n_cases, 'case')}{context}"
 
 
 def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
@@ -134,8 +139,10 @@ def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,
 def _grid_figure(cols, meta, grid, rows, outdir, title, notes) -> Path | None:
     rows = list(rows)
     numeric = [k for k in grid if _numeric(cols[k]) and np.isfinite(cols[k][rows]).any()]
-    if meta.get("mode") == "zip":  # zipped axes move together: one abscissa
-        return _lines(cols, (numeric or grid)[:1], rows, outdir / "sweep_I.png", title, notes)
+    if meta.get("mode") == "zip":  # zipped axes move together: one abscissa, the others a tick row each
+        x_key = (numeric or grid)[0]
+        return _lines(cols, [x_key], rows, outdir / "sweep_I.png", title, notes,
+                      zipped=[k for k in grid if k != x_key])
     if len(grid) == 2 and len(numeric) != 1:  # both numeric or both text: a map of the pairs
         return _heat_map(cols, meta, grid, rows, outdir / "sweep_map.png", title)
     axes = numeric[:1] + [k for k in grid if k not in numeric[:1]]  # numeric abscissa when there is one
@@ -152,7 +159,7 @@ def _positions(cols, key, rows):
     return x, list(range(len(cats))), cats
 
 
-def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
+def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path | None:
     x_key, others = axes[0], axes[1:]
     x_all, ticks, tick_labels = _positions(cols, x_key, rows)
     groups: dict[tuple, list[int]] = {}
@@ -187,7 +194,9 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
         y = np.asarray(cols.get(f"{name}_mean_Ns", np.full(len(x_all), math.nan)), dtype=float)
         shown = [i for i in drawn if math.isfinite(y[i])]
         ax.set_title(_titled(sym, error_title(_sem_mN_s(cols, name, len(x_all))[shown])), fontsize=9)
-        if ticks is not None:
+        if zipped:
+            _zipped_ticks(ax, cols, x_key, zipped, drawn, x_all, tick_labels)
+        elif ticks is not None:
             ax.set_xticks(ticks, tick_labels)
         elif is_integer_key(x_key):  # a roller count has no 14.5
             from matplotlib.ticker import MaxNLocator
@@ -203,6 +212,26 @@ def _lines(cols, axes, rows, path: Path, title: str, notes) -> Path | None:
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
+
+
+def _zipped_ticks(ax, cols, x_key, zipped, rows, x_all, names=None):
+    """The ticks of a zipped sweep's abscissa: one per value drawn, the zipped keys' values under it (a tick row
+    each), and the axis label naming them, so that no zipped key's change is read as ``x_key``'s. ``names``: a
+    text key's categories by position."""
+    at: dict[float, list[int]] = {}
+    for i in rows:
+        at.setdefault(float(x_all[i]), []).append(i)
+    ticks = sorted(at)
+    labels = []
+    for p in ticks:
+        first = names[int(p)] if names is not None else _show(cols[x_key][at[p][0]])
+        rows_below = ["/".join(dict.fromkeys(_show(cols[k][i]) for i in at[p])) for k in zipped]
+        labels.append("\n".join([first, *rows_below]))
+    step = -(-len(ticks) // ZIP_TICKS)  # a long axis labels every k-th value
+    ax.set_xticks(ticks[::step], labels[::step])
+    rows_named = ("its values: the second tick row" if len(zipped) == 1
+                  else f"their values: tick rows 2-{len(zipped) + 1}")
+    ax.set_xlabel(f"{axis_label(x_key)}\nzipped with {', '.join(map(axis_label, zipped))}\n({rows_named})")
 
 
 def _sem_mN_s(cols, name: str, n: int) -> np.ndarray:

@@ -405,7 +405,7 @@ def _sweep_sections(index: Path):
     from bearingsim import tables
     from bearingsim.sweeps.grid import MAP_NAME, MAP_FORMAT, read_map
     from bearingsim.sweeps.index import read_index
-    from bearingsim.sweeps.plot import plot_sweep_index, sweep_title
+    from bearingsim.sweeps.plot import plot_sweep_index, sweep_title_lines
     from bearingsim import archive
 
     cols, meta = read_index(index)
@@ -414,7 +414,7 @@ def _sweep_sections(index: Path):
     figures += [{"kind": "text", "text": n} for n in notes]
     keys = ", ".join(meta["axes"]) or "(none)"
     # the figures' two-line title: the page's title, and what the cases share, a sentence under it
-    title, _, shared = sweep_title(meta, len(cols["case"])).partition("\n")
+    title, shared = sweep_title_lines(meta, len(cols["case"]))
     head = {"kind": "text", "text": f"Base scenario {meta.get('scenario') or '(cases only)'}; swept keys: {keys}; "
                                     f"mode {meta.get('mode', '?')}." + (f" What the cases share: {shared}." if shared else "")}
     map_path = index.parent / MAP_NAME
@@ -447,7 +447,7 @@ def _crosscheck_sections(table: Path):
         "crosscheck.png": "I_dec and I_acc per pocket and cage rotation, mean over all pockets ± 1 standard error, "
                           "at each rung of the ladder and each speed"})
     sections = [Section("table", "Cross-check", blocks), Section("figures", "Figures", figures)]
-    return f"Cross-check of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")
+    return cc.ladder_title(meta, {r["rpm"] for r in rows}), sections, meta.get("scenario")
 
 
 def _pm(mean, sem) -> str:

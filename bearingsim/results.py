@@ -27,6 +27,25 @@ from bearingsim.errors import UserError, check_path
 PER_ROTATION = "results/per_rotation"
 IMPACTS = "results/impacts"
 SUMMARY = "results/summary"
+SET_NOTE_CHARS = 60  # longest list of --set values a title gives (more: their count)
+
+
+def set_note(command) -> str:
+    """`` (--set operating.inner_ring_speed_rpm=500)``: the ``--set`` values of the command line that made a
+    run (its provenance's ``command``), to go beside the scenario's name in a title, since the file of that
+    name does not hold them; `` (with 3 --set values)`` when they are long; "" when none (or no command)."""
+    import shlex
+
+    try:
+        words = shlex.split(command) if isinstance(command, str) else []
+    except ValueError:  # not a shell line
+        return ""
+    sets = [w.removeprefix("--set=") if w.startswith("--set=") else nxt
+            for w, nxt in zip(words, words[1:] + [""]) if w.startswith("--set=") or w == "--set" and nxt]
+    if not sets:
+        return ""
+    text = ", ".join(sets)
+    return f" (--set {text})" if len(text) <= SET_NOTE_CHARS else f" (with {len(sets)} --set values)"
 
 
 def read_only(a) -> np.ndarray:
@@ -232,14 +251,15 @@ class Result:
 
     def title(self) -> str:
         """``<scenario>: <what ran>, <speed> rpm <direction>, <load> N``: names the run as it was actually
-        made; a second line names what the scenario sets differently from its preset and the defaults
+        made, the command line's ``--set`` values beside the scenario's name (:func:`set_note`); a second line
+        names what the scenario sets differently from its preset and the defaults
         (:func:`bearingsim.scenario.differences_from_preset`), so that two runs' figures differ."""
         from bearingsim.scenario import differences_from_preset
 
         sc = self.scenario
         op = sc.operating
-        head = (f"{sc.name}: {self.description()}, {op.inner_ring_speed_rpm:g} rpm {op.direction}, "
-                f"{op.radial_load_N:g} N")
+        head = (f"{sc.name}{set_note(self.provenance.get('command'))}: {self.description()}, "
+                f"{op.inner_ring_speed_rpm:g} rpm {op.direction}, {op.radial_load_N:g} N")
         diffs = differences_from_preset(sc)
         if not diffs:
             return head

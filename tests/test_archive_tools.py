@@ -235,3 +235,16 @@ def test_inspect_of_a_reduced_archive_lists_its_operating_point_pass_and_wear(re
                 assert line.split()[1:] == [f"{values[k]:.6g}", *units[k].split()], line
     assert any(ln.split()[:3] == ["omega_c_rad_s", f"{stored['operating_point'][0]['omega_c_rad_s']:.6g}", "rad/s"]
                for ln in lines), lines
+
+
+def test_a_run_changed_by_set_says_so_beside_its_scenarios_name(tmp_path):
+    """``bearingsim run scenarios/paper_3000rpm.toml --set operating.inner_ring_speed_rpm=500`` titled its
+    figures "paper_3000rpm: reduced model (event), 500 rpm forward, ...": the name of a file that runs at 3000
+    rpm beside the 500 rpm that ran. The title says what --set changed beside the name, also when the
+    figures are drawn again from the archive."""
+    res = cli("run", SCENARIOS / "paper_3000rpm.toml", "--set", "operating.inner_ring_speed_rpm=500", "-o",
+              tmp_path / "a.h5", "-q", "--no-plots")
+    assert res.returncode == 0, res.stderr
+    title = bearingsim.load(tmp_path / "a.h5").plot_pass().axes[0].get_title()
+    assert title.startswith("paper_3000rpm (--set operating.inner_ring_speed_rpm=500): reduced model (event), "
+                            "500 rpm forward"), title

@@ -425,3 +425,20 @@ def test_a_rung_without_a_rear_face_impact_prints_n_a_as_the_docs_do():
     line = cc.format_table([row]).splitlines()[1]
     assert line.split()[-3:] == ["n/a", "0.00", "+7.287"] and "nan" not in line, line
     assert cc.format_table([{**row, "first_impact_speed_m_s": 0.0485}]).splitlines()[1].split()[-3] == "0.0485"
+
+
+def test_the_figures_title_names_the_speeds_it_ran(tmp_path, monkeypatch):
+    """A cross-check over 1000, 3000 and 6000 rpm was titled "Cross-check of multibody_3000rpm", the base
+    scenario's name, as if it had run at 3000 rpm. The title names the speeds that ran."""
+    from bearingsim import plotting
+
+    rows = [dict(rpm=rpm, rung=1, scene="reduced", relaxed="", I_dec_mean_Ns=5e-3, I_dec_sem_Ns=0.0,
+                 I_acc_mean_Ns=2e-3, I_acc_sem_Ns=0.0, first_impact_speed_m_s=0.08, cage_slip=0.0,
+                 change_from_previous=math.nan, archive="", wall_s=1.0, status="done", error="")
+            for rpm in (1000.0, 3000.0, 6000.0)]
+    cc.write_table(tmp_path, rows, load_scenario(SCENARIOS / "multibody_3000rpm.toml"))
+    figs = []
+    monkeypatch.setattr(plotting, "save_figure", lambda fig, path, **kw: figs.append(fig) or Path(path))
+    cc.plot_crosscheck(tmp_path / "crosscheck.h5", tmp_path)
+    title = figs[0].axes[0].get_title()
+    assert title.startswith("Cross-check at 1000, 3000, 6000 rpm of multibody_3000rpm's other settings:"), title

@@ -679,8 +679,9 @@ def test_a_sweep_pages_title_is_one_line_and_its_tables_note_ends_before_the_mar
     html = _page(small_studies / "sweep", tmp_path / "sweep.html")
     title = html_text.unescape(re.search(r"<title>(.*?)</title>", html, re.S).group(1))
     h1 = html_text.unescape(re.search(r"<h1>(.*?)</h1>", html, re.S).group(1))
-    assert "\n" not in title and "\n" not in h1 and h1 == "sweep of drag coefficient (2 cases)", (title, h1)
-    assert "What the cases share: paper_3000rpm: reduced model" in _section_text(html, "table")
+    assert "\n" not in title and "\n" not in h1, (title, h1)
+    assert h1 == "sweep of paper_3000rpm over drag coefficient (2 cases)", h1
+    assert "What the cases share: reduced model" in _section_text(html, "table")
     notes = [html_text.unescape(n) for n in re.findall(r'<p class="note">(.*?)</p>', html, re.S)]
     assert len(notes) == 2 and notes[0].endswith("of a sweep of " + str(PAPER) + "."), notes
     assert notes[1].startswith("* : |x - x_ref| >"), notes

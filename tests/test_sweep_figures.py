@@ -256,11 +256,21 @@ def test_i_dec_and_i_acc_in_separate_panels(tmp_path, figures):
     assert len(panels) == 2 and "I_{dec}" in panels[0]["ylabel"] and "I_{acc}" in panels[1]["ylabel"]
 
 
-def test_title_names_the_swept_keys_not_the_base_scenario(tmp_path, figures):
+def test_title_names_the_swept_keys_and_the_base_scenario_as_a_sweep_of_it(tmp_path, figures):
+    """A sweep of paper_3000rpm over 1000-2000 rpm had the title's second line "paper_3000rpm: reduced model
+    ...", as a run of that scenario is titled, though no case ran at 3000 rpm. The first line says "sweep of
+    paper_3000rpm over" its axes; the second what the cases share, without the name."""
     points = [{SPEED: s, CLEAR: c} for s in (1000.0, 2000.0) for c in (0.1, 0.2)]
-    plot_sweep_index(_index(tmp_path, points, [SPEED, CLEAR]), tmp_path / "f")
+    rows = [{"case": f"c{i}", "values": v, "status": "done", "error": "", "archive": "", "wall_s": 0.1,
+             "summary": {"I_dec_mean_Ns": 0.005, "I_dec_sem_Ns": 1e-4, "I_acc_mean_Ns": 0.002, "I_acc_sem_Ns": 1e-4}}
+            for i, v in enumerate(points)]
+    write_index(tmp_path, rows, [SPEED, CLEAR], {"mode": "product", "grid": json.dumps([SPEED, CLEAR]), "grid_rows": 4,
+                                                 "scenario": "scenarios/paper_3000rpm.toml",
+                                                 "context": "paper_3000rpm: reduced model (event), 970 N"})
+    plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "f")
     title = figures["sweep_map.png"]["title"]
-    assert "inner ring speed × pocket clearance" in title and "4 cases" in title and "paper_3000rpm" not in title
+    assert title == "sweep of paper_3000rpm over inner ring speed × pocket clearance (4 cases)\n" \
+                    "every case: reduced model (event), 970 N", title
 
 
 def test_title_says_what_the_cases_share(tmp_path, figures):
@@ -276,7 +286,7 @@ def test_title_says_what_the_cases_share(tmp_path, figures):
     assert res.returncode == 0, res.stderr
     plot_sweep_index(tmp_path / "s" / "sweep.h5", tmp_path / "f")
     context = figures["sweep_I.png"]["title"].split("\n")[1]
-    assert context == "paper_3000rpm: reduced model (event), 6000 rpm forward, 970 N; s = 0.3 mm"
+    assert context == "every case: reduced model (event), 6000 rpm forward, 970 N; s = 0.3 mm"
     speed = sweep_context(load_scenario(SCENARIOS / "multibody_3000rpm.toml", ["multibody.raceway_contact=rigid"]),
                           ["operating.inner_ring_speed_rpm"])
     assert speed == "multibody_3000rpm: multibody, full scene, forward, 970 N, 1 warm-up + 4 rotations; raceway rigid"

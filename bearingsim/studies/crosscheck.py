@@ -338,9 +338,16 @@ def plot_ladder(rows: list[dict], meta: dict):
                          bars="± 1 standard error (batch means over rotations)")
     errors = (errors.removeprefix("error bars: ") if errors.startswith("error bars: ")
               else f"({errors})" if errors else "")
-    axes[0].set_title(f"Cross-check of {meta.get('scenario_name', '?')}: mean over all pockets {errors}", fontsize=9)
+    axes[0].set_title(f"{ladder_title(meta, speeds)}: mean over all pockets {errors}", fontsize=9)
     legend_outside(axes[0], title="inner ring speed")
     return fig
+
+
+def ladder_title(meta: dict, speeds) -> str:
+    """``Cross-check at 1000, 3000, 6000 rpm of multibody_3000rpm's other settings``: the speeds that ran, and
+    the base scenario as what the rest comes from (its own speed ran only if it is one of ``speeds``)."""
+    at = f" at {', '.join(f'{float(v):g}' for v in sorted(speeds))} rpm" if len(speeds) else ""
+    return f"Cross-check{at} of {meta.get('scenario_name', '?')}'s other settings"
 
 
 def verdicts(rows: list[dict], rotations: int | None = None) -> list[str]:

@@ -24,9 +24,11 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
 * explicit extra ``[[cases]]`` (or a sweep of cases alone): a per-case chart of every case
   (``sweep_cases.png``), each labelled with its swept values.
 
-Titles name the sweep by its varied keys; a panel's title is wrapped to the panel's width
-(:func:`bearingsim.plotting.fit_titles`). Axes are labelled with the parameter's name and unit, read
-from the key's unit suffix. Failed and not-run cases are gaps (NaN), never zeros.
+Titles name the sweep as one of its base scenario over its varied keys (``sweep of paper_3000rpm over inner
+ring speed (6 cases)``: no case need run at the base's own values), and under it what every case shares; a
+panel's title is wrapped to the panel's width (:func:`bearingsim.plotting.fit_titles`). Axes are labelled
+with the parameter's name and unit, read from the key's unit suffix. Failed and not-run cases are gaps (NaN),
+never zeros.
 """
 from __future__ import annotations
 
@@ -81,8 +83,17 @@ def _sampled(col, rows) -> list:
 
 
 def sweep_title(meta: dict, n_cases: int) -> str:
-    """``sweep of inner ring speed × pocket clearance (12 cases)``: the sweep's varied keys; zipped keys
-    ``speed, drag coefficient (zipped, 4 cases)``; extra cases ``; 2 cases over restitution, direction``."""
+    """``sweep of paper_3000rpm over inner ring speed × pocket clearance (12 cases)``: the base scenario and
+    the sweep's varied keys; zipped keys ``speed, drag coefficient (zipped, 4 cases)``; extra cases ``; 2 cases
+    over restitution, direction``; a second line ``every case: ...``, what the cases share
+    (:func:`sweep_title_lines`)."""
+    head, shared = sweep_title_lines(meta, n_cases)
+    return head + (f"\nevery case: {shared}" if shared else "")
+
+
+def sweep_title_lines(meta: dict, n_cases: int) -> tuple[str, str]:
+    """(the sweep's title, what its cases share or ""): the title names the base scenario as what is swept,
+    never as what ran (a sweep of paper_3000rpm over 500-6000 rpm has no case at 3000 rpm)."""
     keys = list(meta.get("axes", []))
     grid = list(meta.get("grid", []))
     n_grid = min(int(meta.get("grid_rows", n_cases)), n_cases) if grid else 0
@@ -93,8 +104,25 @@ def sweep_title(meta: dict, n_cases: int) -> str:
     if n_cases > n_grid:  # the cases off the grid, with the keys they set
         parts.append(f"{counted(n_cases - n_grid, 'case')}" + (" over " + ", ".join(map(name_of, extra)) if extra
                                                                else " off the grid"))
-    context = f"\n{meta['context']}" if meta.get("context") else ""  # what the cases share (older indexes: none)
-    return f"sweep of {'; '.join(parts) or counted(n_cases, 'case')}{context}"
+    what = "; ".join(parts) or counted(n_cases, "case")
+    base = _base_name(meta)
+    head = f"sweep of {base}{' over ' if grid else ': '}{what}" if base else f"sweep of {what}"
+    shared = str(meta.get("context") or "")  # what the cases share (older indexes: none), after the base's name
+    return head, shared.removeprefix(f"{base}: ") if base else shared
+
+
+def _base_name(meta: dict) -> str:
+    """The name of a sweep's base scenario: the one it stores, else its file's stem; "" for a sweep of cases
+    without one."""
+    import tomllib
+
+    try:
+        name = tomllib.loads(meta.get("scenario_toml") or "").get("name")
+    except tomllib.TOMLDecodeError:
+        name = None
+    if isinstance(name, str) and name:
+        return name
+    return Path(str(meta["scenario"])).stem if meta.get("scenario") else ""
 
 
 def plot_sweep_index(index_path: str | Path, outdir: str | Path | None = None,

@@ -371,36 +371,70 @@ def shape_of(psi_deg, depth) -> dict[str, float]:
 
 def plot_wear_profile(rep: WearReport, title: str = ""):
     """Fig. 13 analog: worn depth against psi on the front and the rear face, the mean over pockets and
-    the band from the least to the most worn pocket at each psi; each face in its house colour."""
+    the band from the least to the most worn pocket at each psi. The first row draws the whole face, its
+    end bins hatched (the wear at a face's edge is a line: their depth doubles each time the bins halve,
+    :func:`edge_caveat`); the second the face within its end bins, on its own scale, whose deepest depth the
+    title states (an end bin, hundreds of times deeper, hides it in the first row); each face in its house colour."""
     from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
 
-    fig, axes = subplots(1, 2, figsize=(10, 4), sharey=True)
-    for ax, f, c in ((axes[0], "front", FRONT), (axes[1], "rear", REAR)):
+    fig, grid = subplots(2, 2, figsize=(10, 6.8), sharex=True, sharey="row", gridspec_kw={"height_ratios": (3, 2)})
+    axes, inner = grid[0], grid[1]
+    for k, (f, c) in enumerate((("front", FRONT), ("rear", REAR))):
         d = (rep.depth_front if f == "front" else rep.depth_rear) * 1e6
-        ax.fill_between(rep.psi_deg, d.min(axis=1), d.max(axis=1), step="mid", color=c, alpha=0.25,
-                        label="least to most worn pocket")
-        ax.step(rep.psi_deg, d.mean(axis=1), where="mid", color=c, lw=1.5, label="mean over pockets")
-        ax.set_xlabel("ψ: bore end ← 0 (middle) → rim end [deg]")
-        ax.set_title(f"{f} face", fontsize=9)
+        for ax, rows in ((axes[k], slice(None)), (inner[k], slice(1, -1))):
+            psi, dd = rep.psi_deg[rows], d[rows]
+            ax.fill_between(psi, dd.min(axis=1), dd.max(axis=1), step="mid", color=c, alpha=0.25,
+                            label="least to most worn pocket")
+            ax.step(psi, dd.mean(axis=1), where="mid", color=c, lw=1.5, label="mean over pockets")
+        axes[k].set_title(f"{f} face", fontsize=9)
+        inner[k].set_title(f"{f} face within its edge bins", fontsize=9)
+        inner[k].set_xlabel("ψ: bore end ← 0 (middle) → rim end [deg]")
     axes[0].set_ylim(bottom=0.0)  # shared: after both faces are drawn, so the deeper face's ends stay on the figure
+    inner[0].set_ylim(0.0, 1.15 * max(_interior_depth(rep) * 1e6, 1e-9))
+    _mark_edge_bins(axes, rep.psi_deg)
     if rep.bar_width * 1e6 <= axes[0].get_ylim()[1]:  # within the depth axis: the bar's width as a line
         for ax in axes:
             ax.axhline(rep.bar_width * 1e6, color="0.3", lw=0.8, ls="--",
                        label=f"cage bar width {rep.bar_width * 1e3:.4g} mm")
-    axes[0].set_ylabel("worn depth [µm]")
-    fixed_unit_axis(axes[0])  # shared with axes[1]
+    for ax in grid[:, 0]:
+        ax.set_ylabel("worn depth [µm]")
+        fixed_unit_axis(ax)  # shared with the rear face's
     legend_outside(axes[1])
-    through = rep.worn_through()
-    fig.suptitle(f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
-                 f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa" + (
-                     f", on the scenario's starting depth (deepest {rep.max_start_depth * 1e6:.4g} µm, not drawn)"
-                     if rep.max_start_depth > 0.0 else "") + (
-                     "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % d.shape[1]} and "
-                     f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep"
-                     f"{', starting depth included,' if rep.max_start_depth > 0.0 else ''} against "
-                     f"{rep.bar_width * 1e3:.4g} mm wide): a linear extrapolation past it is meaningless"),
-                 fontsize=9)
+    fig.suptitle(_profile_title(rep, title), fontsize=9)
+    fig.tight_layout()
     return fig
+
+
+def _interior_depth(rep: WearReport) -> float:
+    """The deepest point of the running time's wear within the faces' end bins (every pocket, both faces) [m]."""
+    inner = [d[1:-1] for d in (rep.depth_front, rep.depth_rear) if d.shape[0] > 2]
+    return float(max(d.max() for d in inner)) if inner else float("nan")
+
+
+def _mark_edge_bins(axes, psi_deg) -> None:
+    """Hatch the end bins of psi on ``axes``, labelled as depending on the bin width."""
+    width = float(np.diff(psi_deg).mean()) if len(psi_deg) > 1 else 1.0
+    for ax in axes:
+        for j, end in enumerate((psi_deg[0], psi_deg[-1])):
+            ax.axvspan(end - 0.5 * width, end + 0.5 * width, facecolor="none", edgecolor="0.45", hatch="///", lw=0.0,
+                       label="edge bins: their depth depends on the bin width" if j == 0 else None)
+
+
+def _profile_title(rep: WearReport, title: str) -> str:
+    """The profile figure's title: the run, the running time and Archard's k and H, what the edge bins are and
+    the deepest depth within them, the starting depth and the worn-through cage bar where there are."""
+    through = rep.worn_through()
+    n = len(rep.volume_front)
+    return (f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
+            f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa" + (
+                f", on the scenario's starting depth (deepest {rep.max_start_depth * 1e6:.4g} µm, not drawn)"
+                if rep.max_start_depth > 0.0 else "")
+            + f"\nedge bins (hatched): the wear at a face's edge is a line, whose depth doubles each time the bins "
+              f"halve; deepest within the faces: {_interior_depth(rep) * 1e6:.3g} µm" + (
+                "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % n} and "
+                f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep"
+                f"{', starting depth included,' if rep.max_start_depth > 0.0 else ''} against "
+                f"{rep.bar_width * 1e3:.4g} mm wide): a linear extrapolation past it is meaningless"))
 
 
 def plot_wear_volume(rep: WearReport, title: str = ""):

@@ -1481,3 +1481,26 @@ def test_the_life_historys_depth_rate_is_called_the_fastest_points_not_the_deepe
     labels = [ax.get_ylabel() for ax in fig.axes]
     assert not any("deepest point's" in lb and "rate" in lb for lb in labels), labels
     assert any(lb.startswith("fastest point's depth rate [µm/h]") for lb in labels), labels
+
+
+def test_the_wear_profile_figure_marks_its_edge_bins_and_states_the_faces_interior():
+    """`bearingsim wear` of 3 rotations of multibody_6000rpm for 10 h: the edge bin at psi = -32 deg (~590 um)
+    set the depth axis, the middle of the face (~2 um) could not be seen, and the caveat the command prints
+    (the edge's depth "doubles each time the bins halve") was not on the figure. The edge bins are hatched and
+    labelled, the caveat is in the title, a second row draws the faces within their edge bins on their own
+    scale, and the deepest depth within the faces is stated."""
+    from bearingsim.wear import WearReport, plot_wear_profile
+
+    psi = np.linspace(-30.0, 25.0, 32)
+    front, rear = np.full((32, 2), 2e-6), np.full((32, 2), 1e-6)
+    front[0], rear[-1], front[10, 1] = 590e-6, 80e-6, 4.2e-6
+    fig = plot_wear_profile(WearReport(psi, front, rear, np.ones(2) * 1e-9, np.ones(2) * 1e-9, 1e3, 1.0, 1e3, 5e-6,
+                                       1.5e9, 1e-8, bar_width=5.821e-3))
+    title = fig._suptitle.get_text()
+    assert "doubles each time the bins halve" in title and "deepest within the faces: 4.2 µm" in title, title
+    top, bottom = fig.axes[:2], fig.axes[2:4]
+    labels = top[1].get_legend_handles_labels()[1] + top[0].get_legend_handles_labels()[1]
+    assert "edge bins: their depth depends on the bin width" in labels, labels
+    assert [ax.get_title() for ax in bottom] == ["front face within its edge bins", "rear face within its edge bins"]
+    assert all(top_ax.get_ylim()[1] >= 590.0 for top_ax in top)  # the whole face, edges too
+    assert all(4.2 <= ax.get_ylim()[1] < 10.0 for ax in bottom)  # the interior on its own scale

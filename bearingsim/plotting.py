@@ -12,7 +12,7 @@ import contextlib
 from pathlib import Path
 
 __all__ = ["FRONT", "REAR", "LINE_STYLES", "figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title",
-           "fit_titles", "mark_without_error", "hatch_without_error"]
+           "fit_titles", "mark_without_error", "hatch_without_error", "plain_number"]
 
 #: the house colours of the two pocket faces, the same in every figure: FRONT is the front face, where the roller
 #: pushes the cage (I_acc, F_acc), REAR the rear face, where the cage drags a lagging roller (I_dec, F_dec).
@@ -98,6 +98,26 @@ def fit_titles(fig, axes) -> None:
             lines = ax.title.get_text().split("\n")
             chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
             ax.title.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
+
+
+_SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+
+def plain_number(x: float, digits: int = 3) -> str:
+    """``x`` to ``digits`` significant digits as engineers read it: ``1000``, ``0.0123``, and a power of ten
+    written out beyond them, ``3.6 × 10⁶``, ``5 × 10⁻⁶`` (never ``1e+03`` or ``3.6e+06``)."""
+    import math
+
+    if not math.isfinite(x) or x == 0.0:
+        return f"{x:g}"
+    exp = math.floor(math.log10(abs(x)))
+    if -3 <= exp < 5:
+        text = f"{round(x, digits - 1 - exp):.{max(0, digits - 1 - exp)}f}"
+        return text.rstrip("0").rstrip(".") if "." in text else text
+    mantissa = f"{x / 10.0 ** exp:.{digits - 1}f}".rstrip("0").rstrip(".")
+    if mantissa in ("10", "-10"):  # 9.9996e5 rounds up to the next power
+        mantissa, exp = mantissa[:-1], exp + 1
+    return f"{mantissa} × 10{str(exp).translate(_SUPERSCRIPTS)}"
 
 
 def legend_outside(ax, **kw) -> None:

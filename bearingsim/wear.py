@@ -395,7 +395,7 @@ def plot_wear_profile(rep: WearReport, title: str = ""):
     if rep.bar_width * 1e6 <= axes[0].get_ylim()[1]:  # within the depth axis: the bar's width as a line
         for ax in axes:
             ax.axhline(rep.bar_width * 1e6, color="0.3", lw=0.8, ls="--",
-                       label=f"cage bar width {rep.bar_width * 1e3:.4g} mm")
+                       label=f"cage bar width {rep.bar_width * 1e6:.4g} µm")  # the axis's unit
     for ax in grid[:, 0]:
         ax.set_ylabel("worn depth [µm]")
         fixed_unit_axis(ax)  # shared with the rear face's
@@ -423,37 +423,64 @@ def _mark_edge_bins(axes, psi_deg) -> None:
 def _profile_title(rep: WearReport, title: str) -> str:
     """The profile figure's title: the run, the running time and Archard's k and H, what the edge bins are and
     the deepest depth within them, the starting depth and the worn-through cage bar where there are."""
+    from bearingsim.plotting import plain_number
+
     through = rep.worn_through()
     n = len(rep.volume_front)
-    return (f"{title}\nworn depth after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations), "
-            f"k = {rep.wear_coefficient:.3g}, H = {rep.hardness / 1e9:.3g} GPa" + (
+    return (f"{title}\nworn depth after {_running(rep)}, {_law(rep)}" + (
                 f", on the scenario's starting depth (deepest {rep.max_start_depth * 1e6:.4g} µm, not drawn)"
                 if rep.max_start_depth > 0.0 else "")
             + f"\nedge bins (hatched): the wear at a face's edge is a line, whose depth doubles each time the bins "
-              f"halve; deepest within the faces: {_interior_depth(rep) * 1e6:.3g} µm" + (
+              f"halve; deepest within the faces: {plain_number(_interior_depth(rep) * 1e6)} µm" + (
                 "" if through is None else f"\nthe cage bar between pockets {(through[0] - 1) % n} and "
-                f"{through[0]} worn through ({through[1] * 1e3:.4g} mm deep"
+                f"{through[0]} worn through ({through[1] * 1e6:.0f} µm deep"
                 f"{', starting depth included,' if rep.max_start_depth > 0.0 else ''} against "
-                f"{rep.bar_width * 1e3:.4g} mm wide): a linear extrapolation past it is meaningless"))
+                f"{rep.bar_width * 1e6:.0f} µm wide): a linear extrapolation past it is meaningless"))
 
 
 def plot_wear_volume(rep: WearReport, title: str = ""):
     """Fig. 14 analog: worn volume of the front and the rear face of every pocket (each in its house colour),
-    with the spread."""
+    with the spread, and each
+    face's mean over pockets ± its standard error (:meth:`WearReport.volume_sem`, what ``bearingsim wear``
+    prints) as a line and band."""
     from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
 
     x = np.arange(len(rep.volume_front))
     fig, ax = subplots(figsize=(9, 4))
+    n = rep.recorded_rotations
     for f, dx, c in (("front", -0.2, FRONT), ("rear", 0.2, REAR)):
-        v = rep.volume_front if f == "front" else rep.volume_rear
-        ax.bar(x + dx, v * 1e9, 0.4, color=c,
+        v = (rep.volume_front if f == "front" else rep.volume_rear) * 1e9
+        ax.bar(x + dx, v, 0.4, color=c,
                label=f"{f} face (CV {rep.cov(f):.3f}; sampling alone {rep.sampling_cov(f):.3f})")
+        sem = rep.volume_sem(f) * 1e9
+        if math.isfinite(sem):
+            ax.axhspan(v.mean() - sem, v.mean() + sem, color=c, alpha=0.2, lw=0.0)
+            label = f"{f} face, mean over pockets {v.mean():.4g} ± {sem:.2g} mm³ (±1 standard error)"
+        else:
+            label = (f"{f} face, mean over pockets {v.mean():.4g} mm³ "
+                     f"(no standard error: {counted(n, 'recorded rotation')})")
+        ax.axhline(v.mean(), color=c, lw=1.2, ls="--", label=label)
     ax.set_xticks(x)
     ax.set_xlabel("pocket")
     ax.set_ylabel("worn volume [mm³]")
     fixed_unit_axis(ax)
-    ax.set_title(f"{title}\nworn volume after {rep.hours:.3g} h ({rep.shaft_rotations:.3g} inner-ring rotations)\n"
+    ax.set_title(f"{title}\nworn volume after {_running(rep)}, {_law(rep)}\n"
                  f"CV: coefficient of variation over pockets; sampling alone: identical pockets' CV from the "
-                 f"scatter of the {counted(rep.recorded_rotations, 'recorded rotation')}", fontsize=9)
+                 f"scatter of the {counted(n, 'recorded rotation')}; standard error: batch means over them", fontsize=9)
     legend_outside(ax)
     return fig
+
+
+def _running(rep: WearReport) -> str:
+    """``10 h (3.6 × 10⁶ inner-ring rotations)``: a figure's running time, numbers as engineers read them."""
+    from bearingsim.plotting import plain_number
+
+    return f"{plain_number(rep.hours)} h ({plain_number(rep.shaft_rotations)} inner-ring rotations)"
+
+
+def _law(rep: WearReport) -> str:
+    """The wear law of the report's volumes and depths, with its k and H, for a figure's title."""
+    from bearingsim.plotting import plain_number
+
+    return (f"Archard's law on the sliding work (V = k W / H), k = {plain_number(rep.wear_coefficient)}, "
+            f"H = {plain_number(rep.hardness / 1e9)} GPa")

@@ -1369,7 +1369,7 @@ def test_wear_counts_the_scenarios_own_worn_depth_in_the_deepest_point_and_the_c
     table = wear.format_comparison(["worn.h5"], [rep])
     assert f"{rep.max_depth * 1e6:.4g}" in table and f"worn through (pocket {i})" in table
     title = load(path).plot_wear_profile(hours=10.0)._suptitle.get_text()
-    assert "deepest 2900 µm, not drawn" in title and f"{depth * 1e3:.4g} mm deep, starting depth included" in title
+    assert "deepest 2900 µm, not drawn" in title and f"{depth * 1e6:.0f} µm deep, starting depth included" in title
     assert main(["wear", str(path), "--hours", "10", "--no-plots"]) == 0
     assert "cage bar worn through" in capsys.readouterr().out
 
@@ -1504,3 +1504,36 @@ def test_the_wear_profile_figure_marks_its_edge_bins_and_states_the_faces_interi
     assert [ax.get_title() for ax in bottom] == ["front face within its edge bins", "rear face within its edge bins"]
     assert all(top_ax.get_ylim()[1] >= 590.0 for top_ax in top)  # the whole face, edges too
     assert all(4.2 <= ax.get_ylim()[1] < 10.0 for ax in bottom)  # the interior on its own scale
+
+
+def test_the_wear_volume_figure_names_its_law_and_gives_the_standard_errors_the_command_prints():
+    """`bearingsim wear`'s volume figure did not say which wear law gave its volumes (the sliding work's), drew
+    no error bars though the command prints a standard error of each face's mean (batch means over the recorded
+    rotations), and its titles read "1e+03 h" and "3.6e+06 inner-ring rotations"; the profile figure labelled
+    the cage bar's line in mm on an axis in µm. Now the law, k and H are named, each face's mean over pockets is
+    drawn ± the standard error the command prints, numbers read 1000 h, 3.6 × 10⁶, 1.5 GPa, and one unit per
+    quantity."""
+    from bearingsim.wear import WearReport, format_report, plot_wear_profile, plot_wear_volume
+
+    psi = np.linspace(-30.0, 25.0, 32)
+    rng = np.random.default_rng(3)
+    per_rot = {f: rng.uniform(1e-9, 2e-9, (3, 4)) for f in ("front", "rear")}
+    depth = np.full((32, 4), 6e-3)  # deeper than the cage bar is wide: its line is drawn
+    rep = WearReport(psi, depth, depth, per_rot["front"].mean(axis=0), per_rot["rear"].mean(axis=0), 3.6e6, 1000.0,
+                     1.55e6, 5e-6, 1.5e9, 1e-8, per_rot["front"], per_rot["rear"], bar_width=5.821e-3)
+    fig = plot_wear_volume(rep)
+    ax = fig.axes[0]
+    title = ax.get_title()
+    assert "Archard's law on the sliding work" in title and "H = 1.5 GPa" in title, title
+    assert "1000 h" in title and "3.6 × 10⁶ inner-ring rotations" in title and "e+" not in title, title
+    text = format_report(rep)
+    labels = ax.get_legend_handles_labels()[1]
+    for f in ("front", "rear"):
+        mean, sem = rep.volume_front.mean() if f == "front" else rep.volume_rear.mean(), rep.volume_sem(f)
+        assert f"{f}: worn volume mean {mean * 1e9:.4g} mm^3 over pockets, standard error {sem * 1e9:.2g}" in text
+        assert f"{f} face, mean over pockets {mean * 1e9:.4g} ± {sem * 1e9:.2g} mm³ (±1 standard error)" in labels, \
+            labels
+    profile = plot_wear_profile(rep)
+    assert "cage bar width 5821 µm" in profile.axes[0].get_legend_handles_labels()[1] + \
+        profile.axes[1].get_legend_handles_labels()[1]
+    assert "1000 h" in profile._suptitle.get_text() and "e+" not in profile._suptitle.get_text()

@@ -1537,3 +1537,26 @@ def test_the_wear_volume_figure_names_its_law_and_gives_the_standard_errors_the_
     assert "cage bar width 5821 µm" in profile.axes[0].get_legend_handles_labels()[1] + \
         profile.axes[1].get_legend_handles_labels()[1]
     assert "1000 h" in profile._suptitle.get_text() and "e+" not in profile._suptitle.get_text()
+
+
+def test_the_impulse_figure_draws_the_headline_mean_and_its_standard_error(fast_run, monkeypatch):
+    """The per-pocket impulse figure (`_impulses.png`) showed "mean ± std" per pocket, while the run's headline
+    is the bearing's mean ± its standard error, which was not on it; of 1 recorded rotation it read "mean ± std
+    over 1 cage rotations" with no bars and no word why. Now it says which spread its bars are, draws the
+    headline (as the command prints it) as a line and band, and says that 1 rotation has no spread."""
+    from bearingsim.results import Result
+    from bearingsim.stats import result_standard_errors, with_error
+
+    res, _ = fast_run
+    se = result_standard_errors(res)
+    ax = res.plot_impulses().axes[0]
+    assert "bars: std over the 2 cage rotations of each pocket" in ax.get_title(), ax.get_title()
+    labels = ax.get_legend_handles_labels()[1]
+    for q in ("I_acc", "I_dec"):
+        headline = with_error(res.summary[f"{q}_mean_Ns"] * 1e3, se[f"{q}_sem_Ns"] * 1e3)
+        assert any(f"mean of the bearing {headline} mN s (±1 standard error" in lab for lab in labels), (q, labels)
+    real = Result.per_rotation
+    monkeypatch.setattr(Result, "per_rotation", property(lambda self: {k: v[:1] for k, v in real.fget(self).items()}))
+    ax = res.plot_impulses().axes[0]
+    assert "1 cage rotation: no spread" in ax.get_title() and "1 cage rotations" not in ax.get_title(), ax.get_title()
+    assert any("no standard error from 1 recorded rotation" in lab for lab in ax.get_legend_handles_labels()[1])

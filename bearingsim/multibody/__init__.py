@@ -531,22 +531,35 @@ class MultibodyResult(Result):
         return fig
 
     def plot_impulses(self):
-        """Fig. 7 analog: I_acc (front face's colour, circles) and I_dec (rear face's, squares) per pocket, mean ±
-        std over rotations."""
+        """Fig. 7 analog: I_acc (front face's colour, circles) and I_dec (rear face's, squares) per pocket, the mean
+        over rotations with bars of their standard deviation (the pocket's own scatter), and the bearing's mean ±
+        its standard error (the run's headline, as ``bearingsim run`` prints it) as a line and band."""
         from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
+        from bearingsim.stats import result_standard_errors, with_error
+        from bearingsim.wording import counted
 
-        ia, idc = self.per_rotation["I_acc"], self.per_rotation["I_dec"]
-        x = np.arange(ia.shape[1])
-        fig, ax = subplots(figsize=(9, 4))
-        ax.errorbar(x - 0.12, ia.mean(0) * 1e3, yerr=ia.std(0) * 1e3, fmt="o", color=FRONT,
-                    label="$I_{acc}$ (front face)")
-        ax.errorbar(x + 0.12, idc.mean(0) * 1e3, yerr=idc.std(0) * 1e3, fmt="s", color=REAR,
-                    label="$I_{dec}$ (rear face)")
+        n = self._rotations()
+        se = result_standard_errors(self)
+        x = np.arange(self.per_rotation["I_acc"].shape[1])
+        fig, ax = subplots(figsize=(11.5, 4))  # room for the legend's headline numbers
+        for q, dx, fmt, face, colour in (("I_acc", -0.12, "o", "front", FRONT), ("I_dec", 0.12, "s", "rear", REAR)):
+            v = self.per_rotation[q]
+            ax.errorbar(x + dx, v.mean(0) * 1e3, yerr=v.std(0) * 1e3 if n > 1 else None, fmt=fmt, color=colour,
+                        label=f"$I_{{{q[2:]}}}$ ({face} face), per pocket")
+            mean, sem = self.summary[f"{q}_mean_Ns"] * 1e3, se[f"{q}_sem_Ns"] * 1e3
+            if sem > 0.0:
+                ax.axhspan(mean - sem, mean + sem, color=colour, alpha=0.15, lw=0.0)
+            headline = (f"{with_error(mean, sem)} mN s (±1 standard error)" if sem > 0.0 else
+                        f"{mean:.5g} mN s (no standard error from {counted(n, 'recorded rotation')})")
+            ax.axhline(mean, color=colour, lw=1.0, ls="--", label=f"$I_{{{q[2:]}}}$ mean of the bearing {headline}")
         ax.set_xlabel("pocket")
         ax.set_xticks(x)
         ax.set_ylabel("impulse per cage rotation [mN s]")
         ax.set_ylim(bottom=0.0)
-        ax.set_title(f"{self.title()}\nmean ± std over {self._rotations()} cage rotations", fontsize=9)
+        spread = (f"per pocket: mean, bars: std over the {n} cage rotations of each pocket" if n > 1
+                  else "1 cage rotation: no spread (no bars, no standard error)")
+        ax.set_title(f"{self.title()}\n{spread}; lines: the bearing's mean"
+                     + ("; bands: its standard error (batch means)" if n > 1 else ""), fontsize=9)
         legend_outside(ax)
         return fig
 

@@ -631,7 +631,7 @@ def _life_sections(table: Path):
     blocks.append(table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); "
                               "the worn depth over each face at each stage's end is the figure's", head,
                               life.history_rows(cols, history), [True] * len(head)))
-    notes = life.stage_notes(cols)
+    notes = life.depth_notes(cols, attrs) + life.stage_notes(cols)
     if notes:  # the stages' run notes, each once, as the command prints them under its history
         blocks.append({"kind": "list", "items": notes})
     figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "

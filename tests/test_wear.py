@@ -1560,3 +1560,86 @@ def test_the_impulse_figure_draws_the_headline_mean_and_its_standard_error(fast_
     ax = res.plot_impulses().axes[0]
     assert "1 cage rotation: no spread" in ax.get_title() and "1 cage rotations" not in ax.get_title(), ax.get_title()
     assert any("no standard error from 1 recorded rotation" in lab for lab in ax.get_legend_handles_labels()[1])
+
+
+def _life_of_a_deepest_edge_that_stops_wearing():
+    """A 3-stage clearance life's history as `bearingsim life scenarios/wear_test_6000rpm.toml --limit
+    clearance=0.3mm --stages 3 --rotations 2` wrote it (4 bins of psi, 2 pockets here): the rear face's bore-end
+    bin of pocket 1 wears to 744.7 um in stages 0-1 and not at all in stage 2, where the next bin of pocket 0
+    wears fastest (450.9 um in 4.465 h: 101 um/h), from 36.6 to 487.5 um."""
+    psi = np.array([-32.0, -30.3, 0.0, 25.0])
+    rear = np.zeros((3, 4, 2))
+    rear[:, 0, 1] = [503.1, 744.7, 744.7]
+    rear[:, 1, 0] = [10.0, 36.6, 487.5]
+    front = np.zeros((3, 4, 2))
+    front[:, 3, 0] = [345.4, 464.4, 547.9]
+    hours = np.array([7.163, 12.81, 17.275])
+    return {"stage": np.arange(3), "clearance_start_mm": np.array([0.2, 0.2333, 0.2667]),
+            "stage_rotations": np.array([2.579e6, 2.035e6, 1.607e6]), "rotations_end": np.array([2.579e6, 4.614e6,
+                                                                                                6.221e6]),
+            "hours_end": hours, "max_depth_rate_um_per_h": np.array([503.1 / 7.163, 241.6 / 5.647, 450.9 / 4.465]),
+            "max_volume_rate_mm3_per_h": np.full(3, 0.2), "max_depth_um": np.array([503.1, 744.7, 744.7]),
+            "max_volume_mm3": np.array([1.7, 3.0, 4.5]), "clearance_end_mm": np.array([0.2333, 0.2667, 0.3]),
+            "I_dec_mean_mNs": np.array([18.41, 22.43, 23.13]), "reused": np.zeros(3, dtype=int),
+            "psi_deg": np.tile(psi, (3, 1)), "worn_depth_front_um": front, "worn_depth_rear_um": rear}
+
+
+def test_the_life_history_says_the_deepest_point_stopped_wearing_where_the_fastest_point_wore_on():
+    """A reviewer read life.png of the 3-stage clearance life of wear_test_6000rpm as contradicting itself: the
+    deepest worn point flat at 744.7 um from 12.8 h to 17.3 h (the table's 'deepest' too) while the last stage
+    wears at 101 um/h. Both are true (life.h5's profiles: the deepest point, an end bin, no longer wears in that
+    stage; the fastest point is another bin, which wears 451 um, to 488 um), but neither the table nor the figure
+    said so. The table notes it under the history and the figure draws each stage's fastest point's depth, whose
+    slope is the rate the third panel gives, beside the deepest point."""
+    from bearingsim.studies.life import format_history, plot_life
+
+    cols = _life_of_a_deepest_edge_that_stops_wearing()
+    attrs = {"limit": "clearance=0.3mm", "stages": 3, "mapping": "shape", "rotations": 2}
+    text = format_history(cols, "life of x to clearance=0.3mm", attrs)
+    notes = [ln for ln in text.splitlines() if ln.startswith("stage 2:")]
+    assert notes == ["stage 2: the deepest point (744.7 um: rear face of pocket 1, psi -32 deg) did not wear in "
+                     "this stage; the stage's depth rate, 101 um/h, is the fastest point's (rear face of pocket 0, psi "
+                     "-30.3 deg), which wore 450.9 um, to 487.5 um"], text
+    assert not [ln for ln in text.splitlines() if ln.startswith(("stage 0:", "stage 1:"))], text
+    ax = plot_life(cols, attrs).axes[0]
+    lines = {ln.get_label(): ln for ln in ax.get_lines()}
+    fastest = [ln for label, ln in lines.items() if label.startswith("fastest point of each stage")]
+    assert len(fastest) == 1, list(lines)
+    x, y = (np.asarray(a, dtype=float) for a in fastest[0].get_data())
+    ends = y[np.isfinite(y)][1::2]  # a segment per stage, broken by NaN between them
+    np.testing.assert_allclose(ends, [503.1, 744.7, 487.5], rtol=1e-9)  # stage 1's fastest point: the deepest
+    slope = (y[-2] - y[-3]) / (x[-2] - x[-3])  # the last stage's segment, before its NaN
+    assert slope == pytest.approx(cols["max_depth_rate_um_per_h"][-1], rel=1e-9)
+    assert any("deepest point of any face" in label for label in lines), list(lines)
+
+
+def _contrast_on_white(colour) -> float:
+    """The contrast ratio of ``colour`` on white (WCAG: 3 for graphics)."""
+    from matplotlib.colors import to_rgb
+
+    lin = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in to_rgb(colour)]
+    return 1.05 / (0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2] + 0.05)
+
+
+@pytest.mark.parametrize("stages", [3, 20])
+def test_the_life_figures_worn_faces_name_their_stages_and_show_the_first(stages):
+    """life.png's worn-face panel said 'darker: later' with no colour bar or stage label, and its early stages
+    were nearly invisible (the first of 20 a pale yellow-green on white, under the later ones). A colour bar
+    names the stages and when each ended, and every stage's colour stands out on white (contrast 3 or more)."""
+    from bearingsim.studies.life import plot_life
+
+    cols = _life_of_a_deepest_edge_that_stops_wearing()
+    if stages != 3:
+        cols = {k: np.repeat(v[-1:], stages, axis=0) if k != "stage" else np.arange(stages) for k, v in cols.items()}
+        cols["hours_end"] = np.linspace(1.0, 20.0, stages)
+    fig = plot_life(cols, {"limit": "clearance=0.3mm", "stages": stages})
+    faces = fig.axes[3]
+    bars = [ax for ax in fig.axes[4:] if "stage" in ax.get_ylabel()]
+    assert len(bars) == 1, [ax.get_ylabel() for ax in fig.axes]
+    labels = [t.get_text() for t in bars[0].get_yticklabels()]
+    assert labels[0].startswith("0") and labels[-1].startswith(str(stages - 1)), labels
+    if stages == 3:
+        assert labels == ["0 (to 7.16 h)", "1 (to 12.8 h)", "2 (to 17.3 h)"], labels
+    colours = [ln.get_color() for ln in faces.get_lines()]
+    assert min(_contrast_on_white(c) for c in colours) >= 3.0, sorted(_contrast_on_white(c) for c in colours)[:3]
+    assert "darker: later" not in faces.get_title()

@@ -605,7 +605,66 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
     lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
-    return "\n".join(lines + stage_notes(cols))
+    return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
+
+
+def _history_start(attrs: dict, shape) -> np.ndarray:
+    """The worn depth the first stage started from ((2, bins, pockets) [um]): the history's scenario's own
+    ``[wear] worn_depth_*_um``, or none (zeros)."""
+    import tomllib
+
+    try:
+        wear = tomllib.loads(str(attrs.get("scenario") or "")).get("wear", {})
+        start = np.array([np.asarray(wear[f"worn_depth_{f}_um"], dtype=float).T for f in ("front", "rear")])
+    except (tomllib.TOMLDecodeError, KeyError, ValueError):
+        return np.zeros(shape)
+    return start if start.shape == tuple(shape) else np.zeros(shape)
+
+
+def stage_points(cols: dict, attrs: dict) -> list[dict]:
+    """Per stage, from the history's worn-depth profiles (none in a history written before it held them: []):
+    the deepest point at its end (``deepest``: depth [um] and (face, bin, pocket)) and how much it wore in the
+    stage (``deepest_wore``), and the fastest point, the one that wore most in it, whose depth rate the history's
+    ``max_depth_rate_um_per_h`` is (``fastest``, ``fastest_wore``). They differ: an end bin worn deep may wear no
+    more once the roller no longer reaches it, while another point wears on."""
+    if "worn_depth_front_um" not in cols:
+        return []
+    ends = np.stack([np.asarray(cols["worn_depth_front_um"], dtype=float),
+                     np.asarray(cols["worn_depth_rear_um"], dtype=float)], axis=1)  # (stages, 2, bins, pockets)
+    before, out = _history_start(attrs, ends.shape[1:]), []
+    for end in ends:
+        wore = end - before
+        d = np.unravel_index(np.argmax(end), end.shape)
+        f = np.unravel_index(np.argmax(wore), wore.shape)
+        out.append({"deepest": (float(end[d]), d), "deepest_wore": float(wore[d]),
+                    "fastest": (float(end[f]), f), "fastest_wore": float(wore[f])})
+        before = end
+    return out
+
+
+def _where(cols: dict, j: int, point) -> str:
+    face, k, pocket = (int(i) for i in point)
+    return f"{('front', 'rear')[face]} face of pocket {pocket}, psi {float(cols['psi_deg'][j][k]):.3g} deg"
+
+
+def _stopped(point: dict) -> bool:
+    """Whether a stage's deepest point (:func:`stage_points`) did not wear in it, less than 0.1 % of what its
+    fastest point wore."""
+    wore = point["fastest_wore"]
+    return wore > 0.0 and point["deepest_wore"] <= 1e-3 * wore and point["deepest"][1] != point["fastest"][1]
+
+
+def depth_notes(cols: dict, attrs: dict) -> list[str]:
+    """A line for each stage in which the deepest point did not wear (less than 0.1 % of what the fastest point
+    wore, :func:`stage_points`): the table's 'deepest' stays put while its depth rate is another point's."""
+    notes = []
+    for j, pt in enumerate(stage_points(cols, attrs)):
+        (deep, d), (end, f), wore = pt["deepest"], pt["fastest"], pt["fastest_wore"]
+        if _stopped(pt):
+            notes.append(f"stage {j}: the deepest point ({deep:.4g} um: {_where(cols, j, d)}) did not wear in this "
+                         f"stage; the stage's depth rate, {float(cols['max_depth_rate_um_per_h'][j]):.4g} um/h, is the "
+                         f"fastest point's ({_where(cols, j, f)}), which wore {wore:.4g} um, to {end:.4g} um")
+    return notes
 
 
 def read_life(path) -> tuple[dict, dict]:
@@ -626,8 +685,7 @@ def plot_life(cols: dict, attrs: dict):
     h_end = cols["hours_end"]
     h_start = np.concatenate([[0.0], h_end[:-1]])
     fig, axes = subplots(1, 4, figsize=(16, 3.8))
-    axes[0].plot(np.concatenate([[0.0], h_end]), np.concatenate([[0.0], cols["max_depth_um"]]), "o-")
-    axes[0].set_ylabel("deepest worn point [µm]")
+    _plot_depths(axes[0], cols, attrs)
     axes[1].plot(np.concatenate([[0.0], h_end]), np.concatenate([[cols["clearance_start_mm"][0]],
                                                                    cols["clearance_end_mm"]]), "o-", color="C2")
     axes[1].set_ylabel("effective pocket clearance [mm]\n(worst pocket: s + mean worn depth)")
@@ -642,6 +700,31 @@ def plot_life(cols: dict, attrs: dict):
                  f"inner-ring rotations, {counted(len(h_end), 'stage')}\n{_life_subtitle(attrs)}", fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _plot_depths(ax, cols: dict, attrs: dict) -> None:
+    """The deepest point of any face at each stage's end, and each stage's fastest point (:func:`stage_points`)
+    as a segment from its depth at the stage's start to its end, whose slope is the rate the third panel gives;
+    a stage in which the deepest point did not wear is marked so."""
+    h_end = np.asarray(cols["hours_end"], dtype=float)
+    h_start = np.concatenate([[0.0], h_end[:-1]])
+    points = stage_points(cols, attrs)
+    shape = (2, *np.shape(cols["worn_depth_front_um"][0])) if points else (1,)
+    first = float(_history_start(attrs, shape).max())  # the scenario's own worn depth, if any
+    ax.plot(np.concatenate([[0.0], h_end]), np.concatenate([[first], cols["max_depth_um"]]), "o-", color="C0",
+            label="deepest point of any face")
+    if points:
+        x = np.array([[a, b, np.nan] for a, b in zip(h_start, h_end)]).ravel()
+        y = np.array([[p["fastest"][0] - p["fastest_wore"], p["fastest"][0], np.nan] for p in points]).ravel()
+        ax.plot(x, y, "--", color="C3", lw=1.5, label="fastest point of each stage\n(slope: the third panel's rate)")
+    for j, p in enumerate(points):
+        if _stopped(p):
+            ax.annotate(f"stage {j}: the deepest\npoint wears no more", (0.5 * (h_start[j] + h_end[j]),
+                        p["deepest"][0]), xytext=(0, -6), textcoords="offset points", ha="center", va="top",
+                        fontsize=7)
+    ax.set_ylabel("worn depth [µm]")
+    ax.set_ylim(bottom=0.0)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2))  # below the axes: no data covered
 
 
 def _life_subtitle(attrs: dict) -> str:
@@ -665,24 +748,33 @@ def _life_subtitle(attrs: dict) -> str:
 
 
 def _plot_worn_faces(ax, cols: dict) -> None:
-    """The worn depth over psi at each stage's end, mean over pockets: front face solid, rear dashed, the
-    later stages darker (histories written before life.h5 held the profiles: a note instead)."""
+    """The worn depth over psi at each stage's end, mean over pockets: front face solid, rear dashed, a colour per
+    stage, named by a colour bar (the stage and when it ended); the earlier stages drawn over the later ones, which
+    lie above them, and every colour dark enough to read on white (histories written before life.h5 held the
+    profiles: a note instead)."""
     if "worn_depth_front_um" not in cols:
         ax.text(0.5, 0.5, "no worn-depth profiles in this life.h5", ha="center", va="center", transform=ax.transAxes)
         return
     import matplotlib
+    from matplotlib.colors import BoundaryNorm, ListedColormap
 
-    cmap = matplotlib.colormaps["viridis_r"]
     n = len(cols["stage"])
+    # viridis from its green (the first stage) to its dark purple (the last): its lighter greens and yellows fade
+    # on white (contrast below 3)
+    colours = [matplotlib.colormaps["viridis"](0.58 * (n - 1 - j) / max(n - 1, 1)) for j in range(n)]
     for j in range(n):
-        c = cmap(0.15 + 0.85 * (j + 1) / n)
         psi = cols["psi_deg"][j]
-        ax.step(psi, cols["worn_depth_front_um"][j].mean(axis=1), where="mid", color=c, lw=1.2,
-                label="front" if j == n - 1 else None)
-        ax.step(psi, cols["worn_depth_rear_um"][j].mean(axis=1), where="mid", color=c, lw=1.2, ls="--",
-                label="rear" if j == n - 1 else None)
+        for key, style in (("worn_depth_front_um", "-"), ("worn_depth_rear_um", "--")):
+            ax.step(psi, cols[key][j].mean(axis=1), where="mid", color=colours[j], lw=1.2, ls=style, zorder=3 + n - j)
+    for style, face in (("-", "front"), ("--", "rear")):
+        ax.plot([], [], color="0.3", ls=style, label=f"{face} face")
     ax.set_xlabel("ψ on the face: bore end ← 0 → rim end [deg]")
     ax.set_ylabel("worn depth, mean over pockets [µm]")
-    ax.set_title("worn faces at each stage's end (darker: later)", fontsize=8)
+    ax.set_title("worn faces at each stage's end", fontsize=8)
     ax.set_ylim(bottom=0.0)
     ax.legend(fontsize=7)
+    mappable = matplotlib.cm.ScalarMappable(BoundaryNorm(np.arange(n + 1) - 0.5, n), ListedColormap(colours))
+    ticks = [int(j) for j in np.unique(np.round(np.linspace(0, n - 1, min(n, 10))))]  # the first and last among
+    bar = ax.figure.colorbar(mappable, ax=ax, ticks=ticks, fraction=0.08, pad=0.02)
+    bar.ax.set_yticklabels([f"{j} (to {float(cols['hours_end'][j]):.3g} h)" for j in ticks], fontsize=7)
+    bar.set_label("stage (its end)", fontsize=8)

@@ -693,3 +693,44 @@ def test_a_bad_key_of_the_api_is_named_as_its_argument(tmp_path, study, key, wor
             bearingsim.uncertainty(sc, 4, tmp_path / "o", keys=[key])
     assert str(err.value).startswith(words) and "--keys" not in str(err.value), str(err.value)
     assert not (tmp_path / "o").exists()
+
+
+def _paper_3000rpm_at_16_samples():
+    """The indices and spreads `bearingsim uncertainty scenarios/paper_3000rpm.toml --samples 16` printed (I_dec)."""
+    printed = {"bearing.roller_diameter_mm": ((-0.004, -0.012, 0.000), (0.0001, 0.00001, 0.0004)),
+               "bearing.pitch_diameter_mm": ((0.016, 0.003, 0.030), (0.0002, 0.00001, 0.0009)),
+               "bearing.pocket_clearance_mm": ((-0.063, -0.130, 0.001), (0.016, 0.007, 0.029)),
+               "lubrication.drag_coefficient": ((1.035, 0.536, 1.588), (0.971, 0.566, 1.450)),
+               "contact.restitution": ((-0.003, -0.105, 0.105), (0.031, 0.017, 0.053))}
+    rows = [{"quantity": "I_dec", "key": k, **{f"{n}{end}": v for n, three in zip(("S1", "ST"), both)
+                                              for end, v in zip(("", "_low", "_high"), three)}}
+            for k, both in printed.items()]
+    spread = [{"quantity": "I_dec", "median": 0.005346, "p05": 0.004339, "p95": 0.006581, "runs_used": 32.0}]
+    return rows, spread
+
+
+def test_the_sobol_chart_gives_the_commands_unit_and_says_which_indices_it_does_not_resolve():
+    """uncertainty.png of paper_3000rpm at N = 16 titled its panel "I dec: median 0.005346, 5-95 %: 0.004339 ..
+    0.006581" (N s, no unit; the command prints 5.346 .. mN s), and drew shares from -0.13 to 1.59 as if they
+    were read: 5 of its 10 indices have a 95 % interval that reaches 0 as the command prints it ([-0.130,
+    +0.001], [+0.000, +0.000]), and shares below 0 or above 1 are the estimator's scatter. The title gives the
+    command's numbers and unit, those bars are faded and counted, and the region outside 0..1 is marked."""
+    from bearingsim.studies.uncertainty import format_table, plot_indices
+
+    rows, spread = _paper_3000rpm_at_16_samples()
+    printed = format_table(spread, rows)
+    assert "median 5.346, 5-95 %: 4.339 .. 6.581 mN s" in printed
+    (ax,) = plot_indices(rows, spread).axes
+    title = ax.get_title()
+    assert title.startswith("$I_{dec}$: median 5.346 mN s\n5-95 %: 4.339 .. 6.581 mN s"), title
+    assert "\nnot told from 0 (95 % interval reaches 0): 5 of 10 indices" in title, title
+    faded = {(c.get_label(), round(p.get_y() + p.get_height() / 2)): p.get_alpha() is not None and p.get_alpha() < 1
+             for c in ax.containers if hasattr(c, "patches") for p in c.patches}
+    rows_at = {round(y): k for y, k in zip(range(4, -1, -1), [r["key"] for r in rows])}
+    unresolved = sorted((label, rows_at[y]) for (label, y), f in faded.items() if f)
+    assert unresolved == [("first order", "bearing.pocket_clearance_mm"), ("first order", "bearing.roller_diameter_mm"),
+                          ("first order", "contact.restitution"), ("total", "bearing.pitch_diameter_mm"),
+                          ("total", "bearing.roller_diameter_mm")], unresolved
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(lb.startswith("outside 0..1: no share, the estimate's scatter") for lb in labels), labels
+    assert any("faded: 95 % interval reaches 0" in lb for lb in labels), labels

@@ -236,52 +236,116 @@ def write_tables(outdir, indices, spreads, study) -> list[Path]:
     return [p1, p2, p3]
 
 
+#: what a panel's title counts of the indices whose 95 % interval, as the table prints it, reaches 0: drawn faded
+UNRESOLVED = "not told from 0 (95 % interval reaches 0)"
+#: the colours of the first-order and total indices: a light sand and a dark green, apart in greyscale too, neither a
+#: face's colour
+INDEX_COLOURS = {"S1": "#DDCC77", "ST": "#117733"}
+#: the shade of the shares outside 0..1
+NO_SHARE = "0.92"
+
+
 def plot_indices(indices, spreads, title: str = ""):
     """One panel per output: S1 and ST of every key with their confidence intervals, and the output's
-    median and 5-95 % interval in the panel's title. An index of n/a (its output's variance 0 or unknown,
-    as the table says) has no bar, "n/a" at 0; one without an interval a hatched bar, counted in the title."""
+    median and 5-95 % interval in the panel's title, in the unit the table prints it. An index of n/a (its
+    output's variance 0 or unknown, as the table says) has no bar, "n/a" at 0; one without an interval a
+    hatched bar; one whose interval reaches 0 (:func:`resolved`) a faded bar: each counted in the title. The
+    shares below 0 and above 1, which no index has (the estimate's scatter), are shaded."""
     from bearingsim.plotting import subplots
 
     qs = list(dict.fromkeys(r["quantity"] for r in indices))
     keys = list(dict.fromkeys(r["key"] for r in indices))
     fig, axes = subplots(1, len(qs), figsize=(3.8 * len(qs) + 1.5, 0.35 * len(keys) + 2.0), squeeze=False)
     y = np.arange(len(keys))[::-1]
-    said = 0  # most lines a panel's title says of its missing bars: the figure grows by them
+    said, faded = 0, 0  # most lines a panel's title says of its bars: the figure grows by them
     for ax, q in zip(axes[0], qs):
         rows = {r["key"]: r for r in indices if r["quantity"] == q}
         missing = _index_bars(ax, rows, keys, y)
-        said = max(said, sum(n > 0 for n in missing.values()))
-        sp = next(s for s in spreads if s["quantity"] == q)
-        ax.set_title(f"{q.replace('_', ' ')}: median {sp['median']:.4g}\n5-95 %: {sp['p05']:.4g} .. {sp['p95']:.4g}"
+        said, faded = max(said, sum(n > 0 for n in missing.values())), faded + missing[UNRESOLVED]
+        ax.set_title(_spread_title(q, next(s for s in spreads if s["quantity"] == q))
                      + "".join(f"\n{w}: {n} of {2 * len(keys)} indices" for w, n in missing.items() if n), fontsize=8)
         ax.set_yticks(y)
         ax.set_yticklabels(keys if ax is axes[0][0] else [""] * len(keys), fontsize=8)
         ax.set_xlabel("Sobol index (share of the variance)")
         ax.grid(axis="x", alpha=0.3)
-    axes[0][0].legend(fontsize=8, loc="lower right")
+    shaded = [_shade_no_share(ax) for ax in axes[0]]
+    _index_legend(axes[0][0], faded > 0, any(shaded))
     fig.suptitle(title, fontsize=9)
-    fig.set_figheight(fig.get_figheight() + 0.3 * said)
+    fig.set_figheight(fig.get_figheight() + 0.3 * said + 0.2)
     fig.tight_layout()
     return fig
 
 
+def _spread_title(q: str, sp: dict) -> str:
+    """A panel's first two lines: the output (``$I_{dec}$``) and its median and 5-95 % interval in the unit the
+    table prints (:func:`shown`: the impulses in mN s)."""
+    scale, unit = shown(q)
+    unit = f" {unit}" if unit else ""
+    name = f"$I_{{{q[2:]}}}$" if q in ("I_dec", "I_acc") else q.replace("_", " ")
+    return (f"{name}: median {sp['median'] * scale:.4g}{unit}\n5-95 %: {sp['p05'] * scale:.4g} .. "
+            f"{sp['p95'] * scale:.4g}{unit}")
+
+
+def resolved(low: float, high: float) -> bool:
+    """Whether an index's 95 % interval, as the table prints it (3 decimals), keeps clear of 0; False also
+    without one (NaN)."""
+    lo, hi = round(float(low), 3), round(float(high), 3)
+    return bool(lo > 0.0 or hi < 0.0) if math.isfinite(lo) and math.isfinite(hi) else False
+
+
+def _shade_no_share(ax) -> bool:
+    """Shade the shares below 0 and above 1 that the axis shows (no index lies there: what is, is the
+    estimate's scatter); whether any."""
+    lo, hi = ax.get_xlim()
+    spans = [(a, b) for a, b in ((lo, 0.0), (1.0, hi)) if b > a]
+    for a, b in spans:
+        ax.axvspan(a, b, color=NO_SHARE, zorder=0, lw=0)
+    ax.set_xlim(lo, hi)
+    return bool(spans)
+
+
+def _index_legend(ax, faded: bool, shaded: bool) -> None:
+    """The legend of the first panel, below the axes: the two indices (:data:`INDEX_COLOURS`), and what a faded
+    bar and the shading mean when the figure has them."""
+    from matplotlib.legend_handler import HandlerTuple
+    from matplotlib.patches import Patch
+
+    handles = [Patch(facecolor=c) for c in INDEX_COLOURS.values()]
+    labels = ["first order", "total"]
+    if faded:
+        handles.append(tuple(Patch(facecolor=c, alpha=0.35) for c in INDEX_COLOURS.values()))
+        labels.append("faded: 95 % interval reaches 0 (not told from 0)")
+    if shaded:
+        handles.append(Patch(facecolor=NO_SHARE))
+        labels.append("outside 0..1: no share, the estimate's scatter")
+    ax.legend(handles, labels, fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.2), ncol=2,
+              handler_map={tuple: HandlerTuple(ndivide=None, pad=0.0)})
+
+
 def _index_bars(ax, rows, keys, y) -> dict[str, int]:
-    """S1 and ST of ``keys`` (``rows`` by key) as bars with their intervals, and how many have none:
-    ``{"n/a (variance 0 or unknown)": indices of n/a, no bar (not one of 0), "n/a" at 0;
-    "hatched (no interval)": bars without an error bar (not one of 0)}``. S1 light (sand), ST dark (green):
-    they differ in greyscale too, and neither is a face's colour; a hatch in black on S1, in white on ST."""
+    """S1 and ST of ``keys`` (``rows`` by key) as bars with their intervals, and how many are faded or have
+    none: ``{UNRESOLVED: bars whose interval reaches 0 (:func:`resolved`), faded; "n/a (variance 0 or
+    unknown)": indices of n/a, no bar (not one of 0), "n/a" at 0; "hatched (no interval)": bars without an
+    error bar (not one of 0)}``. S1 light (sand), ST dark (green): they differ in greyscale too, and neither is a
+    face's colour; a hatch in black on S1, in white on ST."""
     from bearingsim.plotting import hatch_without_error
 
-    missing = {"n/a (variance 0 or unknown)": 0, "hatched (no interval)": 0}
-    for off, name, color, hatch_colour in ((0.18, "S1", "#DDCC77", "black"), (-0.18, "ST", "#117733", "white")):
+    missing = {UNRESOLVED: 0, "n/a (variance 0 or unknown)": 0, "hatched (no interval)": 0}
+    for off, name, hatch_colour in ((0.18, "S1", "black"), (-0.18, "ST", "white")):
+        color = INDEX_COLOURS[name]
         v = np.array([rows[k][name] for k in keys], dtype=float)
-        err = np.abs(np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]],
-                              dtype=float) - v)
+        bounds = np.array([[rows[k][f"{name}_low"] for k in keys], [rows[k][f"{name}_high"] for k in keys]],
+                          dtype=float)
+        err = np.abs(bounds - v)
         ok = np.isfinite(v)
         bars = ax.barh(y[ok] + off, v[ok], 0.36, xerr=err[:, ok], color=color, edgecolor=hatch_colour, linewidth=0,
                        capsize=2,
                        label="first order" if name == "S1" else "total")
         hatch_without_error(bars, np.isnan(err[:, ok]).any(axis=0))
+        for bar, (lo, hi) in zip(bars.patches, bounds[:, ok].T):
+            if math.isfinite(lo) and math.isfinite(hi) and not resolved(lo, hi):
+                bar.set_alpha(0.35)
+                missing[UNRESOLVED] += 1
         for yi in y[~ok]:
             ax.text(0.0, yi + off, f" {name} n/a", va="center", fontsize=6, color="0.3")
         missing["n/a (variance 0 or unknown)"] += int((~ok).sum())

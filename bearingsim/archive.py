@@ -125,8 +125,9 @@ def check_writable_dir(folder: str | Path) -> Path:
 class TimeSeries:
     """An H5MD ``{step, time, value}`` group appended in buffered blocks (streamed, not held)."""
 
-    def __init__(self, group, value_shape: tuple[int, ...], unit: str, block: int = 4096):
+    def __init__(self, group, value_shape: tuple[int, ...], unit: str, block: int = 4096, check=None):
         self._group = group
+        self._check = check  # called after each block is written (Spool.check: a failed write stops the run)
         self._shape = tuple(value_shape)
         self._block = block
         self._buf_step: list = []
@@ -168,6 +169,8 @@ class TimeSeries:
             ds[n0:] = arr
         self._buf_step, self._buf_time, self._buf_value = [], [], []
         self._buffered = 0
+        if self._check is not None:
+            self._check()
 
 
 def _prepare_target(path) -> Path:
@@ -194,12 +197,92 @@ def _prepare_target(path) -> Path:
     return path
 
 
+class _SpoolFile:
+    """The spool's temporary file as HDF5 writes it (h5py's ``fileobj`` driver): ``os.pwrite`` and
+    ``os.pread`` of this process, and never a failure seen by HDF5.
+
+    HDF5 keeps a write that failed (a full disk: ENOSPC, or EFBIG past ``RLIMIT_FSIZE``; EIO) in its
+    caches and tries it again at every flush: its file then cannot be closed (h5py raised ``RuntimeError``
+    from ``close``, printed error stacks while freeing each object left open, and the interpreter crashed
+    at exit, in a sweep's worker too). Here the first failure is kept (``error``) and the bytes of that
+    write and of every later one are held in memory, where reads find them, so that HDF5 goes on and
+    closes its file; :meth:`Spool.check` stops the run at its next block. A signal's exception raised
+    inside a call (SIGINT while HDF5 writes) is kept as well (``interrupt``) and raised there.
+
+    Parameters
+    ----------
+    fd : descriptor of the new temporary file, open for reading and writing
+    """
+
+    def __init__(self, fd: int):
+        self.fd, self.pos, self.size = fd, 0, 0
+        self.error: OSError | None = None
+        self.interrupt: BaseException | None = None
+        self._held: list[tuple[int, bytes]] = []  # (offset, bytes) not on disk, in the order written
+
+    def seek(self, pos: int, whence: int = os.SEEK_SET) -> int:
+        self.pos = {os.SEEK_SET: 0, os.SEEK_CUR: self.pos, os.SEEK_END: self.size}[whence] + pos
+        return self.pos
+
+    def tell(self) -> int:
+        return self.pos
+
+    def write(self, data) -> int:
+        view, at, done = memoryview(data).cast("B"), self.pos, 0
+        while done < len(view) and self.error is None:
+            try:
+                done += os.pwrite(self.fd, view[done:], at + done)
+            except OSError as exc:
+                self.error = exc
+            except BaseException as exc:  # noqa: BLE001 - a signal's exception: raised by Spool.check
+                self.interrupt = self.interrupt or exc
+        if done < len(view):
+            self._held.append((at + done, bytes(view[done:])))
+        self.pos = at + len(view)
+        self.size = max(self.size, self.pos)
+        return len(view)
+
+    def read(self, size: int = -1) -> bytes:
+        at = self.pos
+        size = max(0, self.size - at) if size < 0 else size
+        data = None
+        while data is None:
+            try:
+                data = bytearray(os.pread(self.fd, size, at))
+            except OSError as exc:
+                self.error, data = self.error or exc, bytearray()
+            except BaseException as exc:  # noqa: BLE001 - a signal's exception: raised by Spool.check
+                self.interrupt = self.interrupt or exc
+        data.extend(bytes(size - len(data)))  # past the end: zeros, as HDF5's own driver reads
+        for start, held in self._held:
+            lo, hi = max(start, at), min(start + len(held), at + size)
+            if lo < hi:
+                data[lo - at:hi - at] = held[lo - start:hi - start]
+        self.pos = at + size
+        return bytes(data)
+
+    def truncate(self, size: int) -> int:
+        if self.error is None:
+            try:
+                os.ftruncate(self.fd, size)
+            except OSError as exc:
+                self.error = exc
+        self.size = size
+        return size
+
+    def flush(self) -> None:
+        """Nothing buffered here: every write is the system's at once."""
+
+
 class Spool:
     """The sink a model streams its time series into: the temporary file of the archive to be.
 
     Use as a context manager around the run and :func:`write`: on any error the temporary file is
     removed. ``timeseries(name, value_shape, unit, description)`` returns an appender
-    (:class:`TimeSeries`); ``discard_timeseries()`` drops what was streamed (a restarted run).
+    (:class:`TimeSeries`); ``discard_timeseries()`` drops what was streamed (a restarted run). HDF5
+    writes the file through :class:`_SpoolFile`: a full disk stops the run at the next block written
+    (:meth:`check`) with one :class:`bearingsim.outputs.ArchiveWriteError` naming the archive, and the
+    file closes cleanly.
     """
 
     def __init__(self, path):
@@ -207,32 +290,57 @@ class Spool:
         self.tmp = outputs.temporary_name(self.path)
         self._series: list[TimeSeries] = []
         self.f = None
+        self._file: _SpoolFile | None = None
 
     def __enter__(self) -> "Spool":
         try:  # a full disk or I/O error at creation: one line naming the path
-            self.f = _lazy_h5py().File(self.tmp, "w")
+            self._file = _SpoolFile(outputs.create_new(self.tmp, readable=True))
+            self.f = _lazy_h5py().File(self._file, "w")
+            self.check()
         except OSError as exc:
+            self._close()
             self.tmp.unlink(missing_ok=True)
             raise outputs.write_error(self.path, exc) from None
+        except BaseException:
+            self._close()
+            self.tmp.unlink(missing_ok=True)
+            raise
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:
-        if self.f is not None:
-            try:
-                outputs.close_quietly(self.f)
-            except Exception:  # closing a file after an HDF5 error (a full disk): the first error is reported
-                pass
-            self.f = None
+        self._close()
         self.tmp.unlink(missing_ok=True)  # written and renamed by write(), else abandoned
         if exc_type is not None and issubclass(exc_type, OSError) and not isinstance(exc, UserError):
             raise outputs.write_error(self.path, exc) from None
         return False
 
+    def check(self) -> None:
+        """Raise what a write into the file met: a signal's exception, or the first failed write as one
+        :class:`bearingsim.outputs.ArchiveWriteError` naming the archive."""
+        sf = self._file
+        if sf is not None and sf.interrupt is not None:
+            exc, sf.interrupt = sf.interrupt, None
+            raise exc
+        if sf is not None and sf.error is not None:
+            raise outputs.write_error(self.path, sf.error)
+
+    def _close(self) -> None:
+        """Close the HDF5 file (HDF5 has seen no failed write: it closes) and the temporary file's descriptor."""
+        if self.f is not None:
+            f, self.f = self.f, None
+            try:
+                outputs.close_quietly(f)
+            except Exception:  # noqa: BLE001 - an error already on its way is the one reported
+                pass
+        if self._file is not None and self._file.fd >= 0:
+            fd, self._file.fd = self._file.fd, -1
+            os.close(fd)
+
     def timeseries(self, name: str, value_shape=(), unit: str = "1", description: str = "") -> TimeSeries:
         g = self.f.create_group(f"observables/{name}")
         if description:
             g.attrs["description"] = description
-        ts = TimeSeries(g, value_shape, unit)
+        ts = TimeSeries(g, value_shape, unit, check=self.check)
         self._series.append(ts)
         return ts
 
@@ -266,19 +374,18 @@ def write(result, path, spool: Spool | None = None) -> Path:
         except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file
             raise outputs.write_error(path, exc) from None
         return path
-    f = spool.f
     try:
-        with outputs.quiet_stderr():  # HDF5 prints error stacks on a full disk; the OSError says it
-            for ts in spool._series:
-                ts.flush()
-            _fill(f, result)
-            outputs.close_quietly(f)
-            spool.f = None
+        for ts in spool._series:
+            ts.flush()
+        _fill(spool.f, result)
+        spool._close()  # HDF5 has seen no failed write (_SpoolFile): the file closes
+        spool.check()  # a write that failed (ENOSPC/EFBIG/EIO): one line, nothing left behind
         os.replace(spool.tmp, spool.path)
-    except OSError as exc:  # ENOSPC/EIO on flush or close: one line, nothing left behind
+    except OSError as exc:  # the rename
         spool.tmp.unlink(missing_ok=True)
         raise outputs.write_error(spool.path, exc) from None
     except BaseException:
+        spool._close()
         spool.tmp.unlink(missing_ok=True)
         raise
     return spool.path

@@ -886,19 +886,6 @@ def _one_line(exc: BaseException) -> str:
     return printable(str(exc), keep_newlines=False)
 
 
-def _exit_quietly(code: int) -> None:
-    """End the process now with ``code``: stdout flushed, file descriptor 2 sent to /dev/null first, so
-    that nothing HDF5 prints while dying follows the one line already written."""
-    with contextlib.suppress(OSError, ValueError):
-        sys.stdout.flush()
-    with contextlib.suppress(OSError, ValueError):
-        sys.stderr.flush()
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, 2)
-        os.close(devnull)
-    os._exit(code)
-
-
 def _stdout_to_devnull() -> None:
     """Point file descriptor 1 at /dev/null: what is still buffered for a reader that has gone (a pipe
     into ``head``) is dropped at exit instead of failing there with "Exception ignored ... BrokenPipeError"."""
@@ -1033,9 +1020,6 @@ def _failed(exc: BaseException, args) -> int:
     if isinstance(exc, BrokenPipeError):  # output piped into e.g. `head`, which stopped reading: stop quietly
         _stdout_to_devnull()
         return getattr(args, "status", 0)  # compare and rerun: their verdict, decided before they print
-    if isinstance(exc, outputs.ArchiveWriteError):  # HDF5 cannot be torn down cleanly: the line, then out at once
-        print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
-        _exit_quietly(exc.exit_code)
     if isinstance(exc, UserError):
         print(f"bearingsim: error: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code

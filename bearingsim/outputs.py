@@ -74,10 +74,12 @@ def temporary_name(path: Path) -> Path:
     return path.with_name(f".{path.name}.tmp-{os.getpid()}")
 
 
-def _create_new(path: Path) -> int:
-    """Open ``path`` for writing as a new file, never through a symbolic link (``O_EXCL|O_NOFOLLOW``);
-    a leftover of this process's id (a symbolic link planted there included) is removed first."""
-    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
+def create_new(path: Path, readable: bool = False) -> int:
+    """Open ``path`` for writing (and reading, with ``readable``) as a new file, never through a symbolic
+    link (``O_EXCL|O_NOFOLLOW``); a leftover of this process's id (a symbolic link planted there included)
+    is removed first."""
+    flags = ((os.O_RDWR if readable else os.O_WRONLY) | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+             | getattr(os, "O_CLOEXEC", 0))
     try:
         return os.open(path, flags, 0o644)
     except FileExistsError:
@@ -96,7 +98,7 @@ def atomic_file(path: str | Path):
     """
     path = Path(path)
     tmp = temporary_name(path)
-    fd = _create_new(tmp)
+    fd = create_new(tmp)
     try:
         with os.fdopen(fd, "wb") as fh:
             yield fh
@@ -682,9 +684,10 @@ def command_line_owns_stderr():
 @contextlib.contextmanager
 def quiet_stderr():
     """Under the command line only (:func:`command_line_owns_stderr`), send file descriptor 2 to
-    /dev/null for the block: while an archive is written, HDF5 prints its error stack there for each
-    object it fails to flush when the disk is full (and carries on); the failure itself surfaces as an
-    ``OSError`` at the latest when the file is closed. Called from a library, it does nothing."""
+    /dev/null for the block: around the close of a spool's HDF5 file (:func:`close_quietly`), which
+    sees no failed write (a full disk is kept from HDF5: :class:`bearingsim.archive.Spool`) but would
+    print its error stack there for anything else that failed while a signal or an error is already on
+    its way. Called from a library, it does nothing."""
     if not _command_line_owns_stderr:
         yield
         return
@@ -711,12 +714,10 @@ def close_quietly(f) -> None:
 
 
 class ArchiveWriteError(UserError):
-    """The archive could not be written (full disk, I/O error); the temporary file is already removed.
-
-    After such a failure HDF5's objects cannot be released cleanly (h5py prints error stacks while
-    freeing them and the interpreter may crash at exit), so :func:`bearingsim.cli.main` prints the one
-    line, sends file descriptor 2 to /dev/null and ends the process at once. The library only raises
-    it: the process's file descriptors are the caller's."""
+    """The archive could not be written (full disk, I/O error); the temporary file is already removed
+    and HDF5 has closed its file cleanly (the in-memory archive of :func:`bearingsim.archive.to_bytes` is
+    written with plain writes; a spool's file keeps its failed writes from HDF5): the process goes on, or
+    exits, as after any other :class:`UserError` (exit 2)."""
 
 
 def write_error(path: str | Path, exc: OSError) -> ArchiveWriteError:

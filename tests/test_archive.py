@@ -409,6 +409,87 @@ def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
     assert list((tmp_path / "out").iterdir()) == []
 
 
+_SPOOL_FULL_DISK_CHILD = r"""
+import sys
+import numpy as np
+from bearingsim import archive
+from bearingsim.datatypes import AttrGroup, NamedArray
+from bearingsim.outputs import ArchiveWriteError
+from bearingsim.reduced import ReducedResult
+from bearingsim import load_scenario
+
+out, how = sys.argv[1], sys.argv[2]
+sc = load_scenario(sys.argv[3], set={"numerics.rotations": 2})
+res = ReducedResult(sc, {"results/per_rotation/I_dec": NamedArray(np.ones((3, 2)), "N s"),
+                         "results/per_rotation/I_acc": NamedArray(np.ones((3, 2)), "N s")},
+                    {"results/summary": AttrGroup({"I_dec_mean_Ns": 1.0}, {"I_dec_mean_Ns": "N s"})},
+                    provenance={"dt_s": 1e-6, "wall_time_s": 0.5})
+
+
+def stream(sink):  # 640 kB of numbers gzip cannot shrink: a long run's time series
+    ts = sink.timeseries("noise", (2,), "m")
+    rng = np.random.default_rng(1)
+    for i in range(40):
+        ts.append(np.arange(i * 1000, (i + 1) * 1000), np.arange(1000) * 1e-5, rng.random((1000, 2)))
+
+
+if how == "spool":
+    try:
+        with archive.Spool(out) as spool:
+            stream(spool)
+            archive.write(res, out, spool)
+    except ArchiveWriteError as exc:
+        print(f"refused: {exc}")
+else:  # a multibody case of a sweep, its model's run replaced by the streaming above
+    from bearingsim import simulation
+    from bearingsim.sweeps import worker
+
+    def run(scenario, progress=False, sink=None, check_step=False):
+        stream(sink)
+        return res
+
+    simulation.run = run
+    rec = worker.run_case("0" * 16, sc.to_toml(), archive.Path(out), archives="all")
+    print(f"{rec['status']}: {rec['error']}")
+"""
+
+
+def _fsize_limit(limit):
+    """``preexec_fn`` of a child whose writes fail past ``limit`` bytes (EFBIG, "File too large", as a full
+    disk's ENOSPC; Python ignores SIGXFSZ)."""
+    import resource
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    return limited
+
+
+@pytest.mark.parametrize("how", ["spool", "sweep case"])
+@pytest.mark.parametrize("limit", [64 << 10, 400_000], ids=["while streaming", "at close"])
+def test_a_full_disk_while_a_spool_streams_is_one_line_and_a_clean_exit(tmp_path, how, limit):
+    """A full disk met by a streamed (multibody) archive, while its time series stream or when HDF5 closes
+    its file, is one ArchiveWriteError naming the archive and the cause, in a sweep's case its failure;
+    no temporary file, nothing on stderr, a clean exit. It was h5py's RuntimeError "Can't decrement id
+    ref count" from close (not caught), error stacks of each HDF5 object freed, and SIGSEGV at exit."""
+    import subprocess
+    import sys
+
+    from .conftest import ROOT, SCENARIOS
+
+    out = tmp_path / "out" / "a.h5"
+    out.parent.mkdir()
+    child = [sys.executable, "-c", _SPOOL_FULL_DISK_CHILD, out, how, SCENARIOS / "multibody_3000rpm.toml"]
+    proc = subprocess.run(child, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
+                          text=True, preexec_fn=_fsize_limit(limit), timeout=300)
+    stdout, stderr = proc.stdout, proc.stderr
+    assert proc.returncode == 0, stderr[-2000:]
+    first = "refused" if how == "spool" else "failed"
+    assert stdout == f"{first}: {out}: cannot write archive (File too large); nothing was written\n", stdout
+    assert stderr == ""
+    assert list(out.parent.iterdir()) == []
+
+
 def test_a_multibody_archive_of_the_version_before_where_the_cage_rests_still_reads(tmp_path, capsys):
     """Multibody model version 6 added ``cage_rest_offset_m`` and ``cage_rest_angle_deg`` to the summary
     (bearingsim.multibody.SUMMARY_ADDED) and their per-rotation arrays. An archive without them (one of

@@ -118,6 +118,37 @@ def test_an_interrupted_crosscheck_resumes_from_the_finished_rungs(tmp_path):
     assert all(math.isfinite(r["I_dec_mean_Ns"]) for r in table)
 
 
+def test_a_study_whose_every_case_failed_writes_no_table_and_says_so(tmp_path, monkeypatch, capsys):
+    """Every rung of a cross-check failed (each case's archive met a full disk): no crosscheck.csv, .h5 or
+    .png of empty numbers as if done, no table printed, one line naming the failures and where they are
+    kept, exit 1; the case index lists every rung failed with its error. It wrote the three files with
+    empty number columns, printed them and "wrote ..." lines."""
+    from bearingsim.cli import main
+    from bearingsim.sweeps import worker
+
+    def full_disk(case_hash, *args, **kwargs):  # in the forked worker: what a case on a full disk records
+        return {"hash": case_hash, "status": "failed", "wall_s": 0.0, "summary": {},
+                "error": f"cases/{case_hash}.h5: cannot write archive (No space left on device); nothing was written"}
+
+    monkeypatch.setattr(worker, "run_case", full_disk)
+    out = tmp_path / "cc"
+    rc = main(["crosscheck", str(REFERENCE), "--speeds", f"{RPM:g}", "--rotations", "1", "-j", "1", "-o", str(out)])
+    captured = capsys.readouterr()
+    said = [line for line in captured.err.splitlines() if not line.startswith("bearingsim: note:")]
+    assert rc == 1
+    assert len(said) == 6 and all(line.startswith("failed: case ") for line in said[:5])  # one line each, then:
+    assert said[-1].startswith("bearingsim: error: crosscheck: all 5 cases failed, the first (rpm=6000.0, rung=")
+    assert said[-1].count("cannot write archive (No space left on device)") == 1
+    assert said[-1].endswith(f"no table or figure written (the errors are in {out / 'sweep.csv'}; the same command "
+                             "runs them again)")
+    assert "wrote" not in captured.out and "crosscheck.csv" not in captured.out
+    assert not [p.name for p in out.iterdir() if p.name.startswith("crosscheck")]
+    with open(out / "sweep.csv", newline="") as fh:
+        index = list(csv.DictReader(fh))
+    assert [r["status"] for r in index] == ["failed"] * 5
+    assert all("No space left on device" in r["error"] for r in index)
+
+
 # Computed at commit 2e9b5c4 (before the studies moved onto the engine), with
 # bearingsim.reduced.studies.fig9_table(), numbers printed with repr (the reduced model's numbers have
 # not moved since).

@@ -180,6 +180,11 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
     StudiesOutcome
         ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the cases (finished archives
         and the case index are kept; no table is written; run again to resume).
+
+    Raises
+    ------
+    StudyFailed
+        Every case failed (each is in the case index with its error): no table or figure is written.
     """
     from bearingsim.archive import check_writable_dir
     from bearingsim.outputs import FolderLock
@@ -201,6 +206,8 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
         known = {r["case"] for r in sweep.rows}
         out = StudiesOutcome(sweep, planned=len(known) + sum(s.cases_to_come(known) for s in studies))
         if sweep.interrupted is None:
+            if sweep.rows and all(r["status"] == "failed" for r in sweep.rows):
+                raise every_case_failed("+".join(s.name for s in studies), sweep, out.planned)
             records = {r["case"]: r for r in sweep.rows}
             try:
                 for study in studies:
@@ -210,6 +217,28 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
                 exc.resume_note = f"{done} done and kept in {outdir}, its tables and figures not all written"
                 raise
     return out
+
+
+class StudyFailed(UserError):
+    """Every case of a study failed: no table or figure is written (a table of empty numbers would read as
+    a finished study); the cases' errors stay in the folder's case index. Exit code 1, as a study with
+    failed cases."""
+
+    exit_code = 1
+
+
+def every_case_failed(what: str, sweep, planned: int = 0) -> StudyFailed:
+    """The one line of a study (``what``) whose cases all failed, naming the first with its error (a line
+    per failed case is said as it fails); ``planned``: its cases, those of later stages included."""
+    from bearingsim.wording import counted
+
+    n, first = len(sweep.rows), sweep.failed[0]
+    name = ", ".join(f"{k}={v}" for k, v in first["values"].items())
+    which = "its one case failed" if n == 1 else f"all {n} cases failed, the first"
+    rest = planned - n  # a staged study stops at a failed stage
+    later = f"; {counted(rest, 'later case')} not run (each needs the one before)" if rest > 0 else ""
+    return StudyFailed(f"{what}: {which} ({name}: {first['error']}){later}; no table or figure written (the errors "
+                       f"are in {sweep.csv}; the same command runs them again)")
 
 
 def _new_cases(cases: list[Case], more) -> list[Case]:

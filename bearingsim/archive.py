@@ -439,6 +439,13 @@ def to_bytes(result) -> bytes:
     """``result`` as the bytes of a complete archive, built in memory (HDF5 core driver, no file):
     the same content :func:`write` stores, for a caller that writes the file itself (a sweep's
     worker: one write of the whole file, or bytes sent back to the sweep's client)."""
+    return _image(lambda f: _fill(f, result, in_memory=True))
+
+
+def _image(fill) -> bytes:
+    """The bytes of an HDF5 file built in memory (core driver, no backing store) by ``fill(f)``: written
+    then with plain writes (:func:`bearingsim.outputs.write_atomic_bytes`), so that a full disk is an
+    ``OSError`` naming the file, never HDF5's failed write."""
     global _image_count
     h5py = _lazy_h5py()
     _image_count += 1
@@ -446,7 +453,7 @@ def to_bytes(result) -> bytes:
     fapl, fcpl = _image_plists()
     f = h5py.File(h5py.h5f.create(name, h5py.h5f.ACC_TRUNC, fapl=fapl, fcpl=fcpl))
     try:
-        _fill(f, result, in_memory=True)
+        fill(f)
         f.flush()
         return f.id.get_file_image()
     finally:
@@ -1064,26 +1071,23 @@ def write_table_file(path, columns: dict[str, np.ndarray], units: dict[str, str]
     ``descriptions`` has one, its ``description`` are attributes of its dataset."""
     h5py = _lazy_h5py()
     path = Path(path)
-    tmp = outputs.temporary_name(path)
-    try:
-        with h5py.File(tmp, "w") as f:
-            for k, v in attrs.items():
-                f.attrs[k] = v
-            g = f.create_group("index")
-            for name, arr in columns.items():
-                arr = np.asarray(arr)
-                if arr.dtype.kind in "OUS":
-                    ds = g.create_dataset(name, data=arr.astype(object), dtype=h5py.string_dtype())
-                else:
-                    ds = g.create_dataset(name, data=arr)
-                if name in units:
-                    ds.attrs["unit"] = units[name]
-                if descriptions and name in descriptions:
-                    ds.attrs["description"] = descriptions[name]
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+
+    def fill(f):
+        for k, v in attrs.items():
+            f.attrs[k] = v
+        g = f.create_group("index")
+        for name, arr in columns.items():
+            arr = np.asarray(arr)
+            if arr.dtype.kind in "OUS":
+                ds = g.create_dataset(name, data=arr.astype(object), dtype=h5py.string_dtype())
+            else:
+                ds = g.create_dataset(name, data=arr)
+            if name in units:
+                ds.attrs["unit"] = units[name]
+            if descriptions and name in descriptions:
+                ds.attrs["description"] = descriptions[name]
+
+    outputs.write_atomic_bytes(path, _image(fill))  # a full disk: an OSError naming path
     return path
 
 
@@ -1139,7 +1143,6 @@ def write_grid_file(path, axes: list[tuple[str, np.ndarray, dict[str, str]]],
     """
     h5py = _lazy_h5py()
     path = Path(path)
-    tmp = outputs.temporary_name(path)
 
     def create(f, name, arr):
         arr = np.asarray(arr)
@@ -1147,25 +1150,22 @@ def write_grid_file(path, axes: list[tuple[str, np.ndarray, dict[str, str]]],
             return f.create_dataset(name, data=arr.astype(object), dtype=h5py.string_dtype())
         return f.create_dataset(name, data=arr)
 
-    try:
-        with h5py.File(tmp, "w") as f:
-            for k, v in attrs.items():
-                f.attrs[k] = v
-            scales = []
-            for name, values, a in axes:
-                ds = create(f, name, values)
-                ds.make_scale(name)
-                ds.attrs.update(a)
-                scales.append(ds)
-            for name, (arr, a) in variables.items():
-                ds = create(f, name, arr)
-                ds.attrs.update(a)
-                for i, scale in enumerate(scales):
-                    ds.dims[i].attach_scale(scale)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    def fill(f):
+        for k, v in attrs.items():
+            f.attrs[k] = v
+        scales = []
+        for name, values, a in axes:
+            ds = create(f, name, values)
+            ds.make_scale(name)
+            ds.attrs.update(a)
+            scales.append(ds)
+        for name, (arr, a) in variables.items():
+            ds = create(f, name, arr)
+            ds.attrs.update(a)
+            for i, scale in enumerate(scales):
+                ds.dims[i].attach_scale(scale)
+
+    outputs.write_atomic_bytes(path, _image(fill))  # a full disk: an OSError naming path
     return path
 
 

@@ -94,18 +94,32 @@ def atomic_file(path: str | Path):
     The data goes to a new temporary file in the same folder (:func:`temporary_name`), which replaces
     ``path`` by ``os.replace`` only when the block ends without an error: a reader never sees a partial
     file, and a symbolic link at ``path`` is replaced, never written through. On any error (a signal
-    included) the temporary file is removed and ``path`` is untouched.
+    included) the temporary file is removed and ``path`` is untouched; an ``OSError`` of the temporary
+    file (a full disk) is raised as one of ``path`` (its ``filename``).
     """
     path = Path(path)
     tmp = temporary_name(path)
-    fd = create_new(tmp)
+    try:
+        fd = create_new(tmp)
+    except OSError as exc:
+        raise _naming(exc, path) from None
     try:
         with os.fdopen(fd, "wb") as fh:
             yield fh
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.errno is not None and (
+                exc.filename is None or str(exc.filename) == str(tmp)):  # a write, or the rename, of the temporary
+            raise _naming(exc, path) from None
         raise
+
+
+def _naming(exc: OSError, path: Path) -> OSError:
+    """``exc`` (a write to the temporary file, its creation or its rename) as the same error of ``path``, the
+    file the user asked for: a full disk while a sweep's index is written names ``sweep.csv``, never the
+    temporary name nor, with no name at all, standard output (:func:`bearingsim.cli.main`)."""
+    return OSError(exc.errno, exc.strerror or os.strerror(exc.errno), str(path))
 
 
 def write_atomic_bytes(path: Path, data: bytes) -> None:

@@ -1385,3 +1385,27 @@ def test_the_sweeps_page_says_a_range_is_rounded_to_15_digits_as_it_is():
     assert "0.05:0.5:10 gives 0.15 and 0.35, where the floating-point spacing gives 0.15000000000000002" in text
     values = parse_param("bearing.pocket_clearance_mm=0.05:0.5:10")[1]
     assert values[2] == 0.15 and values[6] == 0.35 and np.linspace(0.05, 0.5, 10)[2] == 0.15000000000000002
+
+
+@pytest.mark.parametrize("limit, index", [(64, "sweep.csv"), (4096, "sweep.h5")])
+def test_a_full_disk_while_the_index_is_written_names_the_index(tmp_path, limit, index):
+    """Writes failing past ``limit`` bytes (``RLIMIT_FSIZE`` in the child: EFBIG, "File too large", as a full
+    disk's ENOSPC) while a reduced sweep writes its index (no case archives under the default policy): one
+    line naming the index file and the cause, exit 2, no temporary file. It said "cannot write to standard
+    output (File too large)" (the failed write of the index's temporary file carried no file name), or, where
+    h5py wrote sweep.h5 to disk, printed HDF5's error stacks and died of SIGSEGV."""
+    import resource
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    args = [sys.executable, "-m", "bearingsim", "sweep", BASE, "--param", f"{SPEED}=1000,2000",
+            "--set", "numerics.rotations=2", "-j", "1", "-q"]
+    warm = subprocess.run([*map(str, args), "-o", tmp_path / "warm"], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})  # compiled kernels cached: no write of them
+    assert warm.returncode == 0, warm.stderr
+    out = tmp_path / "sw"
+    proc = subprocess.run([*map(str, args), "-o", out], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)}, preexec_fn=limited)
+    assert (proc.returncode, proc.stderr) == (2, f"bearingsim: error: {out / index}: File too large\n")
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [".sweep.lock"]  # no temporary

@@ -1,5 +1,5 @@
 import sys
 
-from bearingsim.cli import main
+from bearingsim.cli import program
 
-sys.exit(main())
+sys.exit(program())

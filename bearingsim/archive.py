@@ -374,18 +374,23 @@ def write(result, path, spool: Spool | None = None) -> Path:
         except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file
             raise outputs.write_error(path, exc) from None
         return path
+    renaming = False
     try:
         for ts in spool._series:
             ts.flush()
         _fill(spool.f, result)
         spool._close()  # HDF5 has seen no failed write (_SpoolFile): the file closes
         spool.check()  # a write that failed (ENOSPC/EFBIG/EIO): one line, nothing left behind
+        renaming = True
         os.replace(spool.tmp, spool.path)
+        outputs.note_written(spool.path)
     except OSError as exc:  # the rename
         spool.tmp.unlink(missing_ok=True)
         raise outputs.write_error(spool.path, exc) from None
     except BaseException:
         spool._close()
+        if renaming and not os.path.lexists(spool.tmp):  # renamed, then a signal's exception: complete
+            outputs.note_written(spool.path)
         spool.tmp.unlink(missing_ok=True)
         raise
     return spool.path

@@ -72,7 +72,7 @@ def _cmd_run(args) -> int:
     progress = not args.quiet and sys.stderr.isatty()
     out = run_scenario(scenario, args.output, figures=not args.no_plots, progress=progress, notes=not args.quiet,
                        force=args.force, check_step=args.check_step)
-    args.written = out.archive  # from here an error of standard output is not "no archive" (main)
+    args.written, args.finished = out.archive, True  # from here neither stdout's error nor a signal is "no archive"
     if not args.quiet:
         print(f"wrote {out.archive}")
         for png in out.figures:
@@ -365,7 +365,7 @@ def _cmd_rerun(args) -> int:
     if args.output:  # the path of `run`: target checks, output lock, stale temporaries of dead runs cleaned
         run_scenario(old.scenario, args.output, figures=False, progress=progress, notes=not args.quiet,
                      force=args.force, check_step=check_step)
-        args.written = Path(args.output)
+        args.written, args.finished = Path(args.output), True  # its one file: a signal now is not "no archive"
         new = read(args.output, only=COMPARED)  # as written: its time series went to the file, not the result
     else:
         new = run(old.scenario, progress=progress, check_step=check_step)
@@ -956,16 +956,26 @@ def _say_compiling(module: str) -> None:
           f"them from numba's cache)\033[K", file=sys.stderr)
 
 
-def main(argv: list[str] | None = None) -> int:
+def program() -> int:
+    """The ``bearingsim`` program (its console script, ``python -m bearingsim``): :func:`main` of the process's
+    arguments, which then ends with the code returned."""
+    return main(exiting=True)
+
+
+def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
     Exit codes: 0 success, 2 bad input or an unwritable output (one line on stderr), 3 an unstable or
-    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (no archive, no temporary file); 0 also when
+    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (the line says what is complete: nothing, the
+    archive, or every file once all were written); 0 also when
     the reader of the output goes away early (``bearingsim inspect x.h5 | head -1``), with nothing said,
     except for ``compare`` and ``rerun``, whose exit code is their verdict (0 identical, 1 differ) and
-    stays so (``args.status``, set before they print).
+    stays so (``args.status``, set before they print). ``exiting``: the process ends when it returns
+    (:func:`program`): once the exit code is decided SIGINT and SIGTERM are ignored, not restored, so that
+    a signal in its last moments neither ends it silently nor contradicts the line it printed.
     """
     args = build_parser().parse_args(argv)
+    args.files_written = {}  # the files complete so far (outputs.recording_files), for an interrupted command's line
     previous = None
     try:
         previous = signal.signal(signal.SIGTERM, _raise_terminated)
@@ -979,16 +989,34 @@ def main(argv: list[str] | None = None) -> int:
             stream.reconfigure(errors="backslashreplace")
     try:
         with (_interrupts_redelivered() as swallowed, outputs.command_line_owns_stderr(), _notes_on_stderr(),
-              _compile_note(args)):
+              outputs.recording_files(args.files_written), _compile_note(args)):
             return _run_command(args, swallowed)
     except (OSError, UserError, SimulationUnstable, KeyboardInterrupt, MemoryError) as exc:
+        if exiting:  # the outcome is decided: its line is not cut short
+            _ignore_signals()
         return _failed(exc, args)
     finally:
-        if previous is not None:
+        if exiting:
+            _ignore_signals()
+        elif previous is not None:
             signal.signal(signal.SIGTERM, previous)
         for name, err in errors.items():
             with contextlib.suppress(AttributeError, ValueError, OSError):
                 getattr(sys, name).reconfigure(errors=err)
+
+
+def _ignore_signals() -> None:
+    """SIGINT and SIGTERM ignored from now on (the process ends with its exit code decided); a signal whose
+    handler runs meanwhile (it came just before) changes nothing."""
+    for _ in range(3):
+        try:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            signal.signal(signal.SIGTERM, signal.SIG_IGN)
+            return
+        except KeyboardInterrupt:  # SIGINT's or SIGTERM's handler, run between the two: set them again
+            continue
+        except ValueError:  # not the main thread
+            return
 
 
 def _run_command(args, swallowed: _Swallowed) -> int:
@@ -996,6 +1024,7 @@ def _run_command(args, swallowed: _Swallowed) -> int:
     interpreter's last flush)."""
     try:
         code = args.func(args)
+        args.finished = True  # every file it writes is written (a signal from here on says so: _interrupted)
     except Exception as exc:
         signum = swallowed.take()
         if signum is None:
@@ -1057,12 +1086,25 @@ _NOT_WRITTEN.update({c: f"before any case of the {c} study ran (cases an earlier
                         f"runs it)" for c in ("sensitivity", "uncertainty", "crosscheck", "validate")})
 
 
+#: the commands that write one file: once it is complete, all is written
+_ONE_FILE = ("animate", "report")
+
+
 def _interrupted(exc: KeyboardInterrupt, args) -> int:
     """SIGINT or SIGTERM: what was kept, in one line; exit 130 or 143."""
     what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-    written = getattr(exc, "archive_written", None)  # the signal came while figures were drawn
+    written = getattr(exc, "archive_written", None) or getattr(args, "written", None)  # the archive is complete
     kept = getattr(exc, "resume_note", None)  # what a study kept, its cases done (studies.run_studies)
-    if written is not None:
+    done = getattr(args, "files_written", {})  # the files complete (outputs.recording_files)
+    expected = (getattr(args, "expected", None) or ([written, *getattr(exc, "figures_expected", ())] if written else ())
+                or (list(done) if getattr(args, "command", None) in _ONE_FILE else ()))
+    if done and (getattr(args, "finished", False)
+                 or (expected and all(os.path.abspath(p) in done for p in expected))):
+        names = list(done.values())
+        shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+        print(f"bearingsim: {what} once its files were written: {shown} {'is' if len(names) == 1 else 'are'} "
+              f"complete", file=sys.stderr)
+    elif written is not None:
         print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
               f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
     elif kept is not None:  # worded as the other studies' (cli_common.report_study)

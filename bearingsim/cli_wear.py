@@ -57,6 +57,7 @@ def _cmd_wear(args) -> int:
         tell(f"{paths[0]}: " + wear.format_report(done[0][1]))
     else:
         tell(_comparison(paths, done))
+    args.expected = [png for named in pngs for png in named.values()]  # an interrupt's line says which are complete
     for (result, rep), named in zip(done, pngs):
         for name, png in named.items():
             tell(f"wrote {save_figure(figures[name](rep, result.title()), png)}")

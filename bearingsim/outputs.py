@@ -103,11 +103,17 @@ def atomic_file(path: str | Path):
         fd = create_new(tmp)
     except OSError as exc:
         raise _naming(exc, path) from None
+    renaming = False
     try:
         with os.fdopen(fd, "wb") as fh:
             yield fh
+        renaming = True
         os.replace(tmp, path)
+        note_written(path)
     except BaseException as exc:
+        if renaming and not os.path.lexists(tmp):  # renamed, then a signal's exception: the file is complete
+            note_written(path)
+            raise
         tmp.unlink(missing_ok=True)
         if isinstance(exc, OSError) and exc.errno is not None and (
                 exc.filename is None or str(exc.filename) == str(tmp)):  # a write, or the rename, of the temporary
@@ -120,6 +126,31 @@ def _naming(exc: OSError, path: Path) -> OSError:
     file the user asked for: a full disk while a sweep's index is written names ``sweep.csv``, never the
     temporary name nor, with no name at all, standard output (:func:`bearingsim.cli.main`)."""
     return OSError(exc.errno, exc.strerror or os.strerror(exc.errno), str(path))
+
+
+#: while the command line records them (:func:`recording_files`): the files written so far, renamed into place
+#: complete (absolute path -> the path as given), what an interrupted command says it leaves
+_recorded: dict[str, str] | None = None
+
+
+@contextlib.contextmanager
+def recording_files(ledger: dict[str, str]):
+    """Within it, every file bearingsim writes whole (:func:`atomic_file`, an archive's rename) is noted in
+    ``ledger`` once it is complete, also when a signal's exception comes right after its rename (the
+    command line: ``bearingsim: interrupted once its files were written ...``). Called by the command line
+    only; a library call records nothing."""
+    global _recorded
+    previous, _recorded = _recorded, ledger
+    try:
+        yield ledger
+    finally:
+        _recorded = previous
+
+
+def note_written(path) -> None:
+    """Note ``path`` as complete where files are recorded (:func:`recording_files`); else nothing."""
+    if _recorded is not None:
+        _recorded.setdefault(os.path.abspath(path), str(path))
 
 
 def write_atomic_bytes(path: Path, data: bytes) -> None:

@@ -265,35 +265,47 @@ def run_scenario(
     except BaseException:
         outputs.remove_empty(made)
         raise
-    written = False
+    written, drawn = False, ()
     try:
-        if not force:
-            check_same_scenario(out, scenario)
-        if exclusive:
-            outputs.clean_stale_temporaries(out.parent)
-        with archive.Spool(out) as spool:
-            result = run(scenario, progress=progress, sink=spool, check_step=check_step)  # exit 3: nothing written
-            if notes:
-                for note in result.notes:
-                    log.info(note)
-            archive.write(result, out, spool)
-        written = True
-        drawn = type(result).FIGURES if figures else ()  # an earlier run's figures at this stem are not this run's
-        outputs.remove_figures(out.with_suffix(""), [n for names in MODEL_FIGURES.values() for n in names
-                                                     if n not in drawn])
-        pngs = []
-        if figures:
-            try:
-                pngs = archive.read(out, type(result)).save_figures(out.with_suffix(""))
-            except OSError as exc:
-                raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
-                                f"({exc.strerror or exc}); the archive {out} is complete") from None
-            except KeyboardInterrupt as exc:  # SIGINT/SIGTERM while drawing: the archive is a result, kept
-                exc.archive_written = out  # the command line says so (not "no archive written")
-                raise
-    finally:
-        if lock is not None:
-            lock.release()
-        if not written:  # refused (exit 2/3), interrupted or failed: no folder of its own left behind
-            outputs.remove_empty(made)
+        try:
+            if not force:
+                check_same_scenario(out, scenario)
+            if exclusive:
+                outputs.clean_stale_temporaries(out.parent)
+            with archive.Spool(out) as spool:
+                result = run(scenario, progress=progress, sink=spool, check_step=check_step)  # exit 3: no archive
+                if notes:
+                    for note in result.notes:
+                        log.info(note)
+                archive.write(result, out, spool)
+            written = True
+            drawn = type(result).FIGURES if figures else ()  # an earlier run's figures at this stem are not this run's
+            pngs = _figures(out, result, drawn)
+        finally:
+            if lock is not None:
+                lock.release()
+            if not written:  # refused (exit 2/3), interrupted or failed: no folder of its own left behind
+                outputs.remove_empty(made)
+    except KeyboardInterrupt as exc:  # SIGINT/SIGTERM once the archive is written: it is a result, kept
+        if written:  # the command line says so (not "no archive written"), and which figures it had to draw
+            exc.archive_written = out
+            exc.figures_expected = [outputs.figure_path(out.with_suffix(""), n) for n in drawn]
+        raise
     return RunOutput(archive=out, figures=list(pngs), result=result)
+
+
+def _figures(out: Path, result, drawn) -> list[Path]:
+    """Once the archive ``out`` is written: remove the figures at its stem that this run does not draw (a
+    replaced archive's), then draw those of ``drawn``; return their paths."""
+    from bearingsim import archive, outputs
+    from bearingsim.errors import UserError
+
+    outputs.remove_figures(out.with_suffix(""), [n for names in MODEL_FIGURES.values() for n in names
+                                                 if n not in drawn])
+    if not drawn:
+        return []
+    try:
+        return archive.read(out, type(result)).save_figures(out.with_suffix(""))
+    except OSError as exc:
+        raise UserError(f"{exc.filename or str(out.with_suffix('')) + '_*.png'}: cannot write figure "
+                        f"({exc.strerror or exc}); the archive {out} is complete") from None

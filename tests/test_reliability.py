@@ -1080,6 +1080,74 @@ def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary
 
 
+def _signal_here(sig) -> None:
+    """Send ``sig`` to this process and wait for its handler to raise."""
+    os.kill(os.getpid(), sig)
+    for _ in range(1000):  # the handler raises here
+        time.sleep(0.01)
+    raise AssertionError("signal not delivered")
+
+
+@pytest.mark.parametrize("where", ["the last figure renamed into place", "the output lock released"])
+@pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
+                                             (signal.SIGINT, 130, "interrupted")])
+def test_a_signal_once_every_file_is_written_says_they_are_complete(tmp_path, monkeypatch, capsys, sig, code, word,
+                                                                     where):
+    """A signal that lands once the archive and its figures are complete (as soon as the last figure's file
+    appeared, or as the run released its output lock) said "figures not all written" or "no archive
+    written". The one line names every file as complete; exit 128 + signal; nothing else left."""
+    from bearingsim import cli, outputs, plotting
+
+    owner, name = (plotting, "save_figure") if where.startswith("the last figure") else (outputs.OutputLock, "release")
+    real = getattr(owner, name)
+
+    def then_signal(*a, **kw):
+        real(*a, **kw)
+        _signal_here(sig)
+
+    monkeypatch.setattr(owner, name, then_signal)
+    out = tmp_path / "out.h5"
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [f"bearingsim: {word} once its files were written: {out}, {tmp_path / 'out_pass.png'} are complete"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5", "out_pass.png"]  # no lock, no temporary
+
+
+_LATE_SIGNAL = r"""
+import atexit, os, runpy, sys, time
+
+SIG = int(sys.argv[1])
+
+
+def late():  # the signal in the process's last moments: the command has returned its exit code
+    os.kill(os.getpid(), SIG)
+    time.sleep(0.5)
+
+atexit.register(late)
+sys.argv = ["bearingsim", *sys.argv[2:]]
+runpy.run_module("bearingsim", run_name="__main__", alter_sys=True)
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_in_the_last_moments_of_the_program_changes_nothing(tmp_path, sig):
+    """``python -m bearingsim run`` that had written everything and printed its lines died of a signal that
+    came while the interpreter ended (SIGTERM: silently, exit 143; SIGINT: a traceback of the atexit
+    callback). Once the exit code is decided the program ignores both: exit 0, nothing more said."""
+    out = tmp_path / "z.h5"
+    cmd = [sys.executable, "-c", _LATE_SIGNAL, int(sig), "run", PAPER, "-o", out, "--no-plots"]
+    with started(cmd, cwd=tmp_path, env=forked_cli.environment(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                 text=True) as proc:
+        stdout, stderr = proc.communicate(timeout=300)
+    assert (proc.returncode, stderr) == (0, ""), stderr[-2000:]
+    assert stdout.startswith(f"wrote {out}\n")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["z.h5"]
+
+
 @pytest.mark.slow
 def test_a_refused_run_leaves_no_folder_it_created(tmp_path):
     """Issue 30, Low: a run refused after it took its output lock (here a step too long for the euler

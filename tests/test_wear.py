@@ -1643,3 +1643,32 @@ def test_the_life_figures_worn_faces_name_their_stages_and_show_the_first(stages
     colours = [ln.get_color() for ln in faces.get_lines()]
     assert min(_contrast_on_white(c) for c in colours) >= 3.0, sorted(_contrast_on_white(c) for c in colours)[:3]
     assert "darker: later" not in faces.get_title()
+
+
+@pytest.mark.parametrize("after, said", [(1, "interrupted, its figures not all written"),
+                                         (2, "interrupted once its files were written: {0}, {1} are complete")])
+def test_a_signal_after_wear_figures_says_which_are_complete(fast_run, tmp_path, monkeypatch, capsys, after, said):
+    """SIGINT as soon as wear's first or second (last) figure was written: after the last it said "its figures
+    not all written" too; the line names both as complete once both are, exit 130."""
+    from bearingsim import plotting
+    from bearingsim.cli import main
+
+    real, written = plotting.save_figure, []
+
+    def then_signal(*a, **kw):
+        written.append(real(*a, **kw))
+        if len(written) == after:
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(1000):  # the handler raises here
+                time.sleep(0.01)
+            raise AssertionError("signal not delivered")
+        return written[-1]
+
+    monkeypatch.setattr(plotting, "save_figure", then_signal)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        assert main(["wear", str(fast_run[1]), "--hours", "1", "-o", str(tmp_path), "-q"]) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert capsys.readouterr().err.strip().splitlines() == [f"bearingsim: {said.format(*written)}"]
+    assert sorted(tmp_path.iterdir()) == sorted(written)

@@ -23,11 +23,13 @@ only a file with it is replaced.
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.outputs import printable
 
 __all__ = ["has_motion", "max_exaggeration", "render_result", "SECONDS_PER_ROTATION"]
 
@@ -504,25 +506,67 @@ class _Drawing:
 
 # --- writers -------------------------------------------------------------------------------------------
 def _write_mp4(out: Path, frames, fps: float, total: int, progress) -> None:
-    """H.264 MP4 through the ffmpeg binary of ``imageio-ffmpeg``, with the comment tag
-    :data:`bearingsim.outputs.MARK`, into a temporary file renamed at the end."""
+    """H.264 MP4 through the ffmpeg binary of ``imageio-ffmpeg`` (the command its ``write_frames`` builds),
+    with the comment tag :data:`bearingsim.outputs.MARK`, into a temporary file renamed at the end. ffmpeg's
+    own messages are read, not shown: a failure (a full disk) is one :class:`UserError` naming ``out`` and
+    the cause (:func:`_ffmpeg_failure`)."""
+    import subprocess
+    import threading
+    from fractions import Fraction
+
     import imageio_ffmpeg
 
     from bearingsim.outputs import MARK, atomic_file, temporary_name
 
     with atomic_file(out):  # ffmpeg writes the temporary file by its name; renamed when complete
-        writer = imageio_ffmpeg.write_frames(
-            str(temporary_name(out)), (WIDTH_PX, HEIGHT_PX), fps=fps, codec="libx264", quality=7,
-            macro_block_size=16, output_params=["-preset", "veryfast", "-metadata", f"comment={MARK}", "-f", "mp4"],
-            ffmpeg_log_level="error")
-        writer.send(None)
+        cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-y", "-f", "rawvideo", "-vcodec", "rawvideo",
+               "-s", f"{WIDTH_PX:d}x{HEIGHT_PX:d}", "-pix_fmt", "rgb24", "-r", str(Fraction(fps).limit_denominator()),
+               "-i", "-", "-an", "-vcodec", "libx264", "-pix_fmt", "yuv420p", "-crf", str(int((1 - 7 / 10.0) * 51)),
+               "-v", "error", "-preset", "veryfast", "-metadata", f"comment={MARK}", "-f", "mp4",
+               str(temporary_name(out))]
+        proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                                process_group=0)  # its own group: a terminal's Ctrl-C reaches this process only
+        said = []
+        reader = threading.Thread(target=lambda: said.append(proc.stderr.read()), daemon=True)
+        reader.start()
         try:
-            for i, frame in enumerate(frames):
-                writer.send(frame)
-                if progress is not None:
-                    progress(i + 1, total)
+            try:
+                for i, frame in enumerate(frames):
+                    proc.stdin.write(np.ascontiguousarray(frame, dtype=np.uint8).data)
+                    if progress is not None:
+                        progress(i + 1, total)
+                proc.stdin.close()
+            except BrokenPipeError:  # ffmpeg has ended: its exit status and its words say why
+                pass
+            code = proc.wait()
         finally:
-            writer.close()
+            if proc.poll() is None:  # interrupted, or a frame failed to draw
+                proc.kill()
+                proc.wait()
+            reader.join()
+            for stream in (proc.stdin, proc.stderr):
+                try:
+                    stream.close()
+                except OSError:  # the frames ffmpeg did not take: nothing to flush them to
+                    pass
+        if code != 0:
+            raise _ffmpeg_failure(out, code, b"".join(said).decode("utf-8", "replace"))
+
+
+def _ffmpeg_failure(out: Path, code: int, said: str) -> UserError:
+    """One line for ffmpeg that failed with exit status ``code`` having said ``said`` on its stderr: the
+    system's error it names (a full disk: "No space left on device"), "File too large" when the file size
+    limit ended it (SIGXFSZ), else its last line."""
+    import errno
+    import signal
+
+    causes = [os.strerror(e) for e in (errno.ENOSPC, errno.EFBIG, errno.EDQUOT, errno.EIO, errno.EROFS, errno.EACCES)]
+    cause = next((c for c in causes if c in said), None)
+    if cause is None and code == -signal.SIGXFSZ:
+        cause = os.strerror(errno.EFBIG)
+    lines = [line.strip() for line in said.splitlines() if line.strip()]
+    cause = cause or (f"ffmpeg: {lines[-1]}" if lines else f"ffmpeg ended with exit status {code}")
+    return UserError(f"{out}: cannot write the animation ({printable(cause, keep_newlines=False)})")
 
 
 def _write_gif(out: Path, frames, fps: float, total: int, progress) -> None:

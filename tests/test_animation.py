@@ -130,6 +130,48 @@ def test_mp4_through_the_command_line(runs, tmp_path, capsys):
     assert not [p for p in tmp_path.iterdir() if p.name != "a.mp4"]  # no temporary file left
 
 
+def test_an_mp4_on_a_full_disk_is_one_line_naming_the_cause(runs, tmp_path):
+    """``bearingsim animate ... -o a.mp4`` whose writes fail past 4 KiB (``RLIMIT_FSIZE`` in the child, which
+    ffmpeg inherits: it ends of SIGXFSZ, as on a full disk it fails with ENOSPC): one line naming the file
+    and the cause, exit 2, no temporary file; ffmpeg's own words not on the terminal. It printed ffmpeg's
+    lines, then "cannot write the animation ([Errno 32] Broken pipe" with ffmpeg's command on more lines."""
+    import os
+    import resource
+    import sys
+
+    import matplotlib.font_manager  # noqa: F401 - its cache written before the child's writes are limited
+
+    from tests.conftest import ROOT
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))
+
+    out = tmp_path / "out" / "a.mp4"
+    out.parent.mkdir()
+    proc = subprocess.run([sys.executable, "-m", "bearingsim", "animate", str(runs[1]), "-o", str(out),
+                           "--rotations", "0.5:0.75", "--fps", "20"], capture_output=True, text=True, timeout=300,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)}, preexec_fn=limited)
+    assert (proc.returncode, proc.stderr) == (2, f"bearingsim: error: {out}: cannot write the animation (File too "
+                                                 f"large)\n"), proc.stderr[-3000:]
+    assert list(out.parent.iterdir()) == []
+
+
+def test_ffmpegs_failure_is_named_by_its_cause(tmp_path):
+    """What ffmpeg said on a full disk (its lines as ffmpeg 7 words them), a file size limit that ended it, or
+    anything else: one line naming the animation and the cause, never ffmpeg's command."""
+    import signal
+
+    out = tmp_path / "a.mp4"
+    said = ("[vost#0:0/libx264 @ 0x55] Error submitting a packet to the muxer: No space left on device\n"
+            "[out#0/mp4 @ 0x56] Error writing trailer: No space left on device\n")
+    assert str(animation._ffmpeg_failure(out, 228, said)) == (f"{out}: cannot write the animation (No space left "
+                                                              f"on device)")
+    too_large = animation._ffmpeg_failure(out, -signal.SIGXFSZ, "")
+    assert str(too_large) == f"{out}: cannot write the animation (File too large)"
+    assert str(animation._ffmpeg_failure(out, 1, "x\n\x1b[31mbad codec\n")) == (
+        f"{out}: cannot write the animation (ffmpeg: \\x1b[31mbad codec)")
+
+
 def _cage_centre_px(frame, guess):
     """Centre (col, row) [px] of the circle through the outer edges of the cage's bars in ``frame``: the
     outermost pixel of CAGE_COLOUR in each degree around ``guess``, a least-squares circle through them,

@@ -100,7 +100,7 @@ def _cmd_life(args) -> int:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     # the limit reached, or the cage bar worn through first (the end of the life all the same: exit 0)
     print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}", study.attrs()))
-    for path in outcome.written:
+    for path in outcome.written if not args.quiet else ():  # -q: the history alone
         print(f"wrote {path}")
     return 0
 
@@ -143,5 +143,6 @@ def add_commands(sub) -> None:
                     help="how a stage's wear acts back: 'shape' (default), the worn depth added to each face where "
                          "it wore; 'uniform', every pocket's clearance grows by the worst pocket's mean worn depth "
                          "(the pockets stay arcs; docs/wear.md)")
-    li.add_argument("-q", "--quiet", action="store_true", help="no line per stage run")
+    li.add_argument("-q", "--quiet", action="store_true", help="the history table alone: no line per stage "
+                                                                "run, no notes, no 'wrote' lines")
     li.set_defaults(func=_cmd_life)

@@ -248,8 +248,9 @@ def run_scenario(
     progress : show a progress bar (multibody runs)
     exclusive : hold a lock on the target while writing (refusing a concurrent run to it) and clean stale
         temporary files of dead runs in its folder first; a sweep, which locks its whole folder, passes False
-    notes : print the plausibility notes of the run (:func:`bearingsim.plausibility.check`) on stderr;
-        ``bearingsim run -q`` and sweep cases pass False (the counts stay in the archive's provenance)
+    notes : print the plausibility notes of the run (:func:`bearingsim.plausibility.check`) and the note of a
+        dead run's temporary file removed on stderr; ``bearingsim run -q`` and sweep cases pass False (the
+        counts stay in the archive's provenance)
     force : replace an archive of a different scenario at ``out`` (default: refused,
         :func:`check_same_scenario`; a rerun of the same scenario replaces its archive)
     check_step : run it again at half its step and note the change (:func:`run`'s ``check_step``); the note is
@@ -270,8 +271,8 @@ def run_scenario(
         try:
             if not force:
                 check_same_scenario(out, scenario)
-            if exclusive:
-                outputs.clean_stale_temporaries(out.parent)
+            if exclusive:  # its note is one of the run's notes: none with notes=False (run -q)
+                outputs.clean_stale_temporaries(out.parent, report=None if notes else (lambda line: None))
             with archive.Spool(out) as spool:
                 result = run(scenario, progress=progress, sink=spool, check_step=check_step)  # exit 3: no archive
                 if notes:

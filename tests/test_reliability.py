@@ -1148,6 +1148,15 @@ def test_a_signal_in_the_last_moments_of_the_program_changes_nothing(tmp_path, s
     assert sorted(p.name for p in tmp_path.iterdir()) == ["z.h5"]
 
 
+def test_run_q_removes_a_dead_runs_temporary_without_a_word(tmp_path):
+    """``run -q`` prints nothing on success; it printed its note "removed stale temporary file ... of a dead
+    run". The temporary is removed all the same."""
+    _setup_dead_tmp(tmp_path)
+    res = bearingsim("run", PAPER, "-o", tmp_path / "out.h5", "--no-plots", "-q")
+    assert (res.returncode, res.stdout, res.stderr) == (0, "", "")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]
+
+
 @pytest.mark.slow
 def test_a_refused_run_leaves_no_folder_it_created(tmp_path):
     """Issue 30, Low: a run refused after it took its output lock (here a step too long for the euler

@@ -612,7 +612,7 @@ def test_figures_from_the_index(tmp_path):
     assert [p.name for p in out.figures] == ["sweep_I.png"]
     assert axis_label(SPEED) == "inner ring speed [rpm]"
     assert axis_label("bearing.pocket_clearance_mm") == "pocket clearance [mm]"
-    assert axis_label("lubrication.drag_coefficient") == "drag coefficient"
+    assert axis_label("lubrication.drag_coefficient") == "drag coefficient [N^0.754 (s/m)^0.648]"  # its unit as `bearingsim keys` gives it
     # drawn again from the index alone, into another folder
     again = plot_sweep_index(tmp_path / "sweep.h5", tmp_path / "again")
     assert [p.name for p in again] == ["sweep_I.png"] and again[0].stat().st_size > 10_000

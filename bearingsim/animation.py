@@ -106,15 +106,11 @@ def render_result(result, out, *, rotations=None, exaggerate=None, fps=30, progr
     frames = (drawing.draw(f) for f in range(n_frames))
     from bearingsim import outputs
 
-    made = outputs.missing_folders(out.parent)  # created for this animation, removed again if it is not written
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        (_write_gif if out.suffix.lower() == ".gif" else _write_mp4)(out, frames, fps, n_frames, progress)
-    except OSError as exc:  # the folder or its temporary file: found before the first frame is drawn
-        raise UserError(f"{out}: cannot write the animation ({exc.strerror or exc})") from None
-    finally:
-        if not out.exists():
-            outputs.remove_empty(made)
+    with outputs.exclusive_output(out, "animation"):  # one command writes it; folders it made go if unwritten
+        try:
+            (_write_gif if out.suffix.lower() == ".gif" else _write_mp4)(out, frames, fps, n_frames, progress)
+        except OSError as exc:  # its temporary file: found before the first frame is drawn
+            raise UserError(f"{out}: cannot write the animation ({exc.strerror or exc})") from None
     return out
 
 

@@ -576,12 +576,13 @@ def clean_stale_temporaries(folder: str | Path, report=None, names: dict[str, by
     return removed
 
 
-def open_lock_file(lock_path: str | Path, guarded: str | Path) -> int:
+def open_lock_file(lock_path: str | Path, guarded: str | Path, unwritable: str = "output is not writable") -> int:
     """Open (creating it if needed) the lock file ``lock_path`` for ``flock``; return its descriptor.
 
     Never through a symbolic link (``O_NOFOLLOW``: a planted ``.sweep.lock -> ~/notes`` neither truncates
     nor creates its target) and never a file bearingsim did not make: a lock file is an empty regular
-    file, anything else there is refused with one line naming it (``guarded``: what the lock protects).
+    file, anything else there is refused with one line naming it (``guarded``: what the lock protects;
+    ``unwritable``: what its line says of a folder that takes no file).
     """
     lock_path = Path(lock_path)
     flags = (os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
@@ -592,7 +593,7 @@ def open_lock_file(lock_path: str | Path, guarded: str | Path) -> int:
         if exc.errno == errno.ELOOP:
             raise UserError(f"{lock_path}: lock file of {guarded} is a symbolic link; not followed "
                             "(remove it)") from None
-        raise UserError(f"{guarded}: output is not writable ({exc.strerror or exc})") from None
+        raise UserError(f"{guarded}: {unwritable} ({exc.strerror or exc})") from None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode) or st.st_size > 0:
         os.close(fd)
@@ -657,11 +658,13 @@ class OutputLock:
     Parameters
     ----------
     path : archive path the lock guards
+    what : what is written there, as the refusal of a second writer names it
     """
 
-    def __init__(self, path: str | Path):
+    def __init__(self, path: str | Path, what: str = "archive"):
         p = Path(path)
-        self.path = p
+        self.path, self.what = p, what
+        self.unwritable = "output is not writable" if what == "archive" else f"cannot write the {what}"
         self.lock_path = p.with_name(f".{p.name}.lock")
         self._fd: int | None = None
 
@@ -670,14 +673,15 @@ class OutputLock:
             try:
                 self.path.parent.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
-                raise UserError(f"{self.path}: output is not writable ({exc.strerror or exc})") from None
-            fd = open_lock_file(self.lock_path, self.path)
+                raise UserError(f"{self.path}: {self.unwritable} ({exc.strerror or exc})") from None
+            fd = open_lock_file(self.lock_path, self.path, self.unwritable)
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as exc:
                 os.close(fd)
                 if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                    raise UserError(f"{self.path}: another bearingsim run is writing this archive "
+                    raise UserError(f"{self.path}: another bearingsim {'run' if self.what == 'archive' else 'command'} "
+                                    f"is writing this {self.what} "
                                     f"(lock {self.lock_path.name} is held); wait for it or choose another -o") from None
                 raise UserError(f"{self.path}: cannot lock output ({exc.strerror or exc})") from None
             try:
@@ -707,6 +711,20 @@ class OutputLock:
     def __exit__(self, *exc) -> bool:
         self.release()
         return False
+
+
+@contextlib.contextmanager
+def exclusive_output(path: str | Path, what: str):
+    """The block is the one writer of the file ``path`` (a ``what``: "report", "animation"): :class:`OutputLock`
+    held on it, so that a second command writing the same file is refused in one line rather than replacing
+    the first one's file unseen; the folders made for it are removed again if they are left empty."""
+    path = Path(path)
+    made = missing_folders(path.parent)
+    try:
+        with OutputLock(path, what):
+            yield path
+    finally:
+        remove_empty(made)
 
 
 #: True only while :func:`bearingsim.cli.main` runs a command (:func:`command_line_owns_stderr`): then

@@ -96,7 +96,7 @@ def report(path, out=None, *, animation: str | None = "gif") -> Path:
     ``"mp4"`` (a video, smaller), None for none. One-line UserError for a PATH that is none of these and
     for an output that cannot be written."""
     from bearingsim import tables
-    from bearingsim.outputs import atomic_file
+    from bearingsim.outputs import atomic_file, exclusive_output
 
     if animation is not None and animation not in ANIMATIONS:
         raise UserError(f"animation {animation!r}: give one of {', '.join(ANIMATIONS)} or None")
@@ -104,20 +104,20 @@ def report(path, out=None, *, animation: str | None = "gif") -> Path:
     if out is not None:
         check_path(out, "out", "the report (.html)")
     out = check_output(default_output(path) if out is None else out, path)
-    kind, file = kind_of(path)
-    found = tables.studies_of(path) if kind != "run" else []
-    if len(found) > 1:  # a folder of several studies (run_studies of a cross-check and Fig. 9): every one
-        kind = "studies"
-        title, sections = _studies_sections(found)
-    else:
-        title, sections = _sections(kind, file, animation)
-    html = render(title, str(path), kind, sections)
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        with atomic_file(out) as fh:
-            fh.write(html.encode("utf-8"))
-    except OSError as exc:
-        raise UserError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
+    with exclusive_output(out, "report"):  # one command writes it: a second is refused, not silently replaced
+        kind, file = kind_of(path)
+        found = tables.studies_of(path) if kind != "run" else []
+        if len(found) > 1:  # a folder of several studies (run_studies of a cross-check and Fig. 9): every one
+            kind = "studies"
+            title, sections = _studies_sections(found)
+        else:
+            title, sections = _sections(kind, file, animation)
+        html = render(title, str(path), kind, sections)
+        try:
+            with atomic_file(out) as fh:
+                fh.write(html.encode("utf-8"))
+        except OSError as exc:
+            raise UserError(f"{out}: cannot write the report ({exc.strerror or exc})") from None
     return out
 
 

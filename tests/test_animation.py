@@ -532,3 +532,24 @@ def test_frames_after_a_full_impact_tables_end_say_why_they_show_no_impacts(monk
     assert text == (f"★ none marked after t = {t_last:.4g} s:\nthe archive's impact table\nfilled up "
                     "(its run's note)"), text
     assert animation.impact_marks_end(cut, np.array([t_last - 2e-3, t_last])) == ""  # the window ends with it
+
+
+def test_an_animation_another_command_is_writing_is_refused_and_kept(runs, tmp_path):
+    """Two commands writing one animation: the second is refused in one line naming the file (the lock
+    beside it, as a run's archive has), and the first one's file is neither replaced nor removed; no
+    folder of the refused one is left."""
+    from bearingsim.outputs import OutputLock
+
+    _, archive, _, _ = runs
+    out = bearingsim.animate(archive, tmp_path / "a.gif", fps=2)  # a file the refused command must leave alone
+    first = out.read_bytes()
+    with OutputLock(out, "animation"):
+        with pytest.raises(bearingsim.UserError, match=r"a\.gif: another bearingsim command is writing this "
+                                                       r"animation \(lock \.a\.gif\.lock is held\)"):
+            bearingsim.animate(archive, out, fps=2, last=0.5)
+    assert out.read_bytes() == first
+    new = tmp_path / "new" / "b.gif"
+    with OutputLock(new, "animation"):  # the lock made the folder: the refused command leaves it
+        with pytest.raises(bearingsim.UserError, match="is writing this animation"):
+            bearingsim.animate(archive, new, fps=2)
+    assert not new.exists()

@@ -514,7 +514,8 @@ def test_a_check_that_fails_is_shown_as_failed(runs):
     result = bearingsim.load(runs / "r.h5")
     rows = _checks_blocks(result)[0]["rows"]
     assert [r["passed"] for r in rows] == [True, True]
-    result.per_rotation["I_dec"][...] = np.nan  # the arrays of the result, as a damaged archive would give
+    result.data["results/per_rotation/I_dec"].data[...] = np.nan  # its stored array (a result hands out read-only views),
+    # as a damaged archive would give it
     blocks = _checks_blocks(result)
     assert [(r["name"], r["passed"]) for r in blocks[0]["rows"]] == [("summary numbers finite", True),
                                                                       ("I_dec and I_acc per rotation finite", False)]
@@ -739,3 +740,19 @@ def test_the_crosscheck_page_gives_slip_in_per_cent_and_impulses_as_the_table_do
     slip = block["head"].index("cage slip [%]")
     first = block["rows"][0]
     assert first[slip] == "1" and first[4] == "5.00 ± 0.20" and first[5] == "3.00 ± 0.10", first
+
+
+def test_a_report_another_command_is_writing_is_refused_in_one_line(runs, tmp_path):
+    """Two commands writing one report page: the second is refused in one line naming the file and its lock,
+    where the last to finish replaced the other's page unseen."""
+    from bearingsim.outputs import OutputLock
+
+    out = tmp_path / "r.html"
+    with OutputLock(out, "report"):
+        res = cli("report", runs / "r.h5", "-o", out)
+    assert res.returncode == 2
+    assert res.stderr.strip().splitlines() == [f"bearingsim: error: {out}: another bearingsim command is writing this "
+                                               f"report (lock .r.html.lock is held); wait for it or choose another -o"]
+    assert not out.exists()
+    assert cli("report", runs / "r.h5", "-o", out).returncode == 0 and out.is_file()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]  # its lock gone with it

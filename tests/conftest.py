@@ -92,3 +92,16 @@ def pytest_xdist_auto_num_workers(config):
         return None  # xdist's own hook reads it
     n = min(len(os.sched_getaffinity(0)), MAX_WORKERS)
     return n if n > 1 else 0
+
+
+#: module fixtures that run a study or a ladder of runs (seconds each): a test that takes one is no test of
+#: "about a second or less", whatever its own call takes, so it is left out of the quick subset with them
+SLOW_FIXTURES = {"ladder", "folders"}
+
+
+def pytest_collection_modifyitems(items):
+    """Mark ``slow`` every test that takes a fixture of :data:`SLOW_FIXTURES`."""
+    for item in items:
+        if SLOW_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.slow)
+

@@ -1133,6 +1133,7 @@ runpy.run_module("bearingsim", run_name="__main__", alter_sys=True)
 """
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_a_signal_in_the_last_moments_of_the_program_changes_nothing(tmp_path, sig):
     """``python -m bearingsim run`` that had written everything and printed its lines died of a signal that

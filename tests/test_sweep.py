@@ -1387,6 +1387,7 @@ def test_the_sweeps_page_says_a_range_is_rounded_to_15_digits_as_it_is():
     assert values[2] == 0.15 and values[6] == 0.35 and np.linspace(0.05, 0.5, 10)[2] == 0.15000000000000002
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("limit, index", [(64, "sweep.csv"), (4096, "sweep.h5")])
 def test_a_full_disk_while_the_index_is_written_names_the_index(tmp_path, limit, index):
     """Writes failing past ``limit`` bytes (``RLIMIT_FSIZE`` in the child: EFBIG, "File too large", as a full

@@ -378,6 +378,8 @@ def _cmd_rerun(args) -> int:
     if c.identical:
         say(args)(f"{args.archive}: rerun is bit-identical ({len(c.summary)} summary numbers, "
                    f"{c.arrays_compared} arrays and other numbers)")
+        for line in c.unrecorded_lines():
+            say(args)(line)
         return 0
     print(f"{args.archive}: rerun differs")
     print(c.summary_table())
@@ -411,7 +413,7 @@ def _cmd_compare(args) -> int:
     else:
         print("scenarios: identical")
     print(c.summary_table())
-    for line in c.difference_lines():
+    for line in c.difference_lines() if not c.identical else c.unrecorded_lines():
         print(line)
     print(f"results: identical ({len(c.summary)} summary numbers, {c.arrays_compared} arrays and other numbers, "
           "bit for bit)" if c.identical else "results: differ")
@@ -1118,4 +1120,4 @@ def _interrupted(exc: KeyboardInterrupt, args) -> int:
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+    sys.exit(program())

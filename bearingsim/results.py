@@ -85,6 +85,9 @@ class Result:
     SUMMARY_NUMBERS: tuple[str, ...] = ()
     #: keys of ``/results/summary`` that are numbers where present (added after archives were written without)
     SUMMARY_OPTIONAL: tuple[str, ...] = ()
+    #: arrays a later version records beside the same numbers (no model version bump): absent from the archives
+    #: written before, which is no difference of the run (:func:`bearingsim.compare.compare_results`)
+    ADDED_ARRAYS: frozenset = frozenset()
 
     @classmethod
     def archive_dims(cls, scenario) -> dict[str, int]:

@@ -102,6 +102,29 @@ def test_rerun_is_bit_identical_and_names_what_differs(tmp_path, reduced_archive
            "CHANGELOG.md says which)" in res.stdout, res.stdout
 
 
+def test_an_archive_written_before_an_added_array_reruns_and_compares_identical(tmp_path, reduced_archive):
+    """A reduced archive of a version that did not record the trace's I_acc_cumulative (ADDED_ARRAYS: recorded
+    since, beside the same numbers) reruns bit-identical and compares identical to a new one (exit 0), each
+    saying which array it did not compare and why; a number changed in such an archive still differs."""
+    old = tmp_path / "old.h5"
+    shutil.copy(reduced_archive, old)
+    with h5py.File(old, "r+") as f:
+        del f["results/trace/I_acc_cumulative"]
+    line = ("  not in {}: trace/I_acc_cumulative (recorded by later versions than the one that wrote {}; "
+            "not compared)")
+    res = cli("rerun", old)
+    assert res.returncode == 0, res.stdout + res.stderr
+    assert "rerun is bit-identical" in res.stdout and line.format("A", "A") in res.stdout.splitlines(), res.stdout
+    res = cli("compare", reduced_archive, old)
+    assert res.returncode == 0 and line.format("B", "B") in res.stdout.splitlines(), res.stdout
+    assert res.stdout.splitlines()[-1].startswith("results: identical")
+    with h5py.File(old, "r+") as f:
+        f["results/trace/I_dec_cumulative"][-1] *= 1.0 + 1e-12
+    res = cli("compare", reduced_archive, old)
+    assert res.returncode == 1 and "differs: trace/I_dec_cumulative" in res.stdout, res.stdout
+    assert line.format("B", "B") in res.stdout.splitlines()
+
+
 @pytest.mark.slow
 def test_rerun_of_a_multibody_archive_is_bit_identical(multibody_archive):
     res = cli("rerun", multibody_archive, fresh_interpreter=True)  # another process than the run's

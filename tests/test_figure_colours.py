@@ -60,7 +60,8 @@ def test_reduced_pass_figure_draws_cumulative_I_acc_and_I_dec(rpm, method):
 
 
 def test_reduced_pass_figure_of_an_archive_without_cumulative_I_acc(tmp_path):
-    """An archive written before the trace recorded I_acc reads and draws: I_dec, and I_acc in the title."""
+    """An archive written before the trace recorded I_acc reads and draws: I_dec, I_acc in the title, and the
+    legend says its curve is not recorded there (not I_acc = 0)."""
     import h5py
 
     path = tmp_path / "old.h5"
@@ -72,6 +73,8 @@ def test_reduced_pass_figure_of_an_archive_without_cumulative_I_acc(tmp_path):
     fig = bearingsim.load(path).plot_pass()
     assert same(_line(fig.axes[2], "$I_{dec}$").get_color(), REAR)
     assert "$I_{acc}$ = 8.742 mN s" in fig.axes[0].get_title()
+    legend = [t.get_text() for t in fig.axes[2].get_legend().get_texts()]
+    assert any(t.startswith("$I_{acc}$: not recorded\nin this archive") for t in legend), legend
 
 
 # --- the two faces in their house colours, in every figure that draws them --------------------------------

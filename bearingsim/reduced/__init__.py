@@ -90,6 +90,7 @@ class ReducedResult(Result):
         **{f"results/trace/{c}": ("trace points",) for c in _TRACE + _TRACE_ADDED},
     }
     OPTIONAL = (frozenset(f"results/trace/{c}" for c in _TRACE), frozenset(f"results/trace/{c}" for c in _TRACE_ADDED))
+    ADDED_ARRAYS = frozenset(f"results/trace/{c}" for c in _TRACE_ADDED)
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(SUMMARY_UNITS)
     FIGURE_DATA = ("results/trace",)
@@ -213,6 +214,8 @@ class ReducedResult(Result):
         if "results/trace/I_acc_cumulative" in self.data:  # archives written before it was recorded lack it
             ax[2].plot(th, self.get("trace/I_acc_cumulative") * 1e3, lw=1.2, color=FRONT, ls="--",
                        label="$I_{acc}$ (front face)" + ("" if i_acc else " = 0"))
+        else:  # said in the legend, so that a missing curve is not read as I_acc = 0
+            ax[2].plot([], [], lw=0, color=FRONT, label="$I_{acc}$: not recorded\nin this archive (an\nearlier version's)")
         ax[2].set_ylabel("cumulative impulse [mN s]")
         ax[2].set_xlabel("θ from the load-zone centre, in the direction of rotation [deg]")
         ax[0].set_title(f"{self.title()}\nc = {p.contact.drag_coefficient:g}, e = {p.contact.restitution:g}, "

@@ -246,6 +246,17 @@ def test_the_default_keys_are_those_the_model_reads():
     assert "wear.wear_coefficient" in ranged_keys(multibody) and "wear.wear_coefficient" not in keys
 
 
+def test_keys_given_as_one_text_are_keys_not_characters():
+    """The API's ``keys`` as one text is one key, or several separated by commas as ``--keys`` takes them (a
+    text is a sequence: it was read as its characters, "keys: c: unknown key")."""
+    sc = load_scenario(PAPER_3000)
+    assert sens.check_keys(sc, "contact.restitution", origin="keys") == ["contact.restitution"]
+    assert sens.check_keys(sc, "contact.restitution, lubrication.drag_coefficient", origin="keys") == [
+        "contact.restitution", "lubrication.drag_coefficient"]
+    with pytest.raises(bearingsim.UserError, match=r"^keys: contact\.restitutio: unknown key"):
+        sens.check_keys(sc, "contact.restitutio", origin="keys")
+
+
 def test_a_range_outside_the_keys_bounds_is_refused_in_one_line(tmp_path, capsys):
     sc = tmp_path / "mine.toml"
     sc.write_text(REDUCED.read_text() + '\n[ranges.contact.restitution]\nrange = [0.5, 1.2]\nreason = "mine"\n')

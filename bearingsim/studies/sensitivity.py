@@ -133,12 +133,15 @@ def check_keys(scenario, keys, *, relative: bool = True, left_out: list | None =
     naming it otherwise) and, with ``relative`` (the sensitivity study's steps x (1 -+ step)), a nonzero
     numeric value. A default key whose value is 0 is left out (a relative step cannot move it), named with
     why in ``left_out``; one given in ``keys`` is refused. The uncertainty study samples the ranges
-    themselves (``relative=False``): a key's own value does not matter there. ``origin``: what gave ``keys``,
+    themselves (``relative=False``): a key's own value does not matter there. ``keys`` may be one text, of one
+    key or of several separated by commas as ``--keys`` takes them. ``origin``: what gave ``keys``,
     as the refusals name it (``--keys`` of the command line, ``keys`` of the Python API's argument)."""
     from bearingsim.ranges import ranged_keys, value_of
 
     have = ranged_keys(scenario)
     given = keys is not None
+    if isinstance(keys, str):  # one key, or several as --keys takes them ("a.b,c.d"): not its characters
+        keys = [k.strip() for k in keys.split(",") if k.strip()]
     keys = default_keys(scenario) if keys is None else list(dict.fromkeys(keys))
     if not keys:
         raise UserError(f"{scenario.source}: no key has a range ([ranges.<section>.<key>] or the preset's); "

@@ -234,7 +234,8 @@ def test_a_maps_threshold_is_the_tables_test(tmp_path, figures):
 @pytest.mark.slow
 def test_a_large_map_is_a_page_with_every_kth_value_labelled(tmp_path, figures):
     """The 100 x 100 map of scenarios/sweeps/map_speed_clearance.toml: the figure stays within the bounds
-    of sweeps.plot (21 x 12 in, 2520 x 1440 px at 120 dpi; it grew with the axes to 29160 x 5700 px),
+    of sweeps.plot (9 x 13 in, 1080 x 1555 px at 120 dpi, its panels one above the other; it grew with the
+    axes to 29160 x 5700 px, and was 2520 x 1440 px with the panels side by side),
     at most 20 labelled ticks per axis, every 5th value, and no values written in cells of 0.09 in."""
     from PIL import Image
 
@@ -243,7 +244,7 @@ def test_a_large_map_is_a_page_with_every_kth_value_labelled(tmp_path, figures):
     h5 = _index(tmp_path, [{SPEED: s, CLEAR: c} for s in xs for c in ys], [SPEED, CLEAR])
     (png,) = plot_sweep_index(h5, tmp_path / "f")
     with Image.open(png) as im:
-        assert im.size == (2520, 1440)
+        assert im.size == (1080, 1555)
     for a in figures["sweep_map.png"]["axes"]:
         assert a["xticks"] == [f"{v:g}" for v in xs[::5]] and a["yticks"] == [f"{v:g}" for v in ys[::5]]
         assert a["xlim"] == (-0.5, 99.5) and a["ylim"] == (-0.5, 99.5) and a["texts"] == []
@@ -391,3 +392,47 @@ def test_a_zipped_axis_names_every_zipped_key_and_its_values(tmp_path, figures):
     first = fig["title"].split("\n")[0]
     assert "inner ring speed, drag coefficient (zipped, 4 cases)" in first, first
     assert first.endswith("1 case over restitution"), first
+
+
+def _printed_sizes(fig, width_in: float = 6.5) -> dict[str, float]:
+    """Every text of ``fig`` (its titles, tick labels, axis labels, colour bar labels, cell values) and its size
+    [pt] once the figure is shrunk to ``width_in`` inches (a report's text width; never enlarged)."""
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    scale = min(1.0, width_in / fig.get_size_inches()[0])
+    texts = [t for t in fig.findobj(lambda a: hasattr(a, "get_fontsize") and hasattr(a, "get_text"))
+             if t.get_visible() and t.get_text().strip()]
+    return {t.get_text(): t.get_fontsize() * scale for t in texts}
+
+
+def test_a_map_prints_at_a_report_width_with_rounded_ticks(tmp_path, drawn):
+    """The 8 x 6 map of `--param operating.inner_ring_speed_rpm=1000:6500:8 --param
+    bearing.pocket_clearance_mm=0.1:0.35:6` was 2520 x 624 px (21 x 5.2 in): at a report's 6.5 in its cell
+    values (7 pt) were 2 pt, and its speeds were ticked "1785.71", "2571.43". Its panels are stacked, the
+    figure at most 10 in wide, every text at least 7 pt at 6.5 in, the ticks rounded as far as the values'
+    step allows (distinct values stay distinct)."""
+    speeds = list(np.linspace(1000.0, 6500.0, 8))
+    clear = [round(0.1 + 0.05 * j, 2) for j in range(6)]
+    plot_sweep_index(_index(tmp_path, [{SPEED: s, CLEAR: c} for s in speeds for c in clear], [SPEED, CLEAR]),
+                     tmp_path / "f")
+    fig = drawn["sweep_map.png"]
+    assert fig.get_size_inches()[0] <= 10.0, fig.get_size_inches()
+    small = {t: round(pt, 2) for t, pt in _printed_sizes(fig).items() if pt < 6.95}
+    assert small == {}, small
+    panels = [ax for ax in fig.axes if ax.get_label() != "<colorbar>"]
+    assert len(panels) == 2 and panels[0].get_position().y0 > panels[1].get_position().y1  # one above the other
+    for ax in panels:
+        assert [t.get_text() for t in ax.get_xticklabels()] == ["1000", "1786", "2571", "3357", "4143", "4929",
+                                                                "5714", "6500"]
+        assert [t.get_text() for t in ax.get_yticklabels()] == ["0.1", "0.15", "0.2", "0.25", "0.3", "0.35"]
+    (tmp_path / "g").mkdir()  # close values keep the digits that tell them apart; few values, their own
+    points = [{SPEED: s, CLEAR: c} for s in (1000.0, 1000.4, 1000.8) for c in (0.1, 0.35)]
+    plot_sweep_index(_index(tmp_path / "g", points, [SPEED, CLEAR], failed=(1,)), tmp_path / "g" / "f")
+    fig = drawn["sweep_map.png"]
+    box, edge = fig._suptitle.get_window_extent(fig.canvas.get_renderer()), fig.bbox
+    assert edge.x0 <= box.x0 and box.x1 <= edge.x1, fig._suptitle.get_text()  # a narrow map's title wrapped
+    assert " ".join(fig._suptitle.get_text().split()).endswith("(1 cell failed or not run: blank)")
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["1000", "1000.4", "1000.8"]
+    assert [t.get_text() for t in ax.get_yticklabels()] == ["0.1", "0.35"]
+

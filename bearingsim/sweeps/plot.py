@@ -13,7 +13,9 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
   - one axis, or zipped axes: a line plot against the (first numeric) axis; the other zipped keys' values
     in a tick row each under its values, named in the axis label (their change is not the axis's);
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
-    sampled pair, the sampled values ticked and each cell's value written in it;
+    sampled pair, the sampled values ticked (rounded as far as their step allows) and each cell's value
+    written in it; the I_acc map under the I_dec map, the figure at most 9 in wide and its texts legible
+    in a report's 6.5 in text width;
   - otherwise: one line per combination of the other axes (at most 8).
 
   The lines and bars of I_dec are drawn in the house colour of the rear face, those of I_acc in the front
@@ -50,9 +52,12 @@ MAX_LINES = 8
 MAX_CASES = 60  # most cases a per-case chart labels one by one
 MAP_TICKS = 20  # most labelled ticks on a heat map's axis (a longer axis labels every k-th value)
 ZIP_TICKS = 10  # most labelled ticks on a zipped sweep's abscissa (each a column of the zipped keys' values)
-MAP_TEXT_CELLS = 20  # most cells along either axis of a heat map that still get their value written
-MAP_PANEL_IN = (3.0, 9.0)  # width of a heat map's panel [in]: 1.2 in per cell within these bounds
-MAP_HEIGHT_IN = (4.2, 12.0)  # height of a heat map [in]: 0.45 in per cell and 2.5 in of titles within these
+MAP_TEXT_CELLS = 20  # most rows of a heat map that still get their values written in the cells
+MAP_TEXT_COLUMNS = 12  # most columns that do: 7 pt values of 5 characters fill a column at a report's width
+MAP_WIDTH_IN = (6.0, 9.0)  # width of a heat map [in], its panels one above the other: 2.4 in + 0.7 in per column
+MAP_CELLS_IN = (2.4, 4.5)  # height of a panel's cells [in]: 0.4 in per row within these bounds
+PRINT_WIDTH_IN = 6.5  # a report's text width [in]: a map's texts are at least MIN_PRINT_PT once shrunk to it
+MIN_PRINT_PT = 7.0
 QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
 Y_LABEL = "per pocket and cage rotation [mN s]"
 FACE_COLOURS = {"I_dec": REAR, "I_acc": FRONT}  # the house colours: I_dec the rear face's, I_acc the front's
@@ -287,17 +292,19 @@ def _show(v) -> str:
 
 def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
     """One cell per sampled pair, centred on its tick (sampled values only: no extrapolated edges),
-    equal cells, each with its value written; I_dec and I_acc in two panels with their own scales."""
+    equal cells, each with its value written; I_dec and I_acc in two panels, one above the other, with their
+    own scales. The figure is at most 9 in wide, its texts sized to read at least 7 pt at a report's 6.5 in
+    (:func:`_map_layout`); the ticks are the sampled values rounded as far as their step allows
+    (:func:`tick_texts`)."""
     xk, yk = axes
     xs, ys = _sampled(cols[xk], rows), _sampled(cols[yk], rows)
     xpos = {_show(v): j for j, v in enumerate(xs)}
     ypos = {_show(v): j for j, v in enumerate(ys)}
     from bearingsim.plotting import subplots
 
-    panel = min(MAP_PANEL_IN[1], max(MAP_PANEL_IN[0], 1.2 * len(xs)))  # bounded: a 100 x 100 map stays a page
-    height = min(MAP_HEIGHT_IN[1], max(MAP_HEIGHT_IN[0], 0.45 * len(ys) + 2.5))
-    fig, panels = subplots(1, 2, figsize=(max(9.0, 2 * panel + 3), height), constrained_layout=True)
-    text = len(xs) <= MAP_TEXT_CELLS and len(ys) <= MAP_TEXT_CELLS  # values written while they fit their cells
+    size, pt = _map_layout(len(xs), len(ys))
+    fig, panels = subplots(2, 1, figsize=size, constrained_layout=True)
+    text = len(xs) <= MAP_TEXT_COLUMNS and len(ys) <= MAP_TEXT_CELLS  # values written while they fit their cells
     batches = index_batches(cols, meta, len(cols["case"]))  # each case's batch means (the tables' test)
     n_gap = 0
     for ax, (name, sym) in zip(panels, QUANTITIES):
@@ -312,25 +319,85 @@ def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
         star = np.isnan(err) & has if np.isfinite(err[has]).any() else np.zeros_like(has)  # some cells lack one
         mesh = ax.pcolormesh(np.arange(len(xs) + 1) - 0.5, np.arange(len(ys) + 1) - 0.5,
                              np.ma.masked_invalid(grid), shading="flat", cmap="viridis")
-        fig.colorbar(mesh, ax=ax, label=f"{sym} {Y_LABEL}")
+        bar = fig.colorbar(mesh, ax=ax)
+        bar.set_label(f"{sym} per pocket and\ncage rotation [mN s]", fontsize=pt)
+        bar.ax.tick_params(labelsize=pt)
         finite = grid[np.isfinite(grid)]
         mid = 0.5 * (finite.min() + finite.max()) if finite.size else 0.0
         if text:
             for (yi, xi), z in np.ndenumerate(grid):
                 ax.text(xi, yi, f"{z:.3g}{'*' if star[yi, xi] else ''}" if math.isfinite(z) else "–", ha="center",
-                        va="center", fontsize=7,
+                        va="center", fontsize=pt,
                         color="black" if not math.isfinite(z) or z > mid else "white")
-        kx, ky = -(-len(xs) // MAP_TICKS), -(-len(ys) // MAP_TICKS)  # every k-th value labelled
-        ax.set_xticks(range(0, len(xs), kx), [_show(v) for v in xs[::kx]], rotation=90 if kx > 1 else 0)
-        ax.set_yticks(range(0, len(ys), ky), [_show(v) for v in ys[::ky]])
-        ax.set_xlabel(axis_label(xk))
-        ax.set_ylabel(axis_label(yk))
-        ax.set_title(map_title(sym, grid[has], err[has], marked=text, batches=nb[has]), fontsize=7)
-    fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""), fontsize=10)
+        _map_ticks(ax, xk, yk, xs, ys, pt)
+        ax.set_title(map_title(sym, grid[has], err[has], marked=text, batches=nb[has]), fontsize=pt)
+    fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""),
+                 fontsize=pt * 10 / 7)
     fit_titles(fig, panels)
+    _fit_suptitle(fig)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
+
+
+def _fit_suptitle(fig) -> None:
+    """Wrap ``fig``'s title (at spaces, lines kept) to the figure's width, as :func:`fit_titles` wraps a
+    panel's: a narrow map's title with its failed cells would run past both edges."""
+    import textwrap
+
+    fig.draw_without_rendering()
+    renderer, title = fig.canvas.get_renderer(), fig._suptitle
+    for _ in range(8):  # each pass narrows the longest line by the measured excess
+        drawn, width = title.get_window_extent(renderer).width, 0.96 * fig.bbox.width
+        if drawn <= width:
+            break
+        lines = title.get_text().split("\n")
+        chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
+        title.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
+        fig.draw_without_rendering()
+
+
+def _map_layout(nx: int, ny: int) -> tuple[tuple[float, float], float]:
+    """((width, height) [in], the font size [pt] of its smallest texts) of a heat map of ``nx`` columns and
+    ``ny`` rows, its two panels one above the other: a wider map's texts larger by the factor it is shrunk
+    to a report's text width, so that they print at least :data:`MIN_PRINT_PT`."""
+    width = min(MAP_WIDTH_IN[1], max(MAP_WIDTH_IN[0], 2.4 + 0.7 * nx))
+    cells = min(MAP_CELLS_IN[1], max(MAP_CELLS_IN[0], 0.4 * ny))
+    pt = MIN_PRINT_PT * max(1.0, width / PRINT_WIDTH_IN)
+    return (width, 2 * (cells + 1.1 + 0.06 * pt) + 0.6), round(pt + 0.05, 1)
+
+
+def _map_ticks(ax, xk, yk, xs, ys, pt: float) -> None:
+    """A heat map's ticks and axis labels: every k-th sampled value (at most :data:`MAP_TICKS` an axis),
+    rounded (:func:`tick_texts`), in ``pt`` points or larger."""
+    kx, ky = -(-len(xs) // MAP_TICKS), -(-len(ys) // MAP_TICKS)  # every k-th value labelled
+    ax.set_xticks(range(0, len(xs), kx), tick_texts(xs)[::kx], rotation=90 if kx > 1 else 0)
+    ax.set_yticks(range(0, len(ys), ky), tick_texts(ys)[::ky])
+    ax.tick_params(labelsize=pt * 8 / 7)
+    ax.set_xlabel(axis_label(xk), fontsize=pt * 8 / 7)
+    ax.set_ylabel(axis_label(yk), fontsize=pt * 8 / 7)
+
+
+def tick_texts(values) -> list[str]:
+    """The tick labels of sampled ``values`` (text as it is): numbers to the fewest decimals (none at least)
+    that leave each within 1 % of the smallest step between them, so that distinct values stay distinct
+    (``1000, 1786, 2571`` for 1000..6500 in 8; ``0.1, 0.15``; ``1000.4, 1000.8``), trailing zeros dropped.
+    A value too close to its neighbour for 10 decimals is written as ``%g`` writes it."""
+    if not values or not all(isinstance(v, (float, int, np.floating)) for v in values):
+        return [_show(v) for v in values]
+    vals = np.asarray(values, dtype=float)
+    steps = np.diff(np.unique(vals))
+    tol = 0.01 * float(steps.min()) if steps.size else 0.0
+    for dec in range(11):
+        if np.all(np.abs(np.round(vals, dec) - vals) <= tol) and (steps.size or np.all(np.round(vals, dec) == vals)):
+            return [_plain(v, dec) for v in vals]
+    return [_show(v) for v in values]
+
+
+def _plain(v: float, dec: int) -> str:
+    text = f"{round(v, dec):.{dec}f}"
+    text = text.rstrip("0").rstrip(".") if "." in text else text
+    return "0" if text == "-0" else text
 
 
 def map_title(sym: str, values, sem, marked: bool = True, batches=None) -> str:

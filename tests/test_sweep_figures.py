@@ -436,3 +436,31 @@ def test_a_map_prints_at_a_report_width_with_rounded_ticks(tmp_path, drawn):
     assert [t.get_text() for t in ax.get_xticklabels()] == ["1000", "1000.4", "1000.8"]
     assert [t.get_text() for t in ax.get_yticklabels()] == ["0.1", "0.35"]
 
+
+def test_a_sweep_of_one_or_two_points_draws_markers_on_impulse_axes_from_0(tmp_path, drawn):
+    """A sweep at 3000 rpm alone drew its lone I_acc of 0 on an axis of -0.04..0.04 mN s (negative impulses,
+    impossible), and one of 1000 and 6000 rpm joined its two points by a line, a linear trend that 6 points
+    show is false (I_acc is 0 from 2700 rpm). An impulse axis starts at 0 when every value is at least 0; the
+    points of fewer than 3 values along the axis are markers without a line; 3 or more are joined as before."""
+    def panels(speeds, acc=None):
+        (tmp_path / (d := f"s{len(speeds)}")).mkdir()
+        h5 = _index(tmp_path / d, [{SPEED: s} for s in speeds], [SPEED], sem=lambda i: 0.0)
+        if acc is not None:  # the recorded I_acc, as the reduced model gives it
+            import h5py
+
+            with h5py.File(h5, "r+") as f:
+                f["index/I_acc_mean_Ns"][...] = acc
+        plot_sweep_index(h5, tmp_path / d / "f")
+        return drawn["sweep_I.png"].axes
+
+    def joined(ax) -> bool:
+        return any(line.get_linestyle() not in ("None", "none", "") and len(line.get_xdata()) > 1 for line in ax.lines)
+
+    for ax in panels([3000.0], acc=[0.0]):
+        low, high = ax.get_ylim()
+        assert low == 0.0 < high, (ax.get_ylabel(), low, high)
+        assert not any(t.get_text().startswith(("−", "-")) for t in ax.get_yticklabels())
+    for ax in panels([1000.0, 6000.0]):
+        assert not joined(ax) and ax.get_ylim()[0] == 0.0
+    for ax in panels([1000.0, 2000.0, 6000.0]):
+        assert joined(ax)

@@ -11,7 +11,9 @@ Every sweep draws something, or says in one line (the ``notes``) why a figure co
   bars (:func:`map_title`):
 
   - one axis, or zipped axes: a line plot against the (first numeric) axis; the other zipped keys' values
-    in a tick row each under its values, named in the axis label (their change is not the axis's);
+    in a tick row each under its values, named in the axis label (their change is not the axis's); a line
+    of fewer than 3 values along the axis is markers alone (two joined would read as a trend), and an
+    impulse axis starts at 0 when no value is negative;
   - two axes of a product, both numeric or both text: heat maps (``sweep_map.png``), one cell per
     sampled pair, the sampled values ticked (rounded as far as their step allows) and each cell's value
     written in it; the I_acc map under the I_dec map, the figure at most 9 in wide and its texts legible
@@ -58,6 +60,7 @@ MAP_WIDTH_IN = (6.0, 9.0)  # width of a heat map [in], its panels one above the 
 MAP_CELLS_IN = (2.4, 4.5)  # height of a panel's cells [in]: 0.4 in per row within these bounds
 PRINT_WIDTH_IN = 6.5  # a report's text width [in]: a map's texts are at least MIN_PRINT_PT once shrunk to it
 MIN_PRINT_PT = 7.0
+MIN_JOINED = 3  # fewest values along a line figure's axis joined by a line (two joined would read as a trend)
 QUANTITIES = (("I_dec", "$I_{dec}$"), ("I_acc", "$I_{acc}$"))
 Y_LABEL = "per pocket and cage rotation [mN s]"
 FACE_COLOURS = {"I_dec": REAR, "I_acc": FRONT}  # the house colours: I_dec the rear face's, I_acc the front's
@@ -217,8 +220,8 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
-            ax.errorbar(x, y, yerr=_bar_lengths(err), marker=marker, ls=ls, color=FACE_COLOURS[name], capsize=3, ms=4,
-                        label=extra or None)
+            ax.errorbar(x, y, yerr=_bar_lengths(err), marker=marker, ls=ls if len(set(x)) >= MIN_JOINED else "none",
+                        color=FACE_COLOURS[name], capsize=3, ms=4, label=extra or None)
             mark_without_error(ax, x, y, err, FACE_COLOURS[name], marker, ms=4)  # no error: an open marker
     drawn = [i for idx in groups.values() for i in idx]
     for ax, (name, sym) in zip(panels, QUANTITIES):
@@ -236,6 +239,8 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
 
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
+        if np.all(y[shown] >= 0.0):  # an impulse is never negative: no axis below 0 (a lone 0 drew -0.04..0.04)
+            ax.set_ylim(bottom=0.0)
     for ax in panels[::-1]:  # one legend, on the last panel with lines
         if others and ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7, loc="best")

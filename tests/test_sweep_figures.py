@@ -457,10 +457,13 @@ def test_a_sweep_of_one_or_two_points_draws_markers_on_impulse_axes_from_0(tmp_p
         return any(line.get_linestyle() not in ("None", "none", "") and len(line.get_xdata()) > 1 for line in ax.lines)
 
     for ax in panels([3000.0], acc=[0.0]):
-        low, high = ax.get_ylim()
-        assert low == 0.0 < high, (ax.get_ylabel(), low, high)
-        assert not any(t.get_text().startswith(("−", "-")) for t in ax.get_yticklabels())
+        low, high = ax.get_ylim()  # below 0 only the room of half a marker (one at 0 drawn whole): no tick there
+        assert -0.05 * high < low < 0.0 < high, (ax.get_ylabel(), low, high)
+        assert not any(t.get_text().startswith(("−", "-")) for t in ax.get_yticklabels() if low <= t.get_position()[1])
     for ax in panels([1000.0, 6000.0]):
-        assert not joined(ax) and ax.get_ylim()[0] == 0.0
+        low, high = ax.get_ylim()
+        assert not joined(ax) and -0.05 * high < low < 0.0
+        top = max(line.get_ydata().max() for line in ax.lines if len(line.get_ydata()))
+        assert top < 0.96 * high, (top, high)  # room above the highest marker: drawn whole
     for ax in panels([1000.0, 2000.0, 6000.0]):
         assert joined(ax)

@@ -239,8 +239,10 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
 
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
         ax.grid(alpha=0.3)
-        if np.all(y[shown] >= 0.0):  # an impulse is never negative: no axis below 0 (a lone 0 drew -0.04..0.04)
-            ax.set_ylim(bottom=0.0)
+        if np.all(y[shown] >= 0.0):  # an impulse is never negative: no axis below 0 (a lone 0 drew -0.04..0.04),
+            # room for a marker at the top, and below 0 for half a marker (one at 0 would be cut), less than a tick
+            top = max(ax.get_ylim()[1], 1.06e3 * float(np.max(y[shown], initial=0.0)))  # y in N s, the axis mN s
+            ax.set_ylim(-0.03 * top, top)
     for ax in panels[::-1]:  # one legend, on the last panel with lines
         if others and ax.get_legend_handles_labels()[0]:
             ax.legend(fontsize=7, loc="best")

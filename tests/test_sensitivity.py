@@ -678,6 +678,21 @@ def test_uncertainty_refuses_a_seed_or_a_sample_count_it_cannot_keep(tmp_path, c
     assert not (tmp_path / "u").exists()
 
 
+@pytest.mark.parametrize("kw, words", [
+    (dict(samples=0), "samples: 0: give at least 2 base samples"),
+    (dict(samples=2.5), "samples: 2.5: give at least 2 base samples"),
+    (dict(samples=2, seed=-1), "seed: -1: give an integer from 0 to 9223372036854775807"),
+    (dict(samples=16384), "samples: 16384: 114688 cases (16384 x 7: the samples A, B and one block per key) are more "
+                          "than the 100000 a sweep or study may have; give at most samples=14285"),
+])
+def test_the_apis_uncertainty_refuses_its_samples_and_seed_as_its_arguments(kw, words):
+    """``bearingsim.uncertainty`` names its own arguments in a refusal, not the command's options (it said
+    "--samples 0: ..." to a caller who gave ``samples=0``)."""
+    with pytest.raises(bearingsim.UserError) as err:
+        bearingsim.uncertainty(load_scenario(SCENARIOS / "paper_3000rpm.toml"), **kw)
+    assert str(err.value).startswith(words), str(err.value)
+
+
 def test_the_largest_seed_is_kept_in_the_table(tmp_path):
     from bearingsim.studies.uncertainty import MAX_SEED
 

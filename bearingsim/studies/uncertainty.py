@@ -134,19 +134,24 @@ class Uncertainty(Study):
         from bearingsim.studies.sensitivity import check_keys
         from bearingsim.sweeps.spec import MAX_SWEEP_CASES
 
+        from bearingsim.wording import given_by
+
+        arg = (lambda name: f"--{name}") if origin.startswith("--") else str  # the option, or the API's argument
         if not isinstance(samples, int) or isinstance(samples, bool) or samples < 2:
-            raise UserError(f"--samples {samples!r}: give at least 2 base samples (a power of 2 such as 64 is best)")
+            raise UserError(f"{given_by(arg('samples'), repr(samples))}: give at least 2 base samples (a power of 2 "
+                            f"such as 64 is best)")
         if not isinstance(seed, int) or isinstance(seed, bool) or not 0 <= seed <= MAX_SEED:
-            raise UserError(f"--seed {seed!r}: give an integer from 0 to {MAX_SEED} (2**63 - 1, the largest the "
-                            f"study's table stores)")
+            raise UserError(f"{given_by(arg('seed'), repr(seed))}: give an integer from 0 to {MAX_SEED} (2**63 - 1, "
+                            f"the largest the study's table stores)")
         self.scenario, self.samples, self.seed = scenario, samples, seed
         # the ranges are sampled: any value of the key
         self.keys = check_keys(scenario, keys, relative=False, origin=origin)
         total = samples * (len(self.keys) + 2)
         if total > MAX_SWEEP_CASES:  # counted before any case is built, as a sweep's
-            raise UserError(f"--samples {samples}: {total} cases ({samples} x {len(self.keys) + 2}: the samples A, B and "
-                            f"one block per key) are more than the {MAX_SWEEP_CASES} a sweep or study may have; "
-                            f"give at most --samples {MAX_SWEEP_CASES // (len(self.keys) + 2)}")
+            raise UserError(f"{given_by(arg('samples'), str(samples))}: {total} cases ({samples} x {len(self.keys) + 2}: "
+                            f"the samples A, B and one block per key) are more than the {MAX_SWEEP_CASES} a sweep or "
+                            f"study may have; give at most {arg('samples')}{' ' if origin.startswith('--') else '='}"
+                            f"{MAX_SWEEP_CASES // (len(self.keys) + 2)}")
         r = ranged_keys(scenario)
         self.bounds = np.array([r[k][:2] for k in self.keys])
         self.a, self.b, self.ab = design(self.bounds, samples, seed)

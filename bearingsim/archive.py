@@ -1217,9 +1217,15 @@ def is_grid_file(path, fmt: str) -> bool:
 def table_units(path, attr: str = "unit") -> dict[str, str]:
     """The ``unit`` (or another text ``attr``: ``description``) of every column of a table file
     (:func:`write_table_file`) that has one."""
+    return _column_texts(path, (attr,))[attr]
+
+
+def _column_texts(path, attrs: tuple[str, ...]) -> dict[str, dict[str, str]]:
+    """``{attr: {column: text}}`` of the text attributes ``attrs`` of a table file's columns, read in one
+    opening of the file."""
     p = Path(path)
     with _lazy_h5py().File(p, "r") as f, reading(p, "table"):
-        return {name: _plain(ds.attrs[attr]) for name, ds in f["index"].items() if attr in ds.attrs}
+        return {a: {name: _plain(ds.attrs[a]) for name, ds in f["index"].items() if a in ds.attrs} for a in attrs}
 
 
 def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[str], lines: list[str],
@@ -1233,7 +1239,8 @@ def describe_table(path, what: str, cols: dict[str, np.ndarray], columns: list[s
     for v in (status if status is not None else []):
         by[str(v)] = by.get(str(v), 0) + 1
     counts = " (" + ", ".join(f"{k} {v}" for k, v in sorted(by.items())) + ")" if by else ""
-    units, said = table_units(path), table_units(path, "description")
+    texts = _column_texts(path, ("unit", "description"))
+    units, said = texts["unit"], texts["description"]
     out = [f"{path}: {what}: {counted(n, noun)}{counts}", *lines, "columns:"]
     for c in columns:
         arr = np.asarray(cols[c])
@@ -1566,11 +1573,14 @@ def _attribute_group_lines(f) -> list[str]:
         values, units = group_attrs(grp)
         said = _plain(grp.attrs["description"]) if "description" in grp.attrs else ""
         lines.append(f"/results/{name}:" + (f" {said}" if said else ""))
-        for k in sorted(values):
-            v = values[k]
-            vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
-            lines.append(f"  {k:32s} {vs} {units.get(k, '')}".rstrip())
+        lines += [_number_line(k, values[k], units.get(k, "")).rstrip() for k in sorted(values)]
     return lines
+
+
+def _number_line(key: str, value, unit: str) -> str:
+    """One stored number of ``describe``'s listing: its name, its value (floats to 6 digits) and its unit."""
+    shown = f"{value:.6g}" if isinstance(value, (float, np.floating)) else str(value)
+    return f"  {key:32s} {shown} {unit}"
 
 
 def describe(path: str | Path) -> str:
@@ -1591,11 +1601,7 @@ def describe(path: str | Path) -> str:
         if "results/summary" in f:
             lines.append("summary:")
             sa, su = group_attrs(f["results/summary"])
-            for k in sorted(sa):
-                unit = su.get(k, "")
-                v = sa[k]
-                vs = f"{v:.6g}" if isinstance(v, (float, np.floating)) else str(v)
-                lines.append(f"  {k:32s} {vs} {unit}")
+            lines += [_number_line(k, sa[k], su.get(k, "")) for k in sorted(sa)]
             lines += _error_lines(f, g.attrs["model"])
         lines += _attribute_group_lines(f)
         lines += _notes_lines(read_notes(f, path))

@@ -11,8 +11,8 @@ from __future__ import annotations
 import contextlib
 from pathlib import Path
 
-__all__ = ["FRONT", "REAR", "LINE_STYLES", "figure", "subplots", "save_figure", "figure_png", "legend_outside", "error_title",
-           "fit_titles", "mark_without_error", "hatch_without_error", "plain_number"]
+__all__ = ["FRONT", "REAR", "LINE_STYLES", "figure", "subplots", "save_figure", "figure_png", "legend_outside",
+           "error_title", "fit_titles", "fit_suptitle", "mark_without_error", "hatch_without_error", "plain_number"]
 
 #: the house colours of the two pocket faces, the same in every figure: FRONT is the front face, where the roller
 #: pushes the cage (I_acc, F_acc), REAR the rear face, where the cage drags a lagging roller (I_dec, F_dec).
@@ -85,19 +85,33 @@ def fit_titles(fig, axes) -> None:
     """Wrap each of ``axes``' titles (at spaces, lines kept) to lines no wider than its axes, measured on
     ``fig`` laid out as it stands: a long title would run past the figure's edge or into the next panel's.
     One layout pass without rendering, then a few text measurements per title."""
-    import textwrap
-
     fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
     for ax in axes:
-        width = ax.get_window_extent(renderer).width
-        for _ in range(8):  # each pass narrows the longest line by the measured excess
-            drawn = ax.title.get_window_extent(renderer).width
-            if drawn <= width:
-                break
-            lines = ax.title.get_text().split("\n")
-            chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
-            ax.title.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
+        _wrap_to(ax.title, ax.get_window_extent(renderer).width, renderer)
+
+
+def fit_suptitle(fig) -> None:
+    """Wrap ``fig``'s title (at spaces, lines kept) to the figure's width, as :func:`fit_titles` wraps a
+    panel's (a narrow figure's long title would run past both edges); laid out again after each pass."""
+    fig.draw_without_rendering()
+    _wrap_to(fig._suptitle, 0.96 * fig.bbox.width, fig.canvas.get_renderer(), fig.draw_without_rendering)
+
+
+def _wrap_to(text, width: float, renderer, after=None) -> None:
+    """Wrap the matplotlib ``text`` (at spaces, its lines kept) until it is no wider than ``width`` [px]: each
+    pass narrows the longest line by the measured excess (at most 8 passes); ``after()`` after each pass."""
+    import textwrap
+
+    for _ in range(8):
+        drawn = text.get_window_extent(renderer).width
+        if drawn <= width:
+            break
+        lines = text.get_text().split("\n")
+        chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
+        text.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
+        if after is not None:
+            after()
 
 
 _SUPERSCRIPTS = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")

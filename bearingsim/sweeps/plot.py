@@ -41,8 +41,8 @@ from pathlib import Path
 
 import numpy as np
 
-from bearingsim.plotting import (FRONT, LINE_STYLES, REAR, error_title, fit_titles, hatch_without_error,
-                                 mark_without_error)
+from bearingsim.plotting import (FRONT, LINE_STYLES, REAR, error_title, fit_suptitle, fit_titles,
+                                 hatch_without_error, mark_without_error)
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
 from bearingsim.wording import counted
@@ -341,27 +341,10 @@ def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
     fig.suptitle(title + (f" ({counted(n_gap, 'cell')} failed or not run: blank)" if n_gap else ""),
                  fontsize=pt * 10 / 7)
     fit_titles(fig, panels)
-    _fit_suptitle(fig)
+    fit_suptitle(fig)
     from bearingsim.plotting import save_figure
 
     return save_figure(fig, path, tight=False)
-
-
-def _fit_suptitle(fig) -> None:
-    """Wrap ``fig``'s title (at spaces, lines kept) to the figure's width, as :func:`fit_titles` wraps a
-    panel's: a narrow map's title with its failed cells would run past both edges."""
-    import textwrap
-
-    fig.draw_without_rendering()
-    renderer, title = fig.canvas.get_renderer(), fig._suptitle
-    for _ in range(8):  # each pass narrows the longest line by the measured excess
-        drawn, width = title.get_window_extent(renderer).width, 0.96 * fig.bbox.width
-        if drawn <= width:
-            break
-        lines = title.get_text().split("\n")
-        chars = max(12, int(max(map(len, lines)) * width / drawn) - 1)
-        title.set_text("\n".join(textwrap.fill(line, chars, break_on_hyphens=False) for line in lines))
-        fig.draw_without_rendering()
 
 
 def _map_layout(nx: int, ny: int) -> tuple[tuple[float, float], float]:

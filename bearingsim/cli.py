@@ -805,12 +805,49 @@ def _add_study_commands(sub) -> None:
 
 
 class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised like SIGINT's KeyboardInterrupt so that every clean-up path (temporary archive
-    removed, output lock released) runs the same way."""
+    """SIGTERM, or SIGHUP (a terminal that went away: ``signum`` says which), raised like SIGINT's
+    KeyboardInterrupt so that every clean-up path (temporary archive removed, output lock released) runs the
+    same way."""
+
+    def __init__(self, signum: int = signal.SIGTERM):
+        super().__init__()
+        self.signum = signum
 
 
 def _raise_terminated(signum, frame):
-    raise Terminated()
+    raise Terminated(signum)
+
+
+#: the signals the command line ends a command on by :class:`Terminated` (SIGINT raises Python's own
+#: KeyboardInterrupt); SIGHUP only when the process did not start with it ignored (``nohup`` asks a command to
+#: outlive its terminal)
+TERMINATING = (signal.SIGTERM, signal.SIGHUP)
+
+
+def _stop_words(exc: KeyboardInterrupt) -> str:
+    """How the one line of an interrupted command names its signal."""
+    if not isinstance(exc, Terminated):
+        return "interrupted"
+    return "hung up (SIGHUP)" if exc.signum == signal.SIGHUP else "terminated (SIGTERM)"
+
+
+def _stop_code(exc: KeyboardInterrupt) -> int:
+    """128 + the signal's number: 130 SIGINT, 143 SIGTERM, 129 SIGHUP."""
+    return 128 + (exc.signum if isinstance(exc, Terminated) else signal.SIGINT)
+
+
+def _own_terminating_signals() -> dict:
+    """Install :func:`_raise_terminated` for :data:`TERMINATING` (a SIGHUP ignored at start stays ignored);
+    the handlers they had, to put back. Outside the main thread (main() called from a library): none."""
+    previous = {}
+    for s in TERMINATING:
+        try:
+            if s == signal.SIGHUP and signal.getsignal(s) == signal.SIG_IGN:
+                continue
+            previous[s] = signal.signal(s, _raise_terminated)
+        except ValueError:  # not the main thread: leave the process's signals alone
+            break
+    return previous
 
 
 #: delay before a signal whose exception could not be raised is set pending again [s] (callbacks
@@ -820,7 +857,7 @@ REDELIVER_AFTER_S = 0.02
 
 @contextlib.contextmanager
 def _interrupts_redelivered():
-    """Deliver again a SIGINT or SIGTERM whose exception Python could not raise.
+    """Deliver again a SIGINT, SIGTERM or SIGHUP whose exception Python could not raise.
 
     A signal's handler runs wherever the main thread is. If that is a weakref callback or a
     ``__del__``, Python cannot propagate its ``KeyboardInterrupt`` (or :class:`Terminated`): the
@@ -851,7 +888,7 @@ def _interrupts_redelivered():
     def hook(unraisable):
         exc = unraisable.exc_value
         if isinstance(exc, KeyboardInterrupt):
-            signum = signal.SIGTERM if isinstance(exc, Terminated) else signal.SIGINT
+            signum = exc.signum if isinstance(exc, Terminated) else signal.SIGINT
             with swallowed.lock:
                 swallowed.signum = signum
             threading.Thread(target=deliver, args=(signum,), daemon=True).start()
@@ -968,21 +1005,17 @@ def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
     """Run one ``bearingsim`` command; return its exit code.
 
     Exit codes: 0 success, 2 bad input or an unwritable output (one line on stderr), 3 an unstable or
-    unphysical run (no archive), 130 SIGINT, 143 SIGTERM (the line says what is complete: nothing, the
+    unphysical run (no archive), 130 SIGINT, 143 SIGTERM, 129 SIGHUP (the line says what is complete: nothing, the
     archive, or every file once all were written); 0 also when
     the reader of the output goes away early (``bearingsim inspect x.h5 | head -1``), with nothing said,
     except for ``compare`` and ``rerun``, whose exit code is their verdict (0 identical, 1 differ) and
     stays so (``args.status``, set before they print). ``exiting``: the process ends when it returns
-    (:func:`program`): once the exit code is decided SIGINT and SIGTERM are ignored, not restored, so that
+    (:func:`program`): once the exit code is decided SIGINT, SIGTERM and SIGHUP are ignored, not restored, so that
     a signal in its last moments neither ends it silently nor contradicts the line it printed.
     """
     args = build_parser().parse_args(argv)
     args.files_written = {}  # the files complete so far (outputs.recording_files), for an interrupted command's line
-    previous = None
-    try:
-        previous = signal.signal(signal.SIGTERM, _raise_terminated)
-    except ValueError:  # not the main thread (main() called from a library): leave SIGTERM alone
-        pass
+    previous = _own_terminating_signals()
     errors = {}
     for name in ("stdout", "stderr"):  # a C locale's ASCII stdout: a non-ASCII name is escaped, not a traceback
         stream = getattr(sys, name)
@@ -1000,22 +1033,23 @@ def main(argv: list[str] | None = None, *, exiting: bool = False) -> int:
     finally:
         if exiting:
             _ignore_signals()
-        elif previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        else:
+            for s, handler in previous.items():
+                signal.signal(s, handler)
         for name, err in errors.items():
             with contextlib.suppress(AttributeError, ValueError, OSError):
                 getattr(sys, name).reconfigure(errors=err)
 
 
 def _ignore_signals() -> None:
-    """SIGINT and SIGTERM ignored from now on (the process ends with its exit code decided); a signal whose
-    handler runs meanwhile (it came just before) changes nothing."""
+    """SIGINT, SIGTERM and SIGHUP ignored from now on (the process ends with its exit code decided); a signal
+    whose handler runs meanwhile (it came just before) changes nothing."""
     for _ in range(3):
         try:
-            signal.signal(signal.SIGINT, signal.SIG_IGN)
-            signal.signal(signal.SIGTERM, signal.SIG_IGN)
+            for s in (signal.SIGINT, *TERMINATING):
+                signal.signal(s, signal.SIG_IGN)
             return
-        except KeyboardInterrupt:  # SIGINT's or SIGTERM's handler, run between the two: set them again
+        except KeyboardInterrupt:  # a handler run between two of them: set them again
             continue
         except ValueError:  # not the main thread
             return
@@ -1034,7 +1068,7 @@ def _run_command(args, swallowed: _Swallowed) -> int:
         # the signal came first, and its exception was swallowed in a callback that then could not
         # do its work (numba's compiler, called back from LLVM, left without the object it was
         # handed: "no compiled object yet"); the command failed of that: the signal ends it
-        raise (Terminated() if signum == signal.SIGTERM else KeyboardInterrupt()) from exc
+        raise (KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)) from exc
     try:
         sys.stdout.flush()
     except BrokenPipeError:
@@ -1057,7 +1091,7 @@ def _failed(exc: BaseException, args) -> int:
     if isinstance(exc, SimulationUnstable):
         print(f"bearingsim: unstable run, no archive written: {_one_line(exc)}", file=sys.stderr)
         return exc.exit_code
-    if isinstance(exc, KeyboardInterrupt):  # SIGINT, or SIGTERM (Terminated)
+    if isinstance(exc, KeyboardInterrupt):  # SIGINT, or SIGTERM or SIGHUP (Terminated)
         return _interrupted(exc, args)
     if isinstance(exc, MemoryError):
         print("bearingsim: error: out of memory; run fewer numerics.rotations or a longer numerics.output_rate_hz "
@@ -1093,8 +1127,15 @@ _ONE_FILE = ("animate", "report")
 
 
 def _interrupted(exc: KeyboardInterrupt, args) -> int:
-    """SIGINT or SIGTERM: what was kept, in one line; exit 130 or 143."""
-    what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+    """SIGINT, SIGTERM or SIGHUP: what was kept, in one line (none when the terminal it would go to has gone);
+    exit 130, 143 or 129."""
+    with contextlib.suppress(OSError):
+        _say_interrupted(exc, args)
+    return _stop_code(exc)
+
+
+def _say_interrupted(exc: KeyboardInterrupt, args) -> None:
+    what = _stop_words(exc)
     written = getattr(exc, "archive_written", None) or getattr(args, "written", None)  # the archive is complete
     kept = getattr(exc, "resume_note", None)  # what a study kept, its cases done (studies.run_studies)
     done = getattr(args, "files_written", {})  # the files complete (outputs.recording_files)
@@ -1110,13 +1151,12 @@ def _interrupted(exc: KeyboardInterrupt, args) -> int:
         print(f"bearingsim: {what} while drawing figures: the archive {written} is complete; figures not "
               f"all written ('bearingsim plot {written}' draws them)", file=sys.stderr)
     elif kept is not None:  # worded as the other studies' (cli_common.report_study)
-        name = "SIGTERM" if isinstance(exc, Terminated) else "SIGINT"
+        name = signal.Signals(_stop_code(exc) - 128).name
         print(f"bearingsim: {args.command} interrupted ({name}): {kept}; run the same command again to resume",
               file=sys.stderr)
     else:
         print(f"bearingsim: {what}, {_NOT_WRITTEN.get(getattr(args, 'command', None), 'no archive written')}",
               file=sys.stderr)
-    return 128 + signal.SIGTERM if isinstance(exc, Terminated) else 130
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -21,8 +21,8 @@ def run_sweep_cli(target, params: list[str], sets: list[str], outdir, *, jobs: i
     and return the exit code. ``progress``: the bar on stderr (default: when stderr is a terminal);
     ``archives``: which cases keep an archive (:func:`run_sweep`).
 
-    0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143: interrupted by
-    SIGINT/SIGTERM (finished cases and the index are kept; run again to resume).
+    0: every case done, stale (run again) or cached; 1: some case failed (named on stderr); 130/143/129: interrupted by
+    SIGINT/SIGTERM/SIGHUP (finished cases and the index are kept; run again to resume).
     """
     from bearingsim.cli_common import with_notes
     from bearingsim.sweeps.engines import DaskEngine, LocalEngine

@@ -56,13 +56,14 @@ def _default_signals():  # pragma: no cover - runs in the child between fork and
 
     # a suite started from a background job inherits SIGINT ignored, and Python keeps an ignored SIGINT:
     # the child must see the signals the tests send it as a terminal user's process would
-    for sig in (signal.SIGINT, signal.SIGTERM):
+    # (and one started under nohup, SIGHUP ignored)
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, signal.SIG_DFL)
 
 
 @contextlib.contextmanager
 def started(cmd, **kw):
-    """``subprocess.Popen(cmd, **kw)`` with SIGINT and SIGTERM at their defaults in the child, ended
+    """``subprocess.Popen(cmd, **kw)`` with SIGINT, SIGTERM and SIGHUP at their defaults in the child, ended
     (killed and reaped, its pipes closed) whatever happens in the ``with`` block."""
     proc = subprocess.Popen([str(c) for c in cmd], preexec_fn=_default_signals, **kw)
     try:

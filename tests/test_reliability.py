@@ -664,7 +664,8 @@ def test_too_few_samples_advice_names_the_cause():
 
 # --- signals ----------------------------------------------------------------------------------------
 @pytest.mark.slow
-@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGHUP, 129)],
+                         ids=["SIGTERM", "SIGINT", "SIGHUP"])
 def test_signal_stops_within_a_second_leaving_nothing(tmp_path, sig, code):
     obs = signal_case(tmp_path, sig)
     assert obs.code == code, obs.err
@@ -950,7 +951,7 @@ def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
             obs.err, obs.out = obs.err.replace(d, "{tmp}"), obs.out.replace(d, "{tmp}")
             rows.append((case, obs))
     sig_rows = []
-    for sig, code in ((signal.SIGTERM, 143), (signal.SIGINT, 130)):
+    for sig, code in ((signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGHUP, 129)):
         with tempfile.TemporaryDirectory() as d:
             sig_rows.append((sig, code, signal_case(Path(d), sig)))
 
@@ -1049,7 +1050,8 @@ def test_rerun_output_takes_the_run_lock_and_cleans_dead_temporaries(tmp_path):
 
 
 @pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
-                                             (signal.SIGINT, 130, "interrupted")])
+                                             (signal.SIGINT, 130, "interrupted"),
+                                             (signal.SIGHUP, 129, "hung up (SIGHUP)")])
 def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path, monkeypatch, capsys, sig, code,
                                                                         word):
     """Issue 30, item 4: a signal that lands while the figures are drawn (the archive is written and
@@ -1067,17 +1069,53 @@ def test_a_signal_while_figures_are_drawn_keeps_the_archive_and_says_so(tmp_path
     monkeypatch.setattr(Result, "save_figures", signalled)
     out = tmp_path / "out.h5"
     # a suite started as a background job inherits SIGINT ignored, and Python then keeps it ignored: give
-    # this process the handler a terminal user's Python has (SIGTERM's is the CLI's own)
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    try:
+    # this process the handler a terminal user's Python has (SIGTERM's is the CLI's own, and SIGHUP's when
+    # it was not ignored at start: a suite run under nohup has it ignored)
+    with _as_on_a_terminal():
         assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
-    finally:
-        signal.signal(signal.SIGINT, previous)
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and word in err[0] and "no archive written" not in err[0], err
     assert f"the archive {out} is complete" in err[0] and "figures not all written" in err[0]
     assert archive.peek(out) is not None and archive.is_archive(out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5"]  # no lock, no temporary
+
+
+@contextlib.contextmanager
+def _as_on_a_terminal():
+    """SIGINT and SIGHUP with the handlers a terminal user's process starts with, whatever this process
+    inherited (a background job's SIGINT, nohup's SIGHUP: ignored); as they were afterwards."""
+    previous = {signal.SIGINT: signal.signal(signal.SIGINT, signal.default_int_handler),
+                signal.SIGHUP: signal.signal(signal.SIGHUP, signal.SIG_DFL)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def test_under_nohup_a_hang_up_leaves_the_run_to_finish(tmp_path, monkeypatch, capsys):
+    """``nohup bearingsim run ...``: a command started with SIGHUP ignored is asked to outlive its terminal.
+    The command line ends a command on SIGHUP (exit 129, its files cleaned up) only when SIGHUP was not
+    ignored at start: under nohup the hang-up while it draws its figures changes nothing (exit 0, every
+    file written), and SIGHUP is still ignored afterwards."""
+    from bearingsim import cli, plotting
+
+    real = plotting.save_figure
+
+    def then_hang_up(*a, **kw):
+        os.kill(os.getpid(), signal.SIGHUP)  # ignored: nothing is raised
+        return real(*a, **kw)
+
+    monkeypatch.setattr(plotting, "save_figure", then_hang_up)
+    out = tmp_path / "out.h5"
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == 0
+        assert signal.getsignal(signal.SIGHUP) == signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+    assert capsys.readouterr().err == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5", "out_pass.png"]
 
 
 def _signal_here(sig) -> None:
@@ -1090,7 +1128,8 @@ def _signal_here(sig) -> None:
 
 @pytest.mark.parametrize("where", ["the last figure renamed into place", "the output lock released"])
 @pytest.mark.parametrize("sig, code, word", [(signal.SIGTERM, 143, "terminated (SIGTERM)"),
-                                             (signal.SIGINT, 130, "interrupted")])
+                                             (signal.SIGINT, 130, "interrupted"),
+                                             (signal.SIGHUP, 129, "hung up (SIGHUP)")])
 def test_a_signal_once_every_file_is_written_says_they_are_complete(tmp_path, monkeypatch, capsys, sig, code, word,
                                                                      where):
     """A signal that lands once the archive and its figures are complete (as soon as the last figure's file
@@ -1107,11 +1146,8 @@ def test_a_signal_once_every_file_is_written_says_they_are_complete(tmp_path, mo
 
     monkeypatch.setattr(owner, name, then_signal)
     out = tmp_path / "out.h5"
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
-    try:
+    with _as_on_a_terminal():
         assert cli.main(["run", str(PAPER), "-o", str(out), "-q"]) == code
-    finally:
-        signal.signal(signal.SIGINT, previous)
     err = capsys.readouterr().err.strip().splitlines()
     assert err == [f"bearingsim: {word} once its files were written: {out}, {tmp_path / 'out_pass.png'} are complete"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.h5", "out_pass.png"]  # no lock, no temporary

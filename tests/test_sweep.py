@@ -441,7 +441,7 @@ SWEEP_EVERY_BATCH = ("import sys; import bearingsim.sweeps.run as r; r.INDEX_EVE
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130), (signal.SIGHUP, 129)])
 def test_signal_stops_the_sweep_and_keeps_finished_cases(tmp_path, signum, code):
     """A signal stops the sweep at once: the cases running when it comes are not finished (no row done, no
     archive: a sweep that let its workers finish them wrote theirs), the queued ones not started, the
@@ -843,14 +843,16 @@ def test_stop_ends_a_pool_whose_result_queue_lock_is_held(monkeypatch):
 
 
 def _worker_signals() -> tuple:
-    """In a pool worker: (its parent-death signal, its SIGTERM handler's name, the stop signals it blocks)."""
+    """In a pool worker: (its parent-death signal, its SIGTERM handler's name, the stop signals it blocks,
+    whether it ignores SIGINT and SIGHUP)."""
     import ctypes
 
     sig = ctypes.c_int(0)
     ctypes.CDLL(None, use_errno=True).prctl(2, ctypes.byref(sig))  # PR_GET_PDEATHSIG
     handler = signal.getsignal(signal.SIGTERM)
-    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, set()) & {signal.SIGINT, signal.SIGTERM}
-    return sig.value, getattr(handler, "__name__", str(handler)), sorted(int(s) for s in blocked)
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, set()) & {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
+    ignored = all(signal.getsignal(s) == signal.SIG_IGN for s in (signal.SIGINT, signal.SIGHUP))
+    return sig.value, getattr(handler, "__name__", str(handler)), sorted(int(s) for s in blocked), ignored
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="PR_SET_PDEATHSIG and /proc are Linux's")
@@ -868,7 +870,9 @@ def test_a_worker_ended_by_sigterm_while_it_waits_for_a_task_leaves_the_pool_usa
     engine.start(1)
     try:
         pool = engine._pool
-        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [])
+        # SIGINT and SIGHUP (Ctrl-C, a terminal's hang-up) reach the whole process group: the sweep process acts
+        # on them and ends the pool, so the workers ignore them
+        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [], True)
         (first,) = pool._pool
         time.sleep(0.2)  # idle: waiting for its next task, holding the task queue's lock
         os.kill(first.pid, signal.SIGTERM)
@@ -878,7 +882,9 @@ def test_a_worker_ended_by_sigterm_while_it_waits_for_a_task_leaves_the_pool_usa
             time.sleep(0.01)
         assert first.exitcode == 143
         # the worker the pool starts in its place (forked by its maintenance thread) takes the next task
-        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [])
+        # SIGINT and SIGHUP (Ctrl-C, a terminal's hang-up) reach the whole process group: the sweep process acts
+        # on them and ends the pool, so the workers ignore them
+        assert pool.apply_async(_worker_signals).get(timeout=60) == (int(signal.SIGTERM), "_exit_worker", [], True)
         assert all(p.pid != first.pid for p in pool._pool)
     finally:
         engine.stop()

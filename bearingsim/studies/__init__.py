@@ -5,7 +5,7 @@ A study is a list of cases plus a table and figures (:class:`Study`): the cross-
 (:mod:`bearingsim.studies.rig`) and the reduced model's Fig. 9 analog (:mod:`bearingsim.studies.fig9`),
 both of ``bearingsim validate``. :func:`run_studies` runs their cases on the sweep engine
 (:mod:`bearingsim.sweeps`: local processes or a dask cluster, resume from kept archives, failures kept
-and reported, SIGINT/SIGTERM, progress) under one folder lock, then writes each study's table and
+and reported, SIGINT/SIGTERM/SIGHUP, progress) under one folder lock, then writes each study's table and
 figures atomically.
 """
 from bearingsim.studies.engine import (StudiesOutcome, Study, batch_sem, case_of, in_folder, load_result,

@@ -3,7 +3,7 @@
 A study (:class:`Study`) is a list of cases (resolved scenarios, :class:`bearingsim.sweeps.spec.Case`)
 plus what it makes of their archives: a table and figures. :func:`run_studies` runs the cases of one or
 more studies in one folder on the one sweep engine (:func:`bearingsim.sweeps.run_sweep`: a local pool of
-processes or a dask cluster, resume from the archives already there, failures kept, SIGINT/SIGTERM,
+processes or a dask cluster, resume from the archives already there, failures kept, SIGINT/SIGTERM/SIGHUP,
 progress), holding the folder's lock (:class:`bearingsim.outputs.FolderLock`) until every table and
 figure is written (atomically, :func:`bearingsim.outputs.atomic_file`).
 
@@ -178,7 +178,7 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
     Returns
     -------
     StudiesOutcome
-        ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the cases (finished archives
+        ``interrupted`` is the signal number if SIGINT/SIGTERM/SIGHUP stopped the cases (finished archives
         and the case index are kept; no table is written; run again to resume).
 
     Raises
@@ -264,7 +264,7 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
 
     desc = "+".join(s.name for s in studies)
     sweep, earlier = None, {}
-    # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM end the study as one
+    # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM/SIGHUP end the study as one
     # during a round does: the finished cases kept, the same command resumes
     staged = any(s.staged for s in studies)
     with _Signals() as outer:
@@ -296,7 +296,7 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
 
 def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: bool = False) -> StudiesOutcome:
     """:func:`run_studies` for the Python API: in ``outdir`` or, with None, a temporary folder removed
-    afterwards; ``jobs`` local processes unless ``engine`` is given. SIGINT/SIGTERM during the cases
+    afterwards; ``jobs`` local processes unless ``engine`` is given. SIGINT/SIGTERM/SIGHUP during the cases
     raise KeyboardInterrupt (finished archives in ``outdir`` are kept)."""
     import tempfile
 

@@ -483,7 +483,7 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = STAGES_RESOLVED, r
     ``life.png``). When a pocket's faces wear through the cage bar before the limit, the life ends there: the
     history ends at that time, and ``life.h5``'s attribute ``worn_through`` says what reached the bar's
     width. A stage that fails raises :class:`bearingsim.errors.UserError` with its one-line error (the stages
-    before it are kept); SIGINT/SIGTERM raise KeyboardInterrupt (the same call resumes)."""
+    before it are kept); SIGINT/SIGTERM/SIGHUP raise KeyboardInterrupt (the same call resumes)."""
     import signal
 
     from bearingsim.studies.engine import run_studies

@@ -604,7 +604,7 @@ def run_sensitivity(scenario, outdir=None, keys=None, step: float = DEFAULT_STEP
 
 def run_study(study, outdir=None, *, jobs: int = 1, engine=None, progress=False, log=None, force=False):
     """:func:`bearingsim.studies.run_studies` of one study for the Python API: in ``outdir`` or a temporary
-    folder; failed cases' lines go to ``log`` (default: nowhere, the table has them); SIGINT/SIGTERM
+    folder; failed cases' lines go to ``log`` (default: nowhere, the table has them); SIGINT/SIGTERM/SIGHUP
     during the cases raise KeyboardInterrupt (finished archives in ``outdir`` are kept)."""
     import signal
     import tempfile

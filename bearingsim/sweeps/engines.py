@@ -25,7 +25,7 @@ STOP_WAIT_S = 3.0
 
 
 #: the signals a sweep process acts on; blocked while it forks workers, until they have their own handlers
-_STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM}
+_STOP_SIGNALS = {signal.SIGINT, signal.SIGTERM, signal.SIGHUP}
 
 
 def _exit_worker(signum, frame):
@@ -53,8 +53,9 @@ def _stop_again(unraisable, previous=sys.unraisablehook) -> None:
 
 def _pool_worker_init() -> None:
     # Ctrl-C reaches the whole process group: only the sweep process acts on it and then ends the
-    # pool, so a worker must not die half-way through writing on its own.
+    # pool, so a worker must not die half-way through writing on its own
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGHUP, signal.SIG_IGN)  # so does a terminal's hang-up
     # SIGTERM (the pool's terminate, or a batch system's to the process group) ends a worker by an
     # exception, not at once: an idle worker waits for its next task holding the pool's task queue lock,
     # and a worker killed holding it left the lock taken, so the pool could not be ended (the sweep waited

@@ -56,7 +56,7 @@ class StagedRound:
 
 
 class SweepInterrupted(Exception):
-    """SIGINT or SIGTERM arrived during a sweep; ``signum`` says which."""
+    """SIGINT, SIGTERM or SIGHUP arrived during a sweep; ``signum`` says which."""
 
     def __init__(self, signum: int):
         super().__init__(signal.Signals(signum).name)
@@ -122,8 +122,12 @@ def make_batches(cases: list[Case], workers: int) -> list[list[tuple]]:
     return other + batches
 
 
+#: the signals that stop a sweep (SIGHUP: its terminal went away) as one: finished cases and the index kept
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
 class _Signals:
-    """SIGINT/SIGTERM raise :class:`SweepInterrupted` once in the main thread; later ones are ignored
+    """SIGINT/SIGTERM/SIGHUP raise :class:`SweepInterrupted` once in the main thread; later ones are ignored
     while the sweep cleans up.
 
     A signal can land while Python runs a callback whose exceptions it cannot propagate (a weakref
@@ -161,7 +165,9 @@ class _Signals:
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            for s in (signal.SIGINT, signal.SIGTERM):
+            for s in STOP_SIGNALS:
+                if s == signal.SIGHUP and signal.getsignal(s) == signal.SIG_IGN:
+                    continue  # started under nohup: to outlive its terminal
                 self.old[s] = signal.signal(s, self._handler)
             self.old_hook = sys.unraisablehook
             sys.unraisablehook = self._unraisable
@@ -375,7 +381,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     Returns
     -------
     SweepOutcome
-        ``interrupted`` is the signal number if SIGINT/SIGTERM stopped the sweep (the index is
+        ``interrupted`` is the signal number if SIGINT/SIGTERM/SIGHUP stopped the sweep (the index is
         written and finished archives kept either way).
     """
     from bearingsim.sweeps.engines import LocalEngine
@@ -436,7 +442,7 @@ def _tidy_folder(outdir: Path, has_map: bool) -> None:
 def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map,
                staged=None) -> int | None:
     """Resume, run what is left on ``engine`` and keep the index (and, through ``write_map``, the map)
-    written however the run ends; the signal number if SIGINT/SIGTERM stopped it, else None."""
+    written however the run ends; the signal number if SIGINT/SIGTERM/SIGHUP stopped it, else None."""
     with _Signals() as signals:
         engine.should_stop = lambda: signals.fired is not None
         bar = None

@@ -276,32 +276,96 @@ def _markdown(rows: list[dict]) -> str:
     return "\n".join(out)
 
 
+#: colours of the shaft speeds in bench.png (Okabe-Ito, told apart in greyscale by the markers and lines too)
+_RPM_COLOURS = {500: "#56B4E9", 1000: "#0072B2", 2000: "#009E73", 3000: "#E69F00", 6000: "#D55E00"}
+#: markers of the multibody scenes in bench.png
+_SCENE_MARKERS = {"full": ("s", "full scene, exact faces (over dt)"),
+                  "full_rigid_raceways": ("^", "rigid raceways, automatic dt"),
+                  "full_dynamic_ring": ("D", "free inner ring, automatic dt"),
+                  "reduced_equivalent": ("v", "reduced-equivalent scene (over dt)"),
+                  "polyline": ("x", "faces as 3 straight segments (full, rigid)")}
+#: where bench.png draws an error of zero (below round-off) on its log axis
+_ZERO_ERROR = 1e-16
+
+
 def _plot(rows: list[dict], path: Path) -> None:
-    from bearingsim.plotting import subplots
+    """bench.png: wall time against the error of mean I_dec, the reduced model (per no-load pass) and the
+    multibody model (per cage rotation) in panels of their own; colour = shaft speed, marker = scene; the
+    faces drawn as N segments at 3000 rpm labelled with N (their error against the exact faces)."""
+    from bearingsim.plotting import save_figure, subplots
 
-    fig, ax = subplots(figsize=(7.5, 5.0))
-    groups = {}
-    for r in rows:
-        groups.setdefault((r["model"], r["method"], r["scene"], r["rpm"]), []).append(r)
-    markers = {"event": "*", "euler": "o", "pymunk": "s"}
-    for (model, method, scene, rpm), rs in sorted(groups.items(), key=lambda kv: str(kv[0])):
-        err = np.array([max(x["rel_error"], 1e-17) for x in rs])
-        wall = np.array([x["wall_s"] for x in rs])
-        ok = np.isfinite(err) & np.isfinite(wall)
-        if not ok.any():
-            continue
-        label = f"{model} {method}{'' if scene == 'single_pocket' else ' ' + scene} {rpm} rpm"
-        ax.loglog(err[ok], wall[ok], marker=markers.get(method, "d"), ms=8 if method == "event" else 5,
-                  ls="-" if ok.sum() > 1 else "none", label=label)
-    ax.set_xlabel("relative error of mean $I_{dec}$")
-    ax.set_ylabel("wall time [s] (reduced: per no-load pass; multibody: per cage rotation)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, ncol=2)
-    ax.set_title("bearingsim: speed against error (medians of repeats, one core)", fontsize=9)
+    fig, (red, mb) = subplots(1, 2, figsize=(10.0, 5.6))
+    _plot_reduced(red, [r for r in rows if r["model"] == "reduced"])
+    _plot_multibody(mb, [r for r in rows if r["model"] == "multibody"])
+    for ax in (red, mb):
+        ax.set_xlabel("relative error of mean $I_{dec}$")
+        ax.grid(alpha=0.3, which="both")
+    fig.suptitle("bearingsim: speed against error (medians of repeats, one core)", fontsize=10)
     fig.tight_layout()
-    from bearingsim.plotting import save_figure
-
     save_figure(fig, path, dpi=130, tight=False)
+
+
+def _finite(rs: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    """Errors (zero drawn at :data:`_ZERO_ERROR`) and wall times of the rows that have both."""
+    err = np.array([float(r["rel_error"]) for r in rs], dtype=float)
+    wall = np.array([float(r["wall_s"]) for r in rs], dtype=float)
+    ok = np.isfinite(err) & np.isfinite(wall)
+    return np.maximum(err[ok], _ZERO_ERROR), wall[ok]
+
+
+def _plot_reduced(ax, rows: list[dict]) -> None:
+    for rpm in sorted({int(r["rpm"]) for r in rows}):
+        colour = _RPM_COLOURS.get(rpm, "k")
+        err, wall = _finite([r for r in rows if r["method"] == "euler" and int(r["rpm"]) == rpm])
+        ax.loglog(err, wall, marker="o", ms=4, color=colour, label=f"euler, {rpm} rpm")
+        err, wall = _finite([r for r in rows if r["method"] == "event" and int(r["rpm"]) == rpm])
+        ax.loglog(err, wall, marker="*", ms=11, ls="none", color=colour, markeredgecolor="k", markeredgewidth=0.5)
+    ax.plot([], [], marker="*", ms=11, ls="none", color="w", markeredgecolor="k", label="event (exact)")
+    ax.axvspan(ax.get_xlim()[0], 1e-15, color="0.9", zorder=0)
+    ax.text(1.3e-15, ax.get_ylim()[0], " round-off", fontsize=7, va="bottom", color="0.4")
+    ax.set_ylabel("wall time per no-load pass [s]")
+    ax.set_title("reduced model (single pocket)", fontsize=9)
+    ax.legend(fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+
+
+def _plot_multibody(ax, rows: list[dict]) -> None:
+    from matplotlib.lines import Line2D
+
+    for row_scene, (marker, _) in _SCENE_MARKERS.items():
+        for rpm in sorted({int(r["rpm"]) for r in rows}):
+            rs = [r for r in rows if int(r["rpm"]) == rpm and (r["scene"] == row_scene or (
+                row_scene == "polyline" and r["scene"].endswith("polyline_3")))]
+            err, wall = _finite(rs)
+            if len(err):
+                ax.loglog(err, wall, marker=marker, ms=5, color=_RPM_COLOURS.get(rpm, "k"),
+                          ls="-" if row_scene in ("full", "reduced_equivalent") and len(err) > 1 else "none")
+    refined = sorted(((int(r["scene"].rsplit("_", 1)[1]), r) for r in rows
+                      if r["scene"].startswith("full_polyline_") and int(r["rpm"]) == 3000), key=lambda nr: nr[0])
+    err, wall = _finite([r for _, r in refined])
+    if len(err):
+        ax.loglog(err, wall, ls=":", color="0.3", marker=".", ms=4)
+        for (n, _), e, w in zip(refined, err, wall):
+            ax.annotate(f"N={n}", (e, w), textcoords="offset points", xytext=(4, 3), fontsize=6.5, color="0.3")
+    ax.set_ylabel("wall time per cage rotation [s]")
+    ax.set_title("multibody model (whole bearing)", fontsize=9)
+    scenes = [Line2D([], [], marker=m, ls="none", color="0.3", label=text) for m, text in _SCENE_MARKERS.values()]
+    scenes.append(Line2D([], [], marker=".", ls=":", color="0.3", label="faces as N segments, 3000 rpm"))
+    speeds = [Line2D([], [], color=_RPM_COLOURS.get(v, "k"), lw=3, label=f"{v} rpm")
+              for v in sorted({int(r["rpm"]) for r in rows})]
+    # below the panel: inside, they covered points
+    ax.legend(handles=scenes + speeds, fontsize=7, ncol=2, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+
+
+def plot_table(table: Path, path: Path) -> None:
+    """Draw bench.png from a bench.md table (the one docs/bench.md shows): the same rows, no run."""
+    lines = [ln for ln in Path(table).read_text().splitlines() if ln.startswith("| ")]
+    head = [c.strip() for c in lines[0].strip("|").split("|")]
+    rows = [dict(zip(head, (c.strip() for c in ln.strip("|").split("|")))) for ln in lines[1:] if head[0] != ln[2:7]]
+    for r in rows:
+        for key in ("rel_error", "wall_s"):
+            r[key] = float(r[key]) if r[key] not in ("", "-") else float("nan")
+    _plot([r for r in rows if r.get("model") in ("reduced", "multibody")], path)
+    print(f"wrote {path} ({len(rows)} rows of {table})")
 
 
 def machine_info() -> dict:
@@ -368,3 +432,10 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
     print(f"machine: {meta.get('cpu', meta['processor'])}, {meta['cpu_count']} cores, {meta['platform']}")
     print(f"wrote {outdir / 'bench.csv'}, bench.md, bench.png, bench_meta.json ({meta['bench_wall_s']:.0f} s)")
     return rows
+
+
+if __name__ == "__main__":
+    if len(sys.argv) == 4 and sys.argv[1] == "--plot":
+        plot_table(Path(sys.argv[2]), Path(sys.argv[3]))
+    else:
+        sys.exit("usage: python -m benchmarks.bench --plot TABLE.md OUT.png (the bench itself: bearingsim bench)")

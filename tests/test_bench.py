@@ -1,4 +1,6 @@
 """The benchmark's read-off of issue 2's goal (pure bookkeeping on given rows; no timing here)."""
+from pathlib import Path
+
 import pytest
 
 from benchmarks.bench import reduced_goal
@@ -344,3 +346,29 @@ def test_the_cost_goal_is_judged_on_the_spread_of_interleaved_repeats():
     assert cost_verdict([0.2, 0.21, 0.2], [0.2, 0.2, 0.19])["verdict"] == "met"
     assert cost_verdict([0.3, 0.31, 0.3], [0.2, 0.2, 0.19])["verdict"] == "not met"
     assert cost_verdict([0.2], [0.2])["verdict"] == "not resolved"  # one pair: no spread
+
+
+def test_the_speed_against_error_plot_draws_every_measured_row_once(tmp_path, monkeypatch):
+    """bench.png, drawn from the table docs/bench.md publishes (``plot_table``): every row with both an error
+    and a wall time is a point, in the panel of its model (reduced: per no-load pass; multibody: per cage
+    rotation), at its own (error, wall time), an error of zero at the round-off floor; the reference rows
+    (no error) and the stopped row draw nothing."""
+    import matplotlib.figure
+
+    from benchmarks import bench
+
+    saved = {}
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig", lambda fig, *a, **kw: saved.setdefault("fig", fig))
+    table = Path(__file__).resolve().parents[1] / "docs" / "bench.md"
+    bench.plot_table(table, tmp_path / "bench.png")
+    rows = [ln.strip("|").split("|") for ln in table.read_text().splitlines() if ln.startswith("| ")]
+    head = [c.strip() for c in rows[0]]
+    want = {"reduced": [], "multibody": []}
+    for cells in rows[1:]:
+        r = dict(zip(head, (c.strip() for c in cells)))
+        if r["model"] in want and r["rel_error"] not in ("", "-") and r["wall_s"] not in ("", "-"):
+            want[r["model"]].append((max(float(r["rel_error"]), bench._ZERO_ERROR), float(r["wall_s"])))
+    red, mb = saved["fig"].axes
+    for ax, model in ((red, "reduced"), (mb, "multibody")):
+        drawn = {(x, y) for line in ax.get_lines() for x, y in zip(line.get_xdata(), line.get_ydata())}
+        assert want[model] and drawn == set(want[model]), model

@@ -16,6 +16,7 @@ returning a matplotlib figure without showing it) can be drawn again from a file
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -98,13 +99,27 @@ class Result:
                  series: dict[str, Series] | None = None, provenance: dict[str, Any] | None = None,
                  tables: dict[str, str] | None = None):
         self.scenario = scenario
-        self.data = data
+        # what the result holds is as the run made it: its arrays read-only views (read_only), the run's own
+        # arrays untouched (an in-place change of r.data[...].data or r.series[...].value would have changed the
+        # result, its summary's meaning and the archive it saves)
+        self.data = {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v
+                     for k, v in data.items()}
         self.groups = groups
-        self.series = dict(series or {})
+        self.series = series or {}
         self.provenance = dict(provenance or {})
         self.tables = dict(tables or {})
         self.notes: list[str] = []  # one-line notes of a run that is plausible but not clean (simulation.run)
         self._parameters = None
+
+    @property
+    def series(self) -> dict[str, Series]:
+        """The time series the run recorded, by name (their arrays read-only, as :attr:`data`'s)."""
+        return self._series
+
+    @series.setter
+    def series(self, series: dict[str, Series]) -> None:
+        self._series = {k: replace(s, step=read_only(s.step), time=read_only(s.time), value=read_only(s.value))
+                        for k, s in series.items()}
 
     # --- the API ---------------------------------------------------------------------------
     @property

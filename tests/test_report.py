@@ -3,6 +3,7 @@
 The browser is the distribution's Chromium (/usr/bin/chromium, Debian's package `chromium`) driven by
 playwright; without it these tests FAIL, saying how to install it (the README's test command does).
 """
+import dataclasses
 import re
 from pathlib import Path
 
@@ -514,7 +515,8 @@ def test_a_check_that_fails_is_shown_as_failed(runs):
     result = bearingsim.load(runs / "r.h5")
     rows = _checks_blocks(result)[0]["rows"]
     assert [r["passed"] for r in rows] == [True, True]
-    result.data["results/per_rotation/I_dec"].data[...] = np.nan  # its stored array (a result hands out read-only views),
+    stored = result.data["results/per_rotation/I_dec"]  # its arrays are read-only: put in another, all NaN,
+    result.data["results/per_rotation/I_dec"] = dataclasses.replace(stored, data=np.full_like(stored.data, np.nan))
     # as a damaged archive would give it
     blocks = _checks_blocks(result)
     assert [(r["name"], r["passed"]) for r in blocks[0]["rows"]] == [("summary numbers finite", True),

@@ -126,7 +126,7 @@ def test_get_of_a_name_the_result_lacks_is_one_user_error_naming_what_it_has():
     """``r.get("nope")`` raised a bare ``KeyError: 'results/nope'``; a name of the caller's that is not there is
     one ``bearingsim.UserError`` line (docs/usage.md) naming it, the closest names and every array there is."""
     r = bearingsim.run(_short_scenarios()[0])
-    assert r.get("trace/theta_deg").base is r.data["results/trace/theta_deg"].data  # a read-only view of it
+    assert np.shares_memory(r.get("trace/theta_deg"), r.data["results/trace/theta_deg"].data)  # a view of it
     for name, words in (("nope", ["get('nope'): no array results/nope in this reduced result; its arrays: "
                                   "per_rotation/{I_dec, I_acc}, impacts/{time_s, "]),
                         ("trace/theta", ["(did you mean trace/theta_deg "]),
@@ -166,7 +166,8 @@ def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
     """``a = r.per_rotation["I_dec"]; a *= 1e3`` changed the result in place: its summary no longer agreed with
     it and its archive held the changed numbers (``bearingsim rerun`` then called it different). The arrays of
     ``per_rotation``, ``impacts`` and ``get`` are read-only, of a run and of an archive read back, and computing
-    from them gives new arrays."""
+    from them gives new arrays; so are those the result holds (``r.data[...].data``, and the time series of
+    ``r.series``, docs/dataframes.md)."""
     if model == "reduced":
         sc = _short_scenarios()[0]
     else:
@@ -175,11 +176,14 @@ def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
     r = bearingsim.run(sc)
     before = r.summary["I_dec_mean_Ns"]
     for result in (r, bearingsim.load(r.save(tmp_path / "r.h5"))):
-        arrays = [result.per_rotation["I_dec"], result.get("per_rotation/I_acc"), result.impacts["time_s"]]
+        arrays = [result.per_rotation["I_dec"], result.get("per_rotation/I_acc"), result.impacts["time_s"],
+                  result.data["results/per_rotation/I_dec"].data]
+        arrays += [a for s in result.series.values() for a in (s.step, s.time, s.value)]
+        assert len(arrays) > 4 or model == "reduced"  # a multibody run keeps its bodies' motion (r.series)
         for a in arrays:
             kept = a.copy()
             with pytest.raises(ValueError, match="read-only"):
-                a *= 1e3
+                a *= 2
             with pytest.raises(ValueError, match="read-only"):
                 a[...] = 0
             assert np.array_equal(a, kept) and np.array_equal(a * 1e3, kept * 1e3)

@@ -385,12 +385,8 @@ def _cmd_rerun(args) -> int:
     print(c.summary_table())
     for line in c.difference_lines():
         print(line)
-    for k, va, vb in c.versions:
-        if k == "model_version":
-            print(f"  model version: archive {va}, now {vb} (bumped when a change moves the model's numbers: "
-                  "CHANGELOG.md says which)")
-        else:
-            print(f"  package version {k.removeprefix('version_')}: archive {va}, now {vb}")
+    for line in c.version_lines("archive", "now"):
+        print(line)
     return args.status
 
 
@@ -413,7 +409,7 @@ def _cmd_compare(args) -> int:
     else:
         print("scenarios: identical")
     print(c.summary_table())
-    for line in c.difference_lines() if not c.identical else c.unrecorded_lines():
+    for line in c.difference_lines() + c.version_lines() if not c.identical else c.unrecorded_lines():
         print(line)
     print(f"results: identical ({len(c.summary)} summary numbers, {c.arrays_compared} arrays and other numbers, "
           "bit for bit)" if c.identical else "results: differ")

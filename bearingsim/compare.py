@@ -59,6 +59,20 @@ class Comparison:
                          "(bit for bit)")
         return lines + self.unrecorded_lines()
 
+    def version_lines(self, a: str = "A", b: str = "B") -> list[str]:
+        """One line for each version that differs between the two results' provenance (the model's, a
+        package's), ``a`` and ``b`` naming them: where numbers differ, a likely cause (another numpy can round
+        a transcendental function's last digit otherwise: the same scenario gives bit-identical numbers on one
+        installation)."""
+        lines = []
+        for k, va, vb in self.versions:
+            if k == "model_version":
+                lines.append(f"  model version: {a} {va}, {b} {vb} (bumped when a change moves the model's numbers: "
+                             "CHANGELOG.md says which)")
+            else:
+                lines.append(f"  package version {k.removeprefix('version_')}: {a} {va}, {b} {vb}")
+        return lines
+
     def unrecorded_lines(self) -> list[str]:
         """One line for each array that one archive holds and the other, written by an earlier version, predates
         (:attr:`bearingsim.results.Result.ADDED_ARRAYS`): not compared, and no difference of the run."""

@@ -1,4 +1,5 @@
 """Archives as a working tool: the Python API, and `plot`, `rerun`, `compare`, `show` on archives."""
+import json
 import re
 import shutil
 
@@ -143,6 +144,24 @@ def test_compare_exit_codes_like_diff(tmp_path, reduced_archive):
     bad = tmp_path / "bad.h5"
     bad.write_text("not an archive")
     assert_user_error(cli("compare", reduced_archive, bad), "bad.h5")
+
+
+def test_compare_of_results_that_differ_names_the_versions_that_differ(tmp_path, reduced_archive):
+    """The same scenario gives bit-identical numbers on one installation; another numpy can round a
+    transcendental function's last digit otherwise. ``compare`` of two archives that differ named no version
+    (``rerun`` did): it lists each package or model version that differs between them, as ``rerun`` does;
+    results that are identical need none."""
+    other = tmp_path / "o.h5"
+    shutil.copy(reduced_archive, other)
+    with h5py.File(other, "r+") as f:
+        old = json.loads(f["provenance"].attrs["attrs_json"])["version_numpy"]
+        _edit_json_attr(f["provenance"], "version_numpy", lambda v: "1.26.0")
+    res = cli("compare", reduced_archive, other)
+    assert res.returncode == 0 and "package version" not in res.stdout, res.stdout  # identical results
+    with h5py.File(other, "r+") as f:
+        _edit_json_attr(f["results/wear"], "rear_per_hour_m3_h", lambda v: v * (1.0 + 1e-12))
+    res = cli("compare", reduced_archive, other)
+    assert res.returncode == 1 and f"  package version numpy: A {old}, B 1.26.0\n" in res.stdout, res.stdout
 
 
 @pytest.mark.slow

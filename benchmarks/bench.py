@@ -434,8 +434,19 @@ def run_bench(outdir: Path, quick: bool = False, include_multibody: bool = True)
     return rows
 
 
+def main(argv=None) -> None:
+    """``python -m benchmarks.bench --plot TABLE.md OUT.png``: bench.png drawn from a bench.md table (the bench
+    itself runs as ``bearingsim bench``)."""
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m benchmarks.bench", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--plot", nargs=2, metavar=("TABLE.md", "OUT.png"), required=True,
+                    help="draw bench.png from a bench.md table (docs/bench.md), nothing run; the bench itself: "
+                         "bearingsim bench")
+    args = ap.parse_args(argv)
+    plot_table(Path(args.plot[0]), Path(args.plot[1]))
+
+
 if __name__ == "__main__":
-    if len(sys.argv) == 4 and sys.argv[1] == "--plot":
-        plot_table(Path(sys.argv[2]), Path(sys.argv[3]))
-    else:
-        sys.exit("usage: python -m benchmarks.bench --plot TABLE.md OUT.png (the bench itself: bearingsim bench)")
+    main()

@@ -95,9 +95,9 @@ def pytest_xdist_auto_num_workers(config):
     return n if n > 1 else 0
 
 
-#: module fixtures that run a study or a ladder of runs (seconds each): a test that takes one is no test of
+#: module fixtures that run a study, a ladder of runs or a long run (seconds each): a test that takes one is no test of
 #: "about a second or less", whatever its own call takes, so it is left out of the quick subset with them
-SLOW_FIXTURES = {"ladder", "folders"}
+SLOW_FIXTURES = {"ladder", "folders", "full_3000", "full_3000_reverse"}
 
 
 def pytest_collection_modifyitems(items):

@@ -38,10 +38,16 @@ FORK = os.environ.get("BEARINGSIM_TEST_FORK", "1") != "0"
 FORKED = "<fork of the tests' bearingsim server>"
 
 
+def pythonpath() -> str:
+    """A child interpreter's PYTHONPATH: this checkout first, then the test process's own (where an install
+    by ``pip --target``, Nix or an HPC module puts the dependencies)."""
+    return str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")
+
+
 def environment() -> dict:
     """The environment of a command line: the test process's as it is now, with this checkout first on
     the path."""
-    return {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    return {**os.environ, "PYTHONPATH": pythonpath()}
 
 
 def _translate(data: bytes) -> str:

@@ -17,6 +17,7 @@ from bearingsim.cli import main
 from bearingsim.errors import UserError
 from bearingsim.multibody.scene import pocket_angles
 from tests.conftest import SCENARIOS
+from .forked_cli import pythonpath as _path
 
 pytestmark = pytest.mark.slow
 
@@ -150,7 +151,7 @@ def test_an_mp4_on_a_full_disk_is_one_line_naming_the_cause(runs, tmp_path):
     out.parent.mkdir()
     proc = subprocess.run([sys.executable, "-m", "bearingsim", "animate", str(runs[1]), "-o", str(out),
                            "--rotations", "0.5:0.75", "--fps", "20"], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)}, preexec_fn=limited)
+                          env={**os.environ, "PYTHONPATH": _path()}, preexec_fn=limited)
     assert (proc.returncode, proc.stderr) == (2, f"bearingsim: error: {out}: cannot write the animation (File too "
                                                  f"large)\n"), proc.stderr[-3000:]
     assert list(out.parent.iterdir()) == []

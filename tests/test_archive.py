@@ -9,6 +9,7 @@ from bearingsim import archive
 from bearingsim.archive import Spool, describe, open_archive
 from bearingsim.errors import UserError
 from bearingsim.scenario import resolve
+from .forked_cli import pythonpath as _path
 
 
 def _result(scenario):
@@ -401,7 +402,7 @@ def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
 
     out = tmp_path / "out" / "a.h5"
     with started([sys.executable, "-c", _FULL_DISK_CHILD, out], cwd=tmp_path, env={**__import__("os").environ,
-                 "PYTHONPATH": str(ROOT)}, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
+                 "PYTHONPATH": _path()}, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) as proc:
         stdout, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 0, stderr[-2000:]
     assert stdout.startswith(f"refused: {out}: cannot write archive (File too large)"), stdout
@@ -480,7 +481,7 @@ def test_a_full_disk_while_a_spool_streams_is_one_line_and_a_clean_exit(tmp_path
     out = tmp_path / "out" / "a.h5"
     out.parent.mkdir()
     child = [sys.executable, "-c", _SPOOL_FULL_DISK_CHILD, out, how, SCENARIOS / "multibody_3000rpm.toml"]
-    proc = subprocess.run(child, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(ROOT)}, capture_output=True,
+    proc = subprocess.run(child, cwd=tmp_path, env={**os.environ, "PYTHONPATH": _path()}, capture_output=True,
                           text=True, preexec_fn=_fsize_limit(limit), timeout=300)
     stdout, stderr = proc.stdout, proc.stderr
     assert proc.returncode == 0, stderr[-2000:]

@@ -7,6 +7,7 @@ import pytest
 
 from . import forked_cli
 from .conftest import SCENARIOS
+from .forked_cli import pythonpath as _path
 
 
 def bearingsim(*args, cwd=None, fresh_interpreter=False):
@@ -494,7 +495,7 @@ def test_stdout_on_a_full_device_is_named_in_the_error(tmp_path):
     "bearingsim: error: bearingsim: No space left on device")."""
     from .conftest import ROOT, started
 
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": _path()}
     with open("/dev/full", "w") as full, started([sys.executable, "-m", "bearingsim", "show",
                                                  SCENARIOS / "paper_3000rpm.toml"],
                                                 env=env, stdout=full, stderr=subprocess.PIPE, text=True) as proc:
@@ -517,7 +518,7 @@ def test_a_non_ascii_name_under_an_ascii_locale_is_no_traceback(tmp_path, base_r
     from .conftest import ROOT, started
 
     path = bearingsim.run(resolve({**base_reduced, "name": "café"})).save(tmp_path / "a.h5")
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "LC_ALL": "C", "PYTHONIOENCODING": "ascii",
+    env = {**os.environ, "PYTHONPATH": _path(), "LC_ALL": "C", "PYTHONIOENCODING": "ascii",
            "PYTHONUTF8": "0", "PYTHONCOERCECLOCALE": "0"}
     with started([sys.executable, "-m", "bearingsim", command, path], env=env, stdout=subprocess.PIPE,
                  stderr=subprocess.PIPE) as proc:
@@ -538,7 +539,7 @@ def test_stdout_on_a_full_device_after_the_archive_is_not_exit_2(tmp_path):
     from .conftest import ROOT, started
 
     out = tmp_path / "out.h5"
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": _path()}
     with open("/dev/full", "w") as full, started([sys.executable, "-m", "bearingsim", "run",
                                                  SCENARIOS / "paper_3000rpm.toml", "-o", out, "--no-plots"],
                                                 env=env, stdout=full, stderr=subprocess.PIPE, text=True) as proc:

@@ -19,6 +19,7 @@ from bearingsim.studies import crosscheck as cc
 from bearingsim.cli import main
 from bearingsim.compare import compare_results
 from bearingsim.scenario import load_scenario, parse_toml_text
+from .forked_cli import pythonpath as _path
 
 SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 REFERENCE = SCENARIOS / "multibody_3000rpm.toml"
@@ -260,7 +261,7 @@ def test_a_signal_stops_the_crosscheck_at_once_and_writes_nothing_after_it(tmp_p
     out = tmp_path / "cc"
     cmd = [sys.executable, "-m", "bearingsim", "crosscheck", REFERENCE, "--speeds", f"{RPM:g}", "--rotations",
            str(ROTATIONS), "-j", "2", "-o", out]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": _path()}
     with started(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env) as proc:
         deadline = time.monotonic() + 300  # a hang guard only
         finished = set()

@@ -3,6 +3,7 @@ code, preset, scenarios or docs rely on points outside it."""
 import re
 
 from .conftest import ROOT
+from .forked_cli import pythonpath as _path
 
 PAGES = [ROOT / "README.md", ROOT / "CHANGELOG.md", *sorted((ROOT / "docs").glob("*.md"))]
 
@@ -133,7 +134,7 @@ def test_every_dotted_name_the_pages_give_resolves_after_a_plain_import():
              "    except AttributeError as exc:\n"
              "        bad.append(f'{name}: {exc}')\n"
              "print(json.dumps(bad))\n")
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": _path()}
     out = subprocess.run([sys.executable, "-c", probe, json.dumps(names)], capture_output=True, text=True, env=env,
                          cwd=ROOT, timeout=300)
     assert out.returncode == 0, out.stderr

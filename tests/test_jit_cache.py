@@ -6,7 +6,12 @@ import subprocess
 import sys
 import textwrap
 
+import numba
 import pytest
+
+#: these tests are of numba's compiled kernels and their cache: with NUMBA_DISABLE_JIT in the environment
+#: nothing is compiled and there is nothing to test
+pytestmark = pytest.mark.skipif(bool(numba.config.DISABLE_JIT), reason="NUMBA_DISABLE_JIT is set: nothing compiles")
 
 DEP = """
 from numba import njit

@@ -286,7 +286,9 @@ def _tracked_files() -> list[str]:
 
     if not (ROOT / ".git").exists() or shutil.which("git") is None:
         pytest.skip("not a git checkout (an installed copy has no committed files to check)")
-    out = subprocess.run(["git", "-C", str(ROOT), "ls-files", "-z"], capture_output=True, check=True)
+    # safe.directory: git refuses a checkout another user owns (a container's, a mounted CI volume's)
+    out = subprocess.run(["git", "-c", f"safe.directory={ROOT}", "-C", str(ROOT), "ls-files", "-z"],
+                         capture_output=True, check=True)
     return [f for f in out.stdout.decode().split("\0") if f]
 
 

@@ -9,6 +9,7 @@ import textwrap
 from pathlib import Path
 
 import pytest
+from .forked_cli import pythonpath as _path
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIOS = ROOT / "scenarios"
@@ -51,7 +52,7 @@ PROBE = textwrap.dedent("""
 
 def _probe(stop):
     """What the probe saw loaded after each step, up to ``stop`` ("parser" or "all")."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": _path()}
     out = subprocess.run([sys.executable, "-c", PROBE, json.dumps(HEAVY), str(SCENARIOS / "paper_3000rpm.toml"),
                           str(SCENARIOS / "multibody_3000rpm.toml"), stop], capture_output=True, text=True, env=env,
                          cwd=ROOT, timeout=120)

@@ -26,6 +26,7 @@ from bearingsim.sweeps.worker import standard_errors
 
 from .conftest import ROOT, SCENARIOS, started
 from .test_cli import assert_user_error, bearingsim
+from .forked_cli import pythonpath as _path
 
 BASE = SCENARIOS / "paper_3000rpm.toml"
 SPEED = "operating.inner_ring_speed_rpm"
@@ -1231,7 +1232,7 @@ def test_a_worker_stopped_while_it_warms_up_ends_at_once_unwinding_nothing():
     worker now ends at once, exit 143, the code it was in not unwound (its `finally` does not run)."""
     toml = load_scenario(BASE).to_toml()
     with started([sys.executable, "-c", _WARMING_WORKER, toml], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                 text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}) as proc:
+                 text=True, env={**os.environ, "PYTHONPATH": _path()}) as proc:
         assert proc.stdout.readline() == "warming\n"
         os.kill(proc.pid, signal.SIGTERM)
         _, err = proc.communicate(timeout=300)  # a hang guard only
@@ -1409,10 +1410,10 @@ def test_a_full_disk_while_the_index_is_written_names_the_index(tmp_path, limit,
     args = [sys.executable, "-m", "bearingsim", "sweep", BASE, "--param", f"{SPEED}=1000,2000",
             "--set", "numerics.rotations=2", "-j", "1", "-q"]
     warm = subprocess.run([*map(str, args), "-o", tmp_path / "warm"], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})  # compiled kernels cached: no write of them
+                          env={**os.environ, "PYTHONPATH": _path()})  # compiled kernels cached: no write of them
     assert warm.returncode == 0, warm.stderr
     out = tmp_path / "sw"
     proc = subprocess.run([*map(str, args), "-o", out], capture_output=True, text=True, timeout=300,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)}, preexec_fn=limited)
+                          env={**os.environ, "PYTHONPATH": _path()}, preexec_fn=limited)
     assert (proc.returncode, proc.stderr) == (2, f"bearingsim: error: {out / index}: File too large\n")
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [".sweep.lock"]  # no temporary

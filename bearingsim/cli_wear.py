@@ -94,12 +94,13 @@ def _cmd_life(args) -> int:
     code = report_study(outcome, "life")
     if code:
         return code
-    notes = (life.depth_limit_note(scenario, limit), life.stage_count_note(args.stages, args.mapping))
+    notes = (life.depth_limit_note(scenario, study.limit), life.stage_count_note(args.stages, args.mapping))
     for note in notes:  # how to read the history below
         if note and not args.quiet:
             print(f"bearingsim: note: {note}", file=sys.stderr)
     # the limit reached, or the cage bar worn through first (the end of the life all the same: exit 0)
-    print(life.format_history(study.columns(), f"life of {args.scenario} to {limit.text}", study.attrs()))
+    # the limit as asked and, a relative one, the absolute value it means here: clearance=2x (0.4 mm)
+    print(life.format_history(study.columns(), f"life of {args.scenario} to {study.limit.shown}", study.attrs()))
     for path in outcome.written if not args.quiet else ():  # -q: the history alone
         print(f"wrote {path}")
     return 0
@@ -126,7 +127,9 @@ def add_commands(sub) -> None:
     li.add_argument("scenario", help="multibody scenario TOML file")
     li.add_argument("--limit", required=True, help="depth=<x>mm (deepest worn point: an end bin's, which depends "
                                                    "on the bins of psi, docs/wear.md), clearance=<x>mm (pocket "
-                                                   "clearance), or volume=<x>mm3 (worn volume of one face)")
+                                                   "clearance), clearance=<f>x (the clearance f times its value at "
+                                                   "the start: 2x, the play doubles), or volume=<x>mm3 (worn volume "
+                                                   "of one face)")
     li.add_argument("--stages", type=int, default=DEFAULT_STAGES,
                     help=f"stages (default {DEFAULT_STAGES}: with the worn shape fed back fewer read the life long, "
                          f"docs/wear.md)")

@@ -656,8 +656,8 @@ def _life_limit_note(attrs: dict) -> str | None:
     if not toml or not text:
         return None
     try:
-        limit = life.parse_limit(str(text))
-        if limit.kind != "depth":
+        limit = life.held_limit(str(text))
+        if limit is None or limit.kind != "depth":
             return None
         return life.depth_limit_note(resolve(parse_toml_text(str(toml), "life.h5"), "life.h5"), limit)
     except UserError:

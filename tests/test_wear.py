@@ -382,6 +382,88 @@ def test_limit_parsing():
     assert parse_limit("volume=2mm3").value == pytest.approx(2e-9)
 
 
+@pytest.mark.parametrize("text, words", [
+    ("clearance=0x", "give a finite factor above 1 before the x"),
+    ("clearance=1x", "give a finite factor above 1 before the x"),
+    ("clearance=-2x", "give a finite factor above 1 before the x"),
+    ("clearance=x", "give a finite factor above 1 before the x"),
+    ("clearance=nanx", "give a finite factor above 1 before the x"),
+    ("depth=2x", "a relative limit (<f>x) is for the clearance only; give depth=<x>mm or clearance=<f>x"),
+    ("clearance=2y", "the unit of clearance is one of mm, um or <f>x"),
+])
+def test_a_bad_relative_clearance_limit_is_refused_in_one_line(tmp_path, monkeypatch, capsys, text, words):
+    """`--limit clearance=<f>x` (the clearance f times its value at the start) takes a finite f above 1; any
+    other is refused in one line naming --limit, exit 2, no folder made (it was told the unit of clearance is
+    mm or um)."""
+    from bearingsim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", text])
+    err = capsys.readouterr().err
+    assert code == 2 and f"--limit {text!r}: {words}" in err, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_relative_clearance_limit_is_the_start_clearance_times_its_factor():
+    """`clearance=2x` is twice the effective clearance at the study's start: the scenario's s (0.2 mm: the very
+    number clearance=0.4mm is), or with worn faces of its own s plus the worst pocket's front and rear mean worn
+    depth; the study shows what was asked and the value it means here (the history's `limit`)."""
+    from bearingsim.studies.life import LifeStudy, parse_limit
+
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
+    lim = parse_limit("clearance=2x")
+    assert lim.factor == 2.0 and lim.shown == "clearance=2x"
+    study = LifeStudy(sc, lim, stages=2, rotations=1)
+    assert study.limit.value == parse_limit("clearance=0.4mm").value
+    assert study.limit.shown == study.attrs()["limit"] == "clearance=2x (0.4 mm)"
+    assert not study.limit.same_as(parse_limit("clearance=0.4mm")) and study.limit.same_as(parse_limit("clearance=2.0x"))
+    worn = load_scenario(str(Path(__file__).parent / "data" / "worn_stage05_rigid.toml"))
+    study = LifeStudy(worn, parse_limit("clearance=1.5x"), stages=2, rotations=1)
+    assert study.start_value > worn.bearing.pocket_clearance_mm * 1e-3
+    assert study.limit.value == 1.5 * study.start_value
+    assert study.attrs()["limit"] == f"clearance=1.5x ({study.limit.value * 1e3:.6g} mm)"
+
+
+@pytest.mark.slow
+def test_a_relative_clearance_limit_is_its_absolute_value_and_says_so(tmp_path, capsys):
+    """`--limit clearance=2x` on s = 0.2 mm gives the stage history of `clearance=0.4mm` bit for bit (the same
+    criterion); the command's table, `bearingsim table`, life.h5's `limit`, the figure's title and the report
+    show `clearance=2x (0.4 mm)`. A folder of the absolute limit is not resumed as the relative one, nor the
+    other way round (the same value, another criterion: their clearances would compare otherwise); the
+    relative one again resumes its own folder."""
+    import bearingsim
+    from bearingsim.cli import main
+    from bearingsim.studies.life import parse_limit, plot_life, read_life, run_life
+
+    cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--stages", "2", "--rotations", "1", "-q",
+           "--set", "multibody.raceway_contact=rigid"]
+    assert main([*cmd, "--limit", "clearance=2x", "-o", str(tmp_path / "rel")]) == 0
+    printed = capsys.readouterr().out
+    sc = load_scenario(str(SCENARIOS / "wear_test_6000rpm.toml"), ["multibody.raceway_contact=rigid"])
+    run_life(sc, tmp_path / "abs", parse_limit("clearance=0.4mm"), stages=2, rotations=1)
+    (a_cols, a_attrs), (r_cols, r_attrs) = read_life(tmp_path / "abs"), read_life(tmp_path / "rel")
+    assert a_cols.keys() == r_cols.keys()
+    for k in a_cols:
+        np.testing.assert_array_equal(r_cols[k], a_cols[k], err_msg=k)
+    assert r_cols["clearance_end_mm"][-1] == pytest.approx(0.4, rel=1e-9)
+    assert a_attrs["limit"] == "clearance=0.4mm" and r_attrs["limit"] == "clearance=2x (0.4 mm)"
+    assert printed.splitlines()[0].startswith(f"life of {SCENARIOS / 'wear_test_6000rpm.toml'} to clearance=2x (0.4 mm): ")
+    assert main(["table", str(tmp_path / "rel")]) == 0
+    assert "life of wear_test_6000rpm to clearance=2x (0.4 mm): " in capsys.readouterr().out
+    assert plot_life(r_cols, r_attrs)._suptitle.get_text().startswith("life to clearance=2x (0.4 mm): ")
+    assert "Life of wear_test_6000rpm to clearance=2x (0.4 mm)" in bearingsim.report(
+        tmp_path / "rel", tmp_path / "rel.html", animation=None).read_text()
+    for folder, given, held in (("abs", "clearance=2x", "clearance=0.4mm; this one: --limit clearance=2x (0.4 mm)"),
+                                ("rel", "clearance=0.4mm", "clearance=2x (0.4 mm); this one: --limit clearance=0.4mm")):
+        assert main([*cmd, "--limit", given, "-o", str(tmp_path / folder)]) == 2
+        err = capsys.readouterr().err
+        assert f"holds a life study of another limit ({held}); give another folder or --force" in err, err
+        assert len(err.strip().splitlines()) == 1
+    assert main([*cmd, "--limit", "clearance=2.0x", "-o", str(tmp_path / "rel")]) == 0
+    assert read_life(tmp_path / "rel")[0]["reused"].tolist() == [1, 1]
+
+
 def _stage_path(folder, j: int):
     """Where stage ``j``'s archive of a life study's folder is, as the folder's case index says."""
     from bearingsim.sweeps.index import read_index
@@ -441,7 +523,8 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
     for k in cols:
         if k != "reused":
             np.testing.assert_array_equal(again[k], cols[k])
-    with pytest.raises(UserError, match="another scenario or limit; give another folder or --force"):
+    with pytest.raises(UserError, match=r"another limit \(clearance=0.203mm; this one: --limit clearance=0.204mm\); "
+                                        "give another folder or --force"):
         run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1, mapping=mapping)
     other = "shape" if mapping == "uniform" else "uniform"
     with pytest.raises(UserError, match=f"another wear mapping .*this one: {other}.*give --mapping {mapping} to resume"):

@@ -22,7 +22,9 @@ How the wear maps onto the next stage's geometry (``mapping``, :data:`MAPPINGS`)
 The stages split the way from the limited quantity at the start (the scenario's own worn faces, if
 any; refused when they reach the limit already) to the limit into equal steps. Limits: ``depth`` (the
 deepest point of any face), ``clearance`` (the effective pocket clearance of the worst pocket, ``s`` plus its front and rear
-**mean** worn depth: worn volume / face area), ``volume`` (the largest worn volume of one face).
+**mean** worn depth: worn volume / face area), ``volume`` (the largest worn volume of one face). A clearance
+limit is absolute (``clearance=0.4mm``) or relative to the effective clearance at the start (``clearance=2x``:
+the play doubles), which the study turns into the absolute value it means (:meth:`Limit.of_start`).
 
 The stages are the cases of a staged study on the study engine (:mod:`bearingsim.studies.engine`), run in
 sequence in one folder: ``cases/<hash>.h5`` (each a normal archive, named by its scenario's content hash),
@@ -34,7 +36,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -52,8 +54,34 @@ LIMIT_UNITS = {"depth": {"mm": 1e-3, "um": 1e-6}, "clearance": {"mm": 1e-3, "um"
 @dataclass(frozen=True)
 class Limit:
     kind: str  #: "depth", "clearance" or "volume"
-    value: float  #: SI [m] or [m^3]
+    value: float  #: SI [m] or [m^3]; a relative limit's NaN until a study sets it (:meth:`of_start`)
     text: str  #: as given
+    #: a relative clearance limit's factor (``clearance=2x``: the effective clearance twice its value at the
+    #: study's start); None for an absolute limit
+    factor: float | None = None
+
+    @property
+    def shown(self) -> str:
+        """The limit as asked and, for a relative one set for a study, the absolute value it means there:
+        ``clearance=2x (0.4 mm)`` (an absolute limit: as given)."""
+        if self.factor is None or not math.isfinite(self.value):
+            return self.text
+        return f"{self.text} ({self.value * 1e3:.6g} mm)"
+
+    def of_start(self, start: float) -> Limit:
+        """A relative limit set for a study whose effective clearance at the start is ``start`` [m]: its factor
+        times that; an absolute limit as it is."""
+        return self if self.factor is None else replace(self, value=self.factor * start)
+
+    def same_as(self, other: Limit) -> bool:
+        """Whether ``other`` asks for this limit: the same kind, both absolute and of one value (in any unit:
+        depth=100um is depth=0.1mm) or both relative and of one factor; an absolute limit is not the relative
+        one, even where they meet."""
+        if other.kind != self.kind or (other.factor is None) != (self.factor is None):
+            return False
+        if self.factor is None:
+            return math.isclose(other.value, self.value, rel_tol=1e-12)
+        return math.isclose(float(other.factor), self.factor, rel_tol=1e-12)
 
 
 #: how the wear of a stage acts back on the next (docs/wear.md, *Life*)
@@ -97,14 +125,24 @@ def stage_count_note(stages: int, mapping: str) -> str | None:
             f"docs/wear.md); give --stages {STAGES_RESOLVED} or more")
 
 
+#: the forms of --limit, as its refusals name them
+LIMIT_FORMS = "depth=<x>mm, clearance=<x>mm, clearance=<f>x (f times the clearance at the start) or volume=<x>mm3"
+
+
 def parse_limit(text: str) -> Limit:
-    """``depth=0.1mm``, ``clearance=0.5mm`` or ``volume=2mm3`` (also ``um`` for lengths)."""
+    """``depth=0.1mm``, ``clearance=0.5mm`` or ``volume=2mm3`` (also ``um`` for lengths), or a relative clearance
+    limit, ``clearance=2x``: the effective pocket clearance ``f`` (above 1) times its value at the study's start,
+    whose value a study sets (:meth:`Limit.of_start`)."""
+    rel = re.fullmatch(r"\s*(\w+)\s*=\s*(.*?)\s*x\s*", text or "")
+    if rel and rel.group(1) in LIMIT_UNITS:
+        return _relative_limit(text, *rel.groups())
     m = re.fullmatch(r"\s*(\w+)\s*=\s*([0-9.eE+-]+)\s*(\w+)\s*", text or "")
     if not m or m.group(1) not in LIMIT_UNITS:
-        raise UserError(f"--limit {text!r}: give depth=<x>mm, clearance=<x>mm or volume=<x>mm3")
+        raise UserError(f"--limit {text!r}: give {LIMIT_FORMS}")
     kind, num, unit = m.groups()
     if unit not in LIMIT_UNITS[kind]:
-        raise UserError(f"--limit {text!r}: the unit of {kind} is one of {', '.join(LIMIT_UNITS[kind])}")
+        also = " or <f>x (f times the clearance at the start)" if kind == "clearance" else ""
+        raise UserError(f"--limit {text!r}: the unit of {kind} is one of {', '.join(LIMIT_UNITS[kind])}{also}")
     try:
         value = float(num) * LIMIT_UNITS[kind][unit]
     except ValueError:
@@ -112,6 +150,31 @@ def parse_limit(text: str) -> Limit:
     if not (math.isfinite(value) and value > 0):
         raise UserError(f"--limit {text!r}: must be a finite positive number")
     return Limit(kind, value, text.strip())
+
+
+def _relative_limit(text: str, kind: str, num: str) -> Limit:
+    """``clearance=<f>x`` (:func:`parse_limit`): refused for another kind, and unless ``f`` is a finite number
+    above 1 (at 1 or below the clearance is there at the start)."""
+    if kind != "clearance":
+        raise UserError(f"--limit {text!r}: a relative limit (<f>x) is for the clearance only; give "
+                        f"{kind}=<x>{next(iter(LIMIT_UNITS[kind]))} or clearance=<f>x")
+    try:
+        factor = float(num)
+    except ValueError:
+        factor = math.nan
+    if not (math.isfinite(factor) and factor > 1.0):
+        raise UserError(f"--limit {text!r}: give a finite factor above 1 before the x (clearance=2x: the effective "
+                        f"pocket clearance twice its value at the start)")
+    return Limit(kind, math.nan, text.strip(), factor)
+
+
+def held_limit(text: str) -> Limit | None:
+    """The limit a history's attribute ``limit`` holds (:attr:`Limit.shown`: a relative limit with the absolute
+    value it meant, ``clearance=2x (0.4 mm)``, whose factor is what it asked), or None when it says none."""
+    try:
+        return parse_limit(re.sub(r"\s*\(.*\)\s*$", "", str(text or "")))
+    except UserError:
+        return None
 
 
 class _State:
@@ -219,7 +282,7 @@ def _check_reachable(scenario, limit: Limit) -> None:
         depth = limit.value / face_area(scenario.parameters)
         what = f"a face worn that much ({depth * 1e3:.4g} mm deep on the mean) is through its bar on its own"
     if depth >= bar:
-        raise UserError(f"--limit {limit.text}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide: {what}; "
+        raise UserError(f"--limit {limit.shown}: the cage bar between two pockets is {bar * 1e3:.4g} mm wide: {what}; "
                         f"give a smaller limit")
 
 
@@ -279,6 +342,8 @@ class LifeStudy(Study):
         if rotations is not None and rotations < 1:
             raise UserError(f"--rotations {rotations}: give at least 1 recorded rotation per stage")
         s0 = scenario.bearing.pocket_clearance_mm * 1e-3
+        if limit.factor is not None:  # clearance=2x: twice the effective clearance at the start
+            limit = limit.of_start(_start_value(scenario, limit, s0, _start_depth(scenario)))
         if limit.kind == "clearance" and limit.value <= s0:
             raise UserError(f"--limit {limit.text}: the pocket clearance is {s0 * 1e3:g} mm already "
                             f"(bearing.pocket_clearance_mm); give a larger one")
@@ -404,7 +469,7 @@ class LifeStudy(Study):
     def attrs(self) -> dict:
         """The history's attributes (``life.h5``): the study, and ``worn_through`` when the cage bar wore
         through before the limit (what reached its width; the time is the last stage's end)."""
-        attrs = {"format": LIFE_FORMAT, "limit": self.limit.text, "stages": self.planned,
+        attrs = {"format": LIFE_FORMAT, "limit": self.limit.shown, "stages": self.planned,
                  "rotations": self.stage_rotations, "scenario": self.scenario.to_toml(), "mapping": self.mapping,
                  "mapping_text": MAPPINGS[self.mapping]}
         if self.worn_through:
@@ -413,20 +478,18 @@ class LifeStudy(Study):
 
     def _differs(self, attrs: dict) -> str:
         """What of a ``life.h5``'s study (its attributes) is not this one's: "" when the same, else what
-        differs (the scenario or the limit, the number of stages, the rotations per stage; a limit is the
-        same in other units: depth=100um is depth=0.1mm). The scenario is the one with the stages' rotations,
-        or, in a history written before it held that, the one given with ``--rotations``."""
-        try:
-            held = parse_limit(attrs.get("limit", ""))
-        except UserError:
-            held = None
-        same_limit = (held is not None and held.kind == self.limit.kind
-                      and math.isclose(held.value, self.limit.value, rel_tol=1e-12))
+        differs (the scenario, the limit, the number of stages, the rotations per stage; a limit is the
+        same in other units: depth=100um is depth=0.1mm; a relative clearance limit, clearance=2x, is not an
+        absolute one of the value it means: :meth:`Limit.same_as`). The scenario is the one with the stages'
+        rotations, or, in a history written before it held that, the one given with ``--rotations``."""
+        held = held_limit(attrs.get("limit", ""))
         ours = {self.scenario.to_toml(), self.given_toml}
         if "rotations" in attrs and int(attrs["rotations"]) != self.stage_rotations:  # told below, not as a scenario
             ours.add(self.scenario.replace(**{"numerics.rotations": int(attrs["rotations"])}).to_toml())
-        if attrs.get("scenario") not in ours or not same_limit:
+        if attrs.get("scenario") not in ours:
             return "scenario or limit"
+        if held is None or not held.same_as(self.limit):
+            return f"limit ({attrs.get('limit', 'none')}; this one: --limit {self.limit.shown})"
         if int(attrs.get("stages", self.planned)) != self.planned:
             return f"number of stages ({attrs['stages']}; this one: --stages {self.planned})"
         if "rotations" in attrs and int(attrs["rotations"]) != self.stage_rotations:

@@ -150,6 +150,66 @@ def batch_sem(x, batches: int = BATCHES) -> float:
     return float(means.std(ddof=1) / math.sqrt(b))
 
 
+def pocket_cov(means) -> float:
+    """Coefficient of variation (standard deviation, ÷ n, over the mean) of the pockets' means ``(pockets,)``
+    [-]; NaN for a mean <= 0. ``bearingsim wear`` prints it per face, and a run's note of uneven pockets judges
+    it (:func:`pocket_spread_critical`)."""
+    v = np.asarray(means, dtype=float).ravel()
+    return float(v.std() / v.mean()) if v.size and v.mean() > 0 else float("nan")
+
+
+def pocket_sampling_cov(per_rotation) -> float:
+    """The coefficient of variation over pockets that identical pockets would show from the rotations' scatter
+    alone, of a ``[rotations, pockets]`` array [-]: the pockets' mean standard error of their mean (the
+    batch-means error over the rotations, :func:`batch_sem`) over the overall mean; NaN with fewer than 2
+    rotations or a mean <= 0. :func:`pocket_cov` near it is that scatter, not a difference of the pockets:
+    both fall as 1/sqrt(rotations)."""
+    v = np.asarray(per_rotation, dtype=float)
+    if v.ndim != 2 or v.shape[0] < 2 or not v.mean() > 0.0:
+        return float("nan")
+    return float(np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean())
+
+
+def pocket_spread_critical(pockets: int, rotations: int, false_alarm: float) -> float:
+    """The ratio :func:`pocket_cov` / :func:`pocket_sampling_cov` that identical pockets exceed in a share
+    ``false_alarm`` of runs: with P pocket means scattering independently and normally about one mean, P cov² /
+    s² is chi-square of P - 1 degrees of freedom (s the standard error, relative), and s estimated from B batch
+    means per pocket (:func:`sem_batches`) makes (P / (P - 1)) (c4 cov / s)² Fisher's F of P - 1 and P (B - 1);
+    c4 (:func:`c4`) corrects the mean of the pockets' standard errors, which reads sigma c4 on average, not
+    sigma. So the ratio is sqrt((P - 1) / P F(1 - false_alarm)) / c4 (16 pockets, 5 batches, 5e-4: 1.86).
+    NaN with fewer than 2 pockets or rotations."""
+    b = sem_batches(rotations)
+    if pockets < 2 or b < 2:
+        return float("nan")
+    f = f_quantile(1.0 - false_alarm, pockets - 1, pockets * (b - 1))
+    return math.sqrt((pockets - 1) / pockets * f) / c4(b)
+
+
+def c4(n: int) -> float:
+    """The mean of the sample standard deviation (ddof 1) of ``n`` (>= 2) normal values over their sigma:
+    sqrt(2 / (n - 1)) Gamma(n / 2) / Gamma((n - 1) / 2) (0.798 for 2, 0.940 for 5)."""
+    return math.sqrt(2.0 / (n - 1)) * math.exp(math.lgamma(n / 2.0) - math.lgamma((n - 1) / 2.0))
+
+
+def f_sf(x: float, d1: float, d2: float) -> float:
+    """P(F > x) of Fisher's F with ``d1`` and ``d2`` degrees of freedom: I_{d2 / (d2 + d1 x)}(d2 / 2, d1 / 2)."""
+    if x <= 0.0:
+        return 1.0
+    return _betainc(d2 / 2.0, d1 / 2.0, d2 / (d2 + d1 * x))
+
+
+def f_quantile(p: float, d1: float, d2: float) -> float:
+    """The ``p`` quantile (0 < p < 1) of Fisher's F with ``d1`` and ``d2`` degrees of freedom: bisection on
+    :func:`f_sf` (to 1e-12 relative)."""
+    lo, hi = 0.0, 1.0
+    while f_sf(hi, d1, d2) > 1.0 - p:
+        lo, hi = hi, 2.0 * hi
+    while hi - lo > 1e-12 * hi:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if f_sf(mid, d1, d2) > 1.0 - p else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
 def pocket_means(per_rotation) -> np.ndarray:
     """The per-rotation series of a ``[rotations, pockets]`` array: each rotation averaged over the
     pockets (pockets of one rotation share the cage's motion: they are not independent samples)."""

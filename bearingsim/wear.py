@@ -73,9 +73,11 @@ class WearReport:
         return float(max(0.0 if s is None else s.max() for s in (self.start_front, self.start_rear)))
 
     def cov(self, face: str) -> float:
-        """Coefficient of variation (std / mean) of the worn volume over the pockets of one face [-]."""
-        v = self.volume_front if face == "front" else self.volume_rear
-        return float(v.std() / v.mean()) if v.mean() > 0 else float("nan")
+        """Coefficient of variation (std / mean) of the worn volume over the pockets of one face [-]
+        (:func:`bearingsim.stats.pocket_cov`)."""
+        from bearingsim.stats import pocket_cov
+
+        return pocket_cov(self.volume_front if face == "front" else self.volume_rear)
 
     @property
     def recorded_rotations(self) -> int:
@@ -97,16 +99,14 @@ class WearReport:
 
     def sampling_cov(self, face: str) -> float:
         """The coefficient of variation over pockets that identical pockets would show from the recorded
-        rotations' scatter alone [-]: the pockets' mean standard error of their worn volume (the batch-means
-        error over the recorded rotations, :func:`bearingsim.stats.batch_sem`) over the mean volume; NaN with
-        fewer than 2 recorded rotations. :meth:`cov` near it is that scatter, not a difference of the pockets
-        (the model's pockets are identical): both fall as 1/sqrt(recorded rotations)."""
-        from bearingsim.stats import batch_sem
+        rotations' scatter alone [-] (:func:`bearingsim.stats.pocket_sampling_cov` of the per-rotation volumes):
+        the pockets' mean standard error of their worn volume over the mean volume; NaN with fewer than 2
+        recorded rotations. The pockets are identical in geometry, but the cage's motion can lock into a pattern
+        that loads them unevenly: :meth:`cov` far above this is that (a run's note says when, docs/wear.md,
+        *Uneven pockets*), near it the scatter; both fall as 1/sqrt(recorded rotations) when it is scatter."""
+        from bearingsim.stats import pocket_sampling_cov
 
-        v = self.volume_rotations(face)
-        if v.shape[0] < 2 or not v.mean() > 0.0:
-            return float("nan")
-        return float(np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean())
+        return pocket_sampling_cov(self.volume_rotations(face))
 
     def worn_through(self) -> tuple[int, float] | None:
         """``(i, depth)`` when the two faces on a cage bar, pocket ``i``'s front face and pocket ``i - 1``'s rear

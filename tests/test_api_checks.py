@@ -721,3 +721,60 @@ def test_a_land_guided_cage_that_changes_where_it_rests_is_not_blamed_on_roller_
     assert "runs on its outer ring's land" in land and "docs/stability.md, Land-guided cage" in land, land
     rollers = note("rollers")
     assert rollers is not None and "under load a roller-guided cage can rest in two" in rollers, rollers
+
+
+def _rigid_6000rpm_run(**keys):
+    """A 6000 rpm run of 3 rotations with rigid raceways and the scenario ``keys``, and its PlausibilityWarnings."""
+    from bearingsim.errors import PlausibilityWarning
+
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+        "multibody.raceway_contact": "rigid", "numerics.rotations": 3, **keys})
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        r = bearingsim.run(sc)
+    return r, [str(w.message) for w in seen if issubclass(w.category, PlausibilityWarning)]
+
+
+@pytest.mark.slow  # two 6000 rpm runs of 3 rotations with rigid raceways
+def test_a_cage_that_loads_its_pockets_unevenly_is_noted():
+    """docs/wear.md, Uneven pockets: a polymer-light cage (0.03106 kg, docs/whatif.md) at 6000 rpm locks into a
+    pattern that repeats every 4 pockets. With rigid raceways over 3 rotations its front faces' sliding work varies
+    over the pockets by 0.384 where identical pockets would show 0.096 (4.0 times, the bound 2.18): the note, as a
+    PlausibilityWarning, naming both coefficients and the most and least worn pockets. The brass cage of the
+    reference bearing in the same scene scatters as identical pockets do (ratio below 1.5): no note."""
+    from bearingsim import plausibility
+
+    light, warned = _rigid_6000rpm_run(**{"bearing.cage_mass_kg": 0.03106, "bearing.cage_inertia_kgm2": 7.454e-5})
+    notes = [n for n in light.notes if "uneven pockets" in n]
+    assert len(notes) == 1 and notes[0] in warned, light.notes
+    face, cov, sampling, crit, means = plausibility.pocket_spread(light)[0]
+    assert face == "front" and cov > 3.0 * sampling and 2.0 < crit < 2.4
+    assert f"front faces {cov:.3f} where identical pockets would show {sampling:.3f}" in notes[0]
+    assert f"most worn pocket {int(np.argmax(means))} " in notes[0] and "\n" not in notes[0]
+    assert f"least pocket {int(np.argmin(means))} " in notes[0] and "clearance limit follows the worst" in notes[0]
+    brass, warned = _rigid_6000rpm_run()
+    assert not [n for n in brass.notes + warned if "uneven pockets" in n], brass.notes
+    assert all(c / s < 1.5 for _, c, s, _, _ in plausibility.pocket_spread(brass))
+
+
+def test_the_uneven_pocket_bound_is_an_f_test_at_the_stated_false_alarm():
+    """plausibility.POCKET_SPREAD_FALSE_ALARM (0.1 % of runs, half of it per face): the ratio of the pockets'
+    coefficient of variation to the sampling one that equal pockets exceed is sqrt((P - 1) / P F) / c4, F Fisher's
+    quantile of P - 1 and P (B - 1) degrees of freedom (scipy's: 3.2546 for 15 and 64 at 1 - 5e-4); 16 pockets:
+    1.86 with 5 batch means, 2.96 from 2 rotations. An array of equal pockets and normal scatter stays below it,
+    one pocket raised by 10 standard errors of its mean does not (the bound is
+    about 7); the reduced_equivalent scene and pockets of two shapes are
+    not judged."""
+    from bearingsim import stats
+
+    assert stats.f_quantile(1 - 5e-4, 15, 64) == pytest.approx(3.254585355, rel=1e-8)
+    assert stats.c4(5) == pytest.approx(0.9399856, rel=1e-6)
+    assert stats.pocket_spread_critical(16, 40, 5e-4) == pytest.approx(1.858, abs=1e-3)
+    assert stats.pocket_spread_critical(16, 2, 5e-4) == pytest.approx(2.958, abs=1e-3)
+    assert np.isnan(stats.pocket_spread_critical(16, 1, 5e-4))
+    rng = np.random.default_rng(3)
+    x = 10.0 + rng.standard_normal((40, 16))
+    crit = stats.pocket_spread_critical(16, 40, 5e-4)
+    assert stats.pocket_cov(x.mean(axis=0)) < crit * stats.pocket_sampling_cov(x)
+    x[:, 5] += 10.0 / np.sqrt(40.0)  # 10 standard errors of a pocket's mean
+    assert stats.pocket_cov(x.mean(axis=0)) > crit * stats.pocket_sampling_cov(x)

@@ -896,10 +896,19 @@ def unread_note(scenario, keys, method: str | None = "", varied=()) -> str | Non
     return "; ".join(parts) or None
 
 
-#: what a value below its plausible range may be (:func:`out_of_range_note`): a specific wear rate k' [m^3/(N m)]
-#: given as Archard's dimensionless k = k' H reads the wear ~1e9 times low
-BELOW_RANGE = {"wear.wear_coefficient": "; k is Archard's dimensionless coefficient, k = k' H: a specific wear rate k' "
-                                        "in m^3/(N m) given as k reads the wear about 1e9 times low"}
+#: what a value far below its plausible range may be (:func:`out_of_range_note`): key -> (threshold, hint), the
+#: hint given only below the threshold. A specific wear rate k' [m^3/(N m)] given as Archard's dimensionless
+#: k = k' H reads the wear ~1e9 times low; data sheets give k' of about 1e-17 to 1e-12 m^3/(N m), while k itself
+#: runs from about 1e-9 (polymers, lubricated) to 1e-2, so a k below 1e-11 looks like a k' and one above it is
+#: a k (a polymer's converted k of 2e-7 gets the ordinary note)
+BELOW_RANGE = {"wear.wear_coefficient": (1e-11, "; k is Archard's dimensionless coefficient, k = k' H: a specific "
+                                                "wear rate k' in m^3/(N m) given as k reads the wear about 1e9 times low")}
+
+
+def _below_range_hint(key: str, value: float) -> str:
+    """The :data:`BELOW_RANGE` hint of ``key`` at ``value`` (below its plausible range), or ''."""
+    threshold, hint = BELOW_RANGE.get(key, (None, ""))
+    return hint if threshold is not None and value < threshold else ""
 
 
 def out_of_range_note(scenario) -> str | None:
@@ -917,7 +926,7 @@ def out_of_range_note(scenario) -> str | None:
         lo, hi, _ = ranged[k]
         v = value_of(scenario, k)
         if isinstance(v, (int, float)) and not isinstance(v, bool) and not lo <= v <= hi:
-            out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g}" + (BELOW_RANGE.get(k, "") if v < lo else "") + ")")
+            out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g}" + (_below_range_hint(k, v) if v < lo else "") + ")")
     if not out:
         return None
     return (f"bearingsim: note: {'; '.join(out)}: outside the plausible range of the preset's bearing "

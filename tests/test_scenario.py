@@ -634,3 +634,17 @@ def test_the_repr_of_a_scenario_and_its_result_shows_its_overrides():
     r = bearingsim.run(slow)
     assert repr(r).startswith("<ReducedResult 'paper_3000rpm' with numerics.rotations=1, "
                               "operating.inner_ring_speed_rpm=500: I_dec_mean_Ns="), repr(r)
+
+
+def test_a_wear_coefficient_below_its_range_is_called_a_specific_wear_rate_only_where_it_looks_like_one():
+    """A polymer's converted Archard coefficient (k = k' H = 2e-7, below the brass preset's plausible range)
+    got the hint that it may be a specific wear rate k' given as k, which reads the wear about 1e9 times low;
+    a k' lies about 1e-17 to 1e-12 m^3/(N m) and a k about 1e-9 to 1e-2. Below 1e-11 the note gives the
+    hint; above it, the ordinary out-of-range note."""
+    from bearingsim.scenario import out_of_range_note
+
+    for value, hinted in (("2e-7", False), ("1e-9", False), ("1e-15", True), ("5e-12", True)):
+        note = out_of_range_note(load_scenario(SCENARIOS / "wear_test_6000rpm.toml",
+                                               [f"wear.wear_coefficient={value}"]))
+        assert f"wear.wear_coefficient = {float(value):g} (plausible" in note, note
+        assert ("1e9 times low" in note) is hinted, (value, note)

@@ -929,8 +929,8 @@ def out_of_range_note(scenario) -> str | None:
             out.append(f"{k} = {v:g} (plausible {lo:g} to {hi:g}" + (_below_range_hint(k, v) if v < lo else "") + ")")
     if not out:
         return None
-    return (f"bearingsim: note: {'; '.join(out)}: outside the plausible range of the preset's bearing "
-            f"('bearingsim keys KEY --why' says where it comes from); the run is of another bearing")
+    return (f"bearingsim: note: {'; '.join(out)}: outside the range the preset's sensitivity studies sample "
+            f"('bearingsim keys KEY --why' says where it comes from); the run is valid, of a bearing unlike the preset's")
 
 
 def given_keys(path, overrides=(), values=None) -> list[str]:

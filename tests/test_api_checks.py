@@ -348,8 +348,9 @@ def test_a_key_set_outside_its_plausible_range_gets_a_note_in_the_run_and_the_dr
     paper = PAPER
     wide = run(load_scenario(paper, ["bearing.pocket_clearance_mm=3"]))
     assert [n for n in wide.notes if "plausible" in n] == [
-        "bearingsim: note: bearing.pocket_clearance_mm = 3 (plausible 0.16 to 0.24): outside the plausible range of "
-        "the preset's bearing ('bearingsim keys KEY --why' says where it comes from); the run is of another bearing"]
+        "bearingsim: note: bearing.pocket_clearance_mm = 3 (plausible 0.16 to 0.24): outside the range the preset's "
+        "sensitivity studies sample ('bearingsim keys KEY --why' says where it comes from); the run is valid, of a "
+        "bearing unlike the preset's"]
     for sets in (["bearing.pocket_clearance_mm=0.24"], ["bearing.cage_inner_diameter_mm=80"]):
         assert not [n for n in run(load_scenario(paper, sets)).notes if "plausible" in n], sets
     dry = cli("run", paper, "--set", "bearing.pocket_clearance_mm=3", "--dry-run", cwd=tmp_path)

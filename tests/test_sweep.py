@@ -1293,7 +1293,7 @@ def test_a_runs_notes_are_kept_in_the_sweeps_index_table_and_report(tmp_path, ca
         cols, _ = read_index(out / "sweep.h5")
         assert list(cols["status"]) == ["cached" if again else "done"] * 2
         assert cols["notes"][0] == "" and "bearing.pocket_clearance_mm = 0.3" in cols["notes"][1], cols["notes"]
-        assert "outside the plausible range" in cols["notes"][1] and "bearingsim: note:" not in cols["notes"][1]
+        assert "outside the range the preset's sensitivity studies sample" in cols["notes"][1] and "bearingsim: note:" not in cols["notes"][1]
         assert printed.rstrip().splitlines()[-1].endswith(f"1 case with notes ('bearingsim table {out}' marks them "
                                                           f"in its notes column and lists them)"), printed
         assert _rows(out)[1]["notes"] == cols["notes"][1]

@@ -247,7 +247,7 @@ def test_a_table_of_archives_marks_and_lists_the_notes_they_store(reduced_runs, 
     rows with notes [1], [2] ... in a notes column and lists them under the table, as `table DIR` does."""
     noted = tmp_path / "n.h5"
     sc = bearingsim.load_scenario(PAPER, set={"bearing.pocket_clearance_mm": 0.3})
-    with pytest.warns(UserWarning, match="outside the plausible range"):  # the run's note
+    with pytest.warns(UserWarning, match="outside the range the preset's sensitivity studies sample"):  # the run's note
         bearingsim.run(sc).save(noted)
     assert bearingsim.load(noted).notes
     lines = tables.format_table(tables.table_of_archives([reduced_runs / "a.h5", noted])).splitlines()

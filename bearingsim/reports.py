@@ -664,12 +664,14 @@ def _life_limit_note(attrs: dict) -> str | None:
         return None
 
 
-def _case_values(cols, meta, i: int) -> str:
-    """What case ``i`` of an index varies (its row's axes: ``key = value, ...``), as the tables of its
-    folder's page name it."""
-    from bearingsim.tables import cell_text
+def _case_values(cols, meta) -> list[str]:
+    """What each case of an index varies (its row's axes: ``key = value, ...``), as the tables of its
+    folder's page name it (values written with the digits that tell them apart: :func:`distinct_texts`)."""
+    from bearingsim.wording import distinct_texts
 
-    return ", ".join(f"{k} = {cell_text(cols[k][i])}" for k in meta.get("axes", ()) if k in cols)
+    keys = [k for k in meta.get("axes", ()) if k in cols]
+    texts = {k: distinct_texts(list(cols[k])) for k in keys}
+    return [", ".join(f"{k} = {texts[k][i]}" for k in keys) for i in range(len(cols["case"]))]
 
 
 def _run_notes_blocks(cols, meta) -> list[dict]:
@@ -677,7 +679,8 @@ def _run_notes_blocks(cols, meta) -> list[dict]:
     :func:`bearingsim.plausibility.check`): a line saying how many cases have them and a table of them."""
     from bearingsim.sweeps.index import notes_of
 
-    rows = [[str(c), _case_values(cols, meta, i), note]
+    values = _case_values(cols, meta)
+    rows = [[str(c), values[i], note]
             for i, (c, cell) in enumerate(zip(cols["case"], cols.get("notes", ()))) for note in notes_of(cell)]
     if not rows:
         return []
@@ -701,7 +704,8 @@ def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None)
         cols, meta = read_index(index)
         status = [str(s) for s in cols["status"]]
         counts = ", ".join(f"{s} {status.count(s)}" for s in dict.fromkeys(status))
-        failed = [[str(c), _case_values(cols, meta, i), e]
+        values = _case_values(cols, meta)
+        failed = [[str(c), values[i], e]
                   for i, (c, s, e) in enumerate(zip(cols["case"], status, cols["error"])) if s == "failed"]
         checks.append({"kind": "text", "text": f"{counted(len(status), 'case')}: {counts}. A case's archive is written only when "
                                                "its run passes the plausibility checks (docs/reliability.md); a "
@@ -713,7 +717,7 @@ def _folder_sections(folder: Path, toml, scenarios: list[Section] | None = None)
         row = next((i for i, a in enumerate(cols["archive"]) if a and (folder / a).is_file()), None)
         first = folder / cols["archive"][row] if row is not None else None
         # the case named by what it varies (its index row's axes: a sweep's keys, a study's rung, speed, stage)
-        label = _case_values(cols, meta, row) if row is not None else ""
+        label = values[row] if row is not None else ""
     if scenarios is None:
         blocks = toml if isinstance(toml, list) else _scenario_blocks(toml, folder)
         scenarios = [Section("scenario", "Scenario", blocks)]

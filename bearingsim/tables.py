@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
+from bearingsim.wording import counted, distinct_texts
 from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
@@ -77,13 +78,6 @@ class Table:
         return len(next(iter(self.labels.values()))) if self.labels else 0
 
 
-def cell_text(v) -> str:
-    """A label cell as the tables (and the report's pages) show it: a number in its shortest form, text as it is."""
-    if isinstance(v, (float, np.floating)):
-        return f"{float(v):g}"
-    return str(v)
-
-
 def table_of_index(path) -> Table:
     """The table of a sweep's or study's index (``DIR/sweep.h5`` or the file): one row per case,
     labelled by its swept keys (and its status where it is not done or cached)."""
@@ -94,7 +88,7 @@ def table_of_index(path) -> Table:
     axes = [k for k in meta["axes"] if k in cols]
     status = [str(s) for s in cols["status"]]
     names = list(axes)
-    labels = {k: [cell_text(v) for v in cols[k]] for k in axes}
+    labels = {k: distinct_texts(list(cols[k])) for k in axes}
     if any(s not in ("done", "cached") for s in status):
         names.append("status")
         labels["status"] = status
@@ -102,8 +96,6 @@ def table_of_index(path) -> Table:
         names, labels = ["case"], {"case": [str(c) for c in cols["case"]]}
     numbers = {k: np.asarray(cols[k], float) for k in meta["columns"] if k not in ("case", *FIXED, *axes)
                and np.asarray(cols[k]).dtype.kind == "f"}
-    from bearingsim.wording import counted
-
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     footnotes = _run_notes([notes_of(c) for c in cols.get("notes", [""] * n)], names, labels)
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes,
@@ -144,7 +136,7 @@ def table_of_archives(paths) -> Table:
     names = ["archive", *shown]
     labels = {"archive": distinguishing_labels(paths)}
     for k in shown:
-        labels[k] = [cell_text(f.get(k, "(unset)")) for f in flat]
+        labels[k] = distinct_texts([f.get(k, "(unset)") for f in flat])
     keys = list(dict.fromkeys(k for r in results for k, v in r.summary.items() if _is_number(v)))
     numbers, units = {}, {}
     for k in keys:
@@ -236,7 +228,6 @@ def study_text(kind: str, file: Path) -> str:
     import tomllib
 
     from bearingsim.studies import crosscheck, life, sensitivity, uncertainty
-    from bearingsim.wording import counted
 
     if kind == "validate":
         from bearingsim.studies.validate import format_tables, read_validate

@@ -1,6 +1,9 @@
 """Wording of printed messages shared by the commands."""
 from __future__ import annotations
 
+import math
+import numbers
+
 
 #: how the command line prints a run's note (:func:`bearingsim.plausibility.check`); the stored note keeps it
 NOTE_PREFIX = "bearingsim: note: "
@@ -34,3 +37,17 @@ def given_by(origin: str, what: str) -> str:
     """``what`` (a key or an override) as a refusal names it with the option or argument ``origin`` that gave
     it: "--set KEY" of a command-line option, "overrides: KEY" of a Python argument."""
     return f"{origin} {what}" if origin.startswith("--") else f"{origin}: {what}"
+
+
+def distinct_texts(values) -> list[str]:
+    """A column of values (a swept key's, one per case) as tables and figures write them: numbers as ``%g``
+    writes them, or with the fewest more significant digits (up to 16; beyond, Python's shortest repr) that keep
+    distinct values distinct (970.000001 and 970.000002, both "970" by ``%g``: "970.000001",
+    "970.000002"); text, switches and whole numbers as they are."""
+    def is_float(v):  # a Python or numpy float (numpy registers its floats as numbers.Real)
+        return isinstance(v, numbers.Real) and not isinstance(v, numbers.Integral)
+
+    finite = {float(v) for v in values if is_float(v) and math.isfinite(v)}
+    digits = next((d for d in range(6, 17) if len({f"{v:.{d}g}" for v in finite}) == len(finite)), None)
+    return [(repr(float(v)) if digits is None else f"{float(v):.{digits}g}") if is_float(v) else str(v)
+            for v in values]

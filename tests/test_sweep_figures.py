@@ -467,3 +467,27 @@ def test_a_sweep_of_one_or_two_points_draws_markers_on_impulse_axes_from_0(tmp_p
         assert top < 0.96 * high, (top, high)  # room above the highest marker: drawn whole
     for ax in panels([1000.0, 2000.0, 6000.0]):
         assert joined(ax)
+
+
+def test_swept_values_that_differ_far_down_are_written_apart_in_the_table_and_the_figures(tmp_path, figures):
+    """A sweep of operating.radial_load_N=970.000001,970.000002 printed "970" in both rows of its table
+    (``%g``), and its line figure ticked "1e-6+9.7e2"; a 2-D sweep over such values put both values' cases
+    in one cell of its map (the cells were found by the ``%g`` text). Each value is now written with the
+    digits that tell it apart: in the table, the index CSV, the ticks, and the map's cells."""
+    from bearingsim.tables import format_table, table_of_index
+
+    load = "operating.radial_load_N"
+    (tmp_path / "a").mkdir(), (tmp_path / "b").mkdir()
+    h5 = _index(tmp_path / "a", [{load: 970.000001}, {load: 970.000002}], [load])
+    table = table_of_index(h5)
+    assert table.labels[load] == ["970.000001", "970.000002"]
+    assert [ln.split()[0] for ln in format_table(table).splitlines()[2:4]] == ["970.000001", "970.000002"]
+    assert [ln.split(",")[1] for ln in (tmp_path / "a" / "sweep.csv").read_text().splitlines()[1:]] == [
+        "970.000001", "970.000002"]
+    plot_sweep_index(h5, tmp_path / "fa")
+    assert figures["sweep_I.png"]["axes"][0]["xticks"] == ["970.000001", "970.000002"]
+    points = [{load: v, CLEAR: c} for v in (970.000001, 970.000002) for c in (0.2, 0.2000001)]
+    plot_sweep_index(_index(tmp_path / "b", points, [load, CLEAR]), tmp_path / "fb")
+    panel = figures["sweep_map.png"]["axes"][0]
+    assert panel["xticks"] == ["970.000001", "970.000002"] and panel["yticks"] == ["0.2", "0.2000001"]
+    assert len([t for t in panel["texts"] if t.strip()]) == 4, panel["texts"]

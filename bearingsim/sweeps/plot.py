@@ -45,7 +45,7 @@ from bearingsim.plotting import (FRONT, LINE_STYLES, REAR, error_title, fit_supt
                                  hatch_without_error, mark_without_error)
 from bearingsim.scenario import is_integer_key
 from bearingsim.sweeps.index import index_batches, name_of, read_index, unit_of
-from bearingsim.wording import counted
+from bearingsim.wording import counted, distinct_texts
 
 #: every figure a sweep may draw into its folder (a sweep checks them before it starts)
 FIGURE_NAMES = ("sweep_I.png", "sweep_map.png", "sweep_cases.png")
@@ -199,9 +199,10 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
     x_key, others = axes[0], axes[1:]
     x_all, ticks, tick_labels = _positions(cols, x_key, rows)
     groups: dict[tuple, list[int]] = {}
+    texts = {k: distinct_texts(list(cols[k])) for k in others}  # each line's values, told apart
     for i in rows:
         if math.isfinite(x_all[i]):
-            groups.setdefault(tuple(_show(cols[k][i]) for k in others), []).append(i)
+            groups.setdefault(tuple(texts[k][i] for k in others), []).append(i)
     if len(groups) > MAX_LINES:
         notes.append(f"no line figure: {len(groups)} combinations of "
                      + ", ".join(name_of(k) for k in others) + f" are more than the {MAX_LINES} lines one figure shows")
@@ -238,6 +239,8 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
             from matplotlib.ticker import MaxNLocator
 
             ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+        if ticks is None and not zipped:
+            _close_ticks(ax, _sampled(cols[x_key], drawn))
         ax.grid(alpha=0.3)
         if np.all(y[shown] >= 0.0):  # an impulse is never negative: no axis below 0 (a lone 0 drew -0.04..0.04),
             # room for a marker at the top, and below 0 for half a marker (one at 0 would be cut), less than a tick
@@ -254,6 +257,16 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
     return save_figure(fig, path, tight=False)
 
 
+def _close_ticks(ax, xs: list) -> None:
+    """Ticks at the sampled values ``xs`` written whole (:func:`tick_texts`: ``970.000001, 970.000002``) where
+    they differ by less than 1e-4 of their size, which matplotlib ticks as an offset (``1e-6+9.7e2``) or, as
+    plain numbers, too long to fit; other axes keep matplotlib's ticks."""
+    if len(xs) < 2 or xs[-1] - xs[0] >= 1e-4 * max(abs(xs[0]), abs(xs[-1])):
+        return
+    step = -(-len(xs) // ZIP_TICKS)  # a long axis labels every k-th value
+    ax.set_xticks(xs[::step], tick_texts(xs)[::step])
+
+
 def _zipped_ticks(ax, cols, x_key, zipped, rows, x_all, names=None):
     """The ticks of a zipped sweep's abscissa: one per value drawn, the zipped keys' values under it (a tick row
     each), and the axis label naming them, so that no zipped key's change is read as ``x_key``'s. ``names``: a
@@ -263,9 +276,10 @@ def _zipped_ticks(ax, cols, x_key, zipped, rows, x_all, names=None):
         at.setdefault(float(x_all[i]), []).append(i)
     ticks = sorted(at)
     labels = []
+    texts = {k: distinct_texts(list(cols[k])) for k in (x_key, *zipped)}
     for p in ticks:
-        first = names[int(p)] if names is not None else _show(cols[x_key][at[p][0]])
-        rows_below = ["/".join(dict.fromkeys(_show(cols[k][i]) for i in at[p])) for k in zipped]
+        first = names[int(p)] if names is not None else texts[x_key][at[p][0]]
+        rows_below = ["/".join(dict.fromkeys(texts[k][i] for i in at[p])) for k in zipped]
         labels.append("\n".join([first, *rows_below]))
     step = -(-len(ticks) // ZIP_TICKS)  # a long axis labels every k-th value
     ax.set_xticks(ticks[::step], labels[::step])
@@ -293,8 +307,9 @@ def _titled(sym: str, errors: str) -> str:
     return f"{sym} ({errors})" if errors else sym
 
 
-def _show(v) -> str:
-    return f"{v:g}" if isinstance(v, (float, np.floating)) else str(v)
+def _sample_of(col, i: int):
+    """Row ``i``'s value of a key as :func:`_sampled` lists it (a number as a float, text as text)."""
+    return float(col[i]) if _numeric(col) else str(col[i])
 
 
 def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
@@ -305,8 +320,8 @@ def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
     (:func:`tick_texts`)."""
     xk, yk = axes
     xs, ys = _sampled(cols[xk], rows), _sampled(cols[yk], rows)
-    xpos = {_show(v): j for j, v in enumerate(xs)}
-    ypos = {_show(v): j for j, v in enumerate(ys)}
+    xpos = {v: j for j, v in enumerate(xs)}  # by value: two values %g writes alike are two cells
+    ypos = {v: j for j, v in enumerate(ys)}
     from bearingsim.plotting import subplots
 
     size, pt = _map_layout(len(xs), len(ys))
@@ -318,7 +333,7 @@ def _heat_map(cols, meta, axes, rows, path: Path, title: str) -> Path:
         grid, err, nb = (np.full((len(ys), len(xs)), np.nan) for _ in range(3))
         col, sem = cols.get(f"{name}_mean_Ns"), _sem_mN_s(cols, name, len(cols["case"]))
         for i in rows:
-            xi, yi = xpos.get(_show(cols[xk][i])), ypos.get(_show(cols[yk][i]))
+            xi, yi = xpos.get(_sample_of(cols[xk], i)), ypos.get(_sample_of(cols[yk], i))
             if xi is not None and yi is not None and col is not None:
                 grid[yi, xi], err[yi, xi], nb[yi, xi] = col[i] * 1e3, sem[i], batches[i]
         n_gap = max(n_gap, int(np.isnan(grid).sum()))
@@ -372,16 +387,17 @@ def tick_texts(values) -> list[str]:
     """The tick labels of sampled ``values`` (text as it is): numbers to the fewest decimals (none at least)
     that leave each within 1 % of the smallest step between them, so that distinct values stay distinct
     (``1000, 1786, 2571`` for 1000..6500 in 8; ``0.1, 0.15``; ``1000.4, 1000.8``), trailing zeros dropped.
-    A value too close to its neighbour for 10 decimals is written as ``%g`` writes it."""
+    Values too close to their neighbours for 10 decimals are written with the digits that tell them apart
+    (:func:`distinct_texts`)."""
     if not values or not all(isinstance(v, (float, int, np.floating)) for v in values):
-        return [_show(v) for v in values]
+        return distinct_texts(list(values))
     vals = np.asarray(values, dtype=float)
     steps = np.diff(np.unique(vals))
     tol = 0.01 * float(steps.min()) if steps.size else 0.0
     for dec in range(11):
         if np.all(np.abs(np.round(vals, dec) - vals) <= tol) and (steps.size or np.all(np.round(vals, dec) == vals)):
             return [_plain(v, dec) for v in vals]
-    return [_show(v) for v in values]
+    return distinct_texts([float(v) for v in values])
 
 
 def _plain(v: float, dec: int) -> str:
@@ -428,8 +444,9 @@ def _cases_chart(cols, meta, path: Path, title: str) -> Path:
     keys = [k for k in meta["axes"] if k in cols]
     total = len(cols["case"])
     labels = []
+    texts = {k: distinct_texts(list(cols[k])) for k in keys}
     for i in range(total):
-        parts = [f"{name_of(k)} = {_show(cols[k][i])}" for k in keys if _present(cols[k])[i]]
+        parts = [f"{name_of(k)} = {texts[k][i]}" for k in keys if _present(cols[k])[i]]
         status = str(cols["status"][i]) if "status" in cols else ""
         if status in ("failed", "pending"):
             parts.append("(failed)" if status == "failed" else "(not run)")

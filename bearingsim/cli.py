@@ -720,7 +720,8 @@ def _add_run_commands(sub) -> None:
                                       "the study's own table")
     tb.add_argument("paths", nargs="+", metavar="DIR|FILE",
                     help="one folder, sweep.h5 or study table (crosscheck.h5, sensitivity.h5, uncertainty.h5, life.h5), "
-                         "or run archives")
+                         "or run archives, a row each in the order given: the first is the reference of the marks "
+                         "(a shell's cases/*.h5 comes sorted by name)")
     tb.add_argument("--columns", metavar="KEY,...",
                     help="summary keys to show (default: I_dec_mean_Ns, I_acc_mean_Ns, first_impact_speed_m_s, "
                          "cage_slip, cage_rest_angle_deg, load_zone_half_angle_deg, those present); not for a "

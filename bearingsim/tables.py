@@ -31,7 +31,7 @@ from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_bat
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
 RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) (round-off), "
-        f"x_ref the first row with a number, t Student's {0.5 + SIGNIFICANCE_LEVEL / 2:.1%} quantile of the "
+        f"x_ref the first row with a number (named below), t Student's {0.5 + SIGNIFICANCE_LEVEL / 2:.1%} quantile of the "
         "Welch-Satterthwaite degrees of freedom (each SE: batch means over rotations, batches - 1; "
         "docs/statistics.md); no mark: within that, or no SE to judge by")
 #: the line above the key of a table's ``[k]`` marks, the runs' notes (:attr:`Table.footnotes`)
@@ -391,5 +391,29 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
         out.append(NOTES_HEAD)
         out += noted
     if any(k in SEM_OF for k in keys):
-        out.append(RULE)
+        out += [RULE, reference_line(table, [k for k in keys if k in SEM_OF])]
     return "\n".join(out)
+
+
+def reference_line(table: Table, keys: list[str]) -> str:
+    """The line under a table naming its row x_ref of each of ``keys`` (the columns with standard errors):
+    the first row with a number, the first archive given (the rows keep the order given) or the index's
+    first case: ``x_ref: the row c.h5 (the first archive given)``."""
+    names = [k for k in table.label_names if k not in ("notes", "status")]
+    refs: dict[int, list[str]] = {}
+    for key in keys:
+        finite = np.flatnonzero(np.isfinite(table.numbers[key]))
+        if finite.size:
+            refs.setdefault(int(finite[0]), []).append(_bare(key))
+    if not refs:
+        return "x_ref: none (no row has a number)"
+    archives = names[:1] == ["archive"]
+
+    def row(i):
+        if archives:
+            return table.labels["archive"][i] + (" (the first archive given)" if i == 0 else "")
+        return ", ".join(f"{k} = {table.labels[k][i]}" for k in names) + (" (the first case)" if i == 0 else "")
+
+    if len(refs) == 1:
+        return f"x_ref: the row {row(next(iter(refs)))}"
+    return "x_ref: " + "; ".join(f"of {', '.join(ks)}, the row {row(i)}" for i, ks in refs.items())

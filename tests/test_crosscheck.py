@@ -380,7 +380,8 @@ def test_crosscheck_index_and_table_give_each_rung_one_standard_error(ladder):
         for k in ("I_dec_sem_Ns", "I_acc_sem_Ns"):
             assert row[k] == cols[k][i] == table.numbers[k][0], (row["scene"], k)
     text = tables.format_table(tables.table_of(out))
-    assert "rung" in text.splitlines()[1] and text.splitlines()[-1] == tables.RULE
+    assert "rung" in text.splitlines()[1] and text.splitlines()[-2] == tables.RULE
+    assert text.splitlines()[-1].startswith("x_ref: the row ") and "(the first case)" in text.splitlines()[-1]
 
 
 def test_table_of_the_folder_prints_the_ladder_and_its_verdicts(ladder, capsys):

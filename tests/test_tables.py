@@ -125,7 +125,7 @@ def test_marks_only_where_the_difference_exceeds_t_standard_errors():
     assert rows["beyond"].endswith("*") and not rows["within"].endswith("*") and not rows["no-se"].endswith("*")
     assert not rows["ref"].endswith("*") and "± n/a" in rows["no-se"]
     assert "I_dec_mean [mN s]" in lines[0] and "11.00 ± 0.20" in rows["beyond"]  # the value to its error's decimal place
-    assert lines[-1] == tables.RULE
+    assert lines[-2] == tables.RULE and lines[-1] == "x_ref: the row run = ref (the first case)"
 
 
 def test_student_t_quantiles_match_the_printed_tables():
@@ -240,6 +240,23 @@ def test_table_of_archives_and_its_refusals(reduced_runs, tmp_path):
     assert_user_error(cli("table", d / "a.h5", "--columns", "I_dec_mean"), "--columns", "I_dec_mean")
     assert_user_error(cli("table", tmp_path), str(tmp_path), "sweep.h5")
     assert_user_error(cli("table", d / "nope.h5"), "nope.h5")
+
+
+def test_a_table_of_archives_keeps_the_order_given_and_names_its_reference_row(reduced_runs, capsys):
+    """`bearingsim table A.h5 B.h5 C.h5` marks each mean against x_ref, "the first row with a number", which
+    the table did not name (a shell's cases/*.h5 gives the archives sorted by name, so which row it was went
+    unsaid). The rows keep the order given, the help says the first is the reference, and the line under the
+    rule names that row."""
+    from bearingsim.cli import main
+
+    d = reduced_runs
+    for order in (("c", "a", "b"), ("b", "c", "a")):
+        out = tables.format_paths([d / f"{n}.h5" for n in order]).splitlines()
+        assert [ln.split()[0] for ln in out[1:4]] == [f"{n}.h5" for n in order], out
+        assert out[-1] == f"x_ref: the row {order[0]}.h5 (the first archive given)", out
+    with pytest.raises(SystemExit):
+        main(["table", "--help"])
+    assert "the first is the reference of the marks" in " ".join(capsys.readouterr().out.split())
 
 
 def test_a_table_of_archives_marks_and_lists_the_notes_they_store(reduced_runs, tmp_path):

@@ -66,15 +66,18 @@ def _cmd_wear(args) -> int:
 
 def _comparison(paths, done) -> str:
     """The table of several archives' wear (:func:`bearingsim.wear.format_comparison`), labelled as
-    ``bearingsim table`` labels archives, with the scenario keys that differ between them above it."""
+    ``bearingsim table`` labels archives (:func:`bearingsim.tables.archive_labels`: the file and the values of
+    the scenario keys that differ), those keys named above it."""
     from bearingsim import wear
-    from bearingsim.scenario import differing_keys
-    from bearingsim.tables import distinguishing_labels
+    from bearingsim.tables import archive_labels
 
-    differ = [row[0] for row in differing_keys(*(result.scenario.raw for result, _ in done)) if row[0] != "name"]
+    labels, differ = archive_labels(paths, [result.scenario.raw for result, _ in done])
+    differ = [k for k in differ if k != "name"]
     notes = [f"wear of {len(paths)} archives, each after the running time at its own speed; scenario keys that "
-             f"differ: {', '.join(differ) if differ else 'none'}"]
-    return wear.format_comparison(distinguishing_labels(paths), [rep for _, rep in done], notes)
+             f"differ: {', '.join(differ) if differ else 'none'}"
+             + ("" if len(labels) == 1 else " (as columns)" if len(labels) > len(differ)
+                else f" (the first {len(labels) - 1} as columns)")]
+    return wear.format_comparison(labels, [rep for _, rep in done], notes)
 
 
 def _cmd_life(args) -> int:

@@ -121,22 +121,16 @@ def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[i
 
 def table_of_archives(paths) -> Table:
     """The table of run archives, one row each: labelled by the file and the scenario keys that
-    differ between them (at most 4 as columns; the others listed in ``notes``), and its notes' mark
+    differ between them (:func:`archive_labels`: at most 4 as columns; the others listed in ``notes``), and its notes' mark
     (:func:`_run_notes`); the standard errors computed from each archive's per-rotation impulses
     (:func:`bearingsim.stats.result_standard_errors`)."""
-    from bearingsim.scenario import differing_keys, flatten
     from bearingsim.simulation import TABLED, load
     from bearingsim.stats import result_standard_errors
     from bearingsim.wording import run_notes
 
     results = [load(p, only=TABLED) for p in paths]
-    flat = [flatten(r.scenario.raw) for r in results]
-    differ = [row[0] for row in differing_keys(*(r.scenario.raw for r in results))]
-    shown = [k for k in differ if k != "name"][:4]
-    names = ["archive", *shown]
-    labels = {"archive": distinguishing_labels(paths)}
-    for k in shown:
-        labels[k] = distinct_texts([f.get(k, "(unset)") for f in flat])
+    labels, differ = archive_labels(paths, [r.scenario.raw for r in results])
+    names = list(labels)
     keys = list(dict.fromkeys(k for r in results for k, v in r.summary.items() if _is_number(v)))
     numbers, units = {}, {}
     for k in keys:
@@ -147,8 +141,8 @@ def table_of_archives(paths) -> Table:
         numbers[k] = np.array([e[k] for e in errors])
         units[k] = "N s"
     notes = []
-    if len(differ) > len(shown) + ("name" in differ):
-        rest = [k for k in differ if k not in shown and k != "name"]
+    rest = [k for k in differ if k not in labels and k != "name"]
+    if rest:
         notes.append("scenario keys that also differ: " + ", ".join(rest))
     if not differ and len(results) > 1:
         notes.append("scenarios: identical")
@@ -158,6 +152,24 @@ def table_of_archives(paths) -> Table:
     footnotes = _run_notes([run_notes(r.notes) for r in results], names, labels)  # worded as an index's
     batches = [sem_batches(np.shape(r.per_rotation["I_dec"])[0]) for r in results]
     return Table(names, labels, numbers, units, notes, footnotes, batches)
+
+
+#: the most scenario keys that differ a table of archives shows as label columns (the others in a note)
+SHOWN_KEYS = 4
+
+
+def archive_labels(paths, scenarios) -> tuple[dict[str, list[str]], list[str]]:
+    """The label columns of a table of archives (``bearingsim table``, ``bearingsim wear``), a row per path:
+    ``archive`` (:func:`distinguishing_labels`) and the first :data:`SHOWN_KEYS` scenario keys that differ
+    between the raw scenario tables ``scenarios`` (``name`` aside), their values as the tables write them
+    (:func:`distinct_texts`, ``(unset)`` where a scenario lacks the key); and every key that differs."""
+    from bearingsim.scenario import differing_keys
+
+    rows = differing_keys(*scenarios)
+    labels = {"archive": distinguishing_labels(paths)}
+    for row in [row for row in rows if row[0] != "name"][:SHOWN_KEYS]:
+        labels[row[0]] = distinct_texts(list(row[1:]))
+    return labels, [row[0] for row in rows]
 
 
 def distinguishing_labels(paths) -> list[str]:

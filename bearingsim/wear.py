@@ -298,24 +298,26 @@ def format_report(rep: WearReport) -> str:
     return "\n".join(lines)
 
 
-def format_comparison(labels: list[str], reports: list[WearReport], notes: list[str] = ()) -> str:
-    """Several archives' :class:`WearReport` as one table, a row each (``labels``): the running time, Archard's
-    k and H of each, each face's worn volume mean over pockets with its standard error (batch means over the
-    recorded rotations), the deepest point and whether a cage bar wears through; ``notes`` above it (the
-    scenario keys that differ)."""
-    head = ("archive", "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]",
+def format_comparison(labels: dict[str, list[str]], reports: list[WearReport], notes: list[str] = ()) -> str:
+    """Several archives' :class:`WearReport` as one table, a row each, labelled by the columns ``labels`` (name
+    -> a cell per report: the archive and the values of the scenario keys that differ,
+    :func:`bearingsim.tables.archive_labels`): the running time, Archard's k and H of each, each face's worn
+    volume mean over pockets with its standard error (batch means over the recorded rotations), the deepest
+    point and whether a cage bar wears through; ``notes`` above it (the scenario keys that differ)."""
+    head = (*labels, "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]",
             "cage rotations", "cage bar")
+    nlab = len(labels)
     rows = []
-    for label, rep in zip(labels, reports):
+    for i, rep in enumerate(reports):
         def mean(face):
             v, e = (rep.volume_front if face == "front" else rep.volume_rear).mean(), rep.volume_sem(face)
             return with_error(v * 1e9, e * 1e9)
         through = rep.worn_through() if math.isfinite(rep.bar_width) else None
-        rows.append((label, f"{rep.hours:.4g}", f"{rep.wear_coefficient:g}", f"{rep.hardness:.3g}", mean("front"),
+        rows.append((*(col[i] for col in labels.values()), f"{rep.hours:.4g}", f"{rep.wear_coefficient:g}", f"{rep.hardness:.3g}", mean("front"),
                      mean("rear"), f"{rep.max_depth * 1e6:.4g}", str(rep.recorded_rotations),
                      f"worn through (pocket {through[0]})" if through else "intact"))
     widths = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
-    line = lambda cells: "  ".join(c.ljust(w) if j == 0 else c.rjust(w)  # noqa: E731
+    line = lambda cells: "  ".join(c.ljust(w) if j < nlab else c.rjust(w)  # noqa: E731
                                    for j, (c, w) in enumerate(zip(cells, widths))).rstrip()
     out = [*notes, line(head), *(line(r) for r in rows)]
     out.append("V: worn volume of one face, mean over pockets \u00b1 its standard error (batch means over the "

@@ -330,15 +330,18 @@ def test_wear_of_several_archives_is_one_table_of_their_volumes_with_errors(fast
     out, err = capsys.readouterr()
     assert code == 0, err
     lines = out.splitlines()
-    assert lines[0].endswith("scenario keys that differ: wear.hardness_Pa, wear.wear_coefficient"), lines[0]
+    assert lines[0].endswith("scenario keys that differ: wear.hardness_Pa, wear.wear_coefficient (as columns)")
+    # each row labelled by the values of the keys that differ, as bearingsim table labels it (was: the file alone)
+    assert lines[1].split()[:4] == ["archive", "wear.hardness_Pa", "wear.wear_coefficient", "hours"], lines[1]
     for path, row in zip((fast_run[1], other), lines[2:4]):
         rep = wear.wear_report(load(path), hours=10)
         cells = re.split(r"\s{2,}", row.strip())
-        assert cells[0] == path.name and cells[2] == f"{rep.wear_coefficient:g}"
-        for cell, face in zip(cells[4:6], ("front", "rear")):
+        assert cells[0] == path.name and cells[4] == f"{rep.wear_coefficient:g}"
+        assert cells[1:3] == [f"{rep.hardness:g}", f"{rep.wear_coefficient:g}"], cells
+        for cell, face in zip(cells[6:8], ("front", "rear")):
             v = (rep.volume_front if face == "front" else rep.volume_rear).mean()
             assert cell == with_error(v * 1e9, rep.volume_sem(face) * 1e9)  # as bearingsim table shows a value
-        assert cells[7] == "2"
+        assert cells[9] == "2"
     twin = tmp_path / "twin"
     twin.mkdir()
     shutil.copy(other, twin / fast_run[1].name)
@@ -1449,7 +1452,7 @@ def test_wear_counts_the_scenarios_own_worn_depth_in_the_deepest_point_and_the_c
     assert "the faces start worn" in text and "deepest 2900 um" in text
     assert f"deepest point of any face: {rep.max_depth * 1e6:.4g} um, the starting depth included" in text
     assert f"pocket {i}'s front face" in text and f"{depth * 1e3:.4g} mm deep together" in text
-    table = wear.format_comparison(["worn.h5"], [rep])
+    table = wear.format_comparison({"archive": ["worn.h5"]}, [rep])
     assert f"{rep.max_depth * 1e6:.4g}" in table and f"worn through (pocket {i})" in table
     title = load(path).plot_wear_profile(hours=10.0)._suptitle.get_text()
     assert "deepest 2900 µm, not drawn" in title and f"{depth * 1e6:.0f} µm deep, starting depth included" in title

@@ -414,12 +414,21 @@ def _pinched_note(result) -> str | None:
             f"{s_mm + 2e3 * depth:.4g} (now {s_mm:.4g}) frees them")
 
 
+#: the checks of :func:`checks_made` whose finding is a note, not a failure: :func:`check` notes it and the run
+#: is kept. The warm-up's is a statistical test (is the first recorded rotation still in the start's transient?
+#: :data:`START_TRANSIENT_FALSE_ALARM` of steady runs test positive), and a resting place that changes or a cage
+#: speed that drifts describe the run, valid as it is. A report shows such a check as "note", never "FAILED".
+NOTED_CHECKS = ("warm-up reached a steady state", "cage rests in one place",
+                "cage speed steady (no drift over the recorded rotations)")
+
+
 def checks_made(result) -> list[tuple[str, str, bool | None]]:
     """What :func:`check` verifies of ``result``, for a report: one ``(check, what was measured against
     its limit, passed)`` per check, with the limits :func:`check` uses (a report shows them beside the
     notes and the verdict of :func:`check` itself, which stays the one that refuses a run). ``passed`` is
     None for a check that could not be made of this result (too few recorded rotations; a cage-speed
-    drift, whose start and end speeds only a fresh run holds): the row says why, and is not a pass."""
+    drift, whose start and end speeds only a fresh run holds): the row says why, and is not a pass. ``passed``
+    False of a check in :data:`NOTED_CHECKS` is a note of the run, not a failure."""
     p = result.parameters
     summary = dict(result.summary)
     bad = _nonfinite(summary)

@@ -328,7 +328,9 @@ def _checks_blocks(result) -> list[dict]:
     from bearingsim.errors import SimulationUnstable
 
     rows = plausibility.checks_made(result)
-    blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok} for n, m, ok in rows]}]
+    blocks = [{"kind": "checks", "rows": [{"name": n, "measured": m, "passed": ok,
+                                           "noted": ok is False and n in plausibility.NOTED_CHECKS}
+                                          for n, m, ok in rows]}]
     try:
         again = plausibility.check(result)
         verdict = _checks_verdict(rows)
@@ -343,14 +345,18 @@ def _checks_blocks(result) -> list[dict]:
 
 def _checks_verdict(rows) -> str:
     """The sentence under the checks' table of an archive that :func:`bearingsim.plausibility.check` does not
-    refuse: every check passed, or which did not (they give the notes below it, the run is kept), and which
-    could not be made."""
+    refuse: every check passed, or which gave a note (:data:`bearingsim.plausibility.NOTED_CHECKS`: the notes
+    below, the run kept) or did not pass, and which could not be made."""
+    from bearingsim.plausibility import NOTED_CHECKS
+
     skipped = [n for n, _, ok in rows if ok is None]
-    failed = [n for n, _, ok in rows if ok is False]
-    if failed:
-        verdict = (f"Did not pass: {'; '.join(failed)}. No check that refuses a run failed, so 'bearingsim run' "
-                   "kept it (docs/reliability.md); read its numbers with the notes below. Checked again from this "
-                   "archive.")
+    noted = [n for n, _, ok in rows if ok is False and n in NOTED_CHECKS]
+    failed = [n for n, _, ok in rows if ok is False and n not in NOTED_CHECKS]
+    if failed or noted:
+        verdict = " ".join(part for part in [f"Did not pass: {'; '.join(failed)}." if failed else "",
+                            f"Noted (a finding, not a failure): {'; '.join(noted)}." if noted else "",
+                            "No check that refuses a run failed, so 'bearingsim run' kept it (docs/reliability.md); "
+                            "read its numbers with the notes below. Checked again from this archive."] if part)
     else:
         verdict = (("Every check passed" if not skipped else "Every check that could be made passed")
                    + ": 'bearingsim run' writes an archive only for a run that passes the checks that refuse a run "

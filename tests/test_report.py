@@ -529,11 +529,13 @@ def test_a_check_that_fails_is_shown_as_failed(runs):
 
 
 def test_a_check_that_gives_a_note_is_not_called_passed(runs, monkeypatch):
-    """A kept run whose warm-up and resting-place checks failed (they give notes; only the others refuse a
-    run) read "Every check that could be made passed" under the rows marked FAILED: the verdict names the
-    checks that did not pass and points to the notes."""
+    """A kept run whose warm-up and resting-place checks found something (they give notes; only the others
+    refuse a run) read "Every check that could be made passed" under the rows marked FAILED; then FAILED
+    for a warm-up bias of +0.11 %, the positive of a statistical test (is the first rotation still in the
+    start's transient?), which the command line words as a note. The rows read "note", the verdict names
+    them as noted, not failed, and points to the notes; FAILED stays for a check that failed."""
     from bearingsim import plausibility
-    from bearingsim.reports import _checks_blocks
+    from bearingsim.reports import Section, _checks_blocks, render
 
     rows = [("summary numbers finite", "8 numbers", True), ("warm-up reached a steady state", "+34.4 %", False),
             ("cage rests in one place", "31.5 deg", False), ("cage speed steady", "not evaluated", None)]
@@ -541,9 +543,18 @@ def test_a_check_that_gives_a_note_is_not_called_passed(runs, monkeypatch):
     monkeypatch.setattr(plausibility, "check", lambda result: ["bearingsim: note: the first recorded rotation ..."])
     blocks = _checks_blocks(bearingsim.load(runs / "r.h5"))
     verdict = blocks[1]["text"]
-    assert verdict.startswith("Did not pass: warm-up reached a steady state; cage rests in one place."), verdict
-    assert "Every check" not in verdict and "Not evaluated here, and no pass: cage speed steady" in verdict
+    assert verdict.startswith("Noted (a finding, not a failure): warm-up reached a steady state; cage rests in "
+                              "one place. No check that refuses a run failed"), verdict
+    assert "Every check" not in verdict and "Did not pass" not in verdict
+    assert "Not evaluated here, and no pass: cage speed steady" in verdict
     assert blocks[2]["items"] == ["the first recorded rotation ..."]
+    html = render("r", "r.h5", "run", [Section("checks", "Checks", blocks)])
+    assert html.count('<td class="noted">note</td>') == 2 and "FAILED" not in html
+    rows[0] = ("summary numbers finite", "8 numbers; not finite: I_dec_mean_Ns", False)
+    blocks = _checks_blocks(bearingsim.load(runs / "r.h5"))
+    assert blocks[1]["text"].startswith("Did not pass: summary numbers finite. Noted (a finding, not a failure): ")
+    html = render("r", "r.h5", "run", [Section("checks", "Checks", blocks)])
+    assert html.count('<td class="fail">FAILED</td>') == 1 and html.count('<td class="noted">note</td>') == 2
 
 
 def test_a_life_page_to_a_volume_limit_shows_the_volume_and_the_stages_notes(tmp_path):

@@ -434,10 +434,18 @@ _image_count = 0
 def _image_plists() -> tuple:
     """(file access, file creation) property lists of an in-memory file, built once per process: the
     ones h5py builds for ``File(name, "w", driver="core", backing_store=False)`` (same file), which it
-    would build again for every file (~40 us of a sweep case's archive)."""
-    from h5py._hl.files import make_fapl, make_fcpl
-
-    return make_fapl("core", backing_store=False), make_fcpl()
+    would build again for every file (~40 us of a sweep case's archive). Built with h5py's public
+    low-level API as its private ``h5py._hl.files.make_fapl`` and ``make_fcpl`` do, with their defaults
+    (library version bounds earliest to latest, alignment 1, core driver without backing store; object
+    times not tracked): ``make_fapl``'s arguments have defaults only since h5py 3.13."""
+    h5py = _lazy_h5py()
+    fapl = h5py.h5p.create(h5py.h5p.FILE_ACCESS)
+    fapl.set_libver_bounds(h5py.h5f.LIBVER_EARLIEST, h5py.h5f.LIBVER_LATEST)
+    fapl.set_alignment(1, 1)
+    fapl.set_fapl_core(backing_store=False)
+    fcpl = h5py.h5p.create(h5py.h5p.FILE_CREATE)
+    fcpl.set_obj_track_times(False)
+    return fapl, fcpl
 
 
 def to_bytes(result) -> bytes:

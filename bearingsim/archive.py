@@ -1269,7 +1269,8 @@ def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
     (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
     stores none), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``, ``notes``
-    (the run's stored notes, :func:`read_notes`; None if it stores none). None for a missing, unreadable,
+    (the run's stored notes, :func:`read_notes`; None if it stores none), ``wear`` (the attributes of
+    ``/results/wear``: a reduced run's wear rates; {} without them). None for a missing, unreadable,
     damaged or incomplete file (never trusted)."""
     h5py = _lazy_h5py()
     path = Path(path)
@@ -1294,6 +1295,7 @@ def peek(path) -> dict[str, Any] | None:
                 "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
                 "notes": read_notes(f, path),
+                "wear": group_attrs(f["results/wear"])[0] if "results/wear" in f else {},
             }
     except (*H5_ERRORS, UserError):  # damaged, in any way h5py tells
         return None

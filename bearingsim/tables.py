@@ -43,11 +43,12 @@ MIXED_MODELS = ("rows of both models: the reduced model's '± 0' is its exactnes
                 "which 'bearingsim crosscheck' takes apart assumption by assumption (docs/crosscheck.md)")
 #: number columns shown by default, those present
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
-                   "load_zone_half_angle_deg")
+                   "load_zone_half_angle_deg", "wear_front_mean_m3_h", "wear_rear_mean_m3_h")
 #: summary keys with a standard error (the key of the error)
-SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns"}
+SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns",
+          "wear_front_mean_m3_h": "wear_front_sem_m3_h", "wear_rear_mean_m3_h": "wear_rear_sem_m3_h"}
 #: display scale and unit of units that read better scaled
-SCALED = {"N s": (1e3, "mN s")}
+SCALED = {"N s": (1e3, "mN s"), "m^3/h": (1e9, "mm^3/h")}
 #: display scale and unit of keys stored as a fraction (unit 1) that read better in per cent
 SCALED_KEYS = {"cage_slip": (100.0, "%")}
 
@@ -137,7 +138,7 @@ def table_of_archives(paths) -> Table:
         numbers[k] = np.array([float(r.summary.get(k, math.nan)) for r in results])
         units[k] = next((r.summary_units.get(k) for r in results if k in r.summary_units), "1")
     errors = [result_standard_errors(r) for r in results]
-    for k in SEM_OF.values():
+    for k in ("I_dec_sem_Ns", "I_acc_sem_Ns"):  # an archive's summary has no wear rates (a sweep's index does)
         numbers[k] = np.array([e[k] for e in errors])
         units[k] = "N s"
     notes = []

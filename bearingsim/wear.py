@@ -258,6 +258,58 @@ def wear_report(result, *, hours: float | None = None, rotations: float | None =
                       bar_width(result.scenario), *start_depth(p, psi))
 
 
+#: The wear rates a sweep's index holds for each case (docs/sweeps.md, *Wear in a sweep*), name -> description:
+#: the worn volume of one face per hour of running at the case's speed [m^3/h], what ``bearingsim wear ARCHIVE
+#: --hours 1`` gives (:func:`sweep_rates`)
+SWEEP_RATES = {
+    "wear_front_mean_m3_h": "worn volume of a front face per hour of running, mean over pockets",
+    "wear_front_sem_m3_h": "standard error of wear_front_mean (batch means over the recorded rotations; 0 for the "
+                           "reduced model, exact)",
+    "wear_front_worst_m3_h": "worn volume per hour of the most worn front face (multibody model)",
+    "wear_rear_mean_m3_h": "worn volume of a rear face per hour of running, mean over pockets",
+    "wear_rear_sem_m3_h": "standard error of wear_rear_mean (batch means over the recorded rotations; 0 for the "
+                          "reduced model, exact)",
+    "wear_rear_worst_m3_h": "worn volume per hour of the most worn rear face (multibody model)",
+}
+#: the running time of :data:`SWEEP_RATES` [h]: the volumes after it are the rates per hour
+RATE_HOURS = 1.0
+
+
+def sweep_rates(result) -> dict[str, float]:
+    """The wear rates of :data:`SWEEP_RATES` of ``result`` [m^3/h]. Multibody: the :class:`WearReport` after
+    :data:`RATE_HOURS` (``bearingsim wear ARCHIVE --hours 1``, the same bits): each face's volume mean over pockets,
+    its standard error (:meth:`WearReport.volume_sem`) and the largest; a wear coefficient of 0 wears nothing (0);
+    {} for a result without a wear profile or a measured cage speed. Reduced: the no-load pass's Archard wear per
+    hour (``/results/wear``, Eq. 16 of the impulses, one pocket; :data:`bearingsim.reduced.WEAR_DESCRIPTION`),
+    standard error 0 (its rotations repeat one pass), no worst pocket; {} without that group."""
+    if result.model == "reduced":
+        group = result.groups.get("results/wear")
+        return reduced_rates(group.attrs if group is not None else {})
+    if not has_profile(result):
+        return {}
+    if not result.parameters.wear.wear_coefficient > 0.0:  # nothing wears: wear_report refuses to report it
+        return dict.fromkeys(SWEEP_RATES, 0.0)
+    try:
+        rep = wear_report(result, hours=RATE_HOURS)
+    except UserError:  # no measured cage speed: no running time
+        return {}
+    out = {}
+    for f in ("front", "rear"):
+        v = rep.volume_front if f == "front" else rep.volume_rear
+        out.update({f"wear_{f}_mean_m3_h": float(v.mean()), f"wear_{f}_sem_m3_h": float(rep.volume_sem(f)),
+                    f"wear_{f}_worst_m3_h": float(v.max())})
+    return out
+
+
+def reduced_rates(wear_attrs: dict) -> dict[str, float]:
+    """The :data:`SWEEP_RATES` of a reduced-model result from its ``/results/wear`` attributes ``wear_attrs``: each
+    face's wear per hour, standard error 0 (its rotations repeat one pass); {} without them."""
+    if not all(f"{f}_per_hour_m3_h" in wear_attrs for f in ("front", "rear")):
+        return {}
+    return {k: v for f in ("front", "rear") for k, v in ((f"wear_{f}_mean_m3_h", float(wear_attrs[f"{f}_per_hour_m3_h"])),
+                                                         (f"wear_{f}_sem_m3_h", 0.0))}
+
+
 def format_report(rep: WearReport) -> str:
     """The report as text: running time, k and H, per pocket the worn volumes and deepest points, the
     spread over pockets, and the mean depth profile at the face's ends and middle."""

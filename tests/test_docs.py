@@ -409,6 +409,7 @@ def test_commands_page_names_every_default_column_of_table():
     sentence = sentence[:sentence.index("those present")]
     words = {"I_dec_mean_Ns": "`I_dec_mean`", "I_acc_mean_Ns": "`I_acc_mean`",
              "first_impact_speed_m_s": "first impact speed", "cage_slip": "cage slip",
-             "cage_rest_angle_deg": "`cage_rest_angle` [deg]", "load_zone_half_angle_deg": "load-zone half angle"}
+             "cage_rest_angle_deg": "`cage_rest_angle` [deg]", "load_zone_half_angle_deg": "load-zone half angle",
+             "wear_front_mean_m3_h": "`wear_front_mean`", "wear_rear_mean_m3_h": "`wear_rear_mean`"}
     assert set(words) == set(DEFAULT_COLUMNS)
     assert [k for k, w in words.items() if w not in sentence] == [], sentence

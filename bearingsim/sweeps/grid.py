@@ -105,6 +105,8 @@ def _coordinate(values: list) -> np.ndarray:
 def write_map(path: Path, axes: list[tuple[str, list]], columns: dict[str, np.ndarray], attrs: dict) -> Path:
     """Write ``map.h5`` at ``path`` from the index ``columns`` (one array per index column, the grid's
     cases first, in product order over ``axes``) atomically; return the path."""
+    from bearingsim.wear import SWEEP_RATES
+
     shape = tuple(len(v) for _, v in axes)
     n = math.prod(shape)
     keys = [k for k, _ in axes]
@@ -120,7 +122,7 @@ def write_map(path: Path, axes: list[tuple[str, list]], columns: dict[str, np.nd
         if name in keys or name in NOT_MAPPED:
             continue
         arr = np.asarray(col)[:n].reshape(shape)
-        a = {"long_name": LONG_NAMES.get(name, name_of(name))}
+        a = {"long_name": LONG_NAMES.get(name) or SWEEP_RATES.get(name) or name_of(name)}
         if arr.dtype.kind == "f" and name != "model_version":
             a["units"] = unit_of(name)
         variables[name] = (arr, a)

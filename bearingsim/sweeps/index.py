@@ -47,11 +47,15 @@ PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "
 
 
 def summary_columns(rows: list[dict]) -> list[str]:
-    """Summary number names present in ``rows``: the preferred ones first, then the rest sorted."""
+    """Summary number names present in ``rows``: the preferred ones first, then the rest sorted, then the wear
+    rates (:data:`bearingsim.wear.SWEEP_RATES`, last: the columns an index had before them keep their places)."""
+    from bearingsim.wear import SWEEP_RATES
+
     present = set()
     for r in rows:
         present.update(r.get("summary", {}))
-    return [k for k in PREFERRED if k in present] + sorted(present - set(PREFERRED))
+    return ([k for k in PREFERRED if k in present] + sorted(present - set(PREFERRED) - set(SWEEP_RATES))
+            + [k for k in SWEEP_RATES if k in present])
 
 
 def _is_number(v) -> bool:
@@ -147,13 +151,20 @@ class IndexWriter:
         text = buf.getvalue() + "".join(self._lines)
         write_atomic_bytes(csv_path, text.encode("utf-8"))
         attrs = {"format": INDEX_FORMAT, "columns": json.dumps(columns), "axes": json.dumps(keys), **self.meta}
-        archive.write_table_file(h5_path, {c: cols[c] for c in columns}, self._units, attrs)
+        archive.write_table_file(h5_path, {c: cols[c] for c in columns}, self._units, attrs, _descriptions())
         return csv_path, h5_path
 
     @property
     def columns(self) -> dict[str, np.ndarray]:
         """The index's columns as last written (one array per column, in column order)."""
         return {c: self._cols[c] for c in ["case", *self.keys, *FIXED, *(self._summ or [])]}
+
+
+def _descriptions() -> dict[str, str]:
+    """The descriptions ``sweep.h5`` stores with its columns: those of the wear rates."""
+    from bearingsim.wear import SWEEP_RATES
+
+    return dict(SWEEP_RATES)
 
 
 def notes_text(notes) -> str:
@@ -220,8 +231,8 @@ def index_dataframe(path, units_in_names: bool = False):
 
 # unit suffixes of scenario and summary keys -> unit text for labels
 # (first match wins: "_N_m" before "_m", "_m_s" before "_s")
-UNITS = (("_kgm2", "kg m²"), ("_N_m", "N/m"), ("_Nms", "N m s"), ("_Ns", "N s"), ("_m_s", "m/s"), ("_rad_s", "rad/s"),
-         ("_mm", "mm"), ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"), ("_hz", "Hz"), ("_N", "N"),
+UNITS = (("_m3_h", "m^3/h"), ("_kgm2", "kg m²"), ("_N_m", "N/m"), ("_Nms", "N m s"), ("_Ns", "N s"), ("_m_s", "m/s"),
+         ("_rad_s", "rad/s"), ("_mm", "mm"), ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"), ("_hz", "Hz"), ("_N", "N"),
          ("_J", "J"), ("_s", "s"), ("_um", "µm"), ("_m", "m"))
 
 
@@ -266,6 +277,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     """
     from bearingsim.model_versions import MODEL_VERSIONS
     from bearingsim.stats import impulse_standard_errors as standard_errors
+    from bearingsim.wear import reduced_rates
 
     got = archive.peek(archive_path)
     if got is None or got["scenario"] != toml_text:
@@ -274,6 +286,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
         return {"status": "stale"}
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
     summary.update(standard_errors(got["I_dec"], got["I_acc"], got["model"]))
+    summary.update(reduced_rates(got["wear"]) if got["model"] == "reduced" else archive_rates(archive_path))
     wall = got["wall_time_s"]
     rec = {"status": "cached", "error": "", "wall_s": wall, "summary": summary, "model_version": got["model_version"]}
     if got.get("notes") is not None:  # an archive that stores its run's notes
@@ -281,6 +294,24 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
 
         rec["notes"] = run_notes([got["notes"]] if isinstance(got["notes"], str) else got["notes"])
     return rec
+
+
+#: what :func:`archive_rates` reads of an archive beside its summary and scenario
+RATE_DATA = ("results/per_rotation", "results/wear")
+
+
+def archive_rates(path: Path) -> dict[str, float]:
+    """The wear rates of the complete multibody archive ``path`` (:func:`bearingsim.wear.sweep_rates`, the numbers
+    a case run now records; a reduced archive's come with :func:`bearingsim.archive.peek`); {} for an archive that
+    cannot be read."""
+    from bearingsim.errors import UserError
+    from bearingsim.simulation import load
+    from bearingsim.wear import sweep_rates
+
+    try:
+        return sweep_rates(load(path, only=RATE_DATA))
+    except (UserError, OSError):
+        return {}
 
 
 #: statuses of an index row whose numbers a resumed sweep may take (when its model version matches)
@@ -317,13 +348,17 @@ def trusted_row(row: dict | None, model: str) -> dict | None:
     ``cached`` or ``stale``) computed by the current version of ``model``
     (:data:`bearingsim.model_versions.MODEL_VERSIONS`); ``{"status": "stale"}`` when they came from
     another version or an index that recorded none; None (run it) for no row, or a failed or pending
-    one. The row is the case's because the index names it by the content hash of its scenario."""
+    one, or a row of an index written before the wear rates (:data:`bearingsim.wear.SWEEP_RATES`), which it has
+    none of. The row is the case's because the index names it by the content hash of its scenario."""
     from bearingsim.model_versions import MODEL_VERSIONS
+    from bearingsim.wear import SWEEP_RATES
 
     if row is None or row["status"] not in HAS_NUMBERS:
         return None
     if row["model_version"] is None or row["model_version"] != MODEL_VERSIONS.get(model):
         return {"status": "stale"}
+    if next(iter(SWEEP_RATES)) not in row["summary"]:  # an index written before the wear rates: run to get them
+        return None
     return {"status": "cached", "error": "", "wall_s": row["wall_s"], "summary": dict(row["summary"]),
             "model_version": row["model_version"], "notes": list(row.get("notes", ()))}
 

@@ -108,10 +108,12 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
     wall time, ``wall_time_s`` of its provenance, which its archive stores; of a failed case, the time to
     its failure),
     ``model_version`` (of the model that computed it), ``notes`` (the run's plausibility notes,
-    :func:`bearingsim.wording.run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`.
+    :func:`bearingsim.wording.run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`
+    and the wear rates of :func:`bearingsim.wear.sweep_rates`.
     """
     from bearingsim.scenario import Scenario
     from bearingsim.sweeps.spec import scenario_from_toml
+    from bearingsim.wear import sweep_rates
 
     t0 = time.perf_counter()
     data = None
@@ -137,6 +139,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
                 data = path.read_bytes()
         summary = _numbers(res.summary)
         summary.update(standard_errors(*_per_rotation(res), scenario.model))
+        summary.update(sweep_rates(res))  # the wear rates, as 'bearingsim wear' computes them (docs/sweeps.md)
         # the run's own wall time, the one its archive stores: the same number when the case is cached later
         wall = res.provenance.get("wall_time_s")
         rec = {"hash": case_hash, "status": "done", "error": "",

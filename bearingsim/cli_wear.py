@@ -35,6 +35,10 @@ def _cmd_wear(args) -> int:
     from bearingsim.plotting import save_figure
 
     paths = [Path(a) for a in args.archive]
+    folder = _sweep_folder(paths)
+    if folder is not None:  # a sweep's folder: the wear of its cases, a row each (no figures)
+        say(args)(_sweep_wear(folder, args))
+        return 0
     seen = {}
     for path in paths:  # one archive twice would be one row twice, its figures drawn twice onto each other
         first = seen.setdefault(path.resolve(), path)
@@ -80,6 +84,106 @@ def _comparison(paths, done) -> str:
     return wear.format_comparison(labels, [rep for _, rep in done], notes)
 
 
+def _sweep_folder(paths: list[Path]) -> Path | None:
+    """The sweep (or study) folder of the one path given, the folder or its index ``sweep.h5``; None otherwise."""
+    from bearingsim import archive
+    from bearingsim.sweeps.index import INDEX_FORMAT
+
+    if len(paths) != 1:
+        return None
+    path = paths[0]
+    if path.is_dir() and (path / "sweep.h5").is_file():
+        return path
+    return path.parent if path.is_file() and archive.is_table_file(path, INDEX_FORMAT) else None
+
+
+def _sweep_wear(folder: Path, args) -> str:
+    """The wear table of the sweep in ``folder`` (docs/wear.md, *A sweep's wear*): a row per case labelled by the
+    values of the swept keys that differ (:func:`bearingsim.tables.archive_labels`, as ``bearingsim table`` labels
+    archives), from its archive (:func:`_case_wear`), or from the index's wear rates; a case of neither named
+    under the table as not available, with why."""
+    from bearingsim import wear
+    from bearingsim.sweeps.index import read_index
+    from bearingsim.tables import archive_labels
+
+    _check_time(args)
+    cols, meta = read_index(folder / "sweep.h5")
+    n = len(cols["case"])
+    axes = [k for k in meta["axes"] if k in cols]
+    cases = [str(c) for c in cols["case"]]
+    labels, differ = archive_labels(cases, [{k: cols[k][i] for k in axes} for i in range(n)])
+    labels = {("case" if k == "archive" else k): v for k, v in labels.items()}
+    rows, missing = [], []
+    for i in range(n):
+        cells, why = _case_wear(folder, cols, i, args)
+        rows.append(cells)
+        if why:
+            missing.append(f"not available: case {cases[i]}"
+                           + "".join(f", {k} = {labels[k][i]}" for k in labels if k != "case") + f": {why}")
+    notes = [f"wear of the {n} cases of the sweep {folder}, each after the running time at its own speed; swept keys "
+             f"that differ: {', '.join(differ) if differ else 'none'}"
+             + ("" if len(labels) == 1 else " (as columns)" if len(labels) > len(differ)
+                else f" (the first {len(labels) - 1} as columns)")]
+    table = wear.format_comparison(labels, rows, notes)
+    rated = any(not isinstance(r, wear.WearReport) and r[3] != "-" for r in rows)  # a row of the index's rates
+    return "\n".join([table, *missing, *([SWEEP_ROWS] if rated else [])])
+
+
+#: the line under the wear table of a sweep's folder that says where its rows come from
+SWEEP_ROWS = ("a case with a multibody archive: its wear as 'bearingsim wear ARCHIVE' computes it; a case without one "
+              "(a reduced case: always, its model has no wear profile): the index's wear rates per hour "
+              "(wear_*_mean_m3_h, wear_*_sem_m3_h) times the hours, '-' where they do not tell; a reduced case's "
+              "wear is Archard's law on its no-load pass's impulses (Eq. 16), not on the sliding work (docs/wear.md)")
+
+
+def _check_time(args) -> None:
+    """Refuse a running time no case could take (:func:`bearingsim.wear.running_time`'s bounds, in hours; the
+    rotations' bound depends on each case's speed), naming the option, before any case is read."""
+    import math
+
+    from bearingsim.wear import MAX_RUNNING_HOURS
+
+    value, name = (args.hours, "--hours") if args.hours is not None else (args.rotations, "--rotations")
+    if not (math.isfinite(value) and value > 0):
+        raise UserError(f"{name} {value!r}: must be a positive number")
+    if args.hours is not None and value > MAX_RUNNING_HOURS:
+        raise UserError(f"--hours {value:g}: more than {MAX_RUNNING_HOURS:g} h of running, 114 years, ten times the "
+                        f"longest life a bearing is designed for; give a shorter running time")
+
+
+def _case_wear(folder: Path, cols: dict, i: int, args) -> tuple:
+    """(the cells of case ``i``'s row of the sweep's wear table after its labels, why it is not available or "")."""
+    import math
+
+    from bearingsim import wear
+    from bearingsim.cli_common import options_named
+    from bearingsim.simulation import load
+
+    status, stored = str(cols["status"][i]), str(cols["archive"][i])
+    if status not in ("done", "cached", "stale"):
+        error = str(cols["error"][i]) if "error" in cols else ""
+        return wear.rate_cells(None, 0.0), f"the case is {status}" + (f" ({error})" if error else "")
+    path = folder / stored if stored else None
+    if path is not None and path.is_file():
+        try:
+            result = load(path)
+            if result.model == "multibody":
+                with options_named("hours", "rotations"):
+                    return wear.wear_report(result, hours=args.hours, rotations=args.rotations), ""
+        except UserError as exc:
+            if str(exc).startswith("--"):  # the running time's refusal (options_named): the command's, not the case's
+                raise
+            return wear.rate_cells(None, 0.0), f"{stored}: {exc}"
+    rates = {k: float(cols[k][i]) for k in wear.SWEEP_RATES if k in cols}
+    if not all(math.isfinite(rates.get(f"wear_{f}_{q}_m3_h", math.nan)) for f in ("front", "rear")
+               for q in ("mean", "sem")):
+        return wear.rate_cells(None, 0.0), ("no archive, and no wear rates in the index (one written before them: "
+                                            "the same sweep command run again adds them)")
+    if args.hours is None:
+        return wear.rate_cells(None, 0.0), "no archive, and the index's wear rates are per hour: give --hours"
+    return wear.rate_cells(rates, args.hours), ""
+
+
 def _cmd_life(args) -> int:
     from bearingsim.cli_common import given_once, progress_wanted, report_study
     from bearingsim.scenario import load_scenario
@@ -118,7 +222,8 @@ def add_commands(sub) -> None:
     """Register ``wear`` and ``life`` on the subparsers ``sub``."""
     w = sub.add_parser("wear", help="worn depth profile and volume of every pocket face after a running time "
                                     "(from a multibody archive's wear profile)")
-    w.add_argument("archive", nargs="+", help="multibody archive (.h5); several: one table of their wear, a row each")
+    w.add_argument("archive", nargs="+", help="multibody archive (.h5); several: one table of their wear, a row each; "
+                                              "a sweep's folder: the wear of its cases, a row each")
     t = w.add_mutually_exclusive_group(required=True)
     t.add_argument("--hours", type=float, help="running time [h] at the archive's speed")
     t.add_argument("--rotations", type=float, help="running time as inner-ring (shaft) rotations")

@@ -350,24 +350,18 @@ def format_report(rep: WearReport) -> str:
     return "\n".join(lines)
 
 
-def format_comparison(labels: dict[str, list[str]], reports: list[WearReport], notes: list[str] = ()) -> str:
+def format_comparison(labels: dict[str, list[str]], reports: list, notes: list[str] = ()) -> str:
     """Several archives' :class:`WearReport` as one table, a row each, labelled by the columns ``labels`` (name
     -> a cell per report: the archive and the values of the scenario keys that differ,
     :func:`bearingsim.tables.archive_labels`): the running time, Archard's k and H of each, each face's worn
     volume mean over pockets with its standard error (batch means over the recorded rotations), the deepest
-    point and whether a cage bar wears through; ``notes`` above it (the scenario keys that differ)."""
+    point and whether a cage bar wears through; ``notes`` above it (the scenario keys that differ). A row given
+    as its cells instead of a report (a sweep's case without an archive: :func:`rate_cells`) is shown as given."""
     head = (*labels, "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]",
             "cage rotations", "cage bar")
     nlab = len(labels)
-    rows = []
-    for i, rep in enumerate(reports):
-        def mean(face):
-            v, e = (rep.volume_front if face == "front" else rep.volume_rear).mean(), rep.volume_sem(face)
-            return with_error(v * 1e9, e * 1e9)
-        through = rep.worn_through() if math.isfinite(rep.bar_width) else None
-        rows.append((*(col[i] for col in labels.values()), f"{rep.hours:.4g}", f"{rep.wear_coefficient:g}", f"{rep.hardness:.3g}", mean("front"),
-                     mean("rear"), f"{rep.max_depth * 1e6:.4g}", str(rep.recorded_rotations),
-                     f"worn through (pocket {through[0]})" if through else "intact"))
+    rows = [(*(col[i] for col in labels.values()), *(report_cells(rep) if isinstance(rep, WearReport) else rep))
+            for i, rep in enumerate(reports)]
     widths = [max(len(h), *(len(r[j]) for r in rows)) for j, h in enumerate(head)]
     line = lambda cells: "  ".join(c.ljust(w) if j < nlab else c.rjust(w)  # noqa: E731
                                    for j, (c, w) in enumerate(zip(cells, widths))).rstrip()
@@ -378,6 +372,32 @@ def format_comparison(labels: dict[str, list[str]], reports: list[WearReport], n
                "whether the two faces on one bar, starting depth included, wear through it ('bearingsim wear ARCHIVE' "
                "gives one archive's whole report)")
     return "\n".join(out)
+
+
+def report_cells(rep: WearReport) -> tuple[str, ...]:
+    """The cells of one report's row of :func:`format_comparison` after its labels."""
+    def mean(face):
+        v, e = (rep.volume_front if face == "front" else rep.volume_rear).mean(), rep.volume_sem(face)
+        return with_error(v * 1e9, e * 1e9)
+
+    through = rep.worn_through() if math.isfinite(rep.bar_width) else None
+    return (f"{rep.hours:.4g}", f"{rep.wear_coefficient:g}", f"{rep.hardness:.3g}", mean("front"), mean("rear"),
+            f"{rep.max_depth * 1e6:.4g}", str(rep.recorded_rotations),
+            f"worn through (pocket {through[0]})" if through else "intact")
+
+
+def rate_cells(rates: dict[str, float] | None, hours: float) -> tuple[str, ...]:
+    """The cells of :func:`format_comparison`'s row of a case known by its wear rates alone (``rates``: a sweep
+    index's :data:`SWEEP_RATES` of the case [m^3/h]) after ``hours``: each face's volume, the rate times the
+    hours, and its standard error so; '-' where the rates do not tell (k, H, the deepest point, the recorded
+    rotations, the cage bar), and every cell '-' for ``rates`` None (not available)."""
+    if rates is None:
+        return ("-",) * 8
+
+    def mean(face):
+        return with_error(rates[f"wear_{face}_mean_m3_h"] * hours * 1e9, rates[f"wear_{face}_sem_m3_h"] * hours * 1e9)
+
+    return f"{hours:.4g}", "-", "-", mean("front"), mean("rear"), "-", "-", "-"
 
 
 def bar_line(rep: WearReport) -> str:

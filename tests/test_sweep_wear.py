@@ -1,5 +1,5 @@
-"""The wear of a sweep's cases: the rates its index carries (``wear_*_m3_h``), its table and map (docs/sweeps.md,
-*Wear in a sweep*)."""
+"""The wear of a sweep's cases: the rates its index carries (``wear_*_m3_h``), its table and map, and
+``bearingsim wear DIR`` (docs/sweeps.md, *Wear in a sweep*; docs/wear.md, *A sweep's wear*)."""
 import re
 import shutil
 
@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from bearingsim import tables, wear
+from bearingsim.cli import main
 from bearingsim.scenario import load_scenario
 from bearingsim.simulation import load, run as simulate
 from bearingsim.stats import with_error
@@ -37,10 +38,10 @@ def _cells(line: str) -> list[str]:
 
 
 @pytest.mark.slow
-def test_a_multibody_sweeps_index_holds_the_wear_bearingsim_wear_computes_from_each_cases_archive(mb_sweep):
-    """An engineer sweeping k read impulses only: the index (sweep.h5, map.h5) and its table now carry each case's
-    worn volume per hour, bit for bit what 'bearingsim wear ARCHIVE --hours 1' computes, with its standard error and
-    the worst pocket's."""
+def test_a_multibody_sweeps_index_holds_the_wear_bearingsim_wear_computes_from_each_cases_archive(mb_sweep, capsys):
+    """An engineer sweeping k read impulses only: the index (sweep.h5, map.h5), its table and 'bearingsim wear DIR'
+    now carry each case's worn volume per hour, bit for bit what 'bearingsim wear ARCHIVE --hours 1' computes, with
+    its standard error and the worst pocket's; 'wear DIR' labels the rows by the swept values (it was refused)."""
     folder, _ = mb_sweep
     cols, meta = read_index(folder / "sweep.h5")
     assert list(cols["status"]) == ["done", "done"]
@@ -63,6 +64,18 @@ def test_a_multibody_sweeps_index_holds_the_wear_bearingsim_wear_computes_from_e
     assert head[-2:] == ["wear_front_mean [mm^3/h]", "wear_rear_mean [mm^3/h]"], head
     assert _cells(text.splitlines()[2])[-2] == with_error(cols["wear_front_mean_m3_h"][0] * 1e9,
                                                           cols["wear_front_sem_m3_h"][0] * 1e9)
+    assert main(["wear", str(folder), "--hours", "10"]) == 0
+    out, err = capsys.readouterr()
+    lines = out.splitlines()
+    assert "wear of the 2 cases of the sweep" in lines[0] and lines[0].endswith(f"differ: {K} (as columns)")
+    assert _cells(lines[1])[:3] == ["case", K, "hours"]
+    for i, line in enumerate(lines[2:4]):
+        rep = wear.wear_report(load(folder / str(cols["archive"][i])), hours=10)
+        cells = _cells(line)
+        assert cells[:2] == [str(cols["case"][i]), ("5e-06", "1e-05")[i]]
+        assert cells[5:7] == [with_error(v.mean() * 1e9, rep.volume_sem(f) * 1e9)
+                              for f, v in (("front", rep.volume_front), ("rear", rep.volume_rear))]
+    assert not list(folder.glob("**/*.png"))  # a sweep's wear draws no figures
 
 
 @pytest.mark.slow
@@ -86,9 +99,10 @@ def reduced_sweep(tmp_path_factory):
 
 
 @pytest.mark.slow
-def test_a_reduced_sweeps_index_holds_its_models_wear(reduced_sweep):
-    """The reduced model's wear per hour (its archive's /results/wear, Eq. 16), exact (± 0), no worst pocket; a
-    case cached from its archive takes the same."""
+def test_a_reduced_sweeps_index_holds_its_models_wear_and_wear_dir_reads_it(reduced_sweep, capsys):
+    """The reduced model's wear per hour (its archive's /results/wear, Eq. 16), exact (± 0), no worst pocket;
+    'wear DIR' of its cases, which keep no archive, multiplies the index's rate by the hours; with --rotations
+    (the index's rates are per hour) each case is named as not available."""
     cols, _ = read_index(reduced_sweep / "sweep.h5")
     assert list(cols["archive"]) == ["", ""]
     for i, s in enumerate((0.18, 0.22)):
@@ -105,12 +119,27 @@ def test_a_reduced_sweeps_index_holds_its_models_wear(reduced_sweep):
         assert list(again["status"]) == [status] * 2
         for k in ("wear_front_mean_m3_h", "wear_rear_mean_m3_h", "wear_rear_sem_m3_h"):
             np.testing.assert_array_equal(again[k], cols[k])
+    assert main(["wear", str(reduced_sweep), "--hours", "2"]) == 0
+    out, _ = capsys.readouterr()
+    lines = out.splitlines()
+    for i, line in enumerate(lines[2:4]):
+        cells = _cells(line)
+        assert cells[1] == ("0.18", "0.22")[i]
+        assert cells[5] == with_error(cols["wear_front_mean_m3_h"][i] * 2 * 1e9, 0.0)
+        assert cells[-1] == "-"
+    assert "Eq. 16" in lines[-1]
+    assert main(["wear", str(reduced_sweep / "sweep.h5"), "--rotations", "1e5"]) == 0
+    out, _ = capsys.readouterr()
+    assert out.count("not available: case") == 2 and "give --hours" in out
+    assert main(["wear", str(reduced_sweep), "--hours", "-1"]) == 2
+    assert "--hours -1.0: must be a positive number" in capsys.readouterr().err
 
 
 @pytest.mark.slow
-def test_an_index_written_before_the_wear_rates_is_read_tabulated_and_resumed(tmp_path):
-    """An index the code before these columns wrote (tests/data) reads and tabulates (no wear column); resumed, its
-    cases (no archives) run again to get their rates, the impulses the same bits."""
+def test_an_index_written_before_the_wear_rates_is_read_tabulated_and_resumed(tmp_path, capsys):
+    """An index the code before these columns wrote (tests/data) reads, tabulates (no wear column) and gives 'wear
+    DIR' its cases as not available; resumed, its cases (no archives) run again to get their rates, the impulses
+    the same bits."""
     folder = tmp_path / "sw"
     folder.mkdir()
     shutil.copy(OLD_INDEX, folder / "sweep.h5")
@@ -118,6 +147,9 @@ def test_an_index_written_before_the_wear_rates_is_read_tabulated_and_resumed(tm
     assert "wear_front_mean_m3_h" not in old
     text = tables.format_table(tables.table_of(folder))
     assert "I_dec_mean [mN s]" in text and "wear" not in text.splitlines()[1]
+    assert main(["wear", str(folder), "--hours", "1"]) == 0
+    out, _ = capsys.readouterr()
+    assert out.count("no wear rates in the index") == 2
     spec = SweepSpec(scenario=SCENARIOS / "paper_3000rpm.toml", axes=[(CLEARANCE, [0.18, 0.22])])
     run_sweep(spec, folder, engine=LocalEngine(1), figures=False, progress=False)
     new, _ = read_index(folder / "sweep.h5")

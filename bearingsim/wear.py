@@ -306,8 +306,10 @@ def reduced_rates(wear_attrs: dict) -> dict[str, float]:
     face's wear per hour, standard error 0 (its rotations repeat one pass); {} without them."""
     if not all(f"{f}_per_hour_m3_h" in wear_attrs for f in ("front", "rear")):
         return {}
-    return {k: v for f in ("front", "rear") for k, v in ((f"wear_{f}_mean_m3_h", float(wear_attrs[f"{f}_per_hour_m3_h"])),
-                                                         (f"wear_{f}_sem_m3_h", 0.0))}
+    out = {}
+    for f in ("front", "rear"):
+        out.update({f"wear_{f}_mean_m3_h": float(wear_attrs[f"{f}_per_hour_m3_h"]), f"wear_{f}_sem_m3_h": 0.0})
+    return out
 
 
 def format_report(rep: WearReport) -> str:

@@ -232,8 +232,8 @@ def index_dataframe(path, units_in_names: bool = False):
 # unit suffixes of scenario and summary keys -> unit text for labels
 # (first match wins: "_N_m" before "_m", "_m_s" before "_s")
 UNITS = (("_m3_h", "m^3/h"), ("_kgm2", "kg m²"), ("_N_m", "N/m"), ("_Nms", "N m s"), ("_Ns", "N s"), ("_m_s", "m/s"),
-         ("_rad_s", "rad/s"), ("_mm", "mm"), ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"), ("_hz", "Hz"), ("_N", "N"),
-         ("_J", "J"), ("_s", "s"), ("_um", "µm"), ("_m", "m"))
+         ("_rad_s", "rad/s"), ("_mm", "mm"), ("_rpm", "rpm"), ("_kg", "kg"), ("_deg", "deg"), ("_Pa", "Pa"),
+         ("_hz", "Hz"), ("_N", "N"), ("_J", "J"), ("_s", "s"), ("_um", "µm"), ("_m", "m"))
 
 
 #: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md)

@@ -201,24 +201,42 @@ def test_save_refuses_a_symbolic_link_as_figures_do(tmp_path, base_reduced):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling.h5", "link.h5", "real.h5"]
 
 
-def test_a_refused_save_leaves_no_folder_behind(tmp_path, base_reduced):
+def test_a_refused_save_leaves_no_folder_behind(tmp_path, tmp_path_factory, base_reduced):
     """Result.save made the missing folders of its path before checking the path's name, so a refused
-    ``a/b/x.txt`` left ``a/b`` behind; a refusal writes nothing (as the command line's does)."""
+    ``a/b/x.txt`` left ``a/b`` behind; a refusal writes nothing (as the command line's does). A folder that
+    cannot be made (its parent not writable) is refused in one line and leaves nothing either."""
     import bearingsim
 
     r = bearingsim.run(resolve(base_reduced))
     for target in (tmp_path / "a" / "b" / "x.txt", tmp_path / "c" / "deep" / "x"):
         with pytest.raises(UserError, match="archive path must end in .h5 or .hdf5"):
             r.save(target)
+    assert list(tmp_path.iterdir()) == []
+    # A folder the user may not write into: root writes anywhere (CAP_DAC_OVERRIDE), and the suite runs as
+    # root in CI, so there the save runs in a child under setpriv without the override capabilities
+    # (test_damaged_files._obeying_file_modes), where the kernel's own refusal is what is tested.
+    import subprocess
+    import sys
+
+    from . import forked_cli
+    from .test_damaged_files import _obeying_file_modes
+
+    prefix = _obeying_file_modes()
+    if prefix is None:
+        pytest.skip("root, and no setpriv to obey file modes: the locked-folder refusal is not checked here")
+    source = r.save(tmp_path_factory.mktemp("source") / "r.h5")
     locked = tmp_path / "locked"
     locked.mkdir()
     locked.chmod(0o500)
+    code = ("import bearingsim, sys\ntry:\n    bearingsim.load(sys.argv[1]).save(sys.argv[2])\n"
+            "except bearingsim.UserError as e:\n    print(e)\n    sys.exit(3)\n")
     try:
-        if not os.access(locked, os.W_OK):  # root writes anywhere: the check needs a user the mode binds
-            with pytest.raises(UserError, match="cannot create output folder"):
-                r.save(locked / "new" / "x.h5")
+        res = subprocess.run([*prefix, sys.executable, "-c", code, str(source), str(locked / "new" / "x.h5")],
+                             capture_output=True, text=True, env=forked_cli.environment(), timeout=300)
     finally:
         locked.chmod(0o700)
+    assert res.returncode == 3, (res.returncode, res.stdout, res.stderr)
+    assert res.stdout == f"{locked / 'new' / 'x.h5'}: cannot create output folder (Permission denied)\n"
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["locked"]
 
 

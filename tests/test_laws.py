@@ -109,7 +109,37 @@ def test_the_quasi_static_ring_balances_the_load_on_two_contacts_in_series():
 
 
 def test_archard_eq16():
-    """Eq. (16): V = k W L / H with W L = I r_r omega_r: linear in each factor."""
-    v = laws.archard_wear_volume(6e-4, 5e-3, 6.5e-3, 2000.0, 1.5e9)
-    assert v == pytest.approx(6e-4 * 5e-3 * 6.5e-3 * 2000.0 / 1.5e9, rel=1e-15)
-    assert laws.archard_wear_volume(6e-4, np.array([1e-3, 2e-3]), 6.5e-3, 2000.0, 1.5e9)[1] == pytest.approx(2 * v / 5)
+    """Eq. (16) with numbers worked by hand: V = k W L / H, W L = I r_r omega_r. With the preset's k = 5e-6
+    (scenario [wear] default) and H = 1.5e9 Pa, an impulse I = 20 mN s, r_r = 6.5 mm and omega_r = 2000 rad/s:
+    r_r omega_r = 0.0065 m x 2000 /s = 13 m/s, W L = 0.020 N s x 13 m/s = 0.26 N m = 0.26 J,
+    V = 5e-6 x 0.26 J / 1.5e9 N/m^2 = 1.3e-6 / 1.5e9 m^3 = 8.6667e-16 m^3 (8.667e-7 mm^3). The test's worked
+    value is exact decimal arithmetic, so the tolerance is round-off: 1e-12.
+
+    At the wear test's operating point (Table 3, 6000 rpm): omega_r = (1/gamma - gamma) omega_i / 2 (Eq. 12)
+    with gamma = 13 / 97.5 = 0.13333 and omega_i = 628.32 rad/s is 2314.31 rad/s, r_r omega_r = 15.043 m/s,
+    and the rear faces' J_n = 21.77 mN s per rotation (docs/validation.md) gives W L = 0.32749 J and
+    V = 5e-6 x 0.32749 / 1.5e9 = 1.0916e-15 m^3 per pocket face and cage rotation (the five digits carried: 1e-4).
+
+    Properties that a wrong law breaks: V is linear in the impulse (an array: 0, 1, 2, 3 x I) and in the
+    roller speed, zero for zero impulse, inversely proportional to H; and its units are m^3: lengths given in
+    mm (r_r x 1e3, H in N/mm^2 = Pa x 1e-6) give the same volume in mm^3 (x 1e9) -- a wrong power of r_r or
+    H fails that. The impulse form equals the sliding-work form of the law with W L = I r_r omega_r.
+    Every comparison sets abs=0: pytest.approx's default absolute tolerance, 1e-12, is a thousand times these
+    volumes in m^3 and would pass any of them."""
+    k, h = 5e-6, 1.5e9
+    v = laws.archard_wear_volume(k, 0.020, 6.5e-3, 2000.0, h)
+    assert v == pytest.approx(8.6667e-16, rel=1e-4, abs=0.0)
+    assert v == pytest.approx(1.3e-6 / 1.5e9, rel=1e-12, abs=0.0)
+    assert laws.archard_wear_volume(k, 21.77e-3, 6.5e-3, 2314.31, h) == pytest.approx(1.0916e-15, rel=1e-4, abs=0.0)
+    # linear in the impulse, zero for none (an array, as the multibody archive passes per pocket)
+    impulses = np.array([0.0, 0.020, 0.040, 0.060])
+    assert laws.archard_wear_volume(k, impulses, 6.5e-3, 2000.0, h) == pytest.approx(v * np.arange(4), rel=1e-12, abs=0.0)
+    assert laws.archard_wear_volume(k, 0.0, 6.5e-3, 2000.0, h) == 0.0
+    # linear in the roller's speed and in k, inverse in H
+    assert laws.archard_wear_volume(k, 0.020, 6.5e-3, 3000.0, h) == pytest.approx(1.5 * v, rel=1e-12, abs=0.0)
+    assert laws.archard_wear_volume(3 * k, 0.020, 6.5e-3, 2000.0, h) == pytest.approx(3 * v, rel=1e-12, abs=0.0)
+    assert laws.archard_wear_volume(k, 0.020, 6.5e-3, 2000.0, 2 * h) == pytest.approx(v / 2, rel=1e-12, abs=0.0)
+    # units: the same wear in mm (impulse in N s, speed in rad/s unchanged) is the volume in mm^3
+    assert laws.archard_wear_volume(k, 0.020, 6.5, 2000.0, h * 1e-6) == pytest.approx(v * 1e9, rel=1e-12, abs=0.0)
+    # the impulse form is the sliding-work form with W L = I r_r omega_r = 0.26 J
+    assert laws.archard_volume_from_work(k, 0.26, h) == pytest.approx(v, rel=1e-12, abs=0.0)

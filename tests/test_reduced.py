@@ -54,13 +54,31 @@ def test_first_rear_impact_energy_table4():
 
 
 def test_idec_flat_above_2000rpm_fig9():
-    """§3.1 and Fig. 9: I_dec per rotation hardly changes between 2000 and 6000 rpm (±10 % of the mean)."""
+    """§3.1 and Fig. 9: I_dec per rotation hardly changes between 2000 and 6000 rpm (±10 % of the mean).
+
+    The paper puts no number on it ("almost the same", docs/validation.md), and its Fig. 9 is not in the
+    repository to be read, so the band is not a reading precision. It is the size of what moves a flat
+    curve of this model pointwise: the roller's momentum when the pass is cut at 2π − φ (mid-bounce), m v_end,
+    a sawtooth in speed (test_previous_model_departs_at_low_speed_agrees_at_high_speed). Measured every
+    250 rpm from 2000 to 6000 rpm: m v_end from −0.55 mN s (4750 rpm) to +0.36 mN s, up to 9.9 % of the
+    plateau's 5.53 mN s; a narrower band would test the cut's phase, not the plateau. Measured here
+    (1000-rpm steps, the Fig. 9 study's speeds): 5.55 / 5.28 / 5.75 / 5.34 / 5.75 mN s, at most −4.6 %
+    (3000 rpm) off their mean of 5.53. Not every speed is inside: the smooth part of I_dec (its braking
+    impulse, without the sawtooth) rises 17 % from 2000 to 6000 rpm, and at 4500 rpm, where the sawtooth
+    adds to it, I_dec is 6.12 mN s, +10.9 % off the 250-rpm grid's mean."""
     values = np.array([idec_per_rotation(n) for n in (2000, 3000, 4000, 5000, 6000)])
     assert np.all(np.abs(values / values.mean() - 1.0) <= 0.10), values
 
 
 def test_idec_larger_at_low_speed_fig9():
-    """§3.1 and Fig. 9: I_dec is larger below 1000 rpm than in the 2000-6000 rpm plateau."""
+    """§3.1 and Fig. 9: I_dec is larger below 1000 rpm than in the 2000-6000 rpm plateau.
+
+    The paper says "larger", no number. Measured: 12.89 mN s at 500 rpm against a plateau of 5.68 (mean of
+    2000, 4000, 6000 rpm), 2.27 times. The threshold, 1.5 times, must lie above what the plateau alone
+    reaches, 1.11 times its mean (6.12 mN s at 4500 rpm against 5.52, the mean of a 250-rpm grid from 2000
+    to 6000 rpm: the pass-cut sawtooth, see the test above), so that a rise is not the sawtooth; it lies about midway (on a log scale) between that and
+    the measured 2.27, a third below the measurement. The paper's previous model (no gravity, no resting
+    contact: 2.72 mN s at 500 rpm, 0.48 times) fails it, as its physics should."""
     plateau = np.mean([idec_per_rotation(n) for n in (2000, 4000, 6000)])
     assert idec_per_rotation(500) > 1.5 * plateau
 

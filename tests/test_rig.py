@@ -19,12 +19,26 @@ def test_flat_rig_pocket_against_the_reduced_model_at_1000_rpm():
     I_dec per rotation within +-25 % of the reduced model's. Measured on the exact pocket faces
     (bearingsim validate, 1 warm-up + 20 rotations): 8.86 mN s against 7.83 (ratio 1.13); the arc pockets
     of the same cage see 29.1 mN s. The run is deterministic, so the tolerance is the goal, not scatter.
-    (At 2000-4000 rpm the ratio is 1.26-1.27, just outside the goal: docs/geometry.md.)"""
+    (At 2000-4000 rpm the ratio is 1.26-1.27, just outside the goal: docs/geometry.md.)
+
+    The verdict must not be one that the statistical error of pocket 0's mean could reverse: the ratio's
+    95 % interval, t = 2.776 (Student, 4 degrees of freedom: 5 batch means, docs/statistics.md) times the
+    batch-means standard error over the reduced model's exact value, lies inside the window. Measured: sem
+    1.28e-3 mN s (0.015 % of the mean), interval +-4.5e-4 in the ratio; it would leave the window only for
+    a sem above 3.8 % of the mean. (This replaces "sem < 5 % of the mean", a bound with no reason stated,
+    which allowed an interval of +-0.16 around 1.13, across the window's edge.)
+
+    The arc pockets see more than twice pocket 0's impulse: docs/validation.md's claim that the cage's own
+    pockets, not the rig's flat one, are where the contact impulse is (2.2-3.8 times over the rig's speeds,
+    2.17 the least, at 4000 rpm; hence 2). Measured at 1000 rpm: 3.28 times. Its scatter: the arc pockets'
+    std over pocket-rotations is 6.2 mN s; even with only the 15 pockets as independent samples the error
+    of their mean is 6.2 / sqrt(15) = 1.6 mN s, 0.18 in the ratio, so 2 lies 7 such errors below 3.28."""
     (row,) = rig_table(speeds=(1000,), rotations=20, jobs=1)
     ratio = row["pocket0_I_dec_mean_Ns"] / row["reduced_I_dec_Ns"]
     assert 0.75 <= ratio <= 1.25, ratio
+    half_width = 2.776 * row["pocket0_I_dec_sem_Ns"] / row["reduced_I_dec_Ns"]
+    assert 0.75 <= ratio - half_width and ratio + half_width <= 1.25, (ratio, half_width)
     assert row["arc_pockets_I_dec_mean_Ns"] > 2.0 * row["pocket0_I_dec_mean_Ns"]
-    assert row["pocket0_I_dec_sem_Ns"] < 0.05 * row["pocket0_I_dec_mean_Ns"]
 
 
 def test_batch_sem_of_independent_samples():

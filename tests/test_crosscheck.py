@@ -115,7 +115,9 @@ def test_rung3_cage_speed_is_prescribed(ladder):
     assert r.summary["cage_orbit_max_m"] == 0.0
     t_rec = 2 * math.pi * ROTATIONS / p.operating.omega_c
     assert abs(r.summary["cage_slip"]) <= r.summary["dt_s"] / t_rec
-    assert r.summary["load_zone_half_angle_deg"] == pytest.approx(23.75, abs=3.0)  # emerged (inner ring present)
+    # emerged (inner ring present): 23.75 deg is the continuous quasi-static load zone of the reference bearing at
+    # 970 N (laws.quasi_static_load_zone, docs/physics.md), +-3 deg the window of test_multibody's load-zone test
+    assert r.summary["load_zone_half_angle_deg"] == pytest.approx(23.75, abs=3.0)
 
 
 def test_rung4_cage_centre_held_and_momentum_balanced(ladder):

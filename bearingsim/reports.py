@@ -622,7 +622,7 @@ def _life_sections(table: Path):
     from bearingsim.studies import life
 
     cols, attrs = life.read_life(table)
-    history = life.history_table(attrs.get("limit"))  # a volume limit's columns are the volume's
+    history = life.history_table(attrs.get("limit"), cols)  # a volume limit's columns are the volume's
     head = [h for _, h, _, _ in history]
     mapping = str(attrs.get("mapping", ""))
     blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"

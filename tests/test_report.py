@@ -248,7 +248,9 @@ def _life_table(folder: Path, limit: str = "clearance=0.23mm", mapping: str = "t
             "rotations_end": [1e6, 2e6, 3e6], "hours_end": [10.0, 20.0, 30.0], "max_depth_rate_um_per_h": [1.0] * n,
             "max_volume_rate_mm3_per_h": [1e-3] * n, "max_depth_um": [10.0, 20.0, 30.0],
             "max_volume_mm3": [0.01, 0.02, 0.03], "clearance_end_mm": [0.21, 0.22, 0.23],
-            "I_dec_mean_mNs": [14.0] * n, "reused": [0] * n, "psi_deg": [np.linspace(-30.0, 25.0, 32)] * n,
+            "I_dec_mean_mNs": [14.0] * n, "pocket_worst_read": [1.2] * n, "pocket_worst_scatter": [1.18] * n,
+            "pocket_uneven": [0] * n, "rate_sem_rel": [0.02] * n, "reused": [0] * n,
+            "psi_deg": [np.linspace(-30.0, 25.0, 32)] * n,
             "worn_depth_front_um": np.full((n, 32, 16), 1.25), "worn_depth_rear_um": np.full((n, 32, 16), 2.5)}
     archive.write_table_file(folder / "life.h5", {k: np.asarray(v) for k, v in cols.items()}, life.LIFE_UNITS, {
         "format": life.LIFE_FORMAT, "limit": limit, "stages": n,

@@ -211,6 +211,48 @@ class _State:
         return float(self.s0 + (self.volume - self.start_volume).sum(axis=0).max() / self.area)
 
 
+def pocket_rates(rate, kind: str) -> tuple[np.ndarray, np.ndarray, dict]:
+    """The wear rates a stage wears on with, from its wear report per rotation ``rate``: ``(depth (2, bins,
+    pockets) [m], volume (2, pockets) [m^3], its history columns)``: every pocket's as read (``kind``, the
+    limit's, changes none). Of each pocket's front + rear worn volume per rotation: ``pocket_worst_read``, the
+    worst pocket's rate over the pockets' mean; ``pocket_worst_scatter``, what the worst of identical pockets
+    reads from the rotations' scatter alone (1 + :func:`bearingsim.stats.scatter_lead`; the worst of 16 noisy
+    estimates leads by 1.77 of their standard errors: docs/wear.md, *The worst pocket*); ``pocket_uneven``, 1 when
+    the pockets differ beyond that scatter (the test of a run's note of uneven pockets, at half its false-alarm
+    share); ``rate_sem_rel``, the worst pocket's relative batch-means error (:func:`bearingsim.stats.batch_sem`),
+    for a clearance limit, the pocket it follows (NaN for the others)."""
+    from bearingsim.plausibility import POCKET_SPREAD_FALSE_ALARM
+    from bearingsim.stats import (batch_sem, pocket_cov, pocket_sampling_cov, pocket_spread_critical,
+                                  scatter_lead)
+
+    d = np.stack([rate.depth_front, rate.depth_rear])
+    v = np.stack([rate.volume_front, rate.volume_rear])
+    per = rate.volume_rotations("front") + rate.volume_rotations("rear")  # (rotations, pockets)
+    total = v.sum(axis=0)
+    read = float(total.max() / total.mean()) if total.mean() > 0.0 else math.nan
+    sem, uneven = math.nan, False
+    if per.ndim == 2 and per.shape[0] >= 2 and per.shape[1] >= 2 and per.mean() > 0.0:
+        worst = per[:, int(np.argmax(total))]
+        sem = batch_sem(worst) / worst.mean() if kind == "clearance" else math.nan
+        crit = pocket_spread_critical(per.shape[1], per.shape[0], POCKET_SPREAD_FALSE_ALARM / 2.0)
+        uneven = bool(pocket_cov(per.mean(axis=0)) > crit * pocket_sampling_cov(per))
+    return d, v, {"pocket_worst_read": read, "pocket_worst_scatter": 1.0 + scatter_lead(per),
+                  "pocket_uneven": int(uneven), "rate_sem_rel": sem}
+
+
+def life_error(cols: dict) -> float:
+    """The sampling error of a history's life [h]: each stage's time times the relative error of the worst
+    pocket's rate it wore on with (``rate_sem_rel``, :func:`pocket_rates`; a stage's length goes as 1 / that
+    rate), the stages' errors independent and added in quadrature; NaN for a history written before it held
+    the column, or of another limit than a clearance. Not in it: how the trajectory's pocket differences grow
+    through the worn shape fed back (docs/wear.md, *The worst pocket*: 27.7-30.8 h over three trajectories of
+    multibody_6000rpm at 10 rotations per stage, where this error is 0.7-0.9 h)."""
+    if "rate_sem_rel" not in cols:
+        return math.nan
+    hours = np.diff(np.concatenate([[0.0], np.asarray(cols["hours_end"], dtype=float)]))
+    return float(np.sqrt(np.sum((hours * np.asarray(cols["rate_sem_rel"], dtype=float)) ** 2)))
+
+
 def _stage_length(q_now, q_rate, target) -> float:
     """Inner-ring rotations until the first element of ``q_now + q_rate N`` reaches ``target``."""
     grow = q_rate > 0
@@ -413,8 +455,7 @@ class LifeStudy(Study):
         res = load_result(outdir, record)
         st = self.state
         rate = wear_report(res, rotations=1.0)
-        d_rate = np.stack([rate.depth_front, rate.depth_rear])
-        v_rate = np.stack([rate.volume_front, rate.volume_rear])
+        d_rate, v_rate, spread = pocket_rates(rate, self.limit.kind)
         if st.volume is None:
             st.area = rate.bin_area * len(rate.psi_deg)
             st.depth = np.zeros_like(d_rate) if st.depth is None else st.depth
@@ -432,7 +473,7 @@ class LifeStudy(Study):
         st.volume = st.volume + v_rate * n_stage
         st.shaft += n_stage
         st.hours += n_stage * rate.hours
-        self.rows.append(_row(j, clearance, res, rate, n_stage, st, record["status"] == "cached"))
+        self.rows.append(_row(j, clearance, res, rate, n_stage, st, record["status"] == "cached") | spread)
         if self.progress:
             self.progress(f"stage {j:02d} of {self.planned}: {'reused' if self.rows[-1]['reused'] else 'run'}, "
                           f"I_dec {res.summary['I_dec_mean_Ns'] * 1e3:.4g} mN s; worn on for {n_stage:.4g} inner-ring "
@@ -467,13 +508,17 @@ class LifeStudy(Study):
         return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
 
     def attrs(self) -> dict:
-        """The history's attributes (``life.h5``): the study, and ``worn_through`` when the cage bar wore
-        through before the limit (what reached its width; the time is the last stage's end)."""
+        """The history's attributes (``life.h5``): the study, ``worn_through`` when the cage bar wore
+        through before the limit (what reached its width; the time is the last stage's end), and for a clearance
+        limit ``life_error_h``, the life's sampling error (:func:`life_error`)."""
         attrs = {"format": LIFE_FORMAT, "limit": self.limit.shown, "stages": self.planned,
                  "rotations": self.stage_rotations, "scenario": self.scenario.to_toml(), "mapping": self.mapping,
                  "mapping_text": MAPPINGS[self.mapping]}
         if self.worn_through:
             attrs["worn_through"] = self.worn_through
+        error = life_error(self.columns()) if self.rows else math.nan
+        if math.isfinite(error):  # a clearance limit's (docs/wear.md, The worst pocket)
+            attrs["life_error_h"] = error
         return attrs
 
     def _differs(self, attrs: dict) -> str:
@@ -564,7 +609,8 @@ def run_life(scenario, folder, limit: Limit, *, stages: int = STAGES_RESOLVED, r
 LIFE_UNITS = {"stage": "1", "clearance_start_mm": "mm", "stage_rotations": "1", "rotations_end": "1",
               "hours_end": "h", "max_depth_rate_um_per_h": "um/h", "max_volume_rate_mm3_per_h": "mm^3/h",
               "max_depth_um": "um", "max_volume_mm3": "mm^3", "clearance_end_mm": "mm", "I_dec_mean_mNs": "mN s",
-              "reused": "1", "psi_deg": "deg", "worn_depth_front_um": "um", "worn_depth_rear_um": "um"}
+              "reused": "1", "psi_deg": "deg", "worn_depth_front_um": "um", "worn_depth_rear_um": "um",
+              "pocket_worst_read": "1", "pocket_worst_scatter": "1", "pocket_uneven": "1", "rate_sem_rel": "1"}
 #: what the history's columns are (their datasets' ``description`` in ``life.h5``, which ``inspect`` lists); the
 #: rotations are the inner ring's, as the stage's time: the recorded cage rotations per stage are the root's
 #: ``rotations``
@@ -577,6 +623,14 @@ LIFE_DESCRIPTIONS = {
     "max_depth_rate_um_per_h": "the fastest point's depth rate in the stage: the largest of any point of any face, "
                                "which drives a depth limit (not the deepest point's own rate)",
     "max_volume_rate_mm3_per_h": "the largest worn-volume rate of any face in the stage",
+    "pocket_worst_read": "the worst pocket's worn-volume rate (front + rear) over the pockets' mean, as the stage's "
+                         "rotations read it",
+    "pocket_worst_scatter": "the same that identical pockets read from the rotations' scatter alone, on average "
+                            "(1 + 1.77 standard errors for 16 pockets; docs/wear.md, The worst pocket)",
+    "pocket_uneven": "1 when the pockets' spread is beyond the rotations' scatter (the test of the note of uneven "
+                     "pockets)",
+    "rate_sem_rel": "the relative batch-means standard error of the worst pocket's worn-volume rate (clearance "
+                    "limits; the life's error is these times the stages' hours, in quadrature)",
 }
 
 
@@ -616,20 +670,25 @@ HISTORY_TABLE = (("stage", "stage", 5, "d"), ("clearance_start_mm", "s_eff [mm]"
                  ("stage_rotations", "shaft rotations", 15, ".4g"), ("hours_end", "h at end", 9, ".4g"),
                  ("max_depth_rate_um_per_h", "depth rate, fastest point [um/h]", 32, ".4g"),
                  ("max_depth_um", "deepest [um]", 13, ".4g"),
-                 ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"), ("reused", "reused", 6, "d"))
+                 ("I_dec_mean_mNs", "I_dec [mN s]", 13, ".4g"),
+                 ("pocket_worst_read", "worst/mean", 10, ".3f"),
+                 ("pocket_worst_scatter", "of identical pockets", 20, ".3f"),
+                 ("reused", "reused", 6, "d"))
 #: the columns of a volume limit's quantity in place of the deepest point and the fastest point's depth rate
 #: (:func:`history_table`)
 VOLUME_COLUMNS = {"max_depth_rate_um_per_h": ("max_volume_rate_mm3_per_h", "volume rate [mm3/h]", 19, ".4g"),
                   "max_depth_um": ("max_volume_mm3", "largest volume [mm3]", 20, ".4g")}
 
 
-def history_table(limit: str | None = None) -> tuple:
+def history_table(limit: str | None = None, cols: dict | None = None) -> tuple:
     """:data:`HISTORY_TABLE` for a study to ``limit`` (its text, ``volume=2mm3``): for a volume limit, the
     quantity it reads, the largest worn volume of a face, and its rate in place of the deepest point and the
-    fastest point's depth rate (the largest of any point, which a depth limit reads)."""
-    if str(limit or "").split("=")[0].strip() != "volume":
-        return HISTORY_TABLE
-    return tuple(VOLUME_COLUMNS.get(c[0], c) for c in HISTORY_TABLE)
+    fastest point's depth rate (the largest of any point, which a depth limit reads); with a history's ``cols``,
+    only the columns it holds (one written before the pockets' columns has none of them)."""
+    table = HISTORY_TABLE
+    if str(limit or "").split("=")[0].strip() == "volume":
+        table = tuple(VOLUME_COLUMNS.get(c[0], c) for c in HISTORY_TABLE)
+    return table if cols is None else tuple(c for c in table if c[0] in cols)
 
 
 def history_rows(cols: dict, table: tuple = HISTORY_TABLE) -> list[list[str]]:
@@ -657,18 +716,32 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     row per stage (:func:`history_table` of ``attrs``' limit), then the stages' run notes
     (:func:`stage_notes`)."""
     attrs = attrs or {}
-    table = history_table(attrs.get("limit"))
+    table = history_table(attrs.get("limit"), cols)
     n = len(cols["stage"])
     when = f"{cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations"
     if attrs.get("worn_through"):
         first = (f"{title}: not reached, the cage bar wears through first, after {when}, in stage "
                  f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
     else:
-        first = f"{title}: {when} in {counted(n, 'stage')}"
+        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, ', ')}"
     lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
     lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
     return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
+
+
+def _error_text(cols: dict, sep: str = " ") -> str:
+    """``sep`` and ``± e h (...)`` of a history's life (:func:`life_error`, 2 significant digits) and the worst
+    pocket's lead read against the one identical pockets read from the scatter; "" without the error (a history
+    written before it held the columns, or of another limit)."""
+    e = life_error(cols)
+    if not math.isfinite(e):
+        return ""
+    read, scatter = (np.asarray(cols[c], dtype=float) for c in ("pocket_worst_read", "pocket_worst_scatter"))
+    return (f"{sep}± {e:.2g} h (the sampling error of the worst pocket's rates, not the trajectories' scatter; it "
+            f"read {read.min():.3g}-{read.max():.3g} x the pockets' mean, identical pockets {scatter.min():.3g}-"
+            f"{scatter.max():.3g} x from the scatter alone, the pockets uneven beyond it in "
+            f"{int(np.sum(cols['pocket_uneven']))} of {counted(len(read), 'stage')}; docs/wear.md, The worst pocket)")
 
 
 def _history_start(attrs: dict, shape) -> np.ndarray:
@@ -759,8 +832,13 @@ def plot_life(cols: dict, attrs: dict):
         ax.set_xlabel("running time [h]")
     _plot_worn_faces(axes[3], cols)
     end = "the cage bar worn through first, after " if attrs.get("worn_through") else ""
-    fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g} h, {cols['rotations_end'][-1]:.3g} "
-                 f"inner-ring rotations, {counted(len(h_end), 'stage')}\n{_life_subtitle(attrs)}", fontsize=9)
+    error = life_error(cols)  # a clearance limit's sampling error (docs/wear.md, The worst pocket)
+    pm, what = ("", "")
+    if math.isfinite(error):
+        pm, what = f" ± {error:.2g}", " (±: the worst pocket's rates' sampling error)"
+    fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g}{pm} h, {cols['rotations_end'][-1]:.3g} "
+                 f"inner-ring rotations, {counted(len(h_end), 'stage')}{what}\n"
+                 f"{_life_subtitle(attrs)}", fontsize=9)
     fig.tight_layout()
     return fig
 

@@ -1852,10 +1852,12 @@ def test_the_life_is_given_with_its_sampling_error():
     assert life_error(cols) == pytest.approx(math.hypot(0.3, 0.8), rel=1e-12)
     text = format_history(cols, "life of x to clearance=0.4mm", {"limit": "clearance=0.4mm"})
     first = text.splitlines()[0]
-    assert first.startswith("life of x to clearance=0.4mm: 30 h = 1.08e+07 inner-ring rotations in 2 stages, "
-                            "± 0.85 h (")
+    assert first.startswith("life of x to clearance=0.4mm: 30 ± 0.85 h = 1.08e+07 inner-ring rotations in 2 stages "
+                            "(±: the sampling error of the worst pocket's rates")  # the ± beside the hours
     assert ("read 1.2-1.65 x the pockets' mean, identical pockets 1.19-1.21 x from the scatter alone, the pockets "
             "uneven beyond it in 1 of 2 stages" in first)
+    alike = cols | {"pocket_worst_scatter": np.array([1.21, 1.21])}  # one value, not a span of it to itself
+    assert "identical pockets 1.21 x from" in format_history(alike, "life of x", {}).splitlines()[0]
     assert "worst/mean" in text.splitlines()[1] and " 1.650 " in text.splitlines()[3]
     title = plot_life(cols, {})._suptitle.get_text()
     assert "30 ± 0.85 h, 1.08e+07 inner-ring rotations, 2 stages (±: the worst pocket's rates' sampling error)" in title

@@ -723,25 +723,32 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
         first = (f"{title}: not reached, the cage bar wears through first, after {when}, in stage "
                  f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
     else:
-        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, ', ')}"
+        e = life_error(cols)
+        when = when if not math.isfinite(e) else when.replace(" h = ", f" ± {e:.2g} h = ", 1)
+        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols)}"
     lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
     lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
     return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
 
 
-def _error_text(cols: dict, sep: str = " ") -> str:
-    """``sep`` and ``± e h (...)`` of a history's life (:func:`life_error`, 2 significant digits) and the worst
-    pocket's lead read against the one identical pockets read from the scatter; "" without the error (a history
-    written before it held the columns, or of another limit)."""
-    e = life_error(cols)
-    if not math.isfinite(e):
+def _error_text(cols: dict) -> str:
+    """`` (±: ...)``, what the ± of a history's life (:func:`life_error`) is, and the worst pocket's lead read
+    against the one identical pockets read from the scatter; "" without the error (a history written before it
+    held the columns, or of another limit)."""
+    if not math.isfinite(life_error(cols)):
         return ""
     read, scatter = (np.asarray(cols[c], dtype=float) for c in ("pocket_worst_read", "pocket_worst_scatter"))
-    return (f"{sep}± {e:.2g} h (the sampling error of the worst pocket's rates, not the trajectories' scatter; it "
-            f"read {read.min():.3g}-{read.max():.3g} x the pockets' mean, identical pockets {scatter.min():.3g}-"
-            f"{scatter.max():.3g} x from the scatter alone, the pockets uneven beyond it in "
-            f"{int(np.sum(cols['pocket_uneven']))} of {counted(len(read), 'stage')}; docs/wear.md, The worst pocket)")
+    return (f" (±: the sampling error of the worst pocket's rates, not the trajectories' scatter; it read "
+            f"{_span(read)} x the pockets' mean, identical pockets {_span(scatter)} x from the scatter alone, the "
+            f"pockets uneven beyond it in {int(np.sum(cols['pocket_uneven']))} of {counted(len(read), 'stage')}; "
+            f"docs/wear.md, The worst pocket)")
+
+
+def _span(values: np.ndarray) -> str:
+    """``lo-hi`` of ``values`` to 3 significant digits, or the one value when both read alike."""
+    lo, hi = f"{values.min():.3g}", f"{values.max():.3g}"
+    return lo if lo == hi else f"{lo}-{hi}"
 
 
 def _history_start(attrs: dict, shape) -> np.ndarray:

@@ -1360,8 +1360,8 @@ def _directory_error(p: Path) -> UserError:
         tables = _study_tables(p)
         drawn = (", ".join(f"'bearingsim plot {t}' draws the study's figure" for t in tables) if tables
                  else f"'bearingsim plot {p / 'sweep.h5'}' draws its figures")
-        return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}' and 'bearingsim "
-                         f"report {p}' read it, {drawn}; {cases}")
+        return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}', 'bearingsim "
+                         f"report {p}' and 'bearingsim wear {p}' read it, {drawn}; {cases}")
     return UserError(f"{p}: is a directory, not an archive")
 
 

@@ -73,7 +73,7 @@ def test_automatic_step_leaves_a_restart_s_margin_below_the_overlap_bound():
     p = Parameters.from_scenario(_scenario("rigid"))
     s = p.bearing.pocket_clearance
     v_est = IMPACT_OVERLAP_FRACTION * s / impact_dt(p)  # the estimate impact_dt is made of
-    assert choose_dt(p)[0] * v_est == pytest.approx(0.8 * 0.01 * s, rel=1e-12)
+    assert choose_dt(p)[0] * v_est == pytest.approx(0.8 * 0.01 * s, rel=1e-12, abs=0)
 
 
 @pytest.mark.parametrize("rpm", [pytest.param(1000, marks=pytest.mark.slow), pytest.param(3000, marks=pytest.mark.slow), 6000])
@@ -313,10 +313,10 @@ def test_start_phase_is_the_cage_settling_onto_its_rollers():
     p = Parameters.from_scenario(_scenario("rigid", rpm=500))
     s, g, e = p.bearing.pocket_clearance, p.operating.gravity, p.contact.restitution
     t, dt = rigid_start(p, 1.0)
-    assert t == pytest.approx(math.sqrt(2 * s / g) * (1 + e) / (1 - e), rel=1e-12)
-    assert dt == pytest.approx(0.005 * s / math.sqrt(2 * g * s), rel=1e-12)
+    assert t == pytest.approx(math.sqrt(2 * s / g) * (1 + e) / (1 - e), rel=1e-12, abs=0)
+    assert dt == pytest.approx(0.005 * s / math.sqrt(2 * g * s), rel=1e-12, abs=0)
     p6 = Parameters.from_scenario(_scenario("rigid"))
-    assert rigid_start(p6, 1.0)[0] == pytest.approx(2 * math.pi / p6.operating.omega_c, rel=1e-12)
+    assert rigid_start(p6, 1.0)[0] == pytest.approx(2 * math.pi / p6.operating.omega_c, rel=1e-12, abs=0)
     assert rigid_start(p6, 1e-6) == (pytest.approx(2 * math.pi / p6.operating.omega_c), 1e-6)
     p0 = Parameters.from_scenario(_scenario("rigid", extra=["operating.gravity=false"]))
     assert rigid_start(p0, 2e-5) == (0.0, 2e-5)

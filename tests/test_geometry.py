@@ -99,7 +99,7 @@ def test_exact_face_contact_is_the_circle_s(psi_deg, face, sign):
     # pymunk's normal points from the roller (shape a) to the face (shape b): along d
     assert np.allclose(np.array(cps.normal), direction, atol=1e-12, rtol=0.0)
     assert -cps.points[0].distance == pytest.approx(depth, abs=1e-15)
-    assert R - p.bearing.roller_radius == pytest.approx(half_s, rel=1e-12)
+    assert R - p.bearing.roller_radius == pytest.approx(half_s, rel=1e-12, abs=0)
 
 
 @pytest.mark.parametrize("face", [0, 1])
@@ -140,7 +140,7 @@ def test_face_extent_is_the_cage_wall_s():
     R = g.roller_radius + 0.5 * g.pocket_clearance
     for psi, r_wall in ((lo, g.cage_inner_radius), (hi, g.cage_outer_radius)):
         end = np.array([0.0, g.pitch_radius]) + R * np.array([math.cos(psi), math.sin(psi)])  # e_t = x, e_r = y
-        assert np.linalg.norm(end) == pytest.approx(r_wall, rel=1e-12)
+        assert np.linalg.norm(end) == pytest.approx(r_wall, rel=1e-12, abs=0)
     assert math.degrees(lo) == pytest.approx(-32.94, abs=0.01) and math.degrees(hi) == pytest.approx(26.18, abs=0.01)
     assert p.multibody.pocket_face_rule == "cage wall"
     given = si(load_scenario(MB, ["multibody.pocket_face_half_angle_deg=20"]))
@@ -215,7 +215,7 @@ def test_a_cage_bar_carries_one_pockets_front_face_and_its_neighbours_rear_face(
         for psi in np.radians([-32.0, -10.0, 0.0, 12.0, 26.0]):
             front = centres[i] + af.radius * (math.cos(psi) * af.e_t[i] + math.sin(psi) * af.e_r[i])
             rear = centres[j] + af.radius * (-math.cos(psi) * af.e_t[j] + math.sin(psi) * af.e_r[j])
-            assert np.linalg.norm(front) == pytest.approx(np.linalg.norm(rear), rel=1e-12)
+            assert np.linalg.norm(front) == pytest.approx(np.linalg.norm(rear), rel=1e-12, abs=0)
     bins = 4
     front, rear = np.zeros((bins, n)), np.zeros((bins, n))
     front[1, 5], rear[1, 4], rear[2, 5] = 2.0, 3.0, 7.0
@@ -429,17 +429,17 @@ def test_the_automatic_step_takes_the_play_worn_faces_leave():
     assert worn_play(p0) == (s, None)
     assert pocket == 3 and play == pytest.approx(s + 65e-6, abs=1e-15)
     dt, how, _ = choose_dt(p)
-    assert dt == pytest.approx(choose_dt(p0)[0] * math.sqrt(s / play), rel=1e-12)
+    assert dt == pytest.approx(choose_dt(p0)[0] * math.sqrt(s / play), rel=1e-12, abs=0)
     assert "worn play 0.265 mm" in how and "pocket 3" in how and "worn play" not in choose_dt(p0)[1]
     g = p.operating.gravity
     t_start, dt_start = rigid_start(p, 1.0)
-    assert dt_start == pytest.approx(0.005 * s / math.sqrt(2.0 * g * play), rel=1e-12)
+    assert dt_start == pytest.approx(0.005 * s / math.sqrt(2.0 * g * play), rel=1e-12, abs=0)
     e = p.contact.restitution
     assert t_start == pytest.approx(min(math.sqrt(2.0 * play / g) * (1 + e) / (1 - e),
-                                        2 * math.pi / p.operating.omega_c), rel=1e-12)
+                                        2 * math.pi / p.operating.omega_c), rel=1e-12, abs=0)
     hz0 = si(base.replace(**{"multibody.raceway_contact": "hertz"}))
     hz = si(_worn_scenario(base.replace(**{"multibody.raceway_contact": "hertz"}), front, rear))
-    assert impact_dt(hz) == pytest.approx(impact_dt(hz0) * math.sqrt(s / play), rel=1e-12)
+    assert impact_dt(hz) == pytest.approx(impact_dt(hz0) * math.sqrt(s / play), rel=1e-12, abs=0)
     assert choose_dt(hz)[0] == choose_dt(hz0)[0] < impact_dt(hz)
 
 

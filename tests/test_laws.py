@@ -37,11 +37,11 @@ def test_oil_film_drag_eq2_scalar_and_array_forms_agree(form):
     is zero without contact (N <= 0), and scales with the paper's exponents."""
     f = _scalar(form)
     for n, v in [(3.5, 1.2), (120.0, 18.0), (0.0, 5.0), (-2.0, 5.0)]:
-        assert f.oil_film_drag_scalar(0.02, n, v) == pytest.approx(float(laws.oil_film_drag(0.02, n, v)), rel=1e-14)
+        assert f.oil_film_drag_scalar(0.02, n, v) == pytest.approx(float(laws.oil_film_drag(0.02, n, v)), rel=1e-14, abs=0)
     assert f.oil_film_drag_scalar(0.02, 0.0, 5.0) == 0.0
     base = f.oil_film_drag_scalar(0.02, 10.0, 2.0)
-    assert f.oil_film_drag_scalar(0.02, 20.0, 2.0) / base == pytest.approx(2.0**0.246, rel=1e-14)
-    assert f.oil_film_drag_scalar(0.02, 10.0, 4.0) / base == pytest.approx(2.0**0.648, rel=1e-14)
+    assert f.oil_film_drag_scalar(0.02, 20.0, 2.0) / base == pytest.approx(2.0**0.246, rel=1e-14, abs=0)
+    assert f.oil_film_drag_scalar(0.02, 10.0, 4.0) / base == pytest.approx(2.0**0.648, rel=1e-14, abs=0)
 
 
 def test_epicyclic_kinematics_pure_rolling():
@@ -51,7 +51,7 @@ def test_epicyclic_kinematics_pure_rolling():
     wi = laws.inner_ring_angular_speed(3000.0)
     wc = laws.cage_angular_speed(wi, rr, rp)
     wr = laws.roller_spin_speed(wi, rr, rp)
-    assert wi == pytest.approx(2 * math.pi * 50.0, rel=1e-15)
+    assert wi == pytest.approx(2 * math.pi * 50.0, rel=1e-15, abs=0)
     assert (wi - wc) * (rp - rr) == pytest.approx(wr * rr, rel=1e-12)
     assert wc * (rp + rr) == pytest.approx(wr * rr, rel=1e-12)
     assert laws.rolling_speed(wr, wc, rr, rp + rr) == pytest.approx(wr * rr, rel=1e-12)
@@ -61,7 +61,7 @@ def test_outer_race_load_eq3():
     """Eq. (3): N = m r_p omega_c^2 + m g cos(theta): centrifugal plus weight at the bottom, minus at the top."""
     m, rp, wc, g = 0.013, 48.75e-3, 100.0, laws.STANDARD_GRAVITY
     n = laws.outer_race_normal_load(m, rp, wc, np.array([0.0, math.pi]), g)
-    assert n[0] - n[1] == pytest.approx(2 * m * g, rel=1e-12)
+    assert n[0] - n[1] == pytest.approx(2 * m * g, rel=1e-12, abs=0)
     assert n.mean() == pytest.approx(m * rp * wc**2, rel=1e-12)
 
 
@@ -77,7 +77,7 @@ def test_load_zone_rule():
     assert math.isnan(laws.load_zone_from_displacement(float("nan"), 80e-6))
     phi = laws.load_zone_half_angle(None, 970.0, 16, 13e-3, 80e-6)
     assert math.degrees(phi) == pytest.approx(23.5, abs=0.5)
-    assert laws.load_zone_half_angle(23.5, 970.0, 16, 13e-3, 80e-6) == pytest.approx(math.radians(23.5), rel=1e-15)
+    assert laws.load_zone_half_angle(23.5, 970.0, 16, 13e-3, 80e-6) == pytest.approx(math.radians(23.5), rel=1e-15, abs=0)
     # the ring must close the clearance (P_d / 2 = 40 um) to carry any load
     _, delta = laws.quasi_static_load_zone(970.0, 16, 13e-3, 80e-6)
     assert delta > 40e-6
@@ -99,12 +99,12 @@ def test_the_quasi_static_ring_balances_the_load_on_two_contacts_in_series():
     q = lambda psi: k_s * max(delta_r * math.cos(psi) - pd / 2.0, 0.0) ** (10.0 / 9.0)  # noqa: E731
     total = z / (2.0 * math.pi) * 2.0 * quad(lambda psi: q(psi) * math.cos(psi), 0.0, phi, epsabs=0.0, epsrel=1e-10)[0]
     assert total == pytest.approx(load, rel=1e-4)
-    assert math.cos(phi) == pytest.approx(pd / 2.0 / delta_r, rel=1e-12)
+    assert math.cos(phi) == pytest.approx(pd / 2.0 / delta_r, rel=1e-12, abs=0)
     for qn in (1.0, 50.0, 970.0, 2e4):  # delta = (Q / K)^0.9: Q = K delta^(10/9) back, to round-off
         approach = laws.palmgren_approach(qn, length)
-        assert laws.palmgren_load(laws.palmgren_stiffness(length), approach) == pytest.approx(qn, rel=1e-12)
+        assert laws.palmgren_load(laws.palmgren_stiffness(length), approach) == pytest.approx(qn, rel=1e-12, abs=0)
     # Harris & Kotzalas Eq. 6.40: delta = 3.84e-5 Q^0.9 / l^0.8 [mm, N, mm]; its three digits: 0.2 %
-    assert laws.palmgren_approach(970.0, length) == pytest.approx(3.84e-5 * 970.0 ** 0.9 / 13.0 ** 0.8 * 1e-3, rel=2e-3)
+    assert laws.palmgren_approach(970.0, length) == pytest.approx(3.84e-5 * 970.0 ** 0.9 / 13.0 ** 0.8 * 1e-3, rel=2e-3, abs=0)
     assert laws.palmgren_approach(0.0, length) == 0.0 and laws.palmgren_approach(-5.0, length) == 0.0
 
 

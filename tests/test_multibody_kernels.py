@@ -133,7 +133,7 @@ def test_roller_on_outer_race_carries_its_centrifugal_load():
     out_f = np.zeros(6)
     diag = np.zeros(1, dtype=fk.DIAG)
     fk.raceway_forces(state, h, prm, np.zeros(2), np.zeros(2), np.zeros(2), np.zeros(1, dtype=np.bool_), out_f, diag, np.zeros(1), np.zeros(1))
-    assert diag[0]["delta_out"] == pytest.approx(delta, rel=1e-6)
+    assert diag[0]["delta_out"] == pytest.approx(delta, rel=1e-6, abs=0)
     assert diag[0]["q_out"] == pytest.approx(qc, rel=1e-6)
     # force on the roller: radially inward, magnitude m r0 omega^2 (no traction, drag, gravity)
     assert out_f[0] == pytest.approx(-qc, rel=1e-6)
@@ -166,7 +166,7 @@ def test_rigid_race_carries_the_outward_load_of_a_roller_on_it():
     length is slack in chipmunk, and the load would throw the roller off the race by F h / m), and the
     race's share is the load (it adds to the joint's in the normal force for traction). Exact to rounding."""
     f, held = _rigid_roller(RC, 0.0, 1e-5)
-    assert abs(f) < 1e-12 and held == pytest.approx(ROLLER_MASS * G, rel=1e-12)
+    assert abs(f) < 1e-12 and held == pytest.approx(ROLLER_MASS * G, rel=1e-12, abs=0)
 
 
 @pytest.mark.parametrize("gap", [1e-12, 1e-9, 1e-7])
@@ -185,7 +185,7 @@ def test_rigid_race_leaves_a_lifted_roller_its_whole_load():
     """A roller 1 mm inside the circle (the cage lifted it): the race is not reached within the step and
     takes nothing; the roller falls back under its whole load. Exact to rounding."""
     f, held = _rigid_roller(RC - 1e-3, 0.0, 1e-5)
-    assert f == pytest.approx(ROLLER_MASS * G, rel=1e-12) and held == 0.0
+    assert f == pytest.approx(ROLLER_MASS * G, rel=1e-12, abs=0) and held == 0.0
 
 
 def test_rigid_race_gives_back_the_joints_correction_speed():
@@ -250,11 +250,11 @@ def test_traction_follows_its_tanh_curve_below_saturation(off):
     # contact at +x: N = (-1, 0), T = rot90(N) = (0, -1); the roller's surface slides along T at -v - w r_r
     sliding = -v - w * ROLLER_RADIUS
     entrainment = 0.5 * (abs(w - orbit) * ROLLER_RADIUS + abs(orbit) * prm.outer_race_geom_radius)
-    assert q == pytest.approx(50.0, rel=1e-12) and slip == pytest.approx(sliding / entrainment, rel=1e-12)
+    assert q == pytest.approx(50.0, rel=1e-12, abs=0) and slip == pytest.approx(sliding / entrainment, rel=1e-12, abs=0)
     assert abs(slip / prm.traction_slip_ref) < 3.0  # below saturation: tanh(3) = 0.995
     mu = prm.traction_mu_max * math.tanh(slip / prm.traction_slip_ref)
-    assert -f[1] == pytest.approx(-mu * q, rel=1e-12)  # the force along T opposes the sliding
-    assert f[2] == pytest.approx(ROLLER_RADIUS * mu * q, rel=1e-12)  # torque -r_r (-mu Q)
+    assert -f[1] == pytest.approx(-mu * q, rel=1e-12, abs=0)  # the force along T opposes the sliding
+    assert f[2] == pytest.approx(ROLLER_RADIUS * mu * q, rel=1e-12, abs=0)  # torque -r_r (-mu Q)
 
 
 # --- recording ------------------------------------------------------------------------------------
@@ -319,7 +319,7 @@ def test_front_face_impulse_is_I_acc(roller_is_a):
     assert w["Jn_front"] == pytest.approx(J, abs=1e-15) and w["Jn_rear"] == 0.0
     assert w["Jf_front"] == pytest.approx(JT, abs=1e-15)
     assert acc.f_bin[0]["front"].sum() == pytest.approx(J, abs=1e-15) and acc.f_bin[0]["rear"].sum() == 0.0
-    assert acc.glob[0]["maxpen_front"] == pytest.approx(1e-6) and acc.glob[0]["maxpen_rear"] == 0.0
+    assert acc.glob[0]["maxpen_front"] == pytest.approx(1e-6, rel=1e-6, abs=0) and acc.glob[0]["maxpen_rear"] == 0.0
     assert n_imp == 1
     row = acc.impacts[0]
     assert row["face"] == FACE_FRONT and row["pocket"] == 0 and row["rotation"] == 0
@@ -340,7 +340,7 @@ def test_rear_face_impulse_is_I_dec():
     assert w["I_dec"] == pytest.approx(J, abs=1e-15) and w["I_acc"] == 0.0
     assert w["Jn_rear"] == pytest.approx(J, abs=1e-15) and w["Jn_front"] == 0.0
     assert acc.f_bin[0]["rear"].sum() == pytest.approx(J, abs=1e-15)
-    assert acc.glob[0]["maxpen_rear"] == pytest.approx(2e-6)
+    assert acc.glob[0]["maxpen_rear"] == pytest.approx(2e-6, rel=1e-6, abs=0)
     assert n_imp == 1 and acc.impacts[0]["face"] == FACE_REAR
     assert acc.first_imp[0, 0] == pytest.approx(V, abs=1e-15)
 
@@ -693,7 +693,7 @@ def test_race_rotation_keeps_a_rolling_roller_on_its_circle(angle):
     et = np.array([-er[1], er[0]])
     st, n_extra = _orbit(*(RC * er), *(vt * et), h)
     land = st[0, 0:2] + h * st[0, 3:5]
-    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12)
+    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12, abs=0)
     turned = math.atan2(land[1], land[0]) - angle
     assert (turned + math.pi) % (2 * math.pi) - math.pi == pytest.approx(vt * h / RC, rel=1e-9)
     e_land = land / np.hypot(*land)
@@ -710,7 +710,7 @@ def test_race_rotation_stops_a_small_inward_speed_on_the_race():
     vr = -0.5 * vt**2 * h / RC
     st, n_extra = _orbit(RC, 0.0, vr, vt, h)
     land = st[0, 0:2] + h * st[0, 3:5]
-    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12)
+    assert np.hypot(*land) == pytest.approx(RC, rel=1e-12, abs=0)
     assert abs(st[0, 3:5] @ (land / np.hypot(*land))) < 1e-9 * vt
     assert n_extra == pytest.approx(ROLLER_MASS * (vt**2 / RC + vr / h), rel=1e-12)
 
@@ -722,7 +722,7 @@ def test_race_rotation_leaves_pymunk_the_radial_motion_of_a_roller_beyond_the_ci
     h, vt, vr, r = 2e-5, 10.0, -0.1, RC + 2e-6
     st, n_extra = _orbit(r, 0.0, vr, vt, h)
     land = st[0, 0:2] + h * st[0, 3:5]
-    assert np.hypot(*land) == pytest.approx(r + h * vr, rel=1e-12)
+    assert np.hypot(*land) == pytest.approx(r + h * vr, rel=1e-12, abs=0)
     e_land = land / np.hypot(*land)
     assert st[0, 3:5] @ e_land == pytest.approx(vr, rel=1e-9)
     assert e_land[0] * st[0, 4] - e_land[1] * st[0, 3] == pytest.approx(vt, rel=1e-12)

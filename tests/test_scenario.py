@@ -16,7 +16,7 @@ def test_preset_fills_unset_values_and_marks_reconstructions(base_reduced):
     assert g.roller_count == 16
     assert g.roller_radius == pytest.approx(6.5e-3)
     assert g.pitch_radius == pytest.approx(48.75e-3)
-    assert g.pocket_clearance == pytest.approx(0.20e-3)
+    assert g.pocket_clearance == pytest.approx(0.20e-3, rel=1e-6, abs=0)
     preset = load_preset("NU214-Suzuki2023")
     # Every bearing value carries its source; the values the paper lost are marked reconstructed.
     for key in preset["bearing"]:
@@ -29,10 +29,10 @@ def test_preset_fills_unset_values_and_marks_reconstructions(base_reduced):
 
 def test_scenario_value_beats_preset_and_override_beats_scenario(base_reduced):
     base_reduced["bearing"]["pocket_clearance_mm"] = 0.3
-    assert si(resolve(base_reduced)).bearing.pocket_clearance == pytest.approx(0.3e-3)
+    assert si(resolve(base_reduced)).bearing.pocket_clearance == pytest.approx(0.3e-3, rel=1e-6, abs=0)
     sc = load_scenario(SCENARIOS / "paper_3000rpm.toml",
                        ["bearing.pocket_clearance_mm=0.25", "operating.direction=reverse", "model=reduced"])
-    assert si(sc).bearing.pocket_clearance == pytest.approx(0.25e-3)
+    assert si(sc).bearing.pocket_clearance == pytest.approx(0.25e-3, rel=1e-6, abs=0)
     assert sc.operating.direction == "reverse"
 
 

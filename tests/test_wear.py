@@ -129,7 +129,7 @@ def test_archard_volume_is_k_W_over_H(fast_run):
     w = res.per_rotation["slide_work_rear"].sum(axis=0) / res.per_rotation["I_dec"].shape[0] * cage_rot
     np.testing.assert_allclose(rep.volume_rear, p.wear.wear_coefficient * w / p.wear.hardness, rtol=1e-12)
     np.testing.assert_allclose(rep.depth_rear.sum(axis=0) * rep.bin_area, rep.volume_rear, rtol=1e-12)
-    assert rep.hours == pytest.approx(1.6e5 / 6000 / 60, rel=1e-12)
+    assert rep.hours == pytest.approx(1.6e5 / 6000 / 60, rel=1e-12, abs=0)
     # abs=0: pytest.approx adds an absolute 1e-12 by default, 50 times this volume, and would pass any value
     assert laws.archard_volume_from_work(1e-5, 3.0, 1.5e9) == pytest.approx(2e-14, rel=1e-15, abs=0.0)
 
@@ -149,9 +149,9 @@ def test_a_face_bins_area_is_the_arc_the_rollers_hit_times_the_roller_length(fas
     lo, hi = sc.extent
     rep = res.wear_report(rotations=1.6e5)
     bins = rep.depth_rear.shape[0]
-    assert rep.bin_area == pytest.approx(sc.pocket_radius * (hi - lo) / bins * p.bearing.roller_length, rel=1e-12)
+    assert rep.bin_area == pytest.approx(sc.pocket_radius * (hi - lo) / bins * p.bearing.roller_length, rel=1e-12, abs=0)
     assert rep.bin_area == face_area(p, bins) and sc.pocket_radius == pytest.approx(
-        p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance, rel=1e-15)
+        p.bearing.roller_radius + 0.5 * p.bearing.pocket_clearance, rel=1e-15, abs=0)
 
 
 def test_the_papers_wear_index_takes_the_normal_impulse_and_agrees_with_the_sliding_work(fast_run):
@@ -226,7 +226,7 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
     res = fast_run[0]
     for hours in (0.44, 100.0, MAX_RUNNING_HOURS):
         rep = res.wear_report(hours=hours)
-        assert rep.hours == pytest.approx(hours, rel=1e-12)
+        assert rep.hours == pytest.approx(hours, rel=1e-12, abs=0)
         assert all(math.isfinite(x) for x in (rep.max_depth, rep.cov("front"), rep.cov("rear")))
     rotations = MAX_RUNNING_HOURS * 3600 * res.parameters.operating.omega_i / (2 * math.pi)  # at 6000 rpm: 3.6e11
     assert res.wear_report(rotations=rotations * 0.999).hours == pytest.approx(0.999 * MAX_RUNNING_HOURS, rel=1e-12)
@@ -257,7 +257,7 @@ def test_wear_report_takes_numpy_numbers_and_refuses_what_a_scenario_refuses(fas
     assert res.wear_report(rotations=np.int64(100000)).max_depth == base.max_depth
     k, h = res.parameters.wear.wear_coefficient, res.parameters.wear.hardness
     rep = wear_report(res, rotations=1e5, wear_coefficient=np.float64(2 * k), hardness=np.int64(int(h)))
-    assert rep.max_depth == pytest.approx(2 * base.max_depth, rel=1e-12)
+    assert rep.max_depth == pytest.approx(2 * base.max_depth, rel=1e-12, abs=0)
     lo, hi = HARDNESS_RANGE_PA
     bad = [("wear_coefficient", -1), ("wear_coefficient", 0.0), ("wear_coefficient", 2 * MAX_WEAR_COEFFICIENT),
            ("wear_coefficient", float("nan")), ("wear_coefficient", "1e-6"), ("wear_coefficient", True),
@@ -381,9 +381,9 @@ def test_an_infinite_limit_is_not_called_negative(text):
 def test_limit_parsing():
     from bearingsim.studies.life import parse_limit
 
-    assert parse_limit("depth=0.1mm").value == pytest.approx(1e-4)
-    assert parse_limit("clearance=300um").value == pytest.approx(3e-4)
-    assert parse_limit("volume=2mm3").value == pytest.approx(2e-9)
+    assert parse_limit("depth=0.1mm").value == pytest.approx(1e-4, rel=1e-6, abs=0)
+    assert parse_limit("clearance=300um").value == pytest.approx(3e-4, rel=1e-6, abs=0)
+    assert parse_limit("volume=2mm3").value == pytest.approx(2e-9, rel=1e-6, abs=0)
 
 
 @pytest.mark.parametrize("text, words", [
@@ -1305,7 +1305,7 @@ def test_the_worn_volume_mean_gives_its_standard_error_and_the_rotations_it_extr
     for f, v in (("front", rep.volume_front), ("rear", rep.volume_rear)):
         work = res.per_rotation[f"slide_work_{f}"]
         expected = p.wear.wear_coefficient * batch_sem(pocket_means(work)) * cage_rot / p.wear.hardness
-        assert rep.volume_sem(f) == pytest.approx(expected, rel=1e-12) and rep.volume_sem(f) > 0.0
+        assert rep.volume_sem(f) == pytest.approx(expected, rel=1e-12, abs=0) and rep.volume_sem(f) > 0.0
         np.testing.assert_allclose(rep.volume_rotations(f).mean(axis=0), v, rtol=1e-12)
         line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: worn volume mean"))
         assert f"standard error {rep.volume_sem(f) * 1e9:.2g} mm^3" in line and "2 recorded rotations" in line, line
@@ -1325,7 +1325,7 @@ def test_the_spread_over_pockets_is_given_beside_what_sampling_alone_gives(fast_
     for f in ("front", "rear"):
         v = rep.volume_rotations(f)
         expected = np.mean([batch_sem(v[:, i]) for i in range(v.shape[1])]) / v.mean()
-        assert rep.sampling_cov(f) == pytest.approx(expected, rel=1e-12) and rep.sampling_cov(f) > 0.0
+        assert rep.sampling_cov(f) == pytest.approx(expected, rel=1e-12, abs=0) and rep.sampling_cov(f) > 0.0
         line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: coefficient of variation"))
         assert f"{rep.cov(f):.3f}" in line and f"identical pockets would show {rep.sampling_cov(f):.3f}" in line
         assert "2 recorded rotations" in line, line
@@ -1849,7 +1849,7 @@ def test_the_life_is_given_with_its_sampling_error():
             "reused": np.array([0, 0]), "pocket_worst_read": np.array([1.2, 1.65]),
             "pocket_worst_scatter": np.array([1.19, 1.21]), "pocket_uneven": np.array([0, 1]),
             "rate_sem_rel": np.array([0.03, 0.04])}
-    assert life_error(cols) == pytest.approx(math.hypot(0.3, 0.8), rel=1e-12)
+    assert life_error(cols) == pytest.approx(math.hypot(0.3, 0.8), rel=1e-12, abs=0)
     text = format_history(cols, "life of x to clearance=0.4mm", {"limit": "clearance=0.4mm"})
     first = text.splitlines()[0]
     assert first.startswith("life of x to clearance=0.4mm: 30 ± 0.85 h = 1.08e+07 inner-ring rotations in 2 stages "

@@ -951,7 +951,7 @@ KEPT_SECTION = "## Classes tested outside this table"
 
 
 def write_doc(path: Path = ROOT / "docs" / "reliability.md") -> None:
-    """Run every case (and the two signals) and write the table of input, expected and observed."""
+    """Run every case (and the three signals) and write the table of input, expected and observed."""
     import tempfile
 
     rows = []

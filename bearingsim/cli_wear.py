@@ -78,10 +78,17 @@ def _comparison(paths, done) -> str:
     labels, differ = archive_labels(paths, [result.scenario.raw for result, _ in done])
     differ = [k for k in differ if k != "name"]
     notes = [f"wear of {len(paths)} archives, each after the running time at its own speed; scenario keys that "
-             f"differ: {', '.join(differ) if differ else 'none'}"
-             + ("" if len(labels) == 1 else " (as columns)" if len(labels) > len(differ)
-                else f" (the first {len(labels) - 1} as columns)")]
+             f"differ: {_keys_as_columns(labels, differ)}"]
     return wear.format_comparison(labels, [rep for _, rep in done], notes)
+
+
+def _keys_as_columns(labels: dict, differ: list[str]) -> str:
+    """The keys that differ, named, and how many of them the table's label columns ``labels`` show (the first
+    column names the archive or case; :func:`bearingsim.tables.archive_labels`)."""
+    named = ", ".join(differ) if differ else "none"
+    if len(labels) == 1:
+        return named
+    return named + (" (as columns)" if len(labels) > len(differ) else f" (the first {len(labels) - 1} as columns)")
 
 
 def _sweep_folder(paths: list[Path]) -> Path | None:
@@ -121,9 +128,7 @@ def _sweep_wear(folder: Path, args) -> str:
             missing.append(f"not available: case {cases[i]}"
                            + "".join(f", {k} = {labels[k][i]}" for k in labels if k != "case") + f": {why}")
     notes = [f"wear of the {n} cases of the sweep {folder}, each after the running time at its own speed; swept keys "
-             f"that differ: {', '.join(differ) if differ else 'none'}"
-             + ("" if len(labels) == 1 else " (as columns)" if len(labels) > len(differ)
-                else f" (the first {len(labels) - 1} as columns)")]
+             f"that differ: {_keys_as_columns(labels, differ)}"]
     table = wear.format_comparison(labels, rows, notes)
     rated = any(not isinstance(r, wear.WearReport) and r[3] != "-" for r in rows)  # a row of the index's rates
     return "\n".join([table, *missing, *([SWEEP_ROWS] if rated else [])])

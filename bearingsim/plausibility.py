@@ -230,8 +230,6 @@ def pocket_spread(result) -> list[tuple[str, float, float, float, np.ndarray]]:
     judged: another model, the ``reduced_equivalent`` scene (its rotations repeat), pockets of different shapes
     or starting depths (``flat_pockets``, ``[wear] worn_depth_*``), no sliding work recorded, fewer than 2
     rotations or no scatter."""
-    from bearingsim.stats import pocket_cov, pocket_sampling_cov, pocket_spread_critical
-
     p = result.parameters
     if p.model != "multibody" or p.multibody.scene == "reduced_equivalent" or not _same_pockets(p):
         return []
@@ -240,12 +238,23 @@ def pocket_spread(result) -> list[tuple[str, float, float, float, np.ndarray]]:
         arr = np.asarray(result.per_rotation.get(f"slide_work_{face}", np.zeros((0, 0))), dtype=float)
         if arr.ndim != 2 or arr.shape[0] < 2 or arr.shape[1] < 2 or not np.all(np.isfinite(arr)):
             continue
-        sampling = pocket_sampling_cov(arr)
-        if not sampling > 0.0:
-            continue
-        crit = pocket_spread_critical(arr.shape[1], arr.shape[0], POCKET_SPREAD_FALSE_ALARM / 2.0)
-        out.append((face, pocket_cov(arr.mean(axis=0)), sampling, crit, arr.mean(axis=0)))
+        cov, sampling, crit = face_spread(arr)
+        if sampling > 0.0:
+            out.append((face, cov, sampling, crit, arr.mean(axis=0)))
     return out
+
+
+def face_spread(per_rotation) -> tuple[float, float, float]:
+    """The test of equal pocket means of one face's ``[rotations, pockets]`` array: ``(cov, sampling cov,
+    critical ratio)`` (:func:`bearingsim.stats.pocket_cov` of the pockets' means,
+    :func:`bearingsim.stats.pocket_sampling_cov`, and the ratio of the two that identical pockets exceed in half of
+    :data:`POCKET_SPREAD_FALSE_ALARM` of runs); the pockets differ when ``cov > critical ratio * sampling cov``.
+    A run's note of uneven pockets (:func:`pocket_spread`) and a life study's stages judge by it."""
+    from bearingsim.stats import pocket_cov, pocket_sampling_cov, pocket_spread_critical
+
+    v = np.asarray(per_rotation, dtype=float)
+    crit = pocket_spread_critical(v.shape[1], v.shape[0], POCKET_SPREAD_FALSE_ALARM / 2.0)
+    return pocket_cov(v.mean(axis=0)), pocket_sampling_cov(v), crit
 
 
 def _same_pockets(p) -> bool:

@@ -218,12 +218,11 @@ def pocket_rates(rate, kind: str) -> tuple[np.ndarray, np.ndarray, dict]:
     worst pocket's rate over the pockets' mean; ``pocket_worst_scatter``, what the worst of identical pockets
     reads from the rotations' scatter alone (1 + :func:`bearingsim.stats.scatter_lead`; the worst of 16 noisy
     estimates leads by 1.77 of their standard errors: docs/wear.md, *The worst pocket*); ``pocket_uneven``, 1 when
-    the pockets differ beyond that scatter (the test of a run's note of uneven pockets, at half its false-alarm
-    share); ``rate_sem_rel``, the worst pocket's relative batch-means error (:func:`bearingsim.stats.batch_sem`),
+    the pockets differ beyond that scatter (:func:`bearingsim.plausibility.face_spread`, the test of a run's note
+    of uneven pockets); ``rate_sem_rel``, the worst pocket's relative batch-means error (:func:`bearingsim.stats.batch_sem`),
     for a clearance limit, the pocket it follows (NaN for the others)."""
-    from bearingsim.plausibility import POCKET_SPREAD_FALSE_ALARM
-    from bearingsim.stats import (batch_sem, pocket_cov, pocket_sampling_cov, pocket_spread_critical,
-                                  scatter_lead)
+    from bearingsim.plausibility import face_spread
+    from bearingsim.stats import batch_sem, scatter_lead
 
     d = np.stack([rate.depth_front, rate.depth_rear])
     v = np.stack([rate.volume_front, rate.volume_rear])
@@ -234,8 +233,8 @@ def pocket_rates(rate, kind: str) -> tuple[np.ndarray, np.ndarray, dict]:
     if per.ndim == 2 and per.shape[0] >= 2 and per.shape[1] >= 2 and per.mean() > 0.0:
         worst = per[:, int(np.argmax(total))]
         sem = batch_sem(worst) / worst.mean() if kind == "clearance" else math.nan
-        crit = pocket_spread_critical(per.shape[1], per.shape[0], POCKET_SPREAD_FALSE_ALARM / 2.0)
-        uneven = bool(pocket_cov(per.mean(axis=0)) > crit * pocket_sampling_cov(per))
+        cov, sampling, crit = face_spread(per)
+        uneven = bool(cov > crit * sampling)
     return d, v, {"pocket_worst_read": read, "pocket_worst_scatter": 1.0 + scatter_lead(per),
                   "pocket_uneven": int(uneven), "rate_sem_rel": sem}
 

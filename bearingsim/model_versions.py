@@ -30,9 +30,11 @@ This module imports nothing, so a sweep's resume check does not load the models.
 # summary (cage_rest_offset_m, cage_rest_angle_deg) and per rotation (numbers an archive of 5 lacks; no
 # number of 5 moved); 7: the paper's wear index (/results/wear/paper_index_*) from the normal impulse, not its
 # circumferential component; 8: the kinematic_cage scene's automatic step divided by 8 (core.KINEMATIC_DT_DIVISOR:
-# its I_dec moves, +6.7 % at 3000 rpm; no other scene's number moved)
+# its I_dec moves, +6.7 % at 3000 rpm; no other scene's number moved); 9: the quasi-static ring's solve converges
+# where Newton cycled (forces.solve_ring_centre: Armijo-damped Newton, then nested bracketing; every Hertz-raceway
+# run moves, rigid raceways bit-identical)
 #: version of each model's numbers (bumped when a change moves numbers; see the module docstring)
-MODEL_VERSIONS = {"reduced": 1, "multibody": 8}
+MODEL_VERSIONS = {"reduced": 1, "multibody": 9}
 
 #: the models, by the name a scenario's ``model`` key and an archive's ``/bearingsim@model`` give
 MODELS = tuple(MODEL_VERSIONS)

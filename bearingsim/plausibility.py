@@ -25,15 +25,12 @@ DISPLACEMENT_MARGIN = 2.0
 # Fewest recorded samples of the cage orbit that make a figure and a mean of it.
 MIN_ORBIT_SAMPLES = 2
 # What the note of a few steps in which the quasi-static ring's force balance did not converge says
-# (more than multibody.core.MAX_NEWTON_FAILURE_FRACTION of the steps are refused). Measured: Newton
-# cycles (period 2; 3 in the first step) for its 60 iterations across a kink of the contact law, and the
-# step uses the last iterate for its raceway forces. In the first two steps (the ring starts off its
-# balance: 946 N at 6000 rpm) the kink is an opening contact whose damped force is cut off at zero (last
-# residual 1.1 to 762 N against a 970 N load); in every later failing step it is a roller entering the
-# load zone (closing at 0.0045 to 0.065 m/s), out of contact at one iterate and 5 to 85 nm in at the next,
-# where its force rises from zero as its damping fades in (last residual 4.1 to 69 N, median 8.8 N at
-# 6000 rpm): multibody_3000rpm 1 + 1 rotations, 5 of 22922 steps (3 entering); multibody_6000rpm 1 + 3,
-# 23 of 23128 (21); multibody_1000rpm 1 + 2, 9 of 102534 (7).
+# (more than multibody.core.MAX_NEWTON_FAILURE_FRACTION of the steps are refused). Newton's iteration
+# cycles across a kink of the contact law (a roller entering the load zone, its damping fading in; an
+# opening contact in a run's first two steps); forces.solve_ring_centre then solves the step again with
+# Armijo-halved steps and, where that stalls, by bracketing, and only a step all of them fail keeps the
+# last iterate for its raceway forces. Measured: 0 such steps in multibody_3000rpm, multibody_6000rpm and
+# multibody_1000rpm (Newton alone failed in 14, 193 and 9).
 NEWTON_NOTE = ("bearingsim: note: the inner ring's force balance did not converge in {fails} of {steps} steps "
                "({share:.2%}; refused above 1%): those isolated steps kept the solve's last iterate for their raceway "
                "forces (provenance ring_newton_failures, docs/archive.md)")

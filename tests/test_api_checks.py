@@ -654,21 +654,18 @@ def test_a_step_check_gives_the_steps_error_as_twice_the_change_for_the_first_or
             f"{2 * bound:.1%} for a first-order scheme, more for a slower one)") in note, note
 
 
-@pytest.mark.slow  # a Hertz run on 4 rollers that stops after 0.012 s (~4 s)
-def test_a_quasi_static_ring_on_one_roller_that_blows_up_is_told_to_go_dynamic():
-    """docs/stability.md, The inner ring: a ring resting on a single roller has no stable sideways equilibrium,
-    and held quasi-static with 4 rollers at 970 N the raceway approach blows up at t = 0.012 s. The stop said
-    "try a smaller numerics.dt_s than 1.69e-07 s", and at 1e-7 s the same blow-up came at the same moment: the
-    instability is the ring's, not the step's. With the ring on one roller (laws.loaded_rollers_with_one_at_centre
-    < 2, the rule of multibody.inner_ring = "auto") the stop names the dynamic ring instead. Its force balance
-    fails in nearly every step, so the run stops on that as soon as it is certain (more than 1 % of the most
-    steps the run may take), before the blow-up: either stop names the dynamic ring, neither a smaller step."""
+def test_a_quasi_static_ring_on_one_roller_is_told_to_go_dynamic_not_to_shorten_the_step():
+    """docs/stability.md, The inner ring: a ring resting on a single roller has no stable sideways equilibrium.
+    Held quasi-static with 4 rollers at 970 N (the refusal bypassed, 4 rotations) it gives I_dec 16.1 mN s
+    against the dynamic ring's 27.4: the error is the model's, and no step mends it. With the ring on
+    one roller (laws.loaded_rollers_with_one_at_centre < 2, the rule of multibody.inner_ring = "auto") the
+    scenario is refused before its first step, and the one line names the dynamic ring, not a smaller step."""
     sc = bearingsim.load_scenario(MULTIBODY, overrides=["multibody.inner_ring=quasi_static", "bearing.roller_count=4",
                                                         "numerics.rotations=1"])
-    with pytest.raises(bearingsim.SimulationUnstable) as err:
+    with pytest.raises(bearingsim.UserError) as err:
         bearingsim.run(sc)
     msg = str(err.value)
-    assert ("energy blow-up" in msg or "force balance did not converge" in msg) and "\n" not in msg, msg
+    assert msg.startswith('multibody.inner_ring = "quasi_static"') and "\n" not in msg, msg
     assert 'multibody.inner_ring = "dynamic"' in msg and "try a smaller" not in msg, msg
 
 

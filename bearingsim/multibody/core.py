@@ -157,6 +157,9 @@ def inner_ring_model(p):
     if mode == "none":
         return 0.0, "none (reduced-equivalent scene)"
     if mode == "quasi_static":
+        advice = one_roller_ring_advice(p)
+        if advice is not None:
+            raise UserError(f'multibody.inner_ring = "quasi_static": {advice}')
         return 0.0, "quasi-static (massless)" + (f"; {why}" if why else "")
     mb = p.multibody
     load = p.operating.radial_load
@@ -1086,8 +1089,9 @@ def one_roller_ring_advice(p) -> str | None:
         k = laws.loaded_rollers_with_one_at_centre(load, g.roller_count, g.roller_length, g.radial_clearance)
         if k < 2:
             return (f"the quasi-static inner ring rests on one roller here ({k} loaded with one at the load-zone "
-                    f"centre), which has no stable sideways equilibrium and a smaller numerics.dt_s does not give "
-                    f"it one: set multibody.inner_ring = \"dynamic\" (or \"auto\", which chooses it here)")
+                    f"centre), which has no stable sideways equilibrium: a massless ring jumps between supports "
+                    f"(docs/stability.md, The inner ring) and a smaller numerics.dt_s does not help; set "
+                    f"multibody.inner_ring = \"dynamic\" (or \"auto\", which chooses it here)")
     return None
 
 

@@ -91,6 +91,8 @@ DIAG = np.dtype([
 ], align=True)
 
 TEN_NINTHS = 10.0 / 9.0
+NEWTON_ITERATIONS = 60  # of the ring centre's Newton iteration
+NEWTON_HALVINGS = 30  # of its step (Armijo's rule), down to 2^-29 of Newton's step
 
 
 @njit(cache=True, inline="always")
@@ -111,66 +113,134 @@ def _normal_force(delta, delta_rate, K, c_r, d_fade):
     return q, k_lin + dc * delta_rate, c
 
 
-@njit(cache=True)
-def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
-    """Quasi-static inner-ring centre: Newton on sum_i Q_i N_i = (0, -W).
-
-    Parameters
-    ----------
-    xp : (n, 2) predicted roller centres [m].
-    delta_prev : (n,) inner-race approach of each roller at the current positions and ``c_prev`` [m];
-        the damping uses the rate ``(delta - delta_prev) / h`` over the step.
-    c_prev : (2,) ring centre of the previous step [m].
-    h : time step [s].
-    prm : :class:`RacewayParams`.
-    out_c : (2,) in: initial guess, out: solution [m].
-
-    Returns
-    -------
-    (iterations, residual norm [N]); iterations < 0 if Newton did not converge.
-    """
-    n = xp.shape[0]
+@njit(cache=True, inline="always")
+def _ring_balance(xp, delta_prev, h, prm, cx, cy):
+    """Force balance of the quasi-static inner ring centred at (cx, cy): the residual
+    ``sum_i Q_i N_i + (0, W)`` [N] and its Jacobian in the centre [N/m], ``(rx, ry, j00, j01, j10, j11)``.
+    Each component increases with its own coordinate (a ring moved towards rollers presses them harder)."""
     rr = prm.roller_radius
     r_race = prm.inner_race_radius
     K = prm.palmgren_stiffness
     c_r = prm.damping_time
     d_fade = prm.damping_fade
-    load = prm.radial_load
+    rx = 0.0
+    ry = prm.radial_load
+    j00 = 0.0
+    j01 = 0.0
+    j10 = 0.0
+    j11 = 0.0
+    for i in range(xp.shape[0]):
+        dx = xp[i, 0] - cx
+        dy = xp[i, 1] - cy
+        d = math.sqrt(dx * dx + dy * dy)
+        nx = dx / d
+        ny = dy / d
+        delta = r_race + rr - d
+        if delta <= 0.0:
+            continue
+        rate = (delta - delta_prev[i]) / h
+        q, dq_dd, dq_drate = _normal_force(delta, rate, K, c_r, d_fade)
+        if q <= 0.0:
+            continue
+        rx += q * nx
+        ry += q * ny
+        # d delta / dc = N ; d rate / dc = N / h (through c_dot); d N / dc = -(I - N N^T) / d
+        g = dq_dd + dq_drate / h
+        qd = q / d
+        j00 += g * nx * nx - qd * (1.0 - nx * nx)
+        j01 += g * nx * ny + qd * nx * ny
+        j10 += g * ny * nx + qd * nx * ny
+        j11 += g * ny * ny - qd * (1.0 - ny * ny)
+    return rx, ry, j00, j01, j10, j11
+
+
+@njit(cache=True, inline="always")
+def _safeguarded(t, f, df, lo, hi):
+    """Next iterate towards a root bracketed in (lo, hi): Newton's from t if it stays inside, else the midpoint."""
+    if df > 0.0:
+        tn = t - f / df
+        if lo < tn < hi:
+            return tn
+    return 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def _ring_y(xp, delta_prev, h, prm, cx, cy, tol):
+    """The ring's vertical balance at a given ``cx``: the root of ``ry(cy)`` (increasing), bracketed by
+    steps from ``cy`` doubling from 1e-10 m, then closed in by :func:`_safeguarded` to ``tol`` or to the
+    resolution of float64. Returns ``(cy, rx, ry, dg)``: ``dg`` = ``j00 - j01 j10 / j11``, the derivative of
+    ``rx`` along the balanced path; ``|ry| > tol`` where no root was found."""
+    rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, cy)
+    t = lo = hi = cy
+    f0 = ry
+    step = 1e-10 if ry < 0.0 else -1e-10
+    while abs(ry) > tol and (ry < 0.0) == (f0 < 0.0) and abs(step) < 1e-2:  # bracket
+        lo, hi = (t, t + step) if step > 0.0 else (t + step, t)
+        t += step
+        step *= 2.0
+        rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, t)
+    found = (ry < 0.0) != (f0 < 0.0)
+    for _ in range(200):
+        if abs(ry) <= tol or not found:  # balanced, or no root within 1 cm
+            break
+        if ry < 0.0:
+            lo = t
+        else:
+            hi = t
+        if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+            break
+        t = _safeguarded(t, ry, j11, lo, hi)
+        rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, t)
+    dg = j00 - j01 * j10 / j11 if j11 > 0.0 else j00
+    return t, rx, ry, dg
+
+
+@njit(cache=True)
+def _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol):
+    """The ring centre by nested 1-D root finding, where Newton has failed: ``rx`` along the path of
+    vertical balance (:func:`_ring_y`) is continuous and increasing but for the ring's curvature; its root
+    is bracketed from ``out_c[0]`` by doubling steps and closed in by :func:`_safeguarded`. Continuous
+    contact forces give a root whatever their kinks. ``out_c``: in, the start; out, the centre.
+    Returns the residual norm [N]."""
+    cx = out_c[0]
+    half = 0.5 * tol
+    cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, out_c[1], half)
+    f0 = rx
+    step = 1e-10 if rx < 0.0 else -1e-10
+    lo = hi = cx
+    while abs(rx) > half and (rx < 0.0) == (f0 < 0.0) and abs(step) < 1e-2:  # bracket
+        lo, hi = (cx, cx + step) if step > 0.0 else (cx + step, cx)
+        cx += step
+        step *= 2.0
+        cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
+    found = (rx < 0.0) != (f0 < 0.0)
+    for _ in range(200):
+        if abs(rx) <= half or not found:  # balanced, or no root within 1 cm
+            break
+        if rx < 0.0:
+            lo = cx
+        else:
+            hi = cx
+        if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+            break
+        cx = _safeguarded(cx, rx, dg, lo, hi)
+        cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
+    out_c[0] = cx
+    out_c[1] = cy
+    return math.sqrt(rx * rx + ry * ry)
+
+
+@njit(cache=True)
+def _ring_newton(xp, delta_prev, h, prm, out_c, tol, armijo):
+    """Newton's iteration for the ring centre from ``out_c`` (out: its last iterate), each step limited to
+    ``prm.newton_max_step``; with ``armijo``, halved until the residual norm falls (Armijo's rule), and
+    stopped where no halving does. Returns (iterations, residual norm [N]); iterations < 0 if not converged."""
     max_step = prm.newton_max_step
     cx = out_c[0]
     cy = out_c[1]
-    tol = 1e-9 * (load + 1.0)
-    res = 0.0
-    for it in range(60):
-        rx = 0.0
-        ry = load  # residual = sum Q N - (0, -W)
-        j00 = 0.0
-        j01 = 0.0
-        j10 = 0.0
-        j11 = 0.0
-        for i in range(n):
-            dx = xp[i, 0] - cx
-            dy = xp[i, 1] - cy
-            d = math.sqrt(dx * dx + dy * dy)
-            nx = dx / d
-            ny = dy / d
-            delta = r_race + rr - d
-            if delta <= 0.0:
-                continue
-            rate = (delta - delta_prev[i]) / h
-            q, dq_dd, dq_drate = _normal_force(delta, rate, K, c_r, d_fade)
-            if q <= 0.0:
-                continue
-            rx += q * nx
-            ry += q * ny
-            # d delta / dc = N ; d rate / dc = N / h (through c_dot); d N / dc = -(I - N N^T) / d
-            g = dq_dd + dq_drate / h
-            qd = q / d
-            j00 += g * nx * nx - qd * (1.0 - nx * nx)
-            j01 += g * nx * ny + qd * nx * ny
-            j10 += g * ny * nx + qd * nx * ny
-            j11 += g * ny * ny - qd * (1.0 - ny * ny)
-        res = math.sqrt(rx * rx + ry * ry)
+    rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, cy)
+    res = math.sqrt(rx * rx + ry * ry)
+    for it in range(NEWTON_ITERATIONS):
         if res <= tol:
             out_c[0] = cx
             out_c[1] = cy
@@ -189,13 +259,63 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
         if sn > max_step:
             sx *= max_step / sn
             sy *= max_step / sn
-        cx += sx
-        cy += sy
+        t = 1.0
+        for _ in range(NEWTON_HALVINGS if armijo else 1):
+            rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx + t * sx, cy + t * sy)
+            r_try = math.sqrt(rx * rx + ry * ry)
+            if not armijo or r_try <= (1.0 - 1e-4 * t) * res:
+                break
+            t *= 0.5
+        else:
+            break  # no step along Newton's direction lowers the residual: stalled at a kink
+        cx += t * sx
+        cy += t * sy
+        res = r_try
         if sn < 1e-16:
             break
     out_c[0] = cx
     out_c[1] = cy
     return -1, res
+
+
+@njit(cache=True)
+def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
+    """Quasi-static inner-ring centre: the root of sum_i Q_i N_i = (0, -W).
+
+    Newton's iteration (:func:`_ring_newton`); where it does not converge in ``NEWTON_ITERATIONS``, it has
+    cycled across a kink of the contact law (a roller entering the load zone, whose damping is faded in
+    over its first ``damping_fade``; at a run's start, an opening contact whose force is cut off at zero),
+    and the solve starts again from the guess with the step halved until the residual falls (Armijo's rule),
+    then, where that stalls, by nested bracketing (:func:`_bracketed_ring_centre`) from its last iterate.
+    A step that Newton alone solves keeps its iterates (with rigid raceways, every step).
+
+    Parameters
+    ----------
+    xp : (n, 2) predicted roller centres [m].
+    delta_prev : (n,) inner-race approach of each roller at the current positions and ``c_prev`` [m];
+        the damping uses the rate ``(delta - delta_prev) / h`` over the step.
+    c_prev : (2,) ring centre of the previous step [m].
+    h : time step [s].
+    prm : :class:`RacewayParams`.
+    out_c : (2,) in: initial guess, out: solution [m].
+
+    Returns
+    -------
+    (iterations, residual norm [N]); iterations < 0 if none converged (to 1e-9 (W + 1 N)).
+    """
+    tol = 1e-9 * (prm.radial_load + 1.0)
+    gx = out_c[0]
+    gy = out_c[1]
+    it, res = _ring_newton(xp, delta_prev, h, prm, out_c, tol, False)
+    if it >= 0:
+        return it, res
+    out_c[0] = gx
+    out_c[1] = gy
+    it, res = _ring_newton(xp, delta_prev, h, prm, out_c, tol, True)
+    if it >= 0:
+        return NEWTON_ITERATIONS + it, res
+    res = _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol)
+    return (2 * NEWTON_ITERATIONS if res <= tol else -1), res
 
 
 @njit(cache=True, inline="always")

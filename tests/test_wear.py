@@ -1832,6 +1832,39 @@ def test_pockets_that_really_differ_lead_beyond_their_scatter():
     assert cols["pocket_worst_read"] - 1.0 > 2.0 * (cols["pocket_worst_scatter"] - 1.0), cols
 
 
+def test_a_volume_limit_carries_the_sampling_error_of_the_face_it_follows():
+    """A volume limit ends when the largest face volume reaches it, so its life's error follows the face whose
+    rate is largest, not the worst pocket's front + rear: here pocket 3's front face wears 2 x, and pocket 7's
+    faces 1.8 x each, together more than pocket 3's (seeded, 10 rotations); the volume limit's
+    ``rate_sem_rel`` is the batch-means error of pocket 3's front series over its mean, the clearance
+    limit's that of pocket 7's front + rear, and a depth limit has none (a point's depth per rotation is not
+    kept). The history's first line and the figure's title then name the face."""
+    from bearingsim.stats import batch_sem
+    from bearingsim.studies.life import format_history, plot_life, pocket_rates
+
+    rng = np.random.default_rng(3)
+    front, rear = _pockets_draw(rng, 10, np.ones(16))
+    front[:, 3] *= 2.0
+    front[:, 7] *= 1.8
+    rear[:, 7] *= 1.8
+    rate = _synthetic_rate(front, rear)
+    assert (front + rear).mean(axis=0).argmax() == 7 and np.stack([front, rear]).mean(axis=1).max() == front[:, 3].mean()
+    vol = pocket_rates(rate, "volume")[2]["rate_sem_rel"]
+    assert vol == batch_sem(front[:, 3]) / front[:, 3].mean()
+    pocket = (front + rear)[:, 7]
+    assert pocket_rates(rate, "clearance")[2]["rate_sem_rel"] == batch_sem(pocket) / pocket.mean()
+    assert math.isnan(pocket_rates(rate, "depth")[2]["rate_sem_rel"])
+    cols = {"stage": np.array([0]), "clearance_start_mm": np.array([0.2]), "stage_rotations": np.array([3.6e6]),
+            "rotations_end": np.array([3.6e6]), "hours_end": np.array([10.0]), "max_depth_rate_um_per_h": np.array([5.0]),
+            "max_depth_um": np.array([50.0]), "max_volume_mm3": np.array([1.0]), "clearance_end_mm": np.array([0.21]),
+            "I_dec_mean_mNs": np.array([18.0]), "reused": np.array([0]), "pocket_worst_read": np.array([1.2]),
+            "pocket_worst_scatter": np.array([1.19]), "pocket_uneven": np.array([0]), "rate_sem_rel": np.array([0.05])}
+    attrs = {"limit": "volume=1mm3"}
+    assert "(±: the sampling error of the worst face's rates" in format_history(cols, "life", attrs).splitlines()[0]
+    assert "10 ± 0.5 h" in format_history(cols, "life", attrs).splitlines()[0]
+    assert "(±: the worst face's rates' sampling error)" in plot_life(cols, attrs)._suptitle.get_text()
+
+
 @pytest.mark.slow
 def test_the_life_is_given_with_its_sampling_error():
     """The history's first line (bearingsim life, bearingsim table) and the figure's title give a clearance

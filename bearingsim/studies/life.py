@@ -219,8 +219,9 @@ def pocket_rates(rate, kind: str) -> tuple[np.ndarray, np.ndarray, dict]:
     reads from the rotations' scatter alone (1 + :func:`bearingsim.stats.scatter_lead`; the worst of 16 noisy
     estimates leads by 1.77 of their standard errors: docs/wear.md, *The worst pocket*); ``pocket_uneven``, 1 when
     the pockets differ beyond that scatter (:func:`bearingsim.plausibility.face_spread`, the test of a run's note
-    of uneven pockets); ``rate_sem_rel``, the worst pocket's relative batch-means error (:func:`bearingsim.stats.batch_sem`),
-    for a clearance limit, the pocket it follows (NaN for the others)."""
+    of uneven pockets); ``rate_sem_rel``, the relative batch-means error (:func:`bearingsim.stats.batch_sem`) of the
+    rate the limit follows: for a clearance limit the worst pocket's (front + rear), for a volume limit the worst
+    face's; NaN for a depth limit (a point's depth per rotation is not kept)."""
     from bearingsim.plausibility import face_spread
     from bearingsim.stats import batch_sem, scatter_lead
 
@@ -232,7 +233,10 @@ def pocket_rates(rate, kind: str) -> tuple[np.ndarray, np.ndarray, dict]:
     sem, uneven = math.nan, False
     if per.ndim == 2 and per.shape[0] >= 2 and per.shape[1] >= 2 and per.mean() > 0.0:
         worst = per[:, int(np.argmax(total))]
-        sem = batch_sem(worst) / worst.mean() if kind == "clearance" else math.nan
+        if kind == "volume":  # the face that reaches a volume limit first: the largest rate of any face
+            face, pocket = np.unravel_index(int(np.argmax(v)), v.shape)
+            worst = rate.volume_rotations(("front", "rear")[face])[:, pocket]
+        sem = batch_sem(worst) / worst.mean() if kind != "depth" and worst.mean() > 0.0 else math.nan
         cov, sampling, crit = face_spread(per)
         uneven = bool(cov > crit * sampling)
     return d, v, {"pocket_worst_read": read, "pocket_worst_scatter": 1.0 + scatter_lead(per),
@@ -243,7 +247,7 @@ def life_error(cols: dict) -> float:
     """The sampling error of a history's life [h]: each stage's time times the relative error of the worst
     pocket's rate it wore on with (``rate_sem_rel``, :func:`pocket_rates`; a stage's length goes as 1 / that
     rate), the stages' errors independent and added in quadrature; NaN for a history written before it held
-    the column, or of another limit than a clearance. Not in it: how the trajectory's pocket differences grow
+    the column, or of a depth limit. Not in it: how the trajectory's pocket differences grow
     through the worn shape fed back (docs/wear.md, *The worst pocket*: 27.7-30.8 h over three trajectories of
     multibody_6000rpm at 10 rotations per stage, where this error is 0.7-0.9 h)."""
     if "rate_sem_rel" not in cols:
@@ -628,8 +632,9 @@ LIFE_DESCRIPTIONS = {
                             "(1 + 1.77 standard errors for 16 pockets; docs/wear.md, The worst pocket)",
     "pocket_uneven": "1 when the pockets' spread is beyond the rotations' scatter (the test of the note of uneven "
                      "pockets)",
-    "rate_sem_rel": "the relative batch-means standard error of the worst pocket's worn-volume rate (clearance "
-                    "limits; the life's error is these times the stages' hours, in quadrature)",
+    "rate_sem_rel": "the relative batch-means standard error of the rate the limit follows: the worst pocket's "
+                    "worn-volume rate (clearance limits) or the worst face's (volume limits); the life's error is "
+                    "these times the stages' hours, in quadrature",
 }
 
 
@@ -724,21 +729,24 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     else:
         e = life_error(cols)
         when = when if not math.isfinite(e) else when.replace(" h = ", f" ± {e:.2g} h = ", 1)
-        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols)}"
+        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, attrs.get('limit'))}"
     lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
     lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
     return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
 
 
-def _error_text(cols: dict) -> str:
+def _error_text(cols: dict, limit: str | None = None) -> str:
     """`` (±: ...)``, what the ± of a history's life (:func:`life_error`) is, and the worst pocket's lead read
     against the one identical pockets read from the scatter; "" without the error (a history written before it
-    held the columns, or of another limit)."""
+    held the columns, or of a depth limit). ``limit``: the history's limit as given (``volume=...`` follows the
+    worst face, the others the worst pocket)."""
     if not math.isfinite(life_error(cols)):
         return ""
     read, scatter = (np.asarray(cols[c], dtype=float) for c in ("pocket_worst_read", "pocket_worst_scatter"))
-    return (f" (±: the sampling error of the worst pocket's rates, not the trajectories' scatter; it read "
+    what = "face" if str(limit or "").split("=")[0].strip() == "volume" else "pocket"
+    return (f" (±: the sampling error of the worst {what}'s rates, not the trajectories' scatter; the worst pocket "
+            f"read "
             f"{_span(read)} x the pockets' mean, identical pockets {_span(scatter)} x from the scatter alone, the "
             f"pockets uneven beyond it in {int(np.sum(cols['pocket_uneven']))} of {counted(len(read), 'stage')}; "
             f"docs/wear.md, The worst pocket)")
@@ -838,10 +846,11 @@ def plot_life(cols: dict, attrs: dict):
         ax.set_xlabel("running time [h]")
     _plot_worn_faces(axes[3], cols)
     end = "the cage bar worn through first, after " if attrs.get("worn_through") else ""
-    error = life_error(cols)  # a clearance limit's sampling error (docs/wear.md, The worst pocket)
+    error = life_error(cols)  # a clearance or volume limit's sampling error (docs/wear.md, The worst pocket)
     pm, what = ("", "")
     if math.isfinite(error):
-        pm, what = f" ± {error:.2g}", " (±: the worst pocket's rates' sampling error)"
+        face = str(attrs.get("limit", "")).split("=")[0].strip() == "volume"
+        pm, what = f" ± {error:.2g}", f" (±: the worst {'face' if face else 'pocket'}'s rates' sampling error)"
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g}{pm} h, {cols['rotations_end'][-1]:.3g} "
                  f"inner-ring rotations, {counted(len(h_end), 'stage')}{what}\n"
                  f"{_life_subtitle(attrs)}", fontsize=9)

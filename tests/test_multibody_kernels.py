@@ -109,15 +109,20 @@ def test_ring_centre_balances_the_load_on_a_symmetric_set():
     assert q.max() == pytest.approx(4.08 * load / n, rel=0.005)
 
 
-def test_ring_centre_converges_as_rollers_enter_and_leave_the_load_zone():
+@pytest.mark.parametrize("load", [970.0, 10.0])
+def test_ring_centre_converges_as_rollers_enter_and_leave_the_load_zone(load):
     """The quasi-static ring on 16 rollers turned on a circle 40 um outside the inner race (the reference
     bearing's radial clearance) under W = 970 N, 400 steps of 4 us at 250 rad/s (one roller pitch: every
     phase of a roller entering and leaving the load zone), with contact damping and the approach rate over
     each step, started from the elastic balance. Newton alone failed in 122 of these 401 solves (the elastic
     start among them, 302 N left): it cycles across the kink of a roller entering contact, as in the full
     scene's failing steps (docs/archive.md, ring_newton_failures). Every solve converges to its tolerance,
-    1e-9 (W + 1 N)."""
-    n, load, h, omega = 16, 970.0, 4e-6, 250.0
+    1e-9 (W + 1 N), or, where the bracketing closes to adjacent floats, to the rounding of the force sum: at
+    W = 10 N the tolerance (1.1e-8 N) is below what a contact closing at the damping fade's stiffness resolves
+    (one ulp of a roller's 0.049 m distance, 6.9e-18 m, times ~3e8 N/m), and one of the 401 solves had ended
+    there, rx flipping sign between adjacent floats (1e-7 N), counted as not converged. Where the returned
+    residual exceeds the tolerance it is within that rounding (8 ulps times the contacts' stiffness)."""
+    n, h, omega = 16, 4e-6, 250.0
     prm = _params(radial_load=load, inner_ring=True)
     r = prm.inner_race_radius + ROLLER_RADIUS + 40e-6
     a0 = -0.5 * math.pi + 2.0 * math.pi * np.arange(n) / n + 0.013
@@ -135,10 +140,23 @@ def test_ring_centre_converges_as_rollers_enter_and_leave_the_load_zone():
         delta_prev = prm.inner_race_radius + ROLLER_RADIUS - np.hypot(x[:, 0] - c[0], x[:, 1] - c[1])
         out = c.copy()
         it, res = fk.solve_ring_centre(xn, delta_prev, c, h, prm, out)
-        if it < 0 or res > 1e-9 * (load + 1.0):
+        if it < 0 or res > 1e-9 * (load + 1.0) + _rounding(xn, delta_prev, h, prm, out):
             failed.append((k, res))
         c, x = out, xn
     assert failed == [], f"{len(failed)} of 401 solves did not converge: {failed[:5]}"
+
+
+def _rounding(xp, delta_prev, h, prm, c):
+    """What rounding alone leaves of the ring's force sum at ``c`` [N]: 8 ulps of a roller's distance from the
+    centre times the contacts' stiffness, summed here in numpy from the force law's own slopes."""
+    d = np.hypot(xp[:, 0] - c[0], xp[:, 1] - c[1])
+    delta = prm.inner_race_radius + ROLLER_RADIUS - d
+    s = 0.0
+    for i in np.flatnonzero(delta > 0.0):
+        q, dq_dd, dq_drate = fk._normal_force(delta[i], (delta[i] - delta_prev[i]) / h, prm.palmgren_stiffness,
+                                              prm.damping_time, prm.damping_fade)
+        s += (dq_dd + dq_drate / h) if q > 0.0 else 0.0
+    return 8.0 * s * np.finfo(float).eps * (prm.inner_race_radius + ROLLER_RADIUS)
 
 
 # --- one roller on the outer race -----------------------------------------------------------------

@@ -164,12 +164,23 @@ def _safeguarded(t, f, df, lo, hi):
     return 0.5 * (lo + hi)
 
 
+@njit(cache=True, inline="always")
+def _float_limited(f, s, prm, tol):
+    """Whether a residual ``f`` [N] left where a bracket has closed to adjacent floats is the rounding of the
+    force sum: within ``tol`` plus 8 ulps of a roller's distance from the ring centre times the contacts'
+    stiffness ``s`` [N/m] (the trace of the Jacobian; a stiff or fast-closing contact's rounding alone can
+    exceed ``tol``), not a jump of the forces between those floats."""
+    return abs(f) <= tol + 8.0 * s * 2.220446049250313e-16 * (prm.inner_race_radius + prm.roller_radius)
+
+
 @njit(cache=True)
 def _ring_y(xp, delta_prev, h, prm, cx, cy, tol):
     """The ring's vertical balance at a given ``cx``: the root of ``ry(cy)`` (increasing), bracketed by
     steps from ``cy`` doubling from 1e-10 m, then closed in by :func:`_safeguarded` to ``tol`` or to the
-    resolution of float64. Returns ``(cy, rx, ry, dg)``: ``dg`` = ``j00 - j01 j10 / j11``, the derivative of
-    ``rx`` along the balanced path; ``|ry| > tol`` where no root was found."""
+    resolution of float64. Returns ``(cy, rx, ry, dg, s, ok)``: ``dg`` = ``j00 - j01 j10 / j11``, the derivative
+    of ``rx`` along the balanced path; ``s`` the contacts' stiffness (``|j00| + |j11|``) [N/m]; ``ok`` where
+    ``|ry| <= tol`` or the bracket closed to float64 resolution with ``ry`` its rounding
+    (:func:`_float_limited`); not ``ok`` where no root was found."""
     rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, cy)
     t = lo = hi = cy
     f0 = ry
@@ -180,19 +191,22 @@ def _ring_y(xp, delta_prev, h, prm, cx, cy, tol):
         step *= 2.0
         rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, t)
     found = (ry < 0.0) != (f0 < 0.0)
+    ok = abs(ry) <= tol
     for _ in range(200):
-        if abs(ry) <= tol or not found:  # balanced, or no root within 1 cm
+        if ok or not found:  # balanced, or no root within 1 cm
             break
         if ry < 0.0:
             lo = t
         else:
             hi = t
         if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+            ok = _float_limited(ry, abs(j00) + abs(j11), prm, tol)
             break
         t = _safeguarded(t, ry, j11, lo, hi)
         rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, t)
+        ok = abs(ry) <= tol
     dg = j00 - j01 * j10 / j11 if j11 > 0.0 else j00
-    return t, rx, ry, dg
+    return t, rx, ry, dg, abs(j00) + abs(j11), ok
 
 
 @njit(cache=True)
@@ -201,10 +215,11 @@ def _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol):
     vertical balance (:func:`_ring_y`) is continuous and increasing but for the ring's curvature; its root
     is bracketed from ``out_c[0]`` by doubling steps and closed in by :func:`_safeguarded`. Continuous
     contact forces give a root whatever their kinks. ``out_c``: in, the start; out, the centre.
-    Returns the residual norm [N]."""
+    Returns (residual norm [N], converged): converged where both balances are within ``tol / 2`` or closed to
+    float64 resolution with a residual that is their rounding (:func:`_float_limited`)."""
     cx = out_c[0]
     half = 0.5 * tol
-    cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, out_c[1], half)
+    cy, rx, ry, dg, s, ok_y = _ring_y(xp, delta_prev, h, prm, cx, out_c[1], half)
     f0 = rx
     step = 1e-10 if rx < 0.0 else -1e-10
     lo = hi = cx
@@ -212,22 +227,26 @@ def _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol):
         lo, hi = (cx, cx + step) if step > 0.0 else (cx + step, cx)
         cx += step
         step *= 2.0
-        cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
+        cy, rx, ry, dg, s, ok_y = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
     found = (rx < 0.0) != (f0 < 0.0)
+    ok_x = abs(rx) <= half
     for _ in range(200):
-        if abs(rx) <= half or not found:  # balanced, or no root within 1 cm
+        if ok_x or not found:  # balanced, or no root within 1 cm
             break
         if rx < 0.0:
             lo = cx
         else:
             hi = cx
         if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+            ok_x = _float_limited(rx, s, prm, half)
             break
         cx = _safeguarded(cx, rx, dg, lo, hi)
-        cy, rx, ry, dg = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
+        cy, rx, ry, dg, s, ok_y = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
+        ok_x = abs(rx) <= half
     out_c[0] = cx
     out_c[1] = cy
-    return math.sqrt(rx * rx + ry * ry)
+    res = math.sqrt(rx * rx + ry * ry)
+    return res, res <= tol or (ok_x and ok_y)
 
 
 @njit(cache=True)
@@ -301,7 +320,8 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
 
     Returns
     -------
-    (iterations, residual norm [N]); iterations < 0 if none converged (to 1e-9 (W + 1 N)).
+    (iterations, residual norm [N]); iterations < 0 if none converged (to 1e-9 (W + 1 N), or where the bracketing
+    closed to float64 resolution, to the rounding of the force sum there: :func:`_float_limited`).
     """
     tol = 1e-9 * (prm.radial_load + 1.0)
     gx = out_c[0]
@@ -314,8 +334,8 @@ def solve_ring_centre(xp, delta_prev, c_prev, h, prm, out_c):
     it, res = _ring_newton(xp, delta_prev, h, prm, out_c, tol, True)
     if it >= 0:
         return NEWTON_ITERATIONS + it, res
-    res = _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol)
-    return (2 * NEWTON_ITERATIONS if res <= tol else -1), res
+    res, ok = _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol)
+    return (2 * NEWTON_ITERATIONS if ok else -1), res
 
 
 @njit(cache=True, inline="always")

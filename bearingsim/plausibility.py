@@ -82,8 +82,8 @@ CAGE_REST_MIN_OFFSET = 0.25
 # bearingsim.stats.pocket_cov, pocket_sampling_cov) is tested for equal pocket means (an F test,
 # bearingsim.stats.pocket_spread_critical) at half of POCKET_SPREAD_FALSE_ALARM, so that runs of identical pockets
 # get the note in at most that share, both faces together, when the scatter is normal (0.045-0.13 % of 20 000
-# simulated runs); the reference runs' own arrays, pockets renumbered at random per rotation, got it in 0 to 0.48 %
-# (the impulses' tails). Measured: the reference runs read ratios 0.73 to 1.07
+# simulated runs); the reference runs' own arrays, pockets renumbered at random per rotation, got it in 0 to 0.62 %
+# (the impulses' tails). Measured: the reference runs read ratios 0.69 to 1.17
 # (multibody_6000rpm, 3000rpm, 1000rpm at their default rotations) against critical ratios 1.86 to 2.96.
 POCKET_SPREAD_FALSE_ALARM = 0.001
 # A mean cage speed above this multiple of the epicyclic speed (Eq. 11; a roller-guided cage slips

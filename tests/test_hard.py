@@ -173,7 +173,7 @@ def test_a_cage_that_escapes_faces_already_at_the_wall_is_told_what_holds_it(tmp
 @pytest.mark.slow
 def test_automatic_dt_restart_is_recorded():
     """The 0.02 mm pocket at 20000 rpm needs a shorter step than the automatic estimate (an approach
-    overlaps the 20 um clearance's face by 0.67 um at the automatic step, more than three times the
+    overlaps the 20 um clearance's face by 0.47 um at the automatic step, more than twice the
     1 % bound; at 3000 rpm the exact pocket faces keep it within the bound): the run restarts at a step
     scaled to the measured overlap, ends within the 1 % bound, and the archive's dt_choice says how the
     first step was chosen and why it was shortened."""

@@ -248,8 +248,8 @@ def life_error(cols: dict) -> float:
     pocket's rate it wore on with (``rate_sem_rel``, :func:`pocket_rates`; a stage's length goes as 1 / that
     rate), the stages' errors independent and added in quadrature; NaN for a history written before it held
     the column, or of a depth limit. Not in it: how the trajectory's pocket differences grow
-    through the worn shape fed back (docs/wear.md, *The worst pocket*: 27.7-30.8 h over three trajectories of
-    multibody_6000rpm at 10 rotations per stage, where this error is 0.7-0.9 h)."""
+    through the worn shape fed back (docs/wear.md, *The worst pocket*: 27.6-35.2 h over four rotation counts
+    per stage of multibody_6000rpm, where this error is 0.4-1.3 h)."""
     if "rate_sem_rel" not in cols:
         return math.nan
     hours = np.diff(np.concatenate([[0.0], np.asarray(cols["hours_end"], dtype=float)]))
@@ -684,13 +684,18 @@ VOLUME_COLUMNS = {"max_depth_rate_um_per_h": ("max_volume_rate_mm3_per_h", "volu
                   "max_depth_um": ("max_volume_mm3", "largest volume [mm3]", 20, ".4g")}
 
 
+def _is_volume(limit: str | None) -> bool:
+    """Whether a study's limit as given (``volume=2mm3``, ``clearance=2x``, None) limits a face's worn volume."""
+    return str(limit or "").split("=")[0].strip() == "volume"
+
+
 def history_table(limit: str | None = None, cols: dict | None = None) -> tuple:
     """:data:`HISTORY_TABLE` for a study to ``limit`` (its text, ``volume=2mm3``): for a volume limit, the
     quantity it reads, the largest worn volume of a face, and its rate in place of the deepest point and the
     fastest point's depth rate (the largest of any point, which a depth limit reads); with a history's ``cols``,
     only the columns it holds (one written before the pockets' columns has none of them)."""
     table = HISTORY_TABLE
-    if str(limit or "").split("=")[0].strip() == "volume":
+    if _is_volume(limit):
         table = tuple(VOLUME_COLUMNS.get(c[0], c) for c in HISTORY_TABLE)
     return table if cols is None else tuple(c for c in table if c[0] in cols)
 
@@ -744,7 +749,7 @@ def _error_text(cols: dict, limit: str | None = None) -> str:
     if not math.isfinite(life_error(cols)):
         return ""
     read, scatter = (np.asarray(cols[c], dtype=float) for c in ("pocket_worst_read", "pocket_worst_scatter"))
-    what = "face" if str(limit or "").split("=")[0].strip() == "volume" else "pocket"
+    what = "face" if _is_volume(limit) else "pocket"
     return (f" (±: the sampling error of the worst {what}'s rates, not the trajectories' scatter; the worst pocket "
             f"read "
             f"{_span(read)} x the pockets' mean, identical pockets {_span(scatter)} x from the scatter alone, the "
@@ -849,8 +854,8 @@ def plot_life(cols: dict, attrs: dict):
     error = life_error(cols)  # a clearance or volume limit's sampling error (docs/wear.md, The worst pocket)
     pm, what = ("", "")
     if math.isfinite(error):
-        face = str(attrs.get("limit", "")).split("=")[0].strip() == "volume"
-        pm, what = f" ± {error:.2g}", f" (±: the worst {'face' if face else 'pocket'}'s rates' sampling error)"
+        face = "face" if _is_volume(attrs.get("limit")) else "pocket"
+        pm, what = f" ± {error:.2g}", f" (±: the worst {face}'s rates' sampling error)"
     fig.suptitle(f"life to {attrs.get('limit', '?')}: {end}{h_end[-1]:.3g}{pm} h, {cols['rotations_end'][-1]:.3g} "
                  f"inner-ring rotations, {counted(len(h_end), 'stage')}{what}\n"
                  f"{_life_subtitle(attrs)}", fontsize=9)

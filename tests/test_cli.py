@@ -665,6 +665,7 @@ def test_a_sweep_file_given_for_a_scenario_or_an_archive_says_what_it_is(tmp_pat
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow  # a multibody run (~2 s)
 def test_a_motion_window_longer_than_the_run_is_noted_before_it(tmp_path):
     """`--set output.motion_rotations=50` with `numerics.rotations=3` ran silently and stored 3 rotations of
     motion: the run (and its dry run) says so in one note before it starts; a window the run holds, a run

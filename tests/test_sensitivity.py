@@ -693,6 +693,7 @@ def test_the_apis_uncertainty_refuses_its_samples_and_seed_as_its_arguments(kw, 
     assert str(err.value).startswith(words), str(err.value)
 
 
+@pytest.mark.slow  # a sensitivity study of a few reduced runs (~3.6 s)
 def test_the_largest_seed_is_kept_in_the_table(tmp_path):
     from bearingsim.studies.uncertainty import MAX_SEED
 

@@ -780,6 +780,7 @@ def test_a_pool_worker_that_dies_mid_batch_fails_its_cases_and_the_sweep_ends(tm
     assert "the worker process running it ended (signal 9)" in rows[1]["error"]
 
 
+@pytest.mark.slow  # sweeps and their figures (~1.5 s)
 def test_figure_kind_follows_the_grid(tmp_path):
     from bearingsim.sweeps.index import write_index
 

@@ -405,6 +405,7 @@ def _printed_sizes(fig, width_in: float = 6.5) -> dict[str, float]:
     return {t.get_text(): t.get_fontsize() * scale for t in texts}
 
 
+@pytest.mark.slow  # draws a map at report width (~2 s)
 def test_a_map_prints_at_a_report_width_with_rounded_ticks(tmp_path, drawn):
     """The 8 x 6 map of `--param operating.inner_ring_speed_rpm=1000:6500:8 --param
     bearing.pocket_clearance_mm=0.1:0.35:6` was 2520 x 624 px (21 x 5.2 in): at a report's 6.5 in its cell

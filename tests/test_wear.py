@@ -625,6 +625,7 @@ def test_plot_and_table_of_a_life_history_again(tmp_path, capsys):
         assert printed[1:] == history[1:]
 
 
+@pytest.mark.slow  # a life study of 2 stages (~1.7 s)
 def test_life_table_shows_a_volume_limits_quantity_and_the_stages_notes(tmp_path, capsys):
     """The life table of a volume limit gave the deepest point and its rate, not the largest face volume
     that the limit reads (life.h5 held it), and no table gave the stages' run notes (their archives hold
@@ -1394,6 +1395,7 @@ def test_the_wear_figure_names_the_impulse_its_archive_computed_the_index_from(f
                           "rear face, impulse index (Eq. 16, circumferential impulse I_dec)"], labels
 
 
+@pytest.mark.slow  # draws the wear figures (~1.6 s)
 def test_wear_figures_use_one_fixed_unit_per_quantity(fast_run, monkeypatch):
     """The run's wear figure labelled its axis [10^6 um^3 per hour] for one archive and [10^9 um^3 per hour]
     for another (an exponent chosen from the data), and matplotlib may put its own multiplier on an axis: two

@@ -83,7 +83,7 @@ RIGID_DT_CAP_S = 1.0e-4  # never above this
 # one core (the main job: 237 011 steps in 3.3 s), so 1e7 is ~2 min a rotation, a convergence study's
 # finest step with room to spare, where a mistyped exponent (1e-9 for 1e-6 s) would run for hours.
 MAX_STEPS_PER_ROTATION = 10_000_000
-# Steps in which the quasi-static inner ring's force balance (Newton iteration) did not converge: a
+# Steps in which the quasi-static inner ring's force balance (forces.solve_ring_centre) did not converge: a
 # few isolated steps are harmless (the next step starts again from the last iterate) and are noted
 # (bearingsim.plausibility); in more than 1 % of the steps the ring equilibrium the model assumes is
 # not met and the run is refused, as soon as the failures exceed 1 % of the most steps it may take

@@ -65,7 +65,7 @@ LOOP_STATE = np.dtype([
     ("n_samples", np.int64),  # samples in the block not yet handed to Python
     ("n_orbit", np.int64),  # cage-centre samples written into the orbit ring buffer
     ("recording", np.int64),  # 1 once the cage has turned through the warm-up rotations
-    ("newton_failures", np.int64),  # steps whose ring-centre Newton solve did not converge
+    ("newton_failures", np.int64),  # steps whose ring-centre solve did not converge
     ("t", np.float64),  # time [s]
     ("pymunk_ns", np.float64),  # time spent in pymunk's step [ns]
     ("ring_sum_x", np.float64), ("ring_sum_y", np.float64),  # sum of inner-ring centres, recorded steps [m]

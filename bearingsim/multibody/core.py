@@ -1022,7 +1022,7 @@ def newton_refusal(p, fails: int, steps: int, max_steps: int | None = None) -> s
     """The refusal of a run whose quasi-static ring's force balance failed in more than
     :data:`MAX_NEWTON_FAILURE_FRACTION` of its ``steps`` (:func:`bearingsim.plausibility.check`, the run done), or,
     with ``max_steps``, of the most steps it may take, said as soon as that is certain (the step loop)."""
-    advice = one_roller_ring_advice(p) or "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
+    advice = "set a smaller numerics.dt_s or multibody.inner_ring=dynamic"
     if max_steps is None:
         return (f"the inner ring's force balance did not converge in {fails} of {steps} steps ({fails / steps:.2%}; "
                 f"provenance ring_newton_failures); {advice}")
@@ -1073,10 +1073,9 @@ def _stop(code, su: MultibodySetup, inp, wk, acc, state, t, step):
 
 def _blowup_advice(su: MultibodySetup, h: float) -> str:
     """What to change after an energy blow-up with step ``h``: a smaller step (the automatic one for a given step
-    longer than it, :func:`unstable_advice`), unless the ring is held quasi-static while it rests on a single
-    roller (:func:`one_roller_ring_advice`)."""
-    return (one_roller_ring_advice(su.p) or unstable_advice(su.p, h, su.dt_how)
-            or f"try a smaller numerics.dt_s than {h:.3g} s")
+    longer than it, :func:`unstable_advice`). A quasi-static ring resting on a single roller, which no step
+    mends, never runs (:func:`inner_ring_model` refuses it)."""
+    return unstable_advice(su.p, h, su.dt_how) or f"try a smaller numerics.dt_s than {h:.3g} s"
 
 
 def one_roller_ring_advice(p) -> str | None:

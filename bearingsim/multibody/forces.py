@@ -165,6 +165,24 @@ def _safeguarded(t, f, df, lo, hi):
 
 
 @njit(cache=True, inline="always")
+def _widen(t, step):
+    """One step of a bracket's search from ``t``: ``(lo, hi, next t, next step)``, the step doubled."""
+    lo, hi = (t, t + step) if step > 0.0 else (t + step, t)
+    return lo, hi, t + step, step * 2.0
+
+
+@njit(cache=True, inline="always")
+def _narrow(f, t, lo, hi):
+    """The bracket ``(lo, hi)`` closed in to ``t`` on the side of its residual ``f``'s sign, and whether it has
+    closed to adjacent floats (no midpoint between them): ``(lo, hi, closed)``."""
+    if f < 0.0:
+        lo = t
+    else:
+        hi = t
+    return lo, hi, not lo < 0.5 * (lo + hi) < hi
+
+
+@njit(cache=True, inline="always")
 def _float_limited(f, s, prm, tol):
     """Whether a residual ``f`` [N] left where a bracket has closed to adjacent floats is the rounding of the
     force sum: within ``tol`` plus 8 ulps of a roller's distance from the ring centre times the contacts'
@@ -186,20 +204,15 @@ def _ring_y(xp, delta_prev, h, prm, cx, cy, tol):
     f0 = ry
     step = 1e-10 if ry < 0.0 else -1e-10
     while abs(ry) > tol and (ry < 0.0) == (f0 < 0.0) and abs(step) < 1e-2:  # bracket
-        lo, hi = (t, t + step) if step > 0.0 else (t + step, t)
-        t += step
-        step *= 2.0
+        lo, hi, t, step = _widen(t, step)
         rx, ry, j00, j01, j10, j11 = _ring_balance(xp, delta_prev, h, prm, cx, t)
     found = (ry < 0.0) != (f0 < 0.0)
     ok = abs(ry) <= tol
     for _ in range(200):
         if ok or not found:  # balanced, or no root within 1 cm
             break
-        if ry < 0.0:
-            lo = t
-        else:
-            hi = t
-        if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+        lo, hi, closed = _narrow(ry, t, lo, hi)
+        if closed:  # float64 resolution
             ok = _float_limited(ry, abs(j00) + abs(j11), prm, tol)
             break
         t = _safeguarded(t, ry, j11, lo, hi)
@@ -224,20 +237,15 @@ def _bracketed_ring_centre(xp, delta_prev, h, prm, out_c, tol):
     step = 1e-10 if rx < 0.0 else -1e-10
     lo = hi = cx
     while abs(rx) > half and (rx < 0.0) == (f0 < 0.0) and abs(step) < 1e-2:  # bracket
-        lo, hi = (cx, cx + step) if step > 0.0 else (cx + step, cx)
-        cx += step
-        step *= 2.0
+        lo, hi, cx, step = _widen(cx, step)
         cy, rx, ry, dg, s, ok_y = _ring_y(xp, delta_prev, h, prm, cx, cy, half)
     found = (rx < 0.0) != (f0 < 0.0)
     ok_x = abs(rx) <= half
     for _ in range(200):
         if ok_x or not found:  # balanced, or no root within 1 cm
             break
-        if rx < 0.0:
-            lo = cx
-        else:
-            hi = cx
-        if not lo < 0.5 * (lo + hi) < hi:  # float64 resolution
+        lo, hi, closed = _narrow(rx, cx, lo, hi)
+        if closed:  # float64 resolution
             ok_x = _float_limited(rx, s, prm, half)
             break
         cx = _safeguarded(cx, rx, dg, lo, hi)

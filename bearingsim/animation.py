@@ -288,9 +288,7 @@ def impact_marks_end(result, t_frames) -> str:
     """What the legend says when the archive's impact table (``/results/impacts``) filled up (provenance
     ``impacts_table_full``, the run's note) before the last frame's time of ``t_frames`` [s]: from when no impact
     is marked, and why; "" otherwise."""
-    from bearingsim.plausibility import impact_table_end
-
-    t_last = impact_table_end(result)
+    t_last = result.impacts_end_s
     if t_last is None or not len(t_frames) or t_last >= float(t_frames[-1]):
         return ""
     return f"★ none marked after t = {t_last:.4g} s:\nthe archive's impact table\nfilled up (its run's note)"

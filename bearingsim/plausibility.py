@@ -284,20 +284,11 @@ def uneven_pockets(result) -> str | None:
             f"the worst pocket ('bearingsim wear' gives each pocket's; docs/wear.md, Uneven pockets)")
 
 
-def impact_table_end(result) -> float | None:
-    """The time [s] of the last row of a result's impact table (``/results/impacts``) when it filled its rows
-    (``multibody.core.IMPACT_CAPACITY``; provenance ``impacts_table_full``), else None."""
-    if not result.provenance.get("impacts_table_full", False):  # first: most results need not read the table
-        return None
-    times = result.impacts.get("time_s", ())
-    return float(times[-1]) if len(times) else None
-
-
 def impact_table_note(result) -> str | None:
-    """The note of a run whose impact table filled its rows (:func:`impact_table_end`): up to when it lists
-    impacts. The impulses, wear and every other result are summed in the step loop, not from the table, and
-    count every impact."""
-    t = impact_table_end(result)
+    """The note of a run whose impact table filled its rows (:attr:`bearingsim.results.Result.impacts_end_s`):
+    up to when it lists impacts. The impulses, wear and every other result are summed in the step loop, not from
+    the table, and count every impact."""
+    t = result.impacts_end_s
     if t is None:
         return None
     imp = result.impacts

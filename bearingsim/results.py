@@ -155,6 +155,16 @@ class Result:
         """The impact table: one array per column (``time_s``, ``theta_deg``, ``face`` ...)."""
         return self._under(IMPACTS)
 
+    @property
+    def impacts_end_s(self) -> float | None:
+        """The time [s] of the impact table's last row when the table filled its rows (provenance
+        ``impacts_table_full``; ``multibody.core.IMPACT_CAPACITY``): it lists the impacts up to there only. None
+        when it holds every impact."""
+        if not self.provenance.get("impacts_table_full", False):  # first: most results need not read the table
+            return None
+        times = self.impacts.get("time_s", ())
+        return float(times[-1]) if len(times) else None
+
     def get(self, name: str) -> np.ndarray:
         """The array stored at ``results/<name>`` (e.g. ``"theta_deg"``, ``"wear/paper_index_rear"``). A name
         this result holds no array under is a one-line :class:`bearingsim.UserError` naming the names it has."""

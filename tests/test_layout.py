@@ -59,7 +59,19 @@ def _imports(package: Path = PACKAGE):
                     target = target.rpartition(".")[0]
                 if target in mods and target != name:
                     internal.append((name, target, node.lineno))
+                for pkg in _enclosing_packages(target, package.name):  # Python runs them first
+                    if pkg in mods and pkg != name and not name.startswith(pkg + "."):
+                        internal.append((name, pkg, node.lineno))
     return internal, external
+
+
+def _enclosing_packages(target: str, root: str) -> list[str]:
+    """The subpackages that Python imports before the module ``target`` (``a.b`` for ``a.b.c``): importing
+    ``bearingsim.multibody.core`` runs ``bearingsim/multibody/__init__.py``. The root package is left out: it
+    encloses every module, so Python has loaded it before any import of its own, and it imports the package's
+    modules only in its functions, when called (PEP 562)."""
+    parts = target.split(".")
+    return [".".join(parts[:k]) for k in range(2, len(parts)) if parts[0] == root]
 
 
 def _cycles(edges) -> list[list[str]]:
@@ -219,6 +231,19 @@ def test_a_circle_through_a_function_level_import_is_found(tmp_path):
                               "c.py": "import bearingsim.a\n", "d.py": "from bearingsim import a\n"})
     edges, _ = _imports(pkg)
     assert _cycles(edges) == [["bearingsim.a", "bearingsim.b", "bearingsim.c"]]
+
+
+def test_importing_a_subpackage_s_module_runs_the_subpackage_first(tmp_path):
+    """``from bearingsim.m.core import f`` runs ``m/__init__.py`` before ``m/core.py``: a module that imports
+    ``m.core`` while ``m/__init__.py`` imports it (through others) is a circle, though ``m.core`` imports
+    nothing of it; the root package, loaded before any of its modules, is not such an edge."""
+    pkg = _package(tmp_path, {"__init__.py": "", "a.py": "def f():\n    from bearingsim.m.core import g\n",
+                              "m/__init__.py": "from bearingsim import b\n", "m/core.py": "from . import leaf\n",
+                              "m/leaf.py": "", "b.py": "import bearingsim.a\n"})
+    edges, _ = _imports(pkg)
+    assert ("bearingsim.a", "bearingsim.m", 2) in edges
+    assert ("bearingsim.m.core", "bearingsim.m", 1) not in edges  # a module's own package is being loaded
+    assert _cycles(edges) == [["bearingsim.a", "bearingsim.b", "bearingsim.m"]]
 
 
 def test_a_relative_import_and_a_name_that_is_not_a_module_are_read_as_python_reads_them(tmp_path):

@@ -294,15 +294,29 @@ def test_inner_race_contact_extent_matches_discrete_quasi_statics(full_3000):
 def test_dynamic_inner_ring_agrees_with_quasi_static_where_both_apply(full_3000):
     """With 16 rollers at 970 N the load is always shared by >= 2 rollers, so a dynamic inner ring (the
     rotor's mass W/g) must carry the same mean load on the same mean displacement as the quasi-static
-    one: the ring's momentum balance makes the time-mean contact reaction equal W. Mean displacement
-    within 2 % (Hertz nonlinearity under the ring's vibration shifts the mean slightly; measured 0.5 %),
-    mean I_dec within 10 % (8 rotations against 20: statistical scatter, std/mean ~0.4)."""
+    one: the ring's momentum balance makes the time-mean contact reaction equal W. The dynamic ring
+    (8 rotations) against ``full_3000`` (the quasi-static ring, 20 rotations).
+
+    Tolerances from the scatter of the difference over 16 independent trajectories: pairs run with
+    operating.radial_load_N = 970 + k * 0.00000097 (k = 0..15; a last-bits perturbation that only
+    decorrelates the chaotic trajectories), each pair as here (``simulate(_scenario(rotations=20,
+    extra=[load]))`` and ``simulate(_scenario(rotations=8, extra=["multibody.inner_ring=dynamic",
+    load]))``), dynamic / quasi-static - 1:
+
+    - mean displacement: -0.491 % +- 0.013 % (mean +- std; -0.510 .. -0.462 %), a systematic offset
+      (Hertz nonlinearity under the ring's vibration shifts the mean slightly) that the scatter hardly
+      moves; bound 0.6 % = offset + 8 std. A dynamic ring under 10 % less load (873 N) lies -1.12 % off
+      and fails (the 2 % this test had let it pass); one carrying the rotor's weight twice (1940 N), +4.6 %.
+    - mean I_dec: +1.90 % +- 0.48 % (+0.92 .. +2.56 %); bound 4 % = offset + 4.3 std (the 10 % this test
+      had was reasoned from the per-rotation scatter, std/mean ~0.4, not measured on the means). The
+      ring carrying the rotor's weight twice gives -6.2 % and fails (the 10 % had let it pass).
+    """
     sc = _scenario(rotations=8, extra=["multibody.inner_ring=dynamic"])
     r = simulate(sc)
     assert "dynamic" in r.provenance["inner_ring"]
     assert r.summary["inner_ring_displacement_m"] == pytest.approx(
-        full_3000.summary["inner_ring_displacement_m"], rel=0.02, abs=0)
-    assert r.per_rotation["I_dec"].mean() == pytest.approx(full_3000.per_rotation["I_dec"].mean(), rel=0.10)
+        full_3000.summary["inner_ring_displacement_m"], rel=0.006, abs=0)
+    assert r.per_rotation["I_dec"].mean() == pytest.approx(full_3000.per_rotation["I_dec"].mean(), rel=0.04)
 
 
 @pytest.mark.parametrize("extra, ring", [

@@ -163,12 +163,24 @@ def test_a_face_wider_than_the_wall_is_refused(tmp_path):
 def test_land_contact_does_not_depend_on_the_faces(segments):
     """An outer-land-guided cage rides on its land whatever the faces are drawn with: exact faces and
     polylines of 3 and 9 segments all give a land normal impulse of the order of the cage's weight and
-    the rollers' pushes (> 0.1 N s a rotation), where a roller-guided cage has none."""
+    the rollers' pushes, where a cage off its land has none.
+
+    Scale: the cage's weight over the rotation, m g T = 0.2 kg x 9.807 m/s^2 x 46.15 ms (3000 rpm, cage at
+    136.1 rad/s) = 0.0905 N s; the rollers push the cage onto its land too (without gravity the exact
+    faces give 0.115 N s). Measured as here (1 warm-up + 1 rotation) over 8 trajectories differing only
+    in the last bits of the load (operating.radial_load_N = 970 + k * 0.00000097, k = 0..7; mean +- std,
+    lowest): exact faces 0.1219 +- 0.0016 (0.1192), 3 segments 0.1558 +- 0.0028 (0.1522), 9 segments
+    0.1328 +- 0.0016 (0.1296) N s. Bound 0.11 N s (about 1.2 m g T): 7 std below the exact faces' mean, the
+    lowest kind (0.1 N s, reasoned, before). The kinds do not agree within their scatter (the 3-segment
+    polyline is 28 % above the exact faces, 12 std): its slanted segments push the rollers radially at
+    the wrong angle (docs/geometry.md), which changes how hard, not whether, the land carries the cage.
+    Can fail: a diametral land clearance of 0.6 mm (bearing.cage_land_clearance_mm; half of it, 0.3 mm, beyond
+    the ~0.23 mm the rollers let the cage move) leaves the cage on its rollers, land impulse 0.0 with each kind."""
     sc = load_scenario(MB, ["bearing.cage_guidance=outer_land", f"multibody.pocket_face_segments={segments}",
                             "numerics.rotations=1", "numerics.warmup_rotations=1"])
     raw = run(si(sc))
     assert raw.land is not None
-    assert raw.land["win"][:, 0].min() > 0.1
+    assert raw.land["win"][:, 0].min() > 0.11
 
 
 @pytest.mark.slow

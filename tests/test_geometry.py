@@ -187,14 +187,25 @@ def test_land_contact_does_not_depend_on_the_faces(segments):
 def test_exact_faces_reach_the_fine_polyline_s_limit():
     """The circumscribed polyline converges to the exact arc as its segments shrink: over the same two
     rotations at 3000 rpm the exact faces' I_dec is nearer a 15-segment polyline's than the 3-segment
-    polyline is, and within 10 % of the 15-segment one (docs/geometry.md measures 3 to 63 segments over
-    30 rotations; the 15-segment polyline is itself ~3 % above the limit there)."""
+    polyline is, and lies where the converged series puts it against the 15-segment one.
+
+    docs/geometry.md measures 3 to 63 segments over 30 rotations: 17 segments +2.8 % above the exact
+    faces, shrinking as 1/N^2, so 15 segments ~ +2.8 % x (17/15)^2 = +3.6 %: exact / 15-segment - 1 ~
+    -3.5 %. Over two rotations, measured as here over 16 trajectories differing only in the last bits
+    of the load (operating.radial_load_N = 970 + k * 0.00000097, k = 0..15, each with the three runs):
+    exact / 15-segment - 1 = -3.7 % +- 1.7 % (mean +- std; -6.1 .. +0.2 %), the series' value within
+    its standard error (0.4 %). Window -3.5 % +- 7 % (4 std): the 10 % either side this test had lay 3.7
+    std below the mean, so the low side moves out by 0.5 points, and 8 std above it: the high side is
+    tightened to +3.5 %: a 9-segment polyline in the exact faces' place (+7.5 % +- 2.2 % over 15 segments,
+    8 trajectories measured the same way) fails it in 7 of 8 trajectories, where +10 % let it pass in all.
+    The 3-segment polyline gives +57 % +- 2.5 % (lowest +51 %) over the 15-segment one and fails both
+    checks."""
     res = {}
     for n_seg in (0, 3, 15):
         sc = load_scenario(MB, [f"multibody.pocket_face_segments={n_seg}", "numerics.rotations=2"])
         res[n_seg] = float(run(si(sc)).win["I_dec"].sum())
     assert abs(res[0] - res[15]) < abs(res[3] - res[15])
-    assert res[0] == pytest.approx(res[15], rel=0.10)
+    assert res[0] / res[15] - 1 == pytest.approx(-0.035, abs=0.07)
 
 
 # --- worn faces ---------------------------------------------------------------------------------------

@@ -537,6 +537,7 @@ class _FakeResult:
         # 6 steady rotations: enough to judge the warm-up (START_TRANSIENT_MIN_ROTATIONS), which then gives no note
         self.per_rotation = {"I_dec": np.full((6, 16), 0.01), "I_acc": np.full((6, 16), 0.01)}
         self.orbit = np.ones((10, 3))
+        self.impacts_end_s = None  # the impact table holds every impact
 
     def get(self, name):
         assert name == "cage_orbit"

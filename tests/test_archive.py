@@ -484,6 +484,7 @@ def _fsize_limit(limit):
     return limited
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["spool", "sweep case"])
 @pytest.mark.parametrize("limit", [64 << 10, 400_000], ids=["while streaming", "at close"])
 def test_a_full_disk_while_a_spool_streams_is_one_line_and_a_clean_exit(tmp_path, how, limit):

@@ -60,6 +60,7 @@ def test_a_refused_run_names_the_overrides_it_is_about(tmp_path, scenario, sets,
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_wrong_type_in_file_names_key(tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text((SCENARIOS / "paper_3000rpm.toml").read_text().replace("rotations = 1", 'rotations = "one"'))
@@ -131,6 +132,7 @@ def test_every_command_that_writes_files_takes_quiet():
             assert parser.parse_args([str(a) for a in args] + ["-q"]).quiet is True, command
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("command", [
     ["plot", "{R}", "-o", "{out}"],
     ["wear", "{M}", "--hours", "1", "-o", "{out}"],

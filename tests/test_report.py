@@ -587,6 +587,7 @@ def test_the_life_history_of_a_report_is_the_table_the_command_prints(folders, t
         assert "".join(f"<td class=\"num\">{c}</td>" for c in row) in re.sub(r"\s+<", "<", table)
 
 
+@pytest.mark.slow
 def test_a_life_page_to_a_depth_limit_says_what_the_command_notes(tmp_path):
     """`bearingsim life --limit depth=...` notes under its history that the deepest point is an end bin's,
     so the rotations to that limit are those of the bin width (docs/wear.md): the page, which a reader takes

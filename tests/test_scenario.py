@@ -194,6 +194,7 @@ def test_a_motion_window_after_the_run_is_refused_with_advice_that_can_be_follow
     assert advice in str(err.value) and "earlier or set 'last'" not in str(err.value), str(err.value)
 
 
+@pytest.mark.slow
 def test_the_reduced_model_is_not_refused_over_a_motion_window_it_does_not_store():
     """The reduced model stores no motion and reads no [output] key: a window after its recorded rotations
     (start 0, the default 2 rotations, 1 recorded) was refused; it is the usual unread-key note instead,

@@ -92,6 +92,7 @@ def _open_markers(ax) -> list:
             for x, y in zip(line.get_xdata(), line.get_ydata())]
 
 
+@pytest.mark.slow
 def test_a_missing_standard_error_is_no_bar_and_is_said(tmp_path, drawn):
     """A sweep of one recorded rotation per case has no standard error (the table: ``18.41 ± n/a``); the
     line figure drew it as an error bar of 0 (``np.nan_to_num``) under "error bars: ±1 standard error".
@@ -438,6 +439,7 @@ def test_a_map_prints_at_a_report_width_with_rounded_ticks(tmp_path, drawn):
     assert [t.get_text() for t in ax.get_yticklabels()] == ["0.1", "0.35"]
 
 
+@pytest.mark.slow
 def test_a_sweep_of_one_or_two_points_draws_markers_on_impulse_axes_from_0(tmp_path, drawn):
     """A sweep at 3000 rpm alone drew its lone I_acc of 0 on an axis of -0.04..0.04 mN s (negative impulses,
     impossible), and one of 1000 and 6000 rpm joined its two points by a line, a linear trend that 6 points

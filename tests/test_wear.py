@@ -1763,6 +1763,7 @@ def test_a_signal_after_wear_figures_says_which_are_complete(fast_run, tmp_path,
     assert sorted(tmp_path.iterdir()) == sorted(written)
 
 
+@pytest.mark.slow
 def test_life_q_prints_its_history_alone(tmp_path, capsys):
     """``life -q`` drops its line per stage and prints the history table (docs/commands.md); it printed its
     "wrote ..." lines too."""

@@ -545,11 +545,12 @@ def test_pockets_that_pinch_their_most_loaded_roller_jam_and_say_so():
 @pytest.mark.slow
 def test_kinematic_cage_scene_is_converged_in_its_automatic_step():
     """The kinematic_cage scene (cross-check rung 3) pushes every roller from behind through the load zone, and
-    its I_dec converges at first order in the step (before the fix, 2 + 2 rotations at 3000 rpm: 11.770 /
-    12.195 / 12.431 mN s at 4.0 / 2.0 / 1.0 us, +3.6 % and +1.9 % per halving). Its automatic step is the
+    its I_dec converges at first order in the step (at the full scene's Hertz step and below, 2 + 2 rotations at
+    3000 rpm: 11.775 / 12.198 / 12.433 mN s at 4.0 / 2.0 / 1.0 us, +3.6 % and +1.9 % per halving,
+    docs/multibody.md). Its automatic step is the
     Hertz step / 8: a halving must change I_dec by less than 1 %, the step error the full scene's automatic
     step is shown to keep (docs/multibody.md, *Its time step*: at most 0.8 % with Hertz raceways; measured
-    here +0.51 %). The old step fails (+3.6 %). The scene is periodic (no scatter: docs/crosscheck.md), so
+    here +0.51 %). The Hertz step would fail (+3.6 %). The scene is periodic (no scatter: docs/crosscheck.md), so
     the two runs differ by the step alone. 3000 rpm, the speed with the largest step error."""
     sc = load_scenario(SCENARIOS / "multibody_3000rpm.toml", [
         "multibody.scene=kinematic_cage", "numerics.warmup_rotations=2", "numerics.rotations=2"])

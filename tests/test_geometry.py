@@ -246,14 +246,16 @@ def test_a_cage_bar_carries_one_pockets_front_face_and_its_neighbours_rear_face(
     assert on_bar[1, 5] == 5.0 and on_bar[2, 6] == 7.0 and on_bar.sum() == 12.0
 
 
+@pytest.mark.parametrize("sign", [1, -1])
 @pytest.mark.parametrize("face", [0, 1])
 @pytest.mark.parametrize("psi_deg", [0.0, 15.0, -25.0])
-def test_a_uniformly_worn_face_moves_the_contact_outwards_by_w(face, psi_deg):
+def test_a_uniformly_worn_face_moves_the_contact_outwards_by_w(face, psi_deg, sign):
     """A face worn uniformly by w = 30 um is the pocket circle of radius R + w on that face: a roller at
     angle psi pressed 1 um into it has pymunk's contact with normal d/|d| and depth |d| - (s/2 + w)
     (the same rounding tolerances as the unworn face's test: 1e-12, 1e-15 m); at |d| = s/2 + w - 1 um,
-    where it would be 29 um into the unworn face, it touches nothing; the other face is not touched."""
-    p, sc = _scene()
+    where it would be 29 um into the unworn face, it touches nothing; the other face is not touched. In
+    either direction of rotation (``sign``): the front face is the one ahead in the cage's motion."""
+    p, sc = _scene(sign=sign)
     n, i, w = p.bearing.roller_count, 3, 30e-6
     half_s = 0.5 * p.bearing.pocket_clearance
     u, e_r = _frame(p, sc, i, face)

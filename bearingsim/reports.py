@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import base64
 import math
+import re
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -301,9 +302,21 @@ def _run_figures(result) -> list[dict]:
     blocks = []
     for name in result.FIGURES:
         method = getattr(result, f"plot_{name}")
-        doc = (method.__doc__ or name).strip().splitlines()[0]
-        blocks.append(figure_block(method(), doc))
+        blocks.append(figure_block(method(), figure_caption(method.__doc__, name)))
     return blocks
+
+
+def figure_caption(doc: str | None, name: str) -> str:
+    """A run figure's caption: the first paragraph of its ``plot_*`` method's docstring, on one line, its
+    reStructuredText literals and cross-references as plain words (``x`` -> x, :data:`~a.b.C` -> C); the
+    figure's name without one."""
+    import inspect
+
+    if not doc:
+        return name
+    text = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
+    text = re.sub(r":\w+:`~?([^`]+)`", lambda m: m.group(1).rsplit(".", 1)[-1], text)
+    return text.replace("``", "")
 
 
 def _pocket_table(result) -> dict:

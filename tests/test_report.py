@@ -708,6 +708,39 @@ def test_a_sweep_pages_title_is_one_line_and_its_tables_note_ends_before_the_mar
     assert notes[1].startswith("* : |x - x_ref| >"), notes
 
 
+def test_a_figure_caption_is_its_docstrings_first_paragraph_in_plain_words():
+    """A run figure's caption took the first line of its docstring, so a first sentence that wrapped was cut
+    mid-sentence on the page ("...; F_acc", "..., the mean", "...; each"). It is the whole first paragraph
+    now, on one line, with the docstring's literals and cross-references as plain words."""
+    from bearingsim.reports import figure_caption
+
+    doc = """Fig. 9 analog: the impulse against speed, I_dec in
+        :data:`~bearingsim.plotting.REAR` as ``bearingsim run`` prints it, with
+        :func:`bearingsim.stats.batch_sem`.
+
+        Details that are not the caption."""
+    assert figure_caption(doc, "x") == ("Fig. 9 analog: the impulse against speed, I_dec in REAR as bearingsim run "
+                                        "prints it, with batch_sem.")
+    assert figure_caption(None, "orbit") == "orbit"
+
+
+@pytest.mark.slow
+def test_a_run_page_captions_each_figure_with_a_whole_sentence(runs, whole, tmp_path):
+    """Each figure of a run's page (whole bearing and reduced model) is captioned with its plot method's
+    first paragraph, a whole sentence in plain words."""
+    import html as html_text
+    import inspect
+
+    for archive in (whole, runs / "r.h5"):
+        result = bearingsim.load(archive)
+        got = [html_text.unescape(c) for c in
+               re.findall(r"<figcaption>(.*?)</figcaption>", _page(archive, tmp_path / "p.html"), re.S)]
+        want = [" ".join(inspect.cleandoc(getattr(result, f"plot_{n}").__doc__).split("\n\n")[0].split())
+                for n in result.FIGURES]
+        assert got[:len(want)] == [w.replace("``", "") for w in want], got
+        assert all(c.endswith(".") and ":data:" not in c and "``" not in c for c in got), got
+
+
 def test_a_studys_figures_have_captions_saying_what_they_show(small_studies, tmp_path):
     """A run's page captions each figure with what it shows; a study's captioned them with their file names
     ("sweep I", "sensitivity"). Each says what it shows, and the reduced model's tornado chart that it has no

@@ -508,7 +508,7 @@ class MultibodyResult(Result):
 
     def plot_forces(self):
         """Fig. 5 analog: mean circumferential pocket force against θ, pocket 0 and the mean over pockets; F_acc
-        in the house colour of the front face, F_dec in the rear face's."""
+        in the front face's colour, F_dec in the rear face's."""
         from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
         th = self.get("theta_deg")
@@ -603,7 +603,7 @@ class MultibodyResult(Result):
 
     def plot_wear(self):
         """Fig. 14 analog: Archard wear rate per pocket face, from the paper's index and the sliding work; each
-        face in its house colour, the sliding work's bars hatched."""
+        face in its colour, the sliding work's bars hatched."""
         from bearingsim.plotting import FRONT, REAR, fixed_unit_axis, legend_outside, subplots
         from bearingsim.wear import running_time
 

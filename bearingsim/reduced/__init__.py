@@ -189,8 +189,9 @@ class ReducedResult(Result):
     # --- figures -----------------------------------------------------------------------------
     def plot_pass(self):
         """Fig. 8 analog: l_r, dl_r/dt and the cumulative I_dec and I_acc against θ over the no-load pass, the
-        rear face and I_dec in :data:`~bearingsim.plotting.REAR`, the front face and I_acc in
-        :data:`~bearingsim.plotting.FRONT`."""
+        rear face and I_dec in the rear face's colour, the front face and I_acc in the front face's.
+
+        The colours: :data:`~bearingsim.plotting.REAR`, :data:`~bearingsim.plotting.FRONT`."""
         from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
         fig, ax = subplots(3, 1, figsize=(7.5, 7.5), sharex=True)

@@ -21,36 +21,14 @@ from bearingsim.wording import counted
 
 def _print_summary(result) -> None:
     """The headline numbers of a finished run, by their SI keys, and beside each in the units ``bearingsim
-    table`` shows (:func:`bearingsim.tables.shown_as`): the mean impulses per pocket and cage rotation in mN s, a
-    whole-bearing run's with their standard errors (:func:`bearingsim.stats.result_standard_errors`: batch
-    means over the recorded rotations; the reduced model's are exact, every rotation repeating one pass), the
-    cage slip in per cent."""
-    from bearingsim.stats import result_standard_errors
-    from bearingsim.tables import shown_as, with_error
+    table`` shows (:func:`bearingsim.tables.headline`)."""
+    from bearingsim.tables import headline
 
-    summary, units = result.summary, result.summary_units
-    se = result_standard_errors(result)
-    rotations = len(result.per_rotation["I_dec"])
-    for key in ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip",
-                "load_zone_half_angle_deg", "land_normal_impulse_mean_Ns"):
-        if key not in summary:
-            continue
-        v, err = summary[key], se.get(key.replace("_mean_", "_sem_"))
-        scale, unit = shown_as(key, units.get(key, "1"))
+    for key, v, err, words in headline(result):
         text = f"  {key:28s} {v:.6g}"
-        if key == "cage_slip":
-            text += f"  ({v * scale:.4g} {unit})"
-        elif err is not None:
-            per = f"{unit} per pocket and cage rotation"
-            if err == 0.0:
-                human = f"{v * scale:.5g} {per}"
-            elif err != err:  # NaN: one recorded rotation gives no scatter
-                human = f"{v * scale:.5g} {per}; no standard error from {rotations} recorded rotation"
-            else:
-                human = (f"{with_error(v * scale, err * scale)} {per}; standard error, batch means over {rotations} "
-                         f"recorded rotations")
-            text += (f" \u00b1 {err:.2g}" if err == err and err > 0.0 else "") + f"  ({human})"
-        print(text)
+        if err is not None and err == err and err > 0.0:
+            text += f" \u00b1 {err:.2g}"
+        print(text + (f"  ({words})" if words else ""))
 
 
 def _cmd_run(args) -> int:

@@ -273,7 +273,8 @@ def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
     from bearingsim.simulation import load
 
     result = load(path)
-    sections = [Section("summary", "Summary", [{"kind": "text", "text": result.title()}, _run_summary(result)]),
+    sections = [Section("summary", "Summary", [{"kind": "text", "text": result.title()}, _run_headline(result),
+                                               _run_summary(result)]),
                 Section("figures", "Figures", _run_figures(result))]
     anim = _animation_section(path, animation)
     if anim is not None:
@@ -283,6 +284,17 @@ def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
                  Section("scenario", "Scenario", _scenario_blocks(result.scenario.to_toml(), path)),
                  Section("provenance", "Provenance", [_provenance_table(result.provenance)])]
     return f"{result.scenario.name}: {result.description()}", sections
+
+
+def _run_headline(result) -> dict:
+    """The run's headline numbers as ``bearingsim run`` prints them (:func:`bearingsim.tables.headline`): the
+    mean impulses in mN s with their standard errors, the cage slip in per cent."""
+    from bearingsim.tables import headline
+
+    units = result.summary_units
+    rows = [[key, words or f"{_cell(v, digits=6)} {units.get(key, '')}".strip()] for key, v, _, words in headline(result)]
+    return table_block("Headline numbers (as bearingsim run prints them)", ["quantity", "value"], rows,
+                       [False, False])
 
 
 def _run_summary(result) -> dict:

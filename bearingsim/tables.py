@@ -53,6 +53,44 @@ SCALED = {"N s": (1e3, "mN s"), "m^3/h": (1e9, "mm^3/h")}
 SCALED_KEYS = {"cage_slip": (100.0, "%")}
 
 
+#: the summary keys a finished run is read by first (``bearingsim run`` prints them, the report heads its summary)
+HEADLINE_KEYS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "load_zone_half_angle_deg",
+                 "land_normal_impulse_mean_Ns")
+
+
+def headline(result) -> list[tuple[str, float, float | None, str]]:
+    """The headline numbers of a run (:data:`HEADLINE_KEYS` that it has): ``(key, value, standard error or None,
+    words)``, the words in the units the tables show (:func:`shown_as`): the mean impulses per pocket and cage
+    rotation in mN s with their standard errors (:func:`bearingsim.stats.result_standard_errors`: batch means
+    over the recorded rotations; the reduced model's are exact, every rotation repeating one pass), the cage slip
+    in per cent; ``""`` for a number shown as stored."""
+    from bearingsim.stats import result_standard_errors
+
+    summary, units = result.summary, result.summary_units
+    se = result_standard_errors(result)
+    rotations = len(result.per_rotation["I_dec"])
+    rows = []
+    for key in HEADLINE_KEYS:
+        if key not in summary:
+            continue
+        v, err = summary[key], se.get(key.replace("_mean_", "_sem_"))
+        scale, unit = shown_as(key, units.get(key, "1"))
+        words = ""
+        if key == "cage_slip":
+            words = f"{v * scale:.4g} {unit}"
+        elif err is not None:
+            per = f"{unit} per pocket and cage rotation"
+            if err == 0.0:
+                words = f"{v * scale:.5g} {per}"
+            elif err != err:  # NaN: one recorded rotation gives no scatter
+                words = f"{v * scale:.5g} {per}; no standard error from {rotations} recorded rotation"
+            else:
+                words = (f"{with_error(v * scale, err * scale)} {per}; standard error, batch means over {rotations} "
+                         f"recorded rotations")
+        rows.append((key, v, err, words))
+    return rows
+
+
 def shown_as(key: str, unit: str) -> tuple[float, str]:
     """(scale, unit) in which the tables show summary key ``key`` of SI unit ``unit``: cage slip in per cent,
     impulses in mN s, the rest as stored (``bearingsim run`` and the report's tables show them so too)."""

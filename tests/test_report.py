@@ -741,6 +741,24 @@ def test_a_run_page_captions_each_figure_with_a_whole_sentence(runs, whole, tmp_
         assert all(c.endswith(".") and ":data:" not in c and "``" not in c for c in got), got
 
 
+@pytest.mark.slow
+def test_a_run_page_heads_its_summary_with_the_numbers_bearingsim_run_prints(runs, whole, tmp_path):
+    """The summary of a run's page began with every number of /results/summary in SI (0.0180909 N s), where
+    `bearingsim run` prints the headline numbers in mN s with their standard errors: the page now heads its
+    summary with those words (tables.headline, which the command line prints from too)."""
+    from bearingsim.tables import headline
+
+    for archive, words in ((whole, "mN s per pocket and cage rotation; no standard error from 1 recorded rotation"),
+                           (runs / "r.h5", "mN s per pocket and cage rotation")):
+        summary = _section_text(_page(archive, tmp_path / "p.html"), "summary")
+        rows = headline(bearingsim.load(archive))
+        assert [key for key, *_ in rows][:2] == ["I_dec_mean_Ns", "I_acc_mean_Ns"]
+        assert summary.index("Headline numbers") < summary.index("Summary numbers (SI")
+        for key, _, _, said in rows:
+            assert said == "" or said in summary, (key, said, summary)
+        assert rows[0][3].endswith(words), rows[0]
+
+
 def test_a_studys_figures_have_captions_saying_what_they_show(small_studies, tmp_path):
     """A run's page captions each figure with what it shows; a study's captioned them with their file names
     ("sweep I", "sensitivity"). Each says what it shows, and the reduced model's tornado chart that it has no

@@ -619,6 +619,26 @@ def test_figures_from_the_index(tmp_path):
     assert [p.name for p in again] == ["sweep_I.png"] and again[0].stat().st_size > 10_000
 
 
+@pytest.mark.slow
+def test_figures_of_an_earlier_run_of_the_folder_do_not_stay_beside_the_new_ones(tmp_path):
+    """A one-axis sweep (sweep_I.png) swept again into its folder over a second axis through the base value (its
+    cases cached): the folder held the new sweep_map.png and the old sweep_I.png of 2 cases beside an index of 4;
+    a cross-check (or any study) run into a sweep's folder kept its sweep_I.png too. The sweep figures an earlier
+    run drew are removed when a sweep starts (a user's picture of that name, without bearingsim's mark, stays)."""
+    one = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    run_sweep(one, tmp_path, engine=LocalEngine(1), figures=True, progress=False)
+    assert (tmp_path / "sweep_I.png").is_file()
+    two = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000]), ("bearing.pocket_clearance_mm", [0.2, 0.3])])
+    out = run_sweep(two, tmp_path, engine=LocalEngine(1), figures=True, progress=False)
+    assert out.count("cached") == 2, out.counts()
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == ["sweep_map.png"]
+    run_sweep(two, tmp_path, engine=LocalEngine(1), figures=False, progress=False)  # --no-plots: an index alone
+    assert sorted(p.name for p in tmp_path.glob("*.png")) == []
+    (tmp_path / "sweep_I.png").write_bytes(b"\x89PNG\r\n\x1a\n a user's picture")
+    run_sweep(two, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert (tmp_path / "sweep_I.png").read_bytes() == b"\x89PNG\r\n\x1a\n a user's picture"
+
+
 def test_a_sweep_over_an_integer_key_has_whole_ticks(tmp_path, monkeypatch):
     """A roller count of 14 and 16 was drawn with ticks at 14.5 and 15.5: an integer key's axis (the schema's
     type, :func:`bearingsim.scenario.is_integer_key`) has whole ticks only; a float key's keeps matplotlib's."""

@@ -430,13 +430,20 @@ def _tidy_folder(outdir: Path, has_map: bool) -> None:
     (:func:`bearingsim.outputs.clean_stale_temporaries` of :data:`bearingsim.outputs.FOLDER_FILES`) and, for
     a sweep with no map of its own (zipped axes, no axes, a study's cases), the map an earlier product sweep
     of some of these cases left (``check_sweep_outputs`` let through only bearingsim's): it is not this
-    sweep's and would be read as it (a zip sweep that added cases left the product's map of two)."""
-    from bearingsim.outputs import FOLDER_FILES, clean_stale_temporaries
+    sweep's and would be read as it (a zip sweep that added cases left the product's map of two).
+    The sweep figures an earlier run drew (:data:`bearingsim.sweeps.plot.FIGURE_NAMES`, bearingsim's own PNGs
+    only) go too: they were drawn from the index this run rewrites, and a sweep that draws figures draws its
+    own again at its end (a one-axis sweep's sweep_I.png stayed beside the sweep_map.png of the same folder
+    swept over a second axis, and in a cross-check run into a sweep's folder)."""
+    from bearingsim.outputs import FOLDER_FILES, _remove_if_own, clean_stale_temporaries, is_own_png
     from bearingsim.sweeps.grid import MAP_NAME
+    from bearingsim.sweeps.plot import FIGURE_NAMES
 
     clean_stale_temporaries(outdir, report=lambda line: None, names=FOLDER_FILES)
     if not has_map:
         (outdir / MAP_NAME).unlink(missing_ok=True)
+    for name in FIGURE_NAMES:
+        _remove_if_own(outdir / name, is_own_png)
 
 
 def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, log, write_map,

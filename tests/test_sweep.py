@@ -713,6 +713,28 @@ def test_a_users_file_in_cases_is_not_another_sweeps_case(tmp_path):
         ["notes.h5"] + [str(a).split("/")[-1] for a in read_index(tmp_path / "sweep.h5")[0]["archive"]])
 
 
+def test_a_sweep_refused_for_an_edited_scenario_file_names_the_keys_not_the_same_command(tmp_path):
+    """The same command line run again after its scenario file was edited (every case's hash moved) was refused
+    with '(the same command as before resumes it)': the command just run. The refusal now names the base
+    scenario's keys that differ from the one the folder's index stores (old -> new)."""
+    from bearingsim.errors import UserError
+
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(BASE.read_text())
+    spec = SweepSpec(scenario=scenario, axes=[(SPEED, [1000, 2000])])
+    run_sweep(spec, tmp_path / "out", engine=LocalEngine(1), figures=False, progress=False)
+    scenario.write_text(BASE.read_text().replace("radial_load_N = 970", "radial_load_N = 900"))
+    with pytest.raises(UserError) as err:
+        run_sweep(spec, tmp_path / "out", engine=LocalEngine(1), figures=False, progress=False)
+    text = str(err.value)
+    assert "holds another sweep" in text and "operating.radial_load_N 970.0 -> 900.0" in text, text
+    assert "the same command as before resumes it" not in text, text
+    # another sweep of the same base scenario keeps the old hint
+    with pytest.raises(UserError, match=r"\(the same command as before resumes it\)"):
+        run_sweep(SweepSpec(scenario=BASE, axes=[(SPEED, [3000])]), tmp_path / "out", engine=LocalEngine(1),
+                  figures=False, progress=False)
+
+
 def test_temporary_files_a_killed_sweep_left_are_removed_by_the_next(tmp_path):
     """A sweep killed by SIGKILL while it wrote its index leaves '.sweep.h5.tmp-<pid>' (seen after
     'kill -9' of the 100 x 100 map): the next sweep into the folder, which removed its workers' ones in

@@ -213,22 +213,27 @@ def check_sweep_outputs(outdir: Path, figures: bool = True) -> None:
                         f"{'a symbolic link' if cases.is_symlink() else 'not a folder'}; not used (remove it)")
 
 
-def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> None:
+def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, base_toml: str | None = None) -> None:
     """Refuse a folder that holds another sweep or study: cases in its index (``sweep.h5``; failed and
     pending ones, which left no result, aside) or archives in ``cases/`` that the new one does not have. Resuming the same
     sweep (or one that only adds cases) passes. With ``force`` the other sweep's or study's case archives,
     index, map, figures and tables are removed instead (:func:`bearingsim.outputs.remove_folder_files`), so
-    that nothing of it is mixed into the new one or read as its."""
+    that nothing of it is mixed into the new one or read as its. ``base_toml``: the new sweep's base scenario
+    resolved with its ``--set`` (the index's ``scenario_toml``); when the folder's index was written for another,
+    the refusal names the keys that differ (the same command line, run again after its scenario file was edited,
+    was told that the same command resumes the folder)."""
     from bearingsim import archive
     from bearingsim.sweeps.index import INDEX_FORMAT, read_index
 
     new = {c.hash for c in cases}
     old = set()
     versions = {}  # the model version that computed each of the index's cases
+    old_base = None  # the base scenario the folder's sweep ran, as its index stores it
     index = outdir / "sweep.h5"
     if archive.is_table_file(index, INDEX_FORMAT):
         with contextlib.suppress(UserError, OSError, KeyError, ValueError):
-            cols = read_index(index)[0]
+            cols, meta = read_index(index)
+            old_base = meta.get("scenario_toml") or None
             versions = dict(zip((str(h) for h in cols.get("case", [])), cols.get("model_version", [])))
             status = [str(x) for x in cols.get("status", [])]
             # a failed case left no result to mix in: the same study run again with it mended resumes; nor
@@ -246,10 +251,31 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False) -> No
         verb = "is" if len(other) == 1 else "are"
         raise UserError(f"{outdir}: holds another sweep or study ({counted(len(other), 'case')} of its {len(old)} "
                         f"{verb} not in this one); not mixed in: give another -o folder, or add --force to replace it "
-                        f"{_resume_hint(other, versions)}")
+                        f"{_base_changed(old_base, base_toml, index) or _resume_hint(other, versions)}")
     for h in other:
         _remove_if_own(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
+
+
+def _base_changed(old: str | None, new: str | None, index: Path) -> str | None:
+    """The refusal's hint when the folder's sweep ran another base scenario than ``new`` (both resolved TOML, as
+    the index's ``scenario_toml``): the keys that differ, old -> new (a scenario file edited since, or another
+    ``--set``; ``index``: the folder's ``sweep.h5``); None when they are the same or either is unknown."""
+    import tomllib
+
+    from bearingsim.scenario import differing_keys
+
+    if not old or not new or old == new:
+        return None
+    try:
+        keys = differing_keys(tomllib.loads(old), tomllib.loads(new))
+    except (tomllib.TOMLDecodeError, TypeError, ValueError):
+        return None
+    if not keys:
+        return None
+    shown = "; ".join(f"{k} {a} -> {b}" for k, a, b in keys[:3]) + ("; ..." if len(keys) > 3 else "")
+    return (f"(its cases were run on another base scenario: {shown}; a scenario file edited since, or another "
+            f"--set: 'bearingsim show {index}' prints the folder's)")
 
 
 def _resume_hint(other: set[str], versions: dict) -> str:
@@ -396,7 +422,8 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         grid = grid_axes(spec)
         cases, keys, meta, map_attrs = _resolve(spec, engine, archives, grid)
         engine.start(len(cases))  # an unreachable scheduler stops the sweep before anything is written
-        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None)
+        outdir, lock, own = _open_folder(outdir, lock, cases, figures, force, archives, staged is None,
+                                         meta.get("scenario_toml"))
         _tidy_folder(outdir, grid is not None)
     except BaseException:
         engine.stop()
@@ -506,7 +533,8 @@ def _index_finished(cases, rows, index, cases_dir: Path, stale: set) -> None:
         index.changed(i)
 
 
-def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str, check_folder: bool):
+def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, archives: str, check_folder: bool,
+                 base_toml: str | None = None):
     """Check the sweep folder and take its lock (unless the caller holds it): (folder, lock, whether the
     lock is taken here). Refused: an unwritable folder, foreign files, another sweep or study (unless
     the caller checks that itself: ``check_folder`` False)."""
@@ -526,7 +554,7 @@ def _open_folder(outdir, lock, cases: list[Case], figures: bool, force: bool, ar
     try:
         check_sweep_outputs(outdir, figures)
         if check_folder:
-            check_same_sweep(outdir, cases, force)
+            check_same_sweep(outdir, cases, force, base_toml)
         if any(keeps_archive(c.model, archives) for c in cases):
             (outdir / "cases").mkdir(exist_ok=True)
     except BaseException:

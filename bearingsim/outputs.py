@@ -593,6 +593,9 @@ def open_lock_file(lock_path: str | Path, guarded: str | Path, unwritable: str =
         if exc.errno == errno.ELOOP:
             raise UserError(f"{lock_path}: lock file of {guarded} is a symbolic link; not followed "
                             "(remove it)") from None
+        if exc.errno == errno.EISDIR:  # a folder there: said as the lock file's, not as an unwritable folder
+            raise UserError(f"{lock_path}: lock file of {guarded} is a folder, not bearingsim's; not replaced "
+                            "(remove it)") from None
         raise UserError(f"{guarded}: {unwritable} ({exc.strerror or exc})") from None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode) or st.st_size > 0:

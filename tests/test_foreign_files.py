@@ -197,6 +197,18 @@ def test_sweep_lock_link_does_not_truncate_its_target(tmp_path):
     assert sorted(p.name for p in out.iterdir()) == [".sweep.lock"]
 
 
+@pytest.mark.parametrize("command", ["sweep", "run"])
+def test_a_lock_file_that_is_a_folder_is_named_as_the_lock_file(tmp_path, command):
+    """A folder at ``DIR/.sweep.lock`` (or a run's ``.o.h5.lock``) was said as 'DIR: output is not writable (Is a
+    directory)', naming neither the lock file nor what is in the way: now one line naming it, and it is kept."""
+    out = tmp_path / "sw"
+    lock = out / (".sweep.lock" if command == "sweep" else ".o.h5.lock")
+    lock.mkdir(parents=True)
+    res = _sweep(out) if command == "sweep" else cli("run", PAPER, "-o", out / "o.h5", "--no-plots")
+    _one_line_refusal(res, str(lock), "is a folder")
+    assert "not writable" not in res.stderr and lock.is_dir()
+
+
 @pytest.mark.parametrize("name, kind", [("sweep.csv", "text"), ("sweep.h5", "text"), ("sweep_I.png", "symlink"),
                                         ("sweep_map.png", "text"), ("cases", "symlink")])
 @pytest.mark.slow

@@ -1140,6 +1140,16 @@ def read_table_file(path, fmt: str) -> tuple[dict[str, np.ndarray], dict[str, An
             raise UserError(f"{p}: not a {fmt}")
         attrs = {k: _plain(v) for k, v in f.attrs.items()}
         cols = {name: (ds.asstr()[()] if ds.dtype.kind == "O" else ds[()]) for name, ds in f["index"].items()}
+    # one row per entry of every column's first axis: a column of another length (a row cut from one column by
+    # hand) made a sweep's resume fail with IndexError's traceback, after it had rewritten the index all pending
+    rows = {np.shape(c)[0] if np.ndim(c) else None for c in cols.values()}
+    if len(rows) > 1 or None in rows:
+        counts = sorted(f"{name} {np.shape(c)[0] if np.ndim(c) else 'a scalar'}" for name, c in cols.items())
+        if None not in rows:
+            common = max(rows, key=lambda n: sum(np.shape(c)[0] == n for c in cols.values()))
+            counts = [t for t in counts if not t.endswith(f" {common}")]
+        raise _damaged(p, f"its columns are not all of one length: {', '.join(counts[:3])}"
+                          f"{', ...' if len(counts) > 3 else ''}", _table_kind(fmt))
     return cols, attrs
 
 

@@ -1061,6 +1061,25 @@ def test_a_signal_while_the_sweep_writes_its_index_lets_it_finish_and_is_reporte
     assert (tmp_path / "s" / "map.h5").is_file()
 
 
+def test_an_index_whose_columns_differ_in_length_is_refused_in_one_line(tmp_path):
+    """A sweep.h5 one of whose columns had fewer rows (cut by hand) made the sweep's resume fail with IndexError's
+    traceback, after it had rewritten the index all 'pending'. It is a damaged index: refused, not replaced."""
+    from bearingsim.errors import UserError
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0, 3000.0])])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    with h5py.File(tmp_path / "sweep.h5", "r+") as f:
+        status = f["index/status"][()]
+        del f["index/status"]
+        f.create_dataset("index/status", data=status[:2], dtype=h5py.string_dtype())
+    before = (tmp_path / "sweep.h5").read_bytes()
+    with pytest.raises(UserError, match=r"damaged sweep index \(its columns are not all of one length: status 2\)"):
+        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert (tmp_path / "sweep.h5").read_bytes() == before
+    with pytest.raises(UserError, match="not all of one length"):
+        read_index(tmp_path / "sweep.h5")
+
+
 def test_a_worker_told_to_end_takes_no_further_case_and_waits_for_no_further_batch(monkeypatch):
     """A worker's SIGTERM whose exception was swallowed where it landed (a callback of compiled code) leaves
     the worker running its case; it then took the batch's next case, and waited for the next batch, until

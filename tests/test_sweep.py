@@ -1061,6 +1061,75 @@ def test_a_signal_while_the_sweep_writes_its_index_lets_it_finish_and_is_reporte
     assert (tmp_path / "s" / "map.h5").is_file()
 
 
+def _signal_here():
+    """SIGINT to this process, returning only if its handler did not raise (it raises at a call, below)."""
+    os.kill(os.getpid(), signal.SIGINT)
+    for _ in range(1000):
+        time.sleep(0.01)
+
+
+def test_a_signal_as_the_sweep_enters_its_clean_up_is_an_interruption_not_a_traceback(tmp_path, monkeypatch):
+    """SIGINT landing on the call that enters the sweep's clean-up hold (a function call is where Python runs a
+    handler; `timeout -s INT 1.3 bearingsim sweep ...` resuming 1000 cached cases) raised SweepInterrupted out of
+    the sweep: a traceback and exit 1. It is an interruption: the index written, the signal reported."""
+    import bearingsim.sweeps.run as run_module
+
+    for name in ("hold", "held"):  # the call that enters the hold (held: as it was before hold)
+        original = getattr(run_module._Signals, name, None)
+        if original is None:
+            continue
+
+        def entering(self, *args, _original=original, **kw):
+            if self.fired is None:
+                _signal_here()
+            return _original(self, *args, **kw)
+
+        monkeypatch.setattr(run_module._Signals, name, entering)
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0])])
+    out = run_sweep(spec, tmp_path / "s", engine=LocalEngine(1), figures=False, progress=False)
+    assert out.interrupted == signal.SIGINT
+    cols, _ = read_index(tmp_path / "s" / "sweep.h5")
+    assert [str(x) for x in cols["status"]] == ["done", "done"]
+
+
+def test_a_resume_cut_short_leaves_the_folders_index_as_it_was(tmp_path, monkeypatch):
+    """A resume cut short rewrote the index with the rows it had not reached yet 'pending': SIGINT during the
+    resume of a finished 1000-case sweep (no archives) left 349 of them to be run again, and a folder at one case
+    archive's name (an error of the resume) 7 of 12. The folder's index is left as it was: a signal ends the
+    sweep as one while it starts (KeyboardInterrupt here), an error is said as before."""
+    import bearingsim.sweeps.index as index_module
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0, 3000.0, 4000.0])])
+    run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    before = (tmp_path / "sweep.h5").read_bytes()
+    trusted = index_module.trusted_row
+    calls = []
+
+    def signalled(*args, **kw):
+        calls.append(1)
+        if len(calls) == 2:
+            _signal_here()
+        return trusted(*args, **kw)
+
+    monkeypatch.setattr(index_module, "trusted_row", signalled)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert len(calls) == 2 and (tmp_path / "sweep.h5").read_bytes() == before
+    monkeypatch.setattr(index_module, "trusted_row", trusted)
+    third = resolve_cases(spec)[2].hash
+    (tmp_path / "cases" / f"{third}.h5").mkdir(parents=True)  # the resume cannot remove it
+    with pytest.raises(OSError):
+        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert (tmp_path / "sweep.h5").read_bytes() == before
+    (tmp_path / "cases" / f"{third}.h5").rmdir()
+    out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    assert [r["status"] for r in out.rows] == ["cached"] * 4
+
+
 def test_an_index_whose_columns_differ_in_length_is_refused_in_one_line(tmp_path):
     """A sweep.h5 one of whose columns had fewer rows (cut by hand) made the sweep's resume fail with IndexError's
     traceback, after it had rewritten the index all 'pending'. It is a damaged index: refused, not replaced."""

@@ -149,15 +149,14 @@ class _Signals:
             if not self._held:
                 raise SweepInterrupted(signum)
 
-    @contextlib.contextmanager
-    def held(self):
-        """Within it a signal is recorded in ``fired``, not raised: a clean-up that must finish (the index
-        and the map written, the workers ended) is not cut short by it."""
+    def hold(self) -> None:
+        """From now on, until the handlers are taken out, a signal is recorded in ``fired``, not raised: a clean-up
+        that must finish (the index and the map written, the workers ended) is not cut short by it. Call it as
+        ``try: hold() except SweepInterrupted: hold()``: the first signal can land on the call itself (a function
+        call is where Python runs a handler; a SIGINT there, on the way into the hold, ended a sweep with
+        SweepInterrupted's traceback and exit 1), and a handler raises once, so the second call holds. (A hold
+        that ended before the handlers were taken out left a moment in which the first signal raised again.)"""
         self._held = True
-        try:
-            yield
-        finally:
-            self._held = False
 
     def _unraisable(self, unraisable):
         if not isinstance(unraisable.exc_value, SweepInterrupted):
@@ -482,10 +481,12 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
         bar = None
         interrupted = None
         stale: set = set()
+        resumed = False  # the rows hold what the folder had: the index may be written from them
         try:
             _clean_temporaries(cases_dir)
             # stale: hashes of cases whose archive or row came from another version of the model
             todo, stale = _resume(cases, rows, cases_dir.parent, archives, staged.earlier if staged else None)
+            resumed = True
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": 0}
             for r in rows:  # of the cases not to run: cached, or (a staged study's earlier rounds) run this time
@@ -501,19 +502,37 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
         except SweepInterrupted as exc:
             interrupted = exc.signum
         finally:
-            with signals.held():  # a signal from here on (it cut the index's writing short once) is only noted
-                try:
-                    if staged is None:  # a staged study's next round uses it: its caller stops it
-                        engine.stop()
-                finally:
-                    if bar is not None:
-                        bar.close()
-                    _clean_temporaries(cases_dir)
+            try:
+                signals.hold()
+            except SweepInterrupted:  # the first signal, landed on the call: in fired now (_Signals.hold)
+                signals.hold()
+            # a signal from here on (it cut the index's writing short once) is only noted, until the handlers go
+            try:
+                if staged is None:  # a staged study's next round uses it: its caller stops it
+                    engine.stop()
+            finally:
+                if bar is not None:
+                    bar.close()
+                _clean_temporaries(cases_dir)
+                # a resume cut short (a signal, or an error such as a folder at a case archive's name) left the
+                # rows it had not reached 'pending': written, the index lost their numbers (a SIGINT during the
+                # resume of 1000 finished cases left 349 of them to be run again); the folder keeps its own
+                if resumed:
                     if signals.fired is not None:  # the workers have ended: what they finished is on disk
                         _index_finished(cases, rows, index, cases_dir, stale)
                     index.write()
                     write_map()
+    if not resumed and signals.fired is not None:  # stopped before any case ran, nothing written: as a signal
+        _stop_as_at_start(signals.fired)               # while the sweep starts
     return interrupted if interrupted is not None else signals.fired
+
+
+def _stop_as_at_start(signum: int) -> None:
+    """A sweep stopped by ``signum`` before it wrote anything: the signal goes to the handler that was in place
+    before the sweep's (the command line's says the sweep was interrupted before any case ran), as a signal
+    while the sweep is still starting does; KeyboardInterrupt if that handler ignored it."""
+    signal.raise_signal(signum)
+    raise KeyboardInterrupt(signal.Signals(signum).name)
 
 
 def _index_finished(cases, rows, index, cases_dir: Path, stale: set) -> None:

@@ -367,6 +367,12 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
     return todo, stale
 
 
+def _pending_rows(cases: list[Case]) -> list[dict]:
+    """The index's row of each case before it runs: ``pending``, no numbers."""
+    return [{"case": c.hash, "values": c.values, "ran_at": c.ran_at, "status": "pending", "error": "", "archive": "",
+             "wall_s": math.nan, "model_version": None, "summary": {}, "notes": []} for c in cases]
+
+
 def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, figures: bool = True,
               progress: bool | None = None, log=None, lock: FolderLock | None = None,
               desc: str = "sweep", force: bool = False, archives: str = "auto",
@@ -428,8 +434,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
         engine.stop()
         raise
     progress = sys.stderr.isatty() if progress is None else progress
-    rows = [{"case": c.hash, "values": c.values, "ran_at": c.ran_at, "status": "pending", "error": "", "archive": "",
-             "wall_s": math.nan, "model_version": None, "summary": {}, "notes": []} for c in cases]
+    rows = _pending_rows(cases)
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
                            map=outdir / MAP_NAME if grid else None)
     index = IndexWriter(outdir, rows, keys, meta)

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import given_once, progress_wanted, report_study, say, with_notes
+from bearingsim.cli_common import given_once, output_path, progress_wanted, report_study, say, with_notes
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.wording import counted
 
@@ -639,7 +639,7 @@ def _add_run_commands(sub) -> None:
     """One run and its archive: run, inspect, show, plot, rerun, compare, table, keys."""
     r = sub.add_parser("run", help="run a scenario file and write an HDF5 archive and figures")
     r.add_argument("scenario", help="scenario TOML file")
-    r.add_argument("-o", "--output", help="archive path (default outputs/<name>.h5)")
+    r.add_argument("-o", "--output", type=output_path, help="archive path (default outputs/<name>.h5)")
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key, e.g. operating.inner_ring_speed_rpm=3000 (repeatable)")
     r.add_argument("--no-plots", action="store_true", help="write the archive only")
@@ -672,13 +672,13 @@ def _add_run_commands(sub) -> None:
     pl = sub.add_parser("plot", help="draw every figure again from a run's archive, a sweep's sweep.h5, a "
                                      "crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5 alone")
     pl.add_argument("archive", help="a run archive, sweep.h5, crosscheck.h5, sensitivity.h5, uncertainty.h5 or life.h5")
-    pl.add_argument("-o", "--output", help="folder for the PNG files (default: beside the file)")
+    pl.add_argument("-o", "--output", type=output_path, help="folder for the PNG files (default: beside the file)")
     pl.add_argument("-q", "--quiet", action="store_true", help="print nothing on success")
     pl.set_defaults(func=_cmd_plot)
 
     rr = sub.add_parser("rerun", help="run an archive's scenario again and say whether the results are bit-identical")
     rr.add_argument("archive", help="a run archive (.h5) whose stored scenario is run again")
-    rr.add_argument("-o", "--output", help="also write the new run's archive here")
+    rr.add_argument("-o", "--output", type=output_path, help="also write the new run's archive here")
     rr.add_argument("--force", action="store_true",
                     help="with -o: replace an archive of a different scenario there (default: refused)")
     rr.add_argument("-q", "--quiet", action="store_true",
@@ -718,7 +718,7 @@ def _add_study_commands(sub) -> None:
     """Many-case studies that are not sweeps: validate, bench, crosscheck."""
     v = sub.add_parser("validate", help="Fig. 9 analogs: reduced-model I_dec against speed, and the rig scene "
                                         "(pocket 0 flat) against it (tables and PNGs; run again to resume)")
-    v.add_argument("-o", "--output", default="outputs/validate", help="output folder (default outputs/validate)")
+    v.add_argument("-o", "--output", type=output_path, default="outputs/validate", help="output folder (default outputs/validate)")
     v.add_argument("--rig-rotations", type=int, default=20,
                    help="recorded rotations of each rig run (after 1 warm-up); 0 skips the rig (default 20)")
     v.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
@@ -747,7 +747,7 @@ def _add_study_commands(sub) -> None:
     b.add_argument("--map", action="store_true",
                    help="the 100 x 100 reduced-model sweep map (2 workers), map only and with --archives all: "
                         "wall time, resume, files and sizes")
-    b.add_argument("-o", "--output", default="outputs/bench", help="output folder (default outputs/bench)")
+    b.add_argument("-o", "--output", type=output_path, default="outputs/bench", help="output folder (default outputs/bench)")
     b.set_defaults(func=_cmd_bench)
 
     cc = sub.add_parser("crosscheck", help="the reduced model against the whole bearing, one assumption at a time "
@@ -760,7 +760,7 @@ def _add_study_commands(sub) -> None:
                          "the scenario's warm-up rotations")
     cc.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario key (repeatable)")
-    cc.add_argument("-o", "--output", default="outputs/crosscheck",
+    cc.add_argument("-o", "--output", type=output_path, default="outputs/crosscheck",
                     help="output folder (default outputs/crosscheck)")
     cc.add_argument("-j", "--jobs", type=int, default=2, help="local worker processes (default 2)")
     cc.add_argument("--scheduler", metavar="ADDRESS",
@@ -772,7 +772,7 @@ def _add_study_commands(sub) -> None:
     rp = sub.add_parser("report", help="one self-contained HTML page of a run archive, a sweep folder or a study "
                                        "folder: figures, animation, tables, checks, scenario, provenance (docs/report.md)")
     rp.add_argument("path", help="run archive, or sweep, cross-check, validate, sensitivity, uncertainty or life folder")
-    rp.add_argument("-o", "--output", help="the HTML file to write (default: beside PATH, named after it: "
+    rp.add_argument("-o", "--output", type=output_path, help="the HTML file to write (default: beside PATH, named after it: "
                                            "outputs/run.h5 -> outputs/run.html, outputs/sweep -> outputs/sweep.html)")
     rp.add_argument("--animation", choices=("gif", "mp4", "none"), default="gif",
                     help="embed an archive's animation as a GIF image (default), an MP4 video, or not at all")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import sys
 
+from bearingsim.cli_common import output_path
 from bearingsim.errors import UserError
 
 
@@ -58,7 +59,7 @@ def add_commands(sub) -> None:
     a = sub.add_parser("animate", help="an MP4 or GIF of a multibody run's stored motion: rollers in their pockets, "
                                        "cage, face forces, impacts (docs/animation.md)")
     a.add_argument("archive", help="run archive (.h5) with motion (output.motion_rotations > 0 when it ran)")
-    a.add_argument("-o", "--output", required=True, help="animation file, .mp4 (H.264) or .gif")
+    a.add_argument("-o", "--output", type=output_path, required=True, help="animation file, .mp4 (H.264) or .gif")
     a.add_argument("--rotations", metavar="A:B", help="recorded cage rotations to show (default: all stored)")
     a.add_argument("--exaggerate", type=float, metavar="K",
                    help="draw the clearances K times their size (default: automatic, stated on the frame; at most "

@@ -11,6 +11,16 @@ from bearingsim.errors import UserError
 from bearingsim.wording import counted
 
 
+def output_path(text: str) -> str:
+    """``-o``'s value: refused when empty (``-o "$OUT"`` with ``OUT`` unset wrote a sweep's files into the
+    current folder); ``.`` names the current folder."""
+    import argparse
+
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path: give a file or folder ('.' for the current one)")
+    return text
+
+
 @contextlib.contextmanager
 def options_named(*keywords: str):
     """Within it, a library refusal that starts with one of its ``keywords`` ("rotations 3:4: outside ...",

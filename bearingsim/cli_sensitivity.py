@@ -5,6 +5,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from bearingsim.cli_common import output_path
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
 
@@ -76,7 +77,7 @@ def _common(p, default_out):
     p.add_argument("scenario", help="scenario TOML (either model) whose keys carry ranges (its preset's or its own)")
     p.add_argument("--keys", metavar="K1,K2,...", help="dotted keys to vary (default: every ranged key the model reads)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scenario key (repeatable)")
-    p.add_argument("-o", "--output", default=default_out, help=f"output folder (default {default_out})")
+    p.add_argument("-o", "--output", type=output_path, default=default_out, help=f"output folder (default {default_out})")
     p.add_argument("-j", "--jobs", type=int, default=None, help="local worker processes (default: one per core; at most one per case)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="run on an existing dask.distributed cluster")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress bar and no table (failures still said)")

@@ -7,6 +7,7 @@ import signal
 import sys
 from pathlib import Path
 
+from bearingsim.cli_common import output_path
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
 
@@ -91,7 +92,7 @@ def add_commands(sub) -> None:
                         "is the product)")
     s.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="override a scenario key in every case (repeatable)")
-    s.add_argument("-o", "--output", default="outputs/sweep",
+    s.add_argument("-o", "--output", type=output_path, default="outputs/sweep",
                    help="sweep folder (index, map, cases/, figures; default outputs/sweep)")
     s.add_argument("--archives", choices=("none", "all"), default=None,
                    help="per-case archives in DIR/cases/: 'all' or 'none' (default: the multibody cases only; "

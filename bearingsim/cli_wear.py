@@ -5,6 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+from bearingsim.cli_common import output_path
 from bearingsim.errors import UserError
 
 
@@ -232,7 +233,7 @@ def add_commands(sub) -> None:
     t = w.add_mutually_exclusive_group(required=True)
     t.add_argument("--hours", type=float, help="running time [h] at the archive's speed")
     t.add_argument("--rotations", type=float, help="running time as inner-ring (shaft) rotations")
-    w.add_argument("-o", "--output", help="folder for the figures (default: the archive's)")
+    w.add_argument("-o", "--output", type=output_path, help="folder for the figures (default: the archive's)")
     w.add_argument("--no-plots", action="store_true", help="print only")
     w.add_argument("-q", "--quiet", action="store_true", help="print nothing on success (the figures only)")
     w.set_defaults(func=_cmd_wear)
@@ -249,7 +250,7 @@ def add_commands(sub) -> None:
     li.add_argument("--rotations", type=int, help="recorded cage rotations per stage (default: the scenario's)")
     li.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="override a scenario key (repeatable)")
-    li.add_argument("-o", "--output", help="folder (default outputs/<name>_life); the same command resumes")
+    li.add_argument("-o", "--output", type=output_path, help="folder (default outputs/<name>_life); the same command resumes")
     li.add_argument("--scheduler", metavar="ADDRESS", help="run the stages on a dask cluster (tcp://host:8786); "
                                                           "default: one local worker process")
     li.add_argument("--force", action="store_true",

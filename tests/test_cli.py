@@ -774,3 +774,23 @@ def test_inspect_of_a_validate_folder_names_its_csv_tables(tmp_path):
     assert res.stdout.startswith(head + f"{out}: bearingsim validate tables (CSV, one row per speed): "
                                  f"fig9_idec_vs_speed.csv\n'bearingsim table {out}' prints them"), res.stdout
     assert res.stdout.endswith(index), res.stdout
+
+
+@pytest.mark.parametrize("command", [
+    ["run", "{paper}"],
+    ["sweep", "{paper}", "--param", "operating.inner_ring_speed_rpm=1000,2000"],
+    ["sensitivity", "{paper}", "--keys", "contact.restitution"],
+    ["crosscheck", "{mb}"],
+    ["life", "{mb}", "--limit", "clearance=0.4mm"],
+])
+def test_an_empty_output_path_is_refused_not_read_as_the_current_folder(tmp_path, command):
+    """`-o ""` (a shell's `-o "$OUT"` with OUT unset) was read as the current folder: a sweep wrote its index,
+    map and figures there. Every command's -o refuses an empty path, exit 2, naming the option, writing
+    nothing; '.' still names the current folder."""
+    args = [a.format(paper=SCENARIOS / "paper_3000rpm.toml", mb=SCENARIOS / "multibody_6000rpm.toml")
+            for a in command]
+    res = bearingsim(*args, "-o", "", cwd=tmp_path)
+    assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
+    assert res.stderr.strip().splitlines()[-1].endswith(
+        "error: argument -o/--output: an empty path: give a file or folder ('.' for the current one)"), res.stderr
+    assert list(tmp_path.iterdir()) == []

@@ -101,10 +101,10 @@ def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
 
 def max_ring_displacement_m(p) -> float:
     """Largest plausible mean inner-ring displacement [m] for the load of the SI parameters ``p``."""
-    load = p.operating.radial_load
-    if p.multibody.inner_ring_mass is not None:  # a dynamic ring carries its own weight too
-        load += p.multibody.inner_ring_mass * laws.STANDARD_GRAVITY
-    bound = 0.5 * p.bearing.radial_clearance + 2.0 * palmgren_approach_m(load, p.bearing.roller_length)
+    # the ring's load is the radial load alone, whatever its mass: a dynamic ring is driven by -W and the roller
+    # reactions (multibody.forces.raceway_forces), its weight counted in W, not added to it
+    bound = (0.5 * p.bearing.radial_clearance
+             + 2.0 * palmgren_approach_m(p.operating.radial_load, p.bearing.roller_length))
     return DISPLACEMENT_MARGIN * bound
 
 

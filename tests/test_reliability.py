@@ -564,6 +564,18 @@ def test_plausibility_ring_displacement_bound_follows_palmgren():
         pl.check(_FakeResult(sc, inner_ring_displacement_m=95e-6))
 
 
+def test_ring_displacement_bound_does_not_add_a_ring_weight_the_model_does_not_apply():
+    """A dynamic inner ring is driven by the radial load W and the roller reactions alone (its weight is part of
+    W, multibody.forces.raceway_forces), so a given ring mass does not loosen the bound: with 50 kg it was
+    2 (40 + 2 delta(970 N + 490 N)) = 93.9 um against 89.6 um, a bound for a load the model never applies."""
+    from bearingsim import plausibility as pl
+
+    base = pl.max_ring_displacement_m(si(_mb_scenario()))
+    heavy = pl.max_ring_displacement_m(si(_mb_scenario("multibody.inner_ring=dynamic",
+                                                       "multibody.inner_ring_mass_kg=50")))
+    assert heavy == base
+
+
 def test_plausibility_newton_failures_note_then_refusal():
     from bearingsim import plausibility as pl
     from bearingsim.errors import SimulationUnstable

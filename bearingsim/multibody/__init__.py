@@ -47,14 +47,15 @@ Recorded quantities (per pocket i, per rotation k)
 * face: a roller-cage contact is on the *front* face when its normal from roller to cage points along
   e_t, the cage's direction of rotation at the pocket centre, else on the *rear* face;
 * ``I_acc`` = sum of the circumferential (e_t) component of the front-face impulses on the cage,
-  ``I_dec`` = minus the same on the rear face (both >= 0: the roller drives, resp. the cage brakes
-  the roller), [N s]. This is what the paper's load cells measured. ``Jn_front/Jn_rear``: normal
+  ``I_dec`` = minus the same on the rear face (both >= 0: the roller drives the cage, resp. the cage drags
+  a lagging roller along and is braked by it), [N s]. This is what the paper's load cells measured. ``Jn_front/Jn_rear``: normal
   impulses, ``Jf_front/Jf_rear``: friction impulse magnitudes, ``slide_work_front/rear``: sum of
   ``J_n |v_slide|`` [N m] with the tangential relative speed of the contact points;
 * impacts (`/results/impacts`, face column "rear" or "front", as in the reduced model): a contact step whose normal
   approach speed exceeds 0.01 m/s (anything slower is
   resting-contact chatter, which pymunk resolves with restitution on every step);
-* wear per pocket face and cage rotation [m^3]: the paper's index ``k I r_r omega_r / H`` (Eq. 16) and
+* wear per pocket face and cage rotation [m^3]: the paper's index ``k J_n r_r omega_r / H`` (Eq. 16, of the
+  face's normal impulse J_n: on the arc faces the push is oblique; docs/physics.md) and
   the sliding work ``k sum(J_n |v_slide|) / H``.
 """
 from __future__ import annotations

@@ -465,7 +465,7 @@ class MotionSeries:
         self.cage_a = ts("motion_cage_angle", (), "rad", "cage angle (counter-clockwise, unwrapped; 0 at t = 0)")
         self.ring = ts("motion_inner_ring_centre", (2,), "m", "inner-ring centre (x, y)") if with_ring else None
         self.force = ts("motion_pocket_force", (n, 2), "N",
-                        "mean circumferential roller force on each pocket's rear (column 0, braking the roller) "
+                        "mean circumferential roller force on each pocket's rear (column 0, braking the cage) "
                         "and front face (column 1, driving the cage) since the previous sample")
 
     def flush(self, block: np.ndarray, k: int) -> None:

@@ -63,10 +63,11 @@ START_TRANSIENT_MIN_REL = 0.01
 START_TRANSIENT_MIN_ROTATIONS = 6
 
 # Where the cage rests (its centre's mean position in each recorded rotation, as an angle from the bottom:
-# /results/per_rotation/cage_rest_angle) stays within a few degrees in a steady run: at most 8.3 deg over
-# the runs measured (3000 and 6000 rpm for 20 rotations, 500 and 1000 rpm, both land guidances, rigid
-# raceways, pocket clearances 0.1 and 0.4 mm, the rig, and the scenarios/hard multibody cases, of which
-# restitution 0.99 spans 11.8 deg over 4 rotations). Under load a roller-guided cage can take a second
+# /results/per_rotation/cage_rest_angle) stays within about 12 degrees in a steady run: at most 8.3 deg over
+# the runs measured at 970 N (3000 and 6000 rpm for 20 rotations, 500 and 1000 rpm, both land guidances, rigid
+# raceways, pocket clearances 0.1 and 0.4 mm, the rig), 10.2 and 11.3 deg at 12 and 10 kN (3000 rpm, 20
+# rotations; docs/whatif.md, Radial load), and of the scenarios/hard multibody cases restitution 0.99 spans
+# 11.8 deg over 4 rotations. Under load a roller-guided cage can take a second
 # resting place (docs/whatif.md, Radial load): a 14 kN run at 3000 rpm that changes place among its recorded
 # rotations spans 51 deg, the 20000 rpm and 3-roller hard cases 94 and 32 deg. A span beyond
 # CAGE_REST_SPAN_DEG gets a note: the run's means mix the places it rested in. Not judged where the cage's
@@ -619,7 +620,7 @@ def cage_rest_change(result) -> str | None:
                f"two resting places of docs/whatif.md, Radial load are a roller-guided cage's")
     return (f"bearingsim: note: the cage did not rest in one place: the angle of its centre's mean position from "
             f"the bottom spanned {span:.1f} deg over the recorded rotations ({lo:.1f} to {hi:.1f} deg{across}, "
-            f"/results/per_rotation/cage_rest_angle; a steady run's stays within a few, the bound is "
+            f"/results/per_rotation/cage_rest_angle; a steady run's stays within about 12 deg, the bound is "
             f"{CAGE_REST_SPAN_DEG:g}), so the run's means mix the places it rested in ({why})")
 
 

@@ -27,6 +27,9 @@ class Comparison:
     how: dict[str, str] = field(default_factory=dict)  # how each of arrays_differ differs, by its name
     arrays_compared: int = 0  # the arrays and other numbers compared (of either result)
     unrecorded: dict[str, str] = field(default_factory=dict)  # an added array one archive predates: "A" or "B"
+    #: the motion series not compared (the runs stored different motion: :func:`_stored_motion_differs`), and why
+    unstored: list[str] = field(default_factory=list)
+    unstored_why: str = ""
     versions: list[tuple[str, object, object]] = field(default_factory=list)
 
     @property
@@ -76,8 +79,12 @@ class Comparison:
     def unrecorded_lines(self) -> list[str]:
         """One line for each array that one archive holds and the other, written by an earlier version, predates
         (:attr:`bearingsim.results.Result.ADDED_ARRAYS`): not compared, and no difference of the run."""
-        return [f"  not in {side}: {k} (recorded by later versions than the one that wrote {side}; not compared)"
-                for k, side in self.unrecorded.items()]
+        lines = [f"  not in {side}: {k} (recorded by later versions than the one that wrote {side}; not compared)"
+                 for k, side in self.unrecorded.items()]
+        if self.unstored:
+            lines.append(f"  not compared: {len(self.unstored)} motion series (what a run stores for animations "
+                         f"beyond its results; {self.unstored_why})")
+        return lines
 
 
 def relative_change(a: float, b: float) -> str:
@@ -108,10 +115,14 @@ def compare_results(a, b) -> Comparison:
         if k not in sa or k not in sb or not same_bits(va, vb):
             c.summary_differs.append(k)
     added = getattr(type(a), "ADDED_ARRAYS", frozenset()) | getattr(type(b), "ADDED_ARRAYS", frozenset())
+    c.unstored_why = _stored_motion_differs(a, b)
     for pa, pb in ((compared_arrays(a), compared_arrays(b)), (other_numbers(a), other_numbers(b))):
         for k in list(pa) + [k for k in pb if k not in pa]:
             if (k not in pa or k not in pb) and f"results/{k}" in added:
                 c.unrecorded[k] = "A" if k not in pa else "B"
+                continue
+            if c.unstored_why and k.startswith(MOTION_SERIES):
+                c.unstored.append(k)
                 continue
             c.arrays_compared += 1
             how = "only in B" if k not in pa else "only in A" if k not in pb else how_differs(pa[k], pb[k])
@@ -125,6 +136,21 @@ def compare_results(a, b) -> Comparison:
         if va.get(k) != vb.get(k):
             c.versions.append((k, va.get(k, "?"), vb.get(k, "?")))
     return c
+
+
+#: the names (:func:`compared_arrays`) of the motion a multibody run stores for animations: the bodies' states
+#: over the window its ``[output]`` keys set, on which no number of the run depends (docs/archive.md)
+MOTION_SERIES = "observables/motion_"
+
+
+def _stored_motion_differs(a, b) -> str:
+    """Why the two results' motion series are not compared: their ``[output]`` keys differ (one stores no motion,
+    or another window of it), said as those keys; "" when they are the same (the series are then compared bit
+    for bit, as every other)."""
+    out_a, out_b = (r.scenario.raw.get("output") or {} for r in (a, b))
+    keys = differing_keys(out_a, out_b)
+    return ("the runs store different motion: " + ", ".join(f"output.{k} {va!r} -> {vb!r}" for k, va, vb in keys)
+            if keys else "")
 
 
 def compared_arrays(result) -> dict[str, np.ndarray]:

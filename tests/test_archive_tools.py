@@ -127,6 +127,29 @@ def test_an_archive_written_before_an_added_array_reruns_and_compares_identical(
 
 
 @pytest.mark.slow
+def test_compare_of_runs_that_store_different_motion_compares_their_results(multibody_archive):
+    """Storing motion (``[output] motion_*``) changes no number of a run (docs/archive.md), but ``compare`` of a
+    run with it against the same run without it said "results: differ" (exit 1) over the 18 motion series only
+    one held. The motion series are compared only between runs that store the same motion; otherwise they are
+    named as not compared, with the keys that differ. With the same [output] keys a missing series differs."""
+    from bearingsim.compare import compare_results
+    from bearingsim.simulation import COMPARED, load
+
+    a, b = load(multibody_archive, only=COMPARED), load(multibody_archive, only=COMPARED)
+    motion = [k for k in b.series if k.startswith("motion_")]
+    assert len(motion) == 6, motion  # 6 series of step, time and value: 18 arrays
+    for k in motion:
+        del b.series[k]
+    c = compare_results(a, b)
+    assert not c.identical and len(c.arrays_differ) == 18 and c.how[c.arrays_differ[0]] == "only in A"
+    b.scenario = b.scenario.replace(**{"output.motion_rotations": 0.0})
+    c = compare_results(a, b)
+    assert c.identical and len(c.unstored) == 18 and not c.arrays_differ, c.arrays_differ
+    assert ("  not compared: 18 motion series (what a run stores for animations beyond its results; the runs store "
+            "different motion: output.motion_rotations 2.0 -> 0.0)") in c.unrecorded_lines()
+
+
+@pytest.mark.slow
 def test_rerun_of_a_multibody_archive_is_bit_identical(multibody_archive):
     res = cli("rerun", multibody_archive, fresh_interpreter=True)  # another process than the run's
     assert res.returncode == 0 and "bit-identical" in res.stdout, res.stdout + res.stderr

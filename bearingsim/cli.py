@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from bearingsim import __version__, outputs
-from bearingsim.cli_common import given_once, output_path, progress_wanted, report_study, say, with_notes
+from bearingsim.cli_common import Parser, given_once, output_path, progress_wanted, report_study, say, with_notes
 from bearingsim.errors import SimulationUnstable, UserError
 from bearingsim.wording import counted
 
@@ -614,7 +614,7 @@ def _cmd_report(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="bearingsim", description="Roller/cage dynamics and cage-wear impulse.")
+    p = Parser(prog="bearingsim", description="Roller/cage dynamics and cage-wear impulse.")
     p.add_argument("--version", action="version", version=f"bearingsim {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 

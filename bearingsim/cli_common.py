@@ -1,9 +1,11 @@
 """What the subcommands share: a study's exit code, whether a progress bar is drawn, the options a
-library refusal names. Imported by :mod:`bearingsim.cli` and the command modules beside it (``cli_sweep``,
+library refusal names, the parser class whose errors are one line. Imported by :mod:`bearingsim.cli` and the command modules beside it (``cli_sweep``,
 ``cli_sensitivity``, ``cli_wear``, ``cli_animate``), none of which import each other."""
 from __future__ import annotations
 
+import argparse
 import contextlib
+import difflib
 import signal
 import sys
 
@@ -11,11 +13,47 @@ from bearingsim.errors import UserError
 from bearingsim.wording import counted
 
 
+class Parser(argparse.ArgumentParser):
+    """``bearingsim``'s parser and, through argparse's ``parser_class``, every subcommand's: a bad command
+    line is one line on stderr, exit 2, ending with the command's ``--help`` (argparse printed a usage block
+    of several lines above its error); an unknown choice (a subcommand's name, an option's value) names the
+    closest one there is. ``--help`` prints as argparse prints it."""
+
+    def error(self, message: str):
+        from bearingsim.outputs import printable
+
+        self.exit(2, f"{self.prog}: error: {printable(message, keep_newlines=False)} ({self.prog} --help)\n")
+
+    def parse_args(self, args=None, namespace=None):
+        """argparse's, but an argument no parser took is refused by the subcommand's parser, which names
+        it, not by the main one (``bearingsim run x.toml --bogus``: ``bearingsim run: error: ...``)."""
+        namespace, extras = self.parse_known_args(args, namespace)
+        if extras:
+            self._used_parser(namespace).error(f"unrecognized arguments: {' '.join(extras)}")
+        return namespace
+
+    def _used_parser(self, namespace) -> argparse.ArgumentParser:
+        """The subcommand's parser that read ``namespace``, or this one."""
+        for action in self._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                chosen = action.choices.get(getattr(namespace, action.dest, None))
+                if chosen is not None:
+                    return chosen._used_parser(namespace) if isinstance(chosen, Parser) else chosen
+        return self
+
+    def _check_value(self, action, value):
+        try:
+            super()._check_value(action, value)
+        except argparse.ArgumentError as exc:
+            close = difflib.get_close_matches(str(value), [str(c) for c in action.choices or ()], n=1)
+            if not close:
+                raise
+            raise argparse.ArgumentError(action, f"{exc.message}; did you mean {close[0]!r}?") from None
+
+
 def output_path(text: str) -> str:
     """``-o``'s value: refused when empty (``-o "$OUT"`` with ``OUT`` unset wrote a sweep's files into the
     current folder); ``.`` names the current folder."""
-    import argparse
-
     if not text.strip():
         raise argparse.ArgumentTypeError("an empty path: give a file or folder ('.' for the current one)")
     return text

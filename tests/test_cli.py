@@ -794,3 +794,62 @@ def test_an_empty_output_path_is_refused_not_read_as_the_current_folder(tmp_path
     assert res.stderr.strip().splitlines()[-1].endswith(
         "error: argument -o/--output: an empty path: give a file or folder ('.' for the current one)"), res.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def _subparsers() -> dict:
+    """Every subcommand's parser, by name, as the program builds them (not a list that could go stale)."""
+    import argparse
+
+    from bearingsim.cli import build_parser
+
+    return next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
+def assert_argparse_error(res, prog: str, *words):
+    """argparse's refusal of a command line: one line on stderr naming the command and its --help, exit 2."""
+    lines = res.stderr.splitlines()
+    assert res.returncode == 2 and len(lines) == 1, res.stderr
+    assert lines[0].startswith(f"{prog}: error: ") and lines[0].endswith(f" ({prog} --help)"), lines[0]
+    for w in words:
+        assert w in lines[0], lines[0]
+    assert res.stdout == ""
+
+
+@pytest.mark.parametrize("command", sorted(_subparsers()))
+def test_a_bad_command_line_is_one_line_naming_the_commands_help(command):
+    """argparse printed a usage block of three lines and more above its error (`bearingsim run`: the usage,
+    then "bearingsim run: error: the following arguments are required: scenario"), and an option no
+    subcommand takes was refused by the main parser ("bearingsim: error: unrecognized arguments"). Every
+    subcommand's bad option and missing argument is now one line naming the subcommand and its --help,
+    exit 2; --help still prints the usage."""
+    parser = _subparsers()[command]
+    prog = f"bearingsim {command}"
+    required = [a.dest for a in parser._actions if a.required]
+    res = bearingsim(command, "--no-such-option")
+    if required:
+        assert_argparse_error(res, prog, "the following arguments are required: ")
+        assert_argparse_error(bearingsim(command), prog, "the following arguments are required: ")
+    else:
+        assert_argparse_error(res, prog, "unrecognized arguments: --no-such-option")
+    helped = bearingsim(command, "--help")
+    assert helped.returncode == 0 and helped.stdout.startswith(f"usage: {prog} "), helped.stdout
+
+
+@pytest.mark.parametrize("args, words", [
+    (["rnu"], ["argument command: invalid choice: 'rnu' (choose from 'run', ", "did you mean 'run'?"]),
+    (["xyzzy"], ["argument command: invalid choice: 'xyzzy' (choose from 'run', "]),
+    ([], ["the following arguments are required: command"]),
+    (["--no-such-option"], ["the following arguments are required: command"]),
+])
+def test_an_unknown_or_missing_subcommand_is_one_line_with_the_closest_name(args, words):
+    """`bearingsim rnu` printed the usage with the whole command list on three lines, then "invalid choice";
+    now one line, which names the closest command when there is one (difflib), exit 2."""
+    res = bearingsim(*args)
+    assert_argparse_error(res, "bearingsim", *words)
+    assert ("did you mean" in res.stderr) == (args == ["rnu"]), res.stderr
+
+
+def test_an_unknown_option_value_names_the_closest_choice():
+    res = bearingsim("report", "x.h5", "--animation", "gf")
+    assert_argparse_error(res, "bearingsim report", "argument --animation: invalid choice: 'gf'",
+                          "did you mean 'gif'?")

@@ -791,8 +791,9 @@ def test_an_empty_output_path_is_refused_not_read_as_the_current_folder(tmp_path
             for a in command]
     res = bearingsim(*args, "-o", "", cwd=tmp_path)
     assert res.returncode == 2 and "Traceback" not in res.stderr, res.stderr
-    assert res.stderr.strip().splitlines()[-1].endswith(
-        "error: argument -o/--output: an empty path: give a file or folder ('.' for the current one)"), res.stderr
+    assert res.stderr.splitlines() == [
+        f"bearingsim {command[0]}: error: argument -o/--output: an empty path: give a file or folder ('.' for the "
+        f"current one) (bearingsim {command[0]} --help)"], res.stderr
     assert list(tmp_path.iterdir()) == []
 
 

@@ -1098,6 +1098,10 @@ _NOT_WRITTEN.update({c: f"before any case of the {c} study ran (cases an earlier
                         f"runs it)" for c in ("sensitivity", "uncertainty", "crosscheck", "validate")})
 
 
+#: the commands whose cases run on the sweep engine, indexed in their folder's sweep.h5
+_STUDY_COMMANDS = ("sweep", "sensitivity", "uncertainty", "crosscheck", "validate", "life")
+
+
 #: the commands that write one file: once it is complete, all is written
 _ONE_FILE = ("animate", "report")
 
@@ -1113,8 +1117,9 @@ def _interrupted(exc: KeyboardInterrupt, args) -> int:
 def _say_interrupted(exc: KeyboardInterrupt, args) -> None:
     what = _stop_words(exc)
     written = getattr(exc, "archive_written", None) or getattr(args, "written", None)  # the archive is complete
-    kept = getattr(exc, "resume_note", None)  # what a study kept, its cases done (studies.run_studies)
     done = getattr(args, "files_written", {})  # the files complete (outputs.recording_files)
+    # what a study kept, its cases done (studies.run_studies), or the case index a sweep or study wrote
+    kept = getattr(exc, "resume_note", None) or _index_written(args, done)
     expected = (getattr(args, "expected", None) or ([written, *getattr(exc, "figures_expected", ())] if written else ())
                 or (list(done) if getattr(args, "command", None) in _ONE_FILE else ()))
     if done and (getattr(args, "finished", False)
@@ -1133,6 +1138,23 @@ def _say_interrupted(exc: KeyboardInterrupt, args) -> None:
     else:
         print(f"bearingsim: {what}, {_NOT_WRITTEN.get(getattr(args, 'command', None), 'no archive written')}",
               file=sys.stderr)
+
+
+def _index_written(args, done: dict) -> str | None:
+    """What a sweep or study that wrote its case index (``DIR/sweep.h5``) this time kept, when a signal ends it
+    out of the sweep's own handlers: after its cases ran and their index was written, before the command
+    returned (its lock released, its table printed). Said as "before any case of the sweep ran" before; None
+    for another command or when no index was written (the signal came before the cases)."""
+    if getattr(args, "command", None) not in _STUDY_COMMANDS:
+        return None
+    index = next((path for path in done if os.path.basename(path) == "sweep.h5"), None)
+    if index is None:
+        return None
+    beside = [os.path.basename(p) for p in done  # the folder's other files (a study's tables, a sweep's map)
+              if os.path.dirname(p) == os.path.dirname(index) and os.path.basename(p) not in ("sweep.h5", "sweep.csv")]
+    also = f", and {', '.join(beside)} {'is' if len(beside) == 1 else 'are'} complete" if beside else ""
+    return (f"its case index {done[index]} is written, with every case that ran ('bearingsim table {done[index]}' "
+            f"prints them){also}")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1254,6 +1254,48 @@ def test_a_signal_after_the_cases_says_they_are_indexed(tmp_path, monkeypatch, c
     assert [r["status"] for r in _rows(tmp_path)] == ["done", "done"]
 
 
+@pytest.mark.parametrize("stage", ["lock", "outcome", "study"])
+def test_a_signal_once_the_cases_are_indexed_does_not_say_none_ran(tmp_path, monkeypatch, capsys, stage):
+    """SIGINT after a sweep's cases ran and its index was written, before the command returned (its folder's
+    lock released, the command reading the outcome; a study's tables written), said "interrupted, before any
+    case of the sweep ran" (seen once, no data lost). It names the index written and the files complete."""
+    from bearingsim import cli, cli_common, outputs
+    from bearingsim.sweeps import run as run_module
+
+    def signalled(function, before=True):
+        def wrapper(*args, **kw):
+            if not before:
+                function(*args, **kw)
+            os.kill(os.getpid(), signal.SIGINT)
+            for _ in range(1000):  # the handler raises here
+                time.sleep(0.01)
+            raise AssertionError("signal not delivered")
+        return wrapper
+
+    if stage == "lock":  # run_sweep, the index written and the lock released, before it returns
+        monkeypatch.setattr(outputs.FolderLock, "release", signalled(outputs.FolderLock.release, before=False))
+    elif stage == "outcome":  # bearingsim sweep, as it reads the outcome run_sweep returned
+        monkeypatch.setattr(run_module.SweepOutcome, "counts", signalled(run_module.SweepOutcome.counts))
+    else:  # bearingsim sensitivity, its tables written, as it says how the study ended
+        monkeypatch.setattr(cli_common, "report_study", signalled(cli_common.report_study))
+    args = (["sweep", str(BASE), "--param", f"{SPEED}=1000,2000", "--no-plots"] if stage != "study" else
+            ["sensitivity", str(BASE), "--keys", "contact.restitution", "-q"])
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        code = cli.main([*args, "-j", "1", "-o", str(tmp_path)])
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert code == 130
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    command = args[0]
+    also = ", and map.h5 is complete" if stage != "study" else \
+        ", and sensitivity.csv, sensitivity.h5, sensitivity.png are complete"
+    assert err == [f"bearingsim: {command} interrupted (SIGINT): its case index {tmp_path / 'sweep.h5'} is written, "
+                   f"with every case that ran ('bearingsim table {tmp_path / 'sweep.h5'}' prints them){also}; run "
+                   f"the same command again to resume"], err
+    assert all(r["status"] == "done" for r in _rows(tmp_path))
+
+
 @pytest.mark.parametrize("table, got", [("{ start = 0.1, num = 3 }", "start, num"),
                                         ("{ start = 0.1, stop = 0.3, nums = 3 }", "start, stop, nums")])
 def test_a_range_with_a_key_missing_or_misspelt_names_its_axis(tmp_path, table, got):

@@ -371,3 +371,37 @@ def test_every_table_is_written_in_one_csv_dialect(tmp_path):
                             "model_version": 1, "summary": {}}], [], {})
     lines = (tmp_path / "sweep.csv").read_bytes().split(b"\n")
     assert all(line.endswith(b"\r") for line in lines[:-1]) and lines[-1] == b""
+
+
+def test_a_signal_while_the_study_engine_stops_is_an_interruption_not_a_traceback(tmp_path, monkeypatch, capsys):
+    """SIGINT landing while a study's engine stopped after its last round (studies.engine._run_rounds's clean-up,
+    its handler still in) raised SweepInterrupted out of the study: `bearingsim sensitivity` printed its
+    traceback and exited 1. It is an interruption: exit 130, one line, the cases kept, no table; the same
+    command then writes the table from them."""
+    from bearingsim import cli
+    from bearingsim.sweeps import engines
+
+    stop = engines.LocalEngine.stop
+    calls = []
+
+    def stop_then_signal(self):  # the first stop is the sweep's own (its signals held), the second the study's
+        stop(self)
+        calls.append(1)
+        if len(calls) == 2:
+            signal.raise_signal(signal.SIGINT)
+
+    monkeypatch.setattr(engines.LocalEngine, "stop", stop_then_signal)
+    args = ["sensitivity", str(SCENARIOS / "paper_3000rpm.toml"), "--keys", "contact.restitution", "-j", "1", "-q",
+            "-o", str(tmp_path)]
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        code = cli.main(args)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    assert code == 130 and len(calls) == 2
+    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert err == ["bearingsim: sensitivity interrupted (SIGINT): 4 done, 0 cached, 0 failed, 0 not run, of 4 cases; "
+                   "run the same command again to resume"], err
+    assert not (tmp_path / "sensitivity.h5").exists()
+    monkeypatch.setattr(engines.LocalEngine, "stop", stop)
+    assert cli.main(args) == 0 and (tmp_path / "sensitivity.h5").is_file()

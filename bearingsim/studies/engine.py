@@ -267,6 +267,7 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM/SIGHUP end the study as one
     # during a round does: the finished cases kept, the same command resumes
     staged = any(s.staged for s in studies)
+    stopped = None  # the signal that stopped the rounds
     with _Signals() as outer:
         try:
             while True:  # a staged study's rounds share the engine: its workers keep the model they loaded
@@ -274,24 +275,30 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
                                   staged=StagedRound(earlier) if staged else None,
                                   **options)  # tables and figures are made from the cases' archives
                 if sweep.interrupted is not None or sweep.failed:
-                    return sweep
+                    break
                 records = {r["case"]: r for r in sweep.rows}
                 earlier = {h: {k: r[k] for k in _ROW_KEYS} for h, r in records.items()}
                 more = _new_cases(cases, [c for s in studies for c in s.next_cases(outdir, records)])
                 if outer.fired is not None:  # its exception was swallowed (raised inside a callback)
                     raise SweepInterrupted(outer.fired)
                 if len(more) == len(cases):
-                    return sweep
+                    break
                 cases = more
         except SweepInterrupted as exc:
-            if sweep is not None:
-                sweep.interrupted = exc.signum
-                return sweep
-            first = exc.signum
+            stopped = exc.signum
         finally:
+            try:  # a signal while the engine stops is noted, not raised out of the study (a traceback, exit 1)
+                outer.hold()
+            except SweepInterrupted:  # the first signal, landed on the call (sweeps.run._Signals.hold)
+                outer.hold()
             engine.stop()
-    signal.raise_signal(first)  # before any case ran: the signal goes to the handler that was in place
-    raise KeyboardInterrupt(signal.Signals(first).name)  # that handler ignored it: the study is stopped all the same
+    stopped = stopped or outer.fired
+    if sweep is None:  # before any case ran: the signal goes to the handler that was in place
+        signal.raise_signal(stopped)
+        raise KeyboardInterrupt(signal.Signals(stopped).name)  # that handler ignored it: stopped all the same
+    if stopped is not None and sweep.interrupted is None:  # the cases ran; the study is not finished: resumed
+        sweep.interrupted = stopped
+    return sweep
 
 
 def in_folder(studies, outdir=None, *, jobs: int = 1, engine=None, progress: bool = False) -> StudiesOutcome:

@@ -1098,6 +1098,7 @@ def test_a_resume_cut_short_leaves_the_folders_index_as_it_was(tmp_path, monkeyp
     archive's name (an error of the resume) 7 of 12. The folder's index is left as it was: a signal ends the
     sweep as one while it starts (KeyboardInterrupt here), an error is said as before."""
     import bearingsim.sweeps.index as index_module
+    from bearingsim.errors import UserError
 
     spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0, 3000.0, 4000.0])])
     run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
@@ -1122,12 +1123,38 @@ def test_a_resume_cut_short_leaves_the_folders_index_as_it_was(tmp_path, monkeyp
     monkeypatch.setattr(index_module, "trusted_row", trusted)
     third = resolve_cases(spec)[2].hash
     (tmp_path / "cases" / f"{third}.h5").mkdir(parents=True)  # the resume cannot remove it
-    with pytest.raises(OSError):
-        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
+    with pytest.raises(UserError, match="is a folder, not bearingsim's"):  # where the case is to keep its archive
+        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert (tmp_path / "sweep.h5").read_bytes() == before
     (tmp_path / "cases" / f"{third}.h5").rmdir()
     out = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False)
     assert [r["status"] for r in out.rows] == ["cached"] * 4
+
+
+def test_a_folder_at_a_case_archives_path_is_refused_naming_it(tmp_path):
+    """A folder at a case archive's path `DIR/cases/<hash>.h5` (in a new folder, or in place of a finished case's
+    archive) was said as "DIR/cases/<hash>.h5: Is a directory". It is refused as the folder at the lock file's
+    path is: one line naming the file and what is in the way, exit 2, before any case runs, the folder's index
+    as it was and the folder kept. A case that keeps no archive (a reduced one by default) runs beside it."""
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000.0, 2000.0])])
+    second = resolve_cases(spec)[1].hash
+    args = ["sweep", BASE, "--param", f"{SPEED}=1000,2000", "-j", "1", "--no-plots"]
+    blocker = tmp_path / "new" / "cases" / f"{second}.h5"
+    blocker.mkdir(parents=True)
+    res = bearingsim(*args, "--archives", "all", "-o", tmp_path / "new")
+    assert_user_error(res, f"{blocker}: archive of the case {SPEED}=2000 of {tmp_path / 'new'} is a folder, not "
+                           f"bearingsim's; not replaced (remove it)")
+    assert blocker.is_dir() and not (tmp_path / "new" / "sweep.h5").exists()
+    res = bearingsim(*args, "-o", tmp_path / "new")  # reduced cases keep no archive: not in their way
+    assert res.returncode == 0 and blocker.is_dir(), res.stderr
+    assert bearingsim(*args, "--archives", "all", "-o", tmp_path / "done").returncode == 0
+    before = (tmp_path / "done" / "sweep.h5").read_bytes()
+    blocker = tmp_path / "done" / "cases" / f"{second}.h5"  # a finished sweep's archive replaced by a folder
+    blocker.unlink()
+    blocker.mkdir()
+    res = bearingsim(*args, "--archives", "all", "-o", tmp_path / "done")
+    assert_user_error(res, f"{blocker}: archive of the case {SPEED}=2000 of {tmp_path / 'done'} is a folder")
+    assert (tmp_path / "done" / "sweep.h5").read_bytes() == before and blocker.is_dir()
 
 
 def test_an_index_whose_columns_differ_in_length_is_refused_in_one_line(tmp_path):

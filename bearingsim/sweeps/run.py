@@ -352,7 +352,7 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
         where = f"cases/{c.hash}.h5"
         if rec is None or rec["status"] == "stale":
             # the sweep's own file, incomplete, damaged or stale: it is run again and replaced
-            (cases_dir / f"{c.hash}.h5").unlink(missing_ok=True)
+            _remove_case_archive(cases_dir / f"{c.hash}.h5", c, outdir, keeps_archive(c.model, archives))
             if not keeps_archive(c.model, archives):
                 rec = trusted_row(old.get(c.hash), c.model) or rec
                 where = ""
@@ -365,6 +365,18 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
             if "notes" not in rec:  # an archive that stores no notes: its row's in the previous index
                 row["notes"] = list(old.get(c.hash, {}).get("notes", ()))
     return todo, stale
+
+
+def _remove_case_archive(path: Path, case: Case, outdir: Path, keeps: bool) -> None:
+    """Remove the case archive ``path`` that is to be run again. A folder there is refused in one line naming it
+    (it said "Is a directory"), before any case runs and with the folder's index as it was, when the case is to
+    write its archive there (``keeps``); else it is in no one's way and left as it is."""
+    if path.is_dir() and not path.is_symlink():
+        if not keeps:
+            return
+        raise UserError(f"{path}: archive of the case {case.label()} of {outdir} is a folder, not bearingsim's; not "
+                        f"replaced (remove it)")
+    path.unlink(missing_ok=True)
 
 
 def _pending_rows(cases: list[Case]) -> list[dict]:

@@ -299,17 +299,17 @@ class Spool:
             self.check()
         except OSError as exc:
             self._close()
-            self.tmp.unlink(missing_ok=True)
+            outputs.discard_temporary(self.tmp)
             raise outputs.write_error(self.path, exc) from None
         except BaseException:
             self._close()
-            self.tmp.unlink(missing_ok=True)
+            outputs.discard_temporary(self.tmp)
             raise
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:
         self._close()
-        self.tmp.unlink(missing_ok=True)  # written and renamed by write(), else abandoned
+        outputs.discard_temporary(self.tmp)  # written and renamed by write(), else abandoned
         if exc_type is not None and issubclass(exc_type, OSError) and not isinstance(exc, UserError):
             raise outputs.write_error(self.path, exc) from None
         return False
@@ -385,13 +385,13 @@ def write(result, path, spool: Spool | None = None) -> Path:
         os.replace(spool.tmp, spool.path)
         outputs.note_written(spool.path)
     except OSError as exc:  # the rename
-        spool.tmp.unlink(missing_ok=True)
+        outputs.discard_temporary(spool.tmp)
         raise outputs.write_error(spool.path, exc) from None
     except BaseException:
         spool._close()
         if renaming and not os.path.lexists(spool.tmp):  # renamed, then a signal's exception: complete
             outputs.note_written(spool.path)
-        spool.tmp.unlink(missing_ok=True)
+        outputs.discard_temporary(spool.tmp)
         raise
     return spool.path
 

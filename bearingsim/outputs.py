@@ -74,6 +74,14 @@ def temporary_name(path: Path) -> Path:
     return path.with_name(f".{path.name}.tmp-{os.getpid()}")
 
 
+def discard_temporary(tmp: Path) -> None:
+    """Remove the temporary file ``tmp`` if it is there. Its folder removed, or replaced by a file, while it was
+    written (a sweep's ``cases/``) means it is not: that ``NotADirectoryError`` was raised over the write's own
+    error and recorded raw as a sweep case's failure."""
+    with contextlib.suppress(FileNotFoundError, NotADirectoryError):
+        os.unlink(tmp)
+
+
 def create_new(path: Path, readable: bool = False) -> int:
     """Open ``path`` for writing (and reading, with ``readable``) as a new file, never through a symbolic
     link (``O_EXCL|O_NOFOLLOW``); a leftover of this process's id (a symbolic link planted there included)
@@ -114,7 +122,7 @@ def atomic_file(path: str | Path):
         if renaming and not os.path.lexists(tmp):  # renamed, then a signal's exception: the file is complete
             note_written(path)
             raise
-        tmp.unlink(missing_ok=True)
+        discard_temporary(tmp)
         if isinstance(exc, OSError) and exc.errno is not None and (
                 exc.filename is None or str(exc.filename) == str(tmp)):  # a write, or the rename, of the temporary
             raise _naming(exc, path) from None
@@ -795,7 +803,22 @@ def write_error(path: str | Path, exc: OSError) -> ArchiveWriteError:
                 code = c
                 break
     what = os.strerror(code) if code else "write failed"
+    if code in (errno.EISDIR, errno.ENOTDIR, errno.ENOENT):
+        what = _in_the_way(Path(path)) or what
     return ArchiveWriteError(f"{path}: cannot write archive ({what}); nothing was written")
+
+
+def _in_the_way(path: Path) -> str | None:
+    """What stands where the archive ``path`` or its folder should be, once it was checked (a folder made at
+    its name, its folder replaced by a file or removed while the run wrote it), or None."""
+    if path.is_dir() and not path.is_symlink():
+        return "a folder is in the way there, not bearingsim's: remove it"
+    folder = path.parent
+    if folder.is_dir():
+        return None
+    if os.path.lexists(folder):
+        return f"its folder {folder} is a file now, not a folder"
+    return f"its folder {folder} is gone"
 
 
 _CONTROL_RE = re.compile(r"[\x00-\x08\x0b-\x1f\x7f-\x9f]")

@@ -1157,6 +1157,45 @@ def test_a_folder_at_a_case_archives_path_is_refused_naming_it(tmp_path):
     assert (tmp_path / "done" / "sweep.h5").read_bytes() == before and blocker.is_dir()
 
 
+@pytest.mark.parametrize("model", ["reduced", "multibody"])
+@pytest.mark.parametrize("blocker", ["file at cases", "folder at the archive"])
+def test_a_case_whose_archive_cannot_be_written_records_a_sentence_naming_the_path(tmp_path, monkeypatch, model,
+                                                                                  blocker):
+    """`DIR/cases/` replaced by a file while a sweep ran: a multibody case streaming its archive recorded
+    "NotADirectoryError: [Errno 20] Not a directory: 'DIR/cases/.<hash>.h5.tmp-<pid>'" as its failure (the
+    temporary file's removal failed over the write's own error), a reduced one "cannot write archive (Not a
+    directory)". Both record one sentence naming the archive and what is in the way; so does a folder made at
+    the archive's name meanwhile ("Is a directory")."""
+    from bearingsim import simulation
+    from bearingsim.sweeps import worker
+
+    sc = load_scenario(SCENARIOS / ("paper_3000rpm.toml" if model == "reduced" else "multibody_6000rpm.toml"),
+                       ["numerics.rotations=1"])
+    cases = tmp_path / "cases"
+    cases.mkdir()
+    target = cases / "0123456789abcdef.h5"
+    run = simulation.run
+
+    def run_then_block(*args, **kw):  # while the case runs (a multibody case's archive is open in cases/)
+        result = run(*args, **kw)
+        if blocker == "file at cases":
+            for p in cases.iterdir():
+                p.unlink()
+            cases.rmdir()
+            cases.write_text("")
+        else:
+            target.mkdir()
+        return result
+
+    monkeypatch.setattr(simulation, "run", run_then_block)
+    rec = worker.run_case("0123456789abcdef", sc.to_toml(), target, None, "all")
+    what = (f"its folder {cases} is a file now, not a folder" if blocker == "file at cases" else
+            "a folder is in the way there, not bearingsim's: remove it")
+    assert rec["status"] == "failed", rec
+    assert rec["error"] == f"{target}: cannot write archive ({what}); nothing was written", rec["error"]
+    assert (cases.is_file() if blocker == "file at cases" else [p.name for p in cases.iterdir()] == [target.name])
+
+
 def test_an_index_whose_columns_differ_in_length_is_refused_in_one_line(tmp_path):
     """A sweep.h5 one of whose columns had fewer rows (cut by hand) made the sweep's resume fail with IndexError's
     traceback, after it had rewritten the index all 'pending'. It is a damaged index: refused, not replaced."""

@@ -19,10 +19,17 @@ log = logging.getLogger(__name__)
 
 
 def one_line_error(exc: BaseException) -> str:
-    """A failure as one line: ``str(exc)`` for bearingsim's own errors, else ``Class: message``."""
+    """A failure as one line: ``str(exc)`` for bearingsim's own errors, ``path: what`` for the system's error
+    about a file (a raw "NotADirectoryError: [Errno 20] Not a directory: '...'" was recorded), else
+    ``Class: message``."""
     from bearingsim.errors import SimulationUnstable, UserError
 
-    text = str(exc) if isinstance(exc, (UserError, SimulationUnstable)) else f"{exc.__class__.__name__}: {exc}"
+    if isinstance(exc, (UserError, SimulationUnstable)):
+        text = str(exc)
+    elif isinstance(exc, OSError) and exc.filename is not None and exc.strerror:
+        text = f"{exc.filename}: {exc.strerror}"
+    else:
+        text = f"{exc.__class__.__name__}: {exc}"
     text = " ".join(text.split())
     return text[:500] or exc.__class__.__name__
 
@@ -163,14 +170,14 @@ def _run_to_file(scenario, target: Path):
 
 
 def _write_file(target: Path, data: bytes) -> None:
-    """``data`` into ``target`` through a temporary name and a rename (one line if that fails)."""
-    from bearingsim.errors import UserError
-    from bearingsim.outputs import write_atomic_bytes
+    """``data`` into ``target`` through a temporary name and a rename (one line if that fails, naming what is in
+    the way: :func:`bearingsim.outputs.write_error`)."""
+    from bearingsim.outputs import write_atomic_bytes, write_error
 
     try:
         write_atomic_bytes(Path(target), data)
     except OSError as exc:
-        raise UserError(f"{target}: cannot write archive ({exc.strerror or exc}); nothing was written") from None
+        raise write_error(target, exc) from None
 
 
 def warm_up(toml_text: str, archive: bool = True) -> None:

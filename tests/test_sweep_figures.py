@@ -132,13 +132,18 @@ def test_a_case_without_a_standard_error_is_a_hatched_bar_without_an_error_bar(t
         assert ax.get_title().endswith("(error bars: ±1 standard error; hatched: none (n/a), 1 of 2 bars)")
 
 
-def test_a_text_key_is_a_categorical_axis(tmp_path, figures):
+def test_a_text_key_is_a_categorical_axis(tmp_path, figures, drawn):
+    """Text values are categories along the axis, by rank, drawn as markers: a line between them (it was drawn
+    for 3 or more) says the values between are in between, and there is nothing between rollers and outer_land."""
     h5 = _index(tmp_path, [{GUIDE: g} for g in ("rollers", "outer_land", "inner_land")], [GUIDE])
     notes = []
     out = plot_sweep_index(h5, tmp_path / "f", notes=notes)
     assert [p.name for p in out] == ["sweep_I.png"] and notes == []
     panels = figures["sweep_I.png"]["axes"]
     assert [a["xticks"] for a in panels] == [["rollers", "outer_land", "inner_land"]] * 2
+    for ax in drawn["sweep_I.png"].axes:
+        data = [line for line in ax.lines if len(line.get_xdata()) == 3]
+        assert data and all(line.get_linestyle() in ("None", "none", "") for line in data), ax.get_ylabel()
 
 
 @pytest.mark.slow

@@ -221,7 +221,9 @@ def _lines(cols, axes, rows, path: Path, title: str, notes, zipped=()) -> Path |
                 continue
             y = np.asarray(cols[f"{name}_mean_Ns"])[idx] * 1e3
             err = _sem_mN_s(cols, name, len(x_all))[idx]  # NaN: no bar (matplotlib draws none), not a 0 bar
-            ax.errorbar(x, y, yerr=_bar_lengths(err), marker=marker, ls=ls if len(set(x)) >= MIN_JOINED else "none",
+            # a line says the values between are in between: categories (text values by rank) have none
+            joined = ticks is None and len(set(x)) >= MIN_JOINED
+            ax.errorbar(x, y, yerr=_bar_lengths(err), marker=marker, ls=ls if joined else "none",
                         color=FACE_COLOURS[name], capsize=3, ms=4, label=extra or None)
             mark_without_error(ax, x, y, err, FACE_COLOURS[name], marker, ms=4)  # no error: an open marker
     drawn = [i for idx in groups.values() for i in idx]

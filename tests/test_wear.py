@@ -1875,7 +1875,7 @@ def test_the_life_is_given_with_its_sampling_error():
     quadrature (stages of 10 h and 20 h at 3 % and 4 %: sqrt(0.3^2 + 0.8^2) = 0.85 h), and the worst pocket's
     lead read beside the one of identical pockets; a history written before it held the columns prints as it
     did, and a depth limit's (no error: NaN) without one."""
-    from bearingsim.studies.life import format_history, life_error, plot_life
+    from bearingsim.studies.life import format_history, history_table, life_error, plot_life
 
     cols = {"stage": np.array([0, 1]), "clearance_start_mm": np.array([0.2, 0.3]),
             "stage_rotations": np.array([3.6e6, 7.2e6]), "rotations_end": np.array([3.6e6, 1.08e7]),
@@ -1895,6 +1895,10 @@ def test_the_life_is_given_with_its_sampling_error():
     alike = cols | {"pocket_worst_scatter": np.array([1.21, 1.21])}  # one value, not a span of it to itself
     assert "identical pockets 1.21 x from" in format_history(alike, "life of x", {}).splitlines()[0]
     assert "worst/mean" in text.splitlines()[1] and " 1.650 " in text.splitlines()[3]
+    # headers of words stand apart: two spaces at least between columns (one ran "worst/mean of identical pockets
+    # reused" together), so splitting the header at runs of two or more spaces gives them back
+    heads = [head for _, head, _, _ in history_table("clearance=0.4mm", cols)]
+    assert re.split(r" {2,}", text.splitlines()[1].strip()) == heads, text.splitlines()[1]
     title = plot_life(cols, {})._suptitle.get_text()
     assert "30 ± 0.85 h, 1.08e+07 inner-ring rotations, 2 stages (±: the worst pocket's rates' sampling error)" in title
     old = {k: v for k, v in cols.items() if not k.startswith(("pocket_", "rate_sem"))}

@@ -735,8 +735,9 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
         e = life_error(cols)
         when = when if not math.isfinite(e) else when.replace(" h = ", f" ± {e:.2g} h = ", 1)
         first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, attrs.get('limit'))}"
-    lines = [first, " ".join(f"{head:>{width}}" for _, head, width, _ in table)]
-    lines += [" ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
+    # two spaces between columns: their headers are words ("shaft rotations", "of identical pockets")
+    lines = [first, "  ".join(f"{head:>{width}}" for _, head, width, _ in table)]
+    lines += ["  ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
     return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
 

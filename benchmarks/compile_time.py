@@ -7,7 +7,7 @@ for one recorded rotation in a fresh process whose numba cache (``NUMBA_CACHE_DI
 folder, and prints the first run's wall time and the functions numba compiled, longest first, each
 with its compile time including what it compiled inside it (numba's ``numba:compile`` events). A
 process that finds the kernels in the cache loads them instead (about a second). Each scenario takes
-about half a minute to a minute (README: 37.8 s for the main job's on 2 quiet cores); the caches are temporary
+about half a minute to a minute (README: 31.4 s for the main job's on 2 quiet cores); the caches are temporary
 folders, removed after each run, and nothing else is written.
 """
 from __future__ import annotations

@@ -113,7 +113,7 @@ def _normal_force(delta, delta_rate, K, c_r, d_fade):
     return q, k_lin + dc * delta_rate, c
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _ring_balance(xp, delta_prev, h, prm, cx, cy):
     """Force balance of the quasi-static inner ring centred at (cx, cy): the residual
     ``sum_i Q_i N_i + (0, W)`` [N] and its Jacobian in the centre [N/m], ``(rx, ry, j00, j01, j10, j11)``.

@@ -57,6 +57,11 @@ def read_only(a) -> np.ndarray:
     return view
 
 
+def _read_only_data(data: dict[str, NamedArray]) -> dict[str, NamedArray]:
+    """``data`` with each array a read-only view (:func:`read_only`)."""
+    return {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v for k, v in data.items()}
+
+
 class Result:
     """One run's results (base class; :class:`bearingsim.reduced.ReducedResult` and
     :class:`bearingsim.multibody.MultibodyResult` add the model's figures).
@@ -102,14 +107,20 @@ class Result:
         # what the result holds is as the run made it: its arrays read-only views (read_only), the run's own
         # arrays untouched (an in-place change of r.data[...].data or r.series[...].value would have changed the
         # result, its summary's meaning and the archive it saves)
-        self.data = {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v
-                     for k, v in data.items()}
+        self.data = _read_only_data(data)
         self.groups = groups
         self.series = series or {}
         self.provenance = dict(provenance or {})
         self.tables = dict(tables or {})
         self.notes: list[str] = []  # one-line notes of a run that is plausible but not clean (simulation.run)
         self._parameters = None
+
+    def __setstate__(self, state: dict) -> None:
+        """Unpickled (what ``ProcessPoolExecutor().map(bearingsim.run, ...)`` hands back): pickle rebuilds the
+        arrays as writable copies, so they are made read-only again, as those of the run that was pickled."""
+        self.__dict__.update(state)
+        self.data = _read_only_data(self.data)
+        self.series = self.__dict__.get("_series", {})
 
     @property
     def series(self) -> dict[str, Series]:

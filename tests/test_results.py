@@ -189,3 +189,24 @@ def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
             assert np.array_equal(a, kept) and np.array_equal(a * 1e3, kept * 1e3)
         assert np.mean(result.per_rotation["I_dec"]) == pytest.approx(before, rel=1e-12, abs=0)
     assert bearingsim.load(tmp_path / "r.h5").summary["I_dec_mean_Ns"] == before
+
+
+@pytest.mark.parametrize("model", ["reduced", "multibody"])
+def test_a_pickled_result_keeps_its_arrays_read_only(model):
+    """A result back from ``ProcessPoolExecutor().map(bearingsim.run, ...)`` comes through pickle, which rebuilt
+    its arrays writable: ``r.data[...].data *= 2`` or ``r.series[...].value[:] = 0`` changed the result and the
+    archive it saves. Unpickled, they are read-only as the run's."""
+    if model == "reduced":
+        sc = _short_scenarios()[0]
+    else:
+        sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+            "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
+    r = bearingsim.run(sc)
+    back = pickle.loads(pickle.dumps(r))
+    arrays = [v.data for v in back.data.values() if isinstance(v.data, np.ndarray)]
+    arrays += [a for s in back.series.values() for a in (s.step, s.time, s.value)]
+    assert len(arrays) > 4 and (model == "reduced" or back.series)
+    for a in arrays:
+        with pytest.raises(ValueError, match="read-only"):
+            a[...] = 0
+    _same(back, r)

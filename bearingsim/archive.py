@@ -890,11 +890,13 @@ def read(path, result_class, only=None):
         groups: dict[str, AttrGroup] = {}
         tables: dict[str, str] = {}
         columns: dict[str, list[str]] = {}  # each table's column order, as its @columns stores it
+        unread: list[str] = []  # the datasets ``only`` leaves out (Result.partial)
 
         def visit(name, obj):
             if name.startswith("results"):
                 if hasattr(obj, "shape"):
                     if not _wanted(name, only):
+                        unread.append(name)
                         return
                     v = obj[()]
                     if v.dtype.kind == "S":
@@ -914,6 +916,8 @@ def read(path, result_class, only=None):
         for name, g in (f["observables"].items() if "observables" in f and _wanted("observables", only) else ()):
             series[name] = Series(g["step"][()], g["time"][()], g["value"][()], str(g["value"].attrs.get("unit", "1")),
                                   str(g.attrs.get("description", "")))
+        if "observables" in f and not _wanted("observables", only):
+            unread += [f"observables/{name}" for name in f["observables"]]
         provenance = group_attrs(f["provenance"])[0] if "provenance" in f else {}
         notes = read_notes(f, path) or []
     except UserError:
@@ -924,6 +928,8 @@ def read(path, result_class, only=None):
         f.close()
     result = result_class(scenario, data, groups, series=series, provenance=provenance, tables=tables)
     result.notes = notes
+    if unread:
+        result.partial = (path, tuple(only), tuple(unread))
     return result
 
 

@@ -81,6 +81,8 @@ def result_dataframe(result, what: str = "per_rotation", units_in_names: bool = 
 
         raise UserError(f"to_dataframe({what!r}): give one of {', '.join(FRAMES)}")
     pd = need("pandas", "Result.to_dataframe")
+    result.require({"observables": "observables", "summary": "results/summary"}.get(what, f"results/{what}"),
+                   f"to_dataframe({what!r})")
     if what == "per_rotation":
         arrays = _under(result, "results/per_rotation")
         first = next(a.data for a in arrays.values() if np.ndim(a.data) == 2)
@@ -110,6 +112,8 @@ def result_dataframe(result, what: str = "per_rotation", units_in_names: bool = 
 def result_xarray(result):
     """The xarray Dataset of ``result``; see :meth:`Result.to_xarray`."""
     xr = need("xarray", "Result.to_xarray")
+    for prefix in ("results/per_rotation", "results/impacts", "observables"):
+        result.require(prefix, "to_xarray()")
     data_vars = {}
     for name, a in _under(result, "results/per_rotation").items():
         dims = ("rotation", "pocket") if np.ndim(a.data) == 2 else ("rotation",)  # the cage's, per rotation

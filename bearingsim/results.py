@@ -95,6 +95,10 @@ class Result:
     #: written before, which is no difference of the run (:func:`bearingsim.compare.compare_results`)
     ADDED_ARRAYS: frozenset = frozenset()
 
+    #: read from an archive with only part of its arrays (``simulation.load(path, only=...)``): ``(path, only,
+    #: the archive paths of the arrays not read)``, set by :func:`bearingsim.archive.read`; None: it holds them all
+    partial: tuple | None = None
+
     @classmethod
     def archive_dims(cls, scenario) -> dict[str, int]:
         """The lengths of named dimensions of :attr:`LAYOUT` that ``scenario`` fixes."""
@@ -181,8 +185,15 @@ class Result:
         this result holds no array under is a one-line :class:`bearingsim.UserError` naming the names it has."""
         arr = self.data.get(f"results/{name}") if isinstance(name, str) else None
         if arr is None:
+            if isinstance(name, str):
+                self.require(f"results/{name}", f"get({name!r})")
             raise UserError(self._unknown_array(name))
         return read_only(arr.data)
+
+    def require(self, prefix: str, what: str) -> None:
+        """Refuse ``what`` in one line (:class:`bearingsim.UserError`) when this result was read from its archive
+        without an array at or under the archive path ``prefix`` (``""``: any), naming it and how to read them all."""
+        _require(self.partial, prefix, what)
 
     def _unknown_array(self, name) -> str:
         """The message of :meth:`get` for ``name``: the closest names (if any) and every name there is, those
@@ -205,8 +216,9 @@ class Result:
 
     def _under(self, prefix: str) -> dict[str, np.ndarray]:
         p = prefix + "/"
-        return {k[len(p):]: read_only(v.data) for k, v in self.data.items()
-                if k.startswith(p) and "/" not in k[len(p):]}
+        arrays = {k[len(p):]: read_only(v.data) for k, v in self.data.items()
+                  if k.startswith(p) and "/" not in k[len(p):]}
+        return arrays if self.partial is None else _Arrays(arrays, partial=self.partial, prefix=prefix)
 
     def to_dataframe(self, what: str = "per_rotation", units_in_names: bool = False):
         """A pandas DataFrame of ``what`` (needs the extra ``bearingsim[frames]``):
@@ -252,6 +264,7 @@ class Result:
         from bearingsim import archive
 
         check_path(path, "path", "the archive (.h5)")
+        self.require("", "save()")  # an archive without them would be a damaged one
         if not isinstance(force, bool):
             raise UserError(f"save(): force: expected True or False (got {type(force).__name__})")
         if not force and not Path(path).is_symlink():  # a link is refused as it is, whatever it leads to
@@ -314,6 +327,33 @@ class Result:
         head = ", ".join(f"{k}={s[k]:.4g}" for k in ("I_dec_mean_Ns", "I_acc_mean_Ns") if k in s)
         given = getattr(self.scenario, "overrides_text", str)()  # its scenario's overrides ("" without any)
         return f"<{type(self).__name__} {self.scenario.name!r}{given}: {head}>"
+
+
+def _require(partial: tuple | None, prefix: str, what: str) -> None:
+    """:meth:`Result.require` of a result whose :attr:`Result.partial` is ``partial``."""
+    if partial is None:
+        return
+    path, only, unread = partial
+    missing = [u for u in unread if not prefix or u == prefix or u.startswith(prefix + "/")]
+    if missing:
+        more = f" and {len(missing) - 1} more" if len(missing) > 1 else ""
+        raise UserError(f"{what}: this result was read from {path} without {missing[0]}{more} (only={only!r}); "
+                        f"bearingsim.load({str(path)!r}) reads every array")
+
+
+class _Arrays(dict):
+    """The arrays under an archive path (``per_rotation``, ``impacts``) of a result read with part of them: a name
+    its archive holds but was not read (``simulation.load(path, only=...)``) is a one-line
+    :class:`bearingsim.UserError`, not a KeyError."""
+
+    def __init__(self, arrays: dict, *, partial: tuple, prefix: str):
+        super().__init__(arrays)
+        self.partial, self.prefix = partial, prefix
+
+    def __missing__(self, key):
+        if isinstance(key, str):
+            _require(self.partial, f"{self.prefix}/{key}", f"{self.prefix.removeprefix('results/')}[{key!r}]")
+        raise KeyError(key)
 
 
 class MemorySink:

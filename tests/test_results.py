@@ -210,3 +210,45 @@ def test_a_pickled_result_keeps_its_arrays_read_only(model):
         with pytest.raises(ValueError, match="read-only"):
             a[...] = 0
     _same(back, r)
+
+
+def test_a_result_read_with_part_of_its_arrays_says_so_and_is_not_saved(tmp_path):
+    """``simulation.load(path, only=...)`` reads some arrays: saving that result wrote an archive without the others
+    (over its own archive, of the same scenario, without force), which every reader then called damaged; its
+    frames were a StopIteration or silently empty, its figures a KeyError. Each is one line naming the array not
+    read, the archive and how to read it whole; nothing is written."""
+    from bearingsim import simulation
+
+    r = bearingsim.run(_short_scenarios()[0])
+    path = r.save(tmp_path / "r.h5")
+    before = path.read_bytes()
+    part = simulation.load(path, only=("results/per_rotation",))
+    assert part.per_rotation["I_dec"].shape == r.per_rotation["I_dec"].shape  # what was read is there
+    calls = [("save()", lambda: part.save(path)), ("save()", lambda: part.save(tmp_path / "other.h5")),
+             ("to_dataframe('impacts')", lambda: part.to_dataframe("impacts")),
+             ("get('trace/theta_deg')", lambda: part.get("trace/theta_deg")),
+             ("impacts['time_s']", lambda: part.impacts["time_s"]),
+             ("plot_pass()", lambda: part.plot_pass())]  # it said "no trace recorded"
+    for what, call in calls:
+        with pytest.raises(bearingsim.UserError) as info:
+            call()
+        msg = str(info.value)
+        assert msg.startswith(f"{what}: this result was read from {path} without results/") and "\n" not in msg, msg
+        assert msg.endswith(f"bearingsim.load({str(path)!r}) reads every array"), msg
+    assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["r.h5"]
+    with pytest.raises(KeyError):  # a name the archive does not hold is what it was
+        part.per_rotation["nothing"]
+    whole = simulation.load(path, only=simulation.COMPARED)  # every array: a whole result
+    assert whole.partial is None and whole.save(tmp_path / "again.h5").exists()
+
+
+def test_a_figure_of_a_result_read_without_its_arrays_names_them(tmp_path):
+    from bearingsim import simulation
+
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+        "multibody.raceway_contact": "rigid", "numerics.rotations": 1, "output.motion_rotations": 0})
+    path = bearingsim.run(sc).save(tmp_path / "m.h5")
+    part = simulation.load(path, only=("results/impacts",))
+    for name in part.FIGURES:
+        with pytest.raises(bearingsim.UserError, match=f"this result was read from {path} without results/"):
+            getattr(part, f"plot_{name}")()

@@ -194,6 +194,7 @@ class ReducedResult(Result):
         The colours: :data:`~bearingsim.plotting.REAR`, :data:`~bearingsim.plotting.FRONT`."""
         from bearingsim.plotting import FRONT, REAR, legend_outside, subplots
 
+        self.require("results/trace", "plot_pass()")  # read without it: not "no trace recorded"
         fig, ax = subplots(3, 1, figsize=(7.5, 7.5), sharex=True)
         if "results/trace/theta_deg" not in self.data:
             ax[0].text(0.5, 0.5, "no trace recorded", transform=ax[0].transAxes, ha="center")

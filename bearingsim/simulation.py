@@ -75,6 +75,10 @@ COMPARED = ("results", "observables")
 TABLED = ("results/per_rotation",)
 
 
+#: what :func:`run` calls of a ``sink`` (:class:`bearingsim.results.MemorySink`, :class:`bearingsim.archive.Spool`)
+SINK_METHODS = ("timeseries", "discard_timeseries", "collect")
+
+
 def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | None = None, check_step: bool = False):
     """Run a resolved scenario and return its :class:`bearingsim.results.Result`.
 
@@ -103,6 +107,10 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     if not isinstance(scenario, Scenario):
         raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
                         f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
+    if sink is not None and not all(callable(getattr(sink, m, None)) for m in SINK_METHODS):
+        raise UserError(f"run(): sink: expected a sink with the methods {', '.join(SINK_METHODS)}, such as "
+                        f"bearingsim.results.MemorySink (got {type(sink).__name__}; None, the default, keeps the "
+                        f"time series with the result, and result.save(path) writes its archive)")
     t0 = time.perf_counter()
     try:
         if dt is not None:

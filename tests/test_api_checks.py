@@ -172,6 +172,19 @@ def test_wrong_argument_types_are_one_line_errors(base_reduced):
         bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", overrides="numerics.rotations=2")
 
 
+@pytest.mark.parametrize("sink", [3, "x.h5", object()])
+def test_a_sink_that_is_not_one_is_refused_before_the_run(sink):
+    """``bearingsim.run(sc, sink="x.h5")`` (a path for the archive, say) ran a multibody scenario into
+    ``AttributeError: 'str' object has no attribute 'timeseries'`` from the model's recorder; a reduced run took
+    it silently. Both refuse it in one line naming the argument, before anything runs."""
+    for sc in (bearingsim.load_scenario(PAPER), bearingsim.load_scenario(MULTIBODY, overrides=RIGID)):
+        with pytest.raises(bearingsim.UserError) as info:
+            bearingsim.run(sc, sink=sink)
+        msg = str(info.value)
+        assert msg.startswith("run(): sink: expected a sink with the methods timeseries, discard_timeseries, "
+                              f"collect, such as bearingsim.results.MemorySink (got {type(sink).__name__};"), msg
+
+
 @pytest.mark.slow
 def test_a_path_argument_of_another_type_is_a_one_line_error(tmp_path):
     """`bearingsim.load(123)`, `bearingsim.report(path, 5)`, `bearingsim.animate(path, 5)`, `r.save(5)` and

@@ -162,6 +162,22 @@ MIN_CAGE_BAR_TO_ROLLER = 0.1
 class _Section(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False, frozen=True)
 
+    def __setattr__(self, item, value):
+        raise AttributeError(self._frozen(item))  # not pydantic's multi-line ValidationError
+
+    def __delattr__(self, item):
+        raise AttributeError(self._frozen(item))
+
+    def _frozen(self, item: str) -> str:
+        """``sc.operating.radial_load_N = 1.0``'s refusal, as :meth:`Scenario.__setattr__`'s: the dotted key and
+        :meth:`Scenario.replace`, which gives a validated copy (a plausible range's entry: frozen only)."""
+        sections = {f.annotation: name for name, f in ScenarioModel.model_fields.items()}
+        if type(self) is not ScenarioModel and type(self) not in sections:
+            return f"Scenario is frozen: {type(self).__name__}.{item} cannot be assigned"
+        key = f"{sections[type(self)]}.{item}" if type(self) in sections else item
+        return (f"Scenario is frozen: {key} cannot be assigned; use scenario.replace(**{{{key!r}: value}}) "
+                f"(validated) for a changed copy")
+
 
 PosFloat = Field(gt=0.0, allow_inf_nan=False)
 

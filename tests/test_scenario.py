@@ -322,6 +322,23 @@ def test_a_scenario_is_frozen(base_reduced):
         sc.replace(name="../../x")
 
 
+def test_a_scenario_section_is_frozen_in_one_line(base_reduced):
+    """``sc.operating.radial_load_N = 1.0`` (or ``del``) was refused with pydantic's multi-line ValidationError
+    ("1 validation error for OperatingSection ... Instance is frozen [type=frozen_instance ..."). It is the
+    AttributeError of the scenario's own attributes, naming the dotted key and ``replace()``."""
+    sc = resolve(base_reduced)
+    for section, item in (("operating", "radial_load_N"), ("numerics", "rotations"), ("bearing", "new_key")):
+        message = (f"Scenario is frozen: {section}.{item} cannot be assigned; use scenario.replace(**{{"
+                   f"'{section}.{item}': value}}) (validated) for a changed copy")
+        for change in (lambda: setattr(getattr(sc, section), item, 1.0), lambda: delattr(getattr(sc, section), item)):
+            with pytest.raises(AttributeError) as info:
+                change()
+            assert str(info.value) == message
+    with pytest.raises(AttributeError, match=r"^Scenario is frozen: name cannot be assigned; use scenario.replace"):
+        sc.model_.name = "x"
+    assert sc == resolve(base_reduced) and sc.replace(**{"operating.radial_load_N": 500.0}).operating.radial_load_N == 500
+
+
 @pytest.mark.parametrize("sets, words", [
     (["contact.restitution=1.5"], "paper_3000rpm.toml with contact.restitution=1.5: contact.restitution: must be "
                                   "less than or equal to 1 (got 1.5)"),

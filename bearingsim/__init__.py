@@ -98,8 +98,10 @@ def sensitivity(scenario: Scenario, outdir: str | os.PathLike[str] | None = None
     """Normalised sensitivities of I_dec, I_acc, cage slip and eccentricity to every ranged key
     (:func:`bearingsim.studies.sensitivity.run_sensitivity`, docs/sensitivity.md): ``.table``,
     ``.plot_tornado()``. ``outdir`` keeps the case archives (None: a temporary folder)."""
+    from bearingsim.scenario import check_scenario_argument
     from bearingsim.studies.sensitivity import run_sensitivity
 
+    check_scenario_argument(scenario, "sensitivity()")
     return run_sensitivity(scenario, outdir, keys, step, jobs=jobs, engine=engine)
 
 
@@ -109,8 +111,10 @@ def uncertainty(scenario: Scenario, samples: int, outdir: str | os.PathLike[str]
     """Every ranged key sampled over its range (Sobol' design, N (k + 2) runs): median and 5-95 %
     interval of each headline number and first-order and total Sobol indices with bootstrap intervals
     (:func:`bearingsim.studies.uncertainty.run_uncertainty`): ``.table``, ``.spread``, ``.plot_indices()``."""
+    from bearingsim.scenario import check_scenario_argument
     from bearingsim.studies.uncertainty import run_uncertainty
 
+    check_scenario_argument(scenario, "uncertainty()")
     return run_uncertainty(scenario, outdir, samples, seed, keys, jobs=jobs, engine=engine)
 
 

@@ -1178,6 +1178,14 @@ def _validate(merged: dict[str, Any], source: str) -> Scenario:
     return scenario
 
 
+def check_scenario_argument(scenario, what: str) -> None:
+    """Refuse, in one line naming the function ``what`` (``"run()"``), a ``scenario`` argument that is not a
+    :class:`Scenario` (a dictionary, a path: what :func:`load_scenario` and :func:`resolve` turn into one)."""
+    if not isinstance(scenario, Scenario):
+        raise UserError(f"{what}: scenario: expected a Scenario from bearingsim.load_scenario (got "
+                        f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
+
+
 def check_run_request(scenario: "Scenario") -> None:
     """Checks for a run asked for results (``bearingsim.run``, and so ``bearingsim run``, ``rerun``,
     every case of a ``sweep`` and of a study), beyond what the schema allows.

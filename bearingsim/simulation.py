@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from bearingsim.model_versions import MODEL_FIGURES, MODELS  # noqa: F401 - MODELS: the models by name, re-exported here
-from bearingsim.scenario import Scenario, check_run_request
+from bearingsim.scenario import Scenario, check_run_request, check_scenario_argument
 
 log = logging.getLogger(__name__)  # notes of a plausible run that is not clean (the command line prints them)
 
@@ -104,9 +104,7 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     from bearingsim import archive, plausibility
     from bearingsim.errors import UserError
 
-    if not isinstance(scenario, Scenario):
-        raise UserError(f"run(): scenario: expected a Scenario from bearingsim.load_scenario (got "
-                        f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
+    check_scenario_argument(scenario, "run()")
     if sink is not None and not all(callable(getattr(sink, m, None)) for m in SINK_METHODS):
         raise UserError(f"run(): sink: expected a sink with the methods {', '.join(SINK_METHODS)}, such as "
                         f"bearingsim.results.MemorySink (got {type(sink).__name__}; None, the default, keeps the "

@@ -172,6 +172,18 @@ def test_wrong_argument_types_are_one_line_errors(base_reduced):
         bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", overrides="numerics.rotations=2")
 
 
+@pytest.mark.parametrize("call", ["sensitivity", "uncertainty"])
+def test_a_study_of_something_not_a_scenario_is_a_one_line_error(call, base_reduced):
+    """``bearingsim.sensitivity("scenarios/x.toml")`` (a path, or a dict) ended in ``AttributeError: 'str' object
+    has no attribute 'model_'`` from bearingsim/ranges.py; it is refused as ``bearingsim.run`` refuses it."""
+    args = {"sensitivity": (), "uncertainty": (4,)}[call]
+    for scenario in (str(PAPER), base_reduced):
+        with pytest.raises(bearingsim.UserError) as info:
+            getattr(bearingsim, call)(scenario, *args)
+        assert str(info.value) == (f"{call}(): scenario: expected a Scenario from bearingsim.load_scenario (got "
+                                   f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
+
+
 @pytest.mark.parametrize("sink", [3, "x.h5", object()])
 def test_a_sink_that_is_not_one_is_refused_before_the_run(sink):
     """``bearingsim.run(sc, sink="x.h5")`` (a path for the archive, say) ran a multibody scenario into

@@ -252,3 +252,22 @@ def test_a_figure_of_a_result_read_without_its_arrays_names_them(tmp_path):
     for name in part.FIGURES:
         with pytest.raises(bearingsim.UserError, match=f"this result was read from {path} without results/"):
             getattr(part, f"plot_{name}")()
+
+
+def test_a_sink_used_again_holds_only_the_new_runs_series():
+    """A ``MemorySink`` given to a second run kept the series of the first that the second did not record: a run
+    with ``output.motion_rotations = 0`` came back (and saved its archive) with the first run's bodies' motion.
+    Each run's result holds its own series, as with a new sink; the first result keeps its own."""
+    from bearingsim.results import MemorySink
+
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+        "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
+    without = sc.replace(**{"output.motion_rotations": 0})
+    sink = MemorySink()
+    first = bearingsim.run(sc, sink=sink)
+    kept = {k: s.value.copy() for k, s in first.series.items()}
+    second = bearingsim.run(without, sink=sink)
+    assert any(k.startswith("motion_") for k in kept)
+    assert sorted(second.series) == sorted(bearingsim.run(without).series)
+    assert not any(k.startswith("motion_") for k in second.series)
+    assert kept.keys() == first.series.keys() and all(np.array_equal(first.series[k].value, v) for k, v in kept.items())

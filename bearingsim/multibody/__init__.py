@@ -122,6 +122,8 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
     """
     if sink is None:
         sink = MemorySink()
+    else:  # a sink used before still holds that run's series, which are not this run's (nor its archive's)
+        sink.discard_timeseries()
     auto = dt is None and p.numerics.dt is None
     retries = []
     first_how = ""  # how the first run's step was chosen (with the rigid scene's start phase, if any)

@@ -216,6 +216,19 @@ def test_a_path_argument_of_another_type_is_a_one_line_error(tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["r.h5"]
 
 
+def test_a_sweep_table_read_from_something_not_a_path_is_a_one_line_error():
+    """``index_dataframe(3)`` and ``read_map(None)`` (docs/dataframes.md) raised pathlib's TypeError "expected str,
+    bytes or os.PathLike object, not int", naming no argument; a UserError naming it now, as ``bearingsim.load``."""
+    from bearingsim.sweeps import index_dataframe, read_map
+
+    for call, what in ((lambda: index_dataframe(3), "a sweep's or study's folder or its sweep.h5"),
+                       (lambda: read_map(None), "a sweep's folder or its map.h5")):
+        with pytest.raises(bearingsim.UserError) as info:
+            call()
+        assert re.fullmatch(rf"path: expected the path of {what}, a str or a pathlib.Path \(got (int|NoneType)\)",
+                            str(info.value)), str(info.value)
+
+
 def _flagged_share(rotations: int, first_excess: float, runs: int, seed: int, sd: float = 0.022) -> float:
     """The share of ``runs`` simulated series of ``rotations`` normal pocket-mean I_dec values (14.4 mN s, sd ``sd``
     of it; 2.2 %: the 3000 rpm reference over 40 rotations, docs/statistics.md, 0.050 mN s x sqrt(40) / 14.43) whose

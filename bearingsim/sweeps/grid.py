@@ -136,9 +136,11 @@ def read_map(path) -> SweepMap:
     Raises
     ------
     UserError
-        The file is missing or is not a sweep map.
+        The file is missing or is not a sweep map (or ``path`` is not a path).
     """
-    p = Path(path)
+    from bearingsim.errors import check_path
+
+    p = Path(check_path(path, "path", "a sweep's folder or its map.h5"))
     if p.is_dir():
         p = p / MAP_NAME
     data, attrs, root = archive.read_grid_file(p, MAP_FORMAT)

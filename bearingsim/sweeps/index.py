@@ -220,9 +220,10 @@ def read_index(path: str | Path) -> tuple[dict[str, np.ndarray], dict]:
 def index_dataframe(path, units_in_names: bool = False):
     """The index of a sweep or study folder (``DIR`` or ``DIR/sweep.h5``) as a pandas DataFrame, one
     row per case (needs the extra ``bearingsim[frames]``; :func:`bearingsim.frames.index_frame`)."""
+    from bearingsim.errors import check_path
     from bearingsim.frames import index_frame
 
-    p = Path(path)
+    p = Path(check_path(path, "path", "a sweep's or study's folder or its sweep.h5"))
     if p.is_dir():
         p = p / "sweep.h5"
     cols, meta = read_index(p)

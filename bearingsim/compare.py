@@ -114,7 +114,11 @@ def compare_results(a, b) -> Comparison:
             c.absent[k] = "A" if k not in sa else "B"
         if k not in sa or k not in sb or not same_bits(va, vb):
             c.summary_differs.append(k)
-    added = getattr(type(a), "ADDED_ARRAYS", frozenset()) | getattr(type(b), "ADDED_ARRAYS", frozenset())
+    models = getattr(a, "model", None), getattr(b, "model", None)
+    # an array a later version of the model added, which an archive of an earlier one predates; between two models'
+    # results an array of one only is that model's, and differs as any other
+    added = (getattr(type(a), "ADDED_ARRAYS", frozenset()) | getattr(type(b), "ADDED_ARRAYS", frozenset())
+             if models[0] == models[1] else frozenset())
     c.unstored_why = _stored_motion_differs(a, b)
     for pa, pb in ((compared_arrays(a), compared_arrays(b)), (other_numbers(a), other_numbers(b))):
         for k in list(pa) + [k for k in pb if k not in pa]:
@@ -135,6 +139,9 @@ def compare_results(a, b) -> Comparison:
     for k in sorted(set(va) | set(vb)):
         if va.get(k) != vb.get(k):
             c.versions.append((k, va.get(k, "?"), vb.get(k, "?")))
+    if models[0] != models[1]:  # two models' versions are not versions of one model: each named with its model
+        c.versions = [(k, f"{x} ({models[0]} model)", f"{y} ({models[1]} model)") if k == "model_version" else (k, x, y)
+                      for k, x, y in c.versions]
     return c
 
 

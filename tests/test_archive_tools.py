@@ -126,6 +126,28 @@ def test_an_archive_written_before_an_added_array_reruns_and_compares_identical(
     assert line.format("B", "B") in res.stdout.splitlines()
 
 
+def test_compare_of_two_models_results_says_no_array_is_of_a_later_version():
+    """``bearingsim compare`` of a reduced against a multibody archive said "not in B: trace/I_acc_cumulative
+    (recorded by later versions than the one that wrote B; not compared)": the multibody model records no trace,
+    in any version. Between two models an array of one only differs as any other, and each model version is
+    named with its model ("model version: A 1 (reduced model), B 9 (multibody model) ...")."""
+    import warnings
+
+    from bearingsim.compare import compare_results
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        red = bearingsim.run(bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", set={"numerics.rotations": 1}))
+        mb = bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+            "multibody.raceway_contact": "rigid", "numerics.rotations": 1}))
+    c = compare_results(red, mb)
+    text = "\n".join(c.difference_lines(shown=1000) + c.version_lines())
+    assert "later versions" not in text and not c.unrecorded, text
+    assert "trace/I_acc_cumulative" in c.arrays_differ and c.how["trace/I_acc_cumulative"] == "only in A"
+    assert (f"  model version: A {red.provenance['model_version']} (reduced model), B "
+            f"{mb.provenance['model_version']} (multibody model)") in text, text
+
+
 @pytest.mark.slow
 def test_compare_of_runs_that_store_different_motion_compares_their_results(multibody_archive):
     """Storing motion (``[output] motion_*``) changes no number of a run (docs/archive.md), but ``compare`` of a

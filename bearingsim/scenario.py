@@ -514,6 +514,8 @@ def _preset(name: str) -> dict[str, Any]:
 def parse_override(item: str, origin: str = "--set") -> tuple[str, Any]:
     """``KEY=VALUE`` with VALUE read as a TOML value; a bare word is a string. ``origin``: what gave it, as its
     refusals name it (:func:`bearingsim.wording.given_by`: the command line's ``--set``, the API's ``overrides``)."""
+    if not isinstance(item, str):  # bytes, a number: not text to split
+        raise UserError(f"{given_by(origin, repr(item))}: expected a KEY=VALUE string (got {type(item).__name__})")
     if "=" not in item:
         raise UserError(f"{given_by(origin, repr(item))}: expected KEY=VALUE")
     key, text = item.split("=", 1)

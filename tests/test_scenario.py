@@ -624,6 +624,15 @@ def test_a_bad_override_of_the_api_names_the_argument_and_of_the_cli_the_option(
     assert capsys.readouterr().err.startswith(f"bearingsim: error: {cli}")
 
 
+@pytest.mark.parametrize("item", [3, b"numerics.rotations=2", None])
+def test_an_override_that_is_not_text_names_the_argument(item):
+    """``load_scenario(p, overrides=[3])`` (or bytes) raised TypeError "argument of type 'int' is not iterable" from
+    the override's parser; one line naming the argument and the item now."""
+    with pytest.raises(UserError) as err:
+        bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml", overrides=["numerics.rotations=2", item])
+    assert str(err.value) == f"overrides: {item!r}: expected a KEY=VALUE string (got {type(item).__name__})"
+
+
 @pytest.mark.parametrize("given, meant", [("rotations", "numerics.rotations"), ("restitution", "contact.restitution"),
                                           ("numerics.rotation", "numerics.rotations")])
 def test_an_unknown_key_that_ends_one_known_key_is_told_that_key(given, meant):

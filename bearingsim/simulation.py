@@ -16,6 +16,8 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from bearingsim.model_versions import MODEL_FIGURES, MODELS  # noqa: F401 - MODELS: the models by name, re-exported here
 from bearingsim.scenario import Scenario, check_run_request, check_scenario_argument
 
@@ -109,6 +111,9 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
         raise UserError(f"run(): sink: expected a sink with the methods {', '.join(SINK_METHODS)}, such as "
                         f"bearingsim.results.MemorySink (got {type(sink).__name__}; None, the default, keeps the "
                         f"time series with the result, and result.save(path) writes its archive)")
+    for name, flag in (("progress", progress), ("check_step", check_step)):  # "no" is true: it would do it
+        if not isinstance(flag, (bool, np.bool_)):
+            raise UserError(f"run(): {name}: expected True or False (got {type(flag).__name__})")
     t0 = time.perf_counter()
     try:
         if dt is not None:

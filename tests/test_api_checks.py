@@ -184,6 +184,18 @@ def test_a_study_of_something_not_a_scenario_is_a_one_line_error(call, base_redu
                                    f"{type(scenario).__name__}; a dictionary: bearingsim.scenario.resolve(d))")
 
 
+@pytest.mark.parametrize("name, value", [("check_step", "no"), ("check_step", 0), ("progress", "yes"), ("progress", None)])
+def test_a_flag_that_is_not_true_or_false_is_refused(name, value):
+    """``bearingsim.run(sc, check_step="no")`` asked for the step check ("no" is true: an euler run ran twice, an
+    event run was refused as "check_step: the reduced model's event method has no time step to halve"), and
+    ``progress="yes"`` passed. A flag is True or False (numpy's too), as ``Result.save``'s ``force``."""
+    sc = bearingsim.load_scenario(PAPER, set={"reduced.method": "euler", "numerics.rotations": 1})
+    with pytest.raises(bearingsim.UserError) as info:
+        bearingsim.run(sc, **{name: value})
+    assert str(info.value) == f"run(): {name}: expected True or False (got {type(value).__name__})"
+    assert bearingsim.run(sc, **{name: np.False_}).notes == []
+
+
 @pytest.mark.parametrize("sink", [3, "x.h5", object()])
 def test_a_sink_that_is_not_one_is_refused_before_the_run(sink):
     """``bearingsim.run(sc, sink="x.h5")`` (a path for the archive, say) ran a multibody scenario into

@@ -368,11 +368,16 @@ def write(result, path, spool: Spool | None = None) -> Path:
     interpreter could crash at exit).
     """
     if spool is None:
-        path = _prepare_target(check_path(path, "path", "the archive (.h5)"))
+        made = outputs.missing_folders(Path(check_path(path, "path", "the archive (.h5)")).parent)
+        path = _prepare_target(path)
         try:
-            outputs.write_atomic_bytes(path, to_bytes(result))
-        except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file
-            raise outputs.write_error(path, exc) from None
+            try:
+                outputs.write_atomic_bytes(path, to_bytes(result))
+            except OSError as exc:  # ENOSPC/EFBIG/EIO: atomic_file has removed its temporary file
+                raise outputs.write_error(path, exc) from None
+        except BaseException:  # no archive: no folder made for it left behind either
+            outputs.remove_empty(made)
+            raise
         return path
     renaming = False
     try:

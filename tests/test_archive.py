@@ -388,6 +388,27 @@ def test_failed_save_leaves_the_process_file_descriptors_alone(tmp_path, base_re
     assert list(tmp_path.iterdir()) == []
 
 
+def test_a_failed_save_leaves_no_folder_it_made(tmp_path, base_reduced, monkeypatch):
+    """``Result.save("new/deeper/a.h5")`` on a full disk raised its one ArchiveWriteError and removed its temporary
+    file, but kept the folders ``new/deeper`` it had made for the archive ("nothing left behind", docs/usage.md),
+    as ``bearingsim run`` does not. They are removed again; a folder that was there stays."""
+    import errno
+    import os
+
+    from bearingsim.outputs import ArchiveWriteError
+
+    def full_disk(f, result, in_memory=False):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(archive, "_fill", full_disk)
+    res = _result(resolve(base_reduced))
+    (tmp_path / "kept").mkdir()
+    for target in (tmp_path / "new" / "deeper" / "a.h5", tmp_path / "kept" / "a.h5"):
+        with pytest.raises(ArchiveWriteError, match="No space left on device"):
+            res.save(target)
+    assert [p.name for p in tmp_path.iterdir()] == ["kept"] and list((tmp_path / "kept").iterdir()) == []
+
+
 _FULL_DISK_CHILD = r"""
 import resource, signal, sys
 from bearingsim import run
@@ -425,7 +446,7 @@ def test_save_on_a_full_disk_is_one_typed_error_and_a_clean_exit(tmp_path):
     assert proc.returncode == 0, stderr[-2000:]
     assert stdout.startswith(f"refused: {out}: cannot write archive (File too large)"), stdout
     assert stderr == ""
-    assert list((tmp_path / "out").iterdir()) == []
+    assert not (tmp_path / "out").exists()  # no temporary file, nor the folder the save made for the archive
 
 
 _SPOOL_FULL_DISK_CHILD = r"""

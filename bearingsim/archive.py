@@ -1327,7 +1327,8 @@ def check_same_scenario(out: Path, scenario,
     """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
     ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
     that differ, and ``advice`` (the command line's ``-o`` / ``--force``; :meth:`Result.save`'s ``force=True``).
-    A rerun of the same scenario, an unreadable or incomplete archive (never a result) and no file at all pass."""
+    A rerun of the same scenario (or of one of the same model that differs only in keys the model does not read),
+    an unreadable or incomplete archive (never a result) and no file at all pass."""
     import tomllib
 
     from bearingsim.scenario import differing_keys, resolve
@@ -1343,9 +1344,26 @@ def check_same_scenario(out: Path, scenario,
         return
     keys = []
     if old is not None:
-        keys = [f"{k} {va} -> {vb}" for k, va, vb in differing_keys(old.raw, scenario.raw)]
+        differ = differing_keys(old.raw, scenario.raw)
+        if _unread_by_both(old, scenario, [k for k, _, _ in differ]):
+            return  # the same run: its scenario differs only in keys its model does not read (each run notes them)
+        keys = [f"{k} {va} -> {vb}" for k, va, vb in differ]
     what = f" ({'; '.join(keys[:3])}{'; ...' if len(keys) > 3 else ''})" if keys else ""
     raise UserError(f"{out}: holds the run of a different scenario{what}; not replaced: {advice}")
+
+
+def _unread_by_both(old, new, keys) -> bool:
+    """Whether the scenarios ``old`` and ``new``, of one model (and reduced method), differ only in ``keys`` that
+    model does not read (:func:`bearingsim.scenario.unused_keys`: a multibody key given to a reduced run, say),
+    so that their runs are the same run."""
+    from bearingsim.scenario import unused_keys
+
+    if not keys or old.model != new.model:
+        return False
+    methods = {s.raw.get("reduced", {}).get("method") for s in (old, new)}
+    if len(methods) != 1:
+        return False
+    return len(unused_keys(new.model, keys, methods.pop())) == len(keys)
 
 
 def _check_regular(p: Path) -> None:

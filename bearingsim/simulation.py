@@ -226,8 +226,8 @@ def _target(scenario: Scenario, out: str | Path | None, figures: bool) -> Path:
 def check_same_scenario(out: Path, scenario: Scenario) -> None:
     """Refuse to replace the archive ``out`` when it holds a run of another resolved scenario (a
     ``--set`` on the same file writes to the same default name): one line naming the archive, the keys
-    that differ, and ``-o`` / ``--force``. A rerun of the same scenario, an unreadable or incomplete
-    archive (never a result) and no file at all pass (:func:`bearingsim.archive.check_same_scenario`, which
+    that differ, and ``-o`` / ``--force``. A rerun of the same scenario (or of one that differs only in keys
+    its model does not read), an unreadable or incomplete archive (never a result) and no file at all pass (:func:`bearingsim.archive.check_same_scenario`, which
     :meth:`Result.save` calls too)."""
     from bearingsim import archive
 

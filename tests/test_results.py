@@ -161,6 +161,22 @@ def test_save_over_an_archive_of_another_scenario_needs_force(tmp_path):
         other.save(path, force="yes")
 
 
+def test_a_scenario_that_differs_only_in_keys_its_model_does_not_read_replaces_its_archive(tmp_path):
+    """``bearingsim run paper_3000rpm.toml --set multibody.raceway_contact=rigid`` noted that the key has no effect
+    on the reduced run, then refused to replace the archive of the file's own run as "a different scenario": the
+    same run. A scenario of the same model (and reduced method) that differs only in keys the model does not read
+    replaces it; one key it reads among them, or another method, is refused as before."""
+    path = tmp_path / "a.h5"
+    sc = bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")
+    bearingsim.run(sc).save(path)
+    unread = sc.replace(**{"multibody.raceway_contact": "rigid", "multibody.scene": "centred_cage"})
+    bearingsim.run(unread).save(path)  # replaced: the same run
+    assert bearingsim.load(path).scenario == unread
+    for other in (unread.replace(**{"operating.radial_load_N": 1500.0}), sc.replace(**{"reduced.method": "euler"})):
+        with pytest.raises(bearingsim.UserError, match="holds the run of a different scenario"):
+            bearingsim.run(other).save(path)
+
+
 @pytest.mark.parametrize("model", ["reduced", "multibody"])
 def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
     """``a = r.per_rotation["I_dec"]; a *= 1e3`` changed the result in place: its summary no longer agreed with

@@ -656,6 +656,21 @@ def test_life_table_shows_a_volume_limits_quantity_and_the_stages_notes(tmp_path
     assert len(notes) == len(stage_notes)
 
 
+def test_the_stages_notes_of_one_kind_are_given_once():
+    """Under the life history each distinct note was given once, so notes that differ only in their numbers (the
+    warm-up note gives each stage's own rotations' I_dec) came once per stage: a 4-stage study of 3 rotations a
+    stage printed 4 paragraphs that differ in a few digits. A kind of note is given once, in the words of its first
+    stage, saying so; notes of other words stay apart, and a note the same in every stage reads as before."""
+    from bearingsim.studies.life import stage_notes
+
+    cols = {"stage": np.arange(4),
+            "notes": ["rotations read 20.9 / 21.99 mN s", "", "rotations read 23.48 / 21.56 mN s\nk is high",
+                      "rotations read 23.2 / -1e-3 mN s\nk is high"]}
+    assert stage_notes(cols) == [
+        "note (3 of 4 stages; the numbers of stage 0, the others differ in theirs): rotations read 20.9 / 21.99 mN s",
+        "note (2 of 4 stages): k is high"]
+
+
 def test_read_life_takes_the_study_folder(tmp_path):
     """read_life(DIR) on a life study's folder raised a UserError telling to pass DIR/life.h5: it reads
     DIR/life.h5, as read_life(DIR/life.h5) does; a folder without one is still refused in one line."""

@@ -706,17 +706,28 @@ def history_rows(cols: dict, table: tuple = HISTORY_TABLE) -> list[list[str]]:
             for i in range(len(cols["stage"]))]
 
 
+#: a number in a note's text (a sign, digits, a decimal part, an exponent): what two stages' notes of one kind differ in
+_NOTE_NUMBER_RE = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
 def stage_notes(cols: dict) -> list[str]:
     """The stages' run notes (the history's ``notes`` column; none in a history written before it held
-    them): each distinct note once, with how many stages carry it, in the order they first come."""
+    them): each kind of note once, in the order they first come, with how many stages carry it. Notes of one
+    kind differ in their numbers only (the warm-up note gives each stage's own rotations: 20 stages gave 20
+    paragraphs that differ in a few digits); such a kind is given once, in the words of the first stage that
+    carries it, and says so."""
     from bearingsim.sweeps.index import notes_of
 
-    counts: dict[str, int] = {}
-    for cell in cols.get("notes", ()):
+    kinds: dict[str, list] = {}  # the note with its numbers masked -> [first text, stages, its texts, first stage]
+    for stage, cell in zip(cols["stage"], cols.get("notes", ())):
         for note in dict.fromkeys(run_notes(notes_of(cell))):
-            counts[note] = counts.get(note, 0) + 1
+            kind = kinds.setdefault(_NOTE_NUMBER_RE.sub("#", note), [note, 0, set(), int(stage)])
+            kind[1] += 1
+            kind[2].add(note)
     n = len(cols["stage"])
-    return [f"note ({k} of {counted(n, 'stage')}): {note}" for note, k in counts.items()]
+    return [f"note ({k} of {counted(n, 'stage')}"
+            f"{'' if len(texts) == 1 else f'; the numbers of stage {first}, the others differ in theirs'}): {note}"
+            for note, k, texts, first in kinds.values()]
 
 
 def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.wording import counted, distinct_texts
+from bearingsim.wording import counted, distinct_texts, note_kind
 from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
@@ -144,18 +144,24 @@ def table_of_index(path) -> Table:
 def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:
     """The runs' notes (``found``, a list per row: an index's ``notes`` column, an archive's
     ``/bearingsim/notes``) as footnotes, each row with notes marked ``[k]`` in a label column ``notes`` added
-    to ``names`` and ``labels`` (none when no row has notes). Rows with the same notes share one mark, whose
-    footnote is keyed by the first of them (a study's stages or cases often carry one note alike)."""
+    to ``names`` and ``labels`` (none when no row has notes). Rows with notes of the same kind share one mark,
+    whose footnote is keyed by the first of them (a study's stages or cases often carry one note alike, or notes
+    that differ in their numbers only, :func:`bearingsim.wording.note_kind`: then the first row's words, saying so)."""
     rows = [i for i, lines in enumerate(found) if lines]
     if not rows:
         return {}
-    first: dict[str, int] = {}  # the notes' text -> the first row that carries it
+    first: dict[str, int] = {}  # the notes' kind -> the first row that carries it
+    texts: dict[str, set] = {}  # the notes' kind -> their texts
     for i in rows:
-        first.setdefault("; ".join(found[i]), i)
-    number = {text: k for k, text in enumerate(first, 1)}
+        text = "; ".join(found[i])
+        first.setdefault(note_kind(text), i)
+        texts.setdefault(note_kind(text), set()).add(text)
+    number = {kind: k for k, kind in enumerate(first, 1)}
     names.append("notes")
-    labels["notes"] = [f"[{number['; '.join(lines)]}]" if lines else "" for lines in found]
-    return {i: f"[{number[text]}] {text}" for text, i in first.items()}
+    labels["notes"] = [f"[{number[note_kind('; '.join(lines))]}]" if lines else "" for lines in found]
+    return {i: f"[{number[kind]}] {'; '.join(found[i])}" + (
+        "" if len(texts[kind]) == 1 else f" (the numbers of the first row marked [{number[kind]}]; the others "
+                                         "differ in theirs)") for kind, i in first.items()}
 
 
 def table_of_archives(paths) -> Table:

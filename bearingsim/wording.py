@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import re
 
 
 #: how the command line prints a run's note (:func:`bearingsim.plausibility.check`); the stored note keeps it
@@ -13,6 +14,16 @@ def run_notes(notes) -> list[str]:
     """A run's notes (``result.notes``) as tables, indexes, reports and ``inspect`` show them: one line each,
     without the command line's ``bearingsim: note:`` prefix."""
     return [str(n).removeprefix(NOTE_PREFIX) for n in notes or ()]
+
+
+#: a number in a note's text (a sign, digits, a decimal part, an exponent): what two runs' notes of one kind differ in
+_NOTE_NUMBER_RE = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
+
+
+def note_kind(text: str) -> str:
+    """``text``, a note, with its numbers masked: two notes of one kind (the warm-up note, which gives each run's
+    own rotations) differ in their numbers only, and tables give such a kind once."""
+    return _NOTE_NUMBER_RE.sub("#", text)
 
 
 def counted(n, noun: str, plural: str | None = None, fmt: str = "") -> str:

@@ -532,3 +532,18 @@ def test_a_table_of_both_models_says_what_the_reduced_models_zero_error_is(tmp_p
                    ).save(whole)
     assert MIXED_MODELS in table_of([red, whole]).notes
     assert MIXED_MODELS not in table_of([whole, whole]).notes and MIXED_MODELS not in table_of([red]).notes
+
+
+def test_rows_whose_notes_differ_in_their_numbers_only_share_one_mark():
+    """A table's rows each had their own note mark when their notes differed in a number only (the warm-up note
+    gives each run's own rotations): four runs gave four footnotes of ~400 characters that differ in a few digits.
+    Rows whose notes are of one kind share a mark, whose footnote is the first row's, saying the others differ in
+    their numbers; notes in other words keep their own mark, and notes alike read as before."""
+    names, labels = ["run"], {"run": ["a", "b", "c", "d", "e"]}
+    found = [["first rotation +3.2% off (t = 5.0)"], [], ["first rotation -6.5% off (t = 40.5)"], ["k is high"],
+             ["k is high"]]
+    notes = tables._run_notes(found, names, labels)
+    assert labels["notes"] == ["[1]", "", "[1]", "[2]", "[2]"]
+    assert notes == {0: "[1] first rotation +3.2% off (t = 5.0) (the numbers of the first row marked [1]; the others "
+                        "differ in theirs)",
+                     3: "[2] k is high"}

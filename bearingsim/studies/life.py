@@ -43,7 +43,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 from bearingsim.studies.engine import Study, case_of, load_result
-from bearingsim.wording import counted, run_notes
+from bearingsim.wording import counted, note_kind, run_notes
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -706,10 +706,6 @@ def history_rows(cols: dict, table: tuple = HISTORY_TABLE) -> list[list[str]]:
             for i in range(len(cols["stage"]))]
 
 
-#: a number in a note's text (a sign, digits, a decimal part, an exponent): what two stages' notes of one kind differ in
-_NOTE_NUMBER_RE = re.compile(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?")
-
-
 def stage_notes(cols: dict) -> list[str]:
     """The stages' run notes (the history's ``notes`` column; none in a history written before it held
     them): each kind of note once, in the order they first come, with how many stages carry it. Notes of one
@@ -721,7 +717,7 @@ def stage_notes(cols: dict) -> list[str]:
     kinds: dict[str, list] = {}  # the note with its numbers masked -> [first text, stages, its texts, first stage]
     for stage, cell in zip(cols["stage"], cols.get("notes", ())):
         for note in dict.fromkeys(run_notes(notes_of(cell))):
-            kind = kinds.setdefault(_NOTE_NUMBER_RE.sub("#", note), [note, 0, set(), int(stage)])
+            kind = kinds.setdefault(note_kind(note), [note, 0, set(), int(stage)])
             kind[1] += 1
             kind[2].add(note)
     n = len(cols["stage"])

@@ -177,6 +177,15 @@ def test_a_scenario_that_differs_only_in_keys_its_model_does_not_read_replaces_i
             bearingsim.run(other).save(path)
 
 
+def _short_run_of(model: str):
+    """A short scenario of ``model``: the first of :func:`_short_scenarios`, or one rotation of the 3000 rpm whole
+    bearing on rigid raceways."""
+    if model == "reduced":
+        return _short_scenarios()[0]
+    return bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
+        "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
+
+
 @pytest.mark.parametrize("model", ["reduced", "multibody"])
 def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
     """``a = r.per_rotation["I_dec"]; a *= 1e3`` changed the result in place: its summary no longer agreed with
@@ -184,12 +193,7 @@ def test_the_arrays_a_result_hands_out_are_read_only(tmp_path, model):
     ``per_rotation``, ``impacts`` and ``get`` are read-only, of a run and of an archive read back, and computing
     from them gives new arrays; so are those the result holds (``r.data[...].data``, and the time series of
     ``r.series``, docs/dataframes.md)."""
-    if model == "reduced":
-        sc = _short_scenarios()[0]
-    else:
-        sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
-            "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
-    r = bearingsim.run(sc)
+    r = bearingsim.run(_short_run_of(model))
     before = r.summary["I_dec_mean_Ns"]
     for result in (r, bearingsim.load(r.save(tmp_path / "r.h5"))):
         arrays = [result.per_rotation["I_dec"], result.get("per_rotation/I_acc"), result.impacts["time_s"],
@@ -212,12 +216,7 @@ def test_a_pickled_result_keeps_its_arrays_read_only(model):
     """A result back from ``ProcessPoolExecutor().map(bearingsim.run, ...)`` comes through pickle, which rebuilt
     its arrays writable: ``r.data[...].data *= 2`` or ``r.series[...].value[:] = 0`` changed the result and the
     archive it saves. Unpickled, they are read-only as the run's."""
-    if model == "reduced":
-        sc = _short_scenarios()[0]
-    else:
-        sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml", set={
-            "multibody.raceway_contact": "rigid", "numerics.rotations": 1})
-    r = bearingsim.run(sc)
+    r = bearingsim.run(_short_run_of(model))
     back = pickle.loads(pickle.dumps(r))
     arrays = [v.data for v in back.data.values() if isinstance(v.data, np.ndarray)]
     arrays += [a for s in back.series.values() for a in (s.step, s.time, s.value)]

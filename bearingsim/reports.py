@@ -147,6 +147,15 @@ def check_output(out, source=None) -> Path:
     return out
 
 
+def breakable(name: str):
+    """A column's name, escaped, where a line may break after each ``_`` and ``.`` (``<wbr>``): a key's name
+    (``bearing.cage_guidance``, ``load_zone_half_angle [deg]``) is one word to the browser, so a table of many
+    such columns ran past the page's edge and hid its last columns."""
+    from markupsafe import Markup, escape
+
+    return Markup(str(escape(name)).replace("_", "_<wbr>").replace(".", ".<wbr>"))
+
+
 def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
     """The page (text) of ``sections`` from the package's template, every value autoescaped."""
     import jinja2
@@ -156,6 +165,7 @@ def render(title: str, source: str, kind: str, sections: list[Section]) -> str:
     env = jinja2.Environment(loader=jinja2.PackageLoader("bearingsim", "templates"), autoescape=True,
                              undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True,
                              keep_trailing_newline=True)
+    env.filters["breakable"] = breakable
     return env.get_template("report.html.j2").render(title=title, source=source, kind=kind, sections=sections,
                                                      version=__version__)
 

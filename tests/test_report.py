@@ -69,6 +69,8 @@ def open_page(browser, path: Path, screenshot: Path | None = None) -> dict:
         external: Array.from(document.querySelectorAll('[src],[href]')).map(e => e.getAttribute('src') || e.getAttribute('href'))
                        .filter(u => !u.startsWith('data:') && !u.startsWith('#')),
         text: document.body.innerText,
+        // wider than the window: the page scrolls sideways (a table past the page's edge hid its last columns)
+        page_width: [document.documentElement.scrollWidth, window.innerWidth],
     })""")
     if screenshot is not None:
         screenshot.parent.mkdir(parents=True, exist_ok=True)
@@ -89,6 +91,7 @@ def assert_renders(seen: dict, sections: list[str]) -> None:
     assert seen["external"] == []
     assert set(sections) <= set(seen["ids"])
     assert seen["toc"] == [f"#{s}" for s in seen["ids"]]
+    assert seen["page_width"][0] <= seen["page_width"][1], f"the page is wider than the window: {seen['page_width']}"
 
 
 # --- inputs -------------------------------------------------------------------------------------
@@ -279,6 +282,31 @@ def test_report_of_a_folder_renders_in_chromium(folders, browser, tmp_path, name
     assert_renders(seen, ["table", "figures", "checks", "scenario"])
     for w in words:
         assert w in seen["text"], w
+
+
+def test_a_wide_table_stays_on_the_page(browser, tmp_path):
+    """A sweep of two text keys over the whole bearing's ten summary columns drew a table 1300 px wide in a page
+    of 1100: the page scrolled sideways and its last columns (the wear rates) lay past the window's edge. A key's
+    name may break after its "_" and "." (``<wbr>``, not inside a word), and a table still wider than the page
+    scrolls in its place: the page is never wider than the window."""
+    import json
+
+    from bearingsim.sweeps.index import write_index
+
+    keys = ["bearing.cage_guidance", "multibody.pocket_shape"]
+    names = ["I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
+             "load_zone_half_angle_deg", "wear_front_mean_mm3_per_h", "wear_rear_mean_mm3_per_h",
+             "cage_orbit_max_m", "inner_ring_displacement_m"]
+    rows = [{"case": f"c{i}", "values": {keys[0]: g, keys[1]: f}, "status": "done", "error": "", "archive": "",
+             "wall_s": 1.0, "summary": {n: 0.0123456 + i for n in names} | {"I_dec_sem_Ns": 1.1e-5, "I_acc_sem_Ns": 2.2e-5}}
+            for i, (g, f) in enumerate([(g, f) for g in ("outer_land", "inner_land") for f in ("arc", "flat")])]
+    folder = tmp_path / "wide"
+    folder.mkdir()
+    write_index(folder, rows, keys, {"mode": "product", "grid": json.dumps(keys), "grid_rows": 4,
+                                     "scenario": "scenarios/multibody_3000rpm.toml"})
+    html = bearingsim.report(folder, tmp_path / "wide.html")
+    assert "multibody.<wbr>pocket_<wbr>shape" in html.read_text()
+    assert_renders(open_page(browser, html), ["table", "figures"])
 
 
 @pytest.mark.slow

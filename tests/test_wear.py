@@ -757,6 +757,23 @@ def test_life_refuses_a_limit_no_wear_can_reach_before_anything_runs(tmp_path, m
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("address", ["bogus", "inproc://x"])
+def test_life_refuses_an_unusable_scheduler_before_making_its_folder(tmp_path, monkeypatch, capsys, address):
+    """A --scheduler no client can use is refused in one line (exit 2) and leaves no folder, as a sweep's
+    does (docs/wear.md: a study refused for its arguments creates no folder). The study engine made the
+    folder and its lock file first and met the address only at its first case: the refused command left
+    '-o' behind holding '.sweep.lock' alone."""
+    pytest.importorskip("distributed")
+    from bearingsim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    code = main(["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--stages", "1", "--rotations", "1",
+                 "--limit", "depth=0.05mm", "--scheduler", address, "-o", "life"])
+    err = capsys.readouterr().err
+    assert code == 2 and "--scheduler" in err and len(err.strip().splitlines()) == 1, (code, err)
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_pages_cage_bar_width_is_the_wear_test_bearings():
     """docs/wear.md gives the cage bar's width as d_p sin(pi/Z) - D - s = 5.821 mm with the wear-test
     bearing's numbers: each of them is the scenario's, and the arithmetic is laws.cage_bar_width's. The page

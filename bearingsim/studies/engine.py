@@ -192,16 +192,21 @@ def run_studies(studies, outdir, *, engine=None, progress: bool | None = None, l
 
     engine = engine or LocalEngine(1)
     try:
+        cases = _new_cases([], [c for s in studies for c in s.cases])
+        engine.start(len(cases))  # an unusable --scheduler is refused before the folder is made, as a sweep's
         outdir = check_writable_dir(outdir)
         check_outputs(outdir, studies)  # before the lock file: a refusal leaves the folder as it was
-        cases = _new_cases([], [c for s in studies for c in s.cases])
     except BaseException:
         engine.stop()
         raise
     with FolderLock(outdir) as lock:
-        for study in studies:
-            if study.staged:
-                study.check_folder(outdir, force)
+        try:
+            for study in studies:
+                if study.staged:
+                    study.check_folder(outdir, force)
+        except BaseException:  # a folder of another study refused: the engine started above stops
+            engine.stop()
+            raise
         sweep = _run_rounds(studies, cases, outdir, engine, lock, dict(progress=progress, log=log, force=force))
         known = {r["case"] for r in sweep.rows}
         out = StudiesOutcome(sweep, planned=len(known) + sum(s.cases_to_come(known) for s in studies))

@@ -22,8 +22,8 @@ def _wear_of(path: Path, args):
     try:
         with options_named("hours", "rotations"):  # refusals of the archive and the running time
             return result, wear.wear_report(result, hours=args.hours, rotations=args.rotations)
-    except UserError as exc:  # one about the archive's scenario (its k of 0) names the archive
-        if str(exc).startswith("wear."):
+    except UserError as exc:  # one about the archive (no wear profile, its scenario's k of 0) names the archive
+        if not str(exc).startswith("--"):  # the running time's refusals name their option (options_named)
             raise UserError(f"{path}: {exc}") from None
         raise
 

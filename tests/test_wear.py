@@ -190,9 +190,10 @@ def test_wear_profile_figure_shows_the_deepest_point_of_either_face(fast_run):
     assert boxes[0].x1 < boxes[1].x0, "the faces' x labels overlap"
 
 
-def test_archive_without_profile_reads_and_wear_says_why(fast_run, tmp_path):
+def test_archive_without_profile_reads_and_wear_says_why(fast_run, tmp_path, capsys):
     """An archive written before the profile existed (its datasets removed) still reads; the wear report
-    refuses it in one line."""
+    refuses it in one line, and ``bearingsim wear`` names the archive in it (it said 'this archive' alone:
+    of several archives, not which), writing nothing."""
     import h5py
     import shutil
 
@@ -209,6 +210,12 @@ def test_archive_without_profile_reads_and_wear_says_why(fast_run, tmp_path):
     assert "results/wear/profile_work_front" not in res.data
     with pytest.raises(UserError, match="no wear profile"):
         res.wear_report(hours=1.0)
+    from bearingsim.cli import main
+
+    code = main(["wear", str(path), str(old), "--hours", "1", "-o", str(tmp_path / "figs")])
+    out, err = capsys.readouterr()
+    assert code == 2 and out == "" and err.startswith(f"bearingsim: error: {old}: this archive has no wear profile"), err
+    assert len(err.strip().splitlines()) == 1 and not (tmp_path / "figs").exists()
 
 
 @pytest.mark.parametrize("kw", [{"hours": -1.0}, {"rotations": 0.0}, {}, {"hours": 1.0, "rotations": 2.0},

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.wording import counted, distinct_texts, note_kind
+from bearingsim.wording import by_kind, counted, distinct_texts, note_kind
 from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
@@ -150,18 +150,14 @@ def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[i
     rows = [i for i, lines in enumerate(found) if lines]
     if not rows:
         return {}
-    first: dict[str, int] = {}  # the notes' kind -> the first row that carries it
-    texts: dict[str, set] = {}  # the notes' kind -> their texts
-    for i in rows:
-        text = "; ".join(found[i])
-        first.setdefault(note_kind(text), i)
-        texts.setdefault(note_kind(text), set()).add(text)
-    number = {kind: k for k, kind in enumerate(first, 1)}
+    texts = ["; ".join(found[i]) for i in rows]
+    kinds = by_kind(texts)  # the notes' kind -> (the first noted row, how many, whether their numbers differ)
+    number = {kind: k for k, kind in enumerate(kinds, 1)}
     names.append("notes")
     labels["notes"] = [f"[{number[note_kind('; '.join(lines))]}]" if lines else "" for lines in found]
-    return {i: f"[{number[kind]}] {'; '.join(found[i])}" + (
-        "" if len(texts[kind]) == 1 else f" (the numbers of the first row marked [{number[kind]}]; the others "
-                                         "differ in theirs)") for kind, i in first.items()}
+    return {rows[j]: f"[{number[kind]}] {texts[j]}" + (
+        f" (the numbers of the first row marked [{number[kind]}]; the others differ in theirs)" if differ else "")
+        for kind, (j, _, differ) in kinds.items()}
 
 
 def table_of_archives(paths) -> Table:

@@ -26,6 +26,17 @@ def note_kind(text: str) -> str:
     return _NOTE_NUMBER_RE.sub("#", text)
 
 
+def by_kind(notes) -> dict[str, tuple[int, int, bool]]:
+    """``notes`` (texts, in order) grouped by kind (:func:`note_kind`), in the order the kinds first come: for each,
+    ``(the position of its first note, how many notes, whether they differ in their numbers)``."""
+    kinds: dict[str, list] = {}
+    for i, text in enumerate(notes):
+        kind = kinds.setdefault(note_kind(text), [i, 0, set()])
+        kind[1] += 1
+        kind[2].add(text)
+    return {k: (first, n, len(texts) > 1) for k, (first, n, texts) in kinds.items()}
+
+
 def counted(n, noun: str, plural: str | None = None, fmt: str = "") -> str:
     """``n`` and ``noun``, in the plural unless ``n`` is one: ``counted(1, "case")`` is "1 case",
     ``counted(3, "case")`` "3 cases", ``counted(2, "speed", fmt="g")`` "2 speeds". ``plural``: the

@@ -175,6 +175,12 @@ def test_a_scenario_that_differs_only_in_keys_its_model_does_not_read_replaces_i
     for other in (unread.replace(**{"operating.radial_load_N": 1500.0}), sc.replace(**{"reduced.method": "euler"})):
         with pytest.raises(bearingsim.UserError, match="holds the run of a different scenario"):
             bearingsim.run(other).save(path)
+    # the reduced model's method is a key the whole bearing does not read (bearingsim.scenario.unused_keys)
+    from bearingsim.archive import _unread_by_both
+
+    mb = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml")
+    assert _unread_by_both(mb, mb.replace(**{"reduced.method": "euler"}), ["reduced.method"])
+    assert not _unread_by_both(sc, sc.replace(**{"reduced.method": "euler"}), ["reduced.method"])
 
 
 def _short_run_of(model: str):

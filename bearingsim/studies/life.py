@@ -43,7 +43,7 @@ import numpy as np
 
 from bearingsim.errors import UserError
 from bearingsim.studies.engine import Study, case_of, load_result
-from bearingsim.wording import counted, note_kind, run_notes
+from bearingsim.wording import by_kind, counted, run_notes
 
 LIFE_FORMAT = "bearingsim life"
 #: limit kinds and the unit of each in the --limit text (SI factor)
@@ -714,16 +714,12 @@ def stage_notes(cols: dict) -> list[str]:
     carries it, and says so."""
     from bearingsim.sweeps.index import notes_of
 
-    kinds: dict[str, list] = {}  # the note with its numbers masked -> [first text, stages, its texts, first stage]
-    for stage, cell in zip(cols["stage"], cols.get("notes", ())):
-        for note in dict.fromkeys(run_notes(notes_of(cell))):
-            kind = kinds.setdefault(note_kind(note), [note, 0, set(), int(stage)])
-            kind[1] += 1
-            kind[2].add(note)
+    noted = [(int(stage), note) for stage, cell in zip(cols["stage"], cols.get("notes", ()))
+             for note in dict.fromkeys(run_notes(notes_of(cell)))]  # each stage's notes, each once
     n = len(cols["stage"])
     return [f"note ({k} of {counted(n, 'stage')}"
-            f"{'' if len(texts) == 1 else f'; the numbers of stage {first}, the others differ in theirs'}): {note}"
-            for note, k, texts, first in kinds.values()]
+            f"{f'; the numbers of stage {noted[i][0]}, the others differ in theirs' if differ else ''}): {noted[i][1]}"
+            for i, k, differ in by_kind([note for _, note in noted]).values()]
 
 
 def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:

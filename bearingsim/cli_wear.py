@@ -153,7 +153,8 @@ def _check_time(args) -> None:
     if not (math.isfinite(value) and value > 0):
         raise UserError(f"{name} {value!r}: must be a positive number")
     if args.hours is not None and value > MAX_RUNNING_HOURS:
-        raise UserError(f"--hours {value:g}: more than {MAX_RUNNING_HOURS:g} h of running, 114 years, ten times the "
+        given = repr(float(value)).removesuffix(".0")  # as given: 1000000.4 is not rounded to the bound
+        raise UserError(f"--hours {given}: more than {MAX_RUNNING_HOURS:.10g} h of running, 114 years, ten times the "
                         f"longest life a bearing is designed for; give a shorter running time")
 
 

@@ -183,8 +183,9 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
     shaft = float(rotations) if rotations is not None else float(hours) * rot_per_hour
     if (float(hours) if hours is not None else shaft / rot_per_hour) > MAX_RUNNING_HOURS:
-        raise UserError(f"{name} {value:g}: more than {MAX_RUNNING_HOURS:g} h of running "
-                        f"({MAX_RUNNING_HOURS * rot_per_hour:.3g} inner-ring rotations at {rot_per_hour / 60:g} rpm), "
+        given = repr(float(value)).removesuffix(".0")  # as given: 1000000.4 is not rounded to the bound
+        raise UserError(f"{name} {given}: more than {MAX_RUNNING_HOURS:.10g} h of running "
+                        f"({MAX_RUNNING_HOURS * rot_per_hour:.12g} inner-ring rotations at {rot_per_hour / 60:g} rpm), "
                         f"114 years, ten times the longest life a bearing is designed for; give a shorter running time")
     cage_speed = result.summary.get("cage_speed_mean_rad_s", float("nan"))
     if not (math.isfinite(cage_speed) and cage_speed > 0):

@@ -239,8 +239,11 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
     assert res.wear_report(rotations=rotations * 0.999).hours == pytest.approx(0.999 * MAX_RUNNING_HOURS, rel=1e-12)
     for kw, name in (({"hours": MAX_RUNNING_HOURS * 1.001}, "hours"),
                      ({"rotations": rotations * 1.001}, "rotations")):  # the API names its keywords
-        with pytest.raises(UserError, match=f"^{name} .*: more than 1e\\+06 h of running"):
+        with pytest.raises(UserError, match=f"^{name} .*: more than 1000000 h of running"):
             res.wear_report(**kw)
+    with pytest.raises(UserError, match=r"^hours 1000000\.4: more than 1000000 h of running \(360000000000 inner"):
+        res.wear_report(hours=1000000.4)  # just over the bound: both numbers in full (it said "hours 1e+06: more
+        # than 1e+06 h")
     with pytest.raises(UserError, match="^hours 'x': must be a positive number$"):  # it said "--hours x"
         res.wear_report(hours="x")
     with pytest.raises(UserError, match="^give the running time as hours or as inner-ring rotations"):
@@ -280,7 +283,8 @@ def test_wear_report_takes_numpy_numbers_and_refuses_what_a_scenario_refuses(fas
             res.wear_report(rotations=value)
 
 
-@pytest.mark.parametrize("option, value", [("--rotations", "1e300"), ("--hours", "1e300"), ("--hours", "2e6")])
+@pytest.mark.parametrize("option, value", [("--rotations", "1e300"), ("--hours", "1e300"), ("--hours", "2e6"),
+                                           ("--hours", "1000000.4")])
 def test_wear_cli_refuses_an_absurd_running_time_in_one_line(fast_run, capsys, option, value):
     """`bearingsim wear M --rotations 1e300` exited 0 with an overflow warning, a coefficient of variation
     of inf and depths of 1e296 um: a running time beyond 1e6 h (wear.MAX_RUNNING_HOURS) is refused in one
@@ -291,7 +295,8 @@ def test_wear_cli_refuses_an_absurd_running_time_in_one_line(fast_run, capsys, o
     out, err = capsys.readouterr()
     assert code == 2 and out == "", (code, out, err)
     lines = err.strip().splitlines()
-    assert len(lines) == 1 and lines[0].startswith(f"bearingsim: error: {option} ") and "1e+06 h" in lines[0], err
+    assert len(lines) == 1 and lines[0].startswith(f"bearingsim: error: {option} ") and "1000000 h" in lines[0], err
+    assert f" {repr(float(value)).removesuffix('.0')}: " in lines[0], err  # as given, not rounded to the bound
 
 
 def test_wear_cli_checks_its_output_before_printing(fast_run, tmp_path, capsys):

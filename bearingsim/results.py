@@ -5,7 +5,7 @@ A :class:`Result` is plain data with units, laid out as in the archive (``docs/a
 * ``data``: named arrays keyed by their archive path (``"results/per_rotation/I_dec"``,
   ``"results/impacts/time_s"``, ``"results/theta_deg"`` ...), each a :class:`NamedArray` with its unit;
 * ``groups``: named attribute groups (``"results/summary"``, ``"results/pass"`` ...), each a
-  :class:`AttrGroup` of values and their units;
+  :class:`AttrGroup` of values and their units (read-only mappings, as the arrays are read-only views);
 * ``series``: time series (:class:`Series`, H5MD ``{step, time, value}``);
 * ``provenance``: how the run was made (solver, time step and how it was chosen, run facts);
 * ``scenario``: the resolved :class:`bearingsim.scenario.Scenario` it was run from.
@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from bearingsim.datatypes import AttrGroup, NamedArray, Series
+from bearingsim.datatypes import AttrGroup, NamedArray, ReadOnlyMapping, Series
 from bearingsim.errors import UserError, check_path
 
 PER_ROTATION = "results/per_rotation"
@@ -60,6 +60,14 @@ def read_only(a) -> np.ndarray:
 def _read_only_data(data: dict[str, NamedArray]) -> dict[str, NamedArray]:
     """``data`` with each array a read-only view (:func:`read_only`)."""
     return {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v for k, v in data.items()}
+
+
+def _read_only_groups(groups: dict[str, AttrGroup]) -> dict[str, AttrGroup]:
+    """``groups`` with each group's values and units read-only copies (:class:`bearingsim.datatypes.ReadOnlyMapping`;
+    a value that is an array a read-only view, :func:`read_only`)."""
+    return {k: replace(g, attrs=ReadOnlyMapping({n: read_only(v) if isinstance(v, np.ndarray) else v
+                                                 for n, v in g.attrs.items()}),
+                       units=ReadOnlyMapping(g.units)) for k, g in groups.items()}
 
 
 class Result:
@@ -112,7 +120,7 @@ class Result:
         # arrays untouched (an in-place change of r.data[...].data or r.series[...].value would have changed the
         # result, its summary's meaning and the archive it saves)
         self.data = _read_only_data(data)
-        self.groups = groups
+        self.groups = groups  # their values and units read-only too (the summary is read from them)
         self.series = series or {}
         self.provenance = dict(provenance or {})
         self.tables = dict(tables or {})
@@ -121,10 +129,23 @@ class Result:
 
     def __setstate__(self, state: dict) -> None:
         """Unpickled (what ``ProcessPoolExecutor().map(bearingsim.run, ...)`` hands back): pickle rebuilds the
-        arrays as writable copies, so they are made read-only again, as those of the run that was pickled."""
+        arrays as writable copies, so they are made read-only again (those of the groups' values too), as those of
+        the run that was pickled."""
         self.__dict__.update(state)
         self.data = _read_only_data(self.data)
         self.series = self.__dict__.get("_series", {})
+        self.groups = self.__dict__.get("_groups", {})
+
+    @property
+    def groups(self) -> dict[str, AttrGroup]:
+        """The named attribute groups, by archive path; each group's ``attrs`` and ``units`` are read-only
+        (:class:`bearingsim.datatypes.ReadOnlyMapping`: ``attrs[k] = v`` raises a TypeError), as the arrays of
+        :attr:`data` are: :attr:`summary` and the archive :meth:`save` writes are read from them."""
+        return self._groups
+
+    @groups.setter
+    def groups(self, groups: dict[str, AttrGroup]) -> None:
+        self._groups = _read_only_groups(groups)
 
     @property
     def series(self) -> dict[str, Series]:

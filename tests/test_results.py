@@ -233,6 +233,33 @@ def test_a_pickled_result_keeps_its_arrays_read_only(model):
     _same(back, r)
 
 
+@pytest.mark.parametrize("model", ["reduced", "multibody"])
+def test_the_groups_a_result_hands_out_are_read_only(tmp_path, model):
+    """``r.summary`` was a fresh dict, but ``r.groups["results/summary"].attrs`` was the dict it is read from:
+    ``attrs["I_dec_mean_Ns"] = 99.0`` changed the summary and the archive ``save()`` wrote. The values and units
+    of every group are read-only (a TypeError saying so), of a run, of an archive read back and of a result back
+    through pickle (which still pickles), as its arrays are; ``dict(...)`` of them is a copy to change."""
+    r = bearingsim.run(_short_run_of(model))
+    summary, units = r.summary, r.summary_units
+    path = tmp_path / "r.h5"
+    for result in (r, bearingsim.load(r.save(path)), pickle.loads(pickle.dumps(r))):
+        assert result.groups.keys() == r.groups.keys() and "results/summary" in result.groups
+        for name, group in result.groups.items():
+            for values in (group.attrs, group.units):
+                key = next(iter(values), "x")
+                with pytest.raises(TypeError, match="read-only"):
+                    values[key] = 99.0
+                with pytest.raises(TypeError):
+                    del values[key]
+                assert not any(hasattr(values, m) for m in ("update", "pop", "setdefault", "clear", "popitem"))
+            assert group.attrs == r.groups[name].attrs and group.units == r.groups[name].units, name
+        copy = dict(result.groups["results/summary"].attrs)
+        copy["I_dec_mean_Ns"] = 99.0  # a copy changes; the result does not
+        assert result.summary == summary and result.summary_units == units
+        assert pickle.loads(pickle.dumps(result)).summary == summary
+    assert bearingsim.load(path).summary == summary
+
+
 def test_a_result_read_with_part_of_its_arrays_says_so_and_is_not_saved(tmp_path):
     """``simulation.load(path, only=...)`` reads some arrays: saving that result wrote an archive without the others
     (over its own archive, of the same scenario, without force), which every reader then called damaged; its

@@ -676,6 +676,46 @@ def _json_scalar(v):
     return None
 
 
+#: what :func:`check_storable` says an archive stores of a named value
+STORABLE = "a str, bool, int, float or an array of numbers or texts"
+
+
+def _storable(v) -> bool:
+    """True when :func:`_write_group_attrs` stores ``v``: a scalar it writes as JSON, or a value h5py makes an
+    array of an HDF5 type of (numbers, texts); False for anything else (an object, None, a dict, a list of
+    mixed things), which h5py would refuse mid-write with its own TypeError."""
+    if _json_scalar(v) is not None:
+        return True
+    h5py = _lazy_h5py()
+    try:
+        data = _h5base().array_for_new_object(v)
+        if isinstance(data, np.ndarray) and data.dtype.subdtype is None:
+            h5py.h5t.py_create(data.dtype, logical=True)
+    except (TypeError, ValueError):
+        return False
+    return True
+
+
+def check_storable(result, what: str = "save()") -> None:
+    """Refuse, before anything is written, a named value of ``result`` its archive cannot store, in one line
+    (:class:`bearingsim.UserError`) naming ``what`` refuses it, where it is and its type: a value of its
+    provenance or of an attribute group that is not :data:`STORABLE`, a name or unit that is not a str."""
+    named = [(f"groups[{path_!r}].attrs", grp.attrs, grp.units) for path_, grp in result.groups.items()]
+    for where, values, units in [*named, ("provenance", result.provenance, {})]:
+        for k, v in values.items():
+            if not isinstance(k, str):
+                raise UserError(f"{what}: {where}: expected names that are str (got {k!r}, a {type(k).__name__})")
+            if not _storable(v):
+                raise UserError(f"{what}: {where}[{k!r}]: expected {STORABLE}, which an archive stores "
+                                f"(got {type(v).__name__})")
+        for k, u in units.items():
+            where_units = where.replace(".attrs", ".units")
+            if not isinstance(k, str):
+                raise UserError(f"{what}: {where_units}: expected names that are str (got {k!r}, a {type(k).__name__})")
+            if not isinstance(u, str):
+                raise UserError(f"{what}: {where_units}[{k!r}]: expected a unit, a str (got {type(u).__name__})")
+
+
 def _write_group_attrs(w: _Writer, g, values: dict[str, Any], units: dict[str, str]) -> None:
     """Named values and their units as the attributes ``attrs_json`` and ``units_json`` of ``g``.
 

@@ -62,12 +62,15 @@ def _read_only_data(data: dict[str, NamedArray]) -> dict[str, NamedArray]:
     return {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v for k, v in data.items()}
 
 
+def _read_only_values(values) -> ReadOnlyMapping:
+    """A read-only copy of the named values ``values`` (:class:`bearingsim.datatypes.ReadOnlyMapping`), a value
+    that is an array a read-only view (:func:`read_only`)."""
+    return ReadOnlyMapping({k: read_only(v) if isinstance(v, np.ndarray) else v for k, v in values.items()})
+
+
 def _read_only_groups(groups: dict[str, AttrGroup]) -> dict[str, AttrGroup]:
-    """``groups`` with each group's values and units read-only copies (:class:`bearingsim.datatypes.ReadOnlyMapping`;
-    a value that is an array a read-only view, :func:`read_only`)."""
-    return {k: replace(g, attrs=ReadOnlyMapping({n: read_only(v) if isinstance(v, np.ndarray) else v
-                                                 for n, v in g.attrs.items()}),
-                       units=ReadOnlyMapping(g.units)) for k, g in groups.items()}
+    """``groups`` with each group's values and units read-only copies (:func:`_read_only_values`)."""
+    return {k: replace(g, attrs=_read_only_values(g.attrs), units=ReadOnlyMapping(g.units)) for k, g in groups.items()}
 
 
 class Result:
@@ -122,7 +125,7 @@ class Result:
         self.data = _read_only_data(data)
         self.groups = groups  # their values and units read-only too (the summary is read from them)
         self.series = series or {}
-        self.provenance = dict(provenance or {})
+        self.provenance = provenance or {}  # read-only too: the record of how the run was made
         self.tables = dict(tables or {})
         self.notes: list[str] = []  # one-line notes of a run that is plausible but not clean (simulation.run)
         self._parameters = None
@@ -135,6 +138,7 @@ class Result:
         self.data = _read_only_data(self.data)
         self.series = self.__dict__.get("_series", {})
         self.groups = self.__dict__.get("_groups", {})
+        self.provenance = self.__dict__.get("_provenance", {})
 
     @property
     def groups(self) -> dict[str, AttrGroup]:
@@ -146,6 +150,17 @@ class Result:
     @groups.setter
     def groups(self, groups: dict[str, AttrGroup]) -> None:
         self._groups = _read_only_groups(groups)
+
+    @property
+    def provenance(self) -> ReadOnlyMapping:
+        """How the run was made (solver, time step and how it was chosen, the code and machine that ran it), by
+        name; read-only (:class:`bearingsim.datatypes.ReadOnlyMapping`), as the rest of the result: it is the
+        record of the run, which :meth:`save` stores."""
+        return self._provenance
+
+    @provenance.setter
+    def provenance(self, provenance) -> None:
+        self._provenance = _read_only_values(provenance)
 
     @property
     def series(self) -> dict[str, Series]:
@@ -281,11 +296,13 @@ class Result:
         ``path`` of the same scenario is replaced, one of a different scenario only with ``force=True`` (as
         ``bearingsim run -o`` replaces it only with ``--force``); any other file there, and a symbolic link
         (even to an archive: a link is the user's, as at a figure path), is refused (:class:`bearingsim.UserError`,
-        nothing written)."""
+        nothing written); so is a value of :attr:`provenance` or :attr:`groups` the archive cannot store (one
+        made with the result or assigned to it: :func:`bearingsim.archive.check_storable` names it and its type)."""
         from bearingsim import archive
 
         check_path(path, "path", "the archive (.h5)")
         self.require("", "save()")  # an archive without them would be a damaged one
+        archive.check_storable(self, "save()")  # h5py would refuse it mid-write with its own TypeError
         if not isinstance(force, bool):
             raise UserError(f"save(): force: expected True or False (got {type(force).__name__})")
         if not force and not Path(path).is_symlink():  # a link is refused as it is, whatever it leads to

@@ -128,8 +128,8 @@ def run(scenario: Scenario, *, progress: bool = False, sink=None, dt: float | No
     params = scenario.parameters
     result = model_module(params.model).simulate(params, sink=sink, progress=progress, dt=dt)
     result.scenario = scenario
-    result.provenance = {**archive.run_facts(), **result.provenance}  # the code that computed it
-    result.provenance["wall_time_s"] = time.perf_counter() - t0
+    result.provenance = {**archive.run_facts(), **result.provenance,  # the code that computed it
+                         "wall_time_s": time.perf_counter() - t0}
     result.notes = plausibility.check(result)
     if check_step:
         step = plausibility.step_of(result)

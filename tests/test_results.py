@@ -260,6 +260,45 @@ def test_the_groups_a_result_hands_out_are_read_only(tmp_path, model):
     assert bearingsim.load(path).summary == summary
 
 
+def test_a_value_an_archive_cannot_store_is_refused_by_save_before_anything_is_written(tmp_path):
+    """``r.provenance`` was a plain dict: ``r.provenance["note"] = object()`` made ``r.save(path)`` fail with h5py's
+    own TypeError (``Object dtype dtype('O') has no native HDF5 equivalent``). The provenance is read-only, as the
+    rest of the result, of a run, of an archive read back and through pickle; a value an archive cannot store given
+    another way (assigned to ``r.provenance`` or ``r.groups``) is refused by ``save()`` in one line naming where it
+    is and its type, before anything is written: no archive, no temporary, no folder, and the archive already at
+    the path kept as it was. What an archive stores (texts, numbers, arrays of them) still saves and reads back."""
+    from dataclasses import replace
+
+    r = bearingsim.run(_short_scenarios()[0])
+    kept = r.save(tmp_path / "kept.h5")
+    before = kept.read_bytes()
+    for result in (r, pickle.loads(pickle.dumps(r)), bearingsim.load(kept)):
+        assert result.provenance["solver"] == r.provenance["solver"]
+        with pytest.raises(TypeError, match="read-only"):
+            result.provenance["note"] = "by hand"
+        with pytest.raises(TypeError, match="read-only"):
+            del result.provenance["solver"]
+        assert not any(hasattr(result.provenance, m) for m in ("update", "pop", "setdefault", "clear"))
+    summary = r.groups["results/summary"]
+    cases = [("provenance", {**r.provenance, "note": object()}, "provenance['note']", "object"),
+             ("provenance", {**r.provenance, "dt_s": None}, "provenance['dt_s']", "NoneType"),
+             ("groups", {**r.groups, "results/summary": replace(summary, attrs={**summary.attrs, "extra": {"a": 1}})},
+              "groups['results/summary'].attrs['extra']", "dict")]
+    for name, value, where, kind in cases:
+        bad = pickle.loads(pickle.dumps(r))
+        setattr(bad, name, value)
+        for target in (tmp_path / "new" / "a.h5", kept):
+            with pytest.raises(bearingsim.UserError) as info:
+                bad.save(target)
+            assert str(info.value) == (f"save(): {where}: expected a str, bool, int, float or an array of numbers or "
+                                       f"texts, which an archive stores (got {kind})")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["kept.h5"] and kept.read_bytes() == before
+    r.provenance = {**r.provenance, "note": "by hand", "pair": np.array([1, 2]), "names": ["a", "b"]}
+    back = bearingsim.load(r.save(tmp_path / "noted.h5"))
+    assert back.provenance["note"] == "by hand" and list(back.provenance["pair"]) == [1, 2]
+    assert list(back.provenance["names"]) == ["a", "b"] and back.summary == r.summary
+
+
 def test_a_result_read_with_part_of_its_arrays_says_so_and_is_not_saved(tmp_path):
     """``simulation.load(path, only=...)`` reads some arrays: saving that result wrote an archive without the others
     (over its own archive, of the same scenario, without force), which every reader then called damaged; its

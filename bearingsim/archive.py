@@ -114,11 +114,14 @@ def check_writable_dir(folder: str | Path) -> Path:
     folder = outputs.check_folder_path(folder)
     try:
         folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise UserError(f"{folder}: cannot create the output folder ({exc.strerror or exc})") from None
+    try:
         probe = folder / f".bearingsim-probe-{os.getpid()}"
         probe.touch()
         probe.unlink()
     except OSError as exc:
-        raise UserError(f"{folder}: output folder is not writable ({exc.strerror or exc})") from None
+        raise UserError(f"{folder}: {outputs.no_file_in('this output folder', exc)}") from None
     return folder
 
 
@@ -186,10 +189,10 @@ def _prepare_target(path) -> Path:
         try:
             tmp.touch()
         except OSError as exc:
-            raise UserError(f"{path}: output is not writable ({exc.strerror})") from None
+            raise outputs.cannot_write_archive(path, exc) from None
     except OSError as exc:
         outputs.remove_empty(made)
-        raise UserError(f"{path}: cannot create output folder ({exc.strerror})") from None
+        raise outputs.cannot_create_folder(path, exc) from None
     except UserError:
         outputs.remove_empty(made)
         raise

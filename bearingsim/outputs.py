@@ -29,6 +29,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import fcntl
+import functools
 import logging
 import os
 import re
@@ -423,6 +424,25 @@ def remove_folder_files(folder: str | Path) -> list[Path]:
             if _remove_if_own(Path(folder) / name, is_own_png if head == PNG_SIGNATURE else head)]
 
 
+def no_file_in(folder: str | Path, exc: OSError) -> str:
+    """``no file can be created in FOLDER (why)``: what a refusal says of a folder that exists but takes no new
+    file (no permission, a read-only file system, /proc), the OS's reason in brackets. (It said "output is not
+    writable (No such file or directory)", which read as if the output had to exist.)"""
+    return f"no file can be created in {folder} ({exc.strerror or exc})"
+
+
+def cannot_write_archive(path: str | Path, exc: OSError) -> UserError:
+    """The one line for an archive ``path`` whose folder exists but takes no new file (:func:`no_file_in`), the
+    same from ``Result.save``, ``bearingsim run -o`` and its ``--dry-run``."""
+    return UserError(f"{path}: cannot write archive: {no_file_in(Path(path).parent, exc)}")
+
+
+def cannot_create_folder(path: str | Path, exc: OSError) -> UserError:
+    """The one line for an archive ``path`` whose missing folder cannot be made (``Result.save``, ``bearingsim
+    run -o`` and its ``--dry-run`` alike)."""
+    return UserError(f"{path}: cannot create output folder ({exc.strerror or exc})")
+
+
 def check_writable(path: str | Path) -> None:
     """Refuse, in the line a run would give (:meth:`OutputLock.acquire`), an output ``path`` whose folder
     could not be made or would take no new file, without writing anything: the nearest folder of it that
@@ -439,7 +459,8 @@ def check_writable(path: str | Path) -> None:
         with tempfile.TemporaryFile(dir=existing):
             pass
     except OSError as exc:
-        raise UserError(f"{path}: output is not writable ({exc.strerror or exc})") from None
+        raise (cannot_write_archive(path, exc) if existing == path.parent
+               else cannot_create_folder(path, exc)) from None
 
 
 def missing_folders(folder: Path) -> list[Path]:
@@ -584,13 +605,14 @@ def clean_stale_temporaries(folder: str | Path, report=None, names: dict[str, by
     return removed
 
 
-def open_lock_file(lock_path: str | Path, guarded: str | Path, unwritable: str = "output is not writable") -> int:
+def open_lock_file(lock_path: str | Path, guarded: str | Path, unwritable="no file can be created in it") -> int:
     """Open (creating it if needed) the lock file ``lock_path`` for ``flock``; return its descriptor.
 
     Never through a symbolic link (``O_NOFOLLOW``: a planted ``.sweep.lock -> ~/notes`` neither truncates
     nor creates its target) and never a file bearingsim did not make: a lock file is an empty regular
     file, anything else there is refused with one line naming it (``guarded``: what the lock protects;
-    ``unwritable``: what its line says of a folder that takes no file).
+    ``unwritable``: what its line says, after ``guarded: ``, of a folder that takes no file, the OS's reason
+    after it in brackets; or a function of the ``OSError`` giving the exception to raise).
     """
     lock_path = Path(lock_path)
     flags = (os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_CLOEXEC", 0)
@@ -604,6 +626,8 @@ def open_lock_file(lock_path: str | Path, guarded: str | Path, unwritable: str =
         if exc.errno == errno.EISDIR:  # a folder there: said as the lock file's, not as an unwritable folder
             raise UserError(f"{lock_path}: lock file of {guarded} is a folder, not bearingsim's; not replaced "
                             "(remove it)") from None
+        if callable(unwritable):
+            raise unwritable(exc) from None
         raise UserError(f"{guarded}: {unwritable} ({exc.strerror or exc})") from None
     st = os.fstat(fd)
     if not stat.S_ISREG(st.st_mode) or st.st_size > 0:
@@ -675,7 +699,9 @@ class OutputLock:
     def __init__(self, path: str | Path, what: str = "archive"):
         p = Path(path)
         self.path, self.what = p, what
-        self.unwritable = "output is not writable" if what == "archive" else f"cannot write the {what}"
+        # an archive's folder that takes no file: cannot_write_archive's line, as Result.save gives it
+        self.unwritable = (functools.partial(cannot_write_archive, p) if what == "archive"
+                           else f"cannot write the {what}")
         self.lock_path = p.with_name(f".{p.name}.lock")
         self._fd: int | None = None
 
@@ -684,6 +710,8 @@ class OutputLock:
             try:
                 self.path.parent.mkdir(parents=True, exist_ok=True)
             except OSError as exc:
+                if callable(self.unwritable):
+                    raise cannot_create_folder(self.path, exc) from None
                 raise UserError(f"{self.path}: {self.unwritable} ({exc.strerror or exc})") from None
             fd = open_lock_file(self.lock_path, self.path, self.unwritable)
             try:

@@ -1,5 +1,7 @@
 """Archive format: atomic write, units on physical datasets, provenance, and clear errors on bad files."""
 import os
+import sys
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -199,6 +201,33 @@ def test_save_refuses_a_symbolic_link_as_figures_do(tmp_path, base_reduced):
         assert str(err.value).startswith(f"{target}: ") and "\n" not in str(err.value) and target.is_symlink()
     assert real.read_bytes() == before and not (tmp_path / "nowhere.h5").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dangling.h5", "link.h5", "real.h5"]
+
+
+@pytest.mark.skipif(not (Path("/proc/self").is_dir() and sys.platform.startswith("linux")),
+                    reason="needs Linux's /proc, where no file can be created whoever asks")
+def test_an_archive_in_a_folder_that_takes_no_file_is_refused_in_words_that_are_true(base_reduced):
+    """``r.save("/proc/x.h5")`` and ``bearingsim run ... -o /proc/x.h5`` said "/proc/x.h5: output is not writable
+    (No such file or directory)": as if the output had to exist to be written. Both say the same true line, the
+    folder that takes no file named, the OS's reason in brackets; the run's --dry-run too; and a folder that cannot
+    be made is "cannot create output folder", from both. The command exits 2; nothing is written."""
+    import re
+
+    import bearingsim
+
+    from .conftest import SCENARIOS
+    from .test_cli import assert_user_error, bearingsim as cli
+
+    r = bearingsim.run(resolve(base_reduced))
+    for out, line in (("/proc/x.h5", r"/proc/x\.h5: cannot write archive: no file can be created in /proc \([^()]+\)"),
+                      ("/proc/none/x.h5", r"/proc/none/x\.h5: cannot create output folder \([^()]+\)")):
+        with pytest.raises(UserError) as info:
+            r.save(out)
+        assert re.fullmatch(line, str(info.value)), str(info.value)
+        for dry in ((), ("--dry-run",)):
+            res = cli("run", SCENARIOS / "paper_3000rpm.toml", "--no-plots", "-o", out, *dry)  # refused before it runs
+            assert_user_error(res, str(info.value))
+            assert res.stderr == f"bearingsim: error: {info.value}\n"
+    assert not Path("/proc/x.h5").exists() and not Path("/proc/none").exists()
 
 
 def test_a_refused_save_leaves_no_folder_behind(tmp_path, tmp_path_factory, base_reduced):

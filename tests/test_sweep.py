@@ -258,6 +258,17 @@ def test_resume_runs_only_what_is_missing(tmp_path):
         f["bearingsim"].attrs["complete"] = False
     (cases / f".{first.rows[1]['case']}.h5.tmp-99999").write_bytes(data)  # a dead worker's temporary file
 
+    # the truncated file: HDF5 cannot open it, so nothing tells it is bearingsim's (an archive is written through a
+    # temporary file and renamed complete): refused, not removed, until the user removes it
+    truncated = cases / f"{first.rows[2]['case']}.h5"
+    index = (tmp_path / "sweep.h5").read_bytes()
+    from bearingsim.errors import UserError
+
+    with pytest.raises(UserError, match=f"{truncated}: archive of the case {SPEED}=3000 of {tmp_path} is not known to "
+                                        f"be bearingsim's: damaged or truncated file"):
+        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert truncated.read_bytes() == data[: len(data) // 2] and (tmp_path / "sweep.h5").read_bytes() == index
+    truncated.unlink()
     again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
     assert [r["status"] for r in again.rows] == ["cached", "done", "done", "done"]
     assert kept.stat().st_mtime_ns == mtime
@@ -691,6 +702,45 @@ def test_second_sweep_into_the_same_folder_is_refused(tmp_path):
             run_sweep(spec, tmp_path, engine=LocalEngine(2), figures=False, progress=False)
     assert {p.pid for p in psutil.Process().children(recursive=True)} - before == set()  # its pool is gone
     assert run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False).count("done") == 1
+
+
+@pytest.mark.parametrize("what", ["text", "hdf5", "link"])
+def test_a_users_file_at_a_case_archives_name_is_refused_not_removed(tmp_path, what):
+    """The resume removed any file at a case archive's name ``cases/<hash>.h5`` that was not the case's current
+    archive (a user's file put there, another program's HDF5 file, a symbolic link) and wrote the case's archive
+    in its place. Only bearingsim's own archive is replaced now (a stale one, of another model version, as
+    before); anything else is refused in one line naming it, before any case runs, the file and the folder's
+    index as they were; removed by the user, the sweep resumes."""
+    from bearingsim.errors import UserError
+
+    spec = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000, 3000])])
+    first = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    stale, mine = (tmp_path / "cases" / f"{r['case']}.h5" for r in first.rows[1:])
+    _set_provenance(stale, model_version=None)  # bearingsim's, of a model version before versions were stored
+    mine.unlink()
+    if what == "text":
+        mine.write_bytes(b"my notes")
+    elif what == "hdf5":
+        with h5py.File(mine, "w") as f:
+            f["data"] = np.arange(3.0)
+    else:
+        (tmp_path / "elsewhere.h5").write_bytes(b"my notes")
+        mine.symlink_to(tmp_path / "elsewhere.h5")
+    held = mine.read_bytes()
+    index = (tmp_path / "sweep.h5").read_bytes()
+    kind = {"text": "a file, not bearingsim's (not an archive bearingsim wrote)",
+            "hdf5": "a file, not bearingsim's (not an archive bearingsim wrote)",
+            "link": "a symbolic link, not bearingsim's"}[what]
+    with pytest.raises(UserError) as exc:
+        run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert str(exc.value) == (f"{mine}: archive of the case {SPEED}=3000 of {tmp_path} is {kind}; not replaced "
+                              f"(remove it)")
+    assert mine.read_bytes() == held and mine.is_symlink() == (what == "link")
+    assert (tmp_path / "sweep.h5").read_bytes() == index
+    mine.unlink()
+    again = run_sweep(spec, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert [r["status"] for r in again.rows] == ["cached", "stale", "done"]
+    assert (tmp_path / "elsewhere.h5").exists() == (what == "link")
 
 
 def test_a_users_file_in_cases_is_not_another_sweeps_case(tmp_path):

@@ -14,6 +14,7 @@ import contextlib
 import json
 import logging
 import math
+import os
 import re
 import signal
 import sys
@@ -336,7 +337,8 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
     scenario computed by the current model version (:func:`~bearingsim.sweeps.index.read_cached`);
     a case that keeps no archive under ``archives`` is also taken from its row of the previous index
     (:func:`~bearingsim.sweeps.index.trusted_row`: same content hash, same model version). A stale
-    archive or row, or none, means the case runs again; a stale archive is removed first. A cached case
+    archive or row, or none, means the case runs again; a stale, incomplete or different archive is removed first
+    if bearingsim wrote it, and anything else at its name refused (:func:`_replaceable_archive`). A cached case
     keeps the notes of its run: its archive's when it stores them, else its row's in the previous index."""
     from bearingsim.sweeps.index import read_rows, trusted_row
     from bearingsim.sweeps.worker import keeps_archive
@@ -344,6 +346,7 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
     cases_dir = outdir / "cases"
     old = read_rows(outdir / "sweep.h5")  # numbers of cases without an archive; notes of every case
     todo, stale = [], set()
+    replaced = []  # bearingsim's archives of cases to run again: removed once none of the others is refused
     for c, row in zip(cases, rows):
         if earlier and c.hash in earlier:
             row.update(earlier[c.hash])
@@ -351,8 +354,9 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
         rec = read_cached(cases_dir / f"{c.hash}.h5", c.toml)
         where = f"cases/{c.hash}.h5"
         if rec is None or rec["status"] == "stale":
-            # the sweep's own file, incomplete, damaged or stale: it is run again and replaced
-            _remove_case_archive(cases_dir / f"{c.hash}.h5", c, outdir, keeps_archive(c.model, archives))
+            # the sweep's own archive, incomplete or stale: it is run again and replaced; anything else refused
+            if _replaceable_archive(cases_dir / f"{c.hash}.h5", c, outdir, keeps_archive(c.model, archives)):
+                replaced.append(cases_dir / f"{c.hash}.h5")
             if not keeps_archive(c.model, archives):
                 rec = trusted_row(old.get(c.hash), c.model) or rec
                 where = ""
@@ -364,19 +368,39 @@ def _resume(cases: list[Case], rows: list[dict], outdir: Path, archives: str,
             row.update(rec, archive=where)
             if "notes" not in rec:  # an archive that stores no notes: its row's in the previous index
                 row["notes"] = list(old.get(c.hash, {}).get("notes", ()))
+    for path in replaced:
+        path.unlink(missing_ok=True)
     return todo, stale
 
 
-def _remove_case_archive(path: Path, case: Case, outdir: Path, keeps: bool) -> None:
-    """Remove the case archive ``path`` that is to be run again. A folder there is refused in one line naming it
-    (it said "Is a directory"), before any case runs and with the folder's index as it was, when the case is to
-    write its archive there (``keeps``); else it is in no one's way and left as it is."""
-    if path.is_dir() and not path.is_symlink():
-        if not keeps:
-            return
-        raise UserError(f"{path}: archive of the case {case.label()} of {outdir} is a folder, not bearingsim's; not "
-                        f"replaced (remove it)")
-    path.unlink(missing_ok=True)
+def _replaceable_archive(path: Path, case: Case, outdir: Path, keeps: bool) -> bool:
+    """Whether the file at the case archive's name ``path``, of a case to run again, is to be removed: it is
+    bearingsim's own, an archive it wrote (:func:`bearingsim.archive.is_archive`: HDF5 with the root group
+    ``/bearingsim`` and its ``format_version``; incomplete, stale or of another scenario). Anything else there (a
+    folder, a link, a user's file, a file HDF5 cannot open, so that nothing tells it is bearingsim's) is refused in
+    one line naming it, before any case runs and with the folder's index and files as they were, when the case is
+    to write its archive there (``keeps``); else it is in no one's way and left as it is (False, as for no file)."""
+    from bearingsim import archive
+
+    if not os.path.lexists(path):
+        return False
+    if not path.is_symlink() and path.is_file() and archive.is_archive(path):
+        return True
+    if not keeps:
+        return False
+    err = None if path.is_symlink() or not path.is_file() else archive.unreadable_error(path)
+    if path.is_symlink():
+        kind = "a symbolic link, not bearingsim's"
+    elif path.is_dir():
+        kind = "a folder, not bearingsim's"
+    elif not path.is_file():
+        kind = "not a regular file, not bearingsim's"
+    elif err is not None:  # damaged, truncated or unreadable: what it held cannot be told
+        reason = " ".join(str(err).removeprefix(f"{path}: ").split())
+        kind = f"not known to be bearingsim's: {reason}"
+    else:
+        kind = "a file, not bearingsim's (not an archive bearingsim wrote)"
+    raise UserError(f"{path}: archive of the case {case.label()} of {outdir} is {kind}; not replaced (remove it)")
 
 
 def _pending_rows(cases: list[Case]) -> list[dict]:

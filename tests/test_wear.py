@@ -999,6 +999,41 @@ def test_interrupted_life_says_its_stages_are_kept_and_resumes(tmp_path, monkeyp
     assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 0]
 
 
+@pytest.mark.slow
+def test_a_signal_right_after_a_later_stages_cases_counts_them(tmp_path, monkeypatch, capsys):
+    """SIGINT right after the second stage's round has run its case and written the index, before the round's
+    sweep returns (the study's own handler raising in it): the line counted the round before it, "1 done, 0
+    cached, 0 failed, 1 not run, of 2 cases", though the second stage was done and kept. It counts the present
+    round's rows: both stages done; the same command then reuses both."""
+    from bearingsim.cli import main
+    from bearingsim.studies import life
+    from bearingsim.sweeps import run as sweep_run
+
+    run_cases = sweep_run._run_cases
+
+    def then_signal(engine, cases, *args, **kw):
+        interrupted = run_cases(engine, cases, *args, **kw)
+        if len(cases) == 2:  # the second stage's round (with the first's case): ran, its own handlers out
+            os.kill(os.getpid(), signal.SIGINT)
+            _wait_for_the_handler()
+        return interrupted
+
+    monkeypatch.setattr(sweep_run, "_run_cases", then_signal)
+    cmd = _life_cmd(tmp_path, stages=2)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        assert main(cmd) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["bearingsim: life interrupted (SIGINT): 2 done, 0 cached, 0 failed, 0 not run, of 2 cases; run "
+                   "the same command again to resume"]
+    assert not (tmp_path / "life.h5").exists() and len(list((tmp_path / "cases").iterdir())) == 2
+    monkeypatch.undo()
+    assert main(cmd) == 0
+    assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
+
+
 def _watch_stages(monkeypatch, marks, batch, on_next) -> None:
     """``on_next(study, cases)`` sees each stage case a life study makes, before it runs, and the engine's
     batches go through ``batch`` (a function of this module: the forked worker finds it by name)."""

@@ -265,10 +265,11 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     """Run ``cases`` on the engine; then, while the studies call for more (:meth:`Study.next_cases`) and
     none has failed or been interrupted, those too, each round indexed with all before it. Returns the
     last round's sweep outcome."""
-    from bearingsim.sweeps.run import StagedRound, SweepInterrupted, _Signals, run_sweep
+    from bearingsim.sweeps.run import StagedRound, SweepInterrupted, SweepOutcome, _Signals, run_sweep
 
     desc = "+".join(s.name for s in studies)
     sweep, earlier = None, {}
+    round_ = None  # the present round of a staged study: its rows, once its sweep has them (StagedRound)
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM/SIGHUP end the study as one
     # during a round does: the finished cases kept, the same command resumes
     staged = any(s.staged for s in studies)
@@ -276,9 +277,9 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     with _Signals() as outer:
         try:
             while True:  # a staged study's rounds share the engine: its workers keep the model they loaded
+                round_ = StagedRound(earlier) if staged else None
                 sweep = run_sweep(cases, outdir, engine=engine, figures=False, lock=lock, desc=desc, archives="all",
-                                  staged=StagedRound(earlier) if staged else None,
-                                  **options)  # tables and figures are made from the cases' archives
+                                  staged=round_, **options)  # tables and figures are made from the cases' archives
                 if sweep.interrupted is not None or sweep.failed:
                     break
                 records = {r["case"]: r for r in sweep.rows}
@@ -291,6 +292,9 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
                 cases = more
         except SweepInterrupted as exc:
             stopped = exc.signum
+            if round_ is not None and round_.rows is not None and (sweep is None or sweep.rows is not round_.rows):
+                # the signal came after the round's cases, before run_sweep returned: its rows, not the round's before
+                sweep = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", round_.rows)
         finally:
             try:  # a signal while the engine stops is noted, not raised out of the study (a traceback, exit 1)
                 outer.hold()

@@ -44,16 +44,20 @@ _log = logging.getLogger(__name__)  # a failed case, when no progress bar shows 
 _CASE_NAME = re.compile(r"[0-9a-f]{16}")  # a case archive's name: its hash (spec.case_hash)
 
 
-@dataclass(frozen=True)
+@dataclass
 class StagedRound:
     """The cases of :func:`run_sweep` are a round of a staged study (:func:`bearingsim.studies.run_studies`):
     the study checks its folder itself (its later cases are not known before the earlier ones have run, so
     :func:`check_same_sweep` cannot tell its own earlier run from another study's); ``earlier``, the rows
     of the cases earlier rounds ran or took, by hash, are kept as they are (not read again from their
     archives, and a case run this time stays ``done``); and the engine is left started for the next round
-    (its workers keep the compiled model they have loaded), the caller stopping it."""
+    (its workers keep the compiled model they have loaded), the caller stopping it. ``rows``: set by
+    :func:`run_sweep` once it has read what the folder holds (the round's rows, which its cases then fill), so
+    that the caller has this round's rows when a signal ends the round after its cases ran but before
+    :func:`run_sweep` returned (the caller's own handler raising in it)."""
 
     earlier: dict = field(default_factory=dict)
+    rows: list | None = None
 
 
 class SweepInterrupted(Exception):
@@ -528,6 +532,8 @@ def _run_cases(engine, cases, rows, index, cases_dir, archives, progress, desc, 
             # stale: hashes of cases whose archive or row came from another version of the model
             todo, stale = _resume(cases, rows, cases_dir.parent, archives, staged.earlier if staged else None)
             resumed = True
+            if staged is not None:  # the round's rows from here on, however run_sweep ends (StagedRound)
+                staged.rows = rows
             index.write()
             counts = {"done": 0, "stale": 0, "failed": 0, "cached": 0}
             for r in rows:  # of the cases not to run: cached, or (a staged study's earlier rounds) run this time

@@ -470,11 +470,13 @@ def test_a_relative_clearance_limit_is_its_absolute_value_and_says_so(tmp_path, 
     assert plot_life(r_cols, r_attrs)._suptitle.get_text().startswith("life to clearance=2x (0.4 mm): ")
     assert "Life of wear_test_6000rpm to clearance=2x (0.4 mm)" in bearingsim.report(
         tmp_path / "rel", tmp_path / "rel.html", animation=None).read_text()
-    for folder, given, held in (("abs", "clearance=2x", "clearance=0.4mm; this one: --limit clearance=2x (0.4 mm)"),
-                                ("rel", "clearance=0.4mm", "clearance=2x (0.4 mm); this one: --limit clearance=0.4mm")):
+    for folder, given, held, again in (
+            ("abs", "clearance=2x", "clearance=0.4mm; this one: --limit clearance=2x (0.4 mm)", "clearance=0.4mm"),
+            ("rel", "clearance=0.4mm", "clearance=2x (0.4 mm); this one: --limit clearance=0.4mm", "clearance=2x")):
         assert main([*cmd, "--limit", given, "-o", str(tmp_path / folder)]) == 2
         err = capsys.readouterr().err
-        assert f"holds a life study of another limit ({held}); give another folder or --force" in err, err
+        assert (f"holds a life study of another limit ({held}); give --limit {again} to resume it, another folder, or "
+                f"--force to replace it") in err, err
         assert len(err.strip().splitlines()) == 1
     assert main([*cmd, "--limit", "clearance=2.0x", "-o", str(tmp_path / "rel")]) == 0
     assert read_life(tmp_path / "rel")[0]["reused"].tolist() == [1, 1]
@@ -540,7 +542,7 @@ def test_life_stages_are_monotone_reach_the_limit_and_resume(tmp_path, capsys, m
         if k != "reused":
             np.testing.assert_array_equal(again[k], cols[k])
     with pytest.raises(UserError, match=r"another limit \(clearance=0.203mm; this one: --limit clearance=0.204mm\); "
-                                        "give another folder or --force"):
+                                        "give --limit clearance=0.203mm to resume it, another folder, or --force"):
         run_life(sc, tmp_path, parse_limit("clearance=0.204mm"), stages=3, rotations=1, mapping=mapping)
     other = "shape" if mapping == "uniform" else "uniform"
     with pytest.raises(UserError, match=f"another wear mapping .*this one: {other}.*give --mapping {mapping} to resume"):
@@ -877,8 +879,9 @@ def test_life_folder_of_other_stages_or_rotations_is_refused_and_a_limit_in_othe
         assert main([*base, "--limit", "depth=0.1mm", *extra]) == 2
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1 and words in err[0] and "--force" in err[0], err
-        # a folder of another stage count (one of the earlier default, 10) says how to resume it
+        # a folder of another stage count (one of the earlier default, 10) or rotations says how to resume it
         assert ("give --stages 2 to resume it" in err[0]) == (extra[1] == "3"), err
+        assert ("give --rotations 1 to resume it" in err[0]) == (extra[3] == "2"), err
     assert main([*base, "--limit", "depth=100um", "--stages", "2", "--rotations", "1"]) == 0
     assert read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
 
@@ -1032,6 +1035,58 @@ def test_a_signal_right_after_a_later_stages_cases_counts_them(tmp_path, monkeyp
     monkeypatch.undo()
     assert main(cmd) == 0
     assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1, 1]
+
+
+@pytest.mark.slow
+def test_an_unfinished_life_study_resumes_with_its_own_options_only(tmp_path, monkeypatch, capsys):
+    """A life study interrupted after its first stage, before its life.h5 is written: resumed with another
+    --stages, --limit or --mapping it went on as another study over the first's stage (the folder check compared
+    stage 0 alone, which these do not change), and another --rotations was refused as "another sweep or study"
+    without naming --rotations. The case index records the study's options at its start (sweep.h5's root
+    attribute life_study): each is refused in one line naming the option and the value that resumes the folder's
+    study, the folder as it was; the same options resume it, reusing the stage."""
+    from bearingsim.cli import main
+    from bearingsim.studies import life
+
+    next_cases = life.LifeStudy.next_cases
+
+    def stopped(self, outdir, records):  # after stage 0, while the study reads its wear
+        cases = next_cases(self, outdir, records)
+        os.kill(os.getpid(), signal.SIGINT)
+        _wait_for_the_handler()
+        return cases
+
+    def cmd(stages="1", rotations="1", limit="clearance=0.203mm", mapping="shape"):
+        return ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", limit, "--stages", stages, "--rotations",
+                rotations, "--mapping", mapping, "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
+
+    monkeypatch.setattr(life.LifeStudy, "next_cases", stopped)
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)  # as a terminal user's Python has it
+    try:
+        assert main(cmd()) == 130
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    monkeypatch.undo()
+    capsys.readouterr()
+    index = tmp_path / "sweep.h5"
+    before = {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()}
+    assert not (tmp_path / "life.h5").exists() and len(list((tmp_path / "cases").iterdir())) == 1
+    for other, words in (({"stages": "2"}, "another number of stages (1; this one: --stages 2); give --stages 1 to "
+                                           "resume it"),
+                         ({"rotations": "2"}, "another number of rotations per stage (1; this one: --rotations 2); "
+                                              "give --rotations 1 to resume it"),
+                         ({"mapping": "uniform"}, "with another wear mapping (--mapping shape; this one: uniform); "
+                                                  "give --mapping shape to resume it"),
+                         ({"limit": "clearance=0.204mm"}, "another limit (clearance=0.203mm; this one: --limit "
+                                                          "clearance=0.204mm); give --limit clearance=0.203mm to "
+                                                          "resume it")):
+        assert main(cmd(**other)) == 2, other
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and f"{index}: holds an unfinished life study " in err[0] and words in err[0], err
+        assert "--force" in err[0], err
+        assert {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*") if p.is_file()} == before
+    assert main(cmd(limit="clearance=203um")) == 0, capsys.readouterr().err  # the same limit in other units
+    assert life.read_life(tmp_path / "life.h5")[0]["reused"].tolist() == [1]
 
 
 def _watch_stages(monkeypatch, marks, batch, on_next) -> None:

@@ -100,6 +100,12 @@ class Study:
         known yet, so the engine cannot tell its own earlier run from another study's
         (:func:`bearingsim.sweeps.run.check_same_sweep`); with ``force`` another study's files are removed."""
 
+    def index_attrs(self) -> dict:
+        """Root attributes a staged study records in the folder's case index (``sweep.h5``) from its first round
+        on, before any case runs: what its :meth:`check_folder` reads of an earlier run stopped before the study
+        wrote its table ({} by default)."""
+        return {}
+
     def finish(self, outdir: Path, records: dict[str, dict]) -> list[Path]:
         """Build the table from the cases' records (``records[hash]``: a row of the case index with
         ``status``, ``error``, ``archive`` relative to ``outdir``, ``summary``), write it and the
@@ -273,11 +279,12 @@ def _run_rounds(studies, cases: list[Case], outdir: Path, engine, lock, options:
     # between rounds too (a staged study computing its next cases), SIGINT/SIGTERM/SIGHUP end the study as one
     # during a round does: the finished cases kept, the same command resumes
     staged = any(s.staged for s in studies)
+    recorded = {k: v for s in studies if s.staged for k, v in s.index_attrs().items()}  # in every round's index
     stopped = None  # the signal that stopped the rounds
     with _Signals() as outer:
         try:
             while True:  # a staged study's rounds share the engine: its workers keep the model they loaded
-                round_ = StagedRound(earlier) if staged else None
+                round_ = StagedRound(earlier, meta=recorded) if staged else None
                 sweep = run_sweep(cases, outdir, engine=engine, figures=False, lock=lock, desc=desc, archives="all",
                                   staged=round_, **options)  # tables and figures are made from the cases' archives
                 if sweep.interrupted is not None or sweep.failed:

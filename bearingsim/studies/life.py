@@ -46,6 +46,9 @@ from bearingsim.studies.engine import Study, case_of, load_result
 from bearingsim.wording import by_kind, counted, run_notes
 
 LIFE_FORMAT = "bearingsim life"
+#: the root attribute of a life study's case index (``sweep.h5``) that holds the study's options from its start
+#: (:meth:`LifeStudy.index_attrs`, JSON), which its folder check reads while no ``life.h5`` is written
+INDEX_ATTR = "life_study"
 #: limit kinds and the unit of each in the --limit text (SI factor)
 LIMIT_UNITS = {"depth": {"mm": 1e-3, "um": 1e-6}, "clearance": {"mm": 1e-3, "um": 1e-6},
                "volume": {"mm3": 1e-9}}
@@ -166,6 +169,20 @@ def _relative_limit(text: str, kind: str, num: str) -> Limit:
         raise UserError(f"--limit {text!r}: give a finite factor above 1 before the x (clearance=2x: the effective "
                         f"pocket clearance twice its value at the start)")
     return Limit(kind, math.nan, text.strip(), factor)
+
+
+def recorded_options(meta: dict) -> dict | None:
+    """The options of a life study that a case index's attributes ``meta`` record (:data:`INDEX_ATTR`), as a
+    ``life.h5``'s attributes hold them (:meth:`LifeStudy.options`); None when it records none (another sweep or
+    study, or a life study of a bearingsim that did not record them) or none that reads."""
+    import json
+
+    try:
+        held = json.loads(str(meta.get(INDEX_ATTR) or ""))
+    except ValueError:
+        return None
+    keys = ("limit", "stages", "rotations", "scenario", "mapping")
+    return held if isinstance(held, dict) and all(k in held for k in keys) else None
 
 
 def held_limit(text: str) -> Limit | None:
@@ -510,13 +527,26 @@ class LifeStudy(Study):
         archive.write_table_file(outdir / "life.h5", cols, LIFE_UNITS, attrs, LIFE_DESCRIPTIONS)
         return [outdir / "life.h5", save_figure(plot_life(cols, attrs), outdir / "life.png")]
 
+    def options(self) -> dict:
+        """The study's options, as its history's attributes hold them and :meth:`_differs` compares them: the limit
+        (:attr:`Limit.shown`), the stages, the recorded rotations per stage, the scenario (with those rotations)
+        and the wear mapping."""
+        return {"limit": self.limit.shown, "stages": self.planned, "rotations": self.stage_rotations,
+                "scenario": self.scenario.to_toml(), "mapping": self.mapping}
+
+    def index_attrs(self) -> dict:
+        """The study's options (:meth:`options`, as JSON) in the case index's root attribute :data:`INDEX_ATTR`,
+        written before its first stage runs: a folder whose ``life.h5`` is not written yet (the study interrupted,
+        or a stage failed) is resumed with these options only (:meth:`check_folder`)."""
+        import json
+
+        return {INDEX_ATTR: json.dumps(self.options(), sort_keys=True)}
+
     def attrs(self) -> dict:
-        """The history's attributes (``life.h5``): the study, ``worn_through`` when the cage bar wore
-        through before the limit (what reached its width; the time is the last stage's end), and for a clearance
-        limit ``life_error_h``, the life's sampling error (:func:`life_error`)."""
-        attrs = {"format": LIFE_FORMAT, "limit": self.limit.shown, "stages": self.planned,
-                 "rotations": self.stage_rotations, "scenario": self.scenario.to_toml(), "mapping": self.mapping,
-                 "mapping_text": MAPPINGS[self.mapping]}
+        """The history's attributes (``life.h5``): the study (:meth:`options`), ``worn_through`` when the cage bar
+        wore through before the limit (what reached its width; the time is the last stage's end), and for a
+        clearance limit ``life_error_h``, the life's sampling error (:func:`life_error`)."""
+        attrs = {"format": LIFE_FORMAT, **self.options(), "mapping_text": MAPPINGS[self.mapping]}
         if self.worn_through:
             attrs["worn_through"] = self.worn_through
         error = life_error(self.columns()) if self.rows else math.nan
@@ -544,16 +574,40 @@ class LifeStudy(Study):
             return f"number of rotations per stage ({attrs['rotations']}; this one: --rotations {self.stage_rotations})"
         return ""
 
+    def _other_study(self, path: Path, attrs: dict, study: str) -> str | None:
+        """The refusal of the life study whose options ``attrs`` holds (a ``life.h5``'s attributes, or those its
+        case index recorded: :func:`recorded_options`; ``path``: the file, ``study``: what it holds) when it is not
+        this one (:meth:`_differs`, the mapping), naming the option and the value that resumes it; None when it is
+        this one."""
+        what = self._differs(attrs)
+        held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
+        again = "to resume it, another folder, or --force to replace it"
+        limit = held_limit(attrs.get("limit", ""))
+        if what.startswith("number of stages") and "stages" in attrs:  # e.g. one of the earlier default, 10
+            return f"{path}: holds {study} of another {what}; give --stages {int(attrs['stages'])} {again}"
+        if what.startswith("number of rotations"):
+            return f"{path}: holds {study} of another {what}; give --rotations {int(attrs['rotations'])} {again}"
+        if what.startswith("limit") and limit is not None:
+            return f"{path}: holds {study} of another {what}; give --limit {limit.text} {again}"
+        if what:
+            return f"{path}: holds {study} of another {what}; give another folder or --force"
+        if held != self.mapping:
+            return (f"{path}: holds {study} with another wear mapping (--mapping {held}; this one: "
+                    f"{self.mapping}); give --mapping {held} {again}")
+        return None
+
     @property
     def stage_rotations(self) -> int:
         """The recorded cage rotations of each stage (``--rotations``, or the scenario's)."""
         return int(self.rotations or self.scenario.numerics.rotations)
 
     def check_folder(self, outdir: Path, force: bool) -> None:
-        """Refuse a folder that holds another life study (another scenario, limit or mapping in its
-        ``life.h5``) or another sweep or study (a case index without this study's first stage), unless
-        ``force``: then that study's files are removed. This study interrupted before its ``life.h5`` was
-        written (its first stage in the index) resumes."""
+        """Refuse a folder that holds another life study (another scenario, limit, number of stages, rotations per
+        stage or mapping in its ``life.h5``, or, before that is written, in its case index's :data:`INDEX_ATTR`,
+        which the study records at its start) or another sweep or study (a case index without this study's first
+        stage), unless ``force``: then that study's files are removed. This study interrupted before its
+        ``life.h5`` was written resumes. A refusal names the option that differs and, where one value resumes the
+        folder's study, that value."""
         from bearingsim import archive
         from bearingsim.sweeps.index import INDEX_FORMAT, read_index
 
@@ -561,21 +615,15 @@ class LifeStudy(Study):
         index = outdir / "sweep.h5"
         other = None
         if path.exists():
-            _, attrs = archive.read_table_file(path, LIFE_FORMAT)
-            held = attrs.get("mapping", "uniform")  # a history without one predates the shape mapping
-            what = self._differs(attrs)
-            if what.startswith("number of stages") and "stages" in attrs:  # e.g. one of the earlier default, 10
-                other = (f"{path}: holds a life study of another {what}; give --stages {attrs['stages']} to resume "
-                         f"it, another folder, or --force to replace it")
-            elif what:
-                other = f"{path}: holds a life study of another {what}; give another folder or --force"
-            elif held != self.mapping:
-                other = (f"{path}: holds a life study with another wear mapping (--mapping {held}; this one: "
-                         f"{self.mapping}); give --mapping {held} to resume it, another folder, or --force")
-        elif (archive.is_table_file(index, INDEX_FORMAT)
-              and self.stage_cases[0].hash not in {str(h) for h in read_index(index)[0]["case"]}):
-            other = (f"{outdir}: holds another sweep or study (its case index has not this life study's first "
-                     f"stage); not mixed in: give another folder, or add --force to replace it")
+            other = self._other_study(path, archive.read_table_file(path, LIFE_FORMAT)[1], "a life study")
+        elif archive.is_table_file(index, INDEX_FORMAT):
+            cols, meta = read_index(index)
+            held = recorded_options(meta)
+            if held is not None:  # the options the study recorded at its start
+                other = self._other_study(index, held, "an unfinished life study")
+            elif self.stage_cases[0].hash not in {str(h) for h in cols["case"]}:
+                other = (f"{outdir}: holds another sweep or study (its case index has not this life study's first "
+                         f"stage); not mixed in: give another folder, or add --force to replace it")
         if other is None:
             return
         if not force:

@@ -20,7 +20,8 @@ NaN where a case has no value; text as UTF-8), the column order in the attribute
 swept key in ``axes``, the grid's axes in ``grid`` (JSON lists), the sweep ``mode`` (``product`` or
 ``zip``), ``grid_rows`` (the grid's cases come first; explicit extra cases follow) and, for a sweep of a
 scenario, ``scenario_toml``: its base scenario resolved, with the sweep's ``--set`` applied (``scenario``
-is the scenario file's path). Both files are written to a temporary name and renamed.
+is the scenario file's path); a staged study adds its own (a life study's options, ``life_study``:
+:data:`bearingsim.studies.life.INDEX_ATTR`). Both files are written to a temporary name and renamed.
 """
 from __future__ import annotations
 

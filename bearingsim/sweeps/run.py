@@ -54,10 +54,13 @@ class StagedRound:
     (its workers keep the compiled model they have loaded), the caller stopping it. ``rows``: set by
     :func:`run_sweep` once it has read what the folder holds (the round's rows, which its cases then fill), so
     that the caller has this round's rows when a signal ends the round after its cases ran but before
-    :func:`run_sweep` returned (the caller's own handler raising in it)."""
+    :func:`run_sweep` returned (the caller's own handler raising in it). ``meta``: root attributes the study
+    adds to the case index (``sweep.h5``), written with it from the round's start (a life study's options,
+    which its folder check reads before its history is written)."""
 
     earlier: dict = field(default_factory=dict)
     rows: list | None = None
+    meta: dict = field(default_factory=dict)
 
 
 class SweepInterrupted(Exception):
@@ -477,7 +480,7 @@ def run_sweep(spec: SweepSpec | list[Case], outdir: str | Path, *, engine=None, 
     rows = _pending_rows(cases)
     outcome = SweepOutcome(outdir, outdir / "sweep.csv", outdir / "sweep.h5", rows,
                            map=outdir / MAP_NAME if grid else None)
-    index = IndexWriter(outdir, rows, keys, meta)
+    index = IndexWriter(outdir, rows, keys, {**meta, **(staged.meta if staged else {})})  # a staged study's own too
     with lock if own else contextlib.nullcontext():
         outcome.interrupted = _run_cases(engine, cases, rows, index, outdir / "cases", archives, progress, desc, log,
                                          lambda: write_map(outcome.map, grid, index.columns, map_attrs) if grid else None,

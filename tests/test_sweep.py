@@ -763,6 +763,30 @@ def test_a_users_file_in_cases_is_not_another_sweeps_case(tmp_path):
         ["notes.h5"] + [str(a).split("/")[-1] for a in read_index(tmp_path / "sweep.h5")[0]["archive"]])
 
 
+def test_a_users_hdf5_file_named_like_a_case_archive_is_no_case_and_force_keeps_it(tmp_path):
+    """A user's HDF5 file in DIR/cases/ named as a case archive is (16 hex digits, not one of the sweep's cases)
+    was counted as a case of another sweep: the same sweep's resume was refused, and --force removed the file.
+    Only bearingsim's archives are other sweeps' cases: the resume takes its cases beside it, another sweep's
+    archive still refuses a sweep without --force, and --force removes that archive and keeps the user's file."""
+    from bearingsim.errors import UserError
+
+    first = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 2000])])
+    run_sweep(first, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    mine = tmp_path / "cases" / "0123456789abcdef.h5"
+    with h5py.File(mine, "w") as f:
+        f["data"] = np.arange(3.0)
+    held = mine.read_bytes()
+    again = run_sweep(first, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    assert again.count("cached") == 2
+    other = SweepSpec(scenario=BASE, axes=[(SPEED, [1000, 3000])])
+    with pytest.raises(UserError, match=r"holds another sweep or study \(1 case of its 2 is not in this one\)"):
+        run_sweep(other, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all")
+    run_sweep(other, tmp_path, engine=LocalEngine(1), figures=False, progress=False, archives="all", force=True)
+    assert mine.read_bytes() == held
+    assert sorted(p.name for p in (tmp_path / "cases").iterdir()) == sorted(
+        [mine.name] + [str(a).split("/")[-1] for a in read_index(tmp_path / "sweep.h5")[0]["archive"]])
+
+
 def test_a_sweep_refused_for_an_edited_scenario_file_names_the_keys_not_the_same_command(tmp_path):
     """The same command line run again after its scenario file was edited (every case's hash moved) was refused
     with '(the same command as before resumes it)': the command just run. The refusal now names the base

@@ -1152,11 +1152,14 @@ def test_a_failed_stage_ends_the_life_study_keeping_the_stages_before_it(tmp_pat
 def test_life_refuses_a_folder_of_another_sweep_unless_forced(tmp_path, capsys):
     """A life study's later stages are not known before they run, so it tells its own earlier run (its first
     stage in the folder's case index) from another sweep or study itself: another is refused in one line and
-    left as it was; with --force it is replaced."""
+    left as it was; with --force it is replaced, its case archives removed and a user's file in cases/ kept (it
+    removed every cases/*.h5)."""
     from bearingsim.cli import main
 
     assert main(["sweep", str(SCENARIOS / "paper_3000rpm.toml"), "--param", "operating.inner_ring_speed_rpm=1000,2000",
-                 "-q", "--no-plots", "-o", str(tmp_path)]) == 0
+                 "-q", "--no-plots", "--archives", "all", "-o", str(tmp_path)]) == 0
+    mine = tmp_path / "cases" / "notes.h5"
+    mine.write_bytes(b"mine")
     before = sorted(p.name for p in tmp_path.iterdir())
     cmd = ["life", str(SCENARIOS / "wear_test_6000rpm.toml"), "--limit", "clearance=0.201mm", "--stages", "1",
            "--rotations", "1", "-q", "--set", "multibody.raceway_contact=rigid", "-o", str(tmp_path)]
@@ -1168,7 +1171,8 @@ def test_life_refuses_a_folder_of_another_sweep_unless_forced(tmp_path, capsys):
     from bearingsim.sweeps.index import read_index
 
     assert read_index(tmp_path / "sweep.h5")[0]["stage"].tolist() == [0]
-    assert len(list((tmp_path / "cases").iterdir())) == 1
+    assert mine.read_bytes() == b"mine"
+    assert [p for p in (tmp_path / "cases").iterdir() if p != mine] == [_stage_path(tmp_path, 0)]
 
 
 @pytest.mark.slow

@@ -628,10 +628,12 @@ class LifeStudy(Study):
             return
         if not force:
             raise UserError(other)
-        from bearingsim.outputs import remove_folder_files
+        from bearingsim.outputs import _remove_if_own, remove_folder_files
+        from bearingsim.sweeps.run import _CASE_NAME
 
-        for p in outdir.glob("cases/*.h5"):
-            p.unlink()
+        for p in outdir.glob("cases/*.h5"):  # case archives, bearingsim's only: a user's file there stays
+            if _CASE_NAME.fullmatch(p.stem):
+                _remove_if_own(p, archive.is_archive)
         remove_folder_files(outdir)
 
 

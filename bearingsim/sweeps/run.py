@@ -250,7 +250,11 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, base_
                     if not (k < len(status) and status[k] in ("failed", "pending"))}
     cases_dir = outdir / "cases"
     if cases_dir.is_dir() and not cases_dir.is_symlink():
-        old |= _case_archives(cases_dir)
+        # a file of the new sweep's cases is judged by its resume (_replaceable_archive); of the others, only
+        # bearingsim's archives are another sweep's cases (a user's HDF5 file named by a hash is neither counted
+        # nor removed by --force)
+        old |= {h for h in _case_archives(cases_dir) if h in new or h in old
+                or archive.is_archive(cases_dir / f"{h}.h5")}
     other = old - new
     if not other:
         return
@@ -260,7 +264,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, base_
                         f"{verb} not in this one); not mixed in: give another -o folder, or add --force to replace it "
                         f"{_base_changed(old_base, base_toml, index) or _resume_hint(other, versions)}")
     for h in other:
-        _remove_if_own(cases_dir / f"{h}.h5", _HDF5_SIGNATURE)
+        _remove_if_own(cases_dir / f"{h}.h5", archive.is_archive)
     remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
 
 

@@ -703,7 +703,8 @@ def _add_run_commands(sub) -> None:
     tb.add_argument("--columns", metavar="KEY,...",
                     help="summary keys to show (default: I_dec_mean_Ns, I_acc_mean_Ns, first_impact_speed_m_s, "
                          "cage_slip, cage_rest_angle_deg, load_zone_half_angle_deg, wear_front_mean_m3_h, "
-                         "wear_rear_mean_m3_h, those present); not for a "
+                         "wear_rear_mean_m3_h, those present), each by its key or the name its column shows "
+                         "(I_dec_mean); not for a "
                          "study's own table")
     tb.set_defaults(func=_cmd_table)
 

@@ -409,6 +409,16 @@ def column_keys(table: Table) -> list[str]:
     return list(table.numbers)
 
 
+def shown_key(table: Table, name: str) -> str:
+    """The summary key of column ``name`` as ``--columns`` gives it: the key itself (``I_dec_mean_Ns``), or the
+    name the table's header shows for it, without its unit (``I_dec_mean``, ``cage_rest_angle``,
+    ``wear_rear_mean``), when exactly one of the table's numbers has that name; any other name as given."""
+    if name in table.numbers:
+        return name
+    keys = [k for k in table.numbers if _bare(k) == name]
+    return keys[0] if len(keys) == 1 else name
+
+
 def format_table(table: Table, columns=None, max_rows: int | None = None) -> str:
     """The table as aligned text: label columns left-aligned, number columns right-aligned, the rule
     of the marks below it when a column has standard errors. ``columns``: summary keys to show
@@ -416,6 +426,7 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
     saying how many are left out)."""
     if columns:
         accepted = column_keys(table)
+        columns = [shown_key(table, k) for k in columns]
         missing = [k for k in columns if k not in accepted]
         if missing:
             raise UserError(f"--columns: {', '.join(missing)}: not a number of these runs (they have: "

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pydantic import BaseModel
 
 from bearingsim.sweeps.index import DRAG_COEFFICIENT_UNIT, unit_of
+from bearingsim.wording import KEY_TOPICS
 
 #: the sources of the package defaults that have one (bearingsim/scenario.py DEFAULTS, beside each value)
 DEFAULT_SOURCES = {
@@ -40,25 +41,8 @@ DEFAULT_REASONS = {
 #: the units of the keys whose names carry none (:func:`bearingsim.sweeps.index.unit_of` reads a name's suffix):
 #: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md)
 KEY_UNITS = {"lubrication.drag_coefficient": DRAG_COEFFICIENT_UNIT}
-#: words an engineer looks for that no key's name holds: the keys through which they enter, and how
-#: (``bearingsim keys WORD`` answers with those keys and this line)
-TOPICS = {
-    "viscosity": (("lubrication.drag_coefficient",), "a lubricant's viscosity enters through Eq. (2)'s c, as "
-                  "c' = c (eta'/eta)^0.648 (docs/whatif.md, Lubricant)"),
-    "oil": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
-            "an oil enters through the oil-film drag's c and the raceways' traction curve (docs/whatif.md, "
-            "Lubricant)"),
-    "lubricant": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
-                  "a lubricant enters through the oil-film drag's c and the raceways' traction curve "
-                  "(docs/whatif.md, Lubricant)"),
-    "material": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "contact.restitution", "contact.cage_friction",
-                  "contact.land_friction", "wear.wear_coefficient", "wear.hardness_Pa"),
-                 "a cage material enters through the cage's mass and inertia (its density), the roller-cage "
-                 "restitution and friction, and Archard's coefficient and hardness (docs/whatif.md, Cage material)"),
-    "density": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2"),
-                "the cage's density enters through its mass and inertia, both in proportion (docs/whatif.md, "
-                "Cage material)"),
-}
+#: words an engineer looks for that no key's name holds (:data:`bearingsim.wording.KEY_TOPICS`)
+TOPICS = KEY_TOPICS
 #: what a key counts, in the table's source column: these count the cage's rotations, not the inner ring's
 #: (which turns inner-ring speed / cage speed times as often)
 KEY_MEANINGS = {

@@ -1129,9 +1129,29 @@ def is_integer_key(key: str) -> bool:
     return int in kinds and float not in kinds
 
 
+#: the parts of a key's name that are its unit (``_mm``, ``_kg``), which name no quantity
+_UNIT_WORDS = frozenset({"mm", "um", "kg", "kgm2", "n", "s", "pa", "deg", "hz"})
+
+
+def _words(name: str) -> frozenset:
+    """The words of a key's name that name its quantity, singular (``pocket_clearance_mm``: pocket, clearance;
+    ``rollers``: roller)."""
+    words = (w for w in name.lower().split("_") if w and w not in _UNIT_WORDS)
+    return frozenset(w[:-1] if len(w) > 3 and w.endswith("s") and not w.endswith(("ss", "us")) else w for w in words)
+
+
+def _one_of(keys: list, last: str = "or") -> str:
+    """``a``, ``a or b``, ``a, b or c``."""
+    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} {last} {keys[-1]}"
+
+
 def did_you_mean(key: str) -> str:
     """`` (did you mean X?)`` for the accepted key closest to an unknown ``key`` (difflib), or ``""``; a ``key``
-    that is the last part of exactly one accepted key (``rotations``: ``numerics.rotations``) names that key."""
+    that is the last part of exactly one accepted key (``rotations``: ``numerics.rotations``) names that key. A
+    ``key`` that is no misspelling of a key beside it but names words of keys' names (``bearing.clearance``,
+    ``contact.friction``) names every key that holds them (``did you mean X, Y or Z?``), of its section or, when
+    none there does, of any; a word no key's name holds that ``bearingsim keys`` answers (:data:`bearingsim.wording.KEY_TOPICS`:
+    ``bearing.cage_material``) names the keys it enters through."""
     import difflib
 
     known = known_keys()
@@ -1140,6 +1160,22 @@ def did_you_mean(key: str) -> str:
         return f" (did you mean {ending[0]}?)"
     section, _, leaf = key.rpartition(".")
     same = [k for k in known if k.rpartition(".")[0] == section]  # the keys beside it (or the top level)
+    near = difflib.get_close_matches(leaf, [k.rpartition(".")[2] for k in same], n=1, cutoff=0.8)
+    if near:  # a misspelling of one key beside it
+        return f" (did you mean {section + '.' if section else ''}{near[0]}?)"
+    words = _words(leaf)
+    if words:  # a key named by its words (clearance, friction, load): every key of the section that holds them
+        holding = [k for k in same if words <= _words(k.rpartition(".")[2])]
+        if not holding and section:  # the right words in the wrong section
+            holding = [k for k in known if "." in k and words <= _words(k.rpartition(".")[2])]
+        if holding:
+            return f" (did you mean {_one_of(holding)}?)"
+        from bearingsim.wording import KEY_TOPICS
+
+        topic = next((w for w in sorted(words) if w in KEY_TOPICS), None)
+        if topic:  # a word no key's name holds (material, viscosity): the keys it enters through
+            keys, how = KEY_TOPICS[topic]
+            return f" ({topic!r} is in no key's name: {how}: {_one_of(list(keys), 'and')})"
     close = [f"{section}.{m}" if section else m for m in difflib.get_close_matches(
         leaf, [k.rpartition(".")[2] for k in same], n=1, cutoff=0.6)]
     if not close:  # the right name in the wrong section

@@ -6,6 +6,28 @@ import numbers
 import re
 
 
+#: words an engineer looks for that no key's name holds: the keys through which they enter, and how
+#: (``bearingsim keys WORD`` answers with those keys and this line, and an unknown key holding the word,
+#: :func:`bearingsim.scenario.did_you_mean`, names them)
+KEY_TOPICS = {
+    "viscosity": (("lubrication.drag_coefficient",), "a lubricant's viscosity enters through Eq. (2)'s c, as "
+                  "c' = c (eta'/eta)^0.648 (docs/whatif.md, Lubricant)"),
+    "oil": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+            "an oil enters through the oil-film drag's c and the raceways' traction curve (docs/whatif.md, "
+            "Lubricant)"),
+    "lubricant": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+                  "a lubricant enters through the oil-film drag's c and the raceways' traction curve "
+                  "(docs/whatif.md, Lubricant)"),
+    "material": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "contact.restitution", "contact.cage_friction",
+                  "contact.land_friction", "wear.wear_coefficient", "wear.hardness_Pa"),
+                 "a cage material enters through the cage's mass and inertia (its density), the roller-cage "
+                 "restitution and friction, and Archard's coefficient and hardness (docs/whatif.md, Cage material)"),
+    "density": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2"),
+                "the cage's density enters through its mass and inertia, both in proportion (docs/whatif.md, "
+                "Cage material)"),
+}
+
+
 #: how the command line prints a run's note (:func:`bearingsim.plausibility.check`); the stored note keeps it
 NOTE_PREFIX = "bearingsim: note: "
 

@@ -39,6 +39,49 @@ def test_unknown_key_in_set_gets_the_closest_key(tmp_path, setting, hint):
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("key, hint", [
+    ("bearing.clearance", " (did you mean bearing.pocket_clearance_mm, bearing.radial_clearance_mm or "
+                          "bearing.cage_land_clearance_mm?)"),
+    ("contact.friction", " (did you mean contact.cage_friction or contact.land_friction?)"),
+    ("operating.load", " (did you mean operating.radial_load_N?)"),
+    ("operating.speed", " (did you mean operating.inner_ring_speed_rpm?)"),
+    ("lubrication.drag", " (did you mean lubrication.drag_coefficient?)"),
+    ("bearing.rollers", " (did you mean bearing.roller_count, bearing.roller_diameter_mm, bearing.roller_length_mm "
+                        "or bearing.roller_mass_kg?)"),
+    ("bearing.friction", " (did you mean contact.cage_friction or contact.land_friction?)"),  # wrong section
+    # misspellings as before
+    ("numerics.rotation", " (did you mean numerics.rotations?)"),
+    ("operating.inner_ring_sped_rpm", " (did you mean operating.inner_ring_speed_rpm?)"),
+    ("bearing.no_such_key", ""),
+])
+def test_unknown_key_named_by_a_word_gets_every_key_that_holds_it(key, hint):
+    """A key named by a word of the keys' names got difflib's one closest key, which was often the wrong one
+    (`bearing.clearance` -> bearing.radial_clearance_mm, the pocket clearance being what a clearance study
+    means; `contact.friction` -> contact.land_friction, not the roller-cage friction), or none (`operating.load`,
+    `operating.speed`, `lubrication.drag`). Every key that holds the words is named."""
+    from bearingsim.scenario import did_you_mean, known_keys
+
+    assert did_you_mean(key) == hint
+    named = hint.removeprefix(" (did you mean ").removesuffix("?)").replace(" or ", ", ").split(", ")
+    assert not hint or set(named) <= set(known_keys())
+
+
+def test_unknown_key_with_a_word_no_keys_name_holds_gets_the_keys_it_enters_through():
+    """`--set bearing.cage_material=...` said "did you mean bearing.cage_inertia_kgm2?" (difflib's closest); a word
+    `bearingsim keys` answers (material, viscosity) gets the keys it enters through, as `bearingsim keys WORD`."""
+    from bearingsim.errors import UserError
+    from bearingsim.keys import TOPICS
+
+    with pytest.raises(UserError) as err:
+        load_scenario(PAPER, ["bearing.cage_material=1"])
+    message = str(err.value)
+    assert message.endswith("bearing.cage_material: unknown key ('material' is in no key's name: "
+                            f"{TOPICS['material'][1]}: bearing.cage_mass_kg, bearing.cage_inertia_kgm2, "
+                            "contact.restitution, contact.cage_friction, contact.land_friction, "
+                            "wear.wear_coefficient and wear.hardness_Pa)"), message
+    assert "cage_inertia_kgm2?" not in message and "\n" not in message
+
+
 def test_dry_run_with_no_plots_does_not_promise_figures(tmp_path):
     """`run --dry-run --no-plots` said the run would write the archive 'and its figures beside it'."""
     res = cli("run", PAPER, "--dry-run", "--no-plots", cwd=tmp_path)

@@ -254,10 +254,16 @@ def _is_number(kind: str) -> bool:
 
 
 def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = False) -> str:
-    """The keys as an aligned table (``pattern``: only keys containing it); with ``why``, the preset's
+    """The keys as an aligned table (``pattern``: only keys containing it, or, when none does, whose names hold
+    its words: ``roller count``, ``rollers``); with ``why``, the preset's
     reasoning for each of its values and each package default it documents on the line below it, after what
     :data:`KEY_WHY` says of the key."""
     rows = [k for k in keys if not pattern or pattern.lower() in k.key.lower()]
+    if pattern and not rows:  # the words of a name, as an engineer types them: "roller count", "rollers"
+        from bearingsim.scenario import key_words
+
+        words = key_words(pattern.strip().replace(" ", "_").replace(".", "_"))
+        rows = [k for k in keys if words and words <= key_words(k.key.replace(".", "_"))]
     topic = TOPICS.get(pattern.strip().lower()) if pattern and not rows else None
     if topic:  # a word no key's name holds: the keys it enters through, and how
         rows = [k for k in keys if k.key in topic[0]]

@@ -1133,7 +1133,7 @@ def is_integer_key(key: str) -> bool:
 _UNIT_WORDS = frozenset({"mm", "um", "kg", "kgm2", "n", "s", "pa", "deg", "hz"})
 
 
-def _words(name: str) -> frozenset:
+def key_words(name: str) -> frozenset:
     """The words of a key's name that name its quantity, singular (``pocket_clearance_mm``: pocket, clearance;
     ``rollers``: roller)."""
     words = (w for w in name.lower().split("_") if w and w not in _UNIT_WORDS)
@@ -1163,11 +1163,11 @@ def did_you_mean(key: str) -> str:
     near = difflib.get_close_matches(leaf, [k.rpartition(".")[2] for k in same], n=1, cutoff=0.8)
     if near:  # a misspelling of one key beside it
         return f" (did you mean {section + '.' if section else ''}{near[0]}?)"
-    words = _words(leaf)
+    words = key_words(leaf)
     if words:  # a key named by its words (clearance, friction, load): every key of the section that holds them
-        holding = [k for k in same if words <= _words(k.rpartition(".")[2])]
+        holding = [k for k in same if words <= key_words(k.rpartition(".")[2])]
         if not holding and section:  # the right words in the wrong section
-            holding = [k for k in known if "." in k and words <= _words(k.rpartition(".")[2])]
+            holding = [k for k in known if "." in k and words <= key_words(k.rpartition(".")[2])]
         if holding:
             return f" (did you mean {_one_of(holding)}?)"
         from bearingsim.wording import KEY_TOPICS

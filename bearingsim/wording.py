@@ -18,6 +18,9 @@ KEY_TOPICS = {
     "lubricant": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
                   "a lubricant enters through the oil-film drag's c and the raceways' traction curve "
                   "(docs/whatif.md, Lubricant)"),
+    "grease": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+               "a grease enters through the oil-film drag's c (the paper's c = 0.02 is its fit to a lithium-complex "
+               "grease) and the raceways' traction curve (docs/whatif.md, Lubricant)"),
     "material": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "contact.restitution", "contact.cage_friction",
                   "contact.land_friction", "wear.wear_coefficient", "wear.hardness_Pa"),
                  "a cage material enters through the cage's mass and inertia (its density), the roller-cage "

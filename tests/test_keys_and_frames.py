@@ -265,6 +265,8 @@ def test_keys_gives_the_unit_of_eq_2s_drag_coefficient():
 
 
 @pytest.mark.parametrize("word, keys", [("viscosity", {"lubrication.drag_coefficient"}),
+                                        ("grease", {"lubrication.drag_coefficient", "multibody.traction_mu_max",
+                                                    "multibody.traction_slip_ref"}),
                                         ("Oil", {"lubrication.drag_coefficient", "multibody.traction_mu_max",
                                                  "multibody.traction_slip_ref"}),
                                         ("material", {"bearing.cage_mass_kg", "bearing.cage_inertia_kgm2",
@@ -284,6 +286,23 @@ def test_keys_answers_a_word_no_keys_name_holds_with_the_keys_it_enters_through(
     assert lines[1].split()[:2] == ["key", "unit"]
     assert {ln.split()[0] for ln in lines[2:]} == keys
     assert format_keys(list_keys(), "no_such_thing") == ""
+
+
+@pytest.mark.parametrize("words, keys", [("roller count", ["bearing.roller_count"]),
+                                         ("pocket clearance", ["bearing.pocket_clearance_mm"]),
+                                         ("Cage Mass", ["bearing.cage_mass_kg"]),
+                                         ("rollers", ["bearing.roller_count", "bearing.roller_diameter_mm",
+                                                      "bearing.roller_length_mm", "bearing.roller_mass_kg"])])
+def test_keys_finds_a_key_by_the_words_of_its_name(words, keys):
+    """`bearingsim keys "roller count"` (or `rollers`, `"pocket clearance"`) was refused: "no scenario key contains
+    it", the key being bearing.roller_count. A text no key contains gets the keys whose names hold its words
+    (singular, any case); a text whose words no key holds is still refused (empty table)."""
+    from bearingsim.keys import format_keys, list_keys
+
+    lines = format_keys(list_keys(), words).splitlines()
+    assert lines[0].split()[:2] == ["key", "unit"]
+    assert [ln.split()[0] for ln in lines[1:]] == keys
+    assert format_keys(list_keys(), "roller colour") == ""
 
 
 # --- the resolved scenario before a run ------------------------------------------------------------------

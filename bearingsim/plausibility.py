@@ -175,7 +175,7 @@ def check(result) -> list[str]:
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
                 f"for this load and clearance; {_advice(result)}")
         for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result), _pinched_note(result),
-                     land_overlap_note(result), _rigid_kinematic_note(result)):
+                     land_overlap_note(result), land_untouched_note(result), _rigid_kinematic_note(result)):
             if note is not None:
                 notes.append(note)
         orbit = result.get("cage_orbit")
@@ -195,6 +195,24 @@ def check(result) -> list[str]:
                 raise SimulationUnstable(newton_refusal(p, fails, steps))
             notes.append(NEWTON_NOTE.format(fails=fails, steps=steps, share=fails / steps))
     return notes
+
+
+def land_untouched_note(result) -> str | None:
+    """The note of a land-guided cage that never touched its land over the recorded rotations (summary
+    ``land_normal_impulse_mean_Ns`` 0): its rollers held it within half its land clearance, so the run is a
+    roller-guided cage's, its numbers those of ``bearing.cage_guidance = "rollers"`` (docs/whatif.md: from a land
+    clearance of about 0.40 mm up on the reference bearing)."""
+    p = result.parameters
+    impulse = result.summary.get("land_normal_impulse_mean_Ns")
+    if impulse is None or impulse != 0.0 or p.bearing.cage_guidance == "rollers" or not p.bearing.cage_land_clearance:
+        return None
+    half = 0.5 * p.bearing.cage_land_clearance
+    offset = result.summary.get("cage_rest_offset_m")
+    held = f", {offset * 1e6:.3g} um off the axis" if offset is not None and math.isfinite(offset) else ""
+    return (f"bearingsim: note: the cage never touched its {p.bearing.cage_guidance.replace('_', ' ')} over the "
+            f"recorded rotations (land_normal_impulse_mean_Ns = 0): its rollers held it{held}, within half its land "
+            f"clearance ({half * 1e6:.3g} um, bearing.cage_land_clearance_mm = {p.bearing.cage_land_clearance * 1e3:g}), "
+            f"so the run is a roller-guided cage's; a smaller land clearance guides it on its land (docs/whatif.md)")
 
 
 def land_overlap_note(result) -> str | None:

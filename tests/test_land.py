@@ -215,3 +215,30 @@ def test_land_overlap_beyond_the_design_bound_is_noted():
     outer = _mb_scenario("bearing.cage_guidance=outer_land")
     notes = pl.check(_FakeResult(outer, land_overlap_max_m=3.37e-6))
     assert len(notes) == 1 and "multibody.inner_ring" not in notes[0], notes
+
+
+def test_a_land_guided_cage_that_never_touches_its_land_is_noted():
+    """An outer-land-guided cage with a land clearance of 0.5 mm (within the preset's plausible 0.2-0.5 mm) never
+    reaches its land at 970 N: its rollers hold it about 200 um off the axis, inside the 250 um the land leaves, and
+    the run's numbers were the roller-guided cage's bit for bit, with no word that the guidance asked for had no
+    effect. Such a run says so in a note naming the land clearance; a cage that touches its land gets none."""
+    from bearingsim import plausibility as pl
+    from tests.test_reliability import _FakeResult, _mb_scenario
+
+    far = simulate(_scenario("outer_land", rpm=6000, extra=["bearing.cage_land_clearance_mm=0.5"]))
+    rollers = simulate(_scenario("rollers", rpm=6000))
+    assert far.summary["land_normal_impulse_mean_Ns"] == 0.0
+    assert far.summary["I_dec_mean_Ns"] == rollers.summary["I_dec_mean_Ns"]  # the land never acted
+    noted = [n for n in far.notes if "never touched its outer land" in n]
+    assert len(noted) == 1, far.notes
+    assert "(250 um, bearing.cage_land_clearance_mm = 0.5)" in noted[0] and "roller-guided" in noted[0], noted[0]
+    assert not any("never touched" in n for n in rollers.notes)
+    sc = _mb_scenario("bearing.cage_guidance=inner_land")
+    assert any("never touched its inner land" in n
+               for n in pl.check(_FakeResult(sc, land_normal_impulse_mean_Ns=0.0, cage_rest_offset_m=1.9e-4)))
+    assert pl.check(_FakeResult(sc, land_normal_impulse_mean_Ns=0.13, cage_rest_offset_m=1.5e-4)) == []
+    assert pl.check(_FakeResult(_mb_scenario(), land_normal_impulse_mean_Ns=0.0)) == []  # roller-guided: no land
+
+
+def test_the_land_guided_runs_here_touch_their_land(outer_3000, inner_3000):
+    assert not any("never touched" in n for r in (outer_3000, inner_3000) for n in r.notes)

@@ -656,19 +656,24 @@ def _uncertainty_sections(table: Path):
 def _life_sections(table: Path):
     from bearingsim.studies import life
 
+    import tomllib
+
     cols, attrs = life.read_life(table)
     history = life.history_table(attrs.get("limit"), cols)  # a volume limit's columns are the volume's
     head = [h for _, h, _, _ in history]
     mapping = str(attrs.get("mapping", ""))
-    blocks = [{"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"
+    toml = attrs.get("scenario")
+    name = tomllib.loads(toml).get("name", "?") if toml else "?"
+    # the study's answer first, as `bearingsim life` and `bearingsim table` print it above the history: the
+    # life and its error, or where the cage bar wears through before the limit
+    blocks = [{"kind": "text", "text": life.life_headline(cols, f"Life of {name} to {attrs.get('limit', '?')}", attrs)},
+              {"kind": "text", "text": f"Limit {attrs.get('limit', '?')}; mapping {mapping}"
                                        + (f": {life.MAPPINGS[mapping]}." if mapping in life.MAPPINGS else ".")}]
-    if attrs.get("worn_through"):
-        blocks.append({"kind": "text", "text": f"The cage bar wears through before the limit, after "
-                                               f"{float(cols['hours_end'][-1]):.4g} h in stage "
-                                               f"{int(cols['stage'][-1])}: {attrs['worn_through']}."})
-    note = _life_limit_note(attrs)
-    if note:
-        blocks.append({"kind": "text", "text": f"Note: {note}."})
+    stages = attrs.get("stages")
+    counted_note = life.stage_count_note(int(stages), mapping) if stages is not None else None
+    for note in (_life_limit_note(attrs), counted_note):  # what the command notes under its history
+        if note:
+            blocks.append({"kind": "text", "text": f"Note: {note}."})
     blocks.append(table_block("The life history, one row per stage, as `bearingsim table` prints it (docs/wear.md); "
                               "the worn depth over each face at each stage's end is the figure's", head,
                               life.history_rows(cols, history), [True] * len(head)))
@@ -677,10 +682,6 @@ def _life_sections(table: Path):
         blocks.append({"kind": "list", "items": notes})
     figures = [figure_block(life.plot_life(cols, attrs), "Worn depth, pocket clearance and wear rate against "
                                                          "running time, stage by stage")]
-    import tomllib
-
-    toml = attrs.get("scenario")
-    name = tomllib.loads(toml).get("name", "?") if toml else "?"
     sections = [Section("table", "Life", blocks), Section("figures", "Figures", figures)]
     return f"Life of {name} to {attrs.get('limit', '?')}", sections, toml
 

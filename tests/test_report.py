@@ -6,6 +6,7 @@ playwright; without it these tests FAIL, saying how to install it (the README's 
 import dataclasses
 import os
 import re
+from html import unescape
 from pathlib import Path
 
 import numpy as np
@@ -595,6 +596,26 @@ def test_a_life_page_to_a_volume_limit_shows_the_volume_and_the_stages_notes(tmp
     text = re.sub(r"\s+", " ", re.search(r'<section id="table">(.*?)</section>', html, re.S).group(1))
     assert "largest volume [mm3]" in text and "volume rate [mm3/h]" in text and "deepest [um]" not in text
     assert "note (2 of 3 stages): k is high" in text
+
+
+def test_a_life_page_states_the_life_and_the_stage_count_note_as_the_command_does(tmp_path):
+    """The report of a life folder showed the limit and the history, but not the life itself, the study's answer:
+    `bearingsim life` and `bearingsim table` print it first ("life of X to LIMIT: 30 ± 0.35 h = 3e+06 inner-ring
+    rotations in 3 stages (±: ...)"), the page had it only inside its figure's title, a picture. Nor did it say
+    what the command notes of a study with the worn shape fed back in few stages (the life read long). The page
+    states both, in the command's words."""
+    from bearingsim.studies import life
+
+    _life_table(tmp_path / "l", mapping="shape")
+    html = bearingsim.report(tmp_path / "l", tmp_path / "l.html").read_text()
+    text = unescape(re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", re.search(r'<section id="table">(.*?)</section>',
+                                                                          html, re.S).group(1))))
+    cols, attrs = life.read_life(tmp_path / "l" / "life.h5")
+    headline = life.life_headline(cols, "Life of multibody_6000rpm to clearance=0.23mm", attrs)
+    assert headline.startswith("Life of multibody_6000rpm to clearance=0.23mm: 30 ± ") and " h = 3e+06 inner-ring" in headline
+    assert headline in text, text[:400]
+    assert life.format_history(cols, "Life of multibody_6000rpm to clearance=0.23mm", attrs).splitlines()[0] == headline
+    assert "3 stages with the worn shape fed back" in text and "give --stages 20 or more" in text
 
 
 @pytest.mark.slow

@@ -779,20 +779,26 @@ def format_history(cols: dict, title: str, attrs: dict | None = None) -> str:
     (:func:`stage_notes`)."""
     attrs = attrs or {}
     table = history_table(attrs.get("limit"), cols)
-    n = len(cols["stage"])
-    when = f"{cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations"
-    if attrs.get("worn_through"):
-        first = (f"{title}: not reached, the cage bar wears through first, after {when}, in stage "
-                 f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
-    else:
-        e = life_error(cols)
-        when = when if not math.isfinite(e) else when.replace(" h = ", f" ± {e:.2g} h = ", 1)
-        first = f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, attrs.get('limit'))}"
     # two spaces between columns: their headers are words ("shaft rotations", "of identical pockets")
-    lines = [first, "  ".join(f"{head:>{width}}" for _, head, width, _ in table)]
+    lines = [life_headline(cols, title, attrs), "  ".join(f"{head:>{width}}" for _, head, width, _ in table)]
     lines += ["  ".join(f"{cell:>{width}}" for cell, (_, _, width, _) in zip(row, table))
               for row in history_rows(cols, table)]
     return "\n".join(lines + depth_notes(cols, attrs) + stage_notes(cols))
+
+
+def life_headline(cols: dict, title: str, attrs: dict | None = None) -> str:
+    """The first line of the history (:func:`format_history`), the study's answer: ``title`` with the life reached
+    and its sampling error (``life of X to LIMIT: 34.06 ± 1.1 h = 1.226e+07 inner-ring rotations in 5 stages
+    (±: ...)``), or where the cage bar wore through first (``attrs``' ``worn_through``)."""
+    attrs = attrs or {}
+    n = len(cols["stage"])
+    when = f"{cols['hours_end'][-1]:.4g} h = {cols['rotations_end'][-1]:.4g} inner-ring rotations"
+    if attrs.get("worn_through"):
+        return (f"{title}: not reached, the cage bar wears through first, after {when}, in stage "
+                f"{int(cols['stage'][-1])} (of {attrs.get('stages', '?')}): {attrs['worn_through']}")
+    e = life_error(cols)
+    when = when if not math.isfinite(e) else when.replace(" h = ", f" ± {e:.2g} h = ", 1)
+    return f"{title}: {when} in {counted(n, 'stage')}{_error_text(cols, attrs.get('limit'))}"
 
 
 def _error_text(cols: dict, limit: str | None = None) -> str:

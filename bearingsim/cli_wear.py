@@ -145,12 +145,10 @@ SWEEP_ROWS = ("a case with a multibody archive: its wear as 'bearingsim wear ARC
 def _check_time(args) -> None:
     """Refuse a running time no case could take (:func:`bearingsim.wear.running_time`'s bounds, in hours; the
     rotations' bound depends on each case's speed), naming the option, before any case is read."""
-    import math
-
     from bearingsim.wear import MAX_RUNNING_HOURS
 
     value, name = (args.hours, "--hours") if args.hours is not None else (args.rotations, "--rotations")
-    if not (math.isfinite(value) and value > 0):
+    if not value > 0:  # NaN fails it; an infinite time is beyond the bound (hours below, rotations a case's)
         raise UserError(f"{name} {value!r}: must be a positive number")
     if args.hours is not None and value > MAX_RUNNING_HOURS:
         given = repr(float(value)).removesuffix(".0")  # as given: 1000000.4 is not rounded to the bound

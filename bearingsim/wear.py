@@ -177,7 +177,7 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     if (hours is None) == (rotations is None):
         raise UserError("give the running time as hours or as inner-ring rotations (exactly one)")
     value, name = (hours, "hours") if hours is not None else (rotations, "rotations")
-    if not (_is_number(value) and math.isfinite(value) and value > 0):
+    if not (_is_number(value) and value > 0):  # NaN is no number here; an infinite time is beyond the bound below
         raise UserError(f"{name} {value!r}: must be a positive number")
     op = result.parameters.operating
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)

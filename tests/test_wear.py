@@ -250,6 +250,28 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
         res.wear_report()
 
 
+def test_an_infinite_running_time_is_refused_as_beyond_the_bound_not_as_no_positive_number(fast_run):
+    """`bearingsim wear M --hours inf` (and `wear_report(rotations=math.inf)`) said "--hours inf: must be a positive
+    number", which infinity is. It is refused as the time beyond the bound it is, naming it; NaN and what is not
+    above 0 keep their line."""
+    import argparse
+
+    from bearingsim.cli_wear import _check_time
+    from bearingsim.errors import UserError
+
+    res = fast_run[0]
+    for kw, name in (({"hours": math.inf}, "hours"), ({"rotations": math.inf}, "rotations"),
+                     ({"hours": np.float64(np.inf)}, "hours")):
+        with pytest.raises(UserError, match=f"^{name} inf: more than 1000000 h of running "):
+            res.wear_report(**kw)
+    for value in (math.nan, -math.inf, 0.0):
+        with pytest.raises(UserError, match=f"^hours {value!r}: must be a positive number$"):
+            res.wear_report(hours=value)
+    with pytest.raises(UserError, match="^--hours inf: more than 1000000 h of running, 114 years"):
+        _check_time(argparse.Namespace(hours=math.inf, rotations=None))  # a sweep's wear, before any case is read
+    _check_time(argparse.Namespace(hours=None, rotations=math.inf))  # rotations: each case's bound, at its speed
+
+
 def test_wear_report_takes_numpy_numbers_and_refuses_what_a_scenario_refuses(fast_run):
     """`wear_report(rotations=np.int64(100000))` was refused as "must be a positive number" (np.float64 was
     taken); `wear_coefficient=-1` gave a max depth of -0.0 and `hardness=0` NaN with a divide-by-zero warning.

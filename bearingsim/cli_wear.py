@@ -121,13 +121,18 @@ def _sweep_wear(folder: Path, args) -> str:
     cases = [str(c) for c in cols["case"]]
     labels, differ = archive_labels(cases, [{k: cols[k][i] for k in axes} for i in range(n)])
     labels = {("case" if k == "archive" else k): v for k, v in labels.items()}
-    rows, missing = [], []
+    rows, missing, whys = [], [], []
     for i in range(n):
         cells, why = _case_wear(folder, cols, i, args)
         rows.append(cells)
+        whys.append(why)
         if why:
             missing.append(f"not available: case {cases[i]}"
                            + "".join(f", {k} = {labels[k][i]}" for k in labels if k != "case") + f": {why}")
+    if n and all(why == PER_HOUR for why in whys):  # the option, not the cases: a table of dashes says nothing
+        raise UserError(f"--rotations {args.rotations:g}: no case of {folder} has an archive to scale by its cage "
+                        f"speed (a reduced case never keeps one by default), and the index's wear rates are per hour: "
+                        f"give --hours")
     notes = [f"wear of the {n} cases of the sweep {folder}, each after the running time at its own speed; swept keys "
              f"that differ: {_keys_as_columns(labels, differ)}"]
     table = wear.format_comparison(labels, rows, notes)
@@ -185,8 +190,12 @@ def _case_wear(folder: Path, cols: dict, i: int, args) -> tuple:
         return wear.rate_cells(None, 0.0), ("no archive, and no wear rates in the index (one written before them: "
                                             "the same sweep command run again adds them)")
     if args.hours is None:
-        return wear.rate_cells(None, 0.0), "no archive, and the index's wear rates are per hour: give --hours"
+        return wear.rate_cells(None, 0.0), PER_HOUR
     return wear.rate_cells(rates, args.hours), ""
+
+
+#: why a case without an archive has no row for a running time given as rotations
+PER_HOUR = "no archive, and the index's wear rates are per hour: give --hours"
 
 
 def _cmd_life(args) -> int:

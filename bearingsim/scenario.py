@@ -1166,7 +1166,7 @@ def did_you_mean(key: str) -> str:
     words = key_words(leaf)
     if words:  # a key named by its words (clearance, friction, load): every key of the section that holds them
         holding = [k for k in same if words <= key_words(k.rpartition(".")[2])]
-        if not holding and section:  # the right words in the wrong section
+        if not holding:  # the right words in the wrong section, or at the top level without their section
             holding = [k for k in known if "." in k and words <= key_words(k.rpartition(".")[2])]
         if holding:
             return f" (did you mean {_one_of(holding)}?)"

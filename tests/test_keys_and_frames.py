@@ -49,6 +49,13 @@ def test_unknown_key_in_set_gets_the_closest_key(tmp_path, setting, hint):
     ("bearing.rollers", " (did you mean bearing.roller_count, bearing.roller_diameter_mm, bearing.roller_length_mm "
                         "or bearing.roller_mass_kg?)"),
     ("bearing.friction", " (did you mean contact.cage_friction or contact.land_friction?)"),  # wrong section
+    # at the top level, the section left out: the keys of any section that hold the words (none was named, or
+    # difflib's section "lubrication" for "friction")
+    ("friction", " (did you mean contact.cage_friction or contact.land_friction?)"),
+    ("clearance", " (did you mean bearing.pocket_clearance_mm, bearing.radial_clearance_mm or "
+                  "bearing.cage_land_clearance_mm?)"),
+    ("speed", " (did you mean operating.inner_ring_speed_rpm?)"),
+    ("operatin", " (did you mean operating?)"),  # a misspelt section as before
     # misspellings as before
     ("numerics.rotation", " (did you mean numerics.rotations?)"),
     ("operating.inner_ring_sped_rpm", " (did you mean operating.inner_ring_speed_rpm?)"),

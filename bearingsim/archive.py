@@ -565,7 +565,7 @@ class _Writer:
             data = np.asarray(value)
             (htype, mtype), space = self._type(data.dtype.str, data.dtype), self._scalar
         else:
-            data = _h5base().array_for_new_object(value)  # what h5py's attrs[name] = value stores
+            data = _attr_array(value)  # what h5py's attrs[name] = value stores; numpy's texts as a list's
             if not isinstance(data, np.ndarray) or data.dtype.subdtype is not None:  # h5py.Empty, ...
                 h5.AttributeManager(_IdHolder(oid))[name] = value
                 return
@@ -603,6 +603,16 @@ def _h5base():
     from h5py._hl import base
 
     return base
+
+
+def _attr_array(value):
+    """The array an attribute stores of ``value``: what h5py's ``attrs[name] = value`` makes of it
+    (``array_for_new_object``), an array of numpy's texts (``np.array(["a", "b"])``, dtype ``<U1``, which HDF5
+    has no type for) as UTF-8 texts, as a list of str is stored (and read back)."""
+    data = _h5base().array_for_new_object(value)
+    if isinstance(value, np.ndarray) and value.dtype.kind == "U":  # not a list numpy makes texts of ([1, "a"])
+        data = data.astype(_lazy_h5py().string_dtype())
+    return data
 
 
 class _IdHolder:
@@ -681,36 +691,42 @@ def _json_scalar(v):
 
 #: what :func:`check_storable` says an archive stores of a named value
 STORABLE = "a str, bool, int, float or an array of numbers or texts"
+#: the most bytes HDF5 holds in one attribute (its object header message), the name and type included
+ATTR_BYTES = 64 * 1024
 
 
-def _storable(v) -> bool:
-    """True when :func:`_write_group_attrs` stores ``v``: a scalar it writes as JSON, or a value h5py makes an
-    array of an HDF5 type of (numbers, texts); False for anything else (an object, None, a dict, a list of
-    mixed things), which h5py would refuse mid-write with its own TypeError."""
+def _unstorable(name: str, v) -> str | None:
+    """Why :func:`_write_group_attrs` cannot store ``v`` as the value ``name`` ("expected ... (got ...)"), or None
+    when it stores it: a scalar it writes as JSON, or a value whose attribute it writes, tried in an archive in
+    memory (so what h5py would refuse mid-write is known before: an object, None, a dict, a list of mixed things,
+    an array of a type HDF5 has none for, an array larger than an attribute holds)."""
     if _json_scalar(v) is not None:
-        return True
-    h5py = _lazy_h5py()
+        return None
+    kind = f"an array of {v.dtype}" if isinstance(v, np.ndarray) else type(v).__name__
     try:
-        data = _h5base().array_for_new_object(v)
-        if isinstance(data, np.ndarray) and data.dtype.subdtype is None:
-            h5py.h5t.py_create(data.dtype, logical=True)
+        _image(lambda f: _Writer(f, fresh=True).attr(f.id, name, v))
     except (TypeError, ValueError):
-        return False
-    return True
+        return f"expected {STORABLE}, which an archive stores (got {kind})"
+    except (OSError, RuntimeError):  # HDF5's own refusal: the attribute does not fit in its object header
+        size = _attr_array(v).nbytes
+        return (f"expected {STORABLE} of less than {ATTR_BYTES // 1024} KiB, which an archive's attribute holds "
+                f"(got {kind} of {size} bytes)")
+    return None
 
 
 def check_storable(result, what: str = "save()") -> None:
     """Refuse, before anything is written, a named value of ``result`` its archive cannot store, in one line
     (:class:`bearingsim.UserError`) naming ``what`` refuses it, where it is and its type: a value of its
-    provenance or of an attribute group that is not :data:`STORABLE`, a name or unit that is not a str."""
+    provenance or of an attribute group that is not :data:`STORABLE` or is too large for an attribute
+    (:func:`_unstorable`), a name or unit that is not a str."""
     named = [(f"groups[{path_!r}].attrs", grp.attrs, grp.units) for path_, grp in result.groups.items()]
     for where, values, units in [*named, ("provenance", result.provenance, {})]:
         for k, v in values.items():
             if not isinstance(k, str):
                 raise UserError(f"{what}: {where}: expected names that are str (got {k!r}, a {type(k).__name__})")
-            if not _storable(v):
-                raise UserError(f"{what}: {where}[{k!r}]: expected {STORABLE}, which an archive stores "
-                                f"(got {type(v).__name__})")
+            why = _unstorable(k, v)
+            if why is not None:
+                raise UserError(f"{what}: {where}[{k!r}]: {why}")
         for k, u in units.items():
             where_units = where.replace(".attrs", ".units")
             if not isinstance(k, str):

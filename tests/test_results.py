@@ -299,6 +299,28 @@ def test_a_value_an_archive_cannot_store_is_refused_by_save_before_anything_is_w
     assert list(back.provenance["names"]) == ["a", "b"] and back.summary == r.summary
 
 
+def test_an_array_of_texts_saves_and_one_too_large_for_an_attribute_is_refused_before_anything_is_written(tmp_path):
+    """``check_storable`` said an array of numpy's texts (``np.array(["a", "b"])``) was not "an array of numbers or
+    texts" ("(got ndarray)"), though a list of the same texts saves; and it let an array larger than an HDF5
+    attribute holds through, so that ``save()`` failed mid-write with "cannot write archive (write failed)", as if
+    the disk had. The array of texts is stored as the list is (read back as texts); the large array is refused in
+    one line giving its size, nothing written."""
+    r = bearingsim.run(_short_scenarios()[0])
+    r.provenance = {**r.provenance, "names": np.array(["a", "bb"]), "grid": np.array([["x"], ["y"]])}
+    back = bearingsim.load(r.save(tmp_path / "texts.h5"))
+    assert list(back.provenance["names"]) == ["a", "bb"] and back.provenance["grid"].tolist() == [["x"], ["y"]]
+    r.provenance = {**r.provenance, "big": np.zeros(20000)}
+    with pytest.raises(bearingsim.UserError) as info:
+        r.save(tmp_path / "big.h5")
+    assert str(info.value) == ("save(): provenance['big']: expected a str, bool, int, float or an array of numbers or "
+                               "texts of less than 64 KiB, which an archive's attribute holds (got an array of float64 "
+                               "of 160000 bytes)")
+    r.provenance = {**r.provenance, "big": np.array(["2020-01-01"], dtype="M8[D]")}
+    with pytest.raises(bearingsim.UserError, match=r"\(got an array of datetime64\[D\]\)$"):
+        r.save(tmp_path / "big.h5")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["texts.h5"]
+
+
 def test_a_result_read_with_part_of_its_arrays_says_so_and_is_not_saved(tmp_path):
     """``simulation.load(path, only=...)`` reads some arrays: saving that result wrote an archive without the others
     (over its own archive, of the same scenario, without force), which every reader then called damaged; its

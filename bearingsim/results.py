@@ -62,6 +62,22 @@ def _read_only_data(data: dict[str, NamedArray]) -> dict[str, NamedArray]:
     return {k: replace(v, data=read_only(v.data)) if isinstance(v.data, np.ndarray) else v for k, v in data.items()}
 
 
+def _mapping_of(name: str, value, kind: type | None = None, what: str = "values"):
+    """``value``, assigned to the result's attribute ``name``, when it is a mapping of names to ``what`` (each a
+    ``kind`` where given); else a one-line :class:`bearingsim.errors.UserError` naming the attribute (it was an
+    AttributeError of ``.items`` or ``.attrs`` deep in the setter)."""
+    from collections.abc import Mapping
+
+    if not isinstance(value, Mapping):
+        raise UserError(f"Result.{name}: expected a mapping of names to {what}, such as a dict (got "
+                        f"{type(value).__name__})")
+    bad = next((k for k, v in value.items() if kind is not None and not isinstance(v, kind)), None)
+    if bad is not None:
+        raise UserError(f"Result.{name}[{bad!r}]: expected a bearingsim.datatypes.{kind.__name__} (got "
+                        f"{type(value[bad]).__name__})")
+    return value
+
+
 def _read_only_values(values) -> ReadOnlyMapping:
     """A read-only copy of the named values ``values`` (:class:`bearingsim.datatypes.ReadOnlyMapping`), a value
     that is an array a read-only view (:func:`read_only`)."""
@@ -149,7 +165,7 @@ class Result:
 
     @groups.setter
     def groups(self, groups: dict[str, AttrGroup]) -> None:
-        self._groups = _read_only_groups(groups)
+        self._groups = _read_only_groups(_mapping_of("groups", groups, AttrGroup, "attribute groups"))
 
     @property
     def provenance(self) -> ReadOnlyMapping:
@@ -160,7 +176,7 @@ class Result:
 
     @provenance.setter
     def provenance(self, provenance) -> None:
-        self._provenance = _read_only_values(provenance)
+        self._provenance = _read_only_values(_mapping_of("provenance", provenance))
 
     @property
     def series(self) -> dict[str, Series]:
@@ -169,6 +185,7 @@ class Result:
 
     @series.setter
     def series(self, series: dict[str, Series]) -> None:
+        series = _mapping_of("series", series, Series, "time series")
         self._series = {k: replace(s, step=read_only(s.step), time=read_only(s.time), value=read_only(s.value))
                         for k, s in series.items()}
 

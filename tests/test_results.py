@@ -260,6 +260,31 @@ def test_the_groups_a_result_hands_out_are_read_only(tmp_path, model):
     assert bearingsim.load(path).summary == summary
 
 
+def test_assigning_a_result_what_is_not_a_mapping_is_one_line_naming_the_attribute():
+    """``r.provenance = None``, ``r.groups = None`` or ``r.series = 3`` ended in an AttributeError (``.items``)
+    inside the setter, and ``r.groups = {"a": 1}`` in one of ``.attrs``: a user's mistake with a traceback that
+    names no attribute. Each is a one-line :class:`bearingsim.UserError` naming the attribute (and the entry) and
+    what it takes; the result is left as it was, and a mapping of the right kind is still taken."""
+    r = bearingsim.run(_short_scenarios()[0])
+    before = (dict(r.provenance), dict(r.groups), dict(r.series))
+    cases = [("provenance", None, "Result.provenance: expected a mapping of names to values, such as a dict "
+              "(got NoneType)"),
+             ("groups", None, "Result.groups: expected a mapping of names to attribute groups, such as a dict "
+              "(got NoneType)"),
+             ("series", 3, "Result.series: expected a mapping of names to time series, such as a dict (got int)"),
+             ("groups", {**r.groups, "a": 1}, "Result.groups['a']: expected a bearingsim.datatypes.AttrGroup "
+              "(got int)"),
+             ("series", {"x": np.zeros(3)}, "Result.series['x']: expected a bearingsim.datatypes.Series "
+              "(got ndarray)")]
+    for name, value, words in cases:
+        with pytest.raises(bearingsim.UserError) as info:
+            setattr(r, name, value)
+        assert str(info.value) == words and "\n" not in str(info.value)
+    assert (dict(r.provenance), dict(r.groups), dict(r.series)) == before
+    r.provenance = {**r.provenance, "note": "by hand"}
+    assert r.provenance["note"] == "by hand"
+
+
 def test_a_value_an_archive_cannot_store_is_refused_by_save_before_anything_is_written(tmp_path):
     """``r.provenance`` was a plain dict: ``r.provenance["note"] = object()`` made ``r.save(path)`` fail with h5py's
     own TypeError (``Object dtype dtype('O') has no native HDF5 equivalent``). The provenance is read-only, as the

@@ -179,11 +179,16 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     value, name = (hours, "hours") if hours is not None else (rotations, "rotations")
     if not (_is_number(value) and value > 0):  # NaN is no number here; an infinite time is beyond the bound below
         raise UserError(f"{name} {value!r}: must be a positive number")
+    try:
+        amount = float(value)
+    except OverflowError:  # an integer beyond any float (10**400): beyond the bound below
+        amount = math.inf
     op = result.parameters.operating
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
-    shaft = float(rotations) if rotations is not None else float(hours) * rot_per_hour
-    if (float(hours) if hours is not None else shaft / rot_per_hour) > MAX_RUNNING_HOURS:
-        given = repr(float(value)).removesuffix(".0")  # as given: 1000000.4 is not rounded to the bound
+    shaft = amount if rotations is not None else amount * rot_per_hour
+    if (amount if hours is not None else shaft / rot_per_hour) > MAX_RUNNING_HOURS:
+        # as given: 1000000.4 is not rounded to the bound; an integer no float holds is said to be one
+        given = repr(amount).removesuffix(".0") if math.isfinite(amount) or isinstance(value, float) else "above 1e308"
         raise UserError(f"{name} {given}: more than {MAX_RUNNING_HOURS:.10g} h of running "
                         f"({MAX_RUNNING_HOURS * rot_per_hour:.12g} inner-ring rotations at {rot_per_hour / 60:g} rpm), "
                         f"114 years, ten times the longest life a bearing is designed for; give a shorter running time")

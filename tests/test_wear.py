@@ -244,6 +244,9 @@ def test_running_time_up_to_its_bound_gives_finite_numbers(fast_run):
     with pytest.raises(UserError, match=r"^hours 1000000\.4: more than 1000000 h of running \(360000000000 inner"):
         res.wear_report(hours=1000000.4)  # just over the bound: both numbers in full (it said "hours 1e+06: more
         # than 1e+06 h")
+    for kw in ({"hours": 10**400}, {"rotations": 10**400}):  # an integer no float holds: an OverflowError before
+        with pytest.raises(UserError, match=f"^{next(iter(kw))} above 1e308: more than 1000000 h of running"):
+            res.wear_report(**kw)
     with pytest.raises(UserError, match="^hours 'x': must be a positive number$"):  # it said "--hours x"
         res.wear_report(hours="x")
     with pytest.raises(UserError, match="^give the running time as hours or as inner-ring rotations"):

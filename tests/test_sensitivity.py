@@ -422,14 +422,19 @@ def test_a_key_whose_value_is_zero_is_left_out_of_the_default_keys(tmp_path, cap
 
 
 def test_uncertainty_prints_its_spread_in_the_tables_units():
-    """`bearingsim uncertainty` prints the median and 5-95 % interval of the impulses in mN s, as every table
-    does (it printed them in N s without a unit: 0.0145 beside tables of 14.5)."""
+    """`bearingsim uncertainty` prints the median and 5-95 % interval of the impulses in mN s and of the cage slip
+    in per cent, as every table does (it printed the impulses in N s without a unit, 0.0145 beside tables of 14.5,
+    and the slip as a fraction without a unit, 0.004 beside the cross-check's and `table`'s 0.4 %)."""
     from bearingsim.studies.uncertainty import format_table
 
     text = format_table([{"quantity": "I_dec", "median": 0.0145, "p05": 0.0101, "p95": 0.0203, "runs_used": 8.0},
                          {"quantity": "cage_slip", "median": 0.004, "p05": 0.001, "p95": 0.007, "runs_used": 8.0}], [])
     assert "I_dec      median 14.5, 5-95 %: 10.1 .. 20.3 mN s (8 runs)" in text
-    assert "cage_slip  median 0.004, 5-95 %: 0.001 .. 0.007 (8 runs)" in text
+    assert "cage_slip  median 0.4, 5-95 %: 0.1 .. 0.7 % (8 runs)" in text
+    from bearingsim.studies.uncertainty import _spread_title
+
+    title = _spread_title("cage_slip", {"median": 0.004, "p05": 0.001, "p95": 0.007})
+    assert title == "cage slip: median 0.4 %\n5-95 %: 0.1 .. 0.7 %", title
 
 
 def test_uncertainty_shows_indices_it_cannot_give_as_n_a():

@@ -372,14 +372,15 @@ def read_table(path):
     return rows, json.loads(meta["spread"]), meta
 
 
-#: how the terminal shows a quantity of each SI unit: (factor, unit), as the tables do (impulses in mN s)
-_SHOWN = {"N s": (1e3, "mN s"), "1": (1.0, "")}
-
-
 def shown(quantity: str) -> tuple[float, str]:
-    """(factor, unit) in which the tables show ``quantity`` (``I_dec``: 1e3, ``mN s``; ``cage_slip``: 1, "")."""
-    units = {q: unit for q, _, unit in QUANTITIES}
-    return _SHOWN.get(units.get(quantity), (1.0, ""))
+    """(factor, unit) in which the tables show ``quantity``, as ``bearingsim run``, ``table`` and ``crosscheck`` do
+    (:func:`bearingsim.tables.shown_as`: ``I_dec``: 1e3, ``mN s``; ``cage_slip``: 100, ``%``)."""
+    from bearingsim.tables import shown_as
+
+    keys = {q: (key, unit) for q, key, unit in QUANTITIES}
+    key, unit = keys.get(quantity, (quantity, "1"))
+    scale, label = shown_as(key, unit)
+    return scale, ("" if label == "1" else label)
 
 
 def format_table(spreads: list[dict], indices: list[dict]) -> str:

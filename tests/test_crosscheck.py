@@ -441,6 +441,23 @@ def test_a_rung_without_a_rear_face_impact_prints_n_a_as_the_docs_do():
     assert cc.format_table([{**row, "first_impact_speed_m_s": 0.0485}]).splitlines()[1].split()[-3] == "0.0485"
 
 
+def test_a_failed_rung_prints_n_a_not_nan():
+    """A failed rung keeps its row with no numbers (crosscheck.csv: empty fields; the report: "-"), which the
+    terminal table and `bearingsim table DIR` printed as "nan ± n/a" and a slip of "+nan"
+    (`bearingsim crosscheck scenarios/multibody_3000rpm.toml --set numerics.dt_s=3e-5 --speeds 6000`): they print
+    n/a, and the verdict names the failed rung."""
+    nan = math.nan
+    rows = [dict(rpm=6000.0, rung=1, scene="reduced", I_dec_mean_Ns=5.748e-3, I_dec_sem_Ns=0.0, I_acc_mean_Ns=0.0,
+                 I_acc_sem_Ns=0.0, first_impact_speed_m_s=0.1122, cage_slip=0.0, change_from_previous=nan,
+                 status="done"),
+            dict(rpm=6000.0, rung=2, scene="reduced_equivalent", I_dec_mean_Ns=nan, I_dec_sem_Ns=nan,
+                 I_acc_mean_Ns=nan, I_acc_sem_Ns=nan, first_impact_speed_m_s=nan, cage_slip=nan,
+                 change_from_previous=nan, status="failed")]
+    line = cc.format_table(rows).splitlines()[2]
+    assert "nan" not in line.lower(), line
+    assert line.split()[3:] == ["n/a", "±", "n/a", "n/a", "±", "n/a", "n/a", "n/a"], line
+
+
 def test_the_figures_title_names_the_speeds_it_ran(tmp_path, monkeypatch):
     """A cross-check over 1000, 3000 and 6000 rpm was titled "Cross-check of multibody_3000rpm", the base
     scenario's name, as if it had run at 3000 rpm. The title names the speeds that ran."""

@@ -399,9 +399,12 @@ def format_table(rows: list[dict]) -> str:
         def sem(v):  # NaN: fewer than 2 rotations, no standard error
             return f"{'n/a':>6s}" if math.isnan(v) else f"{v * 1e3:6.3f}"
 
+        def mean(v):  # NaN: a failed rung, no number (the verdict names it)
+            return f"{'n/a':>7s}" if math.isnan(v) else f"{v * 1e3:7.3f}"
+
         lines.append(f"{r['rpm']:6g} {r['rung']:4d} {r['scene']:18s} "
-                     f"{r['I_dec_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_dec_sem_Ns'])} "
-                     f"{r['I_acc_mean_Ns'] * 1e3:7.3f} ± {sem(r['I_acc_sem_Ns'])} "
+                     f"{mean(r['I_dec_mean_Ns'])} ± {sem(r['I_dec_sem_Ns'])} "
+                     f"{mean(r['I_acc_mean_Ns'])} ± {sem(r['I_acc_sem_Ns'])} "
                      f"{_first_impact(r['first_impact_speed_m_s'])} {_percent(r['cage_slip']):>9s} {ch:>13s}")
     return "\n".join(lines)
 
@@ -414,6 +417,8 @@ def _first_impact(v: float) -> str:
 
 def _percent(fraction: float) -> str:
     """A fraction in per cent with its sign and 2 decimals ("+0.38", "-0.14"); one that rounds to zero is
-    "0.00", with no sign (a slip of -1.2e-06 is not "-0.00")."""
+    "0.00", with no sign (a slip of -1.2e-06 is not "-0.00"); "n/a" for NaN (a failed rung)."""
+    if math.isnan(fraction):
+        return "n/a"
     text = f"{fraction * 100:+.2f}"
     return "0.00" if float(text) == 0.0 else text

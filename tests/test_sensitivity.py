@@ -421,6 +421,26 @@ def test_a_key_whose_value_is_zero_is_left_out_of_the_default_keys(tmp_path, cap
     assert "lubrication.drag_coefficient" in Uncertainty(sc, 2).keys
 
 
+def test_the_printed_table_says_what_the_cage_slips_s_is():
+    """The cage slip's S is d y / d ln x of the slip itself (a fraction), the other rows' d ln y / d ln x, in one
+    column headed S: `bearingsim sensitivity scenarios/multibody_3000rpm.toml ...` printed "cage_slip  +0.128" beside
+    "I_dec  +15.728" and nothing said which was which, nor in what unit (the report has a measure column). A line
+    under the table says it, when the table has a cage slip's row; the tornado chart's axis names the fraction."""
+    from bearingsim.studies.sensitivity import format_table
+
+    def row(quantity, measure, s):
+        return {"key": "bearing.cage_inner_diameter_mm", "quantity": quantity, "measure": measure, "x": 91.0,
+                "x_minus": 90.0, "x_plus": 92.0, "y_minus": 1.0, "y_minus_se": 0.01, "y_plus": 1.2,
+                "y_plus_se": 0.01, "sensitivity": s, "sensitivity_se": 0.01, "over_range": s * 0.022,
+                "sensitivity_half_step": float("nan"), "x_minus_half": float("nan"), "x_plus_half": float("nan")}
+
+    text = format_table([row("I_dec", "log", 15.7), row("cage_slip", "lin", 0.128)])
+    note = text.splitlines()[-1]
+    assert note.startswith("cage_slip: S = d y / d ln x, y the slip as a fraction (0.001 = 0.1 %"), text
+    assert note.endswith("the other rows: S = d ln y / d ln x"), note
+    assert "d y / d ln x" not in format_table([row("I_dec", "log", 15.7)])
+
+
 def test_uncertainty_prints_its_spread_in_the_tables_units():
     """`bearingsim uncertainty` prints the median and 5-95 % interval of the impulses in mN s and of the cage slip
     in per cent, as every table does (it printed the impulses in N s without a unit, 0.0145 beside tables of 14.5,

@@ -469,6 +469,11 @@ HALF_STEP_NOTE = ("S, half step: the same slope from runs at half the step (a de
                   "the half step onto the full step's values: no second slope to compare)")
 
 
+#: the line under a table with a cage slip's row: its S is of the slip itself, not of its logarithm
+LIN_NOTE = ("cage_slip: S = d y / d ln x, y the slip as a fraction (0.001 = 0.1 %; a signed number near 0, whose "
+            "logarithm has no meaning), and over range the change of y; the other rows: S = d ln y / d ln x")
+
+
 def format_table(rows: list[dict]) -> str:
     """The sensitivities for the terminal, as ``bearingsim sensitivity`` prints them: one row per key and
     quantity, S ± its standard error and the change over the key's range (n/a and why where missing); a
@@ -486,6 +491,8 @@ def format_table(rows: list[dict]) -> str:
                      + (f"  ({note})" if note else ""))
     if half:
         lines.append(HALF_STEP_NOTE)
+    if any(r.get("measure") == "lin" for r in rows):
+        lines.append(LIN_NOTE)
     return "\n".join(lines)
 
 
@@ -533,7 +540,8 @@ def plot_tornado(rows, title: str = ""):
         ranged = [k if np.isfinite(next(r["over_range"] for r in rows if r["key"] == k)) else f"{k} (range from 0)"
                   for k in order]
         ax.set_yticklabels(ranged if ax is axes[0][0] else [""] * len(order), fontsize=8)
-        ax.set_xlabel("change of ln y across the range" if measure == "log" else "change of y across the range")
+        ax.set_xlabel("change of ln y across the range" if measure == "log"
+                      else "change of y across the range\n(y a fraction: 0.001 = 0.1 %)")
         errors = "" if ran_half_steps(rows) else error_title(se[ok], "bar")  # exact: the figure's title says so
         ax.set_title(q + (f"\n{errors}" if "n/a" in errors else ""), fontsize=9)
         ax.grid(axis="x", alpha=0.3)

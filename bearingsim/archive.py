@@ -1443,6 +1443,10 @@ def _check_regular(p: Path) -> None:
         raise UserError(f"{p}: cannot read ({exc.strerror or exc.__class__.__name__})") from None
 
 
+#: the table ``bearingsim validate`` writes in its folder (:mod:`bearingsim.studies.validate`; a CSV: no format)
+VALIDATE_TABLE = "fig9_idec_vs_speed.csv"
+
+
 def _directory_error(p: Path) -> UserError:
     """The refusal of a folder given where an archive is read; a sweep's or a study's folder (its index
     ``sweep.h5``) is named as one, with the commands that read it and the file ``bearingsim plot`` draws its
@@ -1452,8 +1456,13 @@ def _directory_error(p: Path) -> UserError:
         cases = (f"its cases' archives are in {p / 'cases'}" if (p / "cases").is_dir()
                  else "its cases kept no archives (sweep --archives all keeps them)")
         tables = _study_tables(p)
-        drawn = (", ".join(f"'bearingsim plot {t}' draws the study's figure" for t in tables) if tables
-                 else f"'bearingsim plot {p / 'sweep.h5'}' draws its figures")
+        if tables:
+            drawn = ", ".join(f"'bearingsim plot {t}' draws the study's figure" for t in tables)
+        elif (p / VALIDATE_TABLE).is_file():  # validate's figures come from its cases, not from a table file
+            drawn = (f"'bearingsim plot {p / 'sweep.h5'}' draws its cases' overview (validate's own figures: the "
+                     f"same 'bearingsim validate -o {p}' again redraws them from its cases)")
+        else:
+            drawn = f"'bearingsim plot {p / 'sweep.h5'}' draws its figures"
         return UserError(f"{p}: is a sweep or study folder, not an archive: 'bearingsim table {p}', 'bearingsim "
                          f"report {p}' and 'bearingsim wear {p}' read it, {drawn}; {cases}")
     return UserError(f"{p}: is a directory, not an archive")

@@ -854,3 +854,18 @@ def test_an_unknown_option_value_names_the_closest_choice():
     res = bearingsim("report", "x.h5", "--animation", "gf")
     assert_argparse_error(res, "bearingsim report", "argument --animation: invalid choice: 'gf'",
                           "did you mean 'gif'?")
+
+
+def test_a_validate_folder_given_to_plot_says_what_its_sweep_h5_draws(tmp_path):
+    """`bearingsim plot DIR` of a validate folder said "'bearingsim plot DIR/sweep.h5' draws its figures", which
+    draws the cases' overview (sweep_cases.png, written into the folder) and none of validate's Fig. 9 or rig
+    figures: the line says it draws the cases' overview, and that validate run again redraws its own."""
+    folder = tmp_path / "val"
+    folder.mkdir()
+    (folder / "sweep.h5").write_bytes(b"")
+    (folder / "fig9_idec_vs_speed.csv").write_text("speed_rpm,c\n500,1\n")
+    res = bearingsim("plot", folder)
+    assert_user_error(res, f"{folder}: is a sweep or study folder, not an archive",
+                      f"'bearingsim plot {folder / 'sweep.h5'}' draws its cases' overview (validate's own figures: "
+                      f"the same 'bearingsim validate -o {folder}' again redraws them from its cases)")
+    assert "draws its figures" not in res.stderr

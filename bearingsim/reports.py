@@ -617,8 +617,11 @@ def _sensitivity_sections(table: Path):
                           f"d ln y / d ln x, lin: d y / d ln x; {errors} (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False], sens.HALF_STEP_NOTE if deterministic else "")]
     bars = sens.tornado_errors(rows)
+    present = {r["quantity"] for r in rows}  # the chart's panels, in its order (sensitivity.plot_tornado)
+    panels = [f"ln {q}" if m == "log" else f"{q} (a fraction)" for q, _, m in sens.QUANTITIES if q in present]
+    drawn = ", ".join(panels[:-1]) + f" and {panels[-1]}" if len(panels) > 1 else "".join(panels)
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d), {
-        "sensitivity.png": "Tornado chart: the change of ln I_dec and ln I_acc across each key's plausible range "
+        "sensitivity.png": f"Tornado chart: the change of {drawn} across each key's plausible range "
                            f"(S ln(high / low), if linear), keys ordered by the change of I_dec; {bars}"})
     sections = [Section("table", "Sensitivity", blocks), Section("figures", "Figures", figures)]
     return f"Sensitivity of {meta.get('scenario_name', '?')}", sections, meta.get("scenario")

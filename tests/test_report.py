@@ -876,3 +876,28 @@ def test_a_report_another_command_is_writing_is_refused_in_one_line(runs, tmp_pa
     assert not out.exists()
     assert cli("report", runs / "r.h5", "-o", out).returncode == 0 and out.is_file()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["r.html"]  # its lock gone with it
+
+
+def test_a_whole_bearing_sensitivitys_chart_caption_names_every_panel(tmp_path):
+    """The report's caption of a whole-bearing sensitivity's tornado chart read "the change of ln I_dec and ln
+    I_acc across each key's plausible range" under a chart of four panels (the cage slip's, a fraction, and the
+    cage's eccentricity too); it names each panel. A reduced-model study's chart has the two it names."""
+    from bearingsim.reports import _sensitivity_sections
+    from bearingsim.studies import sensitivity as sens
+
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_3000rpm.toml")
+    rows = [{"key": "contact.cage_friction", "quantity": q, "measure": m, "x": 0.1, "x_minus": 0.09,
+             "x_plus": 0.11, "y_minus": 1.0, "y_minus_se": 0.01, "y_plus": 1.1, "y_plus_se": 0.01,
+             "sensitivity": 0.5, "sensitivity_se": 0.05, "over_range": 0.5, "sensitivity_half_step": np.nan,
+             "x_minus_half": np.nan, "x_plus_half": np.nan, "archive_minus": "", "archive_plus": "",
+             "status": "done", "error": ""} for q, _, m in sens.QUANTITIES]
+    sens.write_table(tmp_path, rows, sc, 0.1, runs=2)
+    sections = _sensitivity_sections(tmp_path / "sensitivity.h5")[1]
+    (caption,) = [b["caption"] for s in sections for b in s.blocks if b["kind"] == "figure"]
+    assert caption.startswith("Tornado chart: the change of ln I_dec, ln I_acc, cage_slip (a fraction) and ln "
+                              "cage_eccentricity across each key's plausible range"), caption
+    reduced = [r for r in rows if r["quantity"] in sens.REDUCED_QUANTITIES]
+    sens.write_table(tmp_path, reduced, sc, 0.1, runs=2)
+    sections = _sensitivity_sections(tmp_path / "sensitivity.h5")[1]
+    (caption,) = [b["caption"] for s in sections for b in s.blocks if b["kind"] == "figure"]
+    assert caption.startswith("Tornado chart: the change of ln I_dec and ln I_acc across"), caption

@@ -564,7 +564,7 @@ def _cmd_crosscheck(args) -> int:
     wall = time.perf_counter() - t0
     if outcome.interrupted is None and not args.quiet:
         where = f"dask scheduler {args.scheduler}" if args.scheduler else counted(args.jobs, "process", "processes")
-        warmup = counted(scenario.numerics.warmup_rotations, "warm-up")
+        warmup = cc.warmup_text(scenario.numerics.warmup_rotations)
         print(f"cross-check of {args.scenario}: {counted(len(speeds), 'speed')} x {len(cc.RUNGS)} rungs, {warmup} + "
               f"{counted(rotations, 'rotation')} each, {where}, {wall:.1f} s; impulses per pocket and cage "
               f"rotation, mean over all pockets ± batch-means standard error")

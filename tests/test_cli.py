@@ -251,7 +251,7 @@ def test_a_count_of_one_is_singular(tmp_path):
     res = bearingsim(*commands[0])  # again: every case cached
     assert "1 case: 0 done, 1 cached" in res.stdout, res.stdout
     res = bearingsim(*commands[-1])
-    assert "1 speed x 5 rungs, 1 warm-up + 1 rotation each, 1 process," in res.stdout, res.stdout
+    assert "1 speed x 5 rungs, 1 warm-up (rung 3: 2) + 1 rotation each, 1 process," in res.stdout, res.stdout
 
 
 @pytest.mark.slow

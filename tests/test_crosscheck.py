@@ -458,6 +458,18 @@ def test_a_failed_rung_prints_n_a_not_nan():
     assert line.split()[3:] == ["n/a", "±", "n/a", "n/a", "±", "n/a", "n/a", "n/a"], line
 
 
+def test_the_first_line_gives_rung_3s_own_warm_up():
+    """The command's first line said "1 warm-up + 3 rotations each", but rung 3 warms up for
+    KINEMATIC_WARMUP_ROTATIONS (2) whatever the scenario's single warm-up: it says "1 warm-up (rung 3: 2)", as
+    docs/crosscheck.md does; a scenario's own warm-up of 2 or more is every rung's."""
+    assert cc.KINEMATIC_WARMUP_ROTATIONS == 2
+    assert cc.warmup_text(1) == "1 warm-up (rung 3: 2)"
+    assert cc.warmup_text(2) == "2 warm-ups" and cc.warmup_text(3) == "3 warm-ups"
+    warmups = {scene: sc.numerics.warmup_rotations for _, scene, _, sc in
+               cc.rung_scenarios(load_scenario(REFERENCE), 3000.0, 3)}
+    assert warmups == {"reduced": 1, "reduced_equivalent": 1, "kinematic_cage": 2, "centred_cage": 1, "full": 1}
+
+
 def test_the_figures_title_names_the_speeds_it_ran(tmp_path, monkeypatch):
     """A cross-check over 1000, 3000 and 6000 rpm was titled "Cross-check of multibody_3000rpm", the base
     scenario's name, as if it had run at 3000 rpm. The title names the speeds that ran."""

@@ -49,6 +49,17 @@ DEFAULT_ROTATIONS = 10
 #: its first recorded rotation is still its start: 11.589 against 12.555 mN s at 3000 rpm, 9.771 against 10.069
 #: at 6000, the whole of its batch-means error; with two every recorded rotation is the same)
 KINEMATIC_WARMUP_ROTATIONS = 2
+
+
+def warmup_text(warmup: int) -> str:
+    """The rungs' warm-up rotations as the command's first line gives them: the scenario's ``warmup``, and rung 3's
+    where :data:`KINEMATIC_WARMUP_ROTATIONS` raises it ("1 warm-up (rung 3: 2)", as docs/crosscheck.md says)."""
+    from bearingsim.wording import counted
+
+    text = counted(int(warmup), "warm-up")
+    return text + (f" (rung 3: {KINEMATIC_WARMUP_ROTATIONS})" if warmup < KINEMATIC_WARMUP_ROTATIONS else "")
+
+
 #: (rung, scene, the assumption of the paper's model this rung drops; ``{raceways}``: :func:`rungs` names them)
 RUNGS = (
     (1, "reduced", "none: the paper's reduced model (one pocket; cage at the epicyclic speed)"),

@@ -616,6 +616,8 @@ def _sensitivity_sections(table: Path):
     blocks = [table_block(f"Normalised sensitivities (runs at x (1 ± {sens.step_text(meta.get('step', 0))})); log: "
                           f"d ln y / d ln x, lin: d y / d ln x; {errors} (docs/sensitivity.md)", head, cells,
                           [False, False, False, True, True, False], sens.HALF_STEP_NOTE if deterministic else "")]
+    if meta.get("left_out"):  # default keys not varied, as the command's first lines and `bearingsim table` name them
+        blocks.insert(0, {"kind": "text", "text": f"Left out of the default keys: {meta['left_out']}."})
     bars = sens.tornado_errors(rows)
     present = {r["quantity"] for r in rows}  # the chart's panels, in its order (sensitivity.plot_tornado)
     panels = [f"ln {q}" if m == "log" else f"{q} (a fraction)" for q, _, m in sens.QUANTITIES if q in present]

@@ -901,3 +901,26 @@ def test_a_whole_bearing_sensitivitys_chart_caption_names_every_panel(tmp_path):
     sections = _sensitivity_sections(tmp_path / "sensitivity.h5")[1]
     (caption,) = [b["caption"] for s in sections for b in s.blocks if b["kind"] == "figure"]
     assert caption.startswith("Tornado chart: the change of ln I_dec and ln I_acc across"), caption
+
+
+def test_a_sensitivitys_page_names_the_keys_it_left_out(tmp_path):
+    """A default key whose value is 0 is left out of a sensitivity study (no relative step moves it): the command's
+    first lines and `bearingsim table DIR` name it ("left out: lubrication.drag_coefficient (its value is 0.0: ...)"),
+    the report's page did not, so its table read as every ranged key's. The page names it above the table."""
+    from bearingsim.reports import _sensitivity_sections
+    from bearingsim.studies import sensitivity as sens
+
+    sc = bearingsim.load_scenario(PAPER, set={"lubrication.drag_coefficient": 0.0})
+    rows = [{"key": "contact.restitution", "quantity": q, "measure": "log", "x": 0.8, "x_minus": 0.72,
+             "x_plus": 0.88, "y_minus": 1.0, "y_minus_se": 0.0, "y_plus": 1.1, "y_plus_se": 0.0, "sensitivity": 0.5,
+             "sensitivity_se": 0.0, "over_range": 0.5, "sensitivity_half_step": 0.5, "x_minus_half": 0.76,
+             "x_plus_half": 0.84, "archive_minus": "", "archive_plus": "", "status": "done", "error": ""}
+            for q in sens.REDUCED_QUANTITIES]
+    why = "its value is 0.0: a relative step x (1 ± step) cannot move it"
+    sens.write_table(tmp_path, rows, sc, 0.1, left_out=[("lubrication.drag_coefficient", why)], runs=4)
+    texts = [b["text"] for s in _sensitivity_sections(tmp_path / "sensitivity.h5")[1] for b in s.blocks
+             if b["kind"] == "text"]
+    assert f"Left out of the default keys: lubrication.drag_coefficient ({why})." in texts, texts
+    sens.write_table(tmp_path, rows, sc, 0.1, runs=4)
+    assert not [b for s in _sensitivity_sections(tmp_path / "sensitivity.h5")[1] for b in s.blocks
+                if b["kind"] == "text" and "Left out" in b["text"]]

@@ -718,7 +718,11 @@ def _case_values(cols, meta) -> list[str]:
 
     keys = [k for k in meta.get("axes", ()) if k in cols]
     texts = {k: distinct_texts(list(cols[k])) for k in keys}
-    return [", ".join(f"{k} = {texts[k][i]}" for k in keys) for i in range(len(cols["case"]))]
+
+    def unset(v):  # a key the case does not set: NaN or no text (validate's rig cases: no drag, no variant)
+        return (isinstance(v, float) and v != v) or (isinstance(v, str) and not v)
+
+    return [", ".join(f"{k} = {texts[k][i]}" for k in keys if not unset(cols[k][i])) for i in range(len(cols["case"]))]
 
 
 def _run_notes_blocks(cols, meta) -> list[dict]:

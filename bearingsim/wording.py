@@ -90,11 +90,12 @@ def distinct_texts(values) -> list[str]:
     """A column of values (a swept key's, one per case) as tables and figures write them: numbers as ``%g``
     writes them, or with the fewest more significant digits (up to 16; beyond, Python's shortest repr) that keep
     distinct values distinct (970.000001 and 970.000002, both "970" by ``%g``: "970.000001",
-    "970.000002"); text, switches and whole numbers as they are."""
+    "970.000002"); text, switches and whole numbers as they are; NaN, a case that does not set the key (validate's
+    rig cases have no drag coefficient of their own), as "-", as tables write a missing number."""
     def is_float(v):  # a Python or numpy float (numpy registers its floats as numbers.Real)
         return isinstance(v, numbers.Real) and not isinstance(v, numbers.Integral)
 
     finite = {float(v) for v in values if is_float(v) and math.isfinite(v)}
     digits = next((d for d in range(6, 17) if len({f"{v:.{d}g}" for v in finite}) == len(finite)), None)
-    return [(repr(float(v)) if digits is None else f"{float(v):.{digits}g}") if is_float(v) else str(v)
-            for v in values]
+    return [("-" if v != v else repr(float(v)) if digits is None else f"{float(v):.{digits}g}") if is_float(v)
+            else str(v) for v in values]

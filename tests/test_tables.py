@@ -564,3 +564,23 @@ def test_rows_whose_notes_differ_in_their_numbers_only_share_one_mark():
     assert notes == {0: "[1] first rotation +3.2% off (t = 5.0) (the numbers of the first row marked [1]; the others "
                         "differ in theirs)",
                      3: "[2] k is high"}
+
+
+def test_a_key_a_case_does_not_set_is_shown_as_missing_not_as_nan():
+    """validate's index labels its cases by study, rpm, drag and variant, and its rig cases set no drag (NaN) and no
+    variant (""): `bearingsim table DIR/sweep.h5` and `bearingsim wear DIR` printed "nan" in the drag column, and
+    the report's case notes "study = rig, rpm = 500, drag = nan, variant = ". The table prints "-", as it does a
+    missing number, and the report names only what the case sets."""
+    import numpy as np
+
+    from bearingsim.reports import _case_values
+    from bearingsim.wording import distinct_texts
+
+    drag = [0.01, 0.02, float("nan"), np.float64("nan")]
+    assert distinct_texts(drag) == ["0.01", "0.02", "-", "-"]
+    assert distinct_texts([970.000001, 970.000002, float("nan")]) == ["970.000001", "970.000002", "-"]
+    cols = {"case": ["a", "b"], "study": ["fig9", "rig"], "rpm": np.array([500.0, 500.0]),
+            "drag": np.array([0.02, np.nan]), "variant": ["present", ""]}
+    meta = {"axes": ["study", "rpm", "drag", "variant"]}
+    assert _case_values(cols, meta) == ["study = fig9, rpm = 500, drag = 0.02, variant = present",
+                                        "study = rig, rpm = 500"]

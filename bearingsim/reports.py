@@ -470,11 +470,11 @@ def _sweep_sections(index: Path):
 
 
 def _crosscheck_sections(table: Path):
-    from bearingsim import tables
     from bearingsim.studies import crosscheck as cc
+    from bearingsim.wording import shown_as
 
     rows, meta = cc.read_table(table)
-    slip, slip_unit = tables.shown_as("cage_slip", "1")
+    slip, slip_unit = shown_as("cage_slip", "1")
     head = ["rpm", "rung", "scene", "relaxed", "I_dec [mN s]", "I_acc [mN s]", "first impact speed [m/s]",
             f"cage slip [{slip_unit}]", "change of I_dec [mN s]"]
     cells = [[_cell(r["rpm"]), str(r["rung"]), r["scene"], r["relaxed"], _pm(r["I_dec_mean_Ns"], r["I_dec_sem_Ns"]),

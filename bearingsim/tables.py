@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError
-from bearingsim.wording import by_kind, counted, distinct_texts, note_kind
+from bearingsim.wording import by_kind, counted, distinct_texts, note_kind, shown_as
 from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
@@ -47,10 +47,6 @@ DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "
 #: summary keys with a standard error (the key of the error)
 SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns",
           "wear_front_mean_m3_h": "wear_front_sem_m3_h", "wear_rear_mean_m3_h": "wear_rear_sem_m3_h"}
-#: display scale and unit of units that read better scaled
-SCALED = {"N s": (1e3, "mN s"), "m^3/h": (1e9, "mm^3/h")}
-#: display scale and unit of keys stored as a fraction (unit 1) that read better in per cent
-SCALED_KEYS = {"cage_slip": (100.0, "%")}
 
 
 #: the summary keys a finished run is read by first (``bearingsim run`` prints them, the report heads its summary)
@@ -89,12 +85,6 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
                          f"recorded rotations")
         rows.append((key, v, err, words))
     return rows
-
-
-def shown_as(key: str, unit: str) -> tuple[float, str]:
-    """(scale, unit) in which the tables show summary key ``key`` of SI unit ``unit``: cage slip in per cent,
-    impulses in mN s, the rest as stored (``bearingsim run`` and the report's tables show them so too)."""
-    return SCALED_KEYS.get(key, SCALED.get(unit, (1.0, unit)))
 
 
 @dataclass

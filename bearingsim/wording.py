@@ -99,3 +99,16 @@ def distinct_texts(values) -> list[str]:
     digits = next((d for d in range(6, 17) if len({f"{v:.{d}g}" for v in finite}) == len(finite)), None)
     return [("-" if v != v else repr(float(v)) if digits is None else f"{float(v):.{digits}g}") if is_float(v)
             else str(v) for v in values]
+
+
+#: display scale and unit of units that read better scaled
+SCALED = {"N s": (1e3, "mN s"), "m^3/h": (1e9, "mm^3/h")}
+#: display scale and unit of keys stored as a fraction (unit 1) that read better in per cent
+SCALED_KEYS = {"cage_slip": (100.0, "%")}
+
+
+def shown_as(key: str, unit: str) -> tuple[float, str]:
+    """(scale, unit) in which the tables show summary key ``key`` of SI unit ``unit``: cage slip in per cent,
+    impulses in mN s, the rest as stored (``bearingsim run``, ``bearingsim table``, the study tables and the
+    report's tables show them so)."""
+    return SCALED_KEYS.get(key, SCALED.get(unit, (1.0, unit)))

@@ -374,8 +374,8 @@ def read_table(path):
 
 def shown(quantity: str) -> tuple[float, str]:
     """(factor, unit) in which the tables show ``quantity``, as ``bearingsim run``, ``table`` and ``crosscheck`` do
-    (:func:`bearingsim.tables.shown_as`: ``I_dec``: 1e3, ``mN s``; ``cage_slip``: 100, ``%``)."""
-    from bearingsim.tables import shown_as
+    (:func:`bearingsim.wording.shown_as`: ``I_dec``: 1e3, ``mN s``; ``cage_slip``: 100, ``%``)."""
+    from bearingsim.wording import shown_as
 
     keys = {q: (key, unit) for q, key, unit in QUANTITIES}
     key, unit = keys.get(quantity, (quantity, "1"))

@@ -1730,3 +1730,20 @@ def test_a_full_disk_while_the_index_is_written_names_the_index(tmp_path, limit,
                           env={**os.environ, "PYTHONPATH": _path()}, preexec_fn=limited)
     assert (proc.returncode, proc.stderr) == (2, f"bearingsim: error: {out / index}: File too large\n")
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [".sweep.lock"]  # no temporary
+
+
+def test_a_case_label_shows_a_ranges_value_without_its_round_off():
+    """A range's values carry round-off (``0.01:0.1:10`` gives 0.09000000000000001), which a failed case's message
+    printed as it is ("value=0.09000000000000001"); the label shows a float to 12 significant digits, anything else
+    as it is, and the base scenario's case says so."""
+    import numpy as np
+
+    from bearingsim.sweeps.spec import Case
+
+    values = {"lubrication.drag_coefficient": float(np.linspace(0.01, 0.1, 10)[8]), "bearing.roller_count": 16,
+              "bearing.cage_guidance": "outer_land", "numerics.dt_s": 4e-6}
+    assert values["lubrication.drag_coefficient"] != 0.09  # the round-off is there
+    assert Case("0" * 16, values, "", "multibody").label() == (
+        "lubrication.drag_coefficient=0.09, bearing.roller_count=16, bearing.cage_guidance=outer_land, "
+        "numerics.dt_s=4e-06")
+    assert Case("0" * 16, {}, "", "reduced").label() == "(base scenario)"

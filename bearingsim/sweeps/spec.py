@@ -78,8 +78,14 @@ class Case:
     ran_at: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     def label(self) -> str:
-        """``key=value, ...`` of the swept values, for messages."""
-        return ", ".join(f"{k}={v}" for k, v in self.values.items()) or "(base scenario)"
+        """``key=value, ...`` of the swept values, for messages: a number to 12 significant digits, so that a range's
+        round-off (0.09000000000000001 of ``0.01:0.1:10``) does not show; the case's scenario holds the value itself."""
+        return _label(self.values)
+
+
+def _shown(value) -> str:
+    """A swept value in a message: a float to 12 significant digits, anything else as it is."""
+    return f"{value:.12g}" if isinstance(value, float) else str(value)
 
 
 @dataclass
@@ -439,7 +445,8 @@ def resolved_value(scenario, key: str) -> Any:
 
 
 def _label(values: dict) -> str:
-    return ", ".join(f"{k}={v}" for k, v in values.items()) or "(base scenario)"
+    """``key=value, ...`` of a case's swept values (:meth:`Case.label`)."""
+    return ", ".join(f"{k}={_shown(v)}" for k, v in values.items()) or "(base scenario)"
 
 
 def scenario_from_toml(text: str, source: str = "<sweep case>"):

@@ -169,6 +169,11 @@ def test_ranges_are_stored_in_the_archive_and_shown(tmp_path, capsys):
     (["--keys", "bearing.roller_mass_kg"], "--keys bearing.roller_mass_kg: no range"),  # continuous, unranged, read
     (["--step", "0"], "--step '0'"),
     (["--step", "150%"], "--step '150%'"),
+    # per cent without its sign, and a negative step: the refusal says what to give (it said the bound alone)
+    (["--step", "10"], "--step '10': the relative step must be above 0 and below 100 % (runs at x (1 - step) and "
+                       "x (1 + step)); did you mean --step 10%?"),
+    (["--step=-10%"], "--step '-10%': the relative step must be above 0 and below 100 % (runs at x (1 - step) and "
+                      "x (1 + step)); a step is taken both ways, give it positive"),
 ])
 def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
     code = main(["sensitivity", str(REDUCED), "-o", str(tmp_path / "o"), *args])

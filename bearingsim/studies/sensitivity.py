@@ -71,8 +71,13 @@ def parse_step(text) -> float:
     except ValueError:
         raise UserError(f"--step {text!r}: give a relative step such as 10% or 0.1") from None
     if not (math.isfinite(step) and 0.0 < step < 1.0):
+        hint = ""
+        if not raw.endswith("%") and 1.0 <= abs(step) < 100.0:  # per cent without its sign: --step 10
+            hint = f"; did you mean --step {raw.lstrip('-+')}%?"
+        elif -1.0 < step < 0.0:  # --step=-10%: the runs are at x (1 - step) and x (1 + step) already
+            hint = "; a step is taken both ways, give it positive"
         raise UserError(f"--step {text!r}: the relative step must be above 0 and below 100 % (runs at x (1 - step) "
-                        f"and x (1 + step))")
+                        f"and x (1 + step)){hint}")
     return step
 
 

@@ -478,8 +478,9 @@ def _print_validate(args, studies, outcome) -> None:
         for p in outcome.written[2:]:
             print(f"wrote {p}")
     if outcome.interrupted is None:
+        notes = with_notes(outcome.sweep.rows, "case", Path(args.output) / "sweep.h5")
         print(f"{counted(len(outcome.sweep.rows), 'case')}: {outcome.counts()}; archives in "
-              f"{Path(args.output) / 'cases'}")
+              f"{Path(args.output) / 'cases'}{notes}")
 
 
 def _benchmarks_root() -> Path:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from bearingsim.cli_common import output_path
+from bearingsim.cli_common import output_path, with_notes
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
 
@@ -52,7 +52,8 @@ def _cmd_sensitivity(args) -> int:
         print(format_table(study.rows))
         for name in ("sensitivity.csv", "sensitivity.h5", "sensitivity.png"):
             print(f"wrote {Path(args.output) / name}")
-        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}"
+              f"{with_notes(outcome.sweep.rows, 'run', Path(args.output) / 'sweep.h5')}")
     return report_study(outcome, "sensitivity")
 
 
@@ -69,7 +70,8 @@ def _cmd_uncertainty(args) -> int:
         print(format_table(study.spreads, study.indices))
         for name in ("uncertainty.csv", "uncertainty_spread.csv", "uncertainty.h5", "uncertainty.png"):
             print(f"wrote {Path(args.output) / name}")
-        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}")
+        print(f"runs: {outcome.counts()}; archives in {Path(args.output) / 'cases'}"
+              f"{with_notes(outcome.sweep.rows, 'run', Path(args.output) / 'sweep.h5')}")
     return report_study(outcome, "uncertainty")
 
 

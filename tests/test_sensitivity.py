@@ -791,3 +791,19 @@ def test_the_sobol_chart_gives_the_commands_unit_and_says_which_indices_it_does_
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
     assert any(lb.startswith("outside 0..1: no share, the estimate's scatter") for lb in labels), labels
     assert any("faded: 95 % interval reaches 0" in lb for lb in labels), labels
+
+
+def test_the_closing_line_counts_the_runs_with_notes(tmp_path, capsys):
+    """`bearingsim sensitivity` (and uncertainty, validate) ended on "runs: 4 done, 0 cached, 0 failed; archives in
+    DIR/cases" whatever the runs' notes, where sweep and crosscheck count the cases with notes and say where they are
+    listed. A pocket clearance outside the preset's plausible range notes every run; the preset's notes none."""
+    code = main(["sensitivity", str(REDUCED), "--keys", "lubrication.drag_coefficient", "--set",
+                 "bearing.pocket_clearance_mm=0.1", "-o", str(tmp_path / "noted"), "-j", "1"])
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert code == 0 and last == (f"runs: 4 done, 0 cached, 0 failed; archives in {tmp_path / 'noted' / 'cases'}; "
+                                  f"4 runs with notes ('bearingsim table {tmp_path / 'noted' / 'sweep.h5'}' marks them "
+                                  f"in its notes column and lists them)"), last
+    assert main(["sensitivity", str(REDUCED), "--keys", "lubrication.drag_coefficient", "-o",
+                 str(tmp_path / "clean"), "-j", "1"]) == 0
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last.startswith("runs: 4 done") and "with notes" not in last, last

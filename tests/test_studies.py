@@ -279,7 +279,7 @@ def test_crosscheck_on_a_dask_cluster_gives_the_local_table(tmp_path):
 
     from bearingsim.sweeps.engines import DaskEngine
 
-    scenario = load_scenario(REFERENCE)
+    scenario = load_scenario(REFERENCE, ["multibody.raceway_contact=rigid"])  # the fast scene: the engine is tested
     local, _ = cc.run_crosscheck(scenario, tmp_path / "local", (RPM,), 1, jobs=1, progress=False)
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=True, dashboard_address=":0",
                       host="127.0.0.1") as cluster:

@@ -628,13 +628,9 @@ class LifeStudy(Study):
             return
         if not force:
             raise UserError(other)
-        from bearingsim.outputs import _remove_if_own, remove_folder_files
-        from bearingsim.sweeps.run import _CASE_NAME
+        from bearingsim.sweeps.run import remove_other_study
 
-        for p in outdir.glob("cases/*.h5"):  # case archives, bearingsim's only: a user's file there stays
-            if _CASE_NAME.fullmatch(p.stem):
-                _remove_if_own(p, archive.is_archive)
-        remove_folder_files(outdir)
+        remove_other_study(outdir)  # bearingsim's case archives only: a user's file in cases/ stays
 
 
 def run_life(scenario, folder, limit: Limit, *, stages: int = STAGES_RESOLVED, rotations: int | None = None,

@@ -263,9 +263,7 @@ def check_same_sweep(outdir: Path, cases: list[Case], force: bool = False, base_
         raise UserError(f"{outdir}: holds another sweep or study ({counted(len(other), 'case')} of its {len(old)} "
                         f"{verb} not in this one); not mixed in: give another -o folder, or add --force to replace it "
                         f"{_base_changed(old_base, base_toml, index) or _resume_hint(other, versions)}")
-    for h in other:
-        _remove_if_own(cases_dir / f"{h}.h5", archive.is_archive)
-    remove_folder_files(outdir)  # its index, map, figures and study tables: none left to be read as the new one's
+    remove_other_study(outdir, other)
 
 
 def _base_changed(old: str | None, new: str | None, index: Path) -> str | None:
@@ -303,6 +301,21 @@ def _resume_hint(other: set[str], versions: dict) -> str:
                 "otherwise, so the command that made them is refused too: --force replaces them and computes them "
                 "again)")
     return "(the same command as before resumes it)"
+
+
+def remove_other_study(outdir: Path, hashes=None) -> None:
+    """Remove the sweep or study in ``outdir`` that ``--force`` replaces: its case archives, bearingsim's own only
+    (:func:`bearingsim.archive.is_archive`; those of ``hashes``, or every ``cases/<hash>.h5``: a user's file there
+    stays), then its index, map, figures and study tables (:func:`bearingsim.outputs.remove_folder_files`), so that
+    none is left to be read as the new one's."""
+    from bearingsim import archive
+
+    cases_dir = outdir / "cases"
+    names = ([cases_dir / f"{h}.h5" for h in hashes] if hashes is not None
+             else [p for p in cases_dir.glob("*.h5") if _CASE_NAME.fullmatch(p.stem)])
+    for path in names:
+        _remove_if_own(path, archive.is_archive)
+    remove_folder_files(outdir)
 
 
 def _case_archives(cases_dir: Path) -> set[str]:

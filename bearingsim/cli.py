@@ -428,15 +428,16 @@ def _cmd_table(args) -> int:
 
 def _cmd_keys(args) -> int:
     """``bearingsim keys``: every scenario key with unit, bounds, default and source (:mod:`bearingsim.keys`)."""
-    from bearingsim.keys import TOPICS, format_keys, list_keys
+    from bearingsim.keys import format_keys, list_keys
     from bearingsim.scenario import available_presets
+    from bearingsim.wording import KEY_TOPICS
 
     if args.preset not in available_presets():
         raise UserError(f"--preset {args.preset!r}: unknown preset (available: {', '.join(available_presets())})")
     text = format_keys(list_keys(args.preset), args.pattern, why=args.why)
     if not text:
         raise UserError(f"keys {args.pattern!r}: no scenario key contains it ('bearingsim keys' lists them all; "
-                        f"words a key's name does not hold: {', '.join(TOPICS)})")
+                        f"words a key's name does not hold: {', '.join(KEY_TOPICS)})")
     print(text)
     return 0
 

@@ -130,7 +130,7 @@ def _sweep_wear(folder: Path, args) -> str:
             missing.append(f"not available: case {cases[i]}"
                            + "".join(f", {k} = {labels[k][i]}" for k in labels if k != "case") + f": {why}")
     if n and all(why == PER_HOUR for why in whys):  # the option, not the cases: a table of dashes says nothing
-        raise UserError(f"--rotations {args.rotations:g}: no case of {folder} has an archive to scale by its cage "
+        raise UserError(f"--rotations {wear.given_time(args.rotations)}: no case of {folder} has an archive to scale by its cage "
                         f"speed (a reduced case never keeps one by default), and the index's wear rates are per hour: "
                         f"give --hours")
     notes = [f"wear of the {n} cases of the sweep {folder}, each after the running time at its own speed; swept keys "
@@ -150,14 +150,13 @@ SWEEP_ROWS = ("a case with a multibody archive: its wear as 'bearingsim wear ARC
 def _check_time(args) -> None:
     """Refuse a running time no case could take (:func:`bearingsim.wear.running_time`'s bounds, in hours; the
     rotations' bound depends on each case's speed), naming the option, before any case is read."""
-    from bearingsim.wear import MAX_RUNNING_HOURS
+    from bearingsim.wear import MAX_RUNNING_HOURS, given_time
 
     value, name = (args.hours, "--hours") if args.hours is not None else (args.rotations, "--rotations")
     if not value > 0:  # NaN fails it; an infinite time is beyond the bound (hours below, rotations a case's)
         raise UserError(f"{name} {value!r}: must be a positive number")
     if args.hours is not None and value > MAX_RUNNING_HOURS:
-        given = repr(float(value)).removesuffix(".0")  # as given: 1000000.4 is not rounded to the bound
-        raise UserError(f"--hours {given}: more than {MAX_RUNNING_HOURS:.10g} h of running, 114 years, ten times the "
+        raise UserError(f"--hours {given_time(value)}: more than {MAX_RUNNING_HOURS:.10g} h of running, 114 years, ten times the "
                         f"longest life a bearing is designed for; give a shorter running time")
 
 

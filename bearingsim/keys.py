@@ -41,8 +41,6 @@ DEFAULT_REASONS = {
 #: the units of the keys whose names carry none (:func:`bearingsim.sweeps.index.unit_of` reads a name's suffix):
 #: Eq. (2)'s c, with F_o and N in N and V in m/s (docs/physics.md)
 KEY_UNITS = {"lubrication.drag_coefficient": DRAG_COEFFICIENT_UNIT}
-#: words an engineer looks for that no key's name holds (:data:`bearingsim.wording.KEY_TOPICS`)
-TOPICS = KEY_TOPICS
 #: what a key counts, in the table's source column: these count the cage's rotations, not the inner ring's
 #: (which turns inner-ring speed / cage speed times as often)
 KEY_MEANINGS = {
@@ -264,7 +262,7 @@ def format_keys(keys: list[KeyInfo], pattern: str | None = None, why: bool = Fal
 
         words = key_words(pattern.strip().replace(" ", "_").replace(".", "_"))
         rows = [k for k in keys if words and words <= key_words(k.key.replace(".", "_"))]
-    topic = TOPICS.get(pattern.strip().lower()) if pattern and not rows else None
+    topic = KEY_TOPICS.get(pattern.strip().lower()) if pattern and not rows else None
     if topic:  # a word no key's name holds: the keys it enters through, and how
         rows = [k for k in keys if k.key in topic[0]]
         return f"{pattern!r} is in no key's name: {topic[1]}:\n" + format_keys(rows, why=why)

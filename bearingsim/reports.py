@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from bearingsim.errors import UserError, check_path
-from bearingsim.wording import counted, run_notes
+from bearingsim.wording import counted, listed, run_notes
 
 #: the first bytes of every report bearingsim writes: what ``-o`` may replace
 SIGNATURE = b"<!DOCTYPE html>\n<!-- bearingsim report"
@@ -621,7 +621,7 @@ def _sensitivity_sections(table: Path):
     bars = sens.tornado_errors(rows)
     present = {r["quantity"] for r in rows}  # the chart's panels, in its order (sensitivity.plot_tornado)
     panels = [f"ln {q}" if m == "log" else f"{q} (a fraction)" for q, _, m in sens.QUANTITIES if q in present]
-    drawn = ", ".join(panels[:-1]) + f" and {panels[-1]}" if len(panels) > 1 else "".join(panels)
+    drawn = listed(panels, "and") if panels else ""
     figures = drawn_blocks(lambda d: sens.plot_sensitivity(table, d), {
         "sensitivity.png": f"Tornado chart: the change of {drawn} across each key's plausible range "
                            f"(S ln(high / low), if linear), keys ordered by the change of I_dec; {bars}"})

@@ -25,7 +25,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from bearingsim.errors import UserError
-from bearingsim.wording import counted, given_by
+from bearingsim.wording import KEY_TOPICS, counted, given_by, listed
 
 SCHEMA_VERSION = 1
 
@@ -1140,11 +1140,6 @@ def key_words(name: str) -> frozenset:
     return frozenset(w[:-1] if len(w) > 3 and w.endswith("s") and not w.endswith(("ss", "us")) else w for w in words)
 
 
-def _one_of(keys: list, last: str = "or") -> str:
-    """``a``, ``a or b``, ``a, b or c``."""
-    return keys[0] if len(keys) == 1 else f"{', '.join(keys[:-1])} {last} {keys[-1]}"
-
-
 def did_you_mean(key: str) -> str:
     """`` (did you mean X?)`` for the accepted key closest to an unknown ``key`` (difflib), or ``""``; a ``key``
     that is the last part of exactly one accepted key (``rotations``: ``numerics.rotations``) names that key. A
@@ -1169,13 +1164,11 @@ def did_you_mean(key: str) -> str:
         if not holding:  # the right words in the wrong section, or at the top level without their section
             holding = [k for k in known if "." in k and words <= key_words(k.rpartition(".")[2])]
         if holding:
-            return f" (did you mean {_one_of(holding)}?)"
-        from bearingsim.wording import KEY_TOPICS
-
+            return f" (did you mean {listed(holding)}?)"
         topic = next((w for w in sorted(words) if w in KEY_TOPICS), None)
         if topic:  # a word no key's name holds (material, viscosity): the keys it enters through
             keys, how = KEY_TOPICS[topic]
-            return f" ({topic!r} is in no key's name: {how}: {_one_of(list(keys), 'and')})"
+            return f" ({topic!r} is in no key's name: {how}: {listed(keys, 'and')})"
     close = [f"{section}.{m}" if section else m for m in difflib.get_close_matches(
         leaf, [k.rpartition(".")[2] for k in same], n=1, cutoff=0.6)]
     if not close:  # the right name in the wrong section

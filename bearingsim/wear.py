@@ -170,6 +170,15 @@ def archard_values(wear_coefficient, hardness) -> tuple[float, float]:
     return float(wear_coefficient), float(hardness)
 
 
+def given_time(value) -> str:
+    """A running time as given, in a refusal: 1000000.4 not rounded to the bound it passes (``%g`` wrote
+    "1e+06"), a whole number without ".0", an integer beyond any float (10**400) as "above 1e308"."""
+    try:
+        return repr(float(value)).removesuffix(".0")
+    except OverflowError:
+        return "above 1e308"
+
+
 def running_time(result, *, hours: float | None = None, rotations: float | None = None) -> tuple[float, float, float]:
     """(shaft rotations, hours, cage rotations) of a running time given as ``hours`` or inner-ring
     ``rotations`` (exactly one); the cage rotations at the run's measured mean cage speed. A refusal starts
@@ -187,9 +196,7 @@ def running_time(result, *, hours: float | None = None, rotations: float | None 
     rot_per_hour = 3600.0 * op.omega_i / (2.0 * math.pi)
     shaft = amount if rotations is not None else amount * rot_per_hour
     if (amount if hours is not None else shaft / rot_per_hour) > MAX_RUNNING_HOURS:
-        # as given: 1000000.4 is not rounded to the bound; an integer no float holds is said to be one
-        given = repr(amount).removesuffix(".0") if math.isfinite(amount) or isinstance(value, float) else "above 1e308"
-        raise UserError(f"{name} {given}: more than {MAX_RUNNING_HOURS:.10g} h of running "
+        raise UserError(f"{name} {given_time(value)}: more than {MAX_RUNNING_HOURS:.10g} h of running "
                         f"({MAX_RUNNING_HOURS * rot_per_hour:.12g} inner-ring rotations at {rot_per_hour / 60:g} rpm), "
                         f"114 years, ten times the longest life a bearing is designed for; give a shorter running time")
     cage_speed = result.summary.get("cage_speed_mean_rad_s", float("nan"))

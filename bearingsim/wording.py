@@ -6,19 +6,21 @@ import numbers
 import re
 
 
+#: the keys a lubricant enters through: the oil-film drag's c and the raceways' traction curve
+_LUBRICANT_KEYS = ("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref")
 #: words an engineer looks for that no key's name holds: the keys through which they enter, and how
 #: (``bearingsim keys WORD`` answers with those keys and this line, and an unknown key holding the word,
 #: :func:`bearingsim.scenario.did_you_mean`, names them)
 KEY_TOPICS = {
     "viscosity": (("lubrication.drag_coefficient",), "a lubricant's viscosity enters through Eq. (2)'s c, as "
                   "c' = c (eta'/eta)^0.648 (docs/whatif.md, Lubricant)"),
-    "oil": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+    "oil": (_LUBRICANT_KEYS,
             "an oil enters through the oil-film drag's c and the raceways' traction curve (docs/whatif.md, "
             "Lubricant)"),
-    "lubricant": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+    "lubricant": (_LUBRICANT_KEYS,
                   "a lubricant enters through the oil-film drag's c and the raceways' traction curve "
                   "(docs/whatif.md, Lubricant)"),
-    "grease": (("lubrication.drag_coefficient", "multibody.traction_mu_max", "multibody.traction_slip_ref"),
+    "grease": (_LUBRICANT_KEYS,
                "a grease enters through the oil-film drag's c (the paper's c = 0.02 is its fit to a lithium-complex "
                "grease) and the raceways' traction curve (docs/whatif.md, Lubricant)"),
     "material": (("bearing.cage_mass_kg", "bearing.cage_inertia_kgm2", "contact.restitution", "contact.cage_friction",
@@ -60,6 +62,12 @@ def by_kind(notes) -> dict[str, tuple[int, int, bool]]:
         kind[1] += 1
         kind[2].add(text)
     return {k: (first, n, len(texts) > 1) for k, (first, n, texts) in kinds.items()}
+
+
+def listed(items, last: str = "or") -> str:
+    """``a``, ``a or b``, ``a, b or c`` (``last``: the word before the last item)."""
+    items = list(items)
+    return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} {last} {items[-1]}"
 
 
 def counted(n, noun: str, plural: str | None = None, fmt: str = "") -> str:

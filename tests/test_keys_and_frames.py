@@ -77,13 +77,13 @@ def test_unknown_key_with_a_word_no_keys_name_holds_gets_the_keys_it_enters_thro
     """`--set bearing.cage_material=...` said "did you mean bearing.cage_inertia_kgm2?" (difflib's closest); a word
     `bearingsim keys` answers (material, viscosity) gets the keys it enters through, as `bearingsim keys WORD`."""
     from bearingsim.errors import UserError
-    from bearingsim.keys import TOPICS
+    from bearingsim.wording import KEY_TOPICS
 
     with pytest.raises(UserError) as err:
         load_scenario(PAPER, ["bearing.cage_material=1"])
     message = str(err.value)
     assert message.endswith("bearing.cage_material: unknown key ('material' is in no key's name: "
-                            f"{TOPICS['material'][1]}: bearing.cage_mass_kg, bearing.cage_inertia_kgm2, "
+                            f"{KEY_TOPICS['material'][1]}: bearing.cage_mass_kg, bearing.cage_inertia_kgm2, "
                             "contact.restitution, contact.cage_friction, contact.land_friction, "
                             "wear.wear_coefficient and wear.hardness_Pa)"), message
     assert "cage_inertia_kgm2?" not in message and "\n" not in message

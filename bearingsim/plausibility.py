@@ -180,7 +180,8 @@ def check(result) -> list[str]:
                 f"inner ring displaced {disp:.3g} m, more than the {limit:.3g} m the Palmgren contact law allows "
                 f"for this load and clearance; {_advice(result)}")
         for note in (_unloaded_ring_note(result), _no_classical_load_zone_note(result), _pinched_note(result),
-                     land_overlap_note(result), land_untouched_note(result), _rigid_kinematic_note(result)):
+                     land_overlap_note(result), land_untouched_note(result), _rigid_kinematic_note(result),
+                     _traction_step_note(result)):
             if note is not None:
                 notes.append(note)
         orbit = result.get("cage_orbit")
@@ -419,6 +420,38 @@ def _rigid_kinematic_note(result) -> str | None:
             "the time step (at 3000 rpm I_dec reads 7.9 / 9.4 / 10.6 mN s at 17.8 / 8.9 / 4.4 us, against 12.6 "
             "on Hertz raceways; docs/fast_scene.md, The kinematic cage): set multibody.raceway_contact = \"hertz\" "
             "for that scene")
+
+
+#: h / tau (:func:`bearingsim.multibody.core.traction_relaxation_time`) above which a run's step gets a note, by
+#: raceway contact: on the reference bearing the automatic step's error is resolved at 1000 rpm (Hertz h / tau =
+#: 0.34: -1.2 %; rigid 1.9: -3.6 %) and not at 3000 rpm (Hertz 0.12, rigid 0.52; docs/multibody.md, Its time step)
+TRACTION_STEP_NOTE = {"hertz": 0.3, "rigid": 1.5}
+#: what the reference bearing's automatic step reads at 1000 rpm, by raceway contact (docs/multibody.md)
+_TRACTION_STEP_REFERENCE = {"hertz": "1.2 % low at 1000 rpm (h / tau = 0.34)",
+                            "rigid": "3.6 % low at 1000 rpm against the Hertz scene's limit (h / tau = 1.9)"}
+
+
+def _traction_step_note(result) -> str | None:
+    """A free cage's run whose step is long against the traction's relaxation time (``h / tau`` above
+    :data:`TRACTION_STEP_NOTE`): its I_dec reads low at first order in ``h / tau``, as the reference bearing's
+    below 3000 rpm; None otherwise."""
+    from bearingsim.multibody.core import max_roller_load, rigid, rolling_speed, traction_relaxation_time
+
+    p = result.parameters
+    if p.multibody.scene not in ("full", "centred_cage"):  # the kinematic cage's step is divided for it
+        return None
+    tau = traction_relaxation_time(p)
+    h = float(result.summary.get("dt_s", math.nan))
+    kind = "rigid" if rigid(p) else "hertz"
+    if not h / tau > TRACTION_STEP_NOTE[kind]:
+        return None
+    return (f"bearingsim: note: the step ({h * 1e6:.3g} us) is {h / tau:.2g} of the traction's relaxation time in "
+            f"the load zone (tau = m slip_ref u / (3 mu_max Q) = {tau * 1e6:.3g} us, Q ≈ {max_roller_load(p):.0f} N "
+            f"the most loaded roller's, u = {rolling_speed(p):.3g} m/s its rolling speed): the force kernel's implicit traction and "
+            f"pymunk's contact solve, taken one after the other, read I_dec low at first order in h / tau where "
+            f"the cage pushes its rollers through the load zone; the reference bearing's automatic step reads it "
+            f"{_TRACTION_STEP_REFERENCE[kind]} (docs/multibody.md, Its time step): --check-step measures this "
+            f"run's (half the step about halves it)")
 
 
 def _pinched_note(result) -> str | None:

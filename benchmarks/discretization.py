@@ -4,6 +4,7 @@
     python -m benchmarks.discretization theta   # load-zone contact extent, F_dec onset: 180 / 360 / 720 / 1440 bins of theta
     python -m benchmarks.discretization dt      # I_dec at the automatic step and half of it (the change, not the error)
     python -m benchmarks.discretization order   # I_dec at the step and 3 halvings: observed order, extrapolated error
+    python -m benchmarks.discretization order --bins=500 --raceways=hertz --halvings=4 --warmup=2 --rotations=4
     python -m benchmarks.discretization rig     # the rig's flat pocket 0 over the reduced model: s.e. and dt / 2 (docs/validation.md)
     python -m benchmarks.discretization whatif  # docs/whatif.md's I_dec with standard errors, without rotation 1, at dt / 2
     python -m benchmarks.discretization life    # the life study to depth = 0.1 mm (fast scene) with 16 / 32 / 64 bins of psi
@@ -68,8 +69,8 @@ def dt(rpms=(1000, 3000, 6000), sets=(), raceways=("hertz", "rigid"), rotations=
                   f"{sb * 1e3:.3f} | {diff:+.2%} | {(ia - ib) / math.hypot(sa, sb):+.2f} |", flush=True)
 
 
-def _halvings(rpm, raceway, sets, halvings, rotations):
-    """Mean I_dec over 1 warm-up + ``rotations`` without the first recorded rotation (the warm-up's trace,
+def _halvings(rpm, raceway, sets, halvings, rotations, warmup=1):
+    """Mean I_dec over ``warmup`` + ``rotations`` without the first recorded rotation (the warm-up's trace,
     docs/statistics.md) at the automatic step and ``halvings`` halvings of it: ``[(dt, mean, s.e., CPU s per
     simulated rotation)]``, the CPU time of this process (``time.process_time``: the wall time of a host that runs
     other work too is not the run's); a first run of one rotation before them leaves the kernels' compilation out."""
@@ -80,7 +81,7 @@ def _halvings(rpm, raceway, sets, halvings, rotations):
     name = f"multibody_{rpm}rpm" if (SCENARIOS / f"multibody_{rpm}rpm.toml").exists() else "multibody_3000rpm"
     base = [f"operating.inner_ring_speed_rpm={rpm}", f"multibody.raceway_contact={raceway}", *sets]
     _run(name, [*base, "numerics.warmup_rotations=1", "numerics.rotations=1"])
-    base += ["numerics.warmup_rotations=1", f"numerics.rotations={rotations}"]
+    base += [f"numerics.warmup_rotations={warmup}", f"numerics.rotations={rotations}"]
     rows, step = [], None
     for k in range(halvings + 1):
         t0 = time.process_time()
@@ -105,9 +106,9 @@ def _order(m, s, k):
     return math.log2(d1 / d2), math.sqrt(sum((gi * s[k + i]) ** 2 for i, gi in enumerate(g))) / math.log(2)
 
 
-def order(rpms=(500, 1000), sets=(), raceways=("hertz", "rigid"), halvings=3, rotations=20):
-    """The step's error of the mean I_dec, measured: 1 warm-up + ``rotations`` (the first recorded rotation
-    dropped) at the automatic step and 3 halvings of it. Each row gives the change from the step before with its
+def order(rpms=(500, 1000), sets=(), raceways=("hertz", "rigid"), halvings=3, rotations=20, warmup=1):
+    """The step's error of the mean I_dec, measured: ``warmup`` + ``rotations`` (the first recorded rotation
+    dropped) at the automatic step and ``halvings`` halvings of it (3, 1 warm-up and 20 rotations unless given). Each row gives the change from the step before with its
     standard error (batch means, the runs independent), the observed order from each three successive steps
     (``_order``), and the offset from the first-order Richardson extrapolation of the two finest steps,
     2 I(dt / 8) - I(dt / 4) (the scheme converges at about first order, docs/fast_scene.md). With both raceways,
@@ -121,7 +122,7 @@ def order(rpms=(500, 1000), sets=(), raceways=("hertz", "rigid"), halvings=3, ro
     for rpm in rpms:
         hertz = None
         for raceway in raceways:
-            rows = _halvings(rpm, raceway, sets, halvings, rotations)
+            rows = _halvings(rpm, raceway, sets, halvings, rotations, warmup)
             m, s = [r[1] for r in rows], [r[2] for r in rows]
             ext, se_ext = 2 * m[-1] - m[-2], math.hypot(2 * s[-1], s[-2])
             hertz = (ext, se_ext) if raceway == "hertz" else hertz
@@ -313,6 +314,11 @@ def parser() -> argparse.ArgumentParser:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="scenario override (repeatable)")
     ap.add_argument("--limit", help="life and stages only: the life study's limit (default depth=0.1mm)")
     ap.add_argument("--mapping", choices=("shape", "uniform"), help="stages only: how the wear acts back (default shape)")
+    ap.add_argument("--halvings", type=int, help="order only: halvings of the automatic step (default 3)")
+    ap.add_argument("--warmup", type=int, help="order only: warm-up rotations (default 1)")
+    ap.add_argument("--rotations", type=int, help="order only: recorded rotations, the first dropped (default 20)")
+    ap.add_argument("--raceways", choices=("hertz", "rigid", "both"), help="order only: which raceway contacts "
+                                                                          "(default both)")
     return ap
 
 
@@ -329,6 +335,13 @@ def main(argv=None) -> None:
     extra = {"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}
     if a.mapping:
         extra["mapping"] = a.mapping
+    for key in ("halvings", "warmup", "rotations", "raceways"):
+        if getattr(a, key) is not None:
+            if a.study != "order":
+                ap.error(f"--{key}: only the order study reads it (not {a.study})")
+            extra[key] = getattr(a, key)
+    if extra.get("raceways"):
+        extra["raceways"] = ("hertz", "rigid") if extra["raceways"] == "both" else (extra["raceways"],)
     study(*given, sets=a.set, **extra)
 
 

@@ -73,15 +73,20 @@ def test_the_documented_invocations_parse_as_before():
     assert _parse("wear_bench", ["life"]) == {"what": "life"}
     for table in ("whatif", "orbit", "wear", "extent", "checks", "rig"):
         assert _parse("whole_bearing", [table]) == {"table": table}
+    unset = {"halvings": None, "warmup": None, "rotations": None, "raceways": None}
     for study in ("psi", "theta", "dt", "order", "rig", "whatif", "life", "stages"):
         assert _parse("discretization", [study]) == {"study": study, "bins": None, "set": [], "limit": None,
-                                                     "mapping": None}
+                                                     "mapping": None, **unset}
     assert _parse("discretization", ["life", "--limit=clearance=0.4mm", "--bins=32,64", "--set=numerics.dt_s=2e-6",
                                      "--set=numerics.warmup_rotations=41"]) == {
         "study": "life", "bins": (32, 64), "limit": "clearance=0.4mm", "mapping": None,
-        "set": ["numerics.dt_s=2e-6", "numerics.warmup_rotations=41"]}
+        "set": ["numerics.dt_s=2e-6", "numerics.warmup_rotations=41"], **unset}
     assert _parse("discretization", ["stages", "--bins=5,10", "--mapping=uniform"]) == {
-        "study": "stages", "bins": (5, 10), "limit": None, "mapping": "uniform", "set": []}
+        "study": "stages", "bins": (5, 10), "limit": None, "mapping": "uniform", "set": [], **unset}
+    assert _parse("discretization", ["order", "--bins=500", "--raceways=hertz", "--halvings=4", "--warmup=2",
+                                     "--rotations=4"]) == {
+        "study": "order", "bins": (500,), "set": [], "limit": None, "mapping": None, "halvings": 4, "warmup": 2,
+        "rotations": 4, "raceways": "hertz"}
     assert _parse("sweep_bench", []) == {"command": None}
     assert _parse("sweep_bench", ["map", "out"]) == {"command": "map", "archives": "all", "outdir": "out"}
     assert _parse("sweep_bench", ["map", "--archives", "none", "out"]) == {"command": "map", "archives": "none",
@@ -105,6 +110,18 @@ def test_a_limit_for_a_study_that_does_not_read_it_is_refused(capsys):
     with pytest.raises(SystemExit) as exc:
         discretization.main(["dt", "--limit=depth=1mm"])
     assert exc.value.code == 2 and "--limit: only the life and stages studies read it (not dt)" in capsys.readouterr().err
+
+
+def test_the_order_study_s_options_are_refused_by_the_other_studies(capsys):
+    """``--halvings``, ``--warmup``, ``--rotations`` and ``--raceways`` set the order study's runs; another study
+    given one refuses it as a usage error (exit 2) before running anything, as ``--limit``."""
+    from benchmarks import discretization
+
+    for option in ("--halvings=4", "--warmup=2", "--rotations=4", "--raceways=hertz"):
+        with pytest.raises(SystemExit) as exc:
+            discretization.main(["dt", option])
+        key = option.split("=")[0]
+        assert exc.value.code == 2 and f"{key}: only the order study reads it (not dt)" in capsys.readouterr().err
 
 
 def test_the_observed_order_of_the_step_study_is_that_of_the_means_it_is_given():

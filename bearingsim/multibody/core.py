@@ -203,6 +203,24 @@ def max_roller_load(p) -> float:
     return 5.0 * op.radial_load / g.roller_count + g.roller_mass * g.pitch_radius * op.omega_c**2 + 1.0
 
 
+def traction_relaxation_time(p) -> float:
+    """The time [s] in which the raceway traction brings the most loaded roller's slip back to rolling:
+    ``tau = m slip_ref u / (3 mu_max Q)``, from the traction's slope at zero slip ``C = mu_max Q / (slip_ref u)``
+    acting on the slip speed of a solid roller (``1/m + r^2/J = 3/m``), with ``Q`` :func:`max_roller_load` and
+    ``u`` :func:`rolling_speed`. The force kernel takes that traction implicitly and pymunk's contact solve after
+    it; a roller pressed against a face through the load zone feels the split at first order in ``h / tau``
+    (docs/multibody.md, *Its time step*)."""
+    mu = p.contact.traction_mu_max
+    return (math.inf if mu <= 0.0 else
+            p.bearing.roller_mass * p.contact.traction_slip_ref * rolling_speed(p) / (3.0 * mu * max_roller_load(p)))
+
+
+def rolling_speed(p) -> float:
+    """The rollers' rolling (entrainment) speed in pure rolling, ``omega_c r_o`` [m/s], at least
+    :data:`MIN_ENTRAINMENT_M_S` (the traction's floor)."""
+    return max(abs(p.operating.omega_c) * p.bearing.outer_race_radius, MIN_ENTRAINMENT_M_S)
+
+
 RACEWAY_APPROACH_FACTOR = 3.0  # blow-up: approach > 3x that of one roller carrying the whole load alone
 
 

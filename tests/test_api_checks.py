@@ -426,6 +426,29 @@ def test_a_pass_with_no_force_on_the_roller_is_refused_naming_drag_and_gravity(h
     assert "too short a pass" not in msg and "\n" not in msg
 
 
+@pytest.mark.parametrize("sets, names", [
+    ({"reduced.load_zone_half_angle_deg": 150}, ["reduced.load_zone_half_angle_deg = 150 deg"]),
+    ({"lubrication.drag_coefficient": 0, "operating.gravity": False},
+     ["lubrication.drag_coefficient", "operating.gravity"]),
+])
+def test_the_reduced_equivalent_scene_without_a_rear_impact_names_the_pass_as_the_reduced_model(sets, names):
+    """The whole bearing's scene of the paper's assumptions (multibody.scene = "reduced_equivalent") runs the
+    reduced model's pass in every pocket. A pass in which no roller touches a face (a load zone of +-150 deg at
+    6000 rpm, or neither drag nor gravity) leaves I_dec = I_acc = 0, so no first impact and no torque scale.
+    Was: "non-finite result (first_impact_energy_J, first_impact_speed_m_s, torque_balance_residual); check
+    operating.radial_load_N and operating.inner_ring_speed_rpm, or set a smaller numerics.dt_s" (a load the
+    scene does not read with a given half angle, a step that changes nothing), where the reduced model names
+    the pass's keys."""
+    sc = bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={
+        "multibody.scene": "reduced_equivalent", "numerics.rotations": 1, **sets})
+    with pytest.raises(bearingsim.SimulationUnstable) as err:
+        bearingsim.run(sc)
+    msg = str(err.value)
+    assert "no rear-face impact" in msg and "\n" not in msg, msg
+    assert all(name in msg for name in names), msg
+    assert "radial_load_N" not in msg and "dt_s" not in msg, msg
+
+
 def test_a_classical_half_angle_of_zero_under_load_is_noted_as_no_result():
     """load_zone_half_angle_deg is arccos(P_d / 2 delta_r) of the mean ring displacement along the load, 0
     when delta_r <= P_d/2 ("no roller loaded"). With 3 rollers (scenarios/hard/multibody_rollers_3.toml) the

@@ -6,6 +6,7 @@ Short runs (1 warm-up + 3 cage rotations at 3000 and 6000 rpm, 970 N), shared th
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -168,6 +169,31 @@ def test_zero_land_clearance_is_one_line_from_the_cli(tmp_path):
 def test_bad_land_keys_refused(setting, match):
     with pytest.raises(UserError, match=match):
         _scenario("outer_land", extra=[setting])
+
+
+@pytest.mark.parametrize("clearance", ["0.01", "0.05"])
+def test_an_inner_land_the_assembled_ring_already_overlaps_is_refused_before_the_run(clearance, tmp_path):
+    """The inner ring starts at its quasi-static displacement (43.9 um below the axis at 970 N: P_d/2 = 40 um plus
+    the raceways' approach) and the cage centred on the axis, so an inner land with c_L/2 below that offset starts
+    inside the cage rim, a penalty force of up to 77 times its reference force that no step removes. Was: exit 0,
+    a note of an "impact on the land" of 770 % (74 %) of c_L/2, and at c_L = 0.01 mm (6000 rpm) a cage at 2.2
+    times its epicyclic speed, I_dec 2.2 N s per pocket and rotation. Refused now, by the run and its dry run,
+    naming the key and the least clearance it accepts; that clearance, and any outer land, start clear."""
+    from bearingsim.simulation import check_run
+
+    sc = _scenario("inner_land", extra=[f"bearing.cage_land_clearance_mm={clearance}"])
+    with pytest.raises(UserError, match=r"bearing\.cage_land_clearance_mm = .*inner ring as assembled") as err:
+        check_run(sc)
+    least = re.search(r"at least ([0-9.]+) mm", str(err.value))
+    assert least and 0.08 < float(least.group(1)) < 0.1, str(err.value)
+    with pytest.raises(UserError, match=r"bearing\.cage_land_clearance_mm"):
+        simulate(sc)
+    check_run(_scenario("inner_land", extra=[f"bearing.cage_land_clearance_mm={least.group(1)}"]))
+    check_run(_scenario("outer_land", extra=[f"bearing.cage_land_clearance_mm={clearance}"]))
+    res = bearingsim("run", BASE, "--set", "bearing.cage_guidance=inner_land", "--set",
+                     f"bearing.cage_land_clearance_mm={clearance}", "--dry-run", "-o", tmp_path / "x.h5")
+    assert_user_error(res, "bearing.cage_land_clearance_mm", "at least")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_inner_land_must_clear_the_inner_raceway():

@@ -672,6 +672,42 @@ def check_assembly(p) -> None:
         raise UserError(assembly_refusal(p, f"overlap a pocket face by {overlap:.3g} m"))
 
 
+def ring_start_offset(p) -> float:
+    """Distance [m] of the inner ring's centre below the axis as a run starts it: the continuous quasi-static
+    displacement (:func:`bearingsim.laws.quasi_static_load_zone`), at least P_d/2 (0 in the reduced-equivalent
+    scene, which has no inner ring)."""
+    g = p.bearing
+    if paper_assumptions(p.multibody.scene):
+        return 0.0
+    pd = g.radial_clearance
+    _, delta_qs = laws.quasi_static_load_zone(p.operating.radial_load, g.roller_count, g.roller_length, pd)
+    return max(0.5 * pd, delta_qs)
+
+
+def check_land_assembly(p) -> None:
+    """Refuse an inner-land-guided cage whose land, as the bearing is assembled (the inner ring at
+    :func:`ring_start_offset`, the cage centred on the axis), already reaches into the cage rim by more than
+    ``LAND_OVERLAP_FRACTION`` of half the land clearance: the penalty contact would start with a force of
+    (overlap / that bound) times its reference force, which no step removes. An outer land is centred on
+    the axis, as the cage starts."""
+    g = p.bearing
+    if g.cage_guidance != "inner_land" or p.multibody.scene != "full":
+        return
+    half = 0.5 * g.cage_land_clearance
+    start = ring_start_offset(p)
+    overlap = start - half
+    if overlap > LAND_OVERLAP_FRACTION * half:
+        least = _up3(2.0 * start / (1.0 + LAND_OVERLAP_FRACTION) * 1e3)
+        raise UserError(
+            f"bearing.cage_land_clearance_mm = {g.cage_land_clearance * 1e3:.4g} is too small for this bearing's "
+            f"radial play under its load (bearing.radial_clearance_mm = {g.radial_clearance * 1e3:.4g}, "
+            f"operating.radial_load_N = {p.operating.radial_load:.4g}): the inner ring as assembled "
+            f"({start * 1e6:.3g} um below the axis, where the load puts it) carries its land {overlap * 1e6:.3g} um "
+            f"into the rim of the cage centred on the axis, more than {LAND_OVERLAP_FRACTION:.0%} of half the land "
+            f"clearance, which no step removes; give bearing.cage_land_clearance_mm at least {least:.3g} mm, or "
+            f"guide the cage on the outer land")
+
+
 def assembly_refusal(p, what: str) -> str:
     """The refusal of a bearing whose rollers, as assembled, ``what`` (the check before the run and the
     first step's overlap say the same)."""
@@ -854,8 +890,6 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
     # start at the continuous quasi-static displacement (close to equilibrium: small start transient)
     # (the same start for rigid raceways: the continuous distribution's displacement is that of two
     # contacts in series already)
-    pd = su.radial_play
-    _, delta_qs = laws.quasi_static_load_zone(op.radial_load, n, geo.roller_length, pd) if not su.reduced_eq else (0, 0)
     ids = sc.body_ids
     order = np.argsort(ids)
     if su.reduced_eq or su.rigid:  # held rollers (reduced-equivalent), rollers on the race (rigid): states set too
@@ -866,7 +900,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
         set_arr = np.zeros(nb * 3)
     e = float(p.contact.restitution)
     wk = lp.StepWork(
-        ring_c=np.array([0.0, -max(0.5 * pd, delta_qs)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
+        ring_c=np.array([0.0, -ring_start_offset(p)]), ring_c_prev=np.zeros(2), ring_v=np.zeros(2),
         hold=np.zeros(n, dtype=np.bool_),
         # full scene: the kernel writes the (fx, fy, torque) rows straight into the set buffer
         out_f=np.zeros(nb * 3) if (su.reduced_eq or su.rigid) else set_arr, set_arr=set_arr,

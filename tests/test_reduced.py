@@ -4,6 +4,7 @@ Paper numbers are cited where they are used. The event solver is the reference; 
 the paper's own scheme (Eqs. 7-8) and must converge to it.
 """
 import math
+import re
 
 import numpy as np
 import pytest
@@ -268,6 +269,30 @@ def test_euler_refuses_a_pass_of_too_many_steps_before_running():
     tight = replace(inp, pocket_clearance=1e-12)
     with pytest.raises(UserError, match=r"bearing\.pocket_clearance_mm.*automatic"):
         solve_pass(tight, "euler")
+
+
+def test_euler_automatic_step_refusal_at_a_crawl_names_the_speed_and_a_clearance_that_runs():
+    """At 1 rpm the pass lasts minutes and the automatic step (set by the fastest approach across the pocket,
+    which gravity keeps at any speed) needs 3.8e8 steps. Was: "bearing.pocket_clearance_mm: 0.2 mm makes the
+    euler method's automatic step ... more than 1e+08; use reduced.method = "event" or a larger clearance",
+    naming neither the speed that made the pass long nor how large a clearance would do (`bearingsim run
+    scenarios/paper_3000rpm.toml --set reduced.method=euler --set operating.inner_ring_speed_rpm=1`). It names
+    both; the clearance it gives is accepted."""
+    from dataclasses import replace
+
+    from bearingsim.errors import UserError
+    from bearingsim.reduced import solve_pass
+    from bearingsim.reduced.euler import check_step, default_dt
+
+    inp = _inputs(1)
+    with pytest.raises(UserError, match=r"^bearing\.pocket_clearance_mm: 0\.2 mm makes the euler method's automatic") as err:
+        solve_pass(inp, "euler")
+    msg = str(err.value)
+    assert "operating.inner_ring_speed_rpm" in msg and "\n" not in msg, msg
+    least = re.search(r"clearance of at least ([0-9.e+-]+) mm", msg)
+    assert least, msg
+    wide = replace(inp, pocket_clearance=float(least.group(1)) * 1e-3)
+    check_step(wide, default_dt(wide), automatic=True)
 
 
 def test_euler_impact_buffer_grows_without_changing_a_number():

@@ -216,10 +216,14 @@ def check_step(inp: PassInputs, dt: float, automatic: bool = False) -> int:
     nsteps = steps_per_pass(inp, dt)
     if nsteps > MAX_STEPS_PER_PASS:
         if automatic:
+            # the step is 1/1000 of the time the fastest approach, sqrt(2 a_max s), takes to cross 10 % of s:
+            # the steps of a pass go as s^(-1/2) and as the pass's duration (1 / speed)
+            least = inp.pocket_clearance * 1e3 * (nsteps / MAX_STEPS_PER_PASS) ** 2 * 1.01
             raise UserError(
                 f"bearing.pocket_clearance_mm: {inp.pocket_clearance * 1e3:.3g} mm makes the euler method's automatic "
-                f"step (numerics.dt_s left out) {dt:.3g} s, {nsteps:.3g} steps for one pass, more than "
-                f"{MAX_STEPS_PER_PASS:.0e}; use reduced.method = \"event\" or a larger clearance")
+                f"step (numerics.dt_s left out) {dt:.3g} s, {nsteps:.3g} steps for one pass of {nsteps * dt:.3g} s, "
+                f"more than {MAX_STEPS_PER_PASS:.0e}; use reduced.method = \"event\", a clearance of at least "
+                f"{least:.3g} mm, or a higher operating.inner_ring_speed_rpm (a shorter pass)")
         raise UserError(
             f"numerics.dt_s: {dt:.3g} s needs {nsteps:.3g} euler steps for one pass, more than "
             f"{MAX_STEPS_PER_PASS:.0e}; use at least {1.01 * inp.pass_duration / MAX_STEPS_PER_PASS:.3g} s "

@@ -694,6 +694,17 @@ def test_signal_stops_the_euler_pass_within_a_second_leaving_nothing(tmp_path, s
     assert obs.code == code and not obs.problems, (obs.code, obs.problems, obs.err)
 
 
+@pytest.mark.slow
+def test_signal_stops_a_fine_polyline_run_within_its_chunk_leaving_nothing(tmp_path):
+    """With ``multibody.pocket_face_segments = 1000`` a step costs hundreds of times the exact faces' one, and
+    the compiled loop's chunk of ``CHUNK_STEPS`` steps (0.3 s with exact faces) lasted many minutes. Was:
+    `timeout 600 bearingsim run scenarios/multibody_6000rpm.toml --set multibody.pocket_face_segments=1000
+    --set numerics.rotations=2` still ran 340 s after the SIGTERM (killed with SIGKILL, leaving its temporary
+    archive and lock). The chunk shrinks with the segments: it stops as a run with exact faces does."""
+    obs = signal_case(tmp_path, signal.SIGTERM, "polyline")
+    assert obs.code == 143 and not obs.problems, (obs.code, obs.problems, obs.err)
+
+
 _EULER_SIGNAL_SCRIPT = """
 import os, signal, threading, time
 from bearingsim import cli
@@ -827,12 +838,14 @@ def test_a_command_that_fails_after_a_swallowed_signal_ends_as_the_signal(monkey
 LONG_RUNS = {
     "multibody": [MB, "--set", "numerics.rotations=200"],
     "euler": [PAPER, "--no-plots", "--set", "reduced.method=euler", "--set", "numerics.dt_s=4.02e-10"],
+    # the finest polyline the key allows: 32000 face segments make each step hundreds of times slower
+    "polyline": [MB, "--no-plots", "--set", "multibody.pocket_face_segments=1000"],
 }
 #: seconds from the temporary archive's creation to the signal: past the imports and the compiled
 #: code's loading from numba's cache, into the run's main loop. The multibody run lasts ~20 s here, so its
 #: 0.5 s holds on a host many times faster; the euler pass (~5 s here) has no longer form (1e8 steps is the
 #: most the method takes), so its settle is measured on the host: half its run (:func:`_settle_s`).
-SETTLE_S = {"multibody": 0.5}
+SETTLE_S = {"multibody": 0.5, "polyline": 3.0}
 
 
 def _settle_s(tmp: Path, kind: str) -> float:

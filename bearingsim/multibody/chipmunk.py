@@ -685,7 +685,7 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
             body_ptrs, set_pv, hdr, st0, st1, arb_f, arb_i, ts, fm, vb, mask_now, mask_want, free_on, jn_acc, free_now,
             prev_h, iterations, joint_max, inp, wk, acc, ls):
     """Step until :func:`~bearingsim.multibody.loop.before_step` or ``after_step`` report a code, or
-    ``CHUNK_STEPS`` steps have passed; return the ``CODE_*``.
+    ``inp.lim.chunk_steps`` steps have passed; return the ``CODE_*``.
 
     ``hdr`` (:class:`Headers`): the loop resets ``num`` before each batched call and stops if pymunk
     ever grew an array (``max`` changed), which the sizes chosen in :class:`BatchIO` rule out.
@@ -712,7 +712,7 @@ def advance(step_fn, each_body_fn, each_arb_fn, clock_fn, impulse_fn, elasticity
     capf = hdr.arb_f[1]
     capi = hdr.arb_i[1]
     s = ls[0]
-    step_return = s.step + lp.CHUNK_STEPS
+    step_return = s.step + inp.lim.chunk_steps
     h = inp.h
     while True:
         cur = s.cur

@@ -802,7 +802,7 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         penetration=penetration_limit * s,  # (the stability scan passes 0.5 to look for blow-up alone)
         omega=3.0 * op.omega_i + 10.0, omega_nominal=float(op.omega_c), orbit=float(orbit_limit),
         raceway_approach=raceway_approach_limit(p), out_every=_sample_every(p, h),
-        max_steps=int(3 * steps_est + 1000), **rk.motion_limits(p))
+        max_steps=int(3 * steps_est + 1000), chunk_steps=chunk_steps(p), **rk.motion_limits(p))
     hold = lp.HoldRule(active=reduced_eq, phi=float(phi),
                        radius=r_c if is_rigid else rp - laws.palmgren_approach(n_centrifugal, geo.roller_length),
                        front_offset=0.5 * s, omega_cage=float(op.sign * op.omega_c))
@@ -811,6 +811,15 @@ def make_setup(p, dt=None, penetration_limit=PENETRATION_LIMIT) -> MultibodySetu
         dt=h, dt_how=dt_how, dt_explicit_limit=dt_lim, t_start=t_start, dt_start=h_start, radial_play=pd,
         rigid_radius=r_c, roller_start_radius=r0, centrifugal_load=n_centrifugal, ring_how=ring_how, prm=prm,
         cfg=cfg, land=land, limits=lim, hold_rule=hold, phi=phi, face_reach=face_reach, worn=worn_array(p))
+
+
+def chunk_steps(p) -> int:
+    """Steps the compiled loop takes before it returns to Python at the latest (a pending signal is handled
+    there, the progress bar moves): ``CHUNK_STEPS`` (~0.3 s) with exact faces, divided by N^1.5 for a polyline
+    of N segments a face (``multibody.pocket_face_segments``), whose step costs more the more segments there
+    are (63: 50-65 times, docs/geometry.md; 1000: about 1e4 times, 0.17 s a step on 2 shared cores), so that
+    a chunk lasts no longer. The chunk's end changes no number: the loop goes on from where it returned."""
+    return max(1, int(lp.CHUNK_STEPS / max(1, p.multibody.pocket_face_segments) ** 1.5))
 
 
 def _steps(p, dt, is_rigid):

@@ -111,6 +111,7 @@ class LoopLimits(NamedTuple):
     motion_lo: float = 0.0  #: cage travel of the first motion pose [rad] (:func:`~bearingsim.multibody.recorder.motion_limits`)
     motion_hi: float = 0.0  #: cage travel of the last one [rad]
     motion_step: float = 0.0  #: cage travel between two motion poses [rad]; 0: no motion stored
+    chunk_steps: int = CHUNK_STEPS  #: steps after which the loop returns to Python at the latest (signals, progress)
 
 
 class HoldRule(NamedTuple):
@@ -737,9 +738,9 @@ class PlainLoop:
         return self.states[0]
 
     def advance(self, inp, wk, acc, ls):
-        """Step until :func:`before_step` or :func:`after_step` report a code, or ``CHUNK_STEPS`` steps."""
+        """Step until :func:`before_step` or :func:`after_step` report a code, or ``inp.lim.chunk_steps`` steps."""
         st0, st1 = self.states
-        step_return = int(ls[0]["step"]) + CHUNK_STEPS
+        step_return = int(ls[0]["step"]) + inp.lim.chunk_steps
         h = inp.h
         while True:
             cur = int(ls[0]["cur"])

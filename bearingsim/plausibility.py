@@ -108,9 +108,14 @@ def palmgren_approach_m(load_N: float, roller_length_m: float) -> float:
 def max_ring_displacement_m(p) -> float:
     """Largest plausible mean inner-ring displacement [m] for the load of the SI parameters ``p``."""
     # the ring's load is the radial load alone, whatever its mass: a dynamic ring is driven by -W and the roller
-    # reactions (multibody.forces.raceway_forces), its weight counted in W, not added to it
-    bound = (0.5 * p.bearing.radial_clearance
-             + 2.0 * palmgren_approach_m(p.operating.radial_load, p.bearing.roller_length))
+    # reactions (multibody.forces.raceway_forces), its weight counted in W, not added to it; the rollers' centrifugal
+    # loads press them into the outer race, which leaves the ring that approach as play too (the whole bound
+    # without clearance and load)
+    g = p.bearing
+    centrifugal = g.roller_mass * g.pitch_radius * p.operating.omega_c ** 2
+    bound = (0.5 * g.radial_clearance
+             + 2.0 * palmgren_approach_m(p.operating.radial_load, g.roller_length)
+             + palmgren_approach_m(centrifugal, g.roller_length))
     return DISPLACEMENT_MARGIN * bound
 
 
@@ -513,7 +518,8 @@ def checks_made(result) -> list[tuple[str, str, bool | None]]:
         disp, limit = abs(float(summary["inner_ring_displacement_m"])), max_ring_displacement_m(p)
         out.append(("inner-ring displacement within the Palmgren bound",
                     f"{disp * 1e6:.4g} µm against {limit * 1e6:.4g} µm ({DISPLACEMENT_MARGIN:g} x (half the "
-                    "radial clearance + the approach of one roller carrying the load))", disp <= limit))
+                    "radial clearance + twice the approach of one roller carrying the load + a roller's centrifugal "
+                    "approach))", disp <= limit))
     orbit = result.get("cage_orbit")
     samples = int(np.sum(np.isfinite(orbit[:, 0]))) if np.ndim(orbit) == 2 else 0
     out.append(("cage-orbit samples recorded", f"{samples} against at least {MIN_ORBIT_SAMPLES}",

@@ -564,6 +564,26 @@ def test_plausibility_ring_displacement_bound_follows_palmgren():
         pl.check(_FakeResult(sc, inner_ring_displacement_m=95e-6))
 
 
+def test_ring_displacement_bound_of_an_unloaded_bearing_without_clearance_is_not_zero():
+    """With bearing.radial_clearance_mm = 0 and operating.radial_load_N = 0 the bound was 2 (0 + 2 delta(0)) = 0 m,
+    and `bearingsim run scenarios/multibody_6000rpm.toml --set bearing.radial_clearance_mm=0 --set
+    operating.radial_load_N=0` stopped with exit 3: "inner ring displaced 4.25e-08 m, more than the 0 m the
+    Palmgren contact law allows ...; check operating.radial_load_N ..., or set a smaller numerics.dt_s". The
+    rollers' centrifugal loads press them into the outer race (0.16 um at 6000 rpm), which leaves the inner ring
+    that much play: the bound counts it (a fraction of a micrometre beside the 89.6 um at 970 N)."""
+    from bearingsim import plausibility as pl
+    from bearingsim.errors import SimulationUnstable
+
+    from bearingsim.scenario import load_scenario
+
+    tight = load_scenario(SCENARIOS / "multibody_6000rpm.toml", ["bearing.radial_clearance_mm=0",
+                                                                 "operating.radial_load_N=0"])
+    assert 0.2e-6 < pl.max_ring_displacement_m(si(tight)) < 1e-6
+    pl.check(_FakeResult(tight, inner_ring_displacement_m=4.25e-8))
+    with pytest.raises(SimulationUnstable, match="inner ring displaced"):
+        pl.check(_FakeResult(tight, inner_ring_displacement_m=2e-6))
+
+
 def test_ring_displacement_bound_does_not_add_a_ring_weight_the_model_does_not_apply():
     """A dynamic inner ring is driven by the radial load W and the roller reactions alone (its weight is part of
     W, multibody.forces.raceway_forces), so a given ring mass does not loosen the bound: with 50 kg it was

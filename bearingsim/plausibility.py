@@ -373,9 +373,13 @@ def _unloaded_ring_note(result) -> str | None:
     if p.operating.radial_load > 0.0 or str(result.provenance.get("inner_ring", "none")).startswith("none"):
         return None
     disp = abs(float(result.summary.get("inner_ring_displacement_m", 0.0)))
+    # the classical half angle is arccos(P_d / 2 delta_r) of that drift: without clearance 90 deg for any drift
+    phi = float(result.summary.get("load_zone_half_angle_deg", 0.0))
+    also = (f", nor load_zone_half_angle_deg = {phi:.4g} (arccos(P_d / 2 delta_r) of it; no roller carries a load)"
+            if phi != 0.0 else "")
     return (f"bearingsim: note: operating.radial_load_N = 0: no force places the inner ring within the radial "
             f"clearance, so inner_ring_displacement_m = {disp:.3g} m is where the run started it (P_d/2 = "
-            f"{0.5 * p.bearing.radial_clearance:.3g} m) and let it drift, not a result; a radial load as small as "
+            f"{0.5 * p.bearing.radial_clearance:.3g} m) and let it drift, not a result{also}; a radial load as small as "
             "the rotor's weight places it")
 
 

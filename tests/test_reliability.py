@@ -584,6 +584,24 @@ def test_ring_displacement_bound_of_an_unloaded_bearing_without_clearance_is_not
         pl.check(_FakeResult(tight, inner_ring_displacement_m=2e-6))
 
 
+def test_the_unloaded_ring_note_says_a_load_zone_from_its_drift_is_no_result_either():
+    """Without load the ring's displacement is its start and drift, not a result (the note said so), and the
+    classical half angle arccos(P_d / 2 delta_r) is computed from it: without clearance any drift gives 90 deg.
+    Was: `bearingsim run scenarios/multibody_6000rpm.toml --set bearing.radial_clearance_mm=0 --set
+    operating.radial_load_N=0` reported load_zone_half_angle_deg = 90 for an unloaded bearing with a note on the
+    displacement only. The note names the half angle too when it is not 0; with clearance (0: no roller loaded)
+    it is as before."""
+    from bearingsim import plausibility as pl
+
+    ring = {"inner_ring": "quasi-static (massless)"}
+    tight = _mb_scenario("bearing.radial_clearance_mm=0", "operating.radial_load_N=0")
+    notes = pl.check(_FakeResult(tight, ring, inner_ring_displacement_m=4.25e-8, load_zone_half_angle_deg=90.0))
+    assert len(notes) == 1 and "load_zone_half_angle_deg = 90" in notes[0] and "not a result" in notes[0], notes
+    loose = _mb_scenario("operating.radial_load_N=0")
+    notes = pl.check(_FakeResult(loose, ring, inner_ring_displacement_m=39.9e-6, load_zone_half_angle_deg=0.0))
+    assert len(notes) == 1 and "load_zone_half_angle_deg" not in notes[0], notes
+
+
 def test_ring_displacement_bound_does_not_add_a_ring_weight_the_model_does_not_apply():
     """A dynamic inner ring is driven by the radial load W and the roller reactions alone (its weight is part of
     W, multibody.forces.raceway_forces), so a given ring mass does not loosen the bound: with 50 kg it was

@@ -494,7 +494,7 @@ def _traction_step_note(result) -> str | None:
             f"the force kernel's implicit traction and pymunk's contact solve, taken one after the other, then read "
             f"I_dec low at first order in h / tau; the reference bearing's automatic step reads it "
             f"{_TRACTION_STEP_REFERENCE[kind]} (docs/multibody.md, Its time step): --check-step measures this "
-            f"run's (half the step about halves it)")
+            f"run's (a shorter step shrinks it at first order or slower)")
 
 
 def _pinched_note(result) -> str | None:

@@ -208,6 +208,27 @@ def test_exact_faces_reach_the_fine_polyline_s_limit():
     assert res[0] / res[15] - 1 == pytest.approx(-0.035, abs=0.07)
 
 
+def test_one_segment_faces_on_a_roller_guided_cage_are_refused_before_the_run(tmp_path):
+    """One straight segment per arc face (``multibody.pocket_face_segments = 1``), tangent at the extent's
+    middle (psi = -3.38 deg on the reference cage), closes on a roller only 0.1 mm / sin 3.38 deg = 1.70 mm
+    inward of its pocket centre and never outward: a roller-guided cage drifted there (measured: 1.74 mm off
+    the axis at t = 18.4 ms) and wedged a roller between the faces, which stopped the main job with exit 3 and
+    ever shorter steps advised (overlap 2.15 um at 1.03 us, 2.13 um at 0.70 us). It is refused before the run,
+    naming the key (``--dry-run`` too); two segments, and a land-guided or centred cage with one, still run."""
+    main = SCENARIOS / "multibody_6000rpm.toml"
+    sets = ["--set", "numerics.rotations=2", "--set", "multibody.pocket_face_segments=1"]
+    for extra in ([], ["--dry-run"]):
+        res = bearingsim("run", main, "-q", "--no-plots", "-o", tmp_path / "r.h5", *sets, *extra)
+        assert_user_error(res, "multibody.pocket_face_segments = 1", "1.7 mm inward", "2 or more segments")
+        assert list(tmp_path.iterdir()) == []
+    from bearingsim.simulation import check_run
+
+    for ok in (["multibody.pocket_face_segments=2"],
+               ["multibody.pocket_face_segments=1", "bearing.cage_guidance=outer_land"],
+               ["multibody.pocket_face_segments=1", "multibody.scene=centred_cage"]):
+        check_run(load_scenario(main, ok))
+
+
 # --- worn faces ---------------------------------------------------------------------------------------
 def _worn(n, face, i, row):
     """(n, 2, bins) worn depth: ``row`` [m] on face ``face`` (0 front, 1 rear) of pocket ``i``, else 0."""

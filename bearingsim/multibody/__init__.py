@@ -68,8 +68,9 @@ from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
-                                       PenetrationExceeded, assembly_refusal, check_assembly, check_land_assembly,
-                                       check_rigid, choose_dt, paper_assumptions, rigid, run, unstable_advice)
+                                       PenetrationExceeded, assembly_refusal, check_assembly, check_face_segments,
+                                       check_land_assembly, check_rigid, choose_dt, paper_assumptions, rigid, run,
+                                       unstable_advice)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
 from bearingsim.results import MemorySink, Result
@@ -161,13 +162,15 @@ def simulate(p, sink=None, progress=False, dt=None) -> "MultibodyResult":
 def check_start(p, dt: float | None = None) -> None:
     """Refuse, without running, what :func:`simulate` would refuse before its first step: rigid raceways
     at a speed where the rollers would leave the outer race (:func:`core.check_rigid`), rollers that
-    overlap their pockets' faces as assembled (:func:`core.check_assembly`), an inner land that overlaps the cage
+    overlap their pockets' faces as assembled (:func:`core.check_assembly`), one segment per face on a
+    roller-guided cage (:func:`core.check_face_segments`), an inner land that overlaps the cage
     as assembled (:func:`core.check_land_assembly`), and a given ``dt`` (or
     ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`). The
     automatic step is never refused (at most ``DT_FRACTION`` of the limit, below ``DT_MAX_FACTOR`` of
     it), so it is not computed here: :func:`simulate` computes it once."""
     if rigid(p):
         check_rigid(p)
+    check_face_segments(p)
     check_assembly(p)
     check_land_assembly(p)
     if dt is not None or p.numerics.dt is not None:

@@ -672,6 +672,35 @@ def check_assembly(p) -> None:
         raise UserError(assembly_refusal(p, f"overlap a pocket face by {overlap:.3g} m"))
 
 
+def check_face_segments(p) -> None:
+    """Refuse one straight segment per arc face (``multibody.pocket_face_segments = 1``) on a free roller-guided
+    cage (the full scene guided by its rollers): the segment is tangent to the arc at the extent's middle
+    ``m = (psi_in + psi_out) / 2``, so a pocket's two faces are straight lines tilted by ``m`` either way, and
+    a roller on the pocket's centre line ``y`` off its centre along the radius is ``s/2 - y sin m`` from each.
+    They close on it only at ``y = s / (2 sin m)`` on one side (1.70 mm on the reference cage, ``m`` = -3.38
+    deg; exact faces and polylines of 2 or more segments, slanted both ways, about 0.2-0.5 mm either way), and
+    never on the other: the cage drifts that far off the axis and wedges a roller between faces 2 |m| apart,
+    where it overlaps them by more than the 1 % bound at any step (measured: 2.1-2.3 um at t = 18-19.5 ms with
+    steps of 4.0, 1.03 and 0.70 us, with and without friction). A land-guided or held cage does not drift."""
+    if p.multibody.pocket_face_segments != 1 or p.multibody.scene != "full" or p.bearing.cage_guidance != "rollers":
+        return
+    lo, hi = p.multibody.pocket_face_extent
+    m = 0.5 * (lo + hi)
+    s = p.bearing.pocket_clearance
+    if abs(math.sin(m)) > 1e-12:
+        where = (f"close on a roller only {s / (2.0 * abs(math.sin(m))) * 1e3:.3g} mm "
+                 f"{'inward' if m < 0 else 'outward'} of its pocket centre and never "
+                 f"{'outward' if m < 0 else 'inward'} (exact faces: about 0.2 mm either way), where they wedge it "
+                 f"between lines {2.0 * abs(math.degrees(m)):.2g} deg apart")
+    else:
+        where = "never close on a roller moving along the radius (parallel lines)"
+    raise UserError(
+        f"multibody.pocket_face_segments = 1: one straight segment per arc face (tangent at the extent's middle, "
+        f"psi = {math.degrees(m):.3g} deg) hardly guides the roller-guided cage radially: a pocket's two faces "
+        f"{where}; the cage drifts there and the roller overlaps the faces at any step; use 2 or more segments "
+        f"(0: the exact arc faces) or guide the cage on a ring land (bearing.cage_guidance)")
+
+
 def ring_start_offset(p) -> float:
     """Distance [m] of the inner ring's centre below the axis as a run starts it: the continuous quasi-static
     displacement (:func:`bearingsim.laws.quasi_static_load_zone`), at least P_d/2 (0 in the reduced-equivalent

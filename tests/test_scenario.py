@@ -675,3 +675,21 @@ def test_a_wear_coefficient_below_its_range_is_called_a_specific_wear_rate_only_
                                                [f"wear.wear_coefficient={value}"]))
         assert f"wear.wear_coefficient = {float(value):g} (plausible" in note, note
         assert ("1e9 times low" in note) is hinted, (value, note)
+
+
+def test_drag_refusal_names_the_largest_drag_coefficient_it_accepts():
+    """`--set lubrication.drag_coefficient=100` on the main job said "an oil-film drag of 1.49e+03 N against a
+    roller load of 47.1 N" but not which c would do. The line names the largest c the bound accepts (the drag
+    is c times that of c = 1; rounded down to 3 digits, 3.15 here): it is accepted, 3.16 is refused."""
+    import re
+
+    main = SCENARIOS / "multibody_6000rpm.toml"
+    with pytest.raises(UserError) as err:
+        load_scenario(main, ["lubrication.drag_coefficient=100"])
+    msg = str(err.value)
+    assert "lubrication.drag_coefficient" in msg and "1.49e+03 N" in msg and "47.1 N" in msg
+    largest = float(re.search(r"use at most ([0-9.e+-]+) here", msg).group(1))
+    assert largest == 3.15
+    load_scenario(main, [f"lubrication.drag_coefficient={largest}"])
+    with pytest.raises(UserError, match="use at most 3.15 here"):
+        load_scenario(main, ["lubrication.drag_coefficient=3.16"])

@@ -212,6 +212,39 @@ def test_a_given_step_too_small_to_finish_is_refused_before_the_run():
         api.run(sc, dt=1e-12)
 
 
+def test_the_automatic_step_at_a_crawl_is_refused_before_the_run_naming_the_speed():
+    """The automatic step is ~4 us at any speed (the stiffest contact and the impacts set it), so at 1 rpm the
+    main job's 41 rotations would take 1.41e9 steps (hours) with no word but a progress bar, where a given
+    ``numerics.dt_s`` needing more than ``MAX_STEPS_PER_ROTATION`` steps per cage rotation is refused. The
+    automatic step is refused at the same bound, in one line naming operating.inner_ring_speed_rpm, the
+    rotations' steps and the least speed it runs at, which is accepted (just below it is not); the dry run
+    says the same. No shipped scenario is refused."""
+    from bearingsim.multibody import core
+    from bearingsim.simulation import check_run
+
+    main = SCENARIOS / "multibody_6000rpm.toml"
+    res = bearingsim("run", main, "--set", "operating.inner_ring_speed_rpm=1", "--dry-run")
+    assert_user_error(res, "with operating.inner_ring_speed_rpm=1: operating.inner_ring_speed_rpm: at 1 rpm",
+                      "3.43e+07 steps of the automatic", "numerics.rotations", "1.41e+09 steps")
+    least = float(re.search(r"run at (\S+) rpm or more", res.stderr).group(1))
+    check_run(load_scenario(main, [f"operating.inner_ring_speed_rpm={least}"]))
+    with pytest.raises(UserError, match="operating.inner_ring_speed_rpm: at 3.43 rpm"):
+        check_run(load_scenario(main, [f"operating.inner_ring_speed_rpm={least - 0.01:.3g}"]))
+    p = load_scenario(main, ["operating.inner_ring_speed_rpm=1"]).parameters
+    with pytest.raises(UserError, match=r"^operating.inner_ring_speed_rpm: at 1 rpm"):
+        core.choose_dt(p)
+    for f in [*sorted(SCENARIOS.glob("*.toml")), *HARD]:
+        try:
+            sc = load_scenario(f)
+        except UserError:
+            continue  # a hard file refused as it is
+        if sc.model == "multibody":
+            try:
+                check_run(sc)
+            except UserError as exc:
+                assert "steps of the automatic" not in str(exc), (f, str(exc))
+
+
 def test_the_far_above_refusal_quotes_the_scenes_own_automatic_step():
     """A given step far above the stable one is refused naming the automatic step to fall back on; in the
     kinematic-cage scene, whose automatic step is the Hertz step / KINEMATIC_DT_DIVISOR, it quoted the full

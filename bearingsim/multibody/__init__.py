@@ -69,7 +69,8 @@ from bearingsim.errors import SimulationUnstable
 from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.core import (face_radial_reach, IMPACT_SPEED_THRESHOLD_M_S, PENETRATION_LIMIT, THETA_BINS,
                                        PenetrationExceeded, assembly_refusal, check_assembly, check_face_segments,
-                                       check_land_assembly, check_rigid, choose_dt, paper_assumptions, rigid, run,
+                                       check_land_assembly, check_rigid, choose_dt, automatic_step,
+                                       check_step_count, paper_assumptions, rigid, run,
                                        unstable_advice)
 from bearingsim.datatypes import AttrGroup, NamedArray
 from bearingsim.model_versions import MODEL_FIGURES, MODEL_VERSIONS
@@ -166,8 +167,9 @@ def check_start(p, dt: float | None = None) -> None:
     roller-guided cage (:func:`core.check_face_segments`), an inner land that overlaps the cage
     as assembled (:func:`core.check_land_assembly`), and a given ``dt`` (or
     ``numerics.dt``) far above the stable step (one line naming the key; :func:`core.choose_dt`). The
-    automatic step is never refused (at most ``DT_FRACTION`` of the limit, below ``DT_MAX_FACTOR`` of
-    it), so it is not computed here: :func:`simulate` computes it once."""
+    automatic step is never refused as unstable (at most ``DT_FRACTION`` of the limit, below ``DT_MAX_FACTOR``
+    of it), only at a crawl, where it needs more than ``MAX_STEPS_PER_ROTATION`` steps per cage rotation (as
+    :func:`core.choose_dt` refuses it)."""
     if rigid(p):
         check_rigid(p)
     check_face_segments(p)
@@ -175,6 +177,8 @@ def check_start(p, dt: float | None = None) -> None:
     check_land_assembly(p)
     if dt is not None or p.numerics.dt is not None:
         choose_dt(p, dt)
+    else:
+        check_step_count(p, automatic_step(p), "auto")
 
 
 def _profile_arrays(prof, extent) -> dict:

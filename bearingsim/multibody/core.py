@@ -318,7 +318,7 @@ def choose_dt(p, dt=None, play=None):
         how = "simulate(dt=...)"
     else:
         dt, how = _automatic_dt(p, lim, play)
-    _check_step_count(p, dt, how)
+    check_step_count(p, dt, how)
     if dt > largest:
         raise UserError(_far_above(dt, f"this bearing (Hertz limit 2/omega_n = {lim:.3g} s)", largest,
                                    _automatic_dt(p, lim, play)[0]))
@@ -381,7 +381,7 @@ def _choose_dt_rigid(p, dt, play=None):
         how = "simulate(dt=...)"
     else:
         dt, how = _automatic_dt_rigid(p, lim, play)
-    _check_step_count(p, dt, how)
+    check_step_count(p, dt, how)
     if dt > largest:
         raise UserError(_far_above(dt, f"the cage on its land (2/omega_n = {lim:.3g} s)", largest,
                                    _automatic_dt_rigid(p, lim, play)[0]))
@@ -403,18 +403,58 @@ def _automatic_dt_rigid(p, lim: float, play=None) -> tuple[float, str]:
     return dt, how
 
 
-def _check_step_count(p, dt: float, how: str) -> None:
-    """Refuse a given step (``how`` not automatic) that needs more than :data:`MAX_STEPS_PER_ROTATION` steps
-    per nominal cage rotation (one line naming the key, the steps and the run time they stand for)."""
-    if how.startswith("auto"):
-        return
+def check_step_count(p, dt: float, how: str) -> None:
+    """Refuse a step that needs more than :data:`MAX_STEPS_PER_ROTATION` steps per nominal cage rotation (one
+    line): a given one (``how`` not automatic) naming its key, the steps and the run time they stand for; the
+    automatic one (a crawl: it is set by the stiffest contact and the impacts, about 4 us on the reference bearing
+    at any speed) naming ``operating.inner_ring_speed_rpm``, the steps of the run's ``numerics.rotations`` and the
+    least speed at which the automatic step is accepted."""
     per_rotation = 2.0 * math.pi / abs(p.operating.omega_c) / dt
-    if per_rotation > MAX_STEPS_PER_ROTATION:  # said as the key's refusal ("run(): dt: ..." of the API's dt)
+    if per_rotation <= MAX_STEPS_PER_ROTATION:
+        return
+    if how.startswith("auto"):
+        op, nu = p.operating, p.numerics
+        total = nu.rotations + nu.warmup_rotations
         raise UserError(
-            f"numerics.dt_s: {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
-            f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
-            f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s (or leave the step "
-            f"to the automatic choice)")
+            f"operating.inner_ring_speed_rpm: at {op.inner_ring_speed_rpm:g} rpm a cage rotation takes "
+            f"{2.0 * math.pi / abs(op.omega_c):.3g} s, {per_rotation:.3g} steps of the automatic {dt:.3g} s (set by "
+            f"the stiffest contact and the impacts, not by the speed), more than {MAX_STEPS_PER_ROTATION:.0e} (about "
+            f"2 min each on one core): the {total} rotations (numerics.rotations + numerics.warmup_rotations) would "
+            f"take {total * per_rotation:.3g} steps; run at {least_automatic_speed(p):.3g} rpm or more")
+    # said as the key's refusal ("run(): dt: ..." of the API's dt)
+    raise UserError(
+        f"numerics.dt_s: {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
+        f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
+        f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s (or leave the step "
+        f"to the automatic choice)")
+
+
+def _at_speed(p, rpm: float):
+    """``p`` at the inner-ring speed ``rpm`` [rpm] (its speeds as :meth:`bearingsim.parameters.Parameters.from_scenario`
+    derives them), everything else as it is."""
+    import dataclasses
+
+    g, op = p.bearing, p.operating
+    omega_i = laws.inner_ring_angular_speed(rpm)
+    omega_c = laws.cage_angular_speed(omega_i, g.roller_radius, g.pitch_radius)
+    omega_r = laws.roller_spin_speed(omega_i, g.roller_radius, g.pitch_radius)
+    return dataclasses.replace(p, operating=dataclasses.replace(
+        op, inner_ring_speed_rpm=float(rpm), omega_i=omega_i, omega_c=omega_c, omega_r=omega_r,
+        rolling_velocity=laws.rolling_speed(omega_r, omega_c, g.roller_radius, g.outer_race_radius)))
+
+
+def least_automatic_speed(p) -> float:
+    """The least inner-ring speed [rpm], 3 digits rounded up, at which the automatic step of ``p`` needs at most
+    :data:`MAX_STEPS_PER_ROTATION` steps per cage rotation (the step shortens slowly with the speed: the speed
+    is scaled by the steps' excess until it is within)."""
+    rpm = p.operating.inner_ring_speed_rpm
+    for _ in range(50):
+        q = _at_speed(p, rpm)
+        per_rotation = 2.0 * math.pi / abs(q.operating.omega_c) / automatic_step(q)
+        if per_rotation <= MAX_STEPS_PER_ROTATION:
+            return rpm
+        rpm = _up3(rpm * max(per_rotation / MAX_STEPS_PER_ROTATION, 1.001))
+    return rpm
 
 
 def _up3(x: float) -> float:

@@ -17,6 +17,7 @@ unit in the key name and a default or a preset value), its SI field in one group
 from __future__ import annotations
 
 import math
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -159,6 +160,16 @@ def _motion_window(out, rotations: int) -> dict:
                 motion_samples_per_rotation=int(out.motion_samples_per_rotation))
 
 
+def _speeds(bearing: "Bearing", rpm: float) -> dict:
+    """The speeds of an :class:`OperatingPoint` at the inner-ring speed ``rpm`` [rpm]: the ring's, the cage's
+    epicyclic speed (Eq. 11), the roller's spin and its rolling velocity."""
+    omega_i = laws.inner_ring_angular_speed(rpm)
+    omega_c = laws.cage_angular_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
+    omega_r = laws.roller_spin_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
+    return dict(inner_ring_speed_rpm=float(rpm), omega_i=omega_i, omega_c=omega_c, omega_r=omega_r,
+                rolling_velocity=laws.rolling_speed(omega_r, omega_c, bearing.roller_radius, bearing.outer_race_radius))
+
+
 @dataclass(frozen=True)
 class Parameters:
     """Everything a model run depends on, in SI, grouped by lifetime.
@@ -177,21 +188,18 @@ class Parameters:
     multibody: MultibodyOptions
     wear: Wear
 
+    def at_speed(self, rpm: float) -> "Parameters":
+        """These parameters at the inner-ring speed ``rpm`` [rpm], the speeds derived as :meth:`from_scenario`
+        derives them and everything else as it is."""
+        return dataclasses.replace(self, operating=dataclasses.replace(self.operating, **_speeds(self.bearing, rpm)))
+
     @classmethod
     def from_scenario(cls, scenario) -> "Parameters":
         """Build the SI parameters of a resolved :class:`bearingsim.scenario.Scenario`."""
         bearing = _bearing(scenario.bearing)
         o = scenario.operating
-        omega_i = laws.inner_ring_angular_speed(o.inner_ring_speed_rpm)
-        omega_c = laws.cage_angular_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
-        omega_r = laws.roller_spin_speed(omega_i, bearing.roller_radius, bearing.pitch_radius)
         operating = OperatingPoint(
-            inner_ring_speed_rpm=float(o.inner_ring_speed_rpm),
-            omega_i=omega_i,
-            omega_c=omega_c,
-            omega_r=omega_r,
-            rolling_velocity=laws.rolling_speed(omega_r, omega_c, bearing.roller_radius,
-                                                bearing.outer_race_radius),
+            **_speeds(bearing, o.inner_ring_speed_rpm),
             sign=1 if o.direction == "forward" else -1,
             radial_load=float(o.radial_load_N),
             gravity=laws.STANDARD_GRAVITY if o.gravity else 0.0,

@@ -429,27 +429,13 @@ def check_step_count(p, dt: float, how: str) -> None:
         f"to the automatic choice)")
 
 
-def _at_speed(p, rpm: float):
-    """``p`` at the inner-ring speed ``rpm`` [rpm] (its speeds as :meth:`bearingsim.parameters.Parameters.from_scenario`
-    derives them), everything else as it is."""
-    import dataclasses
-
-    g, op = p.bearing, p.operating
-    omega_i = laws.inner_ring_angular_speed(rpm)
-    omega_c = laws.cage_angular_speed(omega_i, g.roller_radius, g.pitch_radius)
-    omega_r = laws.roller_spin_speed(omega_i, g.roller_radius, g.pitch_radius)
-    return dataclasses.replace(p, operating=dataclasses.replace(
-        op, inner_ring_speed_rpm=float(rpm), omega_i=omega_i, omega_c=omega_c, omega_r=omega_r,
-        rolling_velocity=laws.rolling_speed(omega_r, omega_c, g.roller_radius, g.outer_race_radius)))
-
-
 def least_automatic_speed(p) -> float:
     """The least inner-ring speed [rpm], 3 digits rounded up, at which the automatic step of ``p`` needs at most
     :data:`MAX_STEPS_PER_ROTATION` steps per cage rotation (the step shortens slowly with the speed: the speed
     is scaled by the steps' excess until it is within)."""
     rpm = p.operating.inner_ring_speed_rpm
     for _ in range(50):
-        q = _at_speed(p, rpm)
+        q = p.at_speed(rpm)
         per_rotation = 2.0 * math.pi / abs(q.operating.omega_c) / automatic_step(q)
         if per_rotation <= MAX_STEPS_PER_ROTATION:
             return rpm

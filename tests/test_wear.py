@@ -1712,6 +1712,34 @@ def test_every_count_of_rotations_says_which_body_turns(fast_run, tmp_path, caps
     assert "recorded cage rotations the archive extrapolates from" in lines[-1]
 
 
+def test_consecutive_stages_whose_deepest_point_wears_no_more_share_one_label():
+    """`life scenarios/multibody_3000rpm.toml --set numerics.warmup_rotations=2 --rotations 10 --stages 10
+    --limit clearance=0.3mm` drew "stage 2/3/4: the deepest point wears no more" once per stage, at the middle
+    of each stage of 10 h on a 100 h axis, and the three labels overlapped into an unreadable blur in life.png's
+    first panel. A run of consecutive such stages now gets one label, "stages 2–4: ...", over the run."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from bearingsim.studies.life import _plot_depths
+
+    # 6 stages, 2 bins, 1 pocket: bin 0 (the deepest) wears in stages 0 and 4, bin 1 alone in 1-3 and 5
+    bin0 = [100.0, 100.0, 100.0, 100.0, 150.0, 150.0]
+    bin1 = [0.0, 10.0, 20.0, 30.0, 30.0, 40.0]
+    front = np.array([[[a], [b]] for a, b in zip(bin0, bin1)])
+    cols = {"hours_end": np.arange(1.0, 7.0), "max_depth_um": np.array(bin0),
+            "worn_depth_front_um": front, "worn_depth_rear_um": np.zeros_like(front)}
+    fig, ax = plt.subplots()
+    try:
+        _plot_depths(ax, cols, {})
+        labels = sorted((t.get_text(), t.xy) for t in ax.texts)
+    finally:
+        plt.close(fig)
+    assert labels == [("stage 5: the deepest\npoint wears no more", (5.5, 150.0)),
+                      ("stages 1–3: the deepest\npoint wears no more", (2.5, 100.0))], labels
+
+
 def test_the_life_historys_depth_rate_is_called_the_fastest_points_not_the_deepest_points(tmp_path, capsys):
     """The life history's depth rate is the largest of any point (what drives a depth limit), which is not the
     deepest point's when another bin is deeper. The table, the figure and life.h5's description of the column

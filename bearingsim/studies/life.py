@@ -865,6 +865,19 @@ def _stopped(point: dict) -> bool:
     return wore > 0.0 and point["deepest_wore"] <= 1e-3 * wore and point["deepest"][1] != point["fastest"][1]
 
 
+def _stopped_runs(points: list[dict]) -> list[tuple[int, int]]:
+    """The runs of consecutive stages whose deepest point did not wear (:func:`_stopped`), as (first, last)."""
+    runs: list[tuple[int, int]] = []
+    for j, p in enumerate(points):
+        if not _stopped(p):
+            continue
+        if runs and runs[-1][1] == j - 1:
+            runs[-1] = (runs[-1][0], j)
+        else:
+            runs.append((j, j))
+    return runs
+
+
 def depth_notes(cols: dict, attrs: dict) -> list[str]:
     """A line for each stage in which the deepest point did not wear (less than 0.1 % of what the fastest point
     wore, :func:`stage_points`): the table's 'deepest' stays put while its depth rate is another point's."""
@@ -934,11 +947,11 @@ def _plot_depths(ax, cols: dict, attrs: dict) -> None:
         x = np.array([[a, b, np.nan] for a, b in zip(h_start, h_end)]).ravel()
         y = np.array([[p["fastest"][0] - p["fastest_wore"], p["fastest"][0], np.nan] for p in points]).ravel()
         ax.plot(x, y, "--", color="C3", lw=1.5, label="fastest point of each stage\n(slope: the third panel's rate)")
-    for j, p in enumerate(points):
-        if _stopped(p):
-            ax.annotate(f"stage {j}: the deepest\npoint wears no more", (0.5 * (h_start[j] + h_end[j]),
-                        p["deepest"][0]), xytext=(0, -6), textcoords="offset points", ha="center", va="top",
-                        fontsize=7)
+    for a, b in _stopped_runs(points):  # one label per run of stages: one per stage overlapped into a blur
+        which = f"stage {a}" if a == b else f"stages {a}–{b}"
+        ax.annotate(f"{which}: the deepest\npoint wears no more", (0.5 * (h_start[a] + h_end[b]),
+                    max(points[j]["deepest"][0] for j in range(a, b + 1))), xytext=(0, -6),
+                    textcoords="offset points", ha="center", va="top", fontsize=7)
     ax.set_ylabel("worn depth [µm]")
     ax.set_ylim(bottom=0.0)
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2))  # below the axes: no data covered

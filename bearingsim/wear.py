@@ -373,7 +373,7 @@ def format_comparison(labels: dict[str, list[str]], reports: list, notes: list[s
     point and whether a cage bar wears through; ``notes`` above it (the scenario keys that differ). A row given
     as its cells instead of a report (a sweep's case without an archive: :func:`rate_cells`) is shown as given."""
     head = (*labels, "hours", "k", "H [Pa]", "V front [mm^3]", "V rear [mm^3]", "deepest [um]",
-            "cage rotations", "cage bar")
+            "recorded cage rotations", "cage bar")
     nlab = len(labels)
     rows = [(*(col[i] for col in labels.values()), *(report_cells(rep) if isinstance(rep, WearReport) else rep))
             for i, rep in enumerate(reports)]
@@ -382,10 +382,10 @@ def format_comparison(labels: dict[str, list[str]], reports: list, notes: list[s
                                    for j, (c, w) in enumerate(zip(cells, widths))).rstrip()
     out = [*notes, line(head), *(line(r) for r in rows)]
     out.append("V: worn volume of one face, mean over pockets \u00b1 its standard error (batch means over the "
-               "recorded cage rotations the archive extrapolates from, 'cage rotations'); deepest: any face's deepest "
-               "point, an end bin's as a rule, the scenario's own starting depth included (docs/wear.md); cage bar: "
-               "whether the two faces on one bar, starting depth included, wear through it ('bearingsim wear ARCHIVE' "
-               "gives one archive's whole report)")
+               "recorded cage rotations the archive extrapolates from, 'recorded cage rotations'); deepest: any "
+               "face's deepest point, an end bin's as a rule, the scenario's own starting depth included "
+               "(docs/wear.md); cage bar: whether the two faces on one bar, starting depth included, wear through "
+               "it ('bearingsim wear ARCHIVE' gives one archive's whole report)")
     return "\n".join(out)
 
 

@@ -1679,7 +1679,9 @@ def test_every_count_of_rotations_says_which_body_turns(fast_run, tmp_path, caps
     datasets only the unit 1. Each now names the body: the table's `shaft rotations`, the progress line's and
     life.h5's 'inner-ring (shaft) rotations' (its datasets' description, listed by inspect), inspect's and the
     figure's 'recorded cage rotations per stage', the keys table's 'recorded cage rotations', and the wear
-    comparison's 'cage rotations' (the recorded ones it extrapolates from)."""
+    comparison's 'recorded cage rotations' (the ones it extrapolates from: its header said 'cage rotations',
+    which one archive's report, `wear A.h5 --hours 1000`, gives as the running time's, '7.811e+07 cage
+    rotations', while the table's column held the 40 recorded)."""
     import shutil
 
     import h5py
@@ -1708,7 +1710,7 @@ def test_every_count_of_rotations_says_which_body_turns(fast_run, tmp_path, caps
     assert main(["wear", str(fast_run[1]), str(other), "--hours", "1", "--no-plots"]) == 0
     lines = capsys.readouterr().out.splitlines()
     head = next(ln for ln in lines if ln.startswith("archive "))
-    assert re.split(r"\s{2,}", head.strip())[7] == "cage rotations", lines
+    assert re.split(r"\s{2,}", head.strip())[7] == "recorded cage rotations", lines
     assert "recorded cage rotations the archive extrapolates from" in lines[-1]
 
 

@@ -41,6 +41,9 @@ NOTES_HEAD = ("notes: the runs' notes (of a run that is plausible but not clean,
 MIXED_MODELS = ("rows of both models: the reduced model's '± 0' is its exactness (every rotation repeats its one "
                 "pass), not a measured error, and a mark against a whole-bearing row is the difference of the models, "
                 "which 'bearingsim crosscheck' takes apart assumption by assumption (docs/crosscheck.md)")
+#: the line under the rule of the marks of a table whose rows are all of the reduced model
+REDUCED_EXACT = ("reduced model: each case is one exact pass, repeated in every rotation, so its '± 0' is no "
+                 "measured error and a mark is any difference beyond round-off")
 #: number columns shown by default, those present
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
                    "load_zone_half_angle_deg", "wear_front_mean_m3_h", "wear_rear_mean_m3_h")
@@ -93,7 +96,8 @@ class Table:
     ``units[key]``; ``notes`` are lines printed above the table; ``footnotes`` (row -> text) are printed
     under it for the rows shown, each marked in the row's label column ``notes`` (``[1]``, ``[2]``, ...);
     ``batches`` (per row) the number of batch means its standard errors came from (their degrees of freedom
-    plus one, :func:`bearingsim.stats.sem_batches`; None: :data:`bearingsim.stats.BATCHES` each)."""
+    plus one, :func:`bearingsim.stats.sem_batches`; None: :data:`bearingsim.stats.BATCHES` each); ``exact``:
+    every row is of the reduced model (:data:`REDUCED_EXACT` is printed with the rule of the marks)."""
 
     label_names: list[str]
     labels: dict[str, list[str]]
@@ -102,6 +106,7 @@ class Table:
     notes: list[str] = field(default_factory=list)
     footnotes: dict[int, str] = field(default_factory=dict)
     batches: list[int] | None = None
+    exact: bool = False
 
     def __len__(self) -> int:
         return len(next(iter(self.labels.values()))) if self.labels else 0
@@ -128,7 +133,21 @@ def table_of_index(path) -> Table:
     notes = [f"{path}: {counted(n, 'case')}" + (f" of a sweep of {meta['scenario']}" if meta.get("scenario") else "")]
     footnotes = _run_notes([notes_of(c) for c in cols.get("notes", [""] * n)], names, labels)
     return Table(names, labels, numbers, {k: unit_of(k) for k in numbers}, notes, footnotes,
-                 index_batches(cols, meta, n))
+                 index_batches(cols, meta, n), exact=_index_models(cols, meta) == {"reduced"})
+
+
+def _index_models(cols: dict, meta: dict) -> set:
+    """The models of an index's rows: the swept ``model`` column's, else the base scenario's (an empty set when
+    neither says)."""
+    import tomllib
+
+    if "model" in cols:
+        return {str(m) for m in cols["model"]}
+    try:
+        model = tomllib.loads(meta.get("scenario_toml") or "").get("model")
+    except tomllib.TOMLDecodeError:
+        return set()
+    return {model} if model else set()
 
 
 def _run_notes(found: list[list[str]], names: list[str], labels: dict) -> dict[int, str]:
@@ -182,7 +201,7 @@ def table_of_archives(paths) -> Table:
         notes.append(MIXED_MODELS)
     footnotes = _run_notes([run_notes(r.notes) for r in results], names, labels)  # worded as an index's
     batches = [sem_batches(np.shape(r.per_rotation["I_dec"])[0]) for r in results]
-    return Table(names, labels, numbers, units, notes, footnotes, batches)
+    return Table(names, labels, numbers, units, notes, footnotes, batches, exact=models == {"reduced"})
 
 
 #: the most scenario keys that differ a table of archives shows as label columns (the others in a note)
@@ -445,7 +464,7 @@ def format_table(table: Table, columns=None, max_rows: int | None = None) -> str
         out.append(NOTES_HEAD)
         out += noted
     if any(k in SEM_OF for k in keys):
-        out += [RULE, reference_line(table, [k for k in keys if k in SEM_OF])]
+        out += [RULE, *([REDUCED_EXACT] if table.exact else []), reference_line(table, [k for k in keys if k in SEM_OF])]
     return "\n".join(out)
 
 

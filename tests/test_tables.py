@@ -343,6 +343,7 @@ def test_sweep_prints_its_table_and_table_of_the_folder_is_the_same(tmp_path):
     assert "I_dec_mean [mN s]" in lines[i] and lines[i + 1].startswith("1000 ") and lines[i + 2].startswith("3000 ")
     table = cli("table", out)
     assert table.returncode == 0 and lines[i:i + 4] == table.stdout.splitlines()[1:5]
+    assert tables.REDUCED_EXACT in table.stdout.splitlines()  # a reduced sweep's table says what its '± 0' is
     quiet = cli("sweep", PAPER, "--param", "operating.inner_ring_speed_rpm=1000,3000", "-o", out, "-j", "1",
                 "--no-plots", "-q")
     assert quiet.returncode == 0 and quiet.stdout == "" and quiet.stderr == ""
@@ -540,7 +541,7 @@ def test_a_table_of_both_models_says_what_the_reduced_models_zero_error_is(tmp_p
     says the reduced model's ± 0 is its exactness and a mark is the models' difference; one model's table does
     not."""
     import bearingsim
-    from bearingsim.tables import MIXED_MODELS, table_of
+    from bearingsim.tables import MIXED_MODELS, REDUCED_EXACT, format_table, table_of
 
     red, whole = tmp_path / "r.h5", tmp_path / "m.h5"
     bearingsim.run(bearingsim.load_scenario(SCENARIOS / "paper_3000rpm.toml")).save(red)
@@ -549,6 +550,10 @@ def test_a_table_of_both_models_says_what_the_reduced_models_zero_error_is(tmp_p
                    ).save(whole)
     assert MIXED_MODELS in table_of([red, whole]).notes
     assert MIXED_MODELS not in table_of([whole, whole]).notes and MIXED_MODELS not in table_of([red]).notes
+    # the reduced model's own table says it too, in its own words (every '± 0', every mark a real difference)
+    assert table_of([red, red]).exact and REDUCED_EXACT in format_table(table_of([red, red])).splitlines()
+    assert not table_of([red, whole]).exact and not table_of([whole]).exact
+    assert REDUCED_EXACT not in format_table(table_of([red, whole]))
 
 
 def test_rows_whose_notes_differ_in_their_numbers_only_share_one_mark():

@@ -6,11 +6,28 @@ from __future__ import annotations
 import argparse
 import contextlib
 import difflib
+import re
 import signal
 import sys
 
 from bearingsim.errors import UserError
 from bearingsim.wording import counted
+
+
+def _negative_values_joined(args: list[str]) -> list[str]:
+    """``args`` with a token that starts as a negative number (``-10%``, ``-0.5``, ``-.5``) after a long option
+    joined to it (``--step=-10%``): no bearingsim option starts with a digit, so such a token is a value, and
+    argparse takes only the plain numbers it recognises (``-10``) as one. Nothing after ``--`` is changed."""
+    out: list[str] = []
+    for i, tok in enumerate(args):
+        if tok == "--":
+            return out + args[i:]
+        prev = out[-1] if out else ""
+        if prev.startswith("--") and "=" not in prev and re.match(r"-\.?\d", tok):
+            out[-1] = f"{prev}={tok}"
+        else:
+            out.append(tok)
+    return out
 
 
 class Parser(argparse.ArgumentParser):
@@ -26,7 +43,10 @@ class Parser(argparse.ArgumentParser):
 
     def parse_args(self, args=None, namespace=None):
         """argparse's, but an argument no parser took is refused by the subcommand's parser, which names
-        it, not by the main one (``bearingsim run x.toml --bogus``: ``bearingsim run: error: ...``)."""
+        it, not by the main one (``bearingsim run x.toml --bogus``: ``bearingsim run: error: ...``); a negative
+        value given apart from its option (``--step -10%``) is the option's value, which the option then judges
+        (argparse read ``-10%`` as an unknown option and said only "expected one argument")."""
+        args = _negative_values_joined(sys.argv[1:] if args is None else list(args))
         namespace, extras = self.parse_known_args(args, namespace)
         if extras:
             self._used_parser(namespace).error(f"unrecognized arguments: {' '.join(extras)}")

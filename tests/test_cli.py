@@ -869,3 +869,17 @@ def test_a_validate_folder_given_to_plot_says_what_its_sweep_h5_draws(tmp_path):
                       f"'bearingsim plot {folder / 'sweep.h5'}' draws its cases' overview (validate's own figures: "
                       f"the same 'bearingsim validate -o {folder}' again redraws them from its cases)")
     assert "draws its figures" not in res.stderr
+
+
+def test_a_negative_value_apart_from_its_option_is_joined_to_it_and_nothing_else_is():
+    """cli_common._negative_values_joined: argparse takes '-10' as a value but reads '-10%' or '-.5e-3' as an
+    unknown option; no bearingsim option starts with a digit, so a token that starts as a negative number after a
+    long option is that option's value. A value inside a --set, a short option's, and what follows '--' stay."""
+    from bearingsim.cli_common import _negative_values_joined as joined
+
+    assert joined(["sensitivity", "a.toml", "--step", "-10%"]) == ["sensitivity", "a.toml", "--step=-10%"]
+    assert joined(["--hours", "-.5e-3", "--step", "5%"]) == ["--hours=-.5e-3", "--step", "5%"]
+    assert joined(["--set", "operating.radial_load_N=-5", "-o", "-1"]) == ["--set", "operating.radial_load_N=-5",
+                                                                           "-o", "-1"]
+    assert joined(["--step=-1%", "-2"]) == ["--step=-1%", "-2"]
+    assert joined(["run", "--", "--step", "-10%"]) == ["run", "--", "--step", "-10%"]

@@ -174,6 +174,10 @@ def test_ranges_are_stored_in_the_archive_and_shown(tmp_path, capsys):
                        "x (1 + step)); did you mean --step 10%?"),
     (["--step=-10%"], "--step '-10%': the relative step must be above 0 and below 100 % (runs at x (1 - step) and "
                       "x (1 + step)); a step is taken both ways, give it positive"),
+    # apart from its option: argparse read '-10%' as an unknown option ("expected one argument"); now the value's
+    (["--step", "-10%"], "--step '-10%': the relative step must be above 0 and below 100 % (runs at x (1 - step) "
+                         "and x (1 + step)); a step is taken both ways, give it positive"),
+    (["--step", "-.5"], "--step '-.5'"),
 ])
 def test_bad_sensitivity_input_is_one_line(tmp_path, capsys, args, words):
     code = main(["sensitivity", str(REDUCED), "-o", str(tmp_path / "o"), *args])

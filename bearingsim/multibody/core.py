@@ -204,15 +204,17 @@ def max_roller_load(p) -> float:
 
 
 def traction_relaxation_time(p) -> float:
-    """The time [s] in which the raceway traction brings the most loaded roller's slip back to rolling:
-    ``tau = m slip_ref u / (3 mu_max Q)``, from the traction's slope at zero slip ``C = mu_max Q / (slip_ref u)``
-    acting on the slip speed of a solid roller (``1/m + r^2/J = 3/m``), with ``Q`` :func:`max_roller_load` and
-    ``u`` :func:`rolling_speed`. The force kernel takes that traction implicitly and pymunk's contact solve after
-    it; a roller pressed against a face through the load zone feels the split at first order in ``h / tau``
-    (docs/multibody.md, *Its time step*)."""
+    """The relaxation time [s] of a roller that a pocket face holds against the raceway traction:
+    ``tau = m / (2 C) = m slip_ref u / (2 mu_max Q)``, with ``C = mu_max Q / (slip_ref u)`` the traction's slope at
+    zero slip on each raceway (both at :func:`max_roller_load` ``Q``, ``u`` :func:`rolling_speed`). The force
+    kernel takes the traction implicitly and pymunk's contact solve follows it in the same step, so for a roller
+    held at a face moving at constant speed the face's force comes out ``1 / (1 + h / tau)`` of the exact one at
+    the discrete steady state (equal slopes: the translation and the spin do not couple in the implicit solve, so
+    the roller's inertia about its axis drops out; with one raceway contact alone the force is exact). The cage
+    re-balances, so a run's I_dec moves much less than that (docs/multibody.md, *Its time step*)."""
     mu = p.contact.traction_mu_max
     return (math.inf if mu <= 0.0 else
-            p.bearing.roller_mass * p.contact.traction_slip_ref * rolling_speed(p) / (3.0 * mu * max_roller_load(p)))
+            p.bearing.roller_mass * p.contact.traction_slip_ref * rolling_speed(p) / (2.0 * mu * max_roller_load(p)))
 
 
 def rolling_speed(p) -> float:

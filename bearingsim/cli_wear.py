@@ -123,7 +123,12 @@ def _sweep_wear(folder: Path, args) -> str:
     labels = {("case" if k == "archive" else k): v for k, v in labels.items()}
     rows, missing, whys = [], [], []
     for i in range(n):
-        cells, why = _case_wear(folder, cols, i, args)
+        try:
+            cells, why = _case_wear(folder, cols, i, args)
+        except UserError as exc:  # the running time's refusal at this case's speed: which case it is
+            head, _, rest = str(exc).partition(": ")
+            where = ", ".join(f"{k} = {labels[k][i]}" for k in labels if k != "case")
+            raise UserError(f"{head}: case {cases[i]}{f' ({where})' if where else ''}: {rest}") from None
         rows.append(cells)
         whys.append(why)
         if why:

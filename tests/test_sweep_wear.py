@@ -79,6 +79,20 @@ def test_a_multibody_sweeps_index_holds_the_wear_bearingsim_wear_computes_from_e
 
 
 @pytest.mark.slow
+def test_a_running_time_beyond_the_bound_at_a_cases_speed_names_the_case(mb_sweep, capsys):
+    """'wear DIR --rotations N' bounds N by each case's speed (1e6 h of running): the refusal named the speed of
+    the case it came from but not the case, which a sweep over the speed (or any key) leaves the user to guess;
+    it names the case and its swept values, in one line, exit 2."""
+    folder, _ = mb_sweep
+    cols, _ = read_index(folder / "sweep.h5")
+    assert main(["wear", str(folder), "--rotations", "1e20"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"bearingsim: error: --rotations 1e+20: case {cols['case'][0]} ({K} = 5e-06): more than "
+                          "1000000 h of running (360000000000 inner-ring rotations at 6000 rpm)"), err
+    assert len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.slow
 def test_a_resumed_multibody_sweep_takes_the_same_wear_from_its_archives(mb_sweep):
     """A cached case's rates are read from its archive: the same bits as the run's own."""
     folder, spec = mb_sweep

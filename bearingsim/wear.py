@@ -340,10 +340,12 @@ def format_report(rep: WearReport) -> str:
     for f in ("front", "rear"):
         v = rep.volume_front if f == "front" else rep.volume_rear
         sem = rep.volume_sem(f)
-        error = (f"standard error {sem * 1e9:.2g} mm^3 (batch means over the {n} recorded rotations it extrapolates "
-                 f"from)" if math.isfinite(sem) else f"no standard error ({counted(n, 'recorded rotation')}: "
-                 f"at least 2 give one)")
-        lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, {error}")
+        if math.isfinite(sem):  # as the tables show a value with its error (stats.with_error)
+            lines.append(f"{f}: worn volume mean {with_error(v.mean() * 1e9, sem * 1e9)} mm^3 over pockets (standard "
+                         f"error, batch means over the {n} recorded rotations it extrapolates from)")
+        else:
+            lines.append(f"{f}: worn volume mean {v.mean() * 1e9:.4g} mm^3 over pockets, no standard error "
+                         f"({counted(n, 'recorded rotation')}: at least 2 give one)")
     for f in ("front", "rear"):
         lines.append(f"{f}: coefficient of variation over pockets {rep.cov(f):.3f}; " + (
             f"identical pockets would show {rep.sampling_cov(f):.3f} from the rotation-to-rotation scatter of the "
@@ -544,7 +546,7 @@ def plot_wear_volume(rep: WearReport, title: str = ""):
         sem = rep.volume_sem(f) * 1e9
         if math.isfinite(sem):
             ax.axhspan(v.mean() - sem, v.mean() + sem, color=c, alpha=0.2, lw=0.0)
-            label = f"{f} face, mean over pockets {v.mean():.4g} ± {sem:.2g} mm³ (±1 standard error)"
+            label = f"{f} face, mean over pockets {with_error(v.mean(), sem)} mm³ (±1 standard error)"  # as the table
         else:
             label = (f"{f} face, mean over pockets {v.mean():.4g} mm³ "
                      f"(no standard error: {counted(n, 'recorded rotation')})")

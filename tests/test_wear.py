@@ -1458,7 +1458,7 @@ def test_the_worn_volume_mean_gives_its_standard_error_and_the_rotations_it_extr
     the running time; the report printed it without its error. It gives the batch-means standard error
     (stats.batch_sem over rotations of the per-rotation face totals: the pockets' mean sliding work per rotation,
     scaled as the volume is) and the number of recorded rotations, in the data and in the text."""
-    from bearingsim.stats import batch_sem, pocket_means
+    from bearingsim.stats import batch_sem, pocket_means, with_error
     from bearingsim.wear import format_report
 
     res, _ = fast_run
@@ -1472,7 +1472,8 @@ def test_the_worn_volume_mean_gives_its_standard_error_and_the_rotations_it_extr
         assert rep.volume_sem(f) == pytest.approx(expected, rel=1e-12, abs=0) and rep.volume_sem(f) > 0.0
         np.testing.assert_allclose(rep.volume_rotations(f).mean(axis=0), v, rtol=1e-12)
         line = next(ln for ln in format_report(rep).splitlines() if ln.startswith(f"{f}: worn volume mean"))
-        assert f"standard error {rep.volume_sem(f) * 1e9:.2g} mm^3" in line and "2 recorded rotations" in line, line
+        shown = with_error(v.mean() * 1e9, rep.volume_sem(f) * 1e9)  # as the tables show it
+        assert f"mean {shown} mm^3 over pockets (standard error" in line and "2 recorded rotations" in line, line
 
 
 def test_the_spread_over_pockets_is_given_beside_what_sampling_alone_gives(fast_run):
@@ -1795,7 +1796,8 @@ def test_the_wear_volume_figure_names_its_law_and_gives_the_standard_errors_the_
     the cage bar's line in mm on an axis in µm. Now the law, k and H are named, each face's mean over pockets is
     drawn ± the standard error the command prints, numbers read 1000 h, 3.6 × 10⁶, 1.5 GPa, and one unit per
     quantity."""
-    from bearingsim.wear import WearReport, format_report, plot_wear_profile, plot_wear_volume
+    from bearingsim.stats import with_error
+    from bearingsim.wear import WearReport, format_comparison, format_report, plot_wear_profile, plot_wear_volume
 
     psi = np.linspace(-30.0, 25.0, 32)
     rng = np.random.default_rng(3)
@@ -1812,9 +1814,12 @@ def test_the_wear_volume_figure_names_its_law_and_gives_the_standard_errors_the_
     labels = ax.get_legend_handles_labels()[1]
     for f in ("front", "rear"):
         mean, sem = rep.volume_front.mean() if f == "front" else rep.volume_rear.mean(), rep.volume_sem(f)
-        assert f"{f}: worn volume mean {mean * 1e9:.4g} mm^3 over pockets, standard error {sem * 1e9:.2g}" in text
-        assert f"{f} face, mean over pockets {mean * 1e9:.4g} ± {sem * 1e9:.2g} mm³ (±1 standard error)" in labels, \
-            labels
+        # the report, the figure and a table of several archives give a mean with its error alike (with_error: the
+        # legend read 37.25 ± 0.054 where the table read 37.247 ± 0.054)
+        shown = with_error(mean * 1e9, sem * 1e9)
+        assert f"{f}: worn volume mean {shown} mm^3 over pockets (standard error, batch means" in text
+        assert f"{f} face, mean over pockets {shown} mm³ (±1 standard error)" in labels, labels
+        assert shown in format_comparison({"run": ["a"]}, [rep])
     profile = plot_wear_profile(rep)
     assert "cage bar width 5821 µm" in profile.axes[0].get_legend_handles_labels()[1] + \
         profile.axes[1].get_legend_handles_labels()[1]

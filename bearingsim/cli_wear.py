@@ -123,17 +123,16 @@ def _sweep_wear(folder: Path, args) -> str:
     labels = {("case" if k == "archive" else k): v for k, v in labels.items()}
     rows, missing, whys = [], [], []
     for i in range(n):
+        values = ", ".join(f"{k} = {labels[k][i]}" for k in labels if k != "case")  # the case's swept values
         try:
             cells, why = _case_wear(folder, cols, i, args)
         except UserError as exc:  # the running time's refusal at this case's speed: which case it is
             head, _, rest = str(exc).partition(": ")
-            where = ", ".join(f"{k} = {labels[k][i]}" for k in labels if k != "case")
-            raise UserError(f"{head}: case {cases[i]}{f' ({where})' if where else ''}: {rest}") from None
+            raise UserError(f"{head}: case {cases[i]}{f' ({values})' if values else ''}: {rest}") from None
         rows.append(cells)
         whys.append(why)
         if why:
-            missing.append(f"not available: case {cases[i]}"
-                           + "".join(f", {k} = {labels[k][i]}" for k in labels if k != "case") + f": {why}")
+            missing.append(f"not available: case {cases[i]}{f', {values}' if values else ''}: {why}")
     if n and all(why == PER_HOUR for why in whys):  # the option, not the cases: a table of dashes says nothing
         raise UserError(f"--rotations {wear.given_time(args.rotations)}: no case of {folder} has an archive to scale by its cage "
                         f"speed (a reduced case never keeps one by default), and the index's wear rates are per hour: "

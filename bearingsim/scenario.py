@@ -25,7 +25,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
 
 from bearingsim.errors import UserError
-from bearingsim.wording import KEY_TOPICS, counted, given_by, listed
+from bearingsim.wording import KEY_TOPICS, counted, given_by, listed, rounded3
 
 SCHEMA_VERSION = 1
 
@@ -1278,7 +1278,8 @@ def _check_limits(m: ScenarioModel, source: str, scenario: "Scenario") -> None:
         drag = float(laws.oil_film_drag(m.lubrication.drag_coefficient, n_free, op.rolling_velocity))
         if drag > MAX_DRAG_TO_LOAD * n_free:
             # the drag is c times that of c = 1: the largest c the bound accepts, rounded down to 3 digits
-            largest = _down3(MAX_DRAG_TO_LOAD * n_free / float(laws.oil_film_drag(1.0, n_free, op.rolling_velocity)))
+            largest = rounded3(MAX_DRAG_TO_LOAD * n_free / float(laws.oil_film_drag(1.0, n_free, op.rolling_velocity)),
+                                up=False)
             exc = UserError(f"{source}: lubrication.drag_coefficient: {m.lubrication.drag_coefficient:g} gives an "
                             f"oil-film drag of {drag:.3g} N against a roller load of {n_free:.3g} N (Eq. 2); "
                             f"rolling resistance is a small fraction of the load: use at most {largest:.3g} here "
@@ -1408,12 +1409,6 @@ def _check_geometry(m: ScenarioModel, source: str) -> None:
     if m.reduced.load_zone_half_angle_deg != "auto" and m.model == "reduced":
         if m.reduced.load_zone_half_angle_deg >= 180.0:
             raise UserError(f"{source}: reduced.load_zone_half_angle_deg: must be below 180 deg")
-
-
-def _down3(x: float) -> float:
-    """``x`` > 0 rounded down to 3 significant digits (a bound a user types from a message and is not refused)."""
-    q = 10.0 ** (math.floor(math.log10(x)) - 2)
-    return math.floor(x / q * (1.0 + 1e-12)) * q * (1.0 - 1e-12)
 
 
 def _check_worn(m: ScenarioModel, source: str) -> None:

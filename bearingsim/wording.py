@@ -70,6 +70,15 @@ def listed(items, last: str = "or") -> str:
     return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} {last} {items[-1]}"
 
 
+def rounded3(x: float, *, up: bool) -> float:
+    """``x`` > 0 rounded up (``up``) or down to 3 significant digits: a bound a message names, which a user types
+    back and is not refused."""
+    q = 10.0 ** (math.floor(math.log10(x)) - 2)
+    if up:
+        return math.ceil(x / q * (1.0 - 1e-12)) * q * (1.0 + 1e-12)
+    return math.floor(x / q * (1.0 + 1e-12)) * q * (1.0 - 1e-12)
+
+
 def counted(n, noun: str, plural: str | None = None, fmt: str = "") -> str:
     """``n`` and ``noun``, in the plural unless ``n`` is one: ``counted(1, "case")`` is "1 case",
     ``counted(3, "case")`` "3 cases", ``counted(2, "speed", fmt="g")`` "2 speeds". ``plural``: the

@@ -322,24 +322,25 @@ def parser() -> argparse.ArgumentParser:
     return ap
 
 
+#: the options only some studies read, and those studies
+READ_BY = {"limit": ("life", "stages"), "mapping": ("stages",), "halvings": ("order",), "warmup": ("order",),
+           "rotations": ("order",), "raceways": ("order",)}
+
+
 def main(argv=None) -> None:
     ap = parser()
     a = ap.parse_args(argv)
-    if a.limit and a.study not in ("life", "stages"):
-        ap.error(f"--limit: only the life and stages studies read it (not {a.study})")
-    if a.mapping and a.study != "stages":
-        ap.error(f"--mapping: only the stages study reads it (not {a.study})")
+    extra = {}
+    for key, studies in READ_BY.items():  # an option only some studies read: refused by the others
+        if getattr(a, key) is not None:
+            if a.study not in studies:
+                names = " and ".join(studies)
+                ap.error(f"--{key}: only the {names} {'study reads' if len(studies) == 1 else 'studies read'} it "
+                         f"(not {a.study})")
+            extra[key] = getattr(a, key)
     given = [a.bins] if a.bins else []
     study = {"psi": psi, "theta": theta, "life": life, "stages": stages, "whatif": whatif, "rig": rig, "dt": dt,
              "order": order}[a.study]
-    extra = {"limit": a.limit} if a.study in ("life", "stages") and a.limit else {}
-    if a.mapping:
-        extra["mapping"] = a.mapping
-    for key in ("halvings", "warmup", "rotations", "raceways"):
-        if getattr(a, key) is not None:
-            if a.study != "order":
-                ap.error(f"--{key}: only the order study reads it (not {a.study})")
-            extra[key] = getattr(a, key)
     if extra.get("raceways"):
         extra["raceways"] = ("hertz", "rigid") if extra["raceways"] == "both" else (extra["raceways"],)
     study(*given, sets=a.set, **extra)

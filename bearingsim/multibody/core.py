@@ -33,7 +33,7 @@ from bearingsim.multibody import recorder as rk
 from bearingsim.multibody.scene import build_scene
 from bearingsim.parameters import inner_ring_mode
 from bearingsim.parameters import paper_assumptions  # noqa: F401 - re-exported: the scene of the paper's assumptions
-from bearingsim.wording import given_step
+from bearingsim.wording import given_step, rounded3
 
 # --- fixed model choices (documented, not tuned) ------------------------------------------------
 # exact arc faces: a roller further than this fraction of the play R - r from its pocket centre has its faces
@@ -427,7 +427,7 @@ def check_step_count(p, dt: float, how: str) -> None:
     raise UserError(
         f"numerics.dt_s: {dt:.3g} s needs {per_rotation:.3g} steps per cage rotation, more than "
         f"{MAX_STEPS_PER_ROTATION:.0e} (about 2 min each on one core): use at least "
-        f"{_up3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION):.3g} s (or leave the step "
+        f"{rounded3(2.0 * math.pi / abs(p.operating.omega_c) / MAX_STEPS_PER_ROTATION, up=True):.3g} s (or leave the step "
         f"to the automatic choice)")
 
 
@@ -441,14 +441,8 @@ def least_automatic_speed(p) -> float:
         per_rotation = 2.0 * math.pi / abs(q.operating.omega_c) / automatic_step(q)
         if per_rotation <= MAX_STEPS_PER_ROTATION:
             return rpm
-        rpm = _up3(rpm * max(per_rotation / MAX_STEPS_PER_ROTATION, 1.001))
+        rpm = rounded3(rpm * max(per_rotation / MAX_STEPS_PER_ROTATION, 1.001), up=True)
     return rpm
-
-
-def _up3(x: float) -> float:
-    """``x`` > 0 rounded up to 3 significant digits (a bound a user types from a message and is not refused)."""
-    q = 10.0 ** (math.floor(math.log10(x)) - 2)
-    return math.ceil(x / q * (1.0 - 1e-12)) * q * (1.0 + 1e-12)
 
 
 def rigid_start(p, dt, play=None):
@@ -754,7 +748,7 @@ def check_land_assembly(p) -> None:
     start = ring_start_offset(p)
     overlap = start - half
     if overlap > LAND_OVERLAP_FRACTION * half:
-        least = _up3(2.0 * start / (1.0 + LAND_OVERLAP_FRACTION) * 1e3)
+        least = rounded3(2.0 * start / (1.0 + LAND_OVERLAP_FRACTION) * 1e3, up=True)
         raise UserError(
             f"bearing.cage_land_clearance_mm = {g.cage_land_clearance * 1e3:.4g} is too small for this bearing's "
             f"radial play under its load (bearing.radial_clearance_mm = {g.radial_clearance * 1e3:.4g}, "

@@ -1348,8 +1348,9 @@ def is_table_file(path, fmt: str) -> bool:
 def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
     (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
-    stores none), ``summary`` (numbers), ``I_dec`` and ``I_acc`` per rotation, ``wall_time_s``, ``notes``
-    (the run's stored notes, :func:`read_notes`; None if it stores none), ``wear`` (the attributes of
+    stores none), ``summary`` (numbers), ``per_rotation`` (``I_dec``, ``I_acc`` and, where the archive has it,
+    ``first_impact_speed``: the arrays :func:`bearingsim.stats.summary_standard_errors` reads), ``wall_time_s``,
+    ``notes`` (the run's stored notes, :func:`read_notes`; None if it stores none), ``wear`` (the attributes of
     ``/results/wear``: a reduced run's wear rates; {} without them). None for a missing, unreadable,
     damaged or incomplete file (never trusted)."""
     h5py = _lazy_h5py()
@@ -1372,7 +1373,8 @@ def peek(path) -> dict[str, Any] | None:
                 and not isinstance(version, bool) else None,
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
-                "I_dec": f["results/per_rotation/I_dec"][()], "I_acc": f["results/per_rotation/I_acc"][()],
+                "per_rotation": {k: f[f"results/per_rotation/{k}"][()] for k in ("I_dec", "I_acc", "first_impact_speed")
+                                 if k != "first_impact_speed" or f"results/per_rotation/{k}" in f},
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
                 "notes": read_notes(f, path),
                 "wear": group_attrs(f["results/wear"])[0] if "results/wear" in f else {},
@@ -1656,23 +1658,25 @@ def _notes_lines(notes: list[str] | None) -> list[str]:
 
 
 def _error_lines(f, model) -> list[str]:
-    """The "standard errors" line of :func:`describe`: the mean impulses' batch-means errors over the
-    recorded rotations (:func:`bearingsim.stats.impulse_standard_errors`, as ``bearingsim table`` gives
-    them), for a whole-bearing archive; none for the reduced model's, whose rotations repeat one pass, nor for
-    per-rotation arrays that are not the ``[rotations, pockets]`` numbers of a result."""
-    from bearingsim.stats import impulse_standard_errors
+    """The "standard errors" line of :func:`describe`: the batch-means errors over the recorded rotations of the
+    mean impulses and the first impact speed (:func:`bearingsim.stats.summary_standard_errors`, as ``bearingsim
+    table`` gives them), for a whole-bearing archive; none for the reduced model's, whose rotations repeat one
+    pass, nor for per-rotation arrays that are not the ``[rotations, pockets]`` numbers of a result."""
+    from bearingsim.stats import SEM_UNITS, SUMMARY_SEM_OF, summary_standard_errors
 
-    if _plain(model) == "reduced" or "results/per_rotation/I_dec" not in f or "results/per_rotation/I_acc" not in f:
+    names = [k for k in ("I_dec", "I_acc", "first_impact_speed") if f"results/per_rotation/{k}" in f]
+    if _plain(model) == "reduced" or names[:2] != ["I_dec", "I_acc"]:
         return []
-    i_dec, i_acc = f["results/per_rotation/I_dec"][()], f["results/per_rotation/I_acc"][()]
-    if not all(isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype.kind in "fiu" and a.shape == i_dec.shape
-               for a in (i_dec, i_acc)):
+    per = {k: f[f"results/per_rotation/{k}"][()] for k in names}
+    if not all(isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype.kind in "fiu" and a.shape == per["I_dec"].shape
+               for a in per.values()):
         return []  # a damaged archive is still listed (``bearingsim.load`` names what is wrong with it)
-    se = impulse_standard_errors(i_dec, i_acc, _plain(model))
-    text = ", ".join(f"{k.replace('_sem_', '_mean_')} \u00b1 {v:.2g} N s" for k, v in se.items() if v == v)
+    se = summary_standard_errors(per, _plain(model))
+    mean_of = {v: k for k, v in SUMMARY_SEM_OF.items()}
+    text = ", ".join(f"{mean_of[k]} \u00b1 {v:.2g} {SEM_UNITS[k]}" for k, v in se.items() if v == v)
     if not text:
         return ["standard errors: none (1 recorded rotation gives no scatter)"]
-    return [f"standard errors (batch means over {len(i_dec)} recorded rotations): {text}"]
+    return [f"standard errors (batch means over {len(per['I_dec'])} recorded rotations): {text}"]
 
 
 def _attribute_group_lines(f) -> list[str]:

@@ -298,7 +298,7 @@ def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
 
 def _run_headline(result) -> dict:
     """The run's headline numbers as ``bearingsim run`` prints them (:func:`bearingsim.tables.headline`): the
-    mean impulses in mN s with their standard errors, the cage slip in per cent."""
+    mean impulses in mN s and the first impact speed with their standard errors, the cage slip in per cent."""
     from bearingsim.tables import headline
 
     units = result.summary_units
@@ -308,15 +308,15 @@ def _run_headline(result) -> dict:
 
 
 def _run_summary(result) -> dict:
-    from bearingsim.stats import result_standard_errors
+    from bearingsim.stats import SEM_UNITS, result_standard_errors
 
     units = result.summary_units
     errors = result_standard_errors(result)
     rows = [[k, _cell(v, digits=6), units.get(k, "")] for k, v in result.summary.items()]
-    rows += [[k, _cell(v, digits=3), "N s"] for k, v in errors.items()]
+    rows += [[k, _cell(v, digits=3), SEM_UNITS[k]] for k, v in errors.items()]
     return table_block("Summary numbers (SI; every number of /results/summary)", ["quantity", "value", "unit"],
                        rows, [False, True, False],
-                       "The *_sem_Ns rows: standard errors of the means, batch means over rotations "
+                       "The *_sem_* rows: standard errors of the means, batch means over rotations "
                        "(docs/statistics.md).")
 
 

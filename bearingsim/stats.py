@@ -254,11 +254,52 @@ def impulse_standard_errors(per_rotation_I_dec, per_rotation_I_acc, model: str |
             "I_acc_sem_Ns": batch_sem(pocket_means(per_rotation_I_acc))}
 
 
+#: the summary means :func:`summary_standard_errors` gives a standard error of (the key of the error), and its unit
+SUMMARY_SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns",
+                  "first_impact_speed_m_s": "first_impact_speed_sem_m_s"}
+SEM_UNITS = {"I_dec_sem_Ns": "N s", "I_acc_sem_Ns": "N s", "first_impact_speed_sem_m_s": "m/s"}
+
+
+def first_impact_sem(per_rotation_first_impact, model: str | None = None) -> float:
+    """The standard error of ``first_impact_speed_m_s`` (the mean of every recorded first rear-face impact,
+    pockets and rotations pooled) from a result's ``per_rotation`` array ``first_impact_speed``
+    ``[rotations, pockets]`` (NaN: no impact in that pass) [m/s]: batch means as :func:`batch_sem`'s, each
+    batch's impacts pooled as the summary pools them; NaN with fewer than 2 rotations or a batch without an
+    impact (nothing to estimate its mean from); 0 for the reduced model (``model == "reduced"``: one exact
+    pass)."""
+    if model == "reduced":
+        return 0.0
+    a = np.asarray(per_rotation_first_impact, dtype=float)
+    if a.ndim == 0 or a.size == 0:
+        return float("nan")
+    rows = a.reshape(a.shape[0], -1)
+    b = sem_batches(len(rows))
+    if b < 2:
+        return float("nan")
+    means = []
+    for c in np.array_split(rows, b):
+        got = c[np.isfinite(c)]
+        if got.size == 0:
+            return float("nan")
+        means.append(got.mean())
+    return float(np.std(means, ddof=1) / math.sqrt(b))
+
+
+def summary_standard_errors(per_rotation, model: str | None = None) -> dict[str, float]:
+    """The standard errors of a result's summary means from its ``per_rotation`` arrays (a mapping holding
+    ``I_dec`` and ``I_acc``, and ``first_impact_speed`` where the model records it): ``I_dec_sem_Ns`` and
+    ``I_acc_sem_Ns`` (:func:`impulse_standard_errors`), and ``first_impact_speed_sem_m_s``
+    (:func:`first_impact_sem`) for the reduced model and a result with that array."""
+    se = impulse_standard_errors(per_rotation["I_dec"], per_rotation["I_acc"], model)
+    if model == "reduced" or "first_impact_speed" in per_rotation:
+        se["first_impact_speed_sem_m_s"] = first_impact_sem(per_rotation.get("first_impact_speed"), model)
+    return se
+
+
 def result_standard_errors(result) -> dict[str, float]:
-    """:func:`impulse_standard_errors` of a :class:`bearingsim.results.Result` (its model from its
+    """:func:`summary_standard_errors` of a :class:`bearingsim.results.Result` (its model from its
     scenario, its arrays from ``per_rotation``)."""
-    return impulse_standard_errors(result.per_rotation["I_dec"], result.per_rotation["I_acc"],
-                                   getattr(result.scenario, "model", None))
+    return summary_standard_errors(result.per_rotation, getattr(result.scenario, "model", None))
 
 
 def with_error(v: float, e: float) -> str:

@@ -27,7 +27,8 @@ import numpy as np
 
 from bearingsim.errors import UserError
 from bearingsim.wording import by_kind, counted, distinct_texts, note_kind, shown_as
-from bearingsim.stats import BATCHES, ROUND_OFF_REL, SIGNIFICANCE_LEVEL, sem_batches, significant, with_error
+from bearingsim.stats import (BATCHES, ROUND_OFF_REL, SEM_UNITS, SIGNIFICANCE_LEVEL, SUMMARY_SEM_OF, sem_batches,
+                              significant, with_error)
 
 #: the rule of the marks (:func:`bearingsim.stats.significant`), printed under a table
 RULE = (f"* : |x - x_ref| > t sqrt(SE^2 + SE_ref^2) and > {ROUND_OFF_REL:g} max(|x|, |x_ref|) (round-off), "
@@ -48,9 +49,7 @@ REDUCED_EXACT = ("reduced model: each case is one exact pass, repeated in every 
 DEFAULT_COLUMNS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "cage_rest_angle_deg",
                    "load_zone_half_angle_deg", "wear_front_mean_m3_h", "wear_rear_mean_m3_h")
 #: summary keys with a standard error (the key of the error)
-SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns",
-          "wear_front_mean_m3_h": "wear_front_sem_m3_h", "wear_rear_mean_m3_h": "wear_rear_sem_m3_h"}
-
+SEM_OF = {**SUMMARY_SEM_OF, "wear_front_mean_m3_h": "wear_front_sem_m3_h", "wear_rear_mean_m3_h": "wear_rear_sem_m3_h"}
 
 #: the summary keys a finished run is read by first (``bearingsim run`` prints them, the report heads its summary)
 HEADLINE_KEYS = ("I_dec_mean_Ns", "I_acc_mean_Ns", "first_impact_speed_m_s", "cage_slip", "load_zone_half_angle_deg",
@@ -61,8 +60,8 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
     """The headline numbers of a run (:data:`HEADLINE_KEYS` that it has): ``(key, value, standard error or None,
     words)``, the words in the units the tables show (:func:`shown_as`): the mean impulses per pocket and cage
     rotation in mN s with their standard errors (:func:`bearingsim.stats.result_standard_errors`: batch means
-    over the recorded rotations; the reduced model's are exact, every rotation repeating one pass), the cage slip
-    in per cent; ``""`` for a number shown as stored."""
+    over the recorded rotations; the reduced model's are exact, every rotation repeating one pass), the first
+    impact speed with its standard error, the cage slip in per cent; ``""`` for a number shown as stored."""
     from bearingsim.stats import result_standard_errors
 
     summary, units = result.summary, result.summary_units
@@ -72,17 +71,21 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
     for key in HEADLINE_KEYS:
         if key not in summary:
             continue
-        v, err = summary[key], se.get(key.replace("_mean_", "_sem_"))
+        v, err = summary[key], se.get(SEM_OF.get(key, ""))
         scale, unit = shown_as(key, units.get(key, "1"))
         words = ""
         if key == "cage_slip":
             words = f"{v * scale:.4g} {unit}"
         elif err is not None:
-            per = f"{unit} per pocket and cage rotation"
+            per = f"{unit} per pocket and cage rotation" if key.endswith("_Ns") else unit
             if err == 0.0:
                 words = f"{v * scale:.5g} {per}"
-            elif err != err:  # NaN: one recorded rotation gives no scatter
-                words = f"{v * scale:.5g} {per}; no standard error from {rotations} recorded rotation"
+            elif err != err and v != v:  # no first impact recorded at all
+                words = "none recorded"
+            elif err != err:  # NaN: one recorded rotation gives no scatter, or a batch of rotations had no impact
+                words = f"{v * scale:.5g} {per}; no standard error from " + (
+                    f"{rotations} recorded rotation" if rotations < 2 else
+                    f"{rotations} recorded rotations: a batch of them had no such impact")
             else:
                 words = (f"{with_error(v * scale, err * scale)} {per}; standard error, batch means over {rotations} "
                          f"recorded rotations")
@@ -187,9 +190,10 @@ def table_of_archives(paths) -> Table:
         numbers[k] = np.array([float(r.summary.get(k, math.nan)) for r in results])
         units[k] = next((r.summary_units.get(k) for r in results if k in r.summary_units), "1")
     errors = [result_standard_errors(r) for r in results]
-    for k in ("I_dec_sem_Ns", "I_acc_sem_Ns"):  # an archive's summary has no wear rates (a sweep's index does)
-        numbers[k] = np.array([e[k] for e in errors])
-        units[k] = "N s"
+    # the impulses' and the first impact speed's (an archive's summary has no wear rates: a sweep's index does)
+    for k in dict.fromkeys(k for e in errors for k in e):
+        numbers[k] = np.array([e.get(k, math.nan) for e in errors])
+        units[k] = SEM_UNITS[k]
     notes = []
     rest = [k for k in differ if k not in labels and k != "name"]
     if rest:
@@ -413,8 +417,8 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
 
 def column_keys(table: Table) -> list[str]:
     """The number columns ``columns`` of :func:`format_table` (``--columns``) may name, in the table's order:
-    every summary number of its runs, the standard errors (``I_dec_sem_Ns``, ``I_acc_sem_Ns``) included;
-    the one list its refusal of another name prints."""
+    every summary number of its runs, the standard errors (``I_dec_sem_Ns``, ``I_acc_sem_Ns``,
+    ``first_impact_speed_sem_m_s``) included; the one list its refusal of another name prints."""
     return list(table.numbers)
 
 

@@ -8,8 +8,8 @@ overlap above 1 % of s runs again from the start at a shorter step), wall time p
 run that was kept (solver only, warm-up rotation included in the count; the first run of the process
 loads the compiled kernels before the clock starts) and of the whole call, restarts included, pymunk's
 share, mean I_dec and I_acc per pocket and rotation with their standard errors
-(:func:`bearingsim.sweeps.worker.standard_errors`: per-rotation means over the pockets, rotations taken
-as independent), load-zone half angle, cage slip, and a digest of the per-rotation impulses (the first 12
+(:func:`bearingsim.stats.impulse_standard_errors`: batch means over rotations of the per-rotation means over
+the pockets), load-zone half angle, cage slip, and a digest of the per-rotation impulses (the first 12
 hex digits of the SHA-256 of the I_dec and I_acc arrays' bytes: two runs of the bench give the same
 digests when the runs are deterministic).
 
@@ -49,10 +49,10 @@ def impulse_digest(res) -> str:
 
 def scene_row(rpm, contact, res, total_rot, call_wall_s=math.nan):
     """One table row; ``call_wall_s`` is the wall time of the whole ``simulate`` call (restarts included)."""
-    from bearingsim.sweeps.worker import standard_errors
+    from bearingsim.stats import impulse_standard_errors
 
     s, p = res.summary, res.provenance
-    se = standard_errors(res.per_rotation["I_dec"], res.per_rotation["I_acc"])
+    se = impulse_standard_errors(res.per_rotation["I_dec"], res.per_rotation["I_acc"])
     return {
         "rpm": rpm, "raceway_contact": contact, "dt_s": float(p["dt_s"]), "rotations": total_rot - 1,
         "restarts": str(p.get("dt_choice", "")).count("restarted at dt"),

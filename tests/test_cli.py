@@ -702,6 +702,7 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
     import re
 
     import h5py
+    import numpy as np
 
     from bearingsim import archive
     from bearingsim.stats import batch_sem, pocket_means
@@ -725,6 +726,17 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
             assert math.isclose(mean, float(f"{summary[key]:.6g}"), rel_tol=1e-12)
             assert human == with_error(summary[key] * 1e3, want * 1e3)  # as bearingsim table shows it
             assert f"{key} \u00b1 {want:.2g} N s" in listing
+        # the first impact speed: the mean of every recorded first impact, its error from the 4 rotations' own
+        # means (4 rotations: 4 batches of one), each the mean of the impacts that rotation recorded
+        fi = f["results/per_rotation/first_impact_speed"][()]
+        per_rot = [r[np.isfinite(r)].mean() for r in fi]
+        want = float(np.std(per_rot, ddof=1) / math.sqrt(len(per_rot)))
+        mean = summary["first_impact_speed_m_s"]
+        assert mean == fi[np.isfinite(fi)].mean() and want > 0
+        assert (f"first_impact_speed_m_s       {mean:.6g} \u00b1 {want:.2g}  ({with_error(mean, want)} m/s; standard "
+                f"error, batch means over 4 recorded rotations)") in res.stdout, res.stdout
+        assert f"first_impact_speed_m_s \u00b1 {want:.2g} m/s" in listing
+        assert f" {with_error(mean, want)}  " in bearingsim("table", out).stdout  # its column, as the run's words
     assert "standard errors (batch means over 4 recorded rotations)" in listing
     with h5py.File(out, "a") as f:  # a damaged archive is still listed: no error line from text per rotation
         del f["results/per_rotation/I_dec"]

@@ -153,12 +153,12 @@ def test_unused_keys_per_model():
 
 def test_every_summary_key_is_documented_with_its_unit():
     from bearingsim import multibody, reduced
-    from bearingsim.sweeps.worker import standard_errors
+    from bearingsim.stats import SEM_UNITS
     from .conftest import archive_summary_table
 
     table, rows = archive_summary_table()
     units = {**reduced.SUMMARY_UNITS, **multibody.SUMMARY_UNITS, **multibody.RIGID_SUMMARY_UNITS,
-             **multibody.LAND_SUMMARY_UNITS, **{k: "N s" for k in standard_errors([1.0, 2.0], [1.0, 2.0])}}
+             **multibody.LAND_SUMMARY_UNITS, **SEM_UNITS}
     missing = [k for k in [*units, "scene", "pockets"] if k not in rows and k not in table]
     assert missing == []
     wrong = {k: (rows[k], u) for k, u in units.items() if k in rows and rows[k] != u}

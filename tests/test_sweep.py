@@ -22,7 +22,7 @@ from bearingsim.sweeps.plot import axis_label, plot_sweep_index
 from bearingsim.cli_sweep import run_sweep_cli
 from bearingsim.sweeps.run import make_batches
 from bearingsim.sweeps.spec import Case, load_sweep_file, scenario_from_toml
-from bearingsim.sweeps.worker import standard_errors
+from bearingsim.stats import impulse_standard_errors as standard_errors
 
 from .conftest import ROOT, SCENARIOS, started
 from .test_cli import assert_user_error, bearingsim

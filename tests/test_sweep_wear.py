@@ -100,8 +100,13 @@ def test_a_resumed_multibody_sweep_takes_the_same_wear_from_its_archives(mb_swee
     run_sweep(spec, folder, engine=LocalEngine(1), figures=False, progress=False)
     after, _ = read_index(folder / "sweep.h5")
     assert list(after["status"]) == ["cached", "cached"]
-    for k in (*wear.SWEEP_RATES, "I_dec_mean_Ns", "I_dec_sem_Ns"):
+    for k in (*wear.SWEEP_RATES, "I_dec_mean_Ns", "I_dec_sem_Ns", "first_impact_speed_sem_m_s"):
         np.testing.assert_array_equal(after[k], before[k])
+    # the first impact speed's error is the one 'bearingsim table' computes from the case's archive
+    from bearingsim.stats import result_standard_errors
+
+    se = [result_standard_errors(load(folder / a))["first_impact_speed_sem_m_s"] for a in after["archive"]]
+    assert list(after["first_impact_speed_sem_m_s"]) == se and all(np.isfinite(se))
 
 
 @pytest.fixture(scope="module")

@@ -17,7 +17,7 @@ import pytest
 
 import bearingsim
 from bearingsim import tables
-from bearingsim.stats import batch_sem, impulse_standard_errors
+from bearingsim.stats import batch_sem, first_impact_sem, impulse_standard_errors, summary_standard_errors, with_error
 
 from .conftest import SCENARIOS, started
 from .test_cli import assert_user_error, bearingsim as cli
@@ -51,13 +51,11 @@ def test_sweep_crosscheck_and_table_give_the_same_standard_error():
     Now the worker (sweep), the cross-check's rung numbers and the table call one estimator; on
     correlated rotations it is the batch-means error, which differs from the naive one."""
     from bearingsim.studies.crosscheck import rung_numbers
-    from bearingsim.sweeps.worker import standard_errors
-
     dec, acc = _correlated_series(), _correlated_series(seed=4)
     result = SimpleNamespace(per_rotation={"I_dec": dec, "I_acc": acc}, scenario=SimpleNamespace(model="multibody"),
                              summary={"I_dec_mean_Ns": dec.mean(), "I_acc_mean_Ns": acc.mean(),
                                       "first_impact_speed_m_s": 0.1, "cage_slip": 0.0})
-    sweep = standard_errors(dec, acc, "multibody")
+    sweep = summary_standard_errors({"I_dec": dec, "I_acc": acc}, "multibody")  # what the sweep's worker calls
     cross = rung_numbers(result, reduced=False)
     from bearingsim.stats import result_standard_errors
 
@@ -111,6 +109,49 @@ def test_reduced_model_error_is_zero_and_one_rotation_has_none():
     one = np.ones((1, 4))
     assert impulse_standard_errors(one, one, "reduced") == {"I_dec_sem_Ns": 0.0, "I_acc_sem_Ns": 0.0}
     assert math.isnan(impulse_standard_errors(one, one, "multibody")["I_dec_sem_Ns"])
+
+
+def test_first_impact_speed_error_is_batch_means_of_the_pooled_impacts():
+    """``first_impact_speed_m_s`` is the mean of every recorded first impact (pockets and rotations pooled); its
+    standard error takes the same 5 contiguous batches of rotations as the impulses' (docs/statistics.md), each
+    batch's impacts pooled. Without a missing impact it is the impulses' estimator of the same array; a batch
+    of rotations without any impact leaves nothing to estimate its mean from (NaN), as does 1 rotation; the
+    reduced model's is 0 (one exact pass)."""
+    full = _correlated_series()  # 40 rotations x 4 pockets, correlated rotations
+    assert first_impact_sem(full, "multibody") == batch_sem(full.mean(axis=1))
+    holes = full.copy()
+    holes[::3, 1:] = np.nan  # every third rotation recorded an impact in pocket 0 only
+    batches = [c[np.isfinite(c)].mean() for c in np.array_split(holes, 5)]
+    want = np.std(batches, ddof=1) / math.sqrt(5)
+    assert first_impact_sem(holes, "multibody") == pytest.approx(want, rel=1e-12)
+    assert want != batch_sem(np.nanmean(holes, axis=1))  # pooled, not the mean of the rotations' means
+    holes[8:16] = np.nan  # the second batch (rotations 8-15) without any impact
+    assert math.isnan(first_impact_sem(holes, "multibody"))
+    assert math.isnan(first_impact_sem(full[:1], "multibody")) and first_impact_sem(None, "reduced") == 0.0
+    se = summary_standard_errors({"I_dec": full, "I_acc": full, "first_impact_speed": full}, "multibody")
+    assert se == {"I_dec_sem_Ns": batch_sem(full.mean(axis=1)), "I_acc_sem_Ns": batch_sem(full.mean(axis=1)),
+                  "first_impact_speed_sem_m_s": batch_sem(full.mean(axis=1))}
+    # the reduced model records no per-rotation first impact: its error is still there, 0
+    assert summary_standard_errors({"I_dec": full[:1], "I_acc": full[:1]}, "reduced")["first_impact_speed_sem_m_s"] == 0
+
+
+def test_a_table_marks_the_first_impact_speed_by_its_error():
+    """``bearingsim table`` gives the first impact speed with its standard error and marks a row whose speed differs
+    from the first row's beyond it, as it does the impulses (was: the speed alone, no error, no mark)."""
+    dec = _correlated_series()
+    rows = []
+    for shift in (0.0, 0.0, 0.01):
+        fi = 0.05 + shift + (dec - dec.mean())  # its standard error about 0.0007 m/s
+        rows.append({"I_dec_mean_Ns": dec.mean(), "I_dec_sem_Ns": batch_sem(dec.mean(axis=1)),
+                     "first_impact_speed_m_s": fi.mean(), "first_impact_speed_sem_m_s": first_impact_sem(fi, "multibody")})
+    t = tables.Table(["run"], {"run": ["ref", "same", "faster"]},
+                     {k: np.array([r[k] for r in rows]) for k in rows[0]},
+                     {"I_dec_mean_Ns": "N s", "I_dec_sem_Ns": "N s", "first_impact_speed_m_s": "m/s",
+                      "first_impact_speed_sem_m_s": "m/s"})
+    head, cells = tables.column_cells(t, "first_impact_speed_m_s")
+    assert head == "first_impact_speed [m/s]"
+    assert cells[0] == with_error(rows[0]["first_impact_speed_m_s"], rows[0]["first_impact_speed_sem_m_s"]) + "  "
+    assert [c.endswith(" *") for c in cells] == [False, False, True]
 
 
 # --- significance marks ---------------------------------------------------------------------------

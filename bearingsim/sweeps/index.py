@@ -13,7 +13,8 @@ case is done or cached; of a failed case, the time to its failure), ``model_vers
 model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown), ``notes`` (the run's
 plausibility notes, :func:`bearingsim.plausibility.check`, one a line without the ``bearingsim: note:``
 prefix; empty for a clean run) and the summary numbers (SI, as in the archives' ``/results/summary``,
-plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns``, see :func:`bearingsim.stats.impulse_standard_errors`).
+plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns`` / ``first_impact_speed_sem_m_s``, see
+:func:`bearingsim.stats.summary_standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
 NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every
@@ -41,7 +42,7 @@ CSV_SIGNATURE = b"case,"  # the first bytes of every sweep.csv bearingsim writes
 FIXED = ("status", "error", "archive", "wall_s", "model_version", "notes")
 # summary numbers shown first when present; any others follow in name order
 PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
-             "first_impact_speed_m_s", "first_impact_energy_J", "cage_slip", "cage_rest_angle_deg",
+             "first_impact_speed_m_s", "first_impact_speed_sem_m_s", "first_impact_energy_J", "cage_slip", "cage_rest_angle_deg",
              "load_zone_half_angle_deg")
 
 
@@ -278,7 +279,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     another) gives ``{"status": "stale"}`` without its numbers: the case runs again too.
     """
     from bearingsim.model_versions import MODEL_VERSIONS
-    from bearingsim.stats import impulse_standard_errors as standard_errors
+    from bearingsim.stats import summary_standard_errors
     from bearingsim.wear import reduced_rates
 
     got = archive.peek(archive_path)
@@ -287,7 +288,7 @@ def read_cached(archive_path: Path, toml_text: str) -> dict | None:
     if got["model_version"] is None or got["model_version"] != MODEL_VERSIONS.get(got["model"]):
         return {"status": "stale"}
     summary = {k: v for k, v in got["summary"].items() if k != "wall_s"}
-    summary.update(standard_errors(got["I_dec"], got["I_acc"], got["model"]))
+    summary.update(summary_standard_errors(got["per_rotation"], got["model"]))
     summary.update(reduced_rates(got["wear"]) if got["model"] == "reduced" else archive_rates(archive_path))
     wall = got["wall_time_s"]
     rec = {"status": "cached", "error": "", "wall_s": wall, "summary": summary, "model_version": got["model_version"]}

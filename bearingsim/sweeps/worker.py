@@ -34,14 +34,6 @@ def one_line_error(exc: BaseException) -> str:
     return text[:500] or exc.__class__.__name__
 
 
-def standard_errors(per_rotation_I_dec, per_rotation_I_acc, model: str | None = None) -> dict[str, float]:
-    """Standard errors of the mean impulses: :func:`bearingsim.stats.impulse_standard_errors` (batch
-    means over rotations of the pocket-mean series; the one estimator of every command)."""
-    from bearingsim.stats import impulse_standard_errors
-
-    return impulse_standard_errors(per_rotation_I_dec, per_rotation_I_acc, model)
-
-
 def _numbers(summary: dict) -> dict[str, float]:
     out = {}
     for k, v in summary.items():
@@ -50,11 +42,6 @@ def _numbers(summary: dict) -> dict[str, float]:
         if isinstance(v, (int, float, np.integer, np.floating)) and k != "wall_s":
             out[k] = float(v)
     return out
-
-
-def _per_rotation(res):
-    """(I_dec, I_acc) per rotation [rotations, pockets] of a result."""
-    return res.per_rotation["I_dec"], res.per_rotation["I_acc"]
 
 
 ARCHIVE_POLICIES = ("auto", "all", "none")
@@ -115,10 +102,12 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
     wall time, ``wall_time_s`` of its provenance, which its archive stores; of a failed case, the time to
     its failure),
     ``model_version`` (of the model that computed it), ``notes`` (the run's plausibility notes,
-    :func:`bearingsim.wording.run_notes`) and the summary numbers with the standard errors of :func:`standard_errors`
-    and the wear rates of :func:`bearingsim.wear.sweep_rates`.
+    :func:`bearingsim.wording.run_notes`) and the summary numbers with their standard errors
+    (:func:`bearingsim.stats.summary_standard_errors`, the one estimator of every command) and the wear rates of
+    :func:`bearingsim.wear.sweep_rates`.
     """
     from bearingsim.scenario import Scenario
+    from bearingsim.stats import summary_standard_errors
     from bearingsim.sweeps.spec import scenario_from_toml
     from bearingsim.wear import sweep_rates
 
@@ -145,7 +134,7 @@ def run_case(case_hash: str, toml_text: str, target: Path | None, model=None, ar
                 res = _run_to_file(scenario, path)
                 data = path.read_bytes()
         summary = _numbers(res.summary)
-        summary.update(standard_errors(*_per_rotation(res), scenario.model))
+        summary.update(summary_standard_errors(res.per_rotation, scenario.model))
         summary.update(sweep_rates(res))  # the wear rates, as 'bearingsim wear' computes them (docs/sweeps.md)
         # the run's own wall time, the one its archive stores: the same number when the case is cached later
         wall = res.provenance.get("wall_time_s")

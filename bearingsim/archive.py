@@ -1345,11 +1345,16 @@ def is_table_file(path, fmt: str) -> bool:
     return root_format(path) == fmt
 
 
+#: the per-rotation arrays whose batch means give the standard errors of a result's summary numbers
+#: (:func:`bearingsim.stats.summary_standard_errors`), ``[rotations, pockets]`` or ``[rotations]``
+SEM_SERIES = ("I_dec", "I_acc", "first_impact_speed", "cage_slip", "load_zone_half_angle")
+
+
 def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
     (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
-    stores none), ``summary`` (numbers), ``per_rotation`` (``I_dec``, ``I_acc`` and, where the archive has it,
-    ``first_impact_speed``: the arrays :func:`bearingsim.stats.summary_standard_errors` reads), ``wall_time_s``,
+    stores none), ``summary`` (numbers), ``per_rotation`` (``I_dec``, ``I_acc`` and those of the others of
+    :data:`SEM_SERIES` it has: the arrays :func:`bearingsim.stats.summary_standard_errors` reads), ``wall_time_s``,
     ``notes`` (the run's stored notes, :func:`read_notes`; None if it stores none), ``wear`` (the attributes of
     ``/results/wear``: a reduced run's wear rates; {} without them). None for a missing, unreadable,
     damaged or incomplete file (never trusted)."""
@@ -1373,8 +1378,8 @@ def peek(path) -> dict[str, Any] | None:
                 and not isinstance(version, bool) else None,
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
-                "per_rotation": {k: f[f"results/per_rotation/{k}"][()] for k in ("I_dec", "I_acc", "first_impact_speed")
-                                 if k != "first_impact_speed" or f"results/per_rotation/{k}" in f},
+                "per_rotation": {k: f[f"results/per_rotation/{k}"][()] for k in SEM_SERIES
+                                 if k in ("I_dec", "I_acc") or f"results/per_rotation/{k}" in f},
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
                 "notes": read_notes(f, path),
                 "wear": group_attrs(f["results/wear"])[0] if "results/wear" in f else {},
@@ -1659,21 +1664,23 @@ def _notes_lines(notes: list[str] | None) -> list[str]:
 
 def _error_lines(f, model) -> list[str]:
     """The "standard errors" line of :func:`describe`: the batch-means errors over the recorded rotations of the
-    mean impulses and the first impact speed (:func:`bearingsim.stats.summary_standard_errors`, as ``bearingsim
-    table`` gives them), for a whole-bearing archive; none for the reduced model's, whose rotations repeat one
+    mean impulses, the first impact speed, the cage slip and the load zone's half angle
+    (:func:`bearingsim.stats.summary_standard_errors`, as ``bearingsim table`` gives them), for a whole-bearing archive; none for the reduced model's, whose rotations repeat one
     pass, nor for per-rotation arrays that are not the ``[rotations, pockets]`` numbers of a result."""
     from bearingsim.stats import SEM_UNITS, SUMMARY_SEM_OF, summary_standard_errors
 
-    names = [k for k in ("I_dec", "I_acc", "first_impact_speed") if f"results/per_rotation/{k}" in f]
+    names = [k for k in SEM_SERIES if f"results/per_rotation/{k}" in f]
     if _plain(model) == "reduced" or names[:2] != ["I_dec", "I_acc"]:
         return []
     per = {k: f[f"results/per_rotation/{k}"][()] for k in names}
-    if not all(isinstance(a, np.ndarray) and a.ndim == 2 and a.dtype.kind in "fiu" and a.shape == per["I_dec"].shape
-               for a in per.values()):
+    shape = np.shape(per["I_dec"])
+    if not all(isinstance(a, np.ndarray) and a.dtype.kind in "fiu" and a.shape in (shape, shape[:1])
+               for a in per.values()) or len(shape) != 2:
         return []  # a damaged archive is still listed (``bearingsim.load`` names what is wrong with it)
     se = summary_standard_errors(per, _plain(model))
     mean_of = {v: k for k, v in SUMMARY_SEM_OF.items()}
-    text = ", ".join(f"{mean_of[k]} \u00b1 {v:.2g} {SEM_UNITS[k]}" for k, v in se.items() if v == v)
+    text = ", ".join(f"{mean_of[k]} \u00b1 {v:.2g}" + ("" if SEM_UNITS[k] == "1" else f" {SEM_UNITS[k]}")
+                     for k, v in se.items() if v == v)
     if not text:
         return ["standard errors: none (1 recorded rotation gives no scatter)"]
     return [f"standard errors (batch means over {len(per['I_dec'])} recorded rotations): {text}"]

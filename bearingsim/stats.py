@@ -256,8 +256,10 @@ def impulse_standard_errors(per_rotation_I_dec, per_rotation_I_acc, model: str |
 
 #: the summary means :func:`summary_standard_errors` gives a standard error of (the key of the error), and its unit
 SUMMARY_SEM_OF = {"I_dec_mean_Ns": "I_dec_sem_Ns", "I_acc_mean_Ns": "I_acc_sem_Ns",
-                  "first_impact_speed_m_s": "first_impact_speed_sem_m_s"}
-SEM_UNITS = {"I_dec_sem_Ns": "N s", "I_acc_sem_Ns": "N s", "first_impact_speed_sem_m_s": "m/s"}
+                  "first_impact_speed_m_s": "first_impact_speed_sem_m_s", "cage_slip": "cage_slip_sem",
+                  "load_zone_half_angle_deg": "load_zone_half_angle_sem_deg"}
+SEM_UNITS = {"I_dec_sem_Ns": "N s", "I_acc_sem_Ns": "N s", "first_impact_speed_sem_m_s": "m/s", "cage_slip_sem": "1",
+             "load_zone_half_angle_sem_deg": "deg"}
 
 
 def first_impact_sem(per_rotation_first_impact, model: str | None = None) -> float:
@@ -286,13 +288,23 @@ def first_impact_sem(per_rotation_first_impact, model: str | None = None) -> flo
 
 
 def summary_standard_errors(per_rotation, model: str | None = None) -> dict[str, float]:
-    """The standard errors of a result's summary means from its ``per_rotation`` arrays (a mapping holding
-    ``I_dec`` and ``I_acc``, and ``first_impact_speed`` where the model records it): ``I_dec_sem_Ns`` and
-    ``I_acc_sem_Ns`` (:func:`impulse_standard_errors`), and ``first_impact_speed_sem_m_s``
-    (:func:`first_impact_sem`) for the reduced model and a result with that array."""
+    """The standard errors of a result's summary numbers (:data:`SUMMARY_SEM_OF`) from its ``per_rotation``
+    arrays, a mapping holding ``I_dec`` and ``I_acc`` and, where the model records them, ``first_impact_speed``,
+    ``cage_slip`` and ``load_zone_half_angle``: ``I_dec_sem_Ns`` and ``I_acc_sem_Ns``
+    (:func:`impulse_standard_errors`), ``first_impact_speed_sem_m_s`` (:func:`first_impact_sem`),
+    ``cage_slip_sem`` and ``load_zone_half_angle_sem_deg`` (:func:`batch_sem` of the per-rotation series; the
+    summary's numbers are those of the whole recording, which its rotations' values average to within their
+    differences in length). The reduced model's, every rotation one exact pass: 0 for its impulses, first impact
+    speed and load zone (it has no cage slip)."""
     se = impulse_standard_errors(per_rotation["I_dec"], per_rotation["I_acc"], model)
     if model == "reduced" or "first_impact_speed" in per_rotation:
         se["first_impact_speed_sem_m_s"] = first_impact_sem(per_rotation.get("first_impact_speed"), model)
+    if model != "reduced" and "cage_slip" in per_rotation:
+        se["cage_slip_sem"] = batch_sem(per_rotation["cage_slip"])
+    if model == "reduced":
+        se["load_zone_half_angle_sem_deg"] = 0.0
+    elif "load_zone_half_angle" in per_rotation:
+        se["load_zone_half_angle_sem_deg"] = batch_sem(per_rotation["load_zone_half_angle"])
     return se
 
 

@@ -61,7 +61,8 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
     words)``, the words in the units the tables show (:func:`shown_as`): the mean impulses per pocket and cage
     rotation in mN s with their standard errors (:func:`bearingsim.stats.result_standard_errors`: batch means
     over the recorded rotations; the reduced model's are exact, every rotation repeating one pass), the first
-    impact speed with its standard error, the cage slip in per cent; ``""`` for a number shown as stored."""
+    impact speed, the cage slip in per cent and the load zone's half angle with theirs; ``""`` for a number shown
+    as stored."""
     from bearingsim.stats import result_standard_errors
 
     summary, units = result.summary, result.summary_units
@@ -74,18 +75,19 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
         v, err = summary[key], se.get(SEM_OF.get(key, ""))
         scale, unit = shown_as(key, units.get(key, "1"))
         words = ""
-        if key == "cage_slip":
+        if key == "cage_slip" and (err is None or err != err or err == 0.0):
             words = f"{v * scale:.4g} {unit}"
         elif err is not None:
             per = f"{unit} per pocket and cage rotation" if key.endswith("_Ns") else unit
             if err == 0.0:
                 words = f"{v * scale:.5g} {per}"
-            elif err != err and v != v:  # no first impact recorded at all
+            elif err != err and v != v and key == "first_impact_speed_m_s":  # no first impact recorded at all
                 words = "none recorded"
             elif err != err:  # NaN: one recorded rotation gives no scatter, or a batch of rotations had no impact
                 words = f"{v * scale:.5g} {per}; no standard error from " + (
                     f"{rotations} recorded rotation" if rotations < 2 else
-                    f"{rotations} recorded rotations: a batch of them had no such impact")
+                    f"{rotations} recorded rotations" + (": a batch of them had no such impact"
+                                                         if key == "first_impact_speed_m_s" else ""))
             else:
                 words = (f"{with_error(v * scale, err * scale)} {per}; standard error, batch means over {rotations} "
                          f"recorded rotations")

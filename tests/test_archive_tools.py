@@ -250,6 +250,7 @@ def test_compare_and_rerun_see_every_array_and_time_series_bit_for_bit(tmp_path,
     edits = {"force_vs_theta": lambda d: d.__setitem__((0, 0), d[0, 0] + 100.0),
              "impacts/impulse_Ns": lambda d: d.__setitem__(0, d[0] * 2.0),
              "cage_orbit": lambda d: d.__setitem__((5, 1), d[5, 1] + 1e-6),
+             "per_rotation/cage_slip": lambda d: d.__setitem__(0, d[0] + 1e-9),
              "observables/cage_slip/value": lambda d: d.__setitem__(3, d[3] + 1e-3),
              "observables/motion_pocket_force/value": lambda d: d.__setitem__((2, 3, 1), d[2, 3, 1] + 1.0)}
     for name, edit in edits.items():
@@ -259,9 +260,9 @@ def test_compare_and_rerun_see_every_array_and_time_series_bit_for_bit(tmp_path,
             edit(f[name if name.startswith("observables") else f"results/{name}"])
         res = cli("compare", multibody_archive, tampered)
         assert res.returncode == 1 and f"differs: {name} (1 of " in res.stdout, res.stdout
-        assert "results: differ" in res.stdout and "1 of 67 arrays and other numbers differ" in res.stdout
+        assert "results: differ" in res.stdout and "1 of 69 arrays and other numbers differ" in res.stdout
     res = cli("compare", multibody_archive, multibody_archive)
-    assert res.returncode == 0 and "results: identical (20 summary numbers, 67 arrays" in res.stdout, res.stdout
+    assert res.returncode == 0 and "results: identical (20 summary numbers, 69 arrays" in res.stdout, res.stdout
     zero, signed = tmp_path / "zero.h5", tmp_path / "signed.h5"
     for path, value in ((zero, 0.0), (signed, -0.0)):
         shutil.copy(reduced_archive, path)

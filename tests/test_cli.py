@@ -737,6 +737,13 @@ def test_run_and_inspect_print_the_mean_impulses_with_their_standard_errors(tmp_
                 f"error, batch means over 4 recorded rotations)") in res.stdout, res.stdout
         assert f"first_impact_speed_m_s \u00b1 {want:.2g} m/s" in listing
         assert f" {with_error(mean, want)}  " in bearingsim("table", out).stdout  # its column, as the run's words
+        # the cage slip (shown in per cent) and the load zone: batch means of their values in each rotation
+        for key, name, scale, unit in (("cage_slip", "cage_slip", 100.0, "%"),
+                                       ("load_zone_half_angle_deg", "load_zone_half_angle", 1.0, "deg")):
+            want = batch_sem(f[f"results/per_rotation/{name}"][()])
+            assert (f"{key:28s} {summary[key]:.6g} \u00b1 {want:.2g}  ({with_error(summary[key] * scale, want * scale)} "
+                    f"{unit}; standard error, batch means over 4 recorded rotations)") in res.stdout, res.stdout
+            assert f"{key} \u00b1 {want:.2g}" in listing
     assert "standard errors (batch means over 4 recorded rotations)" in listing
     with h5py.File(out, "a") as f:  # a damaged archive is still listed: no error line from text per rotation
         del f["results/per_rotation/I_dec"]

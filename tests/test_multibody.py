@@ -412,6 +412,26 @@ def test_a_time_step_refused_before_the_run_names_the_scenario_file(capsys, scen
 
 
 @pytest.mark.slow
+def test_the_rotations_cage_slip_and_load_zone_make_up_the_summarys(full_3000):
+    """Each recorded cage rotation's own cage slip, 1 - 2 pi / (T_k omega_c), and load zone (of the ring's mean
+    displacement over its steps): the rotations' times add up to the recorded time, so the summary's slip
+    (1 - 2 pi R / (t_rec omega_c)) is 1 - R / sum_k 1 / (1 - slip_k) to round-off (1e-10: both times are sums
+    of 2e5 steps of h, each addition rounding by up to 1.1e-16 of the sum, 2e-11 in all); the summary's load zone (of the mean over every recorded step) lies within
+    the rotations' and within 1e-3 deg of their mean (the ring moves by nanometres from rotation to rotation).
+    Their batch means are the standard errors the tables print (stats.summary_standard_errors)."""
+    from bearingsim.stats import batch_sem, result_standard_errors
+
+    r = full_3000
+    slip, phi = r.per_rotation["cage_slip"], r.per_rotation["load_zone_half_angle"]
+    assert slip.shape == phi.shape == (20,) and np.all(np.isfinite(slip)) and np.all(np.isfinite(phi))
+    assert 1.0 - len(slip) / np.sum(1.0 / (1.0 - slip)) == pytest.approx(r.summary["cage_slip"], abs=1e-10)
+    assert slip.min() < r.summary["cage_slip"] < slip.max()  # the rotations differ: a scatter to estimate from
+    whole = r.summary["load_zone_half_angle_deg"]
+    assert phi.min() <= whole <= phi.max() and abs(phi.mean() - whole) < 1e-3
+    se = result_standard_errors(r)
+    assert se["cage_slip_sem"] == batch_sem(slip) > 0 and se["load_zone_half_angle_sem_deg"] == batch_sem(phi) > 0
+
+
 def test_cli_main_job(tmp_path):
     """The README's main job writes an archive with the public names and units."""
     out = tmp_path / "mb.h5"

@@ -327,6 +327,27 @@ def _rest_per_rotation(rest_win, sign: int) -> dict:
                                                 "counted in the direction of rotation, " + desc)}
 
 
+def _rotation_arrays(p, rot_win, with_ring: bool) -> dict:
+    """The cage slip and, with an inner ring, the load zone's half angle of each recorded cage rotation, from its
+    time and the inner ring's centre summed over its steps (``rot_win``): ``/results/per_rotation/cage_slip``
+    (``1 - 2 pi / (T_k omega_c)``, the summary's ``cage_slip`` of that rotation alone) and
+    ``load_zone_half_angle`` (the summary's of the ring's mean displacement in that rotation) [deg]: the series
+    whose batch means give those numbers' standard errors (:func:`bearingsim.stats.summary_standard_errors`)."""
+    desc = "per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start)"
+    pr = "results/per_rotation"
+    with np.errstate(invalid="ignore", divide="ignore"):
+        slip = 1.0 - 2.0 * math.pi / (rot_win[:, 0] * p.operating.omega_c)
+    out = {f"{pr}/cage_slip": NamedArray(slip, "1", "1 - (the cage's mean speed) / (its epicyclic speed) in the "
+                                         "rotation, " + desc)}
+    if with_ring:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            displacement = -rot_win[:, 2] / rot_win[:, 3]
+        phi = [math.degrees(laws.load_zone_from_displacement(d, p.bearing.radial_clearance)) for d in displacement]
+        out[f"{pr}/load_zone_half_angle"] = NamedArray(np.array(phi), "deg", "classical load-zone half angle of "
+                                                       "the inner ring's mean displacement in the rotation, " + desc)
+    return out
+
+
 def _per_rotation_arrays(per, first_imp, land) -> dict:
     """``/results/per_rotation``: the impulses, sliding work and first impact speed [rotation, pocket],
     and a land-guided cage's land impulses [rotation]."""
@@ -448,10 +469,11 @@ class MultibodyResult(Result):
                      "slide_work_rear", "first_impact_speed")
     _LAND = ("land_normal", "land_friction", "land_torque")
     _REST = ("cage_rest_offset", "cage_rest_angle")  # where the cage rests (model version 6)
+    _ROTATION = ("cage_slip", "load_zone_half_angle")  # their standard errors' series (model version 10)
     _IMPACTS = ("time_s", "theta_deg", "approach_speed_m_s", "impulse_Ns", "pocket", "face", "rotation")
     LAYOUT = {
         **{f"results/per_rotation/{c}": ("rotations", "pockets") for c in _PER_ROTATION},
-        **{f"results/per_rotation/{c}": ("rotations",) for c in _LAND + _REST},
+        **{f"results/per_rotation/{c}": ("rotations",) for c in _LAND + _REST + _ROTATION},
         "results/theta_deg": ("theta bins",),
         **{f"results/{c}": ("theta bins", "pockets") for c in ("force_vs_theta", "force_vs_theta_acc",
                                                                 "force_vs_theta_dec")},
@@ -466,7 +488,9 @@ class MultibodyResult(Result):
     OPTIONAL = (frozenset(f"results/per_rotation/{c}" for c in _LAND),  # a land-guided cage
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
                 PROFILE_PATHS,  # archives written before the wear profile
-                frozenset(f"results/per_rotation/{c}" for c in _REST))  # archives of model version 5 and before
+                frozenset(f"results/per_rotation/{c}" for c in _REST),  # archives of model version 5 and before
+                frozenset({"results/per_rotation/load_zone_half_angle"}),  # a scene without a ring
+                frozenset(f"results/per_rotation/{c}" for c in _ROTATION))  # archives of model version 9 and before
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m"  # no ring: absent
                             and k not in SUMMARY_ADDED)
@@ -493,7 +517,8 @@ class MultibodyResult(Result):
             ("slide_work_rear", "work_rear"))}
         summary, units = _summary(p, raw, per)
         data = {**_per_rotation_arrays(per, raw.first_imp, raw.land),
-                **_rest_per_rotation(raw.rest_win, p.operating.sign), **_theta_arrays(raw),
+                **_rest_per_rotation(raw.rest_win, p.operating.sign),
+                **_rotation_arrays(p, raw.rot_win, not paper_assumptions(raw.setup.scene)), **_theta_arrays(raw),
                 **_impact_arrays(raw.impacts), **_wear_arrays(p, per),
                 **_profile_arrays(raw.prof, p.multibody.pocket_face_extent)}
         orbit = raw.orbit

@@ -972,7 +972,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
         n_extra=np.zeros(n),
         arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
         arc_todo=np.zeros((n, 2), dtype=np.bool_), rest_win=np.zeros((p.numerics.rotations, 3)),
-        mot=rk.motion_block(n))
+        rot_win=np.zeros((p.numerics.rotations, 4)), mot=rk.motion_block(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
@@ -1044,6 +1044,8 @@ class MultibodyRaw(NamedTuple):
     beyond_before: float | None  #: rigid raceways: the move beyond the race before the joint acted [m]
     land: dict | None  #: land-guided cage: per-rotation impulses, torque, overlap, stiffness, half clearance
     rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
+    #: (R, 4) per cage rotation: its time [s], sums of the inner-ring centre's x and y over its steps [m], step count
+    rot_win: np.ndarray
 
 
 def run(p, sink=None, progress=False, dt=None, penetration_limit=PENETRATION_LIMIT,
@@ -1260,5 +1262,5 @@ def _raw(su: MultibodySetup, pl: _Placed, acc, st, loop_s: float, t_wall0: float
         beyond_before=float(st["beyond_before"]) if rigid_ else None,
         land=(dict(win=wk.land_win.copy(), tau=float(st["land_tau"]), overlap_max=float(st["land_overlap_max"]),
                    stiffness=land.stiffness, half_clearance=land.half_clearance) if land.active else None),
-        rest_win=wk.rest_win.copy(),
+        rest_win=wk.rest_win.copy(), rot_win=wk.rot_win.copy(),
     )

@@ -42,8 +42,8 @@ CSV_SIGNATURE = b"case,"  # the first bytes of every sweep.csv bearingsim writes
 FIXED = ("status", "error", "archive", "wall_s", "model_version", "notes")
 # summary numbers shown first when present; any others follow in name order
 PREFERRED = ("I_dec_mean_Ns", "I_dec_sem_Ns", "I_dec_std_Ns", "I_acc_mean_Ns", "I_acc_sem_Ns", "I_acc_std_Ns",
-             "first_impact_speed_m_s", "first_impact_speed_sem_m_s", "first_impact_energy_J", "cage_slip", "cage_rest_angle_deg",
-             "load_zone_half_angle_deg")
+             "first_impact_speed_m_s", "first_impact_speed_sem_m_s", "first_impact_energy_J", "cage_slip", "cage_slip_sem",
+             "cage_rest_angle_deg", "load_zone_half_angle_deg", "load_zone_half_angle_sem_deg")
 
 
 

@@ -1346,8 +1346,19 @@ def is_table_file(path, fmt: str) -> bool:
 
 
 #: the per-rotation arrays whose batch means give the standard errors of a result's summary numbers
-#: (:func:`bearingsim.stats.summary_standard_errors`), ``[rotations, pockets]`` or ``[rotations]``
-SEM_SERIES = ("I_dec", "I_acc", "first_impact_speed", "cage_slip", "load_zone_half_angle")
+#: (:func:`bearingsim.stats.summary_standard_errors`), each with its dimensions: 2 ``[rotations, pockets]``,
+#: 1 ``[rotations]``
+SEM_SERIES = {"I_dec": 2, "I_acc": 2, "first_impact_speed": 2, "cage_slip": 1, "load_zone_half_angle": 1}
+
+
+def sem_series_ok(per: dict) -> bool:
+    """Whether the arrays ``per`` (name -> array, of :data:`SEM_SERIES`) are numbers of the shapes a result's are:
+    ``I_dec`` ``[rotations, pockets]`` and each other one ``[rotations, pockets]`` or ``[rotations]`` as
+    :data:`SEM_SERIES` says (a damaged or crafted archive's are not)."""
+    shape = np.shape(per.get("I_dec"))
+    return len(shape) == 2 and all(
+        isinstance(a, np.ndarray) and a.dtype.kind in "fiu" and a.shape == shape[:SEM_SERIES[k]]
+        for k, a in per.items())
 
 
 def peek(path) -> dict[str, Any] | None:
@@ -1371,6 +1382,10 @@ def peek(path) -> dict[str, Any] | None:
             summary = group_attrs(f["results/summary"])[0]
             prov = group_attrs(f["provenance"])[0] if "provenance" in f else {}
             version = prov.get("model_version")
+            per = {k: f[f"results/per_rotation/{k}"][()] for k in SEM_SERIES
+                   if k in ("I_dec", "I_acc") or f"results/per_rotation/{k}" in f}
+            if not sem_series_ok(per):
+                return None  # damaged: the case runs again
             return {
                 "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
                 "model": str(g.attrs["model"]),
@@ -1378,8 +1393,7 @@ def peek(path) -> dict[str, Any] | None:
                 and not isinstance(version, bool) else None,
                 "summary": {k: float(v) for k, v in summary.items()
                             if isinstance(v, (int, float)) and not isinstance(v, bool)},
-                "per_rotation": {k: f[f"results/per_rotation/{k}"][()] for k in SEM_SERIES
-                                 if k in ("I_dec", "I_acc") or f"results/per_rotation/{k}" in f},
+                "per_rotation": per,
                 "wall_time_s": float(prov.get("wall_time_s", float("nan"))),
                 "notes": read_notes(f, path),
                 "wear": group_attrs(f["results/wear"])[0] if "results/wear" in f else {},
@@ -1673,10 +1687,9 @@ def _error_lines(f, model) -> list[str]:
     if _plain(model) == "reduced" or names[:2] != ["I_dec", "I_acc"]:
         return []
     per = {k: f[f"results/per_rotation/{k}"][()] for k in names}
-    shape = np.shape(per["I_dec"])
-    if not all(isinstance(a, np.ndarray) and a.dtype.kind in "fiu" and a.shape in (shape, shape[:1])
-               for a in per.values()) or len(shape) != 2:
+    if not sem_series_ok({k: per[k] for k in ("I_dec", "I_acc")}):
         return []  # a damaged archive is still listed (``bearingsim.load`` names what is wrong with it)
+    per = {k: a for k, a in per.items() if sem_series_ok({"I_dec": per["I_dec"], k: a})}  # and a damaged one left out
     se = summary_standard_errors(per, _plain(model))
     mean_of = {v: k for k, v in SUMMARY_SEM_OF.items()}
     text = ", ".join(f"{mean_of[k]} \u00b1 {v:.2g}" + ("" if SEM_UNITS[k] == "1" else f" {SEM_UNITS[k]}")

@@ -265,9 +265,11 @@ SEM_UNITS = {"I_dec_sem_Ns": "N s", "I_acc_sem_Ns": "N s", "first_impact_speed_s
 def first_impact_sem(per_rotation_first_impact, model: str | None = None) -> float:
     """The standard error of ``first_impact_speed_m_s`` (the mean of every recorded first rear-face impact,
     pockets and rotations pooled) from a result's ``per_rotation`` array ``first_impact_speed``
-    ``[rotations, pockets]`` (NaN: no impact in that pass) [m/s]: batch means as :func:`batch_sem`'s, each
-    batch's impacts pooled as the summary pools them; NaN with fewer than 2 rotations or a batch without an
-    impact (nothing to estimate its mean from); 0 for the reduced model (``model == "reduced"``: one exact
+    ``[rotations, pockets]`` (NaN: no impact in that pass) [m/s]: the batches of :func:`batch_sem`, each with the
+    sum S_b of its n_b impacts, and the pooled mean's ratio-estimator error
+    ``sqrt(sum_b (S_b - m n_b)^2 / (B (B - 1))) / mean_b(n_b)``, m the pooled mean (with the same count in every
+    batch: the batch means' error; with counts that differ it weighs a batch by its impacts, as the mean does).
+    NaN with fewer than 2 rotations or no impact; 0 for the reduced model (``model == "reduced"``: one exact
     pass)."""
     if model == "reduced":
         return 0.0
@@ -278,13 +280,13 @@ def first_impact_sem(per_rotation_first_impact, model: str | None = None) -> flo
     b = sem_batches(len(rows))
     if b < 2:
         return float("nan")
-    means = []
-    for c in np.array_split(rows, b):
-        got = c[np.isfinite(c)]
-        if got.size == 0:
-            return float("nan")
-        means.append(got.mean())
-    return float(np.std(means, ddof=1) / math.sqrt(b))
+    parts = np.array_split(rows, b)
+    sums = np.array([np.nansum(c) for c in parts])
+    counts = np.array([np.isfinite(c).sum() for c in parts], dtype=float)
+    if counts.sum() == 0:
+        return float("nan")
+    m = sums.sum() / counts.sum()
+    return float(math.sqrt(np.sum((sums - m * counts) ** 2) / (b * (b - 1))) / counts.mean())
 
 
 def summary_standard_errors(per_rotation, model: str | None = None) -> dict[str, float]:

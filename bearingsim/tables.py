@@ -75,19 +75,16 @@ def headline(result) -> list[tuple[str, float, float | None, str]]:
         v, err = summary[key], se.get(SEM_OF.get(key, ""))
         scale, unit = shown_as(key, units.get(key, "1"))
         words = ""
-        if key == "cage_slip" and (err is None or err != err or err == 0.0):
-            words = f"{v * scale:.4g} {unit}"
-        elif err is not None:
+        if err is None:  # no standard error: an archive of an earlier version, a cage turned at its epicyclic speed
+            words = f"{v * scale:.4g} {unit}" if key == "cage_slip" else ""
+        else:
             per = f"{unit} per pocket and cage rotation" if key.endswith("_Ns") else unit
             if err == 0.0:
                 words = f"{v * scale:.5g} {per}"
             elif err != err and v != v and key == "first_impact_speed_m_s":  # no first impact recorded at all
                 words = "none recorded"
-            elif err != err:  # NaN: one recorded rotation gives no scatter, or a batch of rotations had no impact
-                words = f"{v * scale:.5g} {per}; no standard error from " + (
-                    f"{rotations} recorded rotation" if rotations < 2 else
-                    f"{rotations} recorded rotations" + (": a batch of them had no such impact"
-                                                         if key == "first_impact_speed_m_s" else ""))
+            elif err != err:  # NaN: one recorded rotation gives no scatter
+                words = f"{v * scale:.5g} {per}; no standard error from {counted(rotations, 'recorded rotation')}"
             else:
                 words = (f"{with_error(v * scale, err * scale)} {per}; standard error, batch means over {rotations} "
                          f"recorded rotations")
@@ -420,7 +417,8 @@ def column_cells(table: Table, key: str) -> tuple[str, list[str]]:
 def column_keys(table: Table) -> list[str]:
     """The number columns ``columns`` of :func:`format_table` (``--columns``) may name, in the table's order:
     every summary number of its runs, the standard errors (``I_dec_sem_Ns``, ``I_acc_sem_Ns``,
-    ``first_impact_speed_sem_m_s``) included; the one list its refusal of another name prints."""
+    ``first_impact_speed_sem_m_s``, ``cage_slip_sem``, ``load_zone_half_angle_sem_deg``) included; the one list its
+    refusal of another name prints."""
     return list(table.numbers)
 
 

@@ -121,7 +121,7 @@ def distinct_texts(values) -> list[str]:
 #: display scale and unit of units that read better scaled
 SCALED = {"N s": (1e3, "mN s"), "m^3/h": (1e9, "mm^3/h")}
 #: display scale and unit of keys stored as a fraction (unit 1) that read better in per cent
-SCALED_KEYS = {"cage_slip": (100.0, "%")}
+SCALED_KEYS = {"cage_slip": (100.0, "%"), "cage_slip_sem": (100.0, "%")}
 
 
 def shown_as(key: str, unit: str) -> tuple[float, str]:

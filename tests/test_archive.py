@@ -561,6 +561,48 @@ def test_a_full_disk_while_a_spool_streams_is_one_line_and_a_clean_exit(tmp_path
     assert list(out.parent.iterdir()) == []
 
 
+def test_the_new_per_rotation_series_missing_or_damaged(tmp_path, capsys):
+    """The per-rotation cage slip and load zone (multibody model version 10) give the standard errors of those
+    numbers. An archive without them (version 9) is read, tabled and listed with the other errors and an n/a for
+    theirs; one whose arrays are damaged (text, or another shape) is listed with the intact errors and none for
+    the damaged one, and a sweep's resume check does not trust it (archive.peek: None, so the case runs again)
+    instead of stopping with a traceback."""
+    import shutil
+
+    import bearingsim
+    from bearingsim.cli import main
+
+    from .conftest import SCENARIOS
+
+    out = tmp_path / "v10.h5"
+    bearingsim.run(bearingsim.load_scenario(SCENARIOS / "multibody_6000rpm.toml", set={"numerics.rotations": 3})
+                   ).save(out)
+    assert archive.peek(out)["per_rotation"]["cage_slip"].shape == (3,)
+    old, text, flat = tmp_path / "v9.h5", tmp_path / "text.h5", tmp_path / "flat.h5"
+    for path in (old, text, flat):
+        shutil.copy(out, path)
+    with h5py.File(old, "r+") as f:
+        del f["results/per_rotation/cage_slip"], f["results/per_rotation/load_zone_half_angle"]
+    with h5py.File(text, "r+") as f:
+        del f["results/per_rotation/cage_slip"]
+        f["results/per_rotation/cage_slip"] = [b"x", b"y", b"z"]
+    with h5py.File(flat, "r+") as f:
+        del f["results/per_rotation/load_zone_half_angle"]
+        f["results/per_rotation/load_zone_half_angle"] = np.zeros((3, 16))
+    capsys.readouterr()
+    assert main(["table", str(out), str(old)]) == 0
+    rows = {line.split()[0]: line for line in capsys.readouterr().out.splitlines() if line.startswith("v")}
+    assert "± n/a" not in rows["v10.h5"] and rows["v9.h5"].count("± n/a") == 2, rows  # slip and load zone of v9
+    for path, damaged in ((text, "cage_slip"), (flat, "load_zone_half_angle_deg")):
+        assert archive.peek(path) is None
+        assert main(["inspect", str(path)]) == 0
+        line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("standard errors"))
+        assert "I_dec_mean_Ns \u00b1" in line and f"{damaged} \u00b1" not in line, line
+    assert main(["inspect", str(old)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("standard errors"))
+    assert "first_impact_speed_m_s \u00b1" in line and "cage_slip" not in line, line
+
+
 def test_a_multibody_archive_of_the_version_before_where_the_cage_rests_still_reads(tmp_path, capsys):
     """Multibody model version 6 added ``cage_rest_offset_m`` and ``cage_rest_angle_deg`` to the summary
     (bearingsim.multibody.SUMMARY_ADDED) and their per-rotation arrays. An archive without them (one of

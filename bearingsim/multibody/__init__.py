@@ -327,24 +327,33 @@ def _rest_per_rotation(rest_win, sign: int) -> dict:
                                                 "counted in the direction of rotation, " + desc)}
 
 
-def _rotation_arrays(p, rot_win, with_ring: bool) -> dict:
-    """The cage slip and, with an inner ring, the load zone's half angle of each recorded cage rotation, from its
-    time and the inner ring's centre summed over its steps (``rot_win``): ``/results/per_rotation/cage_slip``
-    (``1 - 2 pi / (T_k omega_c)``, the summary's ``cage_slip`` of that rotation alone) and
-    ``load_zone_half_angle`` (the summary's of the ring's mean displacement in that rotation) [deg]: the series
-    whose batch means give those numbers' standard errors (:func:`bearingsim.stats.summary_standard_errors`)."""
+def _rotation_arrays(p, setup, rot_win) -> dict:
+    """The cage slip and the load zone's half angle of each recorded cage rotation, the series whose batch means
+    give those numbers' standard errors (:func:`bearingsim.stats.summary_standard_errors`), from the rotation's
+    time and the inner ring's centre summed over its steps (``rot_win``): ``/results/per_rotation/cage_slip``,
+    ``1 - 2 pi / (T_k omega_c)`` with T_k from and to where the cage's travel crosses the rotation's ends (the
+    summary's ``cage_slip`` takes the recorded time in whole steps), absent for a cage turned at the epicyclic
+    speed (:data:`~bearingsim.multibody.core.KINEMATIC_CAGE_SCENES`: it has no slip to measure); and
+    ``load_zone_half_angle`` [deg], the summary's of the ring's mean displacement in that rotation, or the given
+    one in every rotation of the scene without an inner ring."""
     desc = "per cage rotation k (cage travel 2 pi (W + k) .. 2 pi (W + k + 1) from the start)"
     pr = "results/per_rotation"
-    with np.errstate(invalid="ignore", divide="ignore"):
-        slip = 1.0 - 2.0 * math.pi / (rot_win[:, 0] * p.operating.omega_c)
-    out = {f"{pr}/cage_slip": NamedArray(slip, "1", "1 - (the cage's mean speed) / (its epicyclic speed) in the "
-                                         "rotation, " + desc)}
-    if with_ring:
+    out = {}
+    if not setup.kinematic:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            slip = 1.0 - 2.0 * math.pi / (rot_win[:, 0] * p.operating.omega_c)
+        out[f"{pr}/cage_slip"] = NamedArray(slip, "1", "1 - (the cage's mean speed) / (its epicyclic speed) in the "
+                                            "rotation, " + desc)
+    if setup.reduced_eq:  # the paper's load zone, given
+        phi = np.full(len(rot_win), math.degrees(setup.phi))
+        what = "the given load-zone half angle (no inner ring), "
+    else:
         with np.errstate(invalid="ignore", divide="ignore"):
             displacement = -rot_win[:, 2] / rot_win[:, 3]
-        phi = [math.degrees(laws.load_zone_from_displacement(d, p.bearing.radial_clearance)) for d in displacement]
-        out[f"{pr}/load_zone_half_angle"] = NamedArray(np.array(phi), "deg", "classical load-zone half angle of "
-                                                       "the inner ring's mean displacement in the rotation, " + desc)
+        phi = np.array([math.degrees(laws.load_zone_from_displacement(d, p.bearing.radial_clearance))
+                        for d in displacement])
+        what = "classical load-zone half angle of the inner ring's mean displacement in the rotation, "
+    out[f"{pr}/load_zone_half_angle"] = NamedArray(phi, "deg", what + desc)
     return out
 
 
@@ -489,7 +498,7 @@ class MultibodyResult(Result):
                 frozenset({"results/raceway_load_inner", "results/raceway_load_outer"}),  # a scene with a ring
                 PROFILE_PATHS,  # archives written before the wear profile
                 frozenset(f"results/per_rotation/{c}" for c in _REST),  # archives of model version 5 and before
-                frozenset({"results/per_rotation/load_zone_half_angle"}),  # a scene without a ring
+                frozenset({"results/per_rotation/cage_slip"}),  # a kinematic cage
                 frozenset(f"results/per_rotation/{c}" for c in _ROTATION))  # archives of model version 9 and before
     TEXT_ARRAYS = frozenset({"results/impacts/face"})
     SUMMARY_NUMBERS = tuple(k for k in SUMMARY_UNITS if k != "inner_ring_displacement_m"  # no ring: absent
@@ -518,7 +527,7 @@ class MultibodyResult(Result):
         summary, units = _summary(p, raw, per)
         data = {**_per_rotation_arrays(per, raw.first_imp, raw.land),
                 **_rest_per_rotation(raw.rest_win, p.operating.sign),
-                **_rotation_arrays(p, raw.rot_win, not paper_assumptions(raw.setup.scene)), **_theta_arrays(raw),
+                **_rotation_arrays(p, raw.setup, raw.rot_win), **_theta_arrays(raw),
                 **_impact_arrays(raw.impacts), **_wear_arrays(p, per),
                 **_profile_arrays(raw.prof, p.multibody.pocket_face_extent)}
         orbit = raw.orbit

@@ -1044,7 +1044,8 @@ class MultibodyRaw(NamedTuple):
     beyond_before: float | None  #: rigid raceways: the move beyond the race before the joint acted [m]
     land: dict | None  #: land-guided cage: per-rotation impulses, torque, overlap, stiffness, half clearance
     rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
-    #: (R, 4) per cage rotation: its time [s], sums of the inner-ring centre's x and y over its steps [m], step count
+    #: (R, 4) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
+    #: sums of the inner-ring centre's x and y over its steps [m], step count
     rot_win: np.ndarray
 
 

@@ -82,6 +82,8 @@ LOOP_STATE = np.dtype([
     ("n_motion", np.int64),  # rows of the motion block not yet handed to Python
     ("motion_next", np.float64),  # cage travel of the next motion pose (recorder.record_motion) [rad]
     ("t_motion", np.float64),  # time of the last motion pose [s]
+    ("travel_prev", np.float64),  # cage travel at the start of the previous step [rad]
+    ("h_prev", np.float64),  # the previous step [s]
 ], align=True)
 
 #: Time-series samples, one row every ``out_every`` steps (array shape (block,)).
@@ -416,7 +418,8 @@ class StepWork(NamedTuple):
     arc_ends: np.ndarray  #: (n, 2, 4) exact faces: each pocket's (front, rear) segment as placed (ax, ay, bx, by), cage frame [m]
     arc_todo: np.ndarray  #: (n, 2) bool, exact faces: the segments :func:`arc_faces` moved for the coming step
     rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
-    #: (R, 4) per cage rotation: its time [s], sums of the inner-ring centre's x and y over its steps [m], step count
+    #: (R, 4) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
+    #: sums of the inner-ring centre's x and y over its steps [m], step count
     rot_win: np.ndarray
     #: (rows, columns) motion poses (:func:`bearingsim.multibody.recorder.record_motion`)
     mot: np.ndarray = np.zeros((1, 1))
@@ -585,6 +588,9 @@ def before_step(prev, inp, wk, ls):
     sign = inp.cfg.sign
     travel = sign * prev[n, 2]
     if travel >= lim.travel_end:
+        if s.recording == 1 and s.travel_prev < lim.travel_end:  # the last recorded rotation ends inside the step
+            _rotation_boundary(wk.rot_win, s.travel_prev, travel, s.h_prev, inp.cfg.warmup_rotations)
+            s.travel_prev = travel
         return CODE_DONE
     if s.step > lim.max_steps:
         return CODE_STALLED
@@ -607,14 +613,36 @@ def before_step(prev, inp, wk, ls):
         s.ring_sum_x += wk.ring_c[0]
         s.ring_sum_y += wk.ring_c[1]
         s.ring_n += 1.0
-        # the same per recorded cage rotation k (cage travel in [2 pi (W + k), 2 pi (W + k + 1)))
+        # the same per recorded cage rotation k (cage travel in [2 pi (W + k), 2 pi (W + k + 1))), the step's
+        # time to the rotation it starts in, and the part of the previous step after a rotation's start to it
         k = int(math.floor(travel / (2.0 * math.pi) - inp.cfg.warmup_rotations))
         if 0 <= k < wk.rot_win.shape[0]:
             wk.rot_win[k, 0] += inp.h
             wk.rot_win[k, 1] += wk.ring_c[0]
             wk.rot_win[k, 2] += wk.ring_c[1]
             wk.rot_win[k, 3] += 1.0
+        _rotation_boundary(wk.rot_win, s.travel_prev, travel, s.h_prev, inp.cfg.warmup_rotations)
+    s.travel_prev = travel
+    s.h_prev = inp.h
     return CODE_CONTINUE
+
+
+@njit(cache=True, inline="always")
+def _rotation_boundary(rot_win, travel0, travel1, h, warmup):
+    """A step of ``h`` [s] from cage travel ``travel0`` to ``travel1`` [rad] that crosses the start of a recorded
+    rotation (cage travel 2 pi (W + k)) or the recording's end: the part of the step after it, the step's time
+    in the ratio of the travel (linear within the step), moves from the rotation the step started in to rotation
+    k (``rot_win[:, 0]``; the recording's start and end have none on one side). The rotations' times are then
+    the cage's own, not whole steps."""
+    k0 = int(math.floor(travel0 / (2.0 * math.pi) - warmup))
+    k1 = int(math.floor(travel1 / (2.0 * math.pi) - warmup))
+    if k1 <= k0 or travel1 <= travel0:
+        return
+    part = h * (travel1 - 2.0 * math.pi * (warmup + k1)) / (travel1 - travel0)
+    if 0 <= k1 < rot_win.shape[0]:
+        rot_win[k1, 0] += part
+    if 0 <= k0 < rot_win.shape[0]:
+        rot_win[k0, 0] -= part
 
 
 @njit(cache=True, inline="always")

@@ -13,8 +13,8 @@ case is done or cached; of a failed case, the time to its failure), ``model_vers
 model that computed the numbers, :mod:`bearingsim.model_versions`; empty if unknown), ``notes`` (the run's
 plausibility notes, :func:`bearingsim.plausibility.check`, one a line without the ``bearingsim: note:``
 prefix; empty for a clean run) and the summary numbers (SI, as in the archives' ``/results/summary``,
-plus ``I_dec_sem_Ns`` / ``I_acc_sem_Ns`` / ``first_impact_speed_sem_m_s``, see
-:func:`bearingsim.stats.summary_standard_errors`).
+plus the standard errors ``I_dec_sem_Ns``, ``I_acc_sem_Ns``, ``first_impact_speed_sem_m_s``, ``cage_slip_sem`` and
+``load_zone_half_angle_sem_deg``, see :func:`bearingsim.stats.summary_standard_errors`).
 
 ``sweep.h5`` holds the same table as one dataset per column under ``/index`` (numbers as float64,
 NaN where a case has no value; text as UTF-8), the column order in the attribute ``columns``, every

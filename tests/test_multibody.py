@@ -433,6 +433,7 @@ def test_the_rotations_cage_slip_and_load_zone_make_up_the_summarys(full_3000):
     assert se["cage_slip_sem"] == batch_sem(slip) > 0 and se["load_zone_half_angle_sem_deg"] == batch_sem(phi) > 0
 
 
+@pytest.mark.slow  # two kinematic-cage runs at an eighth of the step: 6 s
 def test_a_kinematic_cages_rotations_take_the_epicyclic_period_to_round_off():
     """The kinematic cage turns at exactly the epicyclic speed, so each recorded rotation's time, taken from and to
     where the cage's travel crosses its ends within a step (linear in the step: exact for a constant speed),

@@ -189,7 +189,7 @@ def table_of_archives(paths) -> Table:
         numbers[k] = np.array([float(r.summary.get(k, math.nan)) for r in results])
         units[k] = next((r.summary_units.get(k) for r in results if k in r.summary_units), "1")
     errors = [result_standard_errors(r) for r in results]
-    # the impulses' and the first impact speed's (an archive's summary has no wear rates: a sweep's index does)
+    # those of stats.summary_standard_errors (an archive's summary has no wear rates: a sweep's index does)
     for k in dict.fromkeys(k for e in errors for k in e):
         numbers[k] = np.array([e.get(k, math.nan) for e in errors])
         units[k] = SEM_UNITS[k]

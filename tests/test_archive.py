@@ -593,6 +593,12 @@ def test_the_new_per_rotation_series_missing_or_damaged(tmp_path, capsys):
     assert main(["table", str(out), str(old)]) == 0
     rows = {line.split()[0]: line for line in capsys.readouterr().out.splitlines() if line.startswith("v")}
     assert "± n/a" not in rows["v10.h5"] and rows["v9.h5"].count("± n/a") == 2, rows  # slip and load zone of v9
+    words = tmp_path / "words.h5"  # an older defect: a text I_dec stopped a sweep's resume with a ValueError
+    shutil.copy(out, words)
+    with h5py.File(words, "r+") as f:
+        del f["results/per_rotation/I_dec"]
+        f["results/per_rotation/I_dec"] = [b"a", b"b", b"c"]
+    assert archive.peek(words) is None
     for path, damaged in ((text, "cage_slip"), (flat, "load_zone_half_angle_deg")):
         assert archive.peek(path) is None
         assert main(["inspect", str(path)]) == 0

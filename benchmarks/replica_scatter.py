@@ -1,7 +1,7 @@
 """Does one run's standard error cover the scatter between runs? (docs/statistics.md)
 
 ``python -m benchmarks.replica_scatter [--replicas R] [--rotations N] [--jobs J] [--perturb step]
-[--case RACEWAYS:RPM ...]`` runs the reference
+[--case RACEWAYS:RPM ...] [--others]`` runs the reference
 bearing (as ``bearingsim bench --fast-scene``: 970 N, roller-guided cage, exact faces, 1 warm-up + N
 recorded rotations) R times per case, replica k with the radial load ``970 N (1 + k 1e-9)`` and
 everything else the same, the time step automatic. The whole bearing is chaotic: a change of the load by
@@ -27,7 +27,10 @@ interval is a little narrow). Beside them, a scatter that one odd replica does n
 replica's own ``se``. And the start's transient that one warm-up rotation leaves in the recorded ones:
 ``rotation 1`` and ``rotations 1-5``, the mean I_dec of the first recorded rotation and of the first
 five against that of rotations 9 to N, relative, averaged over the replicas (± its standard error over
-them); 5 is the default ``numerics.rotations``. With N below 9 these two columns are ``-``.
+them); 5 is the default ``numerics.rotations``. With N below 9 these two columns are ``-``. ``--others`` adds a
+table of the first impact speed, the cage slip and the load zone's half angle: per case the standard deviation
+of the replicas' values against the median of their own standard errors
+(:func:`bearingsim.stats.summary_standard_errors`), and the same 95 % range.
 """
 from __future__ import annotations
 
@@ -39,6 +42,10 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 CASES = (("rigid", 1000.0), ("rigid", 3000.0), ("rigid", 6000.0), ("hertz", 3000.0))
+#: the other summary numbers with a standard error (``--others``), each with the key of its error
+OTHER_QUANTITIES = ("first_impact_speed_m_s", "cage_slip", "load_zone_half_angle_deg")
+SEM_KEYS = {"first_impact_speed_m_s": "first_impact_speed_sem_m_s", "cage_slip": "cage_slip_sem",
+            "load_zone_half_angle_deg": "load_zone_half_angle_sem_deg"}
 LOAD_N = 970.0
 LOAD_SCALE = 1e-9
 STEP_SCALE = 1e-6
@@ -61,9 +68,13 @@ def _replica(job):
         if dt is None:
             raise
         return None
+    from bearingsim.stats import result_standard_errors
+
     series = pocket_means(np.asarray(res.get("per_rotation/I_dec")))
     restarted = "restarted" in str(res.provenance.get("dt_choice", ""))
-    return float(res.summary["I_dec_mean_Ns"]), batch_sem(series), series, restarted
+    se = result_standard_errors(res)
+    others = {k: (float(res.summary[k]), se.get(SEM_KEYS[k], math.nan)) for k in OTHER_QUANTITIES}
+    return float(res.summary["I_dec_mean_Ns"]), batch_sem(series), series, restarted, others
 
 
 def _automatic_dt(raceway: str, rpm: float) -> float:
@@ -89,6 +100,8 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--perturb", choices=("load", "step"), default="load")
     ap.add_argument("--case", action="append", help="RACEWAYS:RPM, e.g. rigid:1000 (default: the four cases)")
+    ap.add_argument("--others", action="store_true",
+                    help="also a table of the first impact speed, cage slip and load zone: sd between runs / se")
     args = ap.parse_args(argv)
     cases = [(c.split(":")[0], float(c.split(":")[1])) for c in args.case] if args.case else CASES
     lo, hi = chi_interval(args.replicas)  # (with stopped replicas the interval is a little wider)
@@ -99,6 +112,7 @@ def main(argv=None) -> int:
           f"| sd / se | 95 % range if se is right | robust sd [mN s] | worst [se] | rotation 1 [%] | rotations 1-5 [%] "
           "| corr | restarts | stopped |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    others = []  # (case, quantity, means, ses) for --others
     with ProcessPoolExecutor(args.jobs) as pool:
         for raceway, rpm in cases:
             if args.perturb == "load":
@@ -132,6 +146,17 @@ def main(argv=None) -> int:
             print(f"| {raceway} | {rpm:g} | {statistics.fmean(means) * 1e3:.3f} | {sd * 1e3:.3f} | "
                   f"{se * 1e3:.3f} | {sd / se:.2f} | {lo:.2f}-{hi:.2f} | {robust * 1e3:.4f} | {worst:.1f} | {start(1)} | {start(5)} | {corr:+.2f} | {sum(o[3] for o in out)} | {stopped} |",
                   flush=True)
+            others += [((raceway, rpm), q, [o[4][q][0] for o in out], [o[4][q][1] for o in out])
+                       for q in OTHER_QUANTITIES]
+    if args.others:
+        print()
+        print("| raceways | rpm | quantity | mean | sd between runs | median se of one run | sd / se "
+              "| 95 % range if se is right |")
+        print("|---|---|---|---|---|---|---|---|")
+        for (raceway, rpm), q, means, ses in others:
+            sd, se = statistics.stdev(means), statistics.median(ses)
+            print(f"| {raceway} | {rpm:g} | {q} | {statistics.fmean(means):.6g} | {sd:.2g} | {se:.2g} | "
+                  f"{sd / se:.2f} | {lo:.2f}-{hi:.2f} |", flush=True)
     return 0
 
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from bearingsim import laws
 from bearingsim.errors import SimulationUnstable
-from bearingsim.stats import t_quantile
+from bearingsim.stats import SUMMARY_SEM_OF, t_quantile
 from bearingsim.wording import counted, given_step
 
 # The mean inner-ring displacement along the load is at most half the diametral clearance plus the
@@ -833,7 +833,9 @@ def percent_text(x: float) -> str:
 def step_check_note(result, half) -> str:
     """The note of a run checked at half its time step (``bearingsim run --check-step``): each mean impulse at
     the step and at half of it with their standard errors (batch means; none for the reduced model, exact),
-    the change and whether it is resolved by the tables' rule (:func:`bearingsim.stats.significant`). The
+    the change and whether it is resolved by the tables' rule (:func:`bearingsim.stats.significant`), then the
+    same of the other numbers with a standard error, the first impact speed, the cage slip and the load zone
+    (:func:`_other_step_change`). The
     whole bearing is chaotic: the two runs are two trajectories, so an unresolved change is bounded by about
     twice the combined standard error, not to zero (docs/statistics.md); for the first-order scheme the step's
     error is about twice the change, and the verdict says so (:func:`_step_change`). When either run's
@@ -847,7 +849,34 @@ def step_check_note(result, half) -> str:
     nb = sem_batches(len(result.per_rotation["I_dec"]))
     parts = [_step_change(q, result.summary[f"{q}_mean_Ns"], se_a[f"{q}_sem_Ns"], half.summary[f"{q}_mean_Ns"],
                           se_b[f"{q}_sem_Ns"], nb) for q in ("I_dec", "I_acc")]
+    parts += [_other_step_change(k, result.summary_units.get(k, "1"), result.summary[k], se_a[e], half.summary[k],
+                                 se_b[e], nb)
+              for k, e in SUMMARY_SEM_OF.items() if not k.endswith("_Ns") and e in se_a and e in se_b
+              and k in result.summary and k in half.summary]
     return f"{STEP_CHECK_HEAD} ({dt:.3g} s and {dt / 2:.3g} s): " + "; ".join(parts) + _steady_step_change(result, half)
+
+
+def _other_step_change(key: str, si_unit: str, a: float, ea: float, b: float, eb: float, nb: int) -> str:
+    """``"cage_slip 0.3789 at the step, 0.4051 % at half of it: +0.0262 ± 0.0038 % (resolved)"``: a summary number
+    other than the impulses (the first impact speed, the cage slip, the load zone's half angle) at the step and at
+    half of it, its change as a difference in the unit the tables show it in (a slip near 0 has no meaningful
+    relative change; ``si_unit`` its unit in the summary), ± the combined standard error, and whether the change is
+    resolved by the tables' rule."""
+    from bearingsim.stats import significant
+    from bearingsim.wording import shown_as
+
+    scale, unit = shown_as(key, si_unit)
+    name = key.removesuffix("_m_s").removesuffix("_deg")
+    if not (math.isfinite(a) and math.isfinite(b)):
+        return f"{name}: not compared (none at {'the step' if not math.isfinite(a) else 'half of it'})"
+    mark = significant(b, eb, a, ea, nb, nb)
+    verdict = ("not judged: no standard error" if mark is None else
+               ("exact, the model is deterministic" if ea == 0.0 and eb == 0.0 else "resolved") if mark else
+               ("no change beyond round-off" if ea == 0.0 and eb == 0.0 else "not resolved"))
+    err = math.hypot(ea, eb) * scale
+    spread = f" ± {err:.2g}" if err > 0.0 and math.isfinite(err) else ""
+    return (f"{name} {a * scale:.5g} at the step, {b * scale:.5g} {unit} at half of it: {(b - a) * scale:+.3g}"
+            f"{spread} {unit} ({verdict})")
 
 
 def _step_change(q: str, a: float, ea: float, b: float, eb: float, nb: int) -> str:

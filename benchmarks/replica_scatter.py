@@ -146,8 +146,9 @@ def main(argv=None) -> int:
             print(f"| {raceway} | {rpm:g} | {statistics.fmean(means) * 1e3:.3f} | {sd * 1e3:.3f} | "
                   f"{se * 1e3:.3f} | {sd / se:.2f} | {lo:.2f}-{hi:.2f} | {robust * 1e3:.4f} | {worst:.1f} | {start(1)} | {start(5)} | {corr:+.2f} | {sum(o[3] for o in out)} | {stopped} |",
                   flush=True)
-            others += [((raceway, rpm), q, [o[4][q][0] for o in out], [o[4][q][1] for o in out])
-                       for q in OTHER_QUANTITIES]
+            if args.others:
+                others += [((raceway, rpm), q, [o[4][q][0] for o in out], [o[4][q][1] for o in out])
+                           for q in OTHER_QUANTITIES]
     if args.others:
         print()
         print("| raceways | rpm | quantity | mean | sd between runs | median se of one run | sd / se "

@@ -573,8 +573,30 @@ def test_a_step_check_notes_the_change_at_half_the_step_as_a_second_run_gives_it
     assert f"I_dec {a * 1e3:.5g} at the step, {b * 1e3:.5g} mN s at half of it: {percent_text(b / a - 1)}" in note
     assert re.search(r"I_dec [^;]*\((exact, the model is deterministic; the step's error is about twice this change"
                      r"[^;]*|no change beyond round-off)\)", note), note
+    # and the other numbers with a standard error, as differences: the reduced model's first impact speed moves by
+    # the step (exact), its load zone is the given one
+    v, w = r.summary["first_impact_speed_m_s"], half.summary["first_impact_speed_m_s"]
+    assert (f"first_impact_speed {v:.5g} at the step, {w:.5g} m/s at half of it: {w - v:+.3g} m/s (exact, the model "
+            f"is deterministic)") in note, note
+    assert "load_zone_half_angle 23.5 at the step, 23.5 deg at half of it: +0 deg (no change beyond round-off)" in note
     plain = bearingsim.run(sc)  # the check changes nothing of the run itself
     assert plain.summary == r.summary and not any("time step checked" in n for n in plain.notes)
+
+
+def test_a_step_check_gives_the_slip_load_zone_and_impact_speeds_change_with_its_error():
+    """The whole bearing's other numbers with a standard error at the step and at half of it: the change as a
+    difference in the tables' unit (a slip near 0 has no meaningful relative change) ± the two errors combined,
+    and the tables' verdict. The main job's numbers (`bearingsim run scenarios/multibody_6000rpm.toml --check-step`,
+    docs/statistics.md): the slip's +0.026 % is 7 of its errors, resolved; the first impact speed's -0.00028 m/s
+    is within its, not resolved."""
+    from bearingsim.plausibility import _other_step_change
+
+    slip = _other_step_change("cage_slip", "1", 0.0037886, 2.6e-5, 0.0040514, 2.8e-5, 5)
+    assert slip == "cage_slip 0.37886 at the step, 0.40514 % at half of it: +0.0263 ± 0.0038 % (resolved)", slip
+    v1 = _other_step_change("first_impact_speed_m_s", "m/s", 0.05785, 6.5e-4, 0.057573, 6.2e-4, 5)
+    assert v1.endswith("m/s at half of it: -0.000277 ± 0.0009 m/s (not resolved)"), v1
+    assert _other_step_change("first_impact_speed_m_s", "m/s", float("nan"), float("nan"), 0.05, 1e-3, 5) == \
+        "first_impact_speed: not compared (none at the step)"
 
 
 def test_a_step_check_whose_half_step_would_be_refused_is_refused_before_anything_runs(tmp_path):

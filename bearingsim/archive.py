@@ -1361,6 +1361,11 @@ def sem_series_ok(per: dict) -> bool:
         for k, a in per.items())
 
 
+def read_sem_series(f) -> dict:
+    """The arrays of :data:`SEM_SERIES` that the open archive ``f`` has under ``/results/per_rotation``, by name."""
+    return {k: f[f"results/per_rotation/{k}"][()] for k in SEM_SERIES if f"results/per_rotation/{k}" in f}
+
+
 def peek(path) -> dict[str, Any] | None:
     """The few things a sweep's resume check needs from a complete archive, read cheaply: ``scenario``
     (TOML text), ``model``, ``model_version`` (of the model that computed it; None if the archive
@@ -1382,9 +1387,8 @@ def peek(path) -> dict[str, Any] | None:
             summary = group_attrs(f["results/summary"])[0]
             prov = group_attrs(f["provenance"])[0] if "provenance" in f else {}
             version = prov.get("model_version")
-            per = {k: f[f"results/per_rotation/{k}"][()] for k in SEM_SERIES
-                   if k in ("I_dec", "I_acc") or f"results/per_rotation/{k}" in f}
-            if not sem_series_ok(per):
+            per = read_sem_series(f)
+            if "I_acc" not in per or not sem_series_ok(per):
                 return None  # damaged: the case runs again
             return {
                 "scenario": text.decode("utf-8") if isinstance(text, bytes) else str(text),
@@ -1683,11 +1687,8 @@ def _error_lines(f, model) -> list[str]:
     pass, nor for per-rotation arrays that are not the ``[rotations, pockets]`` numbers of a result."""
     from bearingsim.stats import SEM_UNITS, SUMMARY_SEM_OF, summary_standard_errors
 
-    names = [k for k in SEM_SERIES if f"results/per_rotation/{k}" in f]
-    if _plain(model) == "reduced" or names[:2] != ["I_dec", "I_acc"]:
-        return []
-    per = {k: f[f"results/per_rotation/{k}"][()] for k in names}
-    if not sem_series_ok({k: per[k] for k in ("I_dec", "I_acc")}):
+    per = read_sem_series(f) if _plain(model) != "reduced" else {}
+    if "I_acc" not in per or not sem_series_ok({k: per.get(k) for k in ("I_dec", "I_acc")}):
         return []  # a damaged archive is still listed (``bearingsim.load`` names what is wrong with it)
     per = {k: a for k, a in per.items() if sem_series_ok({"I_dec": per["I_dec"], k: a})}  # and a damaged one left out
     se = summary_standard_errors(per, _plain(model))

@@ -870,9 +870,13 @@ def _other_step_change(key: str, si_unit: str, a: float, ea: float, b: float, eb
     if not (math.isfinite(a) and math.isfinite(b)):
         return f"{name}: not compared (none at {'the step' if not math.isfinite(a) else 'half of it'})"
     mark = significant(b, eb, a, ea, nb, nb)
-    verdict = ("not judged: no standard error" if mark is None else
-               ("exact, the model is deterministic" if ea == 0.0 and eb == 0.0 else "resolved") if mark else
-               ("no change beyond round-off" if ea == 0.0 and eb == 0.0 else "not resolved"))
+    exact = ea == 0.0 and eb == 0.0
+    if mark is None:
+        verdict = "not judged: no standard error"
+    elif mark:
+        verdict = "exact, the model is deterministic" if exact else "resolved"
+    else:
+        verdict = "no change beyond round-off" if exact else "not resolved"
     err = math.hypot(ea, eb) * scale
     spread = f" ± {err:.2g}" if err > 0.0 and math.isfinite(err) else ""
     return (f"{name} {a * scale:.5g} at the step, {b * scale:.5g} {unit} at half of it: {(b - a) * scale:+.3g}"

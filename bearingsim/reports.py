@@ -298,7 +298,8 @@ def _run_sections(path: Path, animation) -> tuple[str, list[Section]]:
 
 def _run_headline(result) -> dict:
     """The run's headline numbers as ``bearingsim run`` prints them (:func:`bearingsim.tables.headline`): the
-    mean impulses in mN s and the first impact speed with their standard errors, the cage slip in per cent."""
+    mean impulses in mN s, the first impact speed, the cage slip in per cent and the load zone, each with its
+    standard error."""
     from bearingsim.tables import headline
 
     units = result.summary_units

@@ -330,7 +330,7 @@ def _rest_per_rotation(rest_win, sign: int) -> dict:
 def _rotation_arrays(p, setup, rot_win) -> dict:
     """The cage slip and the load zone's half angle of each recorded cage rotation, the series whose batch means
     give those numbers' standard errors (:func:`bearingsim.stats.summary_standard_errors`), from the rotation's
-    time and the inner ring's centre summed over its steps (``rot_win``): ``/results/per_rotation/cage_slip``,
+    time and the inner ring's centre (its y) summed over its steps (``rot_win``): ``/results/per_rotation/cage_slip``,
     ``1 - 2 pi / (T_k omega_c)`` with T_k from and to where the cage's travel crosses the rotation's ends (the
     summary's ``cage_slip`` takes the recorded time in whole steps), absent for a cage turned at the epicyclic
     speed (:data:`~bearingsim.multibody.core.KINEMATIC_CAGE_SCENES`: it has no slip to measure); and
@@ -349,7 +349,7 @@ def _rotation_arrays(p, setup, rot_win) -> dict:
         what = "the given load-zone half angle (no inner ring), "
     else:
         with np.errstate(invalid="ignore", divide="ignore"):
-            displacement = -rot_win[:, 2] / rot_win[:, 3]
+            displacement = -rot_win[:, 1] / rot_win[:, 2]
         phi = np.array([math.degrees(laws.load_zone_from_displacement(d, p.bearing.radial_clearance))
                         for d in displacement])
         what = "classical load-zone half angle of the inner ring's mean displacement in the rotation, "

@@ -972,7 +972,7 @@ def _place(su: MultibodySetup, step_loop) -> _Placed:
         n_extra=np.zeros(n),
         arc_ends=sc.face_segments[:, :2, :].copy() if sc.arc_shapes is not None else np.zeros((n, 2, 4)),
         arc_todo=np.zeros((n, 2), dtype=np.bool_), rest_win=np.zeros((p.numerics.rotations, 3)),
-        rot_win=np.zeros((p.numerics.rotations, 4)), mot=rk.motion_block(n))
+        rot_win=np.zeros((p.numerics.rotations, 3)), mot=rk.motion_block(n))
     # room for every roller against every face segment of every pocket: pymunk never grows the arrays
     arb_cap = max(4096, 2 * max(n_seg, 1) * n * n + 64)
     rr = geo.roller_radius
@@ -1044,8 +1044,8 @@ class MultibodyRaw(NamedTuple):
     beyond_before: float | None  #: rigid raceways: the move beyond the race before the joint acted [m]
     land: dict | None  #: land-guided cage: per-rotation impulses, torque, overlap, stiffness, half clearance
     rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
-    #: (R, 4) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
-    #: sums of the inner-ring centre's x and y over its steps [m], step count
+    #: (R, 3) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
+    #: the sum of the inner-ring centre's y over its steps [m], their count
     rot_win: np.ndarray
 
 

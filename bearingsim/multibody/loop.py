@@ -418,8 +418,8 @@ class StepWork(NamedTuple):
     arc_ends: np.ndarray  #: (n, 2, 4) exact faces: each pocket's (front, rear) segment as placed (ax, ay, bx, by), cage frame [m]
     arc_todo: np.ndarray  #: (n, 2) bool, exact faces: the segments :func:`arc_faces` moved for the coming step
     rest_win: np.ndarray  #: (R, 3) per cage rotation: sums of the sampled cage centre's x and y [m], sample count
-    #: (R, 4) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
-    #: sums of the inner-ring centre's x and y over its steps [m], step count
+    #: (R, 3) per cage rotation: its time [s] (from and to where the cage's travel crosses its ends, within a step),
+    #: the sum of the inner-ring centre's y over its steps [m], their count
     rot_win: np.ndarray
     #: (rows, columns) motion poses (:func:`bearingsim.multibody.recorder.record_motion`)
     mot: np.ndarray = np.zeros((1, 1))
@@ -618,9 +618,8 @@ def before_step(prev, inp, wk, ls):
         k = int(math.floor(travel / (2.0 * math.pi) - inp.cfg.warmup_rotations))
         if 0 <= k < wk.rot_win.shape[0]:
             wk.rot_win[k, 0] += inp.h
-            wk.rot_win[k, 1] += wk.ring_c[0]
-            wk.rot_win[k, 2] += wk.ring_c[1]
-            wk.rot_win[k, 3] += 1.0
+            wk.rot_win[k, 1] += wk.ring_c[1]
+            wk.rot_win[k, 2] += 1.0
         _rotation_boundary(wk.rot_win, s.travel_prev, travel, s.h_prev, inp.cfg.warmup_rotations)
     s.travel_prev = travel
     s.h_prev = inp.h
